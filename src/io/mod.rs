@@ -1,0 +1,1 @@
+//! Image, depth and mask I/O.
