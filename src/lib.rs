@@ -1,8 +1,22 @@
 //! viewsynth: headless GPU view synthesis from RGB-D and stereo images.
 //!
 //! Library first: every capability is a typed API here; `src/bin/viewsynth.rs` is a thin CLI.
+//! - [`gpu`]: EGL context and RAII GL resources.
+//! - [`convention`]: NDC depth range, reversed-Z and row order as runtime switches.
+//! - [`camera`]: intrinsics and projections.
+//! - [`io`]: colour, depth and mask files.
+//! - [`refocus`]: same-pose re-rendering at other focal lengths.
+//! - [`metrics`]: error measures used by tests, reports and benchmarks.
 
+pub mod bench;
+pub mod camera;
+pub mod convention;
+pub mod demo;
 pub mod error;
+pub mod gpu;
 pub mod io;
+pub mod metrics;
+pub mod refocus;
+pub mod scene;
 
 pub use error::{Error, Result};

@@ -1,1 +1,316 @@
-fn main() {}
+//! viewsynth command line: parse and validate arguments, call the library. anyhow lives here only.
+
+use anyhow::{bail, Context, Result};
+use clap::{Args, Parser, Subcommand, ValueEnum};
+use std::path::{Path, PathBuf};
+use viewsynth::camera::Intrinsics;
+use viewsynth::convention::{Conventions, NdcDepthRange, RowOrder};
+use viewsynth::gpu::{DeviceChoice, Gpu};
+use viewsynth::io::{self, DepthDecode};
+use viewsynth::refocus::job::{self, DepthFormats, Manifest, RgbFormat, TargetSpec};
+use viewsynth::refocus::{BreakRule, Method, OutputSet, RefocusSource, Refocuser};
+
+#[derive(Parser)]
+#[command(name = "viewsynth", version, about = "Headless GPU view synthesis from RGB-D and stereo images")]
+struct Cli {
+    #[command(subcommand)]
+    command: Command,
+}
+
+#[derive(Subcommand)]
+enum Command {
+    /// Print the GPU, GL version, EGL platform/device and limits this machine renders with.
+    Info {
+        #[command(flatten)]
+        gpu: GpuArgs,
+        /// Print JSON instead of text.
+        #[arg(long)]
+        json: bool,
+    },
+    /// Re-render RGB + metric depth at other focal lengths (same pose).
+    Refocus(RefocusArgs),
+    /// Render the built-in RGB-D scene, refocus it at 5 scales, and write outputs plus an error
+    /// table against the exact ray-traced views.
+    Demo {
+        #[arg(long, default_value = "out/demo")]
+        out_dir: PathBuf,
+        #[command(flatten)]
+        gpu: GpuArgs,
+    },
+    /// Benchmark refocus (mesh and full-screen paths) and print median timings.
+    Bench {
+        /// Sizes WxH to measure.
+        #[arg(long, value_delimiter = ',', default_value = "640x480,1280x720")]
+        sizes: Vec<String>,
+        /// Repetitions per measurement (the median is reported).
+        #[arg(long, default_value_t = 7)]
+        repeats: usize,
+        #[command(flatten)]
+        gpu: GpuArgs,
+    },
+}
+
+#[derive(Args, Clone)]
+struct GpuArgs {
+    /// EGL device: auto (CUDA_VISIBLE_DEVICES match, else first device, else Mesa
+    /// surfaceless), an index from `viewsynth info`, or `surfaceless`.
+    #[arg(long, default_value = "auto")]
+    device: String,
+}
+
+impl GpuArgs {
+    fn open(&self) -> Result<Gpu> {
+        let choice = match self.device.as_str() {
+            "auto" => DeviceChoice::Auto,
+            "surfaceless" => DeviceChoice::Surfaceless,
+            n => DeviceChoice::Index(n.parse().with_context(|| format!("--device '{n}': expected auto, surfaceless or an index"))?),
+        };
+        Ok(Gpu::new(choice)?)
+    }
+}
+
+#[derive(Clone, Copy, ValueEnum)]
+enum NdcArg {
+    /// OpenGL: NDC z in [-1, 1].
+    Gl,
+    /// Vulkan/D3D: NDC z in [0, 1].
+    Vulkan,
+}
+
+#[derive(Clone, Copy, ValueEnum)]
+enum RowsArg {
+    BottomUp,
+    TopDown,
+}
+
+#[derive(Clone, Copy, ValueEnum)]
+enum MethodArg {
+    Mesh,
+    Fullscreen,
+}
+
+#[derive(Clone, Copy, ValueEnum)]
+enum RgbFormatArg {
+    Png,
+    Jpeg,
+    Exr,
+}
+
+#[derive(Args)]
+struct RefocusArgs {
+    /// Source colour (PNG, JPEG, PPM, EXR).
+    #[arg(long)]
+    rgb: PathBuf,
+    /// Source metric depth, view-space Z (EXR, NPY f32/f64/u16, 16-bit PNG/PGM with --depth-scale, PFM).
+    #[arg(long)]
+    depth: PathBuf,
+    /// Raw units per metre for integer depth (5000 for TUM, 1000 for NYU/SUN); divides float depth too when given.
+    #[arg(long)]
+    depth_scale: Option<f64>,
+    /// SUN RGB-D PNG depth: rotate the 16-bit value right by 3 bits before scaling.
+    #[arg(long)]
+    sun_bit_rotate: bool,
+    #[arg(long)]
+    fx: f64,
+    #[arg(long)]
+    fy: f64,
+    #[arg(long)]
+    cx: f64,
+    #[arg(long)]
+    cy: f64,
+    #[arg(long)]
+    out_dir: PathBuf,
+    /// Target focal lengths fx' in pixels (fy' keeps the source fy/fx).
+    #[arg(long, value_delimiter = ',', conflicts_with = "zoom_range")]
+    focal_list: Option<Vec<f64>>,
+    /// Target focal scales s (fx' = s fx).
+    #[arg(long, value_delimiter = ',', default_value = "0.5,0.75,1,1.5,2")]
+    zoom_range: Vec<f64>,
+    /// Break an edge when |za - zb| > tau_rel * min(za, zb).
+    #[arg(long, default_value_t = BreakRule::default().tau_rel)]
+    tau_rel: f64,
+    /// Break an edge when |za - zb| > tau_abs (metres; "inf" disables).
+    #[arg(long, default_value_t = BreakRule::default().tau_abs)]
+    tau_abs: f64,
+    #[arg(long, requires = "height_out")]
+    width_out: Option<u32>,
+    #[arg(long, requires = "width_out")]
+    height_out: Option<u32>,
+    /// Output principal point (default: the source's offset from the image centre).
+    #[arg(long, requires = "cy_out")]
+    cx_out: Option<f64>,
+    #[arg(long, requires = "cx_out")]
+    cy_out: Option<f64>,
+    /// Outputs to produce: any of rgb, depth, mask.
+    #[arg(long, default_value = "rgb,depth,mask")]
+    outputs: String,
+    #[arg(long, value_enum, default_value = "png")]
+    rgb_format: RgbFormatArg,
+    /// Depth file formats: exr, npy or both.
+    #[arg(long, default_value = "exr")]
+    depth_format: String,
+    #[arg(long, value_enum, default_value = "fullscreen")]
+    method: MethodArg,
+    #[arg(long, value_enum, default_value = "gl")]
+    ndc: NdcArg,
+    #[arg(long)]
+    reversed_z: bool,
+    #[arg(long, value_enum, default_value = "bottom-up")]
+    rows: RowsArg,
+    #[command(flatten)]
+    gpu: GpuArgs,
+}
+
+fn main() {
+    let cli = Cli::parse();
+    let result = match cli.command {
+        Command::Info { gpu, json } => info(&gpu, json),
+        Command::Refocus(args) => refocus(args),
+        Command::Demo { out_dir, gpu } => demo(&out_dir, &gpu),
+        Command::Bench { sizes, repeats, gpu } => bench(&sizes, repeats, &gpu),
+    };
+    if let Err(e) = result {
+        eprintln!("error: {e:#}");
+        std::process::exit(1);
+    }
+}
+
+fn info(gpu: &GpuArgs, json: bool) -> Result<()> {
+    let gpu = gpu.open()?;
+    let i = gpu.info();
+    if json {
+        println!("{}", serde_json::to_string_pretty(i)?);
+        return Ok(());
+    }
+    println!("vendor:      {}", i.vendor);
+    println!("renderer:    {}", i.renderer);
+    println!("GL version:  {} (core {}.{}), GLSL {}", i.version, i.gl_major, i.gl_minor, i.glsl_version);
+    println!("EGL:         {} via {} platform", i.egl_version, i.platform);
+    let dev = i.device_index.map_or("-".to_string(), |d| d.to_string());
+    println!("device:      {dev} of {} ({})", i.device_count, i.device_file.as_deref().unwrap_or("no DRM file"));
+    println!("device ext:  {}", if i.device_extensions.is_empty() { "-" } else { &i.device_extensions });
+    println!("limits:      max texture {}, max viewport {}x{}", i.max_texture_size, i.max_viewport[0], i.max_viewport[1]);
+    println!("GPU timers:  {}", if i.gpu_timers_meaningful { "yes" } else { "no (wall clock with glFinish)" });
+    Ok(())
+}
+
+fn refocus(a: RefocusArgs) -> Result<()> {
+    // Everything that can be checked before touching the GPU or the output directory is.
+    let k = Intrinsics { fx: a.fx, fy: a.fy, cx: a.cx, cy: a.cy };
+    k.validate("source intrinsics")?;
+    let rule = BreakRule { tau_rel: a.tau_rel, tau_abs: a.tau_abs };
+    rule.validate()?;
+    let outputs = OutputSet::parse(&a.outputs)?;
+    let depth_formats = parse_depth_formats(&a.depth_format)?;
+    let conv = Conventions {
+        ndc_depth: match a.ndc {
+            NdcArg::Gl => NdcDepthRange::MinusOneToOne,
+            NdcArg::Vulkan => NdcDepthRange::ZeroToOne,
+        },
+        reversed_z: a.reversed_z,
+        row_order: match a.rows {
+            RowsArg::BottomUp => RowOrder::BottomUp,
+            RowsArg::TopDown => RowOrder::TopDown,
+        },
+    };
+    let method = match a.method {
+        MethodArg::Mesh => Method::Mesh,
+        MethodArg::Fullscreen => Method::Fullscreen,
+    };
+    let rgb_format = match a.rgb_format {
+        RgbFormatArg::Png => RgbFormat::Png,
+        RgbFormatArg::Jpeg => RgbFormat::Jpeg,
+        RgbFormatArg::Exr => RgbFormat::Exr,
+    };
+    let rgb = io::load_rgb(&a.rgb)?;
+    let decode = DepthDecode { scale: a.depth_scale, sun_rgbd_bit_rotate: a.sun_bit_rotate, ..Default::default() };
+    let depth = io::load_depth(&a.depth, &decode)?;
+    let src = RefocusSource::new(rgb, depth, k)
+        .with_context(|| format!("{} and {}", a.rgb.display(), a.depth.display()))?;
+    let scales = match &a.focal_list {
+        Some(list) => TargetSpec::scales_from_focal_list(&k, list),
+        None => a.zoom_range.clone(),
+    };
+    let spec = TargetSpec {
+        scales: scales.clone(),
+        size: a.width_out.zip(a.height_out),
+        principal: a.cx_out.zip(a.cy_out),
+    };
+    let targets = spec.targets(&src.camera())?;
+    prepare_out_dir(&a.out_dir)?;
+
+    let gpu = a.gpu.open()?;
+    let mut refocuser = Refocuser::new(&gpu, &src, &rule, method, outputs, conv)?;
+    let bar = indicatif::ProgressBar::new(targets.len() as u64);
+    let mut entries = Vec::new();
+    for (scale, target) in scales.iter().zip(&targets) {
+        let out = refocuser.render(target)?;
+        entries.push(job::write_output(&a.out_dir, *scale, &out, &outputs, rgb_format, depth_formats)?);
+        bar.inc(1);
+    }
+    bar.finish_and_clear();
+    let manifest = Manifest {
+        tool: format!("viewsynth {}", env!("CARGO_PKG_VERSION")),
+        source: src.camera(),
+        method,
+        break_rule: rule,
+        conventions: conv,
+        renderer: gpu.info().renderer.clone(),
+        notes: job::MANIFEST_NOTES.to_string(),
+        outputs: entries,
+    };
+    let path = job::write_manifest(&a.out_dir, &manifest)?;
+    for e in &manifest.outputs {
+        println!(
+            "s={:<6} fx'={:<9.3} {}x{} coverage {:>6.2}%  render {:>7.2} ms",
+            e.scale,
+            e.intrinsics.fx,
+            e.width,
+            e.height,
+            e.coverage.unwrap_or(f64::NAN) * 100.0,
+            e.render_ms
+        );
+    }
+    println!("wrote {} targets; manifest {}", manifest.outputs.len(), path.display());
+    Ok(())
+}
+
+fn demo(out_dir: &Path, gpu: &GpuArgs) -> Result<()> {
+    let gpu = gpu.open()?;
+    let report = viewsynth::demo::run(&gpu, out_dir)?;
+    println!("{}", std::fs::read_to_string(&report)?);
+    println!("demo outputs and report written to {}", out_dir.display());
+    Ok(())
+}
+
+fn parse_depth_formats(list: &str) -> Result<DepthFormats> {
+    let mut f = DepthFormats { exr: false, npy: false };
+    for item in list.split(',').map(str::trim) {
+        match item {
+            "exr" => f.exr = true,
+            "npy" => f.npy = true,
+            _ => bail!("invalid depth-format '{item}': expected exr, npy or exr,npy"),
+        }
+    }
+    Ok(f)
+}
+
+fn prepare_out_dir(dir: &Path) -> Result<()> {
+    std::fs::create_dir_all(dir).with_context(|| format!("cannot create output directory {}", dir.display()))?;
+    // Probe writability now rather than after minutes of rendering.
+    let probe = dir.join(format!(".viewsynth-write-test-{}", std::process::id()));
+    std::fs::write(&probe, b"").with_context(|| format!("output directory {} is not writable", dir.display()))?;
+    let _ = std::fs::remove_file(probe);
+    Ok(())
+}
+
+fn bench(sizes: &[String], repeats: usize, gpu: &GpuArgs) -> Result<()> {
+    let mut parsed = Vec::new();
+    for s in sizes {
+        let (w, h) = s.split_once('x').with_context(|| format!("--sizes '{s}': expected WxH"))?;
+        parsed.push((w.parse::<u32>()?, h.parse::<u32>()?));
+    }
+    let table = viewsynth::bench::refocus_bench(&gpu.open()?, &parsed, repeats.max(1))?;
+    println!("{table}");
+    Ok(())
+}

@@ -1,0 +1,85 @@
+//! Refocus benchmark behind `viewsynth bench`: median milliseconds per frame (5 focal scales,
+//! render + readback) for each GPU path, the f64 CPU reference as the in-run baseline, and the
+//! whole job with file writing. Printed as a Markdown table; nothing here asserts a time.
+
+use crate::convention::Conventions;
+use crate::error::Result;
+use crate::gpu::Gpu;
+use crate::refocus::job::{self, DepthFormats, RgbFormat, TargetSpec};
+use crate::refocus::{reference, BreakRule, Method, OutputSet, RefocusSource, Refocuser};
+use crate::scene;
+use std::fmt::Write as _;
+use std::time::Instant;
+
+fn median(mut v: Vec<f64>) -> f64 {
+    v.sort_by(f64::total_cmp);
+    let n = v.len();
+    if n % 2 == 1 {
+        v[n / 2]
+    } else {
+        0.5 * (v[n / 2 - 1] + v[n / 2])
+    }
+}
+
+const SCALES: [f64; 5] = [0.5, 0.75, 1.0, 1.5, 2.0];
+
+pub fn refocus_bench(gpu: &Gpu, sizes: &[(u32, u32)], repeats: usize) -> Result<String> {
+    let mut t = format!(
+        "refocus benchmark on {} ({} repeats, medians)\n\n\
+         | size | path | setup ms | ms / frame (5 scales) | ms / scale | job ms / frame incl. PNG+EXR+mask writes |\n\
+         |---|---|---|---|---|---|\n",
+        gpu.info().renderer,
+        repeats
+    );
+    let tmp = std::env::temp_dir().join(format!("viewsynth-bench-{}", std::process::id()));
+    std::fs::create_dir_all(&tmp).map_err(|e| crate::Error::io(&tmp, e))?;
+    for &(w, h) in sizes {
+        let cam = scene::demo_camera(w, h);
+        let (rgb, depth) = scene::render(&cam);
+        let src = RefocusSource::new(rgb, depth, cam.k)?;
+        let rule = BreakRule::default();
+        let targets = TargetSpec { scales: SCALES.to_vec(), size: None, principal: None }.targets(&cam)?;
+        let outputs = OutputSet::default();
+        for method in [Method::Fullscreen, Method::Mesh] {
+            let t0 = Instant::now();
+            let mut r = Refocuser::new(gpu, &src, &rule, method, outputs, Conventions::default())?;
+            r.render(&targets[0])?; // warm-up: shader JIT and framebuffer allocation
+            let setup = t0.elapsed().as_secs_f64() * 1e3;
+            let mut frame = Vec::new();
+            let mut with_io = Vec::new();
+            for _ in 0..repeats {
+                let t0 = Instant::now();
+                for target in &targets {
+                    r.render(target)?;
+                }
+                frame.push(t0.elapsed().as_secs_f64() * 1e3);
+                let t0 = Instant::now();
+                for (s, target) in SCALES.iter().zip(&targets) {
+                    let out = r.render(target)?;
+                    job::write_output(&tmp, *s, &out, &outputs, RgbFormat::Png, DepthFormats::default())?;
+                }
+                with_io.push(t0.elapsed().as_secs_f64() * 1e3);
+            }
+            let m = median(frame);
+            let name = match method {
+                Method::Mesh => format!("GPU mesh ({} triangles)", r.triangle_count().unwrap_or(0)),
+                Method::Fullscreen => "GPU full-screen".to_string(),
+            };
+            writeln!(t, "| {w}x{h} | {name} | {setup:.1} | {m:.2} | {:.2} | {:.1} |", m / 5.0, median(with_io))
+                .expect("write to String");
+        }
+        let mut cpu = Vec::new();
+        for _ in 0..repeats.min(3) {
+            let t0 = Instant::now();
+            for target in &targets {
+                std::hint::black_box(reference::refocus_reference(&src, &rule, target));
+            }
+            cpu.push(t0.elapsed().as_secs_f64() * 1e3);
+        }
+        let m = median(cpu);
+        writeln!(t, "| {w}x{h} | CPU f64 reference (1 thread, baseline) | - | {m:.1} | {:.1} | - |", m / 5.0)
+            .expect("write to String");
+    }
+    let _ = std::fs::remove_dir_all(&tmp);
+    Ok(t)
+}

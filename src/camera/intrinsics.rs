@@ -1,0 +1,92 @@
+//! Pinhole intrinsics in the OpenCV convention: pixel (u, v) has its centre at continuous
+//! coordinate (u, v); v grows downwards; view space is x right, y down, z forward.
+
+use crate::error::{Error, Result};
+use serde::{Deserialize, Serialize};
+
+/// Largest image side accepted anywhere (textures of 16384 are the GL 4.5 minimum guarantee
+/// on current GPUs; larger sides are refused before any allocation).
+pub const MAX_IMAGE_SIDE: u32 = 16384;
+
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct Intrinsics {
+    pub fx: f64,
+    pub fy: f64,
+    pub cx: f64,
+    pub cy: f64,
+}
+
+impl Intrinsics {
+    /// Finite values and positive focal lengths; `what` names the camera in the error.
+    pub fn validate(&self, what: &str) -> Result<()> {
+        for (name, v) in [("fx", self.fx), ("fy", self.fy), ("cx", self.cx), ("cy", self.cy)] {
+            if !v.is_finite() {
+                return Err(Error::param(format!("{what} {name}"), format!("{v} is not finite")));
+            }
+        }
+        for (name, v) in [("fx", self.fx), ("fy", self.fy)] {
+            if v <= 0.0 {
+                return Err(Error::param(format!("{what} {name}"), format!("{v} must be > 0")));
+            }
+        }
+        Ok(())
+    }
+
+    /// Pixel coordinates of a view-space point (z > 0 in front of the camera).
+    pub fn project(&self, p: [f64; 3]) -> [f64; 2] {
+        [self.fx * p[0] / p[2] + self.cx, self.fy * p[1] / p[2] + self.cy]
+    }
+
+    /// View-space point at pixel (u, v) with view-space Z = z.
+    pub fn back_project(&self, u: f64, v: f64, z: f64) -> [f64; 3] {
+        [(u - self.cx) * z / self.fx, (v - self.cy) * z / self.fy, z]
+    }
+}
+
+/// Intrinsics plus image size.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct PinholeCamera {
+    #[serde(flatten)]
+    pub k: Intrinsics,
+    pub width: u32,
+    pub height: u32,
+}
+
+impl PinholeCamera {
+    pub fn validate(&self, what: &str) -> Result<()> {
+        self.k.validate(what)?;
+        for (name, v) in [("width", self.width), ("height", self.height)] {
+            if v == 0 || v > MAX_IMAGE_SIDE {
+                return Err(Error::param(
+                    format!("{what} {name}"),
+                    format!("{v} outside 1..={MAX_IMAGE_SIDE}"),
+                ));
+            }
+        }
+        Ok(())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn validation_names_the_parameter() {
+        let k = Intrinsics { fx: 500.0, fy: f64::NAN, cx: 1.0, cy: 1.0 };
+        let e = k.validate("source").unwrap_err().to_string();
+        assert!(e.contains("source fy"), "{e}");
+        let k = Intrinsics { fx: 0.0, fy: 1.0, cx: 1.0, cy: 1.0 };
+        assert!(k.validate("target").unwrap_err().to_string().contains("target fx"));
+        let cam = PinholeCamera { k: Intrinsics { fx: 1.0, fy: 1.0, cx: 0.0, cy: 0.0 }, width: 16385, height: 2 };
+        assert!(cam.validate("output").unwrap_err().to_string().contains("output width"));
+    }
+
+    #[test]
+    fn back_projection_inverts_projection() {
+        let k = Intrinsics { fx: 525.0, fy: 520.0, cx: 319.5, cy: 239.5 };
+        let p = k.back_project(10.7, 400.25, 3.5);
+        let uv = k.project(p);
+        assert!((uv[0] - 10.7).abs() < 1e-12 && (uv[1] - 400.25).abs() < 1e-12);
+    }
+}

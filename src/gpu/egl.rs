@@ -1,0 +1,326 @@
+//! Headless OpenGL 4.5+ core context through EGL: the device platform first, Mesa surfaceless
+//! as fallback. libEGL is loaded at run time, so a machine without it gets an ordinary error.
+
+use crate::error::{Error, Result};
+use khronos_egl as egl;
+use std::ffi::{c_void, CStr};
+
+const EGL_PLATFORM_DEVICE_EXT: egl::Enum = 0x313F;
+const EGL_PLATFORM_SURFACELESS_MESA: egl::Enum = 0x31DD;
+const EGL_EXTENSIONS_DEVICE: egl::Int = 0x3055; // EGL_EXTENSIONS, queried on a device
+const EGL_DRM_DEVICE_FILE_EXT: egl::Int = 0x3233;
+const EGL_CUDA_DEVICE_NV: egl::Int = 0x323A;
+const EGL_CONTEXT_OPENGL_CORE_PROFILE_BIT: egl::Int = 0x1;
+
+type QueryDevices = unsafe extern "system" fn(egl::Int, *mut *mut c_void, *mut egl::Int) -> u32;
+type QueryDeviceString = unsafe extern "system" fn(*mut c_void, egl::Int) -> *const i8;
+type QueryDeviceAttrib = unsafe extern "system" fn(*mut c_void, egl::Int, *mut isize) -> u32;
+type GetPlatformDisplay =
+    unsafe extern "system" fn(egl::Enum, *mut c_void, *const egl::Int) -> *mut c_void;
+
+/// Which EGL device to render on.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum DeviceChoice {
+    /// The CUDA_VISIBLE_DEVICES GPU when that is set and an NVIDIA device matches, else device 0,
+    /// else Mesa surfaceless.
+    #[default]
+    Auto,
+    /// The n-th EGL device from `eglQueryDevicesEXT`.
+    Index(usize),
+    /// Skip device enumeration and use Mesa's surfaceless platform.
+    Surfaceless,
+}
+
+/// What the context runs on, for `viewsynth info` and reports.
+#[derive(Debug, Clone, serde::Serialize)]
+pub struct GpuInfo {
+    pub vendor: String,
+    pub renderer: String,
+    pub version: String,
+    pub glsl_version: String,
+    pub egl_version: String,
+    /// "device" or "surfaceless".
+    pub platform: String,
+    pub device_index: Option<usize>,
+    pub device_count: usize,
+    pub device_file: Option<String>,
+    pub device_extensions: String,
+    pub gl_major: i32,
+    pub gl_minor: i32,
+    pub max_texture_size: i32,
+    pub max_viewport: [i32; 2],
+    /// Whether GL_TIME_ELAPSED timer queries give real values (false on llvmpipe).
+    pub gpu_timers_meaningful: bool,
+}
+
+/// An EGL display and a current GL context on this thread. Dropping it releases the context.
+pub struct EglContext {
+    egl: egl::DynamicInstance<egl::EGL1_4>,
+    display: egl::Display,
+    context: egl::Context,
+    pub(crate) gl: glow::Context,
+    pub(crate) clip_control: unsafe extern "system" fn(u32, u32),
+    pub info: GpuInfo,
+}
+
+fn load_fn<T: Copy>(egl: &egl::DynamicInstance<egl::EGL1_4>, name: &str) -> Option<T> {
+    debug_assert_eq!(std::mem::size_of::<T>(), std::mem::size_of::<extern "system" fn()>());
+    // SAFETY: T is a function pointer type of the same size; the caller names the right signature.
+    egl.get_proc_address(name).map(|f| unsafe { std::mem::transmute_copy::<_, T>(&f) })
+}
+
+fn egl_err(what: &str, e: egl::Error) -> Error {
+    Error::Egl(format!("{what}: {e}"))
+}
+
+impl EglContext {
+    /// Open a display and create a GL 4.6 core context (4.5 if 4.6 is refused), current on
+    /// this thread.
+    pub fn new(choice: DeviceChoice) -> Result<Self> {
+        // SAFETY: loading libEGL runs its initialisers; this is the documented use of the crate.
+        let egl = unsafe { egl::DynamicInstance::<egl::EGL1_4>::load_required() }.map_err(|e| {
+            Error::Egl(format!(
+                "cannot load libEGL ({e}); install libegl1 with a vendor library \
+                 (Mesa: libegl-mesa0 libgl1-mesa-dri; NVIDIA: the driver's EGL via glvnd)"
+            ))
+        })?;
+        let client_ext = egl
+            .query_string(None, egl::EXTENSIONS)
+            .map(|s| s.to_string_lossy().into_owned())
+            .unwrap_or_default();
+        let get_platform_display: Option<GetPlatformDisplay> =
+            load_fn(&egl, "eglGetPlatformDisplayEXT");
+        let get_platform_display = get_platform_display.ok_or_else(|| {
+            Error::Egl("libEGL lacks eglGetPlatformDisplayEXT (EGL_EXT_platform_base)".into())
+        })?;
+
+        let mut attempts = Vec::new();
+        let mut chosen = None;
+        let (devices, query_string) = enumerate_devices(&egl, &client_ext);
+        let device_count = devices.len();
+        if choice != DeviceChoice::Surfaceless && client_ext.contains("EGL_EXT_platform_device") {
+            let order = device_order(&egl, &devices, choice)?;
+            for index in order {
+                // SAFETY: device handle came from eglQueryDevicesEXT; attrib list is EGL_NONE.
+                let ptr = unsafe {
+                    get_platform_display(EGL_PLATFORM_DEVICE_EXT, devices[index], [egl::NONE].as_ptr())
+                };
+                if ptr.is_null() {
+                    attempts.push(format!("device {index}: no display"));
+                    continue;
+                }
+                // SAFETY: non-null EGLDisplay returned by EGL.
+                let display = unsafe { egl::Display::from_ptr(ptr) };
+                match create_context(&egl, display) {
+                    Ok(ctx) => {
+                        let file = query_string.and_then(|q| device_string(q, devices[index], EGL_DRM_DEVICE_FILE_EXT));
+                        let ext = query_string
+                            .and_then(|q| device_string(q, devices[index], EGL_EXTENSIONS_DEVICE))
+                            .unwrap_or_default();
+                        chosen = Some((display, ctx, "device", Some(index), file, ext));
+                        break;
+                    }
+                    Err(e) => attempts.push(format!("device {index}: {e}")),
+                }
+                if matches!(choice, DeviceChoice::Index(_)) {
+                    break;
+                }
+            }
+            if chosen.is_none() && matches!(choice, DeviceChoice::Index(_)) {
+                return Err(Error::Egl(format!("requested EGL device failed: {}", attempts.join("; "))));
+            }
+        } else if let DeviceChoice::Index(i) = choice {
+            return Err(Error::Egl(format!(
+                "EGL device {i} requested but libEGL has no EGL_EXT_platform_device"
+            )));
+        }
+        if chosen.is_none() {
+            if client_ext.contains("EGL_MESA_platform_surfaceless") {
+                // SAFETY: EGL_DEFAULT_DISPLAY with the surfaceless platform is the documented use.
+                let ptr = unsafe {
+                    get_platform_display(EGL_PLATFORM_SURFACELESS_MESA, std::ptr::null_mut(), [egl::NONE].as_ptr())
+                };
+                if ptr.is_null() {
+                    attempts.push("surfaceless: no display".into());
+                } else {
+                    // SAFETY: non-null EGLDisplay returned by EGL.
+                    let display = unsafe { egl::Display::from_ptr(ptr) };
+                    match create_context(&egl, display) {
+                        Ok(ctx) => chosen = Some((display, ctx, "surfaceless", None, None, String::new())),
+                        Err(e) => attempts.push(format!("surfaceless: {e}")),
+                    }
+                }
+            } else {
+                attempts.push("no EGL_MESA_platform_surfaceless".into());
+            }
+        }
+        let Some((display, context, platform, device_index, device_file, device_extensions)) = chosen else {
+            return Err(Error::Egl(format!(
+                "no EGL display gave a GL 4.5 core context ({})",
+                attempts.join("; ")
+            )));
+        };
+
+        // SAFETY: the context is current on this thread; EGL returns GL entry points for it.
+        let gl = unsafe {
+            glow::Context::from_loader_function(|name| {
+                egl.get_proc_address(name).map_or(std::ptr::null(), |f| f as *const c_void)
+            })
+        };
+        let clip_control: unsafe extern "system" fn(u32, u32) = load_fn(&egl, "glClipControl")
+            .ok_or_else(|| Error::Egl("glClipControl missing (needs GL 4.5)".into()))?;
+        let egl_version = egl
+            .query_string(Some(display), egl::VERSION)
+            .map(|s| s.to_string_lossy().into_owned())
+            .unwrap_or_default();
+        let info = gl_info(&gl, egl_version, platform, device_index, device_count, device_file, device_extensions);
+        if (info.gl_major, info.gl_minor) < (4, 5) {
+            return Err(Error::Egl(format!("GL {}.{} < 4.5: {}", info.gl_major, info.gl_minor, info.renderer)));
+        }
+        Ok(EglContext { egl, display, context, gl, clip_control, info })
+    }
+
+    pub fn gl(&self) -> &glow::Context {
+        &self.gl
+    }
+}
+
+impl Drop for EglContext {
+    fn drop(&mut self) {
+        // The display is not terminated: EGL displays are per-process singletons, and other
+        // contexts (other threads, other tests) may still use it.
+        let _ = self.egl.make_current(self.display, None, None, None);
+        let _ = self.egl.destroy_context(self.display, self.context);
+    }
+}
+
+fn create_context(egl: &egl::DynamicInstance<egl::EGL1_4>, display: egl::Display) -> Result<egl::Context> {
+    egl.initialize(display).map_err(|e| egl_err("eglInitialize", e))?;
+    let ext = egl
+        .query_string(Some(display), egl::EXTENSIONS)
+        .map(|s| s.to_string_lossy().into_owned())
+        .unwrap_or_default();
+    if !ext.contains("EGL_KHR_surfaceless_context") {
+        return Err(Error::Egl("display lacks EGL_KHR_surfaceless_context".into()));
+    }
+    egl.bind_api(egl::OPENGL_API).map_err(|e| egl_err("eglBindAPI(OpenGL)", e))?;
+    let config = if ext.contains("EGL_KHR_no_config_context") {
+        // SAFETY: EGL_NO_CONFIG_KHR is the null config, valid with EGL_KHR_no_config_context.
+        unsafe { egl::Config::from_ptr(std::ptr::null_mut()) }
+    } else {
+        egl.choose_first_config(display, &[egl::RENDERABLE_TYPE, egl::OPENGL_BIT, egl::NONE])
+            .map_err(|e| egl_err("eglChooseConfig", e))?
+            .ok_or_else(|| Error::Egl("no EGL config with OpenGL".into()))?
+    };
+    let mut last = None;
+    for (major, minor) in [(4, 6), (4, 5)] {
+        let attribs = [
+            egl::CONTEXT_MAJOR_VERSION, major,
+            egl::CONTEXT_MINOR_VERSION, minor,
+            egl::CONTEXT_OPENGL_PROFILE_MASK, EGL_CONTEXT_OPENGL_CORE_PROFILE_BIT,
+            egl::NONE,
+        ];
+        match egl.create_context(display, config, None, &attribs) {
+            Ok(ctx) => {
+                egl.make_current(display, None, None, Some(ctx)).map_err(|e| egl_err("eglMakeCurrent", e))?;
+                return Ok(ctx);
+            }
+            Err(e) => last = Some(format!("GL {major}.{minor} core: {e}")),
+        }
+    }
+    Err(Error::Egl(last.unwrap_or_default()))
+}
+
+fn enumerate_devices(
+    egl: &egl::DynamicInstance<egl::EGL1_4>,
+    client_ext: &str,
+) -> (Vec<*mut c_void>, Option<QueryDeviceString>) {
+    if !client_ext.contains("EGL_EXT_device_enumeration") && !client_ext.contains("EGL_EXT_device_base") {
+        return (Vec::new(), None);
+    }
+    let Some(query): Option<QueryDevices> = load_fn(egl, "eglQueryDevicesEXT") else {
+        return (Vec::new(), None);
+    };
+    let mut devices = vec![std::ptr::null_mut(); 32];
+    let mut count = 0;
+    // SAFETY: the buffer holds 32 handles and we pass that capacity.
+    if unsafe { query(devices.len() as egl::Int, devices.as_mut_ptr(), &mut count) } == 0 {
+        return (Vec::new(), None);
+    }
+    devices.truncate(count.max(0) as usize);
+    (devices, load_fn(egl, "eglQueryDeviceStringEXT"))
+}
+
+fn device_string(query: QueryDeviceString, device: *mut c_void, name: egl::Int) -> Option<String> {
+    // SAFETY: a valid device handle; EGL returns a static NUL-terminated string or null.
+    let p = unsafe { query(device, name) };
+    // SAFETY: checked non-null above; EGL strings are NUL-terminated.
+    (!p.is_null()).then(|| unsafe { CStr::from_ptr(p) }.to_string_lossy().into_owned())
+}
+
+/// Order to try devices in: the requested index, or the CUDA_VISIBLE_DEVICES match then the rest.
+fn device_order(
+    egl: &egl::DynamicInstance<egl::EGL1_4>,
+    devices: &[*mut c_void],
+    choice: DeviceChoice,
+) -> Result<Vec<usize>> {
+    if let DeviceChoice::Index(i) = choice {
+        if i >= devices.len() {
+            return Err(Error::param("device", format!("index {i} out of range: {} EGL device(s)", devices.len())));
+        }
+        return Ok(vec![i]);
+    }
+    let mut order: Vec<usize> = (0..devices.len()).collect();
+    let cuda_first = std::env::var("CUDA_VISIBLE_DEVICES")
+        .ok()
+        .and_then(|v| v.split(',').next().and_then(|s| s.trim().parse::<isize>().ok()));
+    let attrib: Option<QueryDeviceAttrib> = load_fn(egl, "eglQueryDeviceAttribEXT");
+    if let (Some(cuda), Some(attrib)) = (cuda_first, attrib) {
+        // With CUDA_VISIBLE_DEVICES=3 the process sees that GPU as CUDA device 0; EGL reports
+        // physical CUDA ordinals, so match the physical number.
+        if let Some(pos) = devices.iter().position(|&d| {
+            let mut value: isize = -1;
+            // SAFETY: valid device handle and out-pointer.
+            unsafe { attrib(d, EGL_CUDA_DEVICE_NV, &mut value) != 0 && value == cuda }
+        }) {
+            order.remove(pos);
+            order.insert(0, pos);
+        }
+    }
+    Ok(order)
+}
+
+fn gl_info(
+    gl: &glow::Context,
+    egl_version: String,
+    platform: &str,
+    device_index: Option<usize>,
+    device_count: usize,
+    device_file: Option<String>,
+    device_extensions: String,
+) -> GpuInfo {
+    use glow::HasContext;
+    // SAFETY: plain state queries on the current context.
+    unsafe {
+        let renderer = gl.get_parameter_string(glow::RENDERER);
+        let mut vp = [0i32; 2];
+        gl.get_parameter_i32_slice(glow::MAX_VIEWPORT_DIMS, &mut vp);
+        GpuInfo {
+            vendor: gl.get_parameter_string(glow::VENDOR),
+            gpu_timers_meaningful: !renderer.contains("llvmpipe") && !renderer.contains("softpipe"),
+            renderer,
+            version: gl.get_parameter_string(glow::VERSION),
+            glsl_version: gl.get_parameter_string(glow::SHADING_LANGUAGE_VERSION),
+            egl_version,
+            platform: platform.to_string(),
+            device_index,
+            device_count,
+            device_file,
+            device_extensions,
+            gl_major: gl.get_parameter_i32(glow::MAJOR_VERSION),
+            gl_minor: gl.get_parameter_i32(glow::MINOR_VERSION),
+            max_texture_size: gl.get_parameter_i32(glow::MAX_TEXTURE_SIZE),
+            max_viewport: vp,
+        }
+    }
+}

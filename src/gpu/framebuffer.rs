@@ -1,0 +1,116 @@
+//! Framebuffers with multiple render targets (MRT) and an optional float depth buffer.
+
+use super::{Gpu, Texture, TextureFormat};
+use crate::error::{Error, Result};
+use glow::HasContext;
+
+/// One colour attachment: its format and the value it is cleared to.
+#[derive(Debug, Clone, Copy)]
+pub struct Attachment {
+    pub format: TextureFormat,
+    pub clear: [f32; 4],
+}
+
+/// An FBO owning its colour textures and depth texture. Fragment output location i writes
+/// attachment i; a `None` slot gets no texture and `GL_NONE` as its draw buffer, so a shader
+/// output that is not wanted costs no memory, bandwidth or readback.
+pub struct Framebuffer {
+    gpu: Gpu,
+    raw: glow::Framebuffer,
+    pub colors: Vec<Option<Texture>>,
+    clears: Vec<[f32; 4]>,
+    pub depth: Option<Texture>,
+    pub width: u32,
+    pub height: u32,
+}
+
+impl Framebuffer {
+    pub fn new(gpu: &Gpu, width: u32, height: u32, attachments: &[Option<Attachment>], with_depth: bool) -> Result<Self> {
+        let mut colors = Vec::new();
+        for a in attachments {
+            colors.push(match a {
+                Some(a) => Some(Texture::new(gpu, width, height, a.format, None)?),
+                None => None,
+            });
+        }
+        let depth = if with_depth {
+            Some(Texture::new(gpu, width, height, TextureFormat::Depth32F, None)?)
+        } else {
+            None
+        };
+        let gl = gpu.gl();
+        // SAFETY: attaches textures owned by the returned value; completeness is checked.
+        unsafe {
+            let raw = gl.create_framebuffer().map_err(Error::Gl)?;
+            let fb = Framebuffer {
+                gpu: gpu.clone(),
+                raw,
+                colors,
+                clears: attachments.iter().map(|a| a.map_or([0.0; 4], |a| a.clear)).collect(),
+                depth,
+                width,
+                height,
+            };
+            gl.bind_framebuffer(glow::FRAMEBUFFER, Some(raw));
+            let mut draw = Vec::new();
+            for (i, t) in fb.colors.iter().enumerate() {
+                let at = glow::COLOR_ATTACHMENT0 + i as u32;
+                match t {
+                    Some(t) => {
+                        gl.framebuffer_texture_2d(glow::FRAMEBUFFER, at, glow::TEXTURE_2D, Some(t.raw), 0);
+                        draw.push(at);
+                    }
+                    None => draw.push(glow::NONE),
+                }
+            }
+            if let Some(d) = &fb.depth {
+                gl.framebuffer_texture_2d(glow::FRAMEBUFFER, glow::DEPTH_ATTACHMENT, glow::TEXTURE_2D, Some(d.raw), 0);
+            }
+            gl.draw_buffers(&draw);
+            let status = gl.check_framebuffer_status(glow::FRAMEBUFFER);
+            gl.bind_framebuffer(glow::FRAMEBUFFER, None);
+            if status != glow::FRAMEBUFFER_COMPLETE {
+                return Err(Error::Gl(format!("framebuffer incomplete: 0x{status:04X}")));
+            }
+            gpu.check("framebuffer creation")?;
+            Ok(fb)
+        }
+    }
+
+    /// Bind for drawing, set the viewport and clear every attachment (depth to `clear_depth`).
+    pub fn bind_and_clear(&self, clear_depth: f32) {
+        let gl = self.gpu.gl();
+        // SAFETY: valid FBO; clear values sized per attachment type.
+        unsafe {
+            gl.bind_framebuffer(glow::FRAMEBUFFER, Some(self.raw));
+            gl.viewport(0, 0, self.width as i32, self.height as i32);
+            gl.disable(glow::SCISSOR_TEST);
+            gl.color_mask(true, true, true, true);
+            for (i, (t, c)) in self.colors.iter().zip(&self.clears).enumerate() {
+                let Some(t) = t else { continue };
+                if matches!(t.format, TextureFormat::R32Ui | TextureFormat::R8Ui) {
+                    let v = [c[0] as u32, c[1] as u32, c[2] as u32, c[3] as u32];
+                    gl.clear_buffer_u32_slice(glow::COLOR, i as u32, &v);
+                } else {
+                    gl.clear_buffer_f32_slice(glow::COLOR, i as u32, c);
+                }
+            }
+            if self.depth.is_some() {
+                gl.depth_mask(true);
+                gl.clear_buffer_f32_slice(glow::DEPTH, 0, &[clear_depth]);
+            }
+        }
+    }
+
+    pub fn unbind(&self) {
+        // SAFETY: binding the default framebuffer is always valid.
+        unsafe { self.gpu.gl().bind_framebuffer(glow::FRAMEBUFFER, None) }
+    }
+}
+
+impl Drop for Framebuffer {
+    fn drop(&mut self) {
+        // SAFETY: handle owned by self; the textures drop after it.
+        unsafe { self.gpu.gl().delete_framebuffer(self.raw) }
+    }
+}

@@ -1,0 +1,68 @@
+//! GPU layer: an EGL context and RAII wrappers over raw glow handles. Nothing outside this
+//! folder touches a raw GL handle.
+
+mod egl;
+mod framebuffer;
+mod program;
+mod texture;
+mod timer;
+mod vertex_array;
+
+pub use egl::{DeviceChoice, EglContext, GpuInfo};
+pub use framebuffer::{Attachment, Framebuffer};
+pub use program::Program;
+pub use texture::{Texture, TextureFormat};
+pub use timer::{GpuTimer, Timing};
+pub use vertex_array::VertexArray;
+
+use crate::error::{Error, Result};
+use glow::HasContext;
+use std::rc::Rc;
+
+/// A shared handle to the current GL context. Resources keep one so the context outlives them.
+#[derive(Clone)]
+pub struct Gpu(Rc<EglContext>);
+
+impl Gpu {
+    pub fn new(choice: DeviceChoice) -> Result<Self> {
+        let ctx = EglContext::new(choice)?;
+        Ok(Gpu(Rc::new(ctx)))
+    }
+
+    pub fn gl(&self) -> &glow::Context {
+        &self.0.gl
+    }
+
+    pub fn info(&self) -> &GpuInfo {
+        &self.0.info
+    }
+
+    /// `glClipControl(origin, depth)`: not in glow, loaded through eglGetProcAddress.
+    pub fn clip_control(&self, origin: u32, depth: u32) {
+        // SAFETY: GL 4.5 entry point with two enum arguments; the context is current.
+        unsafe { (self.0.clip_control)(origin, depth) }
+    }
+
+    /// Fail on any pending GL error, naming what was being done.
+    pub fn check(&self, what: &str) -> Result<()> {
+        // SAFETY: plain state query.
+        let err = unsafe { self.gl().get_error() };
+        if err == glow::NO_ERROR {
+            Ok(())
+        } else {
+            Err(Error::Gl(format!("{what}: GL error 0x{err:04X}")))
+        }
+    }
+
+    /// Largest image side this context renders and samples without tiling.
+    pub fn max_image_side(&self) -> u32 {
+        let i = self.info();
+        i.max_texture_size.min(i.max_viewport[0]).min(i.max_viewport[1]).max(0) as u32
+    }
+
+    /// Wait for all submitted GL work (used for wall-clock timing where timer queries lie).
+    pub fn finish(&self) {
+        // SAFETY: no arguments.
+        unsafe { self.gl().finish() }
+    }
+}

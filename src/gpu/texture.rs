@@ -1,0 +1,125 @@
+//! 2-D textures with immutable storage, upload and readback.
+
+use super::Gpu;
+use crate::error::{Error, Result};
+use glow::HasContext;
+
+/// Texel formats used by the passes.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum TextureFormat {
+    Rgba8,
+    R8,
+    R8Ui,
+    R32F,
+    R32Ui,
+    Depth32F,
+}
+
+impl TextureFormat {
+    fn internal(self) -> u32 {
+        match self {
+            TextureFormat::Rgba8 => glow::RGBA8,
+            TextureFormat::R8 => glow::R8,
+            TextureFormat::R8Ui => glow::R8UI,
+            TextureFormat::R32F => glow::R32F,
+            TextureFormat::R32Ui => glow::R32UI,
+            TextureFormat::Depth32F => glow::DEPTH_COMPONENT32F,
+        }
+    }
+    /// (format, type, bytes per texel) for transfers.
+    fn transfer(self) -> (u32, u32, usize) {
+        match self {
+            TextureFormat::Rgba8 => (glow::RGBA, glow::UNSIGNED_BYTE, 4),
+            TextureFormat::R8 => (glow::RED, glow::UNSIGNED_BYTE, 1),
+            TextureFormat::R8Ui => (glow::RED_INTEGER, glow::UNSIGNED_BYTE, 1),
+            TextureFormat::R32F => (glow::RED, glow::FLOAT, 4),
+            TextureFormat::R32Ui => (glow::RED_INTEGER, glow::UNSIGNED_INT, 4),
+            TextureFormat::Depth32F => (glow::DEPTH_COMPONENT, glow::FLOAT, 4),
+        }
+    }
+}
+
+pub struct Texture {
+    gpu: Gpu,
+    pub(crate) raw: glow::Texture,
+    pub width: u32,
+    pub height: u32,
+    pub format: TextureFormat,
+}
+
+impl Texture {
+    /// Allocate a texture; `data` (tightly packed rows, row 0 first) is uploaded when given.
+    /// Sampling is nearest with clamp-to-edge: passes that filter do it themselves in f32 with
+    /// `texelFetch`, because fixed-function bilinear weights have only ~8 bits.
+    pub fn new(gpu: &Gpu, width: u32, height: u32, format: TextureFormat, data: Option<&[u8]>) -> Result<Self> {
+        let max = gpu.max_image_side();
+        if width == 0 || height == 0 || width > max || height > max {
+            return Err(Error::param("texture size", format!("{width}x{height} outside 1..={max} on this GPU")));
+        }
+        let gl = gpu.gl();
+        let (fmt, ty, bpp) = format.transfer();
+        if let Some(d) = data {
+            let need = width as usize * height as usize * bpp;
+            if d.len() != need {
+                return Err(Error::Gl(format!("texture upload: {} bytes given, {need} needed", d.len())));
+            }
+        }
+        // SAFETY: fresh texture; storage sized width x height; data length checked above.
+        unsafe {
+            let raw = gl.create_texture().map_err(Error::Gl)?;
+            gl.bind_texture(glow::TEXTURE_2D, Some(raw));
+            gl.tex_storage_2d(glow::TEXTURE_2D, 1, format.internal(), width as i32, height as i32);
+            for (p, v) in [
+                (glow::TEXTURE_MIN_FILTER, glow::NEAREST),
+                (glow::TEXTURE_MAG_FILTER, glow::NEAREST),
+                (glow::TEXTURE_WRAP_S, glow::CLAMP_TO_EDGE),
+                (glow::TEXTURE_WRAP_T, glow::CLAMP_TO_EDGE),
+            ] {
+                gl.tex_parameter_i32(glow::TEXTURE_2D, p, v as i32);
+            }
+            if let Some(d) = data {
+                gl.pixel_store_i32(glow::UNPACK_ALIGNMENT, 1);
+                gl.tex_sub_image_2d(
+                    glow::TEXTURE_2D, 0, 0, 0, width as i32, height as i32, fmt, ty,
+                    glow::PixelUnpackData::Slice(Some(d)),
+                );
+            }
+            gl.bind_texture(glow::TEXTURE_2D, None);
+            let tex = Texture { gpu: gpu.clone(), raw, width, height, format };
+            gpu.check("texture allocation")?;
+            Ok(tex)
+        }
+    }
+
+    /// Bind to texture unit `unit`.
+    pub fn bind(&self, unit: u32) {
+        // SAFETY: valid handle.
+        unsafe {
+            self.gpu.gl().active_texture(glow::TEXTURE0 + unit);
+            self.gpu.gl().bind_texture(glow::TEXTURE_2D, Some(self.raw));
+        }
+    }
+
+    /// Read the whole texture back, rows in memory order (row 0 = framebuffer row 0).
+    pub fn read(&self) -> Result<Vec<u8>> {
+        let (fmt, ty, bpp) = self.format.transfer();
+        let mut out = vec![0u8; self.width as usize * self.height as usize * bpp];
+        // SAFETY: the buffer is exactly the texture's size in this format; pack alignment 1.
+        unsafe {
+            let gl = self.gpu.gl();
+            gl.pixel_store_i32(glow::PACK_ALIGNMENT, 1);
+            gl.bind_texture(glow::TEXTURE_2D, Some(self.raw));
+            gl.get_tex_image(glow::TEXTURE_2D, 0, fmt, ty, glow::PixelPackData::Slice(Some(&mut out)));
+            gl.bind_texture(glow::TEXTURE_2D, None);
+        }
+        self.gpu.check("texture readback")?;
+        Ok(out)
+    }
+}
+
+impl Drop for Texture {
+    fn drop(&mut self) {
+        // SAFETY: handle owned by self.
+        unsafe { self.gpu.gl().delete_texture(self.raw) }
+    }
+}

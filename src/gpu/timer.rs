@@ -1,0 +1,53 @@
+//! Timing: GL_TIME_ELAPSED queries where the driver gives real values, wall clock always.
+
+use super::Gpu;
+use glow::HasContext;
+use std::time::Instant;
+
+/// GPU and wall time of one timed section, in milliseconds.
+#[derive(Debug, Clone, Copy, Default, serde::Serialize)]
+pub struct Timing {
+    /// None where timer queries are not meaningful (llvmpipe reports CPU-side fragments).
+    pub gpu_ms: Option<f64>,
+    pub wall_ms: f64,
+}
+
+/// Times GL work between `start` and `stop`; `stop` waits with glFinish so wall time is complete.
+pub struct GpuTimer {
+    gpu: Gpu,
+    query: Option<glow::Query>,
+    start: Instant,
+}
+
+impl GpuTimer {
+    pub fn start(gpu: &Gpu) -> Self {
+        let query = if gpu.info().gpu_timers_meaningful {
+            // SAFETY: query object creation and begin on the current context.
+            unsafe {
+                let q = gpu.gl().create_query().ok();
+                if let Some(q) = q {
+                    gpu.gl().begin_query(glow::TIME_ELAPSED, q);
+                }
+                q
+            }
+        } else {
+            None
+        };
+        GpuTimer { gpu: gpu.clone(), query, start: Instant::now() }
+    }
+
+    pub fn stop(self) -> Timing {
+        let gl = self.gpu.gl();
+        let gpu_ms = self.query.map(|q| {
+            // SAFETY: ends the query begun in start; reading the result waits for it.
+            unsafe {
+                gl.end_query(glow::TIME_ELAPSED);
+                let ns = gl.get_query_parameter_u32(q, glow::QUERY_RESULT);
+                gl.delete_query(q);
+                ns as f64 * 1e-6
+            }
+        });
+        self.gpu.finish();
+        Timing { gpu_ms, wall_ms: self.start.elapsed().as_secs_f64() * 1e3 }
+    }
+}

@@ -1,0 +1,147 @@
+//! OpenEXR through the `exr` crate: one depth channel in, f32 channels out.
+
+use std::fs::File;
+use std::io::{BufWriter, Cursor};
+use std::path::Path;
+
+use exr::prelude::{
+    AnyChannel, AnyChannels, Encoding, FlatSamples, Image, Layer, LayerAttributes, MetaData,
+    ReadChannels, ReadLayers, SmallVec, WritableImage,
+};
+
+use super::depth::{RawDepth, RawSamples};
+use super::image_types::{decode_dims, sample_count};
+use crate::error::{Error, Result};
+
+/// Reads the depth channel of a single-layer, flat EXR: "Z", else "depth" (any case), else
+/// "Y", else "R", else the only channel. f16 is widened to f32; u32 stays integer.
+pub(crate) fn read_depth_channel(path: &Path) -> Result<RawDepth> {
+    let bytes = std::fs::read(path).map_err(|e| Error::io(path, e))?;
+    // Headers first, so the size check happens before any pixel allocation.
+    let meta =
+        MetaData::read_from_buffered(Cursor::new(&bytes), false).map_err(|e| exr_error(path, e))?;
+    let header = match meta.headers.as_slice() {
+        [h] => h,
+        hs => {
+            return Err(Error::decode(
+                path,
+                format!("EXR has {} layers; expected exactly one", hs.len()),
+            ))
+        }
+    };
+    if header.deep {
+        return Err(Error::decode(path, "deep EXR data is not supported"));
+    }
+    let (width, height) = decode_dims(
+        path,
+        header.layer_size.width() as u64,
+        header.layer_size.height() as u64,
+    )?;
+
+    let image = exr::prelude::read()
+        .no_deep_data()
+        .largest_resolution_level()
+        .all_channels()
+        .all_layers()
+        .all_attributes()
+        .from_buffered(Cursor::new(&bytes))
+        .map_err(|e| exr_error(path, e))?;
+    let layer = match image.layer_data.into_iter().next() {
+        Some(layer) => layer,
+        None => return Err(Error::decode(path, "EXR has no layers")),
+    };
+    let mut channels = layer.channel_data.list.into_vec();
+    let names: Vec<String> = channels.iter().map(|c| c.name.to_string()).collect();
+    let index = choose_channel(&names).ok_or_else(|| {
+        Error::decode(
+            path,
+            format!(
+                "cannot tell which EXR channel is depth among [{}]; expected one named \
+                 Z, depth, Y or R, or a single channel",
+                names.join(", ")
+            ),
+        )
+    })?;
+    let channel = channels.swap_remove(index);
+    let samples = match channel.sample_data {
+        FlatSamples::F16(v) => RawSamples::F32(v.into_iter().map(|s| s.to_f32()).collect()),
+        FlatSamples::F32(v) => RawSamples::F32(v),
+        FlatSamples::U32(v) => RawSamples::U32(v),
+    };
+    let expected = sample_count(width, height, 1);
+    if expected != Some(samples.len()) {
+        return Err(Error::decode(
+            path,
+            format!(
+                "EXR channel {} has {} samples for a {width}x{height} image (subsampled?)",
+                names[index],
+                samples.len()
+            ),
+        ));
+    }
+    Ok(RawDepth {
+        width,
+        height,
+        samples,
+    })
+}
+
+fn choose_channel(names: &[String]) -> Option<usize> {
+    let find = |pred: &dyn Fn(&str) -> bool| names.iter().position(|n| pred(n));
+    find(&|n| n == "Z")
+        .or_else(|| find(&|n| n.eq_ignore_ascii_case("depth")))
+        .or_else(|| find(&|n| n == "Y"))
+        .or_else(|| find(&|n| n == "R"))
+        .or(if names.len() == 1 { Some(0) } else { None })
+}
+
+/// Writes one scan-line, ZIP-compressed layer of full-resolution f32 channels.
+/// Each channel must hold `width * height` samples, rows top-down.
+pub(crate) fn write_f32_channels(
+    path: &Path,
+    out: &mut BufWriter<File>,
+    width: u32,
+    height: u32,
+    channels: Vec<(&str, Vec<f32>)>,
+) -> Result<()> {
+    let list: SmallVec<[AnyChannel<FlatSamples>; 4]> = channels
+        .into_iter()
+        .map(|(name, data)| AnyChannel::new(name, FlatSamples::F32(data)))
+        .collect();
+    let layer = Layer::new(
+        (width as usize, height as usize),
+        LayerAttributes::default(),
+        Encoding::SMALL_LOSSLESS,
+        AnyChannels::sort(list),
+    );
+    Image::from_layer(layer)
+        .write()
+        .to_buffered(out)
+        .map_err(|e| match e {
+            exr::error::Error::Io(io) => Error::io(path, io),
+            other => Error::encode(path, other.to_string()),
+        })
+}
+
+fn exr_error(path: &Path, e: exr::error::Error) -> Error {
+    Error::decode(path, format!("invalid EXR: {e}"))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn names(v: &[&str]) -> Vec<String> {
+        v.iter().map(|s| s.to_string()).collect()
+    }
+
+    #[test]
+    fn channel_choice_priority() {
+        assert_eq!(choose_channel(&names(&["B", "G", "R", "Z"])), Some(3));
+        assert_eq!(choose_channel(&names(&["B", "Depth", "R"])), Some(1));
+        assert_eq!(choose_channel(&names(&["R", "Y"])), Some(1));
+        assert_eq!(choose_channel(&names(&["B", "G", "R"])), Some(2));
+        assert_eq!(choose_channel(&names(&["disparity"])), Some(0));
+        assert_eq!(choose_channel(&names(&["a", "b"])), None);
+    }
+}

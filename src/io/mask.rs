@@ -1,0 +1,112 @@
+//! Binary masks as 8-bit gray PNG (0 / 255 on disk, 0 / 1 in memory).
+
+use std::path::Path;
+
+use image::codecs::png::PngEncoder;
+use image::{ExtendedColorType, ImageEncoder, ImageFormat};
+
+use super::atomic::atomic_write;
+use super::decode::{decode_image, Decoded, Samples};
+use super::image_types::{encode_dims, Mask};
+use crate::error::{Error, Result};
+
+/// Writes 8-bit gray: 0 -> 0, any nonzero value -> 255.
+pub fn save_mask_png(path: &Path, mask: &Mask) -> Result<()> {
+    encode_dims(path, mask.width, mask.height, 1, mask.data.len())?;
+    let bytes: Vec<u8> = mask
+        .data
+        .iter()
+        .map(|&v| if v == 0 { 0 } else { 255 })
+        .collect();
+    atomic_write(path, |out| {
+        PngEncoder::new(out)
+            .write_image(&bytes, mask.width, mask.height, ExtendedColorType::L8)
+            .map_err(|e| Error::encode(path, e.to_string()))
+    })
+}
+
+/// Reads a PNG mask: a pixel is 1 when any of its colour samples is nonzero (alpha is
+/// ignored), else 0. Gray, gray+alpha, RGB and RGBA at 8 or 16 bits are accepted.
+pub fn load_mask_png(path: &Path) -> Result<Mask> {
+    let Decoded {
+        width,
+        height,
+        channels,
+        samples,
+    } = decode_image(path, Some(ImageFormat::Png))?;
+    let colour = match channels {
+        1 | 2 => 1,
+        _ => 3,
+    };
+    let data = match &samples {
+        Samples::U8(s) => set_pixels(s, channels, colour, |v| v != 0),
+        Samples::U16(s) => set_pixels(s, channels, colour, |v| v != 0),
+        Samples::F32(s) => set_pixels(s, channels, colour, |v| v != 0.0),
+    };
+    Mask::new(width, height, data).map_err(|e| Error::decode(path, e.to_string()))
+}
+
+fn set_pixels<T: Copy>(
+    samples: &[T],
+    channels: usize,
+    colour: usize,
+    nonzero: impl Fn(T) -> bool,
+) -> Vec<u8> {
+    samples
+        .chunks_exact(channels.max(1))
+        .map(|px| u8::from(px.iter().take(colour).any(|&v| nonzero(v))))
+        .collect()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::io::test_util::{list_dir, scratch_dir};
+
+    #[test]
+    fn round_trip_and_on_disk_values() {
+        let dir = scratch_dir("mask");
+        let path = dir.join("m.png");
+        let mask = Mask::new(3, 2, vec![0, 1, 0, 7, 0, 1]).unwrap();
+        save_mask_png(&path, &mask).unwrap();
+        let on_disk = image::open(&path).unwrap();
+        assert_eq!(on_disk.color(), image::ColorType::L8);
+        assert_eq!(
+            on_disk.into_luma8().into_raw(),
+            vec![0, 255, 0, 255, 0, 255]
+        );
+        assert_eq!(load_mask_png(&path).unwrap().data, vec![0, 1, 0, 1, 0, 1]);
+    }
+
+    #[test]
+    fn colour_masks_ignore_alpha() {
+        let dir = scratch_dir("mask-rgba");
+        let path = dir.join("m.png");
+        let px = vec![0, 0, 0, 255, 1, 0, 0, 0, 0, 0, 0, 0];
+        image::RgbaImage::from_raw(3, 1, px)
+            .unwrap()
+            .save(&path)
+            .unwrap();
+        assert_eq!(load_mask_png(&path).unwrap().data, vec![0, 1, 0]);
+    }
+
+    #[test]
+    fn errors_name_the_file() {
+        let dir = scratch_dir("mask-bad");
+        let path = dir.join("m.png");
+        std::fs::write(&path, b"\x89PNG\r\n\x1a\nnope").unwrap();
+        let err = load_mask_png(&path).unwrap_err();
+        assert!(matches!(err, Error::Decode { .. }) && err.to_string().contains("m.png"));
+        let err = load_mask_png(&dir.join("gone.png")).unwrap_err();
+        assert!(matches!(err, Error::Io { .. }) && err.to_string().contains("gone.png"));
+        let bad = Mask {
+            width: 2,
+            height: 2,
+            data: vec![1],
+        };
+        let out = dir.join("sub");
+        std::fs::create_dir(&out).unwrap();
+        assert!(save_mask_png(&out.join("x.png"), &bad).is_err());
+        assert!(list_dir(&out).is_empty());
+    }
+}

@@ -1,0 +1,533 @@
+//! NumPy `.npy` arrays (format versions 1.0, 2.0, 3.0): strict reader, f32 writer.
+
+use std::io::Write;
+use std::path::Path;
+
+use super::atomic::atomic_write;
+use crate::error::{Error, Result};
+
+const MAGIC: &[u8] = b"\x93NUMPY";
+
+/// Element types accepted by [`load_npy`] (either byte order where it applies).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum NpyDtype {
+    /// `|u1`
+    U8,
+    /// `<u2` / `>u2`
+    U16,
+    /// `<f4` / `>f4`
+    F32,
+    /// `<f8` / `>f8`
+    F64,
+}
+
+/// A loaded array, always in C (row-major) order whatever the file's `fortran_order`.
+/// Values are widened to f64, which is exact for every supported dtype.
+#[derive(Debug, Clone, PartialEq)]
+pub struct NpyArray {
+    pub shape: Vec<usize>,
+    pub dtype: NpyDtype,
+    pub data: Vec<f64>,
+}
+
+/// Reads an `.npy` file. The header must be a well-formed dict with exactly the keys
+/// `descr`, `fortran_order` and `shape`; the payload must be exactly as long as it says.
+pub fn load_npy(path: &Path) -> Result<NpyArray> {
+    let bytes = std::fs::read(path).map_err(|e| Error::io(path, e))?;
+    let bad = |msg: String| Error::decode(path, format!("invalid NPY: {msg}"));
+    let (header, payload) = split_header(&bytes).map_err(bad)?;
+    let h = parse_header(header).map_err(bad)?;
+    let count = h
+        .shape
+        .iter()
+        .try_fold(1usize, |acc, &d| acc.checked_mul(d))
+        .ok_or_else(|| bad(format!("shape {:?} overflows", h.shape)))?;
+    let need = count
+        .checked_mul(h.item_size)
+        .ok_or_else(|| bad(format!("shape {:?} overflows", h.shape)))?;
+    if payload.len() != need {
+        let what = if payload.len() < need {
+            "truncated"
+        } else {
+            "trailing bytes"
+        };
+        return Err(bad(format!(
+            "{what}: header says shape {:?} of {} = {need} data bytes, file has {}",
+            h.shape,
+            h.descr,
+            payload.len()
+        )));
+    }
+    let data: Vec<f64> = payload.chunks_exact(h.item_size).map(h.decode).collect();
+    let data = if h.fortran_order {
+        fortran_to_c(&h.shape, &data)
+    } else {
+        data
+    };
+    Ok(NpyArray {
+        shape: h.shape,
+        dtype: h.dtype,
+        data,
+    })
+}
+
+/// Writes `data` as `<f4` in C order with the given shape, NPY format 1.0.
+pub fn save_npy_f32(path: &Path, shape: &[usize], data: &[f32]) -> Result<()> {
+    let count = shape.iter().try_fold(1usize, |acc, &d| acc.checked_mul(d));
+    if count != Some(data.len()) {
+        return Err(Error::SizeMismatch {
+            message: format!(
+                "{}: shape {shape:?} does not hold {} values",
+                path.display(),
+                data.len()
+            ),
+        });
+    }
+    let header = format_header("<f4", shape)
+        .ok_or_else(|| Error::encode(path, "NPY header longer than 65535 bytes"))?;
+    atomic_write(path, |out| {
+        out.write_all(&header).map_err(|e| Error::io(path, e))?;
+        for v in data {
+            out.write_all(&v.to_le_bytes())
+                .map_err(|e| Error::io(path, e))?;
+        }
+        Ok(())
+    })
+}
+
+/// Magic, version, length and dict text padded so the payload starts 64-byte aligned.
+fn format_header(descr: &str, shape: &[usize]) -> Option<Vec<u8>> {
+    let dims: Vec<String> = shape.iter().map(|d| d.to_string()).collect();
+    let shape_text = match dims.as_slice() {
+        [one] => format!("({one},)"),
+        _ => format!("({})", dims.join(", ")),
+    };
+    let mut dict =
+        format!("{{'descr': '{descr}', 'fortran_order': False, 'shape': {shape_text}, }}");
+    let unpadded = MAGIC.len() + 2 + 2 + dict.len() + 1;
+    dict.push_str(&" ".repeat((64 - unpadded % 64) % 64));
+    dict.push('\n');
+    let len = u16::try_from(dict.len()).ok()?;
+    let mut out = Vec::with_capacity(10 + dict.len());
+    out.extend_from_slice(MAGIC);
+    out.extend_from_slice(&[1, 0]);
+    out.extend_from_slice(&len.to_le_bytes());
+    out.extend_from_slice(dict.as_bytes());
+    Some(out)
+}
+
+/// Returns (header dict text, payload).
+fn split_header(bytes: &[u8]) -> std::result::Result<(&str, &[u8]), String> {
+    let rest = bytes
+        .strip_prefix(MAGIC)
+        .ok_or("missing \\x93NUMPY magic")?;
+    let (version, rest) = rest
+        .split_at_checked(2)
+        .ok_or("file ends inside the header")?;
+    let len_bytes = match version {
+        [1, 0] => 2,
+        [2, 0] | [3, 0] => 4,
+        _ => return Err(format!("unsupported format version {version:?}")),
+    };
+    let (len_field, rest) = rest
+        .split_at_checked(len_bytes)
+        .ok_or("file ends inside the header")?;
+    let len = len_field
+        .iter()
+        .rev()
+        .fold(0usize, |acc, &b| (acc << 8) | usize::from(b));
+    let (header, payload) = rest
+        .split_at_checked(len)
+        .ok_or_else(|| format!("header length {len} exceeds the file"))?;
+    let header = std::str::from_utf8(header).map_err(|_| "header is not UTF-8")?;
+    let header = header
+        .strip_suffix('\n')
+        .ok_or("header does not end with a newline")?;
+    Ok((header, payload))
+}
+
+/// Converts one stored element (exactly `item_size` bytes) to f64.
+type DecodeFn = fn(&[u8]) -> f64;
+
+struct Header {
+    descr: String,
+    dtype: NpyDtype,
+    item_size: usize,
+    decode: DecodeFn,
+    fortran_order: bool,
+    shape: Vec<usize>,
+}
+
+fn parse_header(text: &str) -> std::result::Result<Header, String> {
+    let mut p = Parser {
+        s: text.as_bytes(),
+        i: 0,
+    };
+    let (mut descr, mut fortran, mut shape) = (None, None, None);
+    p.expect(b'{')?;
+    loop {
+        p.skip_ws();
+        if p.eat(b'}') {
+            break;
+        }
+        let key = p.string()?;
+        p.expect(b':')?;
+        let dup = match key.as_str() {
+            "descr" => descr.replace(p.string()?).is_some(),
+            "fortran_order" => fortran.replace(p.boolean()?).is_some(),
+            "shape" => shape.replace(p.tuple()?).is_some(),
+            other => return Err(format!("unexpected header key '{other}'")),
+        };
+        if dup {
+            return Err(format!("duplicate header key '{key}'"));
+        }
+        p.skip_ws();
+        if !p.eat(b',') {
+            p.expect(b'}')?;
+            break;
+        }
+    }
+    p.skip_ws();
+    if p.i != p.s.len() {
+        return Err("unexpected text after the header dict".into());
+    }
+    let descr: String = descr.ok_or("header lacks 'descr'")?;
+    let (dtype, item_size, decode): (NpyDtype, usize, DecodeFn) = match descr.as_str() {
+        "|u1" => (NpyDtype::U8, 1, |b| f64::from(b[0])),
+        "<u2" => (NpyDtype::U16, 2, |b| {
+            f64::from(u16::from_le_bytes([b[0], b[1]]))
+        }),
+        ">u2" => (NpyDtype::U16, 2, |b| {
+            f64::from(u16::from_be_bytes([b[0], b[1]]))
+        }),
+        "<f4" => (NpyDtype::F32, 4, |b| {
+            f64::from(f32::from_le_bytes([b[0], b[1], b[2], b[3]]))
+        }),
+        ">f4" => (NpyDtype::F32, 4, |b| {
+            f64::from(f32::from_be_bytes([b[0], b[1], b[2], b[3]]))
+        }),
+        "<f8" => (NpyDtype::F64, 8, |b| f64::from_le_bytes(array8(b))),
+        ">f8" => (NpyDtype::F64, 8, |b| f64::from_be_bytes(array8(b))),
+        other => {
+            return Err(format!(
+                "unsupported dtype '{other}' (supported: |u1 <u2 >u2 <f4 >f4 <f8 >f8)"
+            ))
+        }
+    };
+    Ok(Header {
+        descr,
+        dtype,
+        item_size,
+        decode,
+        fortran_order: fortran.ok_or("header lacks 'fortran_order'")?,
+        shape: shape.ok_or("header lacks 'shape'")?,
+    })
+}
+
+// The decode fns above index within `chunks_exact(item_size)` chunks, so they cannot panic.
+fn array8(b: &[u8]) -> [u8; 8] {
+    let mut a = [0u8; 8];
+    a.copy_from_slice(&b[..8]);
+    a
+}
+
+/// Minimal parser for the Python literal subset NumPy writes in headers.
+struct Parser<'a> {
+    s: &'a [u8],
+    i: usize,
+}
+
+impl Parser<'_> {
+    fn skip_ws(&mut self) {
+        while self.s.get(self.i).is_some_and(|c| c.is_ascii_whitespace()) {
+            self.i += 1;
+        }
+    }
+
+    fn eat(&mut self, c: u8) -> bool {
+        self.skip_ws();
+        let hit = self.s.get(self.i) == Some(&c);
+        if hit {
+            self.i += 1;
+        }
+        hit
+    }
+
+    fn expect(&mut self, c: u8) -> std::result::Result<(), String> {
+        if self.eat(c) {
+            Ok(())
+        } else {
+            Err(format!(
+                "expected '{}' at header offset {}",
+                char::from(c),
+                self.i
+            ))
+        }
+    }
+
+    fn string(&mut self) -> std::result::Result<String, String> {
+        self.skip_ws();
+        let quote = match self.s.get(self.i) {
+            Some(&q @ (b'\'' | b'"')) => q,
+            _ => return Err(format!("expected a string at header offset {}", self.i)),
+        };
+        let start = self.i + 1;
+        let len = self.s[start..]
+            .iter()
+            .position(|&c| c == quote || c == b'\\')
+            .ok_or("unterminated string in header")?;
+        if self.s[start + len] == b'\\' {
+            return Err("escapes in header strings are not supported".into());
+        }
+        self.i = start + len + 1;
+        Ok(String::from_utf8_lossy(&self.s[start..start + len]).into_owned())
+    }
+
+    fn boolean(&mut self) -> std::result::Result<bool, String> {
+        self.skip_ws();
+        for (word, value) in [(&b"True"[..], true), (&b"False"[..], false)] {
+            if self.s[self.i..].starts_with(word) {
+                self.i += word.len();
+                return Ok(value);
+            }
+        }
+        Err(format!(
+            "expected True or False at header offset {}",
+            self.i
+        ))
+    }
+
+    /// `()`, `(n,)`, `(a, b)`, `(a, b,)`; Python 2's `3L` suffix is accepted.
+    fn tuple(&mut self) -> std::result::Result<Vec<usize>, String> {
+        self.expect(b'(')?;
+        let mut dims = Vec::new();
+        let mut trailing_comma = false;
+        while !self.eat(b')') {
+            dims.push(self.uint()?);
+            trailing_comma = self.eat(b',');
+            if !trailing_comma {
+                self.expect(b')')?;
+                break;
+            }
+        }
+        if dims.len() == 1 && !trailing_comma {
+            // "(5)" is an int in Python, not a tuple; NumPy writes "(5,)".
+            return Err("1-D shape must be written '(n,)'".into());
+        }
+        Ok(dims)
+    }
+
+    fn uint(&mut self) -> std::result::Result<usize, String> {
+        self.skip_ws();
+        let start = self.i;
+        while self.s.get(self.i).is_some_and(u8::is_ascii_digit) {
+            self.i += 1;
+        }
+        let dim = std::str::from_utf8(&self.s[start..self.i])
+            .ok()
+            .and_then(|d| d.parse::<usize>().ok())
+            .ok_or_else(|| format!("bad shape dimension at header offset {start}"))?;
+        if self.s.get(self.i) == Some(&b'L') {
+            self.i += 1;
+        }
+        Ok(dim)
+    }
+}
+
+/// Reorders column-major data (first index fastest) to row-major.
+fn fortran_to_c(shape: &[usize], data: &[f64]) -> Vec<f64> {
+    if shape.len() < 2 {
+        return data.to_vec();
+    }
+    // Strides fit: their product is the element count, already checked.
+    let mut strides = vec![1usize; shape.len()];
+    for k in 1..shape.len() {
+        strides[k] = strides[k - 1] * shape[k - 1];
+    }
+    let mut index = vec![0usize; shape.len()];
+    let mut out = Vec::with_capacity(data.len());
+    for _ in 0..data.len() {
+        let offset: usize = index.iter().zip(&strides).map(|(i, s)| i * s).sum();
+        out.push(data.get(offset).copied().unwrap_or(f64::NAN));
+        for k in (0..shape.len()).rev() {
+            index[k] += 1;
+            if index[k] < shape[k] {
+                break;
+            }
+            index[k] = 0;
+        }
+    }
+    out
+}
+
+/// Builds an NPY v1.0 file by hand from raw dict text and payload, for tests.
+#[cfg(test)]
+pub(crate) fn build_npy(dict: &str, payload: &[u8]) -> Vec<u8> {
+    let mut text = dict.to_string();
+    while (10 + text.len() + 1) % 64 != 0 {
+        text.push(' ');
+    }
+    text.push('\n');
+    let mut out = MAGIC.to_vec();
+    out.extend_from_slice(&[1, 0]);
+    out.extend_from_slice(&(text.len() as u16).to_le_bytes());
+    out.extend_from_slice(text.as_bytes());
+    out.extend_from_slice(payload);
+    out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::io::test_util::scratch_dir;
+
+    fn write(dir: &Path, name: &str, bytes: &[u8]) -> std::path::PathBuf {
+        let path = dir.join(name);
+        std::fs::write(&path, bytes).unwrap();
+        path
+    }
+
+    #[test]
+    fn f32_round_trip_and_header_layout() {
+        let dir = scratch_dir("npy-f32");
+        let path = dir.join("a.npy");
+        let data: Vec<f32> = (0..6).map(|i| i as f32 * 0.5 - 1.0).collect();
+        save_npy_f32(&path, &[2, 3], &data).unwrap();
+        let bytes = std::fs::read(&path).unwrap();
+        assert_eq!(&bytes[..8], b"\x93NUMPY\x01\x00");
+        let header_len = usize::from(u16::from_le_bytes([bytes[8], bytes[9]]));
+        assert_eq!((10 + header_len) % 64, 0);
+        assert_eq!(bytes[9 + header_len], b'\n');
+        let text = std::str::from_utf8(&bytes[10..10 + header_len]).unwrap();
+        assert!(text.starts_with("{'descr': '<f4', 'fortran_order': False, 'shape': (2, 3), }"));
+        let arr = load_npy(&path).unwrap();
+        assert_eq!(arr.shape, vec![2, 3]);
+        assert_eq!(arr.dtype, NpyDtype::F32);
+        assert_eq!(
+            arr.data,
+            data.iter().map(|&v| f64::from(v)).collect::<Vec<_>>()
+        );
+    }
+
+    #[test]
+    fn one_d_and_scalar_shapes() {
+        let dir = scratch_dir("npy-shapes");
+        let path = dir.join("a.npy");
+        save_npy_f32(&path, &[3], &[1.0, 2.0, 3.0]).unwrap();
+        assert_eq!(load_npy(&path).unwrap().shape, vec![3]);
+        save_npy_f32(&path, &[], &[4.0]).unwrap();
+        let arr = load_npy(&path).unwrap();
+        assert_eq!((arr.shape.len(), arr.data.as_slice()), (0, &[4.0][..]));
+        assert!(save_npy_f32(&path, &[2, 2], &[1.0]).is_err());
+    }
+
+    #[test]
+    fn f64_big_endian_u16_and_python2_header() {
+        let dir = scratch_dir("npy-dtypes");
+        let payload: Vec<u8> = [1.5f64, -2.0]
+            .iter()
+            .flat_map(|v| v.to_be_bytes())
+            .collect();
+        let p = write(
+            &dir,
+            "be.npy",
+            &build_npy(
+                "{'descr': '>f8', 'fortran_order': False, 'shape': (2,), }",
+                &payload,
+            ),
+        );
+        assert_eq!(load_npy(&p).unwrap().data, vec![1.5, -2.0]);
+
+        let payload: Vec<u8> = [1u16, 65535].iter().flat_map(|v| v.to_le_bytes()).collect();
+        let p = write(
+            &dir,
+            "u2.npy",
+            &build_npy(
+                "{\"shape\": (1L, 2L), \"descr\": \"<u2\", \"fortran_order\": False}",
+                &payload,
+            ),
+        );
+        let arr = load_npy(&p).unwrap();
+        assert_eq!(
+            (arr.dtype, arr.shape, arr.data),
+            (NpyDtype::U16, vec![1, 2], vec![1.0, 65535.0])
+        );
+    }
+
+    #[test]
+    fn fortran_order_is_reordered_to_c() {
+        let dir = scratch_dir("npy-fortran");
+        // C-order [[0, 1, 2], [3, 4, 5]] stored column-major: 0 3 1 4 2 5.
+        let payload: Vec<u8> = [0f32, 3.0, 1.0, 4.0, 2.0, 5.0]
+            .iter()
+            .flat_map(|v| v.to_le_bytes())
+            .collect();
+        let p = write(
+            &dir,
+            "f.npy",
+            &build_npy(
+                "{'descr': '<f4', 'fortran_order': True, 'shape': (2, 3), }",
+                &payload,
+            ),
+        );
+        assert_eq!(
+            load_npy(&p).unwrap().data,
+            vec![0.0, 1.0, 2.0, 3.0, 4.0, 5.0]
+        );
+        let shape = [2, 3, 2];
+        let f: Vec<f64> = (0..12).map(f64::from).collect();
+        let c = fortran_to_c(&shape, &f);
+        // Element (i, j, k) is at i + 2j + 6k in Fortran order.
+        assert_eq!(c[3 * 2 + 2 + 1], f[1 + 2 + 6]);
+    }
+
+    #[test]
+    fn truncated_and_trailing_payloads_are_refused() {
+        let dir = scratch_dir("npy-trunc");
+        let dict = "{'descr': '<f4', 'fortran_order': False, 'shape': (4, 4), }";
+        let p = write(&dir, "short.npy", &build_npy(dict, &[0u8; 60]));
+        let err = load_npy(&p).unwrap_err();
+        assert!(matches!(err, Error::Decode { .. }));
+        let msg = err.to_string();
+        assert!(
+            msg.contains("short.npy") && msg.contains("truncated"),
+            "{msg}"
+        );
+        let p = write(&dir, "long.npy", &build_npy(dict, &[0u8; 65]));
+        assert!(load_npy(&p).is_err());
+        // Header length pointing past the end of the file.
+        let p = write(&dir, "cut.npy", &build_npy(dict, &[])[..30]);
+        assert!(matches!(load_npy(&p), Err(Error::Decode { .. })));
+        // A huge claimed shape must fail on size, not allocate.
+        let big = "{'descr': '<f8', 'fortran_order': False, 'shape': (99999999999, 99999999999), }";
+        let p = write(&dir, "big.npy", &build_npy(big, &[0u8; 8]));
+        assert!(matches!(load_npy(&p), Err(Error::Decode { .. })));
+    }
+
+    #[test]
+    fn malformed_headers_are_refused() {
+        let dir = scratch_dir("npy-bad");
+        let cases = [
+            "{'descr': '<i4', 'fortran_order': False, 'shape': (1,), }",
+            "{'descr': '<f4', 'fortran_order': False, }",
+            "{'descr': '<f4', 'fortran_order': 0, 'shape': (1,), }",
+            "{'descr': '<f4', 'fortran_order': False, 'shape': (1,), 'x': 1}",
+            "{'descr': '<f4', 'descr': '<f4', 'fortran_order': False, 'shape': (1,)}",
+            "{'descr': '<f4', 'fortran_order': False, 'shape': (1), }",
+            "{'descr': '<f4', 'fortran_order': False, 'shape': (-1,), }",
+            "{'descr': [('a', '<f4')], 'fortran_order': False, 'shape': (1,), }",
+            "{'descr': '<f4', 'fortran_order': False, 'shape': (1,), } junk",
+        ];
+        for dict in cases {
+            let p = write(&dir, "bad.npy", &build_npy(dict, &[0u8; 4]));
+            assert!(
+                matches!(load_npy(&p), Err(Error::Decode { .. })),
+                "accepted {dict}"
+            );
+        }
+        let p = write(&dir, "magic.npy", b"\x93NUMPX\x01\x00\x00\x00");
+        assert!(load_npy(&p).is_err());
+        let err = load_npy(&dir.join("missing.npy")).unwrap_err();
+        assert!(err.to_string().contains("missing.npy"));
+    }
+}

@@ -1,0 +1,191 @@
+//! The 2.5D grid mesh shared by every refocus path (CPU reference, GPU mesh, GPU full-screen).
+//!
+//! Vertices sit on source pixel centres, plus a border ring half a pixel outside the image
+//! (depth copied from the nearest pixel) so the mesh covers the whole image [-0.5, W - 0.5]:
+//! without it the last row and column are lost to the fill rule. Vertex column i (0..=W+1) is
+//! at u = -0.5, 0, 1, .., W-1, W-0.5 and takes its depth from pixel clamp(i - 1, 0, W - 1).
+//! Cell (i, j) (0..=W, 0..=H) has corners v00 = (i, j), v10 = (i+1, j), v01 = (i, j+1),
+//! v11 = (i+1, j+1) and two triangles, tri1 = v00 v10 v11 (local a >= b) and
+//! tri2 = v00 v11 v01 (local a <= b), where (a, b) are the cell-local coordinates in [0, 1].
+
+use serde::{Deserialize, Serialize};
+
+/// When an edge between two valid depths is a discontinuity. An edge breaks if
+/// |za - zb| > tau_abs OR |za - zb| > tau_rel * min(za, zb) (the seed's two rules, either
+/// suffices). A triangle is kept only if its three corners are valid and no edge breaks.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct BreakRule {
+    pub tau_rel: f64,
+    /// Metres; `f64::INFINITY` disables the absolute rule.
+    pub tau_abs: f64,
+}
+
+impl Default for BreakRule {
+    /// tau_rel 0.05 (a 5 % jump: 25 cm at 5 m, several times Kinect-class noise) and
+    /// tau_abs 0.2 m (the top of the seed's range, so it only bites beyond 4 m).
+    fn default() -> Self {
+        BreakRule { tau_rel: 0.05, tau_abs: 0.2 }
+    }
+}
+
+impl BreakRule {
+    pub fn validate(&self) -> crate::Result<()> {
+        if !(self.tau_rel >= 0.0) || self.tau_rel.is_nan() {
+            return Err(crate::Error::param("tau-rel", format!("{} must be >= 0", self.tau_rel)));
+        }
+        if !(self.tau_abs >= 0.0) {
+            return Err(crate::Error::param("tau-abs", format!("{} must be >= 0", self.tau_abs)));
+        }
+        Ok(())
+    }
+
+    /// True if the edge between two valid depths is continuous (kept).
+    #[inline]
+    pub fn continuous(&self, za: f64, zb: f64) -> bool {
+        let d = (za - zb).abs();
+        !(d > self.tau_abs || d > self.tau_rel * za.min(zb))
+    }
+}
+
+/// A depth is valid when finite and positive (0, NaN, +-Inf and negatives are holes).
+#[inline]
+pub fn valid_depth(z: f32) -> bool {
+    z.is_finite() && z > 0.0
+}
+
+/// Grid geometry for a W x H source.
+#[derive(Debug, Clone, Copy)]
+pub struct Grid {
+    pub width: u32,
+    pub height: u32,
+}
+
+pub const TRI1: u8 = 1;
+pub const TRI2: u8 = 2;
+
+impl Grid {
+    /// Source coordinate of vertex column (or row) `i` along an axis of `n` pixels.
+    #[inline]
+    pub fn vertex_pos(i: i64, n: u32) -> f64 {
+        if i <= 0 {
+            -0.5
+        } else if i > n as i64 {
+            n as f64 - 0.5
+        } else {
+            (i - 1) as f64
+        }
+    }
+
+    /// Pixel whose depth vertex `i` carries.
+    #[inline]
+    pub fn vertex_pixel(i: i64, n: u32) -> usize {
+        (i - 1).clamp(0, n as i64 - 1) as usize
+    }
+
+    pub fn cells_x(&self) -> usize {
+        self.width as usize + 1
+    }
+    pub fn cells_y(&self) -> usize {
+        self.height as usize + 1
+    }
+
+    /// Depth at vertex (i, j).
+    #[inline]
+    pub fn vertex_depth(&self, depth: &[f32], i: i64, j: i64) -> f32 {
+        depth[Self::vertex_pixel(j, self.height) * self.width as usize + Self::vertex_pixel(i, self.width)]
+    }
+
+    /// Per cell, bit TRI1 / TRI2 set where that triangle is kept. Row-major, cells_x wide.
+    pub fn keep_mask(&self, depth: &[f32], rule: &BreakRule) -> Vec<u8> {
+        let (cx, cy) = (self.cells_x(), self.cells_y());
+        let mut out = vec![0u8; cx * cy];
+        for j in 0..cy as i64 {
+            for i in 0..cx as i64 {
+                let z00 = self.vertex_depth(depth, i, j);
+                let z10 = self.vertex_depth(depth, i + 1, j);
+                let z01 = self.vertex_depth(depth, i, j + 1);
+                let z11 = self.vertex_depth(depth, i + 1, j + 1);
+                let (v00, v10, v01, v11) = (valid_depth(z00), valid_depth(z10), valid_depth(z01), valid_depth(z11));
+                let (z00, z10, z01, z11) = (z00 as f64, z10 as f64, z01 as f64, z11 as f64);
+                let diag = v00 && v11 && rule.continuous(z00, z11);
+                let mut bits = 0;
+                if diag && v10 && rule.continuous(z00, z10) && rule.continuous(z10, z11) {
+                    bits |= TRI1;
+                }
+                if diag && v01 && rule.continuous(z11, z01) && rule.continuous(z00, z01) {
+                    bits |= TRI2;
+                }
+                out[j as usize * cx + i as usize] = bits;
+            }
+        }
+        out
+    }
+
+    /// Kept triangles as codes `(cell_index << 1) | (tri2 ? 1 : 0)`, for the mesh path.
+    pub fn kept_triangles(&self, keep: &[u8]) -> Vec<u32> {
+        let mut out = Vec::with_capacity(keep.len());
+        for (cell, &bits) in keep.iter().enumerate() {
+            if bits & TRI1 != 0 {
+                out.push((cell as u32) << 1);
+            }
+            if bits & TRI2 != 0 {
+                out.push(((cell as u32) << 1) | 1);
+            }
+        }
+        out
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn border_ring_spans_the_whole_image() {
+        assert_eq!(Grid::vertex_pos(0, 4), -0.5);
+        assert_eq!(Grid::vertex_pos(1, 4), 0.0);
+        assert_eq!(Grid::vertex_pos(4, 4), 3.0);
+        assert_eq!(Grid::vertex_pos(5, 4), 3.5);
+        assert_eq!(Grid::vertex_pixel(0, 4), 0);
+        assert_eq!(Grid::vertex_pixel(5, 4), 3);
+        // A 1-pixel axis still forms two half cells around its pixel.
+        assert_eq!([Grid::vertex_pos(0, 1), Grid::vertex_pos(1, 1), Grid::vertex_pos(2, 1)], [-0.5, 0.0, 0.5]);
+    }
+
+    #[test]
+    fn break_rule_uses_either_threshold() {
+        let r = BreakRule { tau_rel: 0.05, tau_abs: 0.2 };
+        assert!(r.continuous(1.0, 1.04));
+        assert!(!r.continuous(1.0, 1.06)); // relative
+        assert!(r.continuous(10.0, 10.19));
+        assert!(!r.continuous(10.0, 10.21)); // absolute (relative alone would keep 2.1 %)
+        let inf = BreakRule { tau_rel: 0.05, tau_abs: f64::INFINITY };
+        assert!(inf.continuous(10.0, 10.4));
+    }
+
+    #[test]
+    fn invalid_corner_drops_exactly_the_triangles_touching_it() {
+        // 3x3 plane with a hole in the centre pixel.
+        let mut depth = vec![2.0f32; 9];
+        depth[4] = f32::NAN;
+        let g = Grid { width: 3, height: 3 };
+        let keep = g.keep_mask(&depth, &BreakRule::default());
+        // Vertex (2, 2) carries pixel (1, 1); it is a corner of cells (1..=2, 1..=2).
+        for j in 0..4 {
+            for i in 0..4 {
+                let bits = keep[j * 4 + i];
+                let touches = (1..=2).contains(&i) && (1..=2).contains(&j);
+                if !touches {
+                    assert_eq!(bits, TRI1 | TRI2, "cell {i},{j}");
+                }
+            }
+        }
+        // The hole is v11 of cell (1,1), v01 of (2,1), v10 of (1,2) and v00 of (2,2); only the
+        // triangle of each cell that avoids that corner survives.
+        assert_eq!(keep[4 + 1], 0);
+        assert_eq!(keep[4 + 2], TRI1);
+        assert_eq!(keep[2 * 4 + 1], TRI2);
+        assert_eq!(keep[2 * 4 + 2], 0);
+        assert_eq!(g.kept_triangles(&keep).len(), 2 * 16 - 6);
+    }
+}

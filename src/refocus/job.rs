@@ -1,0 +1,220 @@
+//! A refocus job: which targets to render (focal list or zoom scales, output size, principal
+//! point), where to write what, and the manifest describing it.
+
+use super::{OutputSet, RefocusOutput};
+use crate::camera::{Intrinsics, PinholeCamera};
+use crate::error::{Error, Result};
+use crate::io;
+use serde::Serialize;
+use std::path::{Path, PathBuf};
+
+/// File format of the colour output.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Default)]
+#[serde(rename_all = "lowercase")]
+pub enum RgbFormat {
+    #[default]
+    Png,
+    Jpeg,
+    Exr,
+}
+
+impl RgbFormat {
+    pub fn extension(self) -> &'static str {
+        match self {
+            RgbFormat::Png => "png",
+            RgbFormat::Jpeg => "jpg",
+            RgbFormat::Exr => "exr",
+        }
+    }
+}
+
+/// File formats of the metric depth output (either or both).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+pub struct DepthFormats {
+    pub exr: bool,
+    pub npy: bool,
+}
+
+impl Default for DepthFormats {
+    fn default() -> Self {
+        DepthFormats { exr: true, npy: false }
+    }
+}
+
+/// How target cameras are derived from the source.
+#[derive(Debug, Clone, PartialEq)]
+pub struct TargetSpec {
+    /// Focal scales s: fx' = s fx, fy' = s fy.
+    pub scales: Vec<f64>,
+    /// Output size; None keeps the source size.
+    pub size: Option<(u32, u32)>,
+    /// Output principal point; None keeps the source's offset from the image centre, i.e.
+    /// cx' = cx + (W' - W) / 2 (= cx at the same size).
+    pub principal: Option<(f64, f64)>,
+}
+
+impl TargetSpec {
+    /// Scales from absolute target focal lengths fx' (fy' follows with the source aspect).
+    pub fn scales_from_focal_list(source: &Intrinsics, fx_list: &[f64]) -> Vec<f64> {
+        fx_list.iter().map(|f| f / source.fx).collect()
+    }
+
+    pub fn targets(&self, source: &PinholeCamera) -> Result<Vec<PinholeCamera>> {
+        if self.scales.is_empty() {
+            return Err(Error::param("scales", "no focal scale given"));
+        }
+        let (w, h) = self.size.unwrap_or((source.width, source.height));
+        let (cx, cy) = self.principal.unwrap_or((
+            source.k.cx + (w as f64 - source.width as f64) / 2.0,
+            source.k.cy + (h as f64 - source.height as f64) / 2.0,
+        ));
+        self.scales
+            .iter()
+            .map(|&s| {
+                if !(s.is_finite() && s > 0.0) {
+                    return Err(Error::param("focal scale", format!("{s} must be finite and > 0")));
+                }
+                let cam = PinholeCamera {
+                    k: Intrinsics { fx: source.k.fx * s, fy: source.k.fy * s, cx, cy },
+                    width: w,
+                    height: h,
+                };
+                cam.validate("target camera")?;
+                Ok(cam)
+            })
+            .collect()
+    }
+}
+
+/// One manifest entry: a target and the files written for it.
+#[derive(Debug, Clone, Serialize)]
+pub struct ManifestEntry {
+    pub scale: f64,
+    pub intrinsics: Intrinsics,
+    pub width: u32,
+    pub height: u32,
+    pub rgb: Option<String>,
+    pub depth_exr: Option<String>,
+    pub depth_npy: Option<String>,
+    pub mask: Option<String>,
+    /// Fraction of output pixels with mask = 1 (when a mask or depth was produced).
+    pub coverage: Option<f64>,
+    pub render_ms: f64,
+    pub readback_ms: f64,
+    pub write_ms: f64,
+}
+
+/// What the output files hold, repeated in every manifest.
+pub const MANIFEST_NOTES: &str = "rgb: 8-bit sRGB as sampled from the source (no hole filling, 0 where invalid); \
+depth: view-space Z in metres (distance along the optical axis), float32, 0 where invalid; \
+mask: 255 where a kept triangle covers the pixel centre, 0 elsewhere; rows top-down; \
+K' follows OpenCV: pixel (u, v) has its centre at (u, v).";
+
+/// The manifest written as `manifest.json` beside the outputs.
+#[derive(Debug, Clone, Serialize)]
+pub struct Manifest {
+    pub tool: String,
+    pub source: PinholeCamera,
+    pub method: super::Method,
+    pub break_rule: super::BreakRule,
+    pub conventions: crate::convention::Conventions,
+    pub renderer: String,
+    /// What the files hold: depth is view-space Z in metres with 0 = invalid; mask 255 = valid.
+    pub notes: String,
+    pub outputs: Vec<ManifestEntry>,
+}
+
+fn scale_tag(scale: f64) -> String {
+    // 0.5 -> "s0.5", 1 -> "s1", 1.25 -> "s1.25": short, sortable enough, unambiguous.
+    format!("s{}", format!("{scale:.6}").trim_end_matches('0').trim_end_matches('.'))
+}
+
+/// Write the requested files of one output under `dir` (atomic: temporary name, then rename).
+pub fn write_output(
+    dir: &Path,
+    scale: f64,
+    out: &RefocusOutput,
+    outputs: &OutputSet,
+    rgb_format: RgbFormat,
+    depth_formats: DepthFormats,
+) -> Result<ManifestEntry> {
+    let t0 = std::time::Instant::now();
+    let tag = scale_tag(scale);
+    let name = |suffix: &str| -> (PathBuf, String) {
+        let file = format!("{tag}_{suffix}");
+        (dir.join(&file), file)
+    };
+    let mut entry = ManifestEntry {
+        scale,
+        intrinsics: out.camera.k,
+        width: out.camera.width,
+        height: out.camera.height,
+        rgb: None,
+        depth_exr: None,
+        depth_npy: None,
+        mask: None,
+        coverage: None,
+        render_ms: out.render.wall_ms,
+        readback_ms: out.readback_ms,
+        write_ms: 0.0,
+    };
+    if let (true, Some(rgb)) = (outputs.rgb, &out.rgb) {
+        let (path, file) = name(&format!("rgb.{}", rgb_format.extension()));
+        io::save_rgb(&path, rgb)?;
+        entry.rgb = Some(file);
+    }
+    if let (true, Some(depth)) = (outputs.depth, &out.depth) {
+        if depth_formats.exr {
+            let (path, file) = name("depth.exr");
+            io::save_depth_exr(&path, depth)?;
+            entry.depth_exr = Some(file);
+        }
+        if depth_formats.npy {
+            let (path, file) = name("depth.npy");
+            io::save_depth_npy(&path, depth)?;
+            entry.depth_npy = Some(file);
+        }
+        let valid = depth.data.iter().filter(|z| **z > 0.0).count();
+        entry.coverage = Some(valid as f64 / depth.data.len() as f64);
+    }
+    if let (true, Some(mask)) = (outputs.mask, &out.mask) {
+        let (path, file) = name("mask.png");
+        io::save_mask_png(&path, mask)?;
+        entry.mask = Some(file);
+        let valid = mask.data.iter().filter(|m| **m != 0).count();
+        entry.coverage = Some(valid as f64 / mask.data.len() as f64);
+    }
+    entry.write_ms = t0.elapsed().as_secs_f64() * 1e3;
+    Ok(entry)
+}
+
+/// Write `manifest.json` atomically.
+pub fn write_manifest(dir: &Path, manifest: &Manifest) -> Result<PathBuf> {
+    let path = dir.join("manifest.json");
+    let text = serde_json::to_string_pretty(manifest)
+        .map_err(|e| Error::encode(&path, e.to_string()))?;
+    io::atomic_write(&path, |w| {
+        use std::io::Write;
+        w.write_all(text.as_bytes()).map_err(|e| Error::io(&path, e))
+    })?;
+    Ok(path)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn targets_keep_the_principal_point_offset_when_the_size_changes() {
+        let src = PinholeCamera { k: Intrinsics { fx: 500.0, fy: 480.0, cx: 319.5, cy: 239.5 }, width: 640, height: 480 };
+        let spec = TargetSpec { scales: vec![0.5, 2.0], size: Some((1280, 720)), principal: None };
+        let t = spec.targets(&src).unwrap();
+        assert_eq!(t[0].k, Intrinsics { fx: 250.0, fy: 240.0, cx: 639.5, cy: 359.5 });
+        assert_eq!(t[1].k.fx, 1000.0);
+        let bad = TargetSpec { scales: vec![f64::NAN], size: None, principal: None };
+        assert!(bad.targets(&src).unwrap_err().to_string().contains("focal scale"));
+        assert_eq!(scale_tag(0.5), "s0.5");
+        assert_eq!(scale_tag(1.0), "s1");
+        assert_eq!(TargetSpec::scales_from_focal_list(&src.k, &[250.0]), vec![0.5]);
+    }
+}

@@ -1,0 +1,122 @@
+//! refocus: one RGB image + metric depth + intrinsics -> RGB, metric depth and validity mask at
+//! other focal lengths, same pose. No hole filling: what the source did not see stays invalid.
+//!
+//! - [`grid`]: the 2.5D grid mesh and its break rule, shared by every path.
+//! - [`render`]: the GPU paths, a mesh rasterised into an MRT framebuffer and a full-screen
+//!   pass that evaluates the same triangles analytically (same pose only).
+//! - [`reference`]: the float64 CPU twin both are tested against.
+//! - [`job`]: targets from focal lists or zoom scales, file outputs and the manifest.
+
+mod grid;
+pub mod job;
+pub mod reference;
+mod render;
+
+pub use grid::{valid_depth, BreakRule, Grid};
+pub use render::{RefocusOutput, Refocuser};
+
+use crate::camera::{Intrinsics, PinholeCamera, MAX_IMAGE_SIDE};
+use crate::error::{Error, Result};
+use crate::io::{DepthMap, RgbImage};
+use serde::{Deserialize, Serialize};
+
+/// A validated refocus input: colour and depth of the same size, and the source intrinsics.
+pub struct RefocusSource {
+    pub rgb: RgbImage,
+    pub depth: DepthMap,
+    pub k: Intrinsics,
+}
+
+impl RefocusSource {
+    pub fn new(rgb: RgbImage, depth: DepthMap, k: Intrinsics) -> Result<Self> {
+        k.validate("source intrinsics")?;
+        if (rgb.width, rgb.height) != (depth.width, depth.height) {
+            return Err(Error::SizeMismatch {
+                message: format!(
+                    "colour is {}x{} but depth is {}x{}; they must be pixel-aligned",
+                    rgb.width, rgb.height, depth.width, depth.height
+                ),
+            });
+        }
+        if rgb.width == 0 || rgb.height == 0 || rgb.width > MAX_IMAGE_SIDE || rgb.height > MAX_IMAGE_SIDE {
+            return Err(Error::param(
+                "source size",
+                format!("{}x{} outside 1..={MAX_IMAGE_SIDE}", rgb.width, rgb.height),
+            ));
+        }
+        Ok(RefocusSource { rgb, depth, k })
+    }
+
+    pub fn camera(&self) -> PinholeCamera {
+        PinholeCamera { k: self.k, width: self.rgb.width, height: self.rgb.height }
+    }
+
+    /// (min, max) of the valid depths, None when no pixel is valid.
+    pub fn depth_range(&self) -> Option<(f64, f64)> {
+        self.depth.data.iter().filter(|z| valid_depth(**z)).fold(None, |acc, &z| {
+            let z = z as f64;
+            Some(acc.map_or((z, z), |(lo, hi): (f64, f64)| (lo.min(z), hi.max(z))))
+        })
+    }
+}
+
+/// Source pixel coordinate seen by target pixel (x, y) under the same pose:
+/// u = cx + (x - cx') fx / fx' (and likewise v).
+pub fn source_point(src: &Intrinsics, dst: &Intrinsics, x: f64, y: f64) -> [f64; 2] {
+    [src.cx + (x - dst.cx) * (src.fx / dst.fx), src.cy + (y - dst.cy) * (src.fy / dst.fy)]
+}
+
+/// How the GPU renders a refocus.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize, Default)]
+#[serde(rename_all = "kebab-case")]
+pub enum Method {
+    /// Grid mesh rasterised into an MRT framebuffer with a depth test (any pose).
+    Mesh,
+    /// One full-screen pass evaluating the same triangles analytically (same pose, faster).
+    #[default]
+    Fullscreen,
+}
+
+impl std::str::FromStr for Method {
+    type Err = Error;
+    fn from_str(s: &str) -> Result<Self> {
+        match s {
+            "mesh" => Ok(Method::Mesh),
+            "fullscreen" | "fast" => Ok(Method::Fullscreen),
+            _ => Err(Error::param("method", format!("'{s}': expected mesh or fullscreen"))),
+        }
+    }
+}
+
+/// Which outputs to produce; nothing is allocated, read back or written for the others.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+pub struct OutputSet {
+    pub rgb: bool,
+    pub depth: bool,
+    pub mask: bool,
+}
+
+impl Default for OutputSet {
+    fn default() -> Self {
+        OutputSet { rgb: true, depth: true, mask: true }
+    }
+}
+
+impl OutputSet {
+    /// Parse "rgb,depth,mask" (any subset, at least one).
+    pub fn parse(list: &str) -> Result<Self> {
+        let mut out = OutputSet { rgb: false, depth: false, mask: false };
+        for item in list.split(',').map(str::trim).filter(|s| !s.is_empty()) {
+            match item {
+                "rgb" => out.rgb = true,
+                "depth" => out.depth = true,
+                "mask" => out.mask = true,
+                _ => return Err(Error::param("outputs", format!("'{item}': expected rgb, depth or mask"))),
+            }
+        }
+        if !(out.rgb || out.depth || out.mask) {
+            return Err(Error::param("outputs", "at least one of rgb, depth, mask"));
+        }
+        Ok(out)
+    }
+}

@@ -1,0 +1,299 @@
+//! GPU refocus: shared inputs (source colour, depth and the kept triangles) are uploaded once;
+//! each target renders into a framebuffer holding only the requested attachments.
+
+use super::grid::Grid;
+use super::{Method, OutputSet, RefocusSource};
+use crate::camera::{clip_from_view_opencv, PinholeCamera};
+use crate::convention::{Conventions, DepthPlanes, RowOrder};
+use crate::error::{Error, Result};
+use crate::gpu::{Attachment, Framebuffer, Gpu, GpuTimer, Program, Texture, TextureFormat, Timing, VertexArray};
+use crate::io::{DepthMap, Mask, RgbImage};
+use glow::HasContext;
+use std::time::Instant;
+
+const GRID_GLSL: &str = include_str!("../../shaders/common/refocus_grid.glsl");
+const FULLSCREEN_VERT: &str = include_str!("../../shaders/common/fullscreen.vert");
+const FULLSCREEN_FRAG: &str = include_str!("../../shaders/refocus/fullscreen.frag");
+const MESH_VERT: &str = include_str!("../../shaders/refocus/mesh.vert");
+const MESH_FRAG: &str = include_str!("../../shaders/refocus/mesh.frag");
+
+/// Width of the texture holding kept-triangle codes for vertex pulling.
+const TRI_TEX_WIDTH: u32 = 4096;
+/// How far (window pixels) the mesh path pushes each triangle out before the exact closed test
+/// in the fragment shader: above the rasteriser's vertex snapping (1/512 px at 8 subpixel bits)
+/// so pixel centres on an edge always reach that test.
+const EXPAND_PX: f32 = 1.0 / 32.0;
+
+const IDENTITY: [[f64; 4]; 4] = [[1.0, 0.0, 0.0, 0.0], [0.0, 1.0, 0.0, 0.0], [0.0, 0.0, 1.0, 0.0], [0.0, 0.0, 0.0, 1.0]];
+
+/// One refocused view. Images are top-down whatever the row-order convention.
+pub struct RefocusOutput {
+    pub camera: PinholeCamera,
+    pub rgb: Option<RgbImage>,
+    /// View-space Z in metres, 0 where invalid.
+    pub depth: Option<DepthMap>,
+    pub mask: Option<Mask>,
+    /// Draw time (GPU timer where meaningful; wall clock with glFinish always).
+    pub render: Timing,
+    /// Readback and conversion to top-down images.
+    pub readback_ms: f64,
+}
+
+enum Geometry {
+    Mesh { tris: Option<Texture>, count: usize },
+    Fullscreen { keep: Texture },
+}
+
+/// A source uploaded to the GPU, ready to render any number of targets.
+pub struct Refocuser {
+    gpu: Gpu,
+    conv: Conventions,
+    outputs: OutputSet,
+    source: PinholeCamera,
+    planes: DepthPlanes,
+    program: Program,
+    rgb: Option<Texture>,
+    depth: Texture,
+    geometry: Geometry,
+    vao: VertexArray,
+    framebuffer: Option<Framebuffer>,
+}
+
+impl Refocuser {
+    pub fn new(
+        gpu: &Gpu,
+        src: &RefocusSource,
+        rule: &super::BreakRule,
+        method: Method,
+        outputs: OutputSet,
+        conv: Conventions,
+    ) -> Result<Self> {
+        rule.validate()?;
+        let (w, h) = (src.rgb.width, src.rgb.height);
+        let max = gpu.max_image_side();
+        if w > max || h > max {
+            return Err(Error::param("source size", format!("{w}x{h} exceeds this GPU's limit of {max}")));
+        }
+        let grid = Grid { width: w, height: h };
+        let keep = grid.keep_mask(&src.depth.data, rule);
+        let defines = format!(
+            "{}#define WANT_RGB {}\n#define TRI_TEX_WIDTH {TRI_TEX_WIDTH}\n",
+            conv.glsl_defines(),
+            outputs.rgb as u8
+        );
+        let (program, geometry) = match method {
+            Method::Fullscreen => {
+                let frag = format!("{GRID_GLSL}\n{FULLSCREEN_FRAG}");
+                let program = Program::new(
+                    gpu,
+                    &defines,
+                    &[(glow::VERTEX_SHADER, "fullscreen.vert", FULLSCREEN_VERT), (glow::FRAGMENT_SHADER, "refocus/fullscreen.frag", &frag)],
+                )?;
+                let keep = Texture::new(gpu, grid.cells_x() as u32, grid.cells_y() as u32, TextureFormat::R8Ui, Some(&keep))?;
+                (program, Geometry::Fullscreen { keep })
+            }
+            Method::Mesh => {
+                let vert = format!("{GRID_GLSL}\n{MESH_VERT}");
+                let frag = format!("{GRID_GLSL}\n{MESH_FRAG}");
+                let program = Program::new(
+                    gpu,
+                    &defines,
+                    &[(glow::VERTEX_SHADER, "refocus/mesh.vert", &vert), (glow::FRAGMENT_SHADER, "refocus/mesh.frag", &frag)],
+                )?;
+                let codes = grid.kept_triangles(&keep);
+                let count = codes.len();
+                let tris = if count == 0 {
+                    None
+                } else {
+                    let rows = count.div_ceil(TRI_TEX_WIDTH as usize);
+                    if rows > max as usize || count.checked_mul(3).is_none_or(|v| v > i32::MAX as usize) {
+                        return Err(Error::param(
+                            "source size",
+                            format!("{count} triangles exceed the mesh path's limit; use the full-screen method"),
+                        ));
+                    }
+                    let mut padded = codes;
+                    padded.resize(rows * TRI_TEX_WIDTH as usize, 0);
+                    let bytes: Vec<u8> = padded.iter().flat_map(|c| c.to_ne_bytes()).collect();
+                    Some(Texture::new(gpu, TRI_TEX_WIDTH, rows as u32, TextureFormat::R32Ui, Some(&bytes))?)
+                };
+                (program, Geometry::Mesh { tris, count })
+            }
+        };
+        let rgb = if outputs.rgb {
+            let rgba: Vec<u8> = src.rgb.data.chunks_exact(3).flat_map(|p| [p[0], p[1], p[2], 255]).collect();
+            Some(Texture::new(gpu, w, h, TextureFormat::Rgba8, Some(&rgba))?)
+        } else {
+            None
+        };
+        let depth_bytes: Vec<u8> = src.depth.data.iter().flat_map(|z| z.to_ne_bytes()).collect();
+        let depth = Texture::new(gpu, w, h, TextureFormat::R32F, Some(&depth_bytes))?;
+        // Every kept vertex lies in [min, max] of the valid depths; the factor 2 leaves room for
+        // the expanded border of each triangle (which the vertex shader keeps within it).
+        let planes = match src.depth_range() {
+            Some((lo, hi)) => DepthPlanes { near: 0.25 * lo, far: 4.0 * hi },
+            None => DepthPlanes { near: 1.0, far: 2.0 },
+        };
+        Ok(Refocuser {
+            gpu: gpu.clone(),
+            conv,
+            outputs,
+            source: src.camera(),
+            planes,
+            program,
+            rgb,
+            depth,
+            geometry,
+            vao: VertexArray::new(gpu)?,
+            framebuffer: None,
+        })
+    }
+
+    /// Number of kept triangles (mesh path) for reports.
+    pub fn triangle_count(&self) -> Option<usize> {
+        match &self.geometry {
+            Geometry::Mesh { count, .. } => Some(*count),
+            Geometry::Fullscreen { .. } => None,
+        }
+    }
+
+    fn framebuffer(&mut self, w: u32, h: u32) -> Result<&Framebuffer> {
+        let reuse = matches!(&self.framebuffer, Some(f) if f.width == w && f.height == h);
+        if !reuse {
+            self.framebuffer = None; // free the old one before allocating
+            let o = self.outputs;
+            let slot = |want: bool, format| want.then_some(Attachment { format, clear: [0.0; 4] });
+            let attachments = [
+                slot(o.rgb, TextureFormat::Rgba8),
+                slot(o.depth, TextureFormat::R32F),
+                slot(o.mask, TextureFormat::R8),
+            ];
+            let with_depth = matches!(self.geometry, Geometry::Mesh { .. });
+            self.framebuffer = Some(Framebuffer::new(&self.gpu, w, h, &attachments, with_depth)?);
+        }
+        Ok(self.framebuffer.as_ref().expect("framebuffer allocated above"))
+    }
+
+    /// Render `target` (same pose as the source) and read back the requested outputs.
+    pub fn render(&mut self, target: &PinholeCamera) -> Result<RefocusOutput> {
+        target.validate("target camera")?;
+        let max = self.gpu.max_image_side();
+        if target.width > max || target.height > max {
+            return Err(Error::param(
+                "output size",
+                format!("{}x{} exceeds this GPU's limit of {max}", target.width, target.height),
+            ));
+        }
+        let conv = self.conv;
+        let clear_depth = conv.clear_depth() as f32;
+        self.framebuffer(target.width, target.height)?;
+        let gpu = self.gpu.clone();
+        let gl = gpu.gl();
+        let fb = self.framebuffer.as_ref().expect("framebuffer allocated above");
+        let p = &self.program;
+        let timer = GpuTimer::start(&gpu);
+        fb.bind_and_clear(clear_depth);
+        p.bind();
+        self.vao.bind();
+        if let Some(rgb) = &self.rgb {
+            rgb.bind(0);
+        }
+        self.depth.bind(1);
+        p.set_i32("u_src_rgb", 0);
+        p.set_i32("u_src_depth", 1);
+        p.set_i32("u_keep", 2);
+        p.set_i32("u_tris", 2);
+        p.set_ivec2("u_src_size", [self.source.width as i32, self.source.height as i32]);
+        let sk = &self.source.k;
+        let tk = &target.k;
+        // SAFETY: plain state setting on the current context.
+        unsafe {
+            gl.disable(glow::BLEND);
+            gl.disable(glow::CULL_FACE);
+            gl.disable(glow::STENCIL_TEST);
+        }
+        p.set_vec4("u_src_k", [sk.fx as f32, sk.fy as f32, sk.cx as f32, sk.cy as f32]);
+        match &self.geometry {
+            Geometry::Fullscreen { keep } => {
+                keep.bind(2);
+                p.set_vec2("u_dst_c", [tk.cx as f32, tk.cy as f32]);
+                p.set_vec2("u_ratio", [(sk.fx / tk.fx) as f32, (sk.fy / tk.fy) as f32]);
+                p.set_i32("u_dst_height", target.height as i32);
+                // SAFETY: one full-screen triangle; no depth buffer is attached.
+                unsafe {
+                    gl.disable(glow::DEPTH_TEST);
+                    gl.draw_arrays(glow::TRIANGLES, 0, 3);
+                }
+            }
+            Geometry::Mesh { tris, count } => {
+                let m = clip_from_view_opencv(target, &self.planes, &conv);
+                p.set_mat4_rows("u_clip_from_target", &m);
+                p.set_mat4_rows("u_target_from_source", &IDENTITY);
+                p.set_mat4_rows("u_source_from_target", &IDENTITY);
+                p.set_vec2("u_dst_size", [target.width as f32, target.height as f32]);
+                p.set_f32("u_expand_px", EXPAND_PX);
+                let depth_mode = match conv.ndc_depth {
+                    crate::convention::NdcDepthRange::MinusOneToOne => glow::NEGATIVE_ONE_TO_ONE,
+                    crate::convention::NdcDepthRange::ZeroToOne => glow::ZERO_TO_ONE,
+                };
+                gpu.clip_control(glow::LOWER_LEFT, depth_mode);
+                // SAFETY: depth state and a non-indexed draw of 3 vertices per kept triangle.
+                unsafe {
+                    gl.enable(glow::DEPTH_TEST);
+                    gl.depth_mask(true);
+                    gl.depth_range_f64(0.0, 1.0);
+                    gl.depth_func(if conv.reversed_z { glow::GREATER } else { glow::LESS });
+                    if let Some(t) = tris {
+                        t.bind(2);
+                        gl.draw_arrays(glow::TRIANGLES, 0, (*count * 3) as i32);
+                    }
+                }
+                // Leave the default clip control for whoever draws next.
+                gpu.clip_control(glow::LOWER_LEFT, glow::NEGATIVE_ONE_TO_ONE);
+            }
+        }
+        gpu.check("refocus draw")?;
+        let render = timer.stop();
+
+        let t0 = Instant::now();
+        let (w, h) = (target.width, target.height);
+        let flip = conv.row_order == RowOrder::BottomUp;
+        let mut outputs = (None, None, None);
+        if let Some(t) = &fb.colors[0] {
+            let rgba = top_down(t.read()?, w, h, 4, flip);
+            let rgb = rgba.chunks_exact(4).flat_map(|p| [p[0], p[1], p[2]]).collect();
+            outputs.0 = Some(RgbImage::new(w, h, rgb)?);
+        }
+        if let Some(t) = &fb.colors[1] {
+            let bytes = top_down(t.read()?, w, h, 4, flip);
+            let z = bytes.chunks_exact(4).map(|b| f32::from_ne_bytes([b[0], b[1], b[2], b[3]])).collect();
+            outputs.1 = Some(DepthMap::new(w, h, z)?);
+        }
+        if let Some(t) = &fb.colors[2] {
+            let m = top_down(t.read()?, w, h, 1, flip).into_iter().map(|v| (v >= 128) as u8).collect();
+            outputs.2 = Some(Mask::new(w, h, m)?);
+        }
+        fb.unbind();
+        Ok(RefocusOutput {
+            camera: *target,
+            rgb: outputs.0,
+            depth: outputs.1,
+            mask: outputs.2,
+            render,
+            readback_ms: t0.elapsed().as_secs_f64() * 1e3,
+        })
+    }
+}
+
+/// Rows in memory order -> top-down image rows.
+fn top_down(mut data: Vec<u8>, w: u32, h: u32, bytes_per_pixel: usize, flip: bool) -> Vec<u8> {
+    if flip {
+        let row = w as usize * bytes_per_pixel;
+        let h = h as usize;
+        for y in 0..h / 2 {
+            let (a, b) = data.split_at_mut((h - 1 - y) * row);
+            a[y * row..(y + 1) * row].swap_with_slice(&mut b[..row]);
+        }
+    }
+    data
+}

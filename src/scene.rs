@@ -1,0 +1,129 @@
+//! A built-in analytic RGB-D scene, ray traced in f64 on the CPU: the demo input and an exact
+//! ground truth for any pinhole camera (same pose, other intrinsics).
+//!
+//! Camera at the origin looking down +z (OpenCV view space). A textured back wall at z = 6,
+//! a floor at y = 1.2, a sphere and a tilted plate in front: depth discontinuities, slanted
+//! surfaces and texture at several frequencies.
+
+use crate::camera::PinholeCamera;
+use crate::io::{DepthMap, RgbImage};
+
+#[derive(Debug, Clone, Copy)]
+struct Hit {
+    t: f64,
+    material: u8,
+    p: [f64; 3],
+}
+
+/// Procedural texture, smooth enough that resampling error reflects geometry, not aliasing.
+fn shade(hit: &Hit) -> [f64; 3] {
+    let [x, y, z] = hit.p;
+    let stripes = |a: f64, f: f64| 0.5 + 0.5 * (a * f).sin();
+    match hit.material {
+        0 => [200.0 * stripes(x, 3.0) + 30.0, 120.0 * stripes(y, 5.0) + 60.0, 180.0 * stripes(x + y, 1.7) + 40.0],
+        1 => {
+            let checker = (((x * 2.0).floor() + (z * 2.0).floor()) as i64).rem_euclid(2) as f64;
+            [90.0 + 100.0 * checker * stripes(x, 11.0), 80.0 + 60.0 * stripes(z, 4.0), 70.0 + 40.0 * checker]
+        }
+        2 => [230.0 * stripes(y, 9.0) + 20.0, 60.0 + 80.0 * stripes(x, 13.0), 40.0 + 30.0 * stripes(z, 7.0)],
+        _ => [40.0 + 200.0 * stripes(x - y, 20.0), 200.0 * stripes(y, 2.0) + 40.0, 90.0],
+    }
+}
+
+fn trace(dir: [f64; 3]) -> Option<Hit> {
+    let mut best: Option<Hit> = None;
+    let mut take = |t: f64, material: u8| {
+        if t > 1e-9 && best.is_none_or(|b| t < b.t) {
+            best = Some(Hit { t, material, p: [dir[0] * t, dir[1] * t, dir[2] * t] });
+        }
+    };
+    // Back wall z = 6 (bounded so wide views see background: no hit -> invalid depth).
+    let t = 6.0 / dir[2];
+    let p = [dir[0] * t, dir[1] * t];
+    if p[0].abs() < 5.0 && p[1] > -3.5 && p[1] < 1.2 {
+        take(t, 0);
+    }
+    // Floor y = 1.2, z in (0.5, 6).
+    if dir[1] > 0.0 {
+        let t = 1.2 / dir[1];
+        let z = dir[2] * t;
+        if z > 0.5 && z < 6.0 && (dir[0] * t).abs() < 5.0 {
+            take(t, 1);
+        }
+    }
+    // Sphere centre (0.6, 0.2, 3.2), radius 0.7.
+    let c = [0.6, 0.2, 3.2];
+    let b = dir[0] * c[0] + dir[1] * c[1] + dir[2] * c[2];
+    let cc = c[0] * c[0] + c[1] * c[1] + c[2] * c[2] - 0.49;
+    let dd = dir[0] * dir[0] + dir[1] * dir[1] + dir[2] * dir[2];
+    let disc = b * b - dd * cc;
+    if disc >= 0.0 {
+        take((b - disc.sqrt()) / dd, 2);
+    }
+    // Tilted plate: plane through (-0.9, -0.1, 2.2) with normal (0.35, 0, -1), |x+0.9|<0.5, |y+0.1|<0.6.
+    let n = [0.35, 0.0, -1.0];
+    let q = [-0.9, -0.1, 2.2];
+    let den = n[0] * dir[0] + n[2] * dir[2];
+    if den.abs() > 1e-12 {
+        let t = (n[0] * q[0] + n[2] * q[2]) / den;
+        let p = [dir[0] * t, dir[1] * t];
+        if (p[0] - q[0]).abs() < 0.5 && (p[1] - q[1]).abs() < 0.6 {
+            take(t, 3);
+        }
+    }
+    best
+}
+
+/// Colour (rounded to 8 bits) and view-space Z of the scene seen by `cam`; 0 depth where no
+/// surface is hit.
+pub fn render(cam: &PinholeCamera) -> (RgbImage, DepthMap) {
+    let (w, h) = (cam.width as usize, cam.height as usize);
+    let mut rgb = vec![0u8; w * h * 3];
+    let mut depth = vec![0f32; w * h];
+    for y in 0..h {
+        for x in 0..w {
+            let dir = [(x as f64 - cam.k.cx) / cam.k.fx, (y as f64 - cam.k.cy) / cam.k.fy, 1.0];
+            if let Some(hit) = trace(dir) {
+                let o = y * w + x;
+                depth[o] = hit.p[2] as f32;
+                let c = shade(&hit);
+                for k in 0..3 {
+                    rgb[o * 3 + k] = c[k].round().clamp(0.0, 255.0) as u8;
+                }
+            }
+        }
+    }
+    (
+        RgbImage::new(cam.width, cam.height, rgb).expect("sizes match by construction"),
+        DepthMap::new(cam.width, cam.height, depth).expect("sizes match by construction"),
+    )
+}
+
+/// The demo camera: VGA-like intrinsics scaled to `width` x `height`.
+pub fn demo_camera(width: u32, height: u32) -> PinholeCamera {
+    let f = 525.0 * width as f64 / 640.0;
+    PinholeCamera {
+        k: crate::camera::Intrinsics { fx: f, fy: f, cx: (width as f64 - 1.0) / 2.0, cy: (height as f64 - 1.0) / 2.0 },
+        width,
+        height,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn scene_has_background_holes_and_a_depth_range() {
+        let cam = demo_camera(160, 120);
+        let (_, depth) = render(&cam);
+        let valid: Vec<f32> = depth.data.iter().copied().filter(|z| *z > 0.0).collect();
+        assert!(valid.len() > depth.data.len() / 2, "mostly covered");
+        let lo = valid.iter().copied().fold(f32::INFINITY, f32::min);
+        let hi = valid.iter().copied().fold(0.0, f32::max);
+        assert!(lo > 1.5 && lo < 3.0 && (hi - 6.0).abs() < 0.5, "{lo}..{hi}");
+        // Wall pixel at the image centre row, far left column: z = 6 exactly.
+        let (_, wide) = render(&PinholeCamera { k: crate::camera::Intrinsics { fx: 40.0, ..cam.k }, ..cam });
+        assert_eq!(wide.data[0], 0.0, "a wide view sees past the wall's edge");
+    }
+}

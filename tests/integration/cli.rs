@@ -1,0 +1,134 @@
+//! The binary end to end: a successful run writes exactly the requested files and a manifest;
+//! bad input exits non-zero with an error naming the file or parameter, without a panic and
+//! without leaving output files behind.
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+use viewsynth::io::{self, DepthMap, RgbImage};
+
+fn bin() -> Command {
+    Command::new(env!("CARGO_BIN_EXE_viewsynth"))
+}
+
+fn scratch(name: &str) -> PathBuf {
+    let d = std::env::temp_dir().join(format!("viewsynth-cli-{}-{name}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&d);
+    std::fs::create_dir_all(&d).unwrap();
+    d
+}
+
+/// A small valid input pair (PNG colour, NPY depth) in `dir`.
+fn inputs(dir: &Path, w: u32, h: u32) -> (PathBuf, PathBuf) {
+    let rgb: Vec<u8> = (0..w * h * 3).map(|i| (i % 251) as u8).collect();
+    let depth: Vec<f32> = (0..w * h).map(|i| 1.0 + 0.01 * (i % w) as f32).collect();
+    let (rp, dp) = (dir.join("rgb.png"), dir.join("depth.npy"));
+    io::save_rgb(&rp, &RgbImage::new(w, h, rgb).unwrap()).unwrap();
+    io::save_depth_npy(&dp, &DepthMap::new(w, h, depth).unwrap()).unwrap();
+    (rp, dp)
+}
+
+fn refocus(rgb: &Path, depth: &Path, out: &Path, extra: &[&str]) -> Output {
+    let mut c = bin();
+    c.args(["refocus", "--fx", "40", "--fy", "40", "--cx", "15.5", "--cy", "11.5", "--rgb"])
+        .arg(rgb)
+        .arg("--depth")
+        .arg(depth)
+        .arg("--out-dir")
+        .arg(out)
+        .args(extra);
+    c.output().expect("run viewsynth")
+}
+
+fn files_in(dir: &Path) -> Vec<String> {
+    let mut v: Vec<String> = std::fs::read_dir(dir)
+        .map(|r| r.filter_map(|e| e.ok()).map(|e| e.file_name().to_string_lossy().into_owned()).collect())
+        .unwrap_or_default();
+    v.sort();
+    v
+}
+
+#[test]
+fn refocus_writes_requested_files_and_a_manifest() {
+    let d = scratch("ok");
+    let (rgb, depth) = inputs(&d, 32, 24);
+    let out = d.join("out");
+    let o = refocus(&rgb, &depth, &out, &["--zoom-range", "0.5,2", "--depth-format", "exr,npy"]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let files = files_in(&out);
+    assert_eq!(
+        files,
+        [
+            "manifest.json", "s0.5_depth.exr", "s0.5_depth.npy", "s0.5_mask.png", "s0.5_rgb.png",
+            "s2_depth.exr", "s2_depth.npy", "s2_mask.png", "s2_rgb.png"
+        ]
+    );
+    let manifest: serde_json::Value = serde_json::from_slice(&std::fs::read(out.join("manifest.json")).unwrap()).unwrap();
+    assert_eq!(manifest["outputs"][1]["intrinsics"]["fx"], 80.0);
+    let z = io::load_depth(&out.join("s2_depth.npy"), &Default::default()).unwrap();
+    assert_eq!((z.width, z.height), (32, 24));
+
+    let only_depth = d.join("only-depth");
+    let o = refocus(&rgb, &depth, &only_depth, &["--zoom-range", "1", "--outputs", "depth"]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    assert_eq!(files_in(&only_depth), ["manifest.json", "s1_depth.exr"]);
+}
+
+fn assert_clean_failure(o: &Output, needle: &str, out: &Path) {
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(1), "stderr: {err}");
+    assert!(err.contains("error:") && err.contains(needle), "expected '{needle}' in: {err}");
+    assert!(!err.contains("panicked"), "{err}");
+    let left: Vec<String> = files_in(out).into_iter().filter(|f| !f.starts_with(".viewsynth-write-test")).collect();
+    assert!(left.is_empty(), "left behind: {left:?}");
+}
+
+#[test]
+fn bad_input_fails_cleanly() {
+    let d = scratch("bad");
+    let (rgb, depth) = inputs(&d, 32, 24);
+    let out = d.join("out");
+
+    let missing = d.join("nope.png");
+    assert_clean_failure(&refocus(&missing, &depth, &out, &[]), "nope.png", &out);
+
+    let small = scratch("bad-small");
+    let (_, depth_small) = inputs(&small, 16, 12);
+    assert_clean_failure(&refocus(&rgb, &depth_small, &out, &[]), "size mismatch", &out);
+
+    let empty = d.join("empty.npy");
+    std::fs::write(&empty, b"").unwrap();
+    assert_clean_failure(&refocus(&rgb, &empty, &out, &[]), "empty.npy", &out);
+
+    let corrupt = d.join("corrupt.png");
+    std::fs::write(&corrupt, b"\x89PNG\r\n\x1a\nthis is not a png").unwrap();
+    assert_clean_failure(&refocus(&corrupt, &depth, &out, &[]), "corrupt.png", &out);
+
+    assert_clean_failure(&refocus(&rgb, &depth, &out, &["--width-out", "16385", "--height-out", "10"]), "width", &out);
+    assert_clean_failure(&refocus(&rgb, &depth, &out, &["--zoom-range", "0"]), "focal scale", &out);
+    assert_clean_failure(&refocus(&rgb, &depth, &out, &["--tau-rel", "-1"]), "tau-rel", &out);
+    assert_clean_failure(&refocus(&rgb, &depth, &out, &["--outputs", "rgb,normals"]), "outputs", &out);
+
+    // Non-finite and non-positive intrinsics.
+    for (flag, value, needle) in [("--fx", "0", "fx"), ("--fy", "-3", "fy"), ("--cx", "nan", "cx"), ("--fx", "inf", "fx")] {
+        let mut c = bin();
+        let mut args = vec!["refocus", "--fx", "40", "--fy", "40", "--cx", "15.5", "--cy", "11.5"];
+        let pos = args.iter().position(|a| *a == flag).unwrap();
+        args[pos + 1] = value;
+        let o = c.args(&args).arg("--rgb").arg(&rgb).arg("--depth").arg(&depth).arg("--out-dir").arg(&out).output().unwrap();
+        assert_clean_failure(&o, needle, &out);
+    }
+
+    // Unwritable output directory: a path below a regular file (fails for root too).
+    let blocker = d.join("blocker");
+    std::fs::write(&blocker, b"x").unwrap();
+    let o = refocus(&rgb, &depth, &blocker.join("out"), &[]);
+    assert_clean_failure(&o, "blocker", &blocker.join("out"));
+}
+
+#[test]
+fn info_reports_the_renderer() {
+    let o = bin().args(["info"]).output().unwrap();
+    let text = String::from_utf8_lossy(&o.stdout);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    assert!(text.contains("renderer:") && text.contains("GL version:"), "{text}");
+}

@@ -1,0 +1,104 @@
+//! Shared helpers: GPU context, real data frames, GPU-vs-reference comparison.
+
+use std::path::PathBuf;
+use viewsynth::camera::{Intrinsics, PinholeCamera};
+use viewsynth::gpu::{DeviceChoice, Gpu};
+use viewsynth::io::{self, DepthDecode};
+use viewsynth::metrics::{self, Agreement};
+use viewsynth::refocus::reference::{refocus_reference, ReferenceImage};
+use viewsynth::refocus::{BreakRule, RefocusOutput, RefocusSource};
+
+pub fn gpu() -> Gpu {
+    Gpu::new(DeviceChoice::Auto).unwrap_or_else(|e| {
+        panic!("GPU tests need EGL + OpenGL 4.5 core (run ci/install-deps.sh for Mesa llvmpipe): {e}")
+    })
+}
+
+/// `../shared/data` next to the repository, or $VIEWSYNTH_DATA_DIR.
+pub fn data_dir() -> PathBuf {
+    let dir = std::env::var_os("VIEWSYNTH_DATA_DIR")
+        .map(PathBuf::from)
+        .unwrap_or_else(|| PathBuf::from(concat!(env!("CARGO_MANIFEST_DIR"), "/../shared/data")));
+    assert!(dir.is_dir(), "test data missing: {} (set VIEWSYNTH_DATA_DIR)", dir.display());
+    dir
+}
+
+/// The real RGB-D frames of ../shared/data with the intrinsics its README gives.
+pub fn real_frame(name: &str) -> RefocusSource {
+    let d = data_dir().join("rgbd_open3d_testdata");
+    let (color, depth, decode, k) = match name {
+        "TUM" => (
+            "TUM_color.png",
+            "TUM_depth.png",
+            DepthDecode { scale: Some(5000.0), ..Default::default() },
+            Intrinsics { fx: 525.0, fy: 525.0, cx: 319.5, cy: 239.5 },
+        ),
+        "SUN" => (
+            "SUN_color.jpg",
+            "SUN_depth.png",
+            DepthDecode { scale: Some(1000.0), sun_rgbd_bit_rotate: true, ..Default::default() },
+            Intrinsics { fx: 570.0, fy: 570.0, cx: 320.0, cy: 240.0 },
+        ),
+        "NYU" => (
+            "NYU_color.ppm",
+            "NYU_depth.pgm",
+            // Raw Kinect values, little-endian despite the PGM header; converted below.
+            DepthDecode { scale: Some(1.0), swap_bytes: true, ..Default::default() },
+            Intrinsics { fx: 518.9, fy: 519.5, cx: 325.6, cy: 253.7 },
+        ),
+        _ => panic!("unknown frame {name}"),
+    };
+    let rgb = io::load_rgb(&d.join(color)).expect("colour loads");
+    let mut depth = io::load_depth(&d.join(depth), &decode).expect("depth loads");
+    if name == "NYU" {
+        // The data README: raw 2047 = invalid, metres = 351.3 / (1092.5 - raw).
+        for z in depth.data.iter_mut() {
+            *z = if *z >= 2047.0 || *z <= 0.0 { 0.0 } else { (351.3 / (1092.5 - *z as f64)) as f32 };
+        }
+    }
+    RefocusSource::new(rgb, depth, k).expect("valid frame")
+}
+
+pub fn synthetic(width: u32, height: u32) -> RefocusSource {
+    let cam = viewsynth::scene::demo_camera(width, height);
+    let (rgb, depth) = viewsynth::scene::render(&cam);
+    RefocusSource::new(rgb, depth, cam.k).unwrap()
+}
+
+pub fn mask_bools(out: &RefocusOutput) -> Vec<bool> {
+    out.mask.as_ref().expect("mask requested").data.iter().map(|v| *v != 0).collect()
+}
+
+pub fn compare(out: &RefocusOutput, reference: &ReferenceImage) -> Agreement {
+    metrics::agreement(
+        out.rgb.as_ref().map(|i| i.data.as_slice()),
+        out.depth.as_ref().map(|d| d.data.as_slice()),
+        &mask_bools(out),
+        &reference.rgb,
+        &reference.depth,
+        &reference.mask,
+    )
+}
+
+pub fn reference(src: &RefocusSource, target: &PinholeCamera) -> ReferenceImage {
+    refocus_reference(src, &BreakRule::default(), target)
+}
+
+/// On a failed comparison, write the GPU and reference masks and colour next to each other so
+/// the difference can be looked at (target/test-output/<tag>_{gpu,ref}_{rgb,mask}.png).
+pub fn dump_on_failure(tag: &str, out: &RefocusOutput, reference: &ReferenceImage) -> PathBuf {
+    let dir = PathBuf::from(concat!(env!("CARGO_MANIFEST_DIR"), "/target/test-output"));
+    let _ = std::fs::create_dir_all(&dir);
+    let (w, h) = (reference.width, reference.height);
+    if let Some(rgb) = &out.rgb {
+        let _ = io::save_rgb(&dir.join(format!("{tag}_gpu_rgb.png")), rgb);
+    }
+    if let Some(m) = &out.mask {
+        let _ = io::save_mask_png(&dir.join(format!("{tag}_gpu_mask.png")), m);
+    }
+    let ref_rgb: Vec<u8> = reference.rgb.iter().flat_map(|c| c.map(metrics::quantize_u8)).collect();
+    let _ = io::save_rgb(&dir.join(format!("{tag}_ref_rgb.png")), &io::RgbImage::new(w, h, ref_rgb).unwrap());
+    let ref_mask: Vec<u8> = reference.mask.iter().map(|m| *m as u8).collect();
+    let _ = io::save_mask_png(&dir.join(format!("{tag}_ref_mask.png")), &io::Mask::new(w, h, ref_mask).unwrap());
+    dir
+}

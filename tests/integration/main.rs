@@ -1,0 +1,9 @@
+//! Integration tests: one binary. GPU tests need EGL with GL 4.5 (Mesa llvmpipe in CI); a
+//! missing EGL fails them with the library's error, never a skip.
+
+mod cli;
+mod common;
+mod gpu_context;
+mod refocus_accuracy;
+mod refocus_conventions;
+mod refocus_edge_cases;
