@@ -70,6 +70,6 @@ pub(crate) fn decode_image(path: &Path, format: Option<ImageFormat>) -> Result<D
 }
 
 /// Every `image` failure after the file opened is a content problem (truncation included).
-pub(crate) fn image_error(path: &Path, e: image::ImageError) -> Error {
+fn image_error(path: &Path, e: image::ImageError) -> Error {
     Error::decode(path, e.to_string())
 }

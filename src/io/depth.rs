@@ -193,7 +193,7 @@ fn to_metres(path: &Path, raw: RawDepth, decode: &DepthDecode) -> Result<DepthMa
         RawSamples::U8(v) => {
             let s = need_scale(
                 "8-bit",
-                "8-bit depth is unusual; e.g. 4 for Middlebury 2003 disparity",
+                "unusual for depth; e.g. 4 for Middlebury 2003 disparity",
             )?;
             v.into_iter().map(|d| int_to_metres(d.into(), s)).collect()
         }
