@@ -29,6 +29,19 @@ pub fn quantize_u8(v: f64) -> u8 {
     v.round().clamp(0.0, 255.0) as u8
 }
 
+/// Half-level window around which rounding is a tie. Bilinear weights of 0.5 (focal scales
+/// 0.5, 0.75, 2, ...) put many exact values on k + 0.5, where f32 and f64 arithmetic land on
+/// either side; f32 sample positions (error <= ~2e-5 px on a 16k image) times the steepest
+/// possible gradient (255 levels/px) stay within this window, so either neighbour is correct.
+pub const ROUNDING_TIE_WINDOW: f64 = 5e-3;
+
+/// Level difference between an 8-bit value and the exact value it should be a rounding of:
+/// 0 when it is the nearest integer, or either neighbour of a tie.
+pub fn quantization_error(stored: u8, exact: f64) -> u32 {
+    // Distance to the nearest acceptable value, in whole levels.
+    ((stored as f64 - exact).abs() - 0.5 - ROUNDING_TIE_WINDOW).max(0.0).ceil() as u32
+}
+
 /// GPU output against a reference, over the pixels both mark valid.
 #[derive(Debug, Clone, Copy, Default, serde::Serialize)]
 pub struct Agreement {
@@ -37,7 +50,8 @@ pub struct Agreement {
     /// Pixels valid in exactly one.
     pub mask_mismatch: usize,
     pub mask_iou: f64,
-    /// Colour PSNR (dB) on the common pixels, reference quantised to 8 bits first.
+    /// Colour PSNR (dB) on the common pixels, against the reference rounded to 8 bits (either
+    /// neighbour of an exact tie counts as right: [`quantization_error`]).
     pub psnr_db: f64,
     pub max_abs_depth: f64,
     pub max_rel_depth: f64,
@@ -68,7 +82,7 @@ pub fn agreement(
         a.common += 1;
         if let Some(rgb) = rgb {
             for c in 0..3 {
-                let d = (rgb[i * 3 + c] as i32 - quantize_u8(ref_rgb[i][c]) as i32).unsigned_abs();
+                let d = quantization_error(rgb[i * 3 + c], ref_rgb[i][c]);
                 sq += (d * d) as f64;
                 a.max_color_diff = a.max_color_diff.max(d as u8);
             }
@@ -93,6 +107,15 @@ mod tests {
         assert_eq!(psnr_from_mse(0.0), f64::INFINITY);
         assert_eq!(mask_iou(&[true, true, false, false], &[true, false, true, false]), 1.0 / 3.0);
         assert_eq!(mask_iou(&[false], &[false]), 1.0);
+    }
+
+    #[test]
+    fn ties_accept_either_neighbour_and_nothing_else() {
+        assert_eq!(quantization_error(204, 204.5), 0);
+        assert_eq!(quantization_error(205, 204.4999999), 0);
+        assert_eq!(quantization_error(205, 204.4), 1);
+        assert_eq!(quantization_error(203, 204.5), 1);
+        assert_eq!(quantization_error(0, 3.0), 3);
     }
 
     #[test]

@@ -20,33 +20,3 @@ float vertex_depth(ivec2 c) {
     return texelFetch(u_src_depth, clamp(c - 1, ivec2(0), u_src_size - 1), 0).r;
 }
 
-// Cell-local coordinates (a, b) of source point uv in cell c.
-vec2 cell_local(ivec2 c, vec2 uv) {
-    vec2 p0 = vec2(vertex_pos(c.x, u_src_size.x), vertex_pos(c.y, u_src_size.y));
-    vec2 p1 = vec2(vertex_pos(c.x + 1, u_src_size.x), vertex_pos(c.y + 1, u_src_size.y));
-    return (uv - p0) / (p1 - p0);
-}
-
-// Is local point ab inside triangle `tri` (0 = tri1, 1 = tri2), closed, within CELL_EPS?
-bool inside_tri(vec2 ab, int tri) {
-    if (tri == 0) {
-        return ab.y >= -CELL_EPS && ab.x <= 1.0 + CELL_EPS && ab.x >= ab.y - CELL_EPS;
-    }
-    return ab.x >= -CELL_EPS && ab.y <= 1.0 + CELL_EPS && ab.y >= ab.x - CELL_EPS;
-}
-
-// Bilinear source colour at continuous pixel coordinate uv (pixel centres at integers), in f32
-// with texelFetch: fixed-function filtering has only ~8 bits of weight precision.
-vec3 bilinear_rgb(vec2 uv) {
-    vec2 f0 = floor(uv);
-    vec2 t = uv - f0;
-    ivec2 i0 = ivec2(f0);
-    ivec2 hi = u_src_size - 1;
-    vec3 c00 = texelFetch(u_src_rgb, clamp(i0, ivec2(0), hi), 0).rgb;
-    vec3 c10 = texelFetch(u_src_rgb, clamp(i0 + ivec2(1, 0), ivec2(0), hi), 0).rgb;
-    vec3 c01 = texelFetch(u_src_rgb, clamp(i0 + ivec2(0, 1), ivec2(0), hi), 0).rgb;
-    vec3 c11 = texelFetch(u_src_rgb, clamp(i0 + ivec2(1, 1), ivec2(0), hi), 0).rgb;
-    vec3 top = mix(c00, c10, t.x);
-    vec3 bottom = mix(c01, c11, t.x);
-    return mix(top, bottom, t.y);
-}

@@ -3,16 +3,13 @@
 // triangle in the source image), giving the mesh path's output in one full-screen pass.
 
 uniform usampler2D u_keep;  // R8UI per cell: bit 0 tri1 kept, bit 1 tri2 kept; (W+1) x (H+1)
-uniform vec2 u_dst_c;       // cx', cy'
-uniform vec2 u_ratio;       // fx / fx', fy / fy'
-uniform int u_dst_height;
 
 layout(location = 0) out vec4 o_rgb;
 layout(location = 1) out float o_depth;
 layout(location = 2) out float o_mask;
 
 // Nearest Z over the kept triangles of cell c containing uv; `best` if none is nearer.
-float cell_depth(ivec2 c, vec2 uv, float best) {
+float cell_depth(ivec2 c, dvec2 uv, float best) {
     uint bits = texelFetch(u_keep, c, 0).r;
     if (bits == 0u) {
         return best;
@@ -21,35 +18,22 @@ float cell_depth(ivec2 c, vec2 uv, float best) {
     float z00 = vertex_depth(c);
     float z11 = vertex_depth(c + ivec2(1, 1));
     if ((bits & 1u) != 0u && inside_tri(ab, 0)) {
-        // Project onto the closed triangle so the weights stay convex (Z stays in range).
-        float a = clamp(ab.x, 0.0, 1.0);
-        float b = clamp(ab.y, 0.0, a);
-        float inv = (1.0 - a) / z00 + (a - b) / vertex_depth(c + ivec2(1, 0)) + b / z11;
-        best = min(best, 1.0 / inv);
+        best = min(best, tri_depth(ab, 0, vec3(z00, vertex_depth(c + ivec2(1, 0)), z11)));
     }
     if ((bits & 2u) != 0u && inside_tri(ab, 1)) {
-        float b = clamp(ab.y, 0.0, 1.0);
-        float a = clamp(ab.x, 0.0, b);
-        float inv = (1.0 - b) / z00 + a / z11 + (b - a) / vertex_depth(c + ivec2(0, 1));
-        best = min(best, 1.0 / inv);
+        best = min(best, tri_depth(ab, 1, vec3(z00, z11, vertex_depth(c + ivec2(0, 1)))));
     }
     return best;
 }
 
 void main() {
-#if ROWS_TOP_DOWN
-    float v_dst = gl_FragCoord.y - 0.5;
-#else
-    float v_dst = float(u_dst_height) - gl_FragCoord.y - 0.5;
-#endif
-    vec2 dst = vec2(gl_FragCoord.x - 0.5, v_dst);
-    vec2 uv = u_src_k.zw + (dst - u_dst_c) * u_ratio;
+    dvec2 uv = same_pose_source_point();
 
     o_rgb = vec4(0.0);
     o_depth = 0.0;
     o_mask = 0.0;
-    vec2 lo = vec2(-0.5) - 0.5 * CELL_EPS;
-    vec2 hi = vec2(u_src_size) - 0.5 + 0.5 * CELL_EPS;
+    dvec2 lo = dvec2(-0.5 - 0.5 * CELL_EPS);
+    dvec2 hi = dvec2(u_src_size) - 0.5 + 0.5 * CELL_EPS;
     if (any(lessThan(uv, lo)) || any(greaterThan(uv, hi))) {
         return;
     }

@@ -5,16 +5,12 @@
 
 uniform usampler2D u_tris;          // R32UI kept-triangle codes, TRI_TEX_WIDTH wide
 uniform mat4 u_target_from_source;  // view transform (identity for a same-pose refocus)
-uniform mat4 u_source_from_target;  // its inverse
 uniform mat4 u_clip_from_target;    // target projection (OpenCV view space, see projection.rs)
 uniform vec2 u_dst_size;
 uniform float u_expand_px;
 
 flat out ivec3 v_cell;  // cell i, j and triangle (0 = tri1, 1 = tri2)
-// Source pixel offset from the cell origin times source Z: affine in 3-D, so perspective-correct
-// interpolation is exact, and small, so f32 keeps ~1e-6 px near the edges the test looks at.
-out vec3 v_src_h;
-out float v_depth;      // target view-space Z
+flat out vec3 v_corner_z;  // source Z of the three corners, for exact depth per fragment
 
 vec3 corner_point(ivec2 c) {
     float z = vertex_depth(c);
@@ -45,10 +41,6 @@ void main() {
     }
     v_cell = ivec3(c, tri);
     vec3 point = p[k];
-    vec2 cell_size = vec2(vertex_pos(c.x + 1, u_src_size.x), vertex_pos(c.y + 1, u_src_size.y))
-                   - vec2(vertex_pos(c.x, u_src_size.x), vertex_pos(c.y, u_src_size.y));
-    vec2 local_k = vec2(corners[k] - c) * cell_size;  // exact offset of an unmoved corner
-    float z_src = vertex_depth(corners[k]);
 
     if (u_expand_px > 0.0 && clip[0].w > 0.0 && clip[1].w > 0.0 && clip[2].w > 0.0) {
         vec2 w0 = window_xy(clip[k]);
@@ -79,15 +71,10 @@ void main() {
                 vec3 moved = dir * (dot(nrm, p[0]) / den);
                 if (moved.z >= 0.5 * zmin && moved.z <= 2.0 * zmax) {
                     point = moved;
-                    vec3 q = (u_source_from_target * vec4(moved, 1.0)).xyz;
-                    vec2 origin = vec2(vertex_pos(c.x, u_src_size.x), vertex_pos(c.y, u_src_size.y));
-                    local_k = (q.xy / q.z * u_src_k.xy + u_src_k.zw) - origin;
-                    z_src = q.z;
                 }
             }
         }
     }
-    v_src_h = vec3(local_k * z_src, z_src);
-    v_depth = point.z;
+    v_corner_z = vec3(vertex_depth(corners[0]), vertex_depth(corners[1]), vertex_depth(corners[2]));
     gl_Position = u_clip_from_target * vec4(point, 1.0);
 }

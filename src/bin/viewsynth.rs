@@ -28,6 +28,7 @@ enum Command {
         json: bool,
     },
     /// Re-render RGB + metric depth at other focal lengths (same pose).
+    #[command(allow_negative_numbers = true)]
     Refocus(RefocusArgs),
     /// Render the built-in RGB-D scene, refocus it at 5 scales, and write outputs plus an error
     /// table against the exact ray-traced views.

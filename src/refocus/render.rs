@@ -12,6 +12,7 @@ use glow::HasContext;
 use std::time::Instant;
 
 const GRID_GLSL: &str = include_str!("../../shaders/common/refocus_grid.glsl");
+const SAMPLE_GLSL: &str = include_str!("../../shaders/common/refocus_sample.glsl");
 const FULLSCREEN_VERT: &str = include_str!("../../shaders/common/fullscreen.vert");
 const FULLSCREEN_FRAG: &str = include_str!("../../shaders/refocus/fullscreen.frag");
 const MESH_VERT: &str = include_str!("../../shaders/refocus/mesh.vert");
@@ -83,7 +84,7 @@ impl Refocuser {
         );
         let (program, geometry) = match method {
             Method::Fullscreen => {
-                let frag = format!("{GRID_GLSL}\n{FULLSCREEN_FRAG}");
+                let frag = format!("{GRID_GLSL}\n{SAMPLE_GLSL}\n{FULLSCREEN_FRAG}");
                 let program = Program::new(
                     gpu,
                     &defines,
@@ -94,7 +95,7 @@ impl Refocuser {
             }
             Method::Mesh => {
                 let vert = format!("{GRID_GLSL}\n{MESH_VERT}");
-                let frag = format!("{GRID_GLSL}\n{MESH_FRAG}");
+                let frag = format!("{GRID_GLSL}\n{SAMPLE_GLSL}\n{MESH_FRAG}");
                 let program = Program::new(
                     gpu,
                     &defines,
@@ -213,12 +214,13 @@ impl Refocuser {
             gl.disable(glow::STENCIL_TEST);
         }
         p.set_vec4("u_src_k", [sk.fx as f32, sk.fy as f32, sk.cx as f32, sk.cy as f32]);
+        p.set_dvec2_split("u_src_c", [sk.cx, sk.cy]);
+        p.set_dvec2_split("u_dst_c", [tk.cx, tk.cy]);
+        p.set_dvec2_split("u_ratio", [sk.fx / tk.fx, sk.fy / tk.fy]);
+        p.set_i32("u_dst_height", target.height as i32);
         match &self.geometry {
             Geometry::Fullscreen { keep } => {
                 keep.bind(2);
-                p.set_vec2("u_dst_c", [tk.cx as f32, tk.cy as f32]);
-                p.set_vec2("u_ratio", [(sk.fx / tk.fx) as f32, (sk.fy / tk.fy) as f32]);
-                p.set_i32("u_dst_height", target.height as i32);
                 // SAFETY: one full-screen triangle; no depth buffer is attached.
                 unsafe {
                     gl.disable(glow::DEPTH_TEST);
@@ -229,7 +231,6 @@ impl Refocuser {
                 let m = clip_from_view_opencv(target, &self.planes, &conv);
                 p.set_mat4_rows("u_clip_from_target", &m);
                 p.set_mat4_rows("u_target_from_source", &IDENTITY);
-                p.set_mat4_rows("u_source_from_target", &IDENTITY);
                 p.set_vec2("u_dst_size", [target.width as f32, target.height as f32]);
                 p.set_f32("u_expand_px", EXPAND_PX);
                 let depth_mode = match conv.ndc_depth {
@@ -240,9 +241,15 @@ impl Refocuser {
                 // SAFETY: depth state and a non-indexed draw of 3 vertices per kept triangle.
                 unsafe {
                     gl.enable(glow::DEPTH_TEST);
+                    // No near/far clipping: with a 1e8 depth ratio, standard-Z f32 puts far
+                    // surfaces on the far plane, where clipping would drop them. Depth precision
+                    // may then only affect which of two overlapping surfaces wins.
+                    gl.enable(glow::DEPTH_CLAMP);
                     gl.depth_mask(true);
                     gl.depth_range_f64(0.0, 1.0);
-                    gl.depth_func(if conv.reversed_z { glow::GREATER } else { glow::LESS });
+                    // LEQUAL/GEQUAL: at a 1e8 depth ratio standard-Z f32 rounds far surfaces onto
+                    // the clear value itself, which a strict test would reject.
+                    gl.depth_func(if conv.reversed_z { glow::GEQUAL } else { glow::LEQUAL });
                     if let Some(t) = tris {
                         t.bind(2);
                         gl.draw_arrays(glow::TRIANGLES, 0, (*count * 3) as i32);
@@ -250,6 +257,8 @@ impl Refocuser {
                 }
                 // Leave the default clip control for whoever draws next.
                 gpu.clip_control(glow::LOWER_LEFT, glow::NEGATIVE_ONE_TO_ONE);
+                // SAFETY: state reset.
+                unsafe { gl.disable(glow::DEPTH_CLAMP) };
             }
         }
         gpu.check("refocus draw")?;

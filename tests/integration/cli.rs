@@ -105,7 +105,7 @@ fn bad_input_fails_cleanly() {
 
     assert_clean_failure(&refocus(&rgb, &depth, &out, &["--width-out", "16385", "--height-out", "10"]), "width", &out);
     assert_clean_failure(&refocus(&rgb, &depth, &out, &["--zoom-range", "0"]), "focal scale", &out);
-    assert_clean_failure(&refocus(&rgb, &depth, &out, &["--tau-rel", "-1"]), "tau-rel", &out);
+    assert_clean_failure(&refocus(&rgb, &depth, &out, &["--tau-rel=-1"]), "tau-rel", &out);
     assert_clean_failure(&refocus(&rgb, &depth, &out, &["--outputs", "rgb,normals"]), "outputs", &out);
 
     // Non-finite and non-positive intrinsics.
