@@ -38,7 +38,12 @@ pub fn refocus_bench(gpu: &Gpu, sizes: &[(u32, u32)], repeats: usize) -> Result<
         let (rgb, depth) = scene::render(&cam);
         let src = RefocusSource::new(rgb, depth, cam.k)?;
         let rule = BreakRule::default();
-        let targets = TargetSpec { scales: SCALES.to_vec(), size: None, principal: None }.targets(&cam)?;
+        let targets = TargetSpec {
+            scales: SCALES.to_vec(),
+            size: None,
+            principal: None,
+        }
+        .targets(&cam)?;
         let outputs = OutputSet::default();
         for method in [Method::Fullscreen, Method::Mesh] {
             let t0 = Instant::now();
@@ -65,8 +70,13 @@ pub fn refocus_bench(gpu: &Gpu, sizes: &[(u32, u32)], repeats: usize) -> Result<
                 Method::Mesh => format!("GPU mesh ({} triangles)", r.triangle_count().unwrap_or(0)),
                 Method::Fullscreen => "GPU full-screen".to_string(),
             };
-            writeln!(t, "| {w}x{h} | {name} | {setup:.1} | {m:.2} | {:.2} | {:.1} |", m / 5.0, median(with_io))
-                .expect("write to String");
+            writeln!(
+                t,
+                "| {w}x{h} | {name} | {setup:.1} | {m:.2} | {:.2} | {:.1} |",
+                m / 5.0,
+                median(with_io)
+            )
+            .expect("write to String");
         }
         let mut cpu = Vec::new();
         for _ in 0..repeats.min(3) {
@@ -77,8 +87,12 @@ pub fn refocus_bench(gpu: &Gpu, sizes: &[(u32, u32)], repeats: usize) -> Result<
             cpu.push(t0.elapsed().as_secs_f64() * 1e3);
         }
         let m = median(cpu);
-        writeln!(t, "| {w}x{h} | CPU f64 reference (1 thread, baseline) | - | {m:.1} | {:.1} | - |", m / 5.0)
-            .expect("write to String");
+        writeln!(
+            t,
+            "| {w}x{h} | CPU f64 reference (1 thread, baseline) | - | {m:.1} | {:.1} | - |",
+            m / 5.0
+        )
+        .expect("write to String");
     }
     let _ = std::fs::remove_dir_all(&tmp);
     Ok(t)

@@ -45,7 +45,11 @@ impl Conventions {
         for ndc_depth in [NdcDepthRange::MinusOneToOne, NdcDepthRange::ZeroToOne] {
             for reversed_z in [false, true] {
                 for row_order in [RowOrder::BottomUp, RowOrder::TopDown] {
-                    out[i] = Conventions { ndc_depth, reversed_z, row_order };
+                    out[i] = Conventions {
+                        ndc_depth,
+                        reversed_z,
+                        row_order,
+                    };
                     i += 1;
                 }
             }
@@ -176,7 +180,10 @@ mod tests {
 
     #[test]
     fn infinite_far_is_finite_and_reaches_far_value_only_at_infinity() {
-        let planes = DepthPlanes { near: 0.05, far: f64::INFINITY };
+        let planes = DepthPlanes {
+            near: 0.05,
+            far: f64::INFINITY,
+        };
         for conv in Conventions::all() {
             let (a, b) = planes.clip_z_coefficients(&conv);
             assert!(a.is_finite() && b.is_finite());

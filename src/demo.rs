@@ -24,7 +24,12 @@ pub fn run(gpu: &Gpu, out_dir: &Path) -> Result<PathBuf> {
     let src = RefocusSource::new(rgb, depth, cam.k)?;
     let rule = BreakRule::default();
     let outputs = OutputSet::default();
-    let targets = job::TargetSpec { scales: DEMO_SCALES.to_vec(), size: None, principal: None }.targets(&cam)?;
+    let targets = job::TargetSpec {
+        scales: DEMO_SCALES.to_vec(),
+        size: None,
+        principal: None,
+    }
+    .targets(&cam)?;
 
     let mut table = String::from(
         "| method | scale | coverage % | PSNR vs scene (dB) | depth MAE vs scene (mm) | PSNR vs f64 ref (dB) | max depth err vs ref (m) | mask IoU vs ref | render ms (wall) |\n\
@@ -42,7 +47,11 @@ pub fn run(gpu: &Gpu, out_dir: &Path) -> Result<PathBuf> {
             let out = r.render(target)?;
             job::write_output(&dir, *scale, &out, &outputs, RgbFormat::Png, DepthFormats::default())?;
             let (gt_rgb, gt_depth) = scene::render(target);
-            let mask: Vec<bool> = out.mask.as_ref().map(|m| m.data.iter().map(|v| *v != 0).collect()).unwrap_or_default();
+            let mask: Vec<bool> = out
+                .mask
+                .as_ref()
+                .map(|m| m.data.iter().map(|v| *v != 0).collect())
+                .unwrap_or_default();
             let rgb = &out.rgb.as_ref().expect("rgb requested").data;
             let z = &out.depth.as_ref().expect("depth requested").data;
             // Against the scene: pixels our output covers and the scene has a surface at.
@@ -58,7 +67,14 @@ pub fn run(gpu: &Gpu, out_dir: &Path) -> Result<PathBuf> {
                 }
             }
             let reference = reference::refocus_reference(&src, &rule, target);
-            let a = metrics::agreement(Some(rgb), Some(z), &mask, &reference.rgb, &reference.depth, &reference.mask);
+            let a = metrics::agreement(
+                Some(rgb),
+                Some(z),
+                &mask,
+                &reference.rgb,
+                &reference.depth,
+                &reference.mask,
+            );
             let coverage = mask.iter().filter(|m| **m).count() as f64 / mask.len() as f64;
             writeln!(
                 table,

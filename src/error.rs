@@ -36,15 +36,27 @@ pub enum Error {
 
 impl Error {
     pub fn io(path: impl Into<PathBuf>, source: std::io::Error) -> Self {
-        Error::Io { path: path.into(), source }
+        Error::Io {
+            path: path.into(),
+            source,
+        }
     }
     pub fn decode(path: impl Into<PathBuf>, message: impl Into<String>) -> Self {
-        Error::Decode { path: path.into(), message: message.into() }
+        Error::Decode {
+            path: path.into(),
+            message: message.into(),
+        }
     }
     pub fn encode(path: impl Into<PathBuf>, message: impl Into<String>) -> Self {
-        Error::Encode { path: path.into(), message: message.into() }
+        Error::Encode {
+            path: path.into(),
+            message: message.into(),
+        }
     }
     pub fn param(name: impl Into<String>, message: impl Into<String>) -> Self {
-        Error::InvalidParameter { name: name.into(), message: message.into() }
+        Error::InvalidParameter {
+            name: name.into(),
+            message: message.into(),
+        }
     }
 }

@@ -39,7 +39,9 @@ pub const ROUNDING_TIE_WINDOW: f64 = 5e-3;
 /// 0 when it is the nearest integer, or either neighbour of a tie.
 pub fn quantization_error(stored: u8, exact: f64) -> u32 {
     // Distance to the nearest acceptable value, in whole levels.
-    ((stored as f64 - exact).abs() - 0.5 - ROUNDING_TIE_WINDOW).max(0.0).ceil() as u32
+    ((stored as f64 - exact).abs() - 0.5 - ROUNDING_TIE_WINDOW)
+        .max(0.0)
+        .ceil() as u32
 }
 
 /// GPU output against a reference, over the pixels both mark valid.
@@ -69,7 +71,10 @@ pub fn agreement(
     ref_depth: &[f64],
     ref_mask: &[bool],
 ) -> Agreement {
-    let mut a = Agreement { mask_iou: mask_iou(mask, ref_mask), ..Default::default() };
+    let mut a = Agreement {
+        mask_iou: mask_iou(mask, ref_mask),
+        ..Default::default()
+    };
     let mut sq = 0.0;
     for i in 0..mask.len() {
         if mask[i] != ref_mask[i] {
@@ -93,7 +98,11 @@ pub fn agreement(
             a.max_rel_depth = a.max_rel_depth.max(e / ref_depth[i].abs());
         }
     }
-    a.psnr_db = if a.common == 0 { f64::INFINITY } else { psnr_from_mse(sq / (3 * a.common) as f64) };
+    a.psnr_db = if a.common == 0 {
+        f64::INFINITY
+    } else {
+        psnr_from_mse(sq / (3 * a.common) as f64)
+    };
     a
 }
 
@@ -105,7 +114,10 @@ mod tests {
     fn psnr_and_iou_known_values() {
         assert!((psnr_from_mse(1.0) - 48.1308).abs() < 1e-3);
         assert_eq!(psnr_from_mse(0.0), f64::INFINITY);
-        assert_eq!(mask_iou(&[true, true, false, false], &[true, false, true, false]), 1.0 / 3.0);
+        assert_eq!(
+            mask_iou(&[true, true, false, false], &[true, false, true, false]),
+            1.0 / 3.0
+        );
         assert_eq!(mask_iou(&[false], &[false]), 1.0);
     }
 

@@ -20,13 +20,29 @@ fn shade(hit: &Hit) -> [f64; 3] {
     let [x, y, z] = hit.p;
     let stripes = |a: f64, f: f64| 0.5 + 0.5 * (a * f).sin();
     match hit.material {
-        0 => [200.0 * stripes(x, 3.0) + 30.0, 120.0 * stripes(y, 5.0) + 60.0, 180.0 * stripes(x + y, 1.7) + 40.0],
+        0 => [
+            200.0 * stripes(x, 3.0) + 30.0,
+            120.0 * stripes(y, 5.0) + 60.0,
+            180.0 * stripes(x + y, 1.7) + 40.0,
+        ],
         1 => {
             let checker = (((x * 2.0).floor() + (z * 2.0).floor()) as i64).rem_euclid(2) as f64;
-            [90.0 + 100.0 * checker * stripes(x, 11.0), 80.0 + 60.0 * stripes(z, 4.0), 70.0 + 40.0 * checker]
+            [
+                90.0 + 100.0 * checker * stripes(x, 11.0),
+                80.0 + 60.0 * stripes(z, 4.0),
+                70.0 + 40.0 * checker,
+            ]
         }
-        2 => [230.0 * stripes(y, 9.0) + 20.0, 60.0 + 80.0 * stripes(x, 13.0), 40.0 + 30.0 * stripes(z, 7.0)],
-        _ => [40.0 + 200.0 * stripes(x - y, 20.0), 200.0 * stripes(y, 2.0) + 40.0, 90.0],
+        2 => [
+            230.0 * stripes(y, 9.0) + 20.0,
+            60.0 + 80.0 * stripes(x, 13.0),
+            40.0 + 30.0 * stripes(z, 7.0),
+        ],
+        _ => [
+            40.0 + 200.0 * stripes(x - y, 20.0),
+            200.0 * stripes(y, 2.0) + 40.0,
+            90.0,
+        ],
     }
 }
 
@@ -34,7 +50,11 @@ fn trace(dir: [f64; 3]) -> Option<Hit> {
     let mut best: Option<Hit> = None;
     let mut take = |t: f64, material: u8| {
         if t > 1e-9 && best.is_none_or(|b| t < b.t) {
-            best = Some(Hit { t, material, p: [dir[0] * t, dir[1] * t, dir[2] * t] });
+            best = Some(Hit {
+                t,
+                material,
+                p: [dir[0] * t, dir[1] * t, dir[2] * t],
+            });
         }
     };
     // Back wall z = 6 (bounded so wide views see background: no hit -> invalid depth).
@@ -103,7 +123,12 @@ pub fn render(cam: &PinholeCamera) -> (RgbImage, DepthMap) {
 pub fn demo_camera(width: u32, height: u32) -> PinholeCamera {
     let f = 525.0 * width as f64 / 640.0;
     PinholeCamera {
-        k: crate::camera::Intrinsics { fx: f, fy: f, cx: (width as f64 - 1.0) / 2.0, cy: (height as f64 - 1.0) / 2.0 },
+        k: crate::camera::Intrinsics {
+            fx: f,
+            fy: f,
+            cx: (width as f64 - 1.0) / 2.0,
+            cy: (height as f64 - 1.0) / 2.0,
+        },
         width,
         height,
     }
@@ -123,7 +148,10 @@ mod tests {
         let hi = valid.iter().copied().fold(0.0, f32::max);
         assert!(lo > 1.5 && lo < 3.0 && (hi - 6.0).abs() < 0.5, "{lo}..{hi}");
         // Wall pixel at the image centre row, far left column: z = 6 exactly.
-        let (_, wide) = render(&PinholeCamera { k: crate::camera::Intrinsics { fx: 40.0, ..cam.k }, ..cam });
+        let (_, wide) = render(&PinholeCamera {
+            k: crate::camera::Intrinsics { fx: 40.0, ..cam.k },
+            ..cam
+        });
         assert_eq!(wide.data[0], 0.0, "a wide view sees past the wall's edge");
     }
 }

@@ -11,7 +11,11 @@ use viewsynth::refocus::job::{self, DepthFormats, Manifest, RgbFormat, TargetSpe
 use viewsynth::refocus::{BreakRule, Method, OutputSet, RefocusSource, Refocuser};
 
 #[derive(Parser)]
-#[command(name = "viewsynth", version, about = "Headless GPU view synthesis from RGB-D and stereo images")]
+#[command(
+    name = "viewsynth",
+    version,
+    about = "Headless GPU view synthesis from RGB-D and stereo images"
+)]
 struct Cli {
     #[command(subcommand)]
     command: Command,
@@ -29,7 +33,7 @@ enum Command {
     },
     /// Re-render RGB + metric depth at other focal lengths (same pose).
     #[command(allow_negative_numbers = true)]
-    Refocus(RefocusArgs),
+    Refocus(Box<RefocusArgs>),
     /// Render the built-in RGB-D scene, refocus it at 5 scales, and write outputs plus an error
     /// table against the exact ray-traced views.
     Demo {
@@ -64,7 +68,10 @@ impl GpuArgs {
         let choice = match self.device.as_str() {
             "auto" => DeviceChoice::Auto,
             "surfaceless" => DeviceChoice::Surfaceless,
-            n => DeviceChoice::Index(n.parse().with_context(|| format!("--device '{n}': expected auto, surfaceless or an index"))?),
+            n => DeviceChoice::Index(
+                n.parse()
+                    .with_context(|| format!("--device '{n}': expected auto, surfaceless or an index"))?,
+            ),
         };
         Ok(Gpu::new(choice)?)
     }
@@ -166,7 +173,7 @@ fn main() {
     let cli = Cli::parse();
     let result = match cli.command {
         Command::Info { gpu, json } => info(&gpu, json),
-        Command::Refocus(args) => refocus(args),
+        Command::Refocus(args) => refocus(*args),
         Command::Demo { out_dir, gpu } => demo(&out_dir, &gpu),
         Command::Bench { sizes, repeats, gpu } => bench(&sizes, repeats, &gpu),
     };
@@ -185,21 +192,53 @@ fn info(gpu: &GpuArgs, json: bool) -> Result<()> {
     }
     println!("vendor:      {}", i.vendor);
     println!("renderer:    {}", i.renderer);
-    println!("GL version:  {} (core {}.{}), GLSL {}", i.version, i.gl_major, i.gl_minor, i.glsl_version);
+    println!(
+        "GL version:  {} (core {}.{}), GLSL {}",
+        i.version, i.gl_major, i.gl_minor, i.glsl_version
+    );
     println!("EGL:         {} via {} platform", i.egl_version, i.platform);
     let dev = i.device_index.map_or("-".to_string(), |d| d.to_string());
-    println!("device:      {dev} of {} ({})", i.device_count, i.device_file.as_deref().unwrap_or("no DRM file"));
-    println!("device ext:  {}", if i.device_extensions.is_empty() { "-" } else { &i.device_extensions });
-    println!("limits:      max texture {}, max viewport {}x{}", i.max_texture_size, i.max_viewport[0], i.max_viewport[1]);
-    println!("GPU timers:  {}", if i.gpu_timers_meaningful { "yes" } else { "no (wall clock with glFinish)" });
+    println!(
+        "device:      {dev} of {} ({})",
+        i.device_count,
+        i.device_file.as_deref().unwrap_or("no DRM file")
+    );
+    println!(
+        "device ext:  {}",
+        if i.device_extensions.is_empty() {
+            "-"
+        } else {
+            &i.device_extensions
+        }
+    );
+    println!(
+        "limits:      max texture {}, max viewport {}x{}",
+        i.max_texture_size, i.max_viewport[0], i.max_viewport[1]
+    );
+    println!(
+        "GPU timers:  {}",
+        if i.gpu_timers_meaningful {
+            "yes"
+        } else {
+            "no (wall clock with glFinish)"
+        }
+    );
     Ok(())
 }
 
 fn refocus(a: RefocusArgs) -> Result<()> {
     // Everything that can be checked before touching the GPU or the output directory is.
-    let k = Intrinsics { fx: a.fx, fy: a.fy, cx: a.cx, cy: a.cy };
+    let k = Intrinsics {
+        fx: a.fx,
+        fy: a.fy,
+        cx: a.cx,
+        cy: a.cy,
+    };
     k.validate("source intrinsics")?;
-    let rule = BreakRule { tau_rel: a.tau_rel, tau_abs: a.tau_abs };
+    let rule = BreakRule {
+        tau_rel: a.tau_rel,
+        tau_abs: a.tau_abs,
+    };
     rule.validate()?;
     let outputs = OutputSet::parse(&a.outputs)?;
     let depth_formats = parse_depth_formats(&a.depth_format)?;
@@ -224,10 +263,14 @@ fn refocus(a: RefocusArgs) -> Result<()> {
         RgbFormatArg::Exr => RgbFormat::Exr,
     };
     let rgb = io::load_rgb(&a.rgb)?;
-    let decode = DepthDecode { scale: a.depth_scale, sun_rgbd_bit_rotate: a.sun_bit_rotate, ..Default::default() };
+    let decode = DepthDecode {
+        scale: a.depth_scale,
+        sun_rgbd_bit_rotate: a.sun_bit_rotate,
+        ..Default::default()
+    };
     let depth = io::load_depth(&a.depth, &decode)?;
-    let src = RefocusSource::new(rgb, depth, k)
-        .with_context(|| format!("{} and {}", a.rgb.display(), a.depth.display()))?;
+    let src =
+        RefocusSource::new(rgb, depth, k).with_context(|| format!("{} and {}", a.rgb.display(), a.depth.display()))?;
     let scales = match &a.focal_list {
         Some(list) => TargetSpec::scales_from_focal_list(&k, list),
         None => a.zoom_range.clone(),
@@ -246,7 +289,14 @@ fn refocus(a: RefocusArgs) -> Result<()> {
     let mut entries = Vec::new();
     for (scale, target) in scales.iter().zip(&targets) {
         let out = refocuser.render(target)?;
-        entries.push(job::write_output(&a.out_dir, *scale, &out, &outputs, rgb_format, depth_formats)?);
+        entries.push(job::write_output(
+            &a.out_dir,
+            *scale,
+            &out,
+            &outputs,
+            rgb_format,
+            depth_formats,
+        )?);
         bar.inc(1);
     }
     bar.finish_and_clear();
@@ -308,7 +358,9 @@ fn prepare_out_dir(dir: &Path) -> Result<()> {
 fn bench(sizes: &[String], repeats: usize, gpu: &GpuArgs) -> Result<()> {
     let mut parsed = Vec::new();
     for s in sizes {
-        let (w, h) = s.split_once('x').with_context(|| format!("--sizes '{s}': expected WxH"))?;
+        let (w, h) = s
+            .split_once('x')
+            .with_context(|| format!("--sizes '{s}': expected WxH"))?;
         parsed.push((w.parse::<u32>()?, h.parse::<u32>()?));
     }
     let table = viewsynth::bench::refocus_bench(&gpu.open()?, &parsed, repeats.max(1))?;

@@ -73,18 +73,42 @@ mod tests {
 
     #[test]
     fn validation_names_the_parameter() {
-        let k = Intrinsics { fx: 500.0, fy: f64::NAN, cx: 1.0, cy: 1.0 };
+        let k = Intrinsics {
+            fx: 500.0,
+            fy: f64::NAN,
+            cx: 1.0,
+            cy: 1.0,
+        };
         let e = k.validate("source").unwrap_err().to_string();
         assert!(e.contains("source fy"), "{e}");
-        let k = Intrinsics { fx: 0.0, fy: 1.0, cx: 1.0, cy: 1.0 };
+        let k = Intrinsics {
+            fx: 0.0,
+            fy: 1.0,
+            cx: 1.0,
+            cy: 1.0,
+        };
         assert!(k.validate("target").unwrap_err().to_string().contains("target fx"));
-        let cam = PinholeCamera { k: Intrinsics { fx: 1.0, fy: 1.0, cx: 0.0, cy: 0.0 }, width: 16385, height: 2 };
+        let cam = PinholeCamera {
+            k: Intrinsics {
+                fx: 1.0,
+                fy: 1.0,
+                cx: 0.0,
+                cy: 0.0,
+            },
+            width: 16385,
+            height: 2,
+        };
         assert!(cam.validate("output").unwrap_err().to_string().contains("output width"));
     }
 
     #[test]
     fn back_projection_inverts_projection() {
-        let k = Intrinsics { fx: 525.0, fy: 520.0, cx: 319.5, cy: 239.5 };
+        let k = Intrinsics {
+            fx: 525.0,
+            fy: 520.0,
+            cx: 319.5,
+            cy: 239.5,
+        };
         let p = k.back_project(10.7, 400.25, 3.5);
         let uv = k.project(p);
         assert!((uv[0] - 10.7).abs() < 1e-12 && (uv[1] - 400.25).abs() < 1e-12);

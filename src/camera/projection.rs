@@ -35,14 +35,29 @@ mod tests {
     use crate::camera::Intrinsics;
 
     fn window_xy(m: &[[f64; 4]; 4], cam: &PinholeCamera, p: [f64; 3]) -> [f64; 2] {
-        let c: Vec<f64> = m.iter().map(|r| r[0] * p[0] + r[1] * p[1] + r[2] * p[2] + r[3]).collect();
+        let c: Vec<f64> = m
+            .iter()
+            .map(|r| r[0] * p[0] + r[1] * p[1] + r[2] * p[2] + r[3])
+            .collect();
         let (xn, yn) = (c[0] / c[3], c[1] / c[3]);
-        [(xn + 1.0) * 0.5 * cam.width as f64, (yn + 1.0) * 0.5 * cam.height as f64]
+        [
+            (xn + 1.0) * 0.5 * cam.width as f64,
+            (yn + 1.0) * 0.5 * cam.height as f64,
+        ]
     }
 
     #[test]
     fn point_at_u_10_7_lands_in_column_11_under_both_row_orders() {
-        let cam = PinholeCamera { k: Intrinsics { fx: 300.0, fy: 310.0, cx: 31.5, cy: 20.25 }, width: 64, height: 48 };
+        let cam = PinholeCamera {
+            k: Intrinsics {
+                fx: 300.0,
+                fy: 310.0,
+                cx: 31.5,
+                cy: 20.25,
+            },
+            width: 64,
+            height: 48,
+        };
         let planes = DepthPlanes { near: 0.1, far: 100.0 };
         let p = cam.k.back_project(10.7, 5.2, 2.0);
         for conv in Conventions::all() {

@@ -15,8 +15,7 @@ const EGL_CONTEXT_OPENGL_CORE_PROFILE_BIT: egl::Int = 0x1;
 type QueryDevices = unsafe extern "system" fn(egl::Int, *mut *mut c_void, *mut egl::Int) -> u32;
 type QueryDeviceString = unsafe extern "system" fn(*mut c_void, egl::Int) -> *const i8;
 type QueryDeviceAttrib = unsafe extern "system" fn(*mut c_void, egl::Int, *mut isize) -> u32;
-type GetPlatformDisplay =
-    unsafe extern "system" fn(egl::Enum, *mut c_void, *const egl::Int) -> *mut c_void;
+type GetPlatformDisplay = unsafe extern "system" fn(egl::Enum, *mut c_void, *const egl::Int) -> *mut c_void;
 
 /// Which EGL device to render on.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
@@ -66,7 +65,8 @@ pub struct EglContext {
 fn load_fn<T: Copy>(egl: &egl::DynamicInstance<egl::EGL1_4>, name: &str) -> Option<T> {
     debug_assert_eq!(std::mem::size_of::<T>(), std::mem::size_of::<extern "system" fn()>());
     // SAFETY: T is a function pointer type of the same size; the caller names the right signature.
-    egl.get_proc_address(name).map(|f| unsafe { std::mem::transmute_copy::<_, T>(&f) })
+    egl.get_proc_address(name)
+        .map(|f| unsafe { std::mem::transmute_copy::<_, T>(&f) })
 }
 
 fn egl_err(what: &str, e: egl::Error) -> Error {
@@ -88,11 +88,9 @@ impl EglContext {
             .query_string(None, egl::EXTENSIONS)
             .map(|s| s.to_string_lossy().into_owned())
             .unwrap_or_default();
-        let get_platform_display: Option<GetPlatformDisplay> =
-            load_fn(&egl, "eglGetPlatformDisplayEXT");
-        let get_platform_display = get_platform_display.ok_or_else(|| {
-            Error::Egl("libEGL lacks eglGetPlatformDisplayEXT (EGL_EXT_platform_base)".into())
-        })?;
+        let get_platform_display: Option<GetPlatformDisplay> = load_fn(&egl, "eglGetPlatformDisplayEXT");
+        let get_platform_display = get_platform_display
+            .ok_or_else(|| Error::Egl("libEGL lacks eglGetPlatformDisplayEXT (EGL_EXT_platform_base)".into()))?;
 
         let mut attempts = Vec::new();
         let mut chosen = None;
@@ -102,9 +100,8 @@ impl EglContext {
             let order = device_order(&egl, &devices, choice)?;
             for index in order {
                 // SAFETY: device handle came from eglQueryDevicesEXT; attrib list is EGL_NONE.
-                let ptr = unsafe {
-                    get_platform_display(EGL_PLATFORM_DEVICE_EXT, devices[index], [egl::NONE].as_ptr())
-                };
+                let ptr =
+                    unsafe { get_platform_display(EGL_PLATFORM_DEVICE_EXT, devices[index], [egl::NONE].as_ptr()) };
                 if ptr.is_null() {
                     attempts.push(format!("device {index}: no display"));
                     continue;
@@ -127,7 +124,10 @@ impl EglContext {
                 }
             }
             if chosen.is_none() && matches!(choice, DeviceChoice::Index(_)) {
-                return Err(Error::Egl(format!("requested EGL device failed: {}", attempts.join("; "))));
+                return Err(Error::Egl(format!(
+                    "requested EGL device failed: {}",
+                    attempts.join("; ")
+                )));
             }
         } else if let DeviceChoice::Index(i) = choice {
             return Err(Error::Egl(format!(
@@ -138,7 +138,11 @@ impl EglContext {
             if client_ext.contains("EGL_MESA_platform_surfaceless") {
                 // SAFETY: EGL_DEFAULT_DISPLAY with the surfaceless platform is the documented use.
                 let ptr = unsafe {
-                    get_platform_display(EGL_PLATFORM_SURFACELESS_MESA, std::ptr::null_mut(), [egl::NONE].as_ptr())
+                    get_platform_display(
+                        EGL_PLATFORM_SURFACELESS_MESA,
+                        std::ptr::null_mut(),
+                        [egl::NONE].as_ptr(),
+                    )
                 };
                 if ptr.is_null() {
                     attempts.push("surfaceless: no display".into());
@@ -164,20 +168,39 @@ impl EglContext {
         // SAFETY: the context is current on this thread; EGL returns GL entry points for it.
         let gl = unsafe {
             glow::Context::from_loader_function(|name| {
-                egl.get_proc_address(name).map_or(std::ptr::null(), |f| f as *const c_void)
+                egl.get_proc_address(name)
+                    .map_or(std::ptr::null(), |f| f as *const c_void)
             })
         };
-        let clip_control: unsafe extern "system" fn(u32, u32) = load_fn(&egl, "glClipControl")
-            .ok_or_else(|| Error::Egl("glClipControl missing (needs GL 4.5)".into()))?;
+        let clip_control: unsafe extern "system" fn(u32, u32) =
+            load_fn(&egl, "glClipControl").ok_or_else(|| Error::Egl("glClipControl missing (needs GL 4.5)".into()))?;
         let egl_version = egl
             .query_string(Some(display), egl::VERSION)
             .map(|s| s.to_string_lossy().into_owned())
             .unwrap_or_default();
-        let info = gl_info(&gl, egl_version, platform, device_index, device_count, device_file, device_extensions);
+        let info = gl_info(
+            &gl,
+            egl_version,
+            platform,
+            device_index,
+            device_count,
+            device_file,
+            device_extensions,
+        );
         if (info.gl_major, info.gl_minor) < (4, 5) {
-            return Err(Error::Egl(format!("GL {}.{} < 4.5: {}", info.gl_major, info.gl_minor, info.renderer)));
+            return Err(Error::Egl(format!(
+                "GL {}.{} < 4.5: {}",
+                info.gl_major, info.gl_minor, info.renderer
+            )));
         }
-        Ok(EglContext { egl, display, context, gl, clip_control, info })
+        Ok(EglContext {
+            egl,
+            display,
+            context,
+            gl,
+            clip_control,
+            info,
+        })
     }
 
     pub fn gl(&self) -> &glow::Context {
@@ -203,7 +226,8 @@ fn create_context(egl: &egl::DynamicInstance<egl::EGL1_4>, display: egl::Display
     if !ext.contains("EGL_KHR_surfaceless_context") {
         return Err(Error::Egl("display lacks EGL_KHR_surfaceless_context".into()));
     }
-    egl.bind_api(egl::OPENGL_API).map_err(|e| egl_err("eglBindAPI(OpenGL)", e))?;
+    egl.bind_api(egl::OPENGL_API)
+        .map_err(|e| egl_err("eglBindAPI(OpenGL)", e))?;
     let config = if ext.contains("EGL_KHR_no_config_context") {
         // SAFETY: EGL_NO_CONFIG_KHR is the null config, valid with EGL_KHR_no_config_context.
         unsafe { egl::Config::from_ptr(std::ptr::null_mut()) }
@@ -215,14 +239,18 @@ fn create_context(egl: &egl::DynamicInstance<egl::EGL1_4>, display: egl::Display
     let mut last = None;
     for (major, minor) in [(4, 6), (4, 5)] {
         let attribs = [
-            egl::CONTEXT_MAJOR_VERSION, major,
-            egl::CONTEXT_MINOR_VERSION, minor,
-            egl::CONTEXT_OPENGL_PROFILE_MASK, EGL_CONTEXT_OPENGL_CORE_PROFILE_BIT,
+            egl::CONTEXT_MAJOR_VERSION,
+            major,
+            egl::CONTEXT_MINOR_VERSION,
+            minor,
+            egl::CONTEXT_OPENGL_PROFILE_MASK,
+            EGL_CONTEXT_OPENGL_CORE_PROFILE_BIT,
             egl::NONE,
         ];
         match egl.create_context(display, config, None, &attribs) {
             Ok(ctx) => {
-                egl.make_current(display, None, None, Some(ctx)).map_err(|e| egl_err("eglMakeCurrent", e))?;
+                egl.make_current(display, None, None, Some(ctx))
+                    .map_err(|e| egl_err("eglMakeCurrent", e))?;
                 return Ok(ctx);
             }
             Err(e) => last = Some(format!("GL {major}.{minor} core: {e}")),
@@ -266,7 +294,10 @@ fn device_order(
 ) -> Result<Vec<usize>> {
     if let DeviceChoice::Index(i) = choice {
         if i >= devices.len() {
-            return Err(Error::param("device", format!("index {i} out of range: {} EGL device(s)", devices.len())));
+            return Err(Error::param(
+                "device",
+                format!("index {i} out of range: {} EGL device(s)", devices.len()),
+            ));
         }
         return Ok(vec![i]);
     }

@@ -25,7 +25,13 @@ pub struct Framebuffer {
 }
 
 impl Framebuffer {
-    pub fn new(gpu: &Gpu, width: u32, height: u32, attachments: &[Option<Attachment>], with_depth: bool) -> Result<Self> {
+    pub fn new(
+        gpu: &Gpu,
+        width: u32,
+        height: u32,
+        attachments: &[Option<Attachment>],
+        with_depth: bool,
+    ) -> Result<Self> {
         let mut colors = Vec::new();
         for a in attachments {
             colors.push(match a {
@@ -64,7 +70,13 @@ impl Framebuffer {
                 }
             }
             if let Some(d) = &fb.depth {
-                gl.framebuffer_texture_2d(glow::FRAMEBUFFER, glow::DEPTH_ATTACHMENT, glow::TEXTURE_2D, Some(d.raw), 0);
+                gl.framebuffer_texture_2d(
+                    glow::FRAMEBUFFER,
+                    glow::DEPTH_ATTACHMENT,
+                    glow::TEXTURE_2D,
+                    Some(d.raw),
+                    0,
+                );
             }
             gl.draw_buffers(&draw);
             let status = gl.check_framebuffer_status(glow::FRAMEBUFFER);

@@ -13,7 +13,11 @@ pub struct Program {
 const VERSION: &str = "#version 450 core\n";
 
 fn numbered(source: &str) -> String {
-    source.lines().enumerate().map(|(i, l)| format!("{:4} | {l}\n", i + 1)).collect()
+    source
+        .lines()
+        .enumerate()
+        .map(|(i, l)| format!("{:4} | {l}\n", i + 1))
+        .collect()
 }
 
 impl Program {
@@ -57,7 +61,10 @@ impl Program {
                 let names: Vec<_> = stages.iter().map(|s| s.1).collect();
                 return Err(Error::Gl(format!("linking {}: {log}", names.join(" + "))));
             }
-            Ok(Program { gpu: gpu.clone(), raw: program })
+            Ok(Program {
+                gpu: gpu.clone(),
+                raw: program,
+            })
         }
     }
 
@@ -91,7 +98,11 @@ impl Program {
     }
     pub fn set_vec4(&self, name: &str, v: [f32; 4]) {
         // SAFETY: as above.
-        unsafe { self.gpu.gl().uniform_4_f32(self.location(name).as_ref(), v[0], v[1], v[2], v[3]) }
+        unsafe {
+            self.gpu
+                .gl()
+                .uniform_4_f32(self.location(name).as_ref(), v[0], v[1], v[2], v[3])
+        }
     }
     /// A double-precision vec2 as the float pair `{name}_hi` + `{name}_lo` (glow has no f64
     /// uniforms); the shader rebuilds it as dvec2(hi) + dvec2(lo), good to ~48 bits.
@@ -110,7 +121,11 @@ impl Program {
             }
         }
         // SAFETY: as above; 16 floats.
-        unsafe { self.gpu.gl().uniform_matrix_4_f32_slice(self.location(name).as_ref(), false, &cols) }
+        unsafe {
+            self.gpu
+                .gl()
+                .uniform_matrix_4_f32_slice(self.location(name).as_ref(), false, &cols)
+        }
     }
 }
 

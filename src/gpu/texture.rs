@@ -54,14 +54,20 @@ impl Texture {
     pub fn new(gpu: &Gpu, width: u32, height: u32, format: TextureFormat, data: Option<&[u8]>) -> Result<Self> {
         let max = gpu.max_image_side();
         if width == 0 || height == 0 || width > max || height > max {
-            return Err(Error::param("texture size", format!("{width}x{height} outside 1..={max} on this GPU")));
+            return Err(Error::param(
+                "texture size",
+                format!("{width}x{height} outside 1..={max} on this GPU"),
+            ));
         }
         let gl = gpu.gl();
         let (fmt, ty, bpp) = format.transfer();
         if let Some(d) = data {
             let need = width as usize * height as usize * bpp;
             if d.len() != need {
-                return Err(Error::Gl(format!("texture upload: {} bytes given, {need} needed", d.len())));
+                return Err(Error::Gl(format!(
+                    "texture upload: {} bytes given, {need} needed",
+                    d.len()
+                )));
             }
         }
         // SAFETY: fresh texture; storage sized width x height; data length checked above.
@@ -80,12 +86,25 @@ impl Texture {
             if let Some(d) = data {
                 gl.pixel_store_i32(glow::UNPACK_ALIGNMENT, 1);
                 gl.tex_sub_image_2d(
-                    glow::TEXTURE_2D, 0, 0, 0, width as i32, height as i32, fmt, ty,
+                    glow::TEXTURE_2D,
+                    0,
+                    0,
+                    0,
+                    width as i32,
+                    height as i32,
+                    fmt,
+                    ty,
                     glow::PixelUnpackData::Slice(Some(d)),
                 );
             }
             gl.bind_texture(glow::TEXTURE_2D, None);
-            let tex = Texture { gpu: gpu.clone(), raw, width, height, format };
+            let tex = Texture {
+                gpu: gpu.clone(),
+                raw,
+                width,
+                height,
+                format,
+            };
             gpu.check("texture allocation")?;
             Ok(tex)
         }

@@ -33,7 +33,11 @@ impl GpuTimer {
         } else {
             None
         };
-        GpuTimer { gpu: gpu.clone(), query, start: Instant::now() }
+        GpuTimer {
+            gpu: gpu.clone(),
+            query,
+            start: Instant::now(),
+        }
     }
 
     pub fn stop(self) -> Timing {
@@ -48,6 +52,9 @@ impl GpuTimer {
             }
         });
         self.gpu.finish();
-        Timing { gpu_ms, wall_ms: self.start.elapsed().as_secs_f64() * 1e3 }
+        Timing {
+            gpu_ms,
+            wall_ms: self.start.elapsed().as_secs_f64() * 1e3,
+        }
     }
 }

@@ -16,10 +16,7 @@ static NEXT_TEMP: AtomicU64 = AtomicU64::new(0);
 /// synced and renamed over `path`. On any error (or a panic in `write`) the temporary file
 /// is removed and an existing file at `path` is left untouched. Errors from the file system
 /// name `path`.
-pub fn atomic_write(
-    path: &Path,
-    write: impl FnOnce(&mut BufWriter<File>) -> Result<()>,
-) -> Result<()> {
+pub fn atomic_write(path: &Path, write: impl FnOnce(&mut BufWriter<File>) -> Result<()>) -> Result<()> {
     let name = path.file_name().ok_or_else(|| {
         Error::io(
             path,
@@ -48,9 +45,7 @@ pub fn atomic_write(
     let mut writer = BufWriter::new(file);
     write(&mut writer)?;
     writer.flush().map_err(|e| Error::io(path, e))?;
-    let file = writer
-        .into_inner()
-        .map_err(|e| Error::io(path, e.into_error()))?;
+    let file = writer.into_inner().map_err(|e| Error::io(path, e.into_error()))?;
     file.sync_all().map_err(|e| Error::io(path, e))?;
     drop(file);
     if let Some(temp) = &guard.0 {
@@ -80,14 +75,8 @@ mod tests {
     fn writes_and_replaces() {
         let dir = scratch_dir("atomic-ok");
         let path = dir.join("out.bin");
-        atomic_write(&path, |w| {
-            w.write_all(b"first").map_err(|e| Error::io("out.bin", e))
-        })
-        .unwrap();
-        atomic_write(&path, |w| {
-            w.write_all(b"second").map_err(|e| Error::io("out.bin", e))
-        })
-        .unwrap();
+        atomic_write(&path, |w| w.write_all(b"first").map_err(|e| Error::io("out.bin", e))).unwrap();
+        atomic_write(&path, |w| w.write_all(b"second").map_err(|e| Error::io("out.bin", e))).unwrap();
         assert_eq!(fs::read(&path).unwrap(), b"second");
         assert_eq!(list_dir(&dir), vec!["out.bin".to_string()]);
     }
@@ -97,8 +86,7 @@ mod tests {
         let dir = scratch_dir("atomic-fail");
         let path = dir.join("out.bin");
         let err = atomic_write(&path, |w| {
-            w.write_all(&[7u8; 100_000])
-                .map_err(|e| Error::io("x", e))?;
+            w.write_all(&[7u8; 100_000]).map_err(|e| Error::io("x", e))?;
             Err(Error::encode("x", "boom"))
         })
         .unwrap_err();
@@ -136,10 +124,7 @@ mod tests {
         let path = dir.join("no-such-dir").join("out.png");
         let err = atomic_write(&path, |_| Ok(())).unwrap_err();
         assert!(matches!(err, Error::Io { .. }));
-        assert!(
-            err.to_string().contains(&path.display().to_string()),
-            "{err}"
-        );
+        assert!(err.to_string().contains(&path.display().to_string()), "{err}");
     }
 
     #[test]
@@ -151,10 +136,7 @@ mod tests {
         let path = blocker.join("out.png");
         let err = atomic_write(&path, |_| Ok(())).unwrap_err();
         assert!(matches!(err, Error::Io { .. }));
-        assert!(
-            err.to_string().contains(&path.display().to_string()),
-            "{err}"
-        );
+        assert!(err.to_string().contains(&path.display().to_string()), "{err}");
         assert_eq!(list_dir(&dir), vec!["file".to_string()]);
     }
 

@@ -28,11 +28,7 @@ pub(crate) fn decode_image(path: &Path, format: Option<ImageFormat>) -> Result<D
     let mut reader = ImageReader::open(path).map_err(|e| Error::io(path, e))?;
     match format {
         Some(f) => reader.set_format(f),
-        None => {
-            reader = reader
-                .with_guessed_format()
-                .map_err(|e| Error::io(path, e))?
-        }
+        None => reader = reader.with_guessed_format().map_err(|e| Error::io(path, e))?,
     }
     if reader.format().is_none() {
         return Err(Error::decode(path, "unrecognised image format"));

@@ -95,11 +95,7 @@ pub fn save_depth_exr(path: &Path, depth: &DepthMap) -> Result<()> {
 /// Writes `<f4`, shape (height, width), C order, NPY 1.0.
 pub fn save_depth_npy(path: &Path, depth: &DepthMap) -> Result<()> {
     encode_dims(path, depth.width, depth.height, 1, depth.data.len())?;
-    save_npy_f32(
-        path,
-        &[depth.height as usize, depth.width as usize],
-        &depth.data,
-    )
+    save_npy_f32(path, &[depth.height as usize, depth.width as usize], &depth.data)
 }
 
 fn read_png(path: &Path) -> Result<RawDepth> {
@@ -107,10 +103,7 @@ fn read_png(path: &Path) -> Result<RawDepth> {
     if img.channels != 1 {
         return Err(Error::decode(
             path,
-            format!(
-                "depth PNG must be single-channel gray, found {} channels",
-                img.channels
-            ),
+            format!("depth PNG must be single-channel gray, found {} channels", img.channels),
         ));
     }
     let samples = match img.samples {
@@ -149,20 +142,13 @@ fn from_npy(path: &Path, arr: NpyArray) -> Result<RawDepth> {
             ))
         }
     };
-    Ok(RawDepth {
-        width,
-        height,
-        samples,
-    })
+    Ok(RawDepth { width, height, samples })
 }
 
 fn to_metres(path: &Path, raw: RawDepth, decode: &DepthDecode) -> Result<DepthMap> {
     let scale = match decode.scale {
         Some(s) if !(s.is_finite() && s > 0.0) => {
-            return Err(Error::param(
-                "depth-scale",
-                format!("must be finite and > 0, got {s}"),
-            ))
+            return Err(Error::param("depth-scale", format!("must be finite and > 0, got {s}")))
         }
         s => s,
     };
@@ -182,19 +168,13 @@ fn to_metres(path: &Path, raw: RawDepth, decode: &DepthDecode) -> Result<DepthMa
         scale.ok_or_else(|| {
             Error::param(
                 "depth-scale",
-                format!(
-                    "{}: {bits} depth needs --depth-scale ({hint})",
-                    path.display()
-                ),
+                format!("{}: {bits} depth needs --depth-scale ({hint})", path.display()),
             )
         })
     };
     let data: Vec<f32> = match raw.samples {
         RawSamples::U8(v) => {
-            let s = need_scale(
-                "8-bit",
-                "unusual for depth; e.g. 4 for Middlebury 2003 disparity",
-            )?;
+            let s = need_scale("8-bit", "unusual for depth; e.g. 4 for Middlebury 2003 disparity")?;
             v.into_iter().map(|d| int_to_metres(d.into(), s)).collect()
         }
         RawSamples::U16(v) => {
@@ -220,10 +200,7 @@ fn to_metres(path: &Path, raw: RawDepth, decode: &DepthDecode) -> Result<DepthMa
             Some(s) => v.into_iter().map(|x| (f64::from(x) / s) as f32).collect(),
             None => v,
         },
-        RawSamples::F64(v) => v
-            .into_iter()
-            .map(|x| (x / scale.unwrap_or(1.0)) as f32)
-            .collect(),
+        RawSamples::F64(v) => v.into_iter().map(|x| (x / scale.unwrap_or(1.0)) as f32).collect(),
     };
     DepthMap::new(raw.width, raw.height, data).map_err(|e| Error::decode(path, e.to_string()))
 }
@@ -258,10 +235,7 @@ mod tests {
 
     fn same(a: &DepthMap, b: &DepthMap) -> bool {
         (a.width, a.height) == (b.width, b.height)
-            && a.data
-                .iter()
-                .zip(&b.data)
-                .all(|(x, y)| x.to_bits() == y.to_bits())
+            && a.data.iter().zip(&b.data).all(|(x, y)| x.to_bits() == y.to_bits())
     }
 
     fn save_png16(path: &Path, w: u32, h: u32, data: Vec<u16>) {
@@ -288,18 +262,10 @@ mod tests {
         let dir = scratch_dir("depth-exr-ambiguous");
         let path = dir.join("d.exr");
         atomic_write(&path, |out| {
-            write_f32_channels(
-                &path,
-                out,
-                1,
-                1,
-                vec![("alpha", vec![1.0]), ("beta", vec![2.0])],
-            )
+            write_f32_channels(&path, out, 1, 1, vec![("alpha", vec![1.0]), ("beta", vec![2.0])])
         })
         .unwrap();
-        let err = load_depth(&path, &DepthDecode::default())
-            .unwrap_err()
-            .to_string();
+        let err = load_depth(&path, &DepthDecode::default()).unwrap_err().to_string();
         assert!(
             err.contains("alpha") && err.contains("beta") && err.contains("d.exr"),
             "{err}"
@@ -330,10 +296,7 @@ mod tests {
         assert_eq!(d.data, vec![0.0, 1.0, 2.0, 3.0, 4.0, 5.0]);
 
         // u2 big-endian needs a scale; 0 stays 0.
-        let payload: Vec<u8> = [5000u16, 0, 10000, 2500]
-            .iter()
-            .flat_map(|v| v.to_be_bytes())
-            .collect();
+        let payload: Vec<u8> = [5000u16, 0, 10000, 2500].iter().flat_map(|v| v.to_be_bytes()).collect();
         let dict = "{'descr': '>u2', 'fortran_order': False, 'shape': (2, 2), }";
         let path = dir.join("u2.npy");
         std::fs::write(&path, build_npy(dict, &payload)).unwrap();
@@ -350,9 +313,7 @@ mod tests {
         let dir = scratch_dir("depth-npy-bad");
         let path = dir.join("rgb.npy");
         save_npy_f32(&path, &[2, 2, 3], &[0.0; 12]).unwrap();
-        let err = load_depth(&path, &DepthDecode::default())
-            .unwrap_err()
-            .to_string();
+        let err = load_depth(&path, &DepthDecode::default()).unwrap_err().to_string();
         assert!(err.contains("(H, W)") && err.contains("[2, 2, 3]"), "{err}");
 
         let path = dir.join("u1.npy");
@@ -373,17 +334,9 @@ mod tests {
         let dir = scratch_dir("depth-png");
         let path = dir.join("d.png");
         save_png16(&path, 2, 1, vec![5000, 0]);
-        let err = load_depth(&path, &DepthDecode::default())
-            .unwrap_err()
-            .to_string();
-        assert!(
-            err.contains("--depth-scale") && err.contains("5000 for TUM"),
-            "{err}"
-        );
-        assert_eq!(
-            load_depth(&path, &scaled(5000.0)).unwrap().data,
-            vec![1.0, 0.0]
-        );
+        let err = load_depth(&path, &DepthDecode::default()).unwrap_err().to_string();
+        assert!(err.contains("--depth-scale") && err.contains("5000 for TUM"), "{err}");
+        assert_eq!(load_depth(&path, &scaled(5000.0)).unwrap().data, vec![1.0, 0.0]);
 
         // SUN stores d rotated left by 3 bits; 2500 mm -> 2.5 m.
         let stored = 2500u16.rotate_left(3);
@@ -399,10 +352,7 @@ mod tests {
             ..scaled(1.0)
         };
         save_png16(&path, 1, 1, vec![0x0102]);
-        assert_eq!(
-            load_depth(&path, &swapped).unwrap().data,
-            vec![f32::from(0x0201u16)]
-        );
+        assert_eq!(load_depth(&path, &swapped).unwrap().data, vec![f32::from(0x0201u16)]);
     }
 
     #[test]
@@ -413,22 +363,14 @@ mod tests {
             .unwrap()
             .save(&path)
             .unwrap();
-        let err = load_depth(&path, &DepthDecode::default())
-            .unwrap_err()
-            .to_string();
+        let err = load_depth(&path, &DepthDecode::default()).unwrap_err().to_string();
         assert!(err.contains("8-bit"), "{err}");
-        assert_eq!(
-            load_depth(&path, &scaled(4.0)).unwrap().data,
-            vec![2.0, 0.0]
-        );
+        assert_eq!(load_depth(&path, &scaled(4.0)).unwrap().data, vec![2.0, 0.0]);
         let rot = DepthDecode {
             sun_rgbd_bit_rotate: true,
             ..scaled(4.0)
         };
-        assert!(matches!(
-            load_depth(&path, &rot),
-            Err(Error::InvalidParameter { .. })
-        ));
+        assert!(matches!(load_depth(&path, &rot), Err(Error::InvalidParameter { .. })));
         assert!(matches!(
             load_depth(&path, &scaled(0.0)),
             Err(Error::InvalidParameter { .. })
@@ -443,10 +385,7 @@ mod tests {
             .unwrap()
             .save(&rgb)
             .unwrap();
-        assert!(matches!(
-            load_depth(&rgb, &scaled(1.0)),
-            Err(Error::Decode { .. })
-        ));
+        assert!(matches!(load_depth(&rgb, &scaled(1.0)), Err(Error::Decode { .. })));
     }
 
     #[test]
@@ -463,10 +402,7 @@ mod tests {
 
         let path = dir.join("d.pgm");
         std::fs::write(&path, b"P5 2 1 65535\n\x13\x88\x00\x00").unwrap();
-        assert_eq!(
-            load_depth(&path, &scaled(5000.0)).unwrap().data,
-            vec![1.0, 0.0]
-        );
+        assert_eq!(load_depth(&path, &scaled(5000.0)).unwrap().data, vec![1.0, 0.0]);
     }
 
     #[test]
@@ -486,11 +422,7 @@ mod tests {
         }
 
         let err = load_depth(&dir.join("d.tiff"), &DepthDecode::default()).unwrap_err();
-        assert!(
-            err.to_string()
-                .contains("expected .exr .npy .png .pgm .pfm"),
-            "{err}"
-        );
+        assert!(err.to_string().contains("expected .exr .npy .png .pgm .pfm"), "{err}");
     }
 
     #[test]

@@ -5,8 +5,8 @@ use std::io::{BufWriter, Cursor};
 use std::path::Path;
 
 use exr::prelude::{
-    AnyChannel, AnyChannels, Encoding, FlatSamples, Image, Layer, LayerAttributes, MetaData,
-    ReadChannels, ReadLayers, SmallVec, WritableImage,
+    AnyChannel, AnyChannels, Encoding, FlatSamples, Image, Layer, LayerAttributes, MetaData, ReadChannels, ReadLayers,
+    SmallVec, WritableImage,
 };
 
 use super::depth::{RawDepth, RawSamples};
@@ -18,8 +18,7 @@ use crate::error::{Error, Result};
 pub(crate) fn read_depth_channel(path: &Path) -> Result<RawDepth> {
     let bytes = std::fs::read(path).map_err(|e| Error::io(path, e))?;
     // Headers first, so the size check happens before any pixel allocation.
-    let meta =
-        MetaData::read_from_buffered(Cursor::new(&bytes), false).map_err(|e| exr_error(path, e))?;
+    let meta = MetaData::read_from_buffered(Cursor::new(&bytes), false).map_err(|e| exr_error(path, e))?;
     let header = match meta.headers.as_slice() {
         [h] => h,
         hs => {
@@ -79,11 +78,7 @@ pub(crate) fn read_depth_channel(path: &Path) -> Result<RawDepth> {
             ),
         ));
     }
-    Ok(RawDepth {
-        width,
-        height,
-        samples,
-    })
+    Ok(RawDepth { width, height, samples })
 }
 
 fn choose_channel(names: &[String]) -> Option<usize> {
@@ -114,13 +109,10 @@ pub(crate) fn write_f32_channels(
         Encoding::SMALL_LOSSLESS,
         AnyChannels::sort(list),
     );
-    Image::from_layer(layer)
-        .write()
-        .to_buffered(out)
-        .map_err(|e| match e {
-            exr::error::Error::Io(io) => Error::io(path, io),
-            other => Error::encode(path, other.to_string()),
-        })
+    Image::from_layer(layer).write().to_buffered(out).map_err(|e| match e {
+        exr::error::Error::Io(io) => Error::io(path, io),
+        other => Error::encode(path, other.to_string()),
+    })
 }
 
 fn exr_error(path: &Path, e: exr::error::Error) -> Error {

@@ -36,11 +36,7 @@ impl RgbImage {
     /// Fails with `SizeMismatch` unless `data.len() == width * height * 3`.
     pub fn new(width: u32, height: u32, data: Vec<u8>) -> Result<Self> {
         check_len("RgbImage", width, height, 3, data.len())?;
-        Ok(Self {
-            width,
-            height,
-            data,
-        })
+        Ok(Self { width, height, data })
     }
 
     /// Pixel at column `x`, row `y` (top-down); `None` outside the image.
@@ -57,18 +53,12 @@ impl DepthMap {
     /// Fails with `SizeMismatch` unless `data.len() == width * height`.
     pub fn new(width: u32, height: u32, data: Vec<f32>) -> Result<Self> {
         check_len("DepthMap", width, height, 1, data.len())?;
-        Ok(Self {
-            width,
-            height,
-            data,
-        })
+        Ok(Self { width, height, data })
     }
 
     /// Value at column `x`, row `y` (top-down); `None` outside the map.
     pub fn get(&self, x: u32, y: u32) -> Option<f32> {
-        self.data
-            .get(pixel_index(self.width, self.height, x, y)?)
-            .copied()
+        self.data.get(pixel_index(self.width, self.height, x, y)?).copied()
     }
 }
 
@@ -76,18 +66,12 @@ impl Mask {
     /// Fails with `SizeMismatch` unless `data.len() == width * height`.
     pub fn new(width: u32, height: u32, data: Vec<u8>) -> Result<Self> {
         check_len("Mask", width, height, 1, data.len())?;
-        Ok(Self {
-            width,
-            height,
-            data,
-        })
+        Ok(Self { width, height, data })
     }
 
     /// Value at column `x`, row `y` (top-down); `None` outside the mask.
     pub fn get(&self, x: u32, y: u32) -> Option<u8> {
-        self.data
-            .get(pixel_index(self.width, self.height, x, y)?)
-            .copied()
+        self.data.get(pixel_index(self.width, self.height, x, y)?).copied()
     }
 }
 
@@ -95,16 +79,12 @@ fn pixel_index(width: u32, height: u32, x: u32, y: u32) -> Option<usize> {
     if x >= width || y >= height {
         return None;
     }
-    (y as usize)
-        .checked_mul(width as usize)?
-        .checked_add(x as usize)
+    (y as usize).checked_mul(width as usize)?.checked_add(x as usize)
 }
 
 /// `width * height * channels`, or `None` on overflow.
 pub(crate) fn sample_count(width: u32, height: u32, channels: usize) -> Option<usize> {
-    (width as usize)
-        .checked_mul(height as usize)?
-        .checked_mul(channels)
+    (width as usize).checked_mul(height as usize)?.checked_mul(channels)
 }
 
 fn check_len(what: &str, width: u32, height: u32, channels: usize, len: usize) -> Result<()> {
@@ -140,13 +120,7 @@ pub(crate) fn decode_dims(path: &Path, width: u64, height: u64) -> Result<(u32, 
 }
 
 /// Dimension check for an in-memory raster about to be written to `path`.
-pub(crate) fn encode_dims(
-    path: &Path,
-    width: u32,
-    height: u32,
-    channels: usize,
-    len: usize,
-) -> Result<()> {
+pub(crate) fn encode_dims(path: &Path, width: u32, height: u32, channels: usize, len: usize) -> Result<()> {
     if let Some(msg) = dims_problem(u64::from(width), u64::from(height)) {
         return Err(Error::encode(path, msg));
     }

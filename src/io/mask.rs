@@ -13,11 +13,7 @@ use crate::error::{Error, Result};
 /// Writes 8-bit gray: 0 -> 0, any nonzero value -> 255.
 pub fn save_mask_png(path: &Path, mask: &Mask) -> Result<()> {
     encode_dims(path, mask.width, mask.height, 1, mask.data.len())?;
-    let bytes: Vec<u8> = mask
-        .data
-        .iter()
-        .map(|&v| if v == 0 { 0 } else { 255 })
-        .collect();
+    let bytes: Vec<u8> = mask.data.iter().map(|&v| if v == 0 { 0 } else { 255 }).collect();
     atomic_write(path, |out| {
         PngEncoder::new(out)
             .write_image(&bytes, mask.width, mask.height, ExtendedColorType::L8)
@@ -46,12 +42,7 @@ pub fn load_mask_png(path: &Path) -> Result<Mask> {
     Mask::new(width, height, data).map_err(|e| Error::decode(path, e.to_string()))
 }
 
-fn set_pixels<T: Copy>(
-    samples: &[T],
-    channels: usize,
-    colour: usize,
-    nonzero: impl Fn(T) -> bool,
-) -> Vec<u8> {
+fn set_pixels<T: Copy>(samples: &[T], channels: usize, colour: usize, nonzero: impl Fn(T) -> bool) -> Vec<u8> {
     samples
         .chunks_exact(channels.max(1))
         .map(|px| u8::from(px.iter().take(colour).any(|&v| nonzero(v))))
@@ -71,10 +62,7 @@ mod tests {
         save_mask_png(&path, &mask).unwrap();
         let on_disk = image::open(&path).unwrap();
         assert_eq!(on_disk.color(), image::ColorType::L8);
-        assert_eq!(
-            on_disk.into_luma8().into_raw(),
-            vec![0, 255, 0, 255, 0, 255]
-        );
+        assert_eq!(on_disk.into_luma8().into_raw(), vec![0, 255, 0, 255, 0, 255]);
         assert_eq!(load_mask_png(&path).unwrap().data, vec![0, 1, 0, 1, 0, 1]);
     }
 
@@ -83,10 +71,7 @@ mod tests {
         let dir = scratch_dir("mask-rgba");
         let path = dir.join("m.png");
         let px = vec![0, 0, 0, 255, 1, 0, 0, 0, 0, 0, 0, 0];
-        image::RgbaImage::from_raw(3, 1, px)
-            .unwrap()
-            .save(&path)
-            .unwrap();
+        image::RgbaImage::from_raw(3, 1, px).unwrap().save(&path).unwrap();
         assert_eq!(load_mask_png(&path).unwrap().data, vec![0, 1, 0]);
     }
 

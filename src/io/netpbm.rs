@@ -18,11 +18,7 @@ impl<'a> HeaderReader<'a> {
             match self.bytes.get(self.pos)? {
                 c if c.is_ascii_whitespace() => self.pos += 1,
                 b'#' => {
-                    while self
-                        .bytes
-                        .get(self.pos)
-                        .is_some_and(|&c| c != b'\n' && c != b'\r')
-                    {
+                    while self.bytes.get(self.pos).is_some_and(|&c| c != b'\n' && c != b'\r') {
                         self.pos += 1;
                     }
                 }
@@ -42,9 +38,7 @@ impl<'a> HeaderReader<'a> {
 
     /// Next token parsed as `T`; `what` names the field in the error.
     pub(crate) fn number<T: FromStr>(&mut self, what: &str) -> Result<T, String> {
-        let token = self
-            .token()
-            .ok_or_else(|| format!("header ends before the {what}"))?;
+        let token = self.token().ok_or_else(|| format!("header ends before the {what}"))?;
         std::str::from_utf8(token)
             .ok()
             .and_then(|t| t.parse().ok())

@@ -83,13 +83,12 @@ pub fn save_npy_f32(path: &Path, shape: &[usize], data: &[f32]) -> Result<()> {
             ),
         });
     }
-    let header = format_header("<f4", shape)
-        .ok_or_else(|| Error::encode(path, "NPY header longer than 65535 bytes"))?;
+    let header =
+        format_header("<f4", shape).ok_or_else(|| Error::encode(path, "NPY header longer than 65535 bytes"))?;
     atomic_write(path, |out| {
         out.write_all(&header).map_err(|e| Error::io(path, e))?;
         for v in data {
-            out.write_all(&v.to_le_bytes())
-                .map_err(|e| Error::io(path, e))?;
+            out.write_all(&v.to_le_bytes()).map_err(|e| Error::io(path, e))?;
         }
         Ok(())
     })
@@ -102,8 +101,7 @@ fn format_header(descr: &str, shape: &[usize]) -> Option<Vec<u8>> {
         [one] => format!("({one},)"),
         _ => format!("({})", dims.join(", ")),
     };
-    let mut dict =
-        format!("{{'descr': '{descr}', 'fortran_order': False, 'shape': {shape_text}, }}");
+    let mut dict = format!("{{'descr': '{descr}', 'fortran_order': False, 'shape': {shape_text}, }}");
     let unpadded = MAGIC.len() + 2 + 2 + dict.len() + 1;
     dict.push_str(&" ".repeat((64 - unpadded % 64) % 64));
     dict.push('\n');
@@ -118,20 +116,14 @@ fn format_header(descr: &str, shape: &[usize]) -> Option<Vec<u8>> {
 
 /// Returns (header dict text, payload).
 fn split_header(bytes: &[u8]) -> std::result::Result<(&str, &[u8]), String> {
-    let rest = bytes
-        .strip_prefix(MAGIC)
-        .ok_or("missing \\x93NUMPY magic")?;
-    let (version, rest) = rest
-        .split_at_checked(2)
-        .ok_or("file ends inside the header")?;
+    let rest = bytes.strip_prefix(MAGIC).ok_or("missing \\x93NUMPY magic")?;
+    let (version, rest) = rest.split_at_checked(2).ok_or("file ends inside the header")?;
     let len_bytes = match version {
         [1, 0] => 2,
         [2, 0] | [3, 0] => 4,
         _ => return Err(format!("unsupported format version {version:?}")),
     };
-    let (len_field, rest) = rest
-        .split_at_checked(len_bytes)
-        .ok_or("file ends inside the header")?;
+    let (len_field, rest) = rest.split_at_checked(len_bytes).ok_or("file ends inside the header")?;
     let len = len_field
         .iter()
         .rev()
@@ -140,9 +132,7 @@ fn split_header(bytes: &[u8]) -> std::result::Result<(&str, &[u8]), String> {
         .split_at_checked(len)
         .ok_or_else(|| format!("header length {len} exceeds the file"))?;
     let header = std::str::from_utf8(header).map_err(|_| "header is not UTF-8")?;
-    let header = header
-        .strip_suffix('\n')
-        .ok_or("header does not end with a newline")?;
+    let header = header.strip_suffix('\n').ok_or("header does not end with a newline")?;
     Ok((header, payload))
 }
 
@@ -194,12 +184,8 @@ fn parse_header(text: &str) -> std::result::Result<Header, String> {
     let descr: String = descr.ok_or("header lacks 'descr'")?;
     let (dtype, item_size, decode): (NpyDtype, usize, DecodeFn) = match descr.as_str() {
         "|u1" => (NpyDtype::U8, 1, |b| f64::from(b[0])),
-        "<u2" => (NpyDtype::U16, 2, |b| {
-            f64::from(u16::from_le_bytes([b[0], b[1]]))
-        }),
-        ">u2" => (NpyDtype::U16, 2, |b| {
-            f64::from(u16::from_be_bytes([b[0], b[1]]))
-        }),
+        "<u2" => (NpyDtype::U16, 2, |b| f64::from(u16::from_le_bytes([b[0], b[1]]))),
+        ">u2" => (NpyDtype::U16, 2, |b| f64::from(u16::from_be_bytes([b[0], b[1]]))),
         "<f4" => (NpyDtype::F32, 4, |b| {
             f64::from(f32::from_le_bytes([b[0], b[1], b[2], b[3]]))
         }),
@@ -257,11 +243,7 @@ impl Parser<'_> {
         if self.eat(c) {
             Ok(())
         } else {
-            Err(format!(
-                "expected '{}' at header offset {}",
-                char::from(c),
-                self.i
-            ))
+            Err(format!("expected '{}' at header offset {}", char::from(c), self.i))
         }
     }
 
@@ -291,10 +273,7 @@ impl Parser<'_> {
                 return Ok(value);
             }
         }
-        Err(format!(
-            "expected True or False at header offset {}",
-            self.i
-        ))
+        Err(format!("expected True or False at header offset {}", self.i))
     }
 
     /// `()`, `(n,)`, `(a, b)`, `(a, b,)`; Python 2's `3L` suffix is accepted.
@@ -403,10 +382,7 @@ mod tests {
         let arr = load_npy(&path).unwrap();
         assert_eq!(arr.shape, vec![2, 3]);
         assert_eq!(arr.dtype, NpyDtype::F32);
-        assert_eq!(
-            arr.data,
-            data.iter().map(|&v| f64::from(v)).collect::<Vec<_>>()
-        );
+        assert_eq!(arr.data, data.iter().map(|&v| f64::from(v)).collect::<Vec<_>>());
     }
 
     #[test]
@@ -424,17 +400,11 @@ mod tests {
     #[test]
     fn f64_big_endian_u16_and_python2_header() {
         let dir = scratch_dir("npy-dtypes");
-        let payload: Vec<u8> = [1.5f64, -2.0]
-            .iter()
-            .flat_map(|v| v.to_be_bytes())
-            .collect();
+        let payload: Vec<u8> = [1.5f64, -2.0].iter().flat_map(|v| v.to_be_bytes()).collect();
         let p = write(
             &dir,
             "be.npy",
-            &build_npy(
-                "{'descr': '>f8', 'fortran_order': False, 'shape': (2,), }",
-                &payload,
-            ),
+            &build_npy("{'descr': '>f8', 'fortran_order': False, 'shape': (2,), }", &payload),
         );
         assert_eq!(load_npy(&p).unwrap().data, vec![1.5, -2.0]);
 
@@ -465,15 +435,9 @@ mod tests {
         let p = write(
             &dir,
             "f.npy",
-            &build_npy(
-                "{'descr': '<f4', 'fortran_order': True, 'shape': (2, 3), }",
-                &payload,
-            ),
+            &build_npy("{'descr': '<f4', 'fortran_order': True, 'shape': (2, 3), }", &payload),
         );
-        assert_eq!(
-            load_npy(&p).unwrap().data,
-            vec![0.0, 1.0, 2.0, 3.0, 4.0, 5.0]
-        );
+        assert_eq!(load_npy(&p).unwrap().data, vec![0.0, 1.0, 2.0, 3.0, 4.0, 5.0]);
         let shape = [2, 3, 2];
         let f: Vec<f64> = (0..12).map(f64::from).collect();
         let c = fortran_to_c(&shape, &f);
@@ -489,10 +453,7 @@ mod tests {
         let err = load_npy(&p).unwrap_err();
         assert!(matches!(err, Error::Decode { .. }));
         let msg = err.to_string();
-        assert!(
-            msg.contains("short.npy") && msg.contains("truncated"),
-            "{msg}"
-        );
+        assert!(msg.contains("short.npy") && msg.contains("truncated"), "{msg}");
         let p = write(&dir, "long.npy", &build_npy(dict, &[0u8; 65]));
         assert!(load_npy(&p).is_err());
         // Header length pointing past the end of the file.
@@ -520,10 +481,7 @@ mod tests {
         ];
         for dict in cases {
             let p = write(&dir, "bad.npy", &build_npy(dict, &[0u8; 4]));
-            assert!(
-                matches!(load_npy(&p), Err(Error::Decode { .. })),
-                "accepted {dict}"
-            );
+            assert!(matches!(load_npy(&p), Err(Error::Decode { .. })), "accepted {dict}");
         }
         let p = write(&dir, "magic.npy", b"\x93NUMPX\x01\x00\x00\x00");
         assert!(load_npy(&p).is_err());

@@ -16,11 +16,7 @@ pub(crate) fn read_pfm(path: &Path) -> Result<RawDepth> {
     let mut header = HeaderReader::new(&bytes);
     match header.token() {
         Some(b"Pf") => {}
-        Some(b"PF") => {
-            return Err(bad(
-                "colour PFM (PF) is not depth; expected grayscale Pf".into()
-            ))
-        }
+        Some(b"PF") => return Err(bad("colour PFM (PF) is not depth; expected grayscale Pf".into())),
         _ => return Err(bad("expected magic Pf".into())),
     }
     let width: u64 = header.number("width").map_err(bad)?;
@@ -104,10 +100,7 @@ mod tests {
         // The first stored row is the bottom one.
         let bytes = build_pfm(3, &TOP_DOWN, true);
         let raster = &bytes[bytes.len() - 24..];
-        assert_eq!(
-            f32::from_le_bytes([raster[0], raster[1], raster[2], raster[3]]),
-            4.0
-        );
+        assert_eq!(f32::from_le_bytes([raster[0], raster[1], raster[2], raster[3]]), 4.0);
     }
 
     #[test]

@@ -37,11 +37,9 @@ pub(crate) fn read_pgm(path: &Path) -> Result<RawDepth> {
         let need = count.checked_mul(if wide { 2 } else { 1 });
         // Trailing bytes are allowed: a PGM file may hold several images.
         match need.and_then(|n| raster.get(..n)) {
-            Some(data) if wide => RawSamples::U16(
-                data.chunks_exact(2)
-                    .map(|b| u16::from_be_bytes([b[0], b[1]]))
-                    .collect(),
-            ),
+            Some(data) if wide => {
+                RawSamples::U16(data.chunks_exact(2).map(|b| u16::from_be_bytes([b[0], b[1]])).collect())
+            }
             Some(data) => RawSamples::U8(data.to_vec()),
             None => {
                 return Err(bad(format!(
@@ -52,18 +50,10 @@ pub(crate) fn read_pgm(path: &Path) -> Result<RawDepth> {
             }
         }
     };
-    Ok(RawDepth {
-        width,
-        height,
-        samples,
-    })
+    Ok(RawDepth { width, height, samples })
 }
 
-fn read_plain(
-    mut header: HeaderReader<'_>,
-    count: usize,
-    wide: bool,
-) -> std::result::Result<RawSamples, String> {
+fn read_plain(mut header: HeaderReader<'_>, count: usize, wide: bool) -> std::result::Result<RawSamples, String> {
     let mut values = Vec::new();
     for _ in 0..count {
         values.push(header.number::<u16>("sample")?);

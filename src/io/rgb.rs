@@ -106,11 +106,7 @@ mod tests {
         let mut data = Vec::new();
         for y in 0..h {
             for x in 0..w {
-                data.extend([
-                    (x * 17 % 256) as u8,
-                    (y * 29 % 256) as u8,
-                    ((x + y) * 5) as u8,
-                ]);
+                data.extend([(x * 17 % 256) as u8, (y * 29 % 256) as u8, ((x + y) * 5) as u8]);
             }
         }
         RgbImage::new(w, h, data).unwrap()
@@ -156,9 +152,7 @@ mod tests {
     fn gray_alpha_and_16_bit_inputs_convert() {
         let dir = scratch_dir("rgb-conv");
         let path = dir.join("g16.png");
-        let gray16 =
-            image::ImageBuffer::<image::Luma<u16>, _>::from_raw(2, 1, vec![0x1234, 0xFF00])
-                .unwrap();
+        let gray16 = image::ImageBuffer::<image::Luma<u16>, _>::from_raw(2, 1, vec![0x1234, 0xFF00]).unwrap();
         gray16.save(&path).unwrap();
         let img = load_rgb(&path).unwrap();
         assert_eq!(img.data, vec![0x12, 0x12, 0x12, 0xFF, 0xFF, 0xFF]);

@@ -24,16 +24,20 @@ impl Default for BreakRule {
     /// tau_rel 0.05 (a 5 % jump: 25 cm at 5 m, several times Kinect-class noise) and
     /// tau_abs 0.2 m (the top of the seed's range, so it only bites beyond 4 m).
     fn default() -> Self {
-        BreakRule { tau_rel: 0.05, tau_abs: 0.2 }
+        BreakRule {
+            tau_rel: 0.05,
+            tau_abs: 0.2,
+        }
     }
 }
 
 impl BreakRule {
     pub fn validate(&self) -> crate::Result<()> {
-        if !(self.tau_rel >= 0.0) || self.tau_rel.is_nan() {
+        // NaN fails every comparison, so `is_ge` alone rejects it.
+        if !self.tau_rel.partial_cmp(&0.0).is_some_and(|o| o.is_ge()) {
             return Err(crate::Error::param("tau-rel", format!("{} must be >= 0", self.tau_rel)));
         }
-        if !(self.tau_abs >= 0.0) {
+        if !self.tau_abs.partial_cmp(&0.0).is_some_and(|o| o.is_ge()) {
             return Err(crate::Error::param("tau-abs", format!("{} must be >= 0", self.tau_abs)));
         }
         Ok(())
@@ -149,17 +153,26 @@ mod tests {
         assert_eq!(Grid::vertex_pixel(0, 4), 0);
         assert_eq!(Grid::vertex_pixel(5, 4), 3);
         // A 1-pixel axis still forms two half cells around its pixel.
-        assert_eq!([Grid::vertex_pos(0, 1), Grid::vertex_pos(1, 1), Grid::vertex_pos(2, 1)], [-0.5, 0.0, 0.5]);
+        assert_eq!(
+            [Grid::vertex_pos(0, 1), Grid::vertex_pos(1, 1), Grid::vertex_pos(2, 1)],
+            [-0.5, 0.0, 0.5]
+        );
     }
 
     #[test]
     fn break_rule_uses_either_threshold() {
-        let r = BreakRule { tau_rel: 0.05, tau_abs: 0.2 };
+        let r = BreakRule {
+            tau_rel: 0.05,
+            tau_abs: 0.2,
+        };
         assert!(r.continuous(1.0, 1.04));
         assert!(!r.continuous(1.0, 1.06)); // relative
         assert!(r.continuous(10.0, 10.19));
         assert!(!r.continuous(10.0, 10.21)); // absolute (relative alone would keep 2.1 %)
-        let inf = BreakRule { tau_rel: 0.05, tau_abs: f64::INFINITY };
+        let inf = BreakRule {
+            tau_rel: 0.05,
+            tau_abs: f64::INFINITY,
+        };
         assert!(inf.continuous(10.0, 10.4));
     }
 

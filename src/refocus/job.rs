@@ -75,7 +75,12 @@ impl TargetSpec {
                     return Err(Error::param("focal scale", format!("{s} must be finite and > 0")));
                 }
                 let cam = PinholeCamera {
-                    k: Intrinsics { fx: source.k.fx * s, fy: source.k.fy * s, cx, cy },
+                    k: Intrinsics {
+                        fx: source.k.fx * s,
+                        fy: source.k.fy * s,
+                        cx,
+                        cy,
+                    },
                     width: w,
                     height: h,
                 };
@@ -191,8 +196,7 @@ pub fn write_output(
 /// Write `manifest.json` atomically.
 pub fn write_manifest(dir: &Path, manifest: &Manifest) -> Result<PathBuf> {
     let path = dir.join("manifest.json");
-    let text = serde_json::to_string_pretty(manifest)
-        .map_err(|e| Error::encode(&path, e.to_string()))?;
+    let text = serde_json::to_string_pretty(manifest).map_err(|e| Error::encode(&path, e.to_string()))?;
     io::atomic_write(&path, |w| {
         use std::io::Write;
         w.write_all(text.as_bytes()).map_err(|e| Error::io(&path, e))
@@ -206,12 +210,37 @@ mod tests {
 
     #[test]
     fn targets_keep_the_principal_point_offset_when_the_size_changes() {
-        let src = PinholeCamera { k: Intrinsics { fx: 500.0, fy: 480.0, cx: 319.5, cy: 239.5 }, width: 640, height: 480 };
-        let spec = TargetSpec { scales: vec![0.5, 2.0], size: Some((1280, 720)), principal: None };
+        let src = PinholeCamera {
+            k: Intrinsics {
+                fx: 500.0,
+                fy: 480.0,
+                cx: 319.5,
+                cy: 239.5,
+            },
+            width: 640,
+            height: 480,
+        };
+        let spec = TargetSpec {
+            scales: vec![0.5, 2.0],
+            size: Some((1280, 720)),
+            principal: None,
+        };
         let t = spec.targets(&src).unwrap();
-        assert_eq!(t[0].k, Intrinsics { fx: 250.0, fy: 240.0, cx: 639.5, cy: 359.5 });
+        assert_eq!(
+            t[0].k,
+            Intrinsics {
+                fx: 250.0,
+                fy: 240.0,
+                cx: 639.5,
+                cy: 359.5
+            }
+        );
         assert_eq!(t[1].k.fx, 1000.0);
-        let bad = TargetSpec { scales: vec![f64::NAN], size: None, principal: None };
+        let bad = TargetSpec {
+            scales: vec![f64::NAN],
+            size: None,
+            principal: None,
+        };
         assert!(bad.targets(&src).unwrap_err().to_string().contains("focal scale"));
         assert_eq!(scale_tag(0.5), "s0.5");
         assert_eq!(scale_tag(1.0), "s1");

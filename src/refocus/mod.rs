@@ -48,22 +48,33 @@ impl RefocusSource {
     }
 
     pub fn camera(&self) -> PinholeCamera {
-        PinholeCamera { k: self.k, width: self.rgb.width, height: self.rgb.height }
+        PinholeCamera {
+            k: self.k,
+            width: self.rgb.width,
+            height: self.rgb.height,
+        }
     }
 
     /// (min, max) of the valid depths, None when no pixel is valid.
     pub fn depth_range(&self) -> Option<(f64, f64)> {
-        self.depth.data.iter().filter(|z| valid_depth(**z)).fold(None, |acc, &z| {
-            let z = z as f64;
-            Some(acc.map_or((z, z), |(lo, hi): (f64, f64)| (lo.min(z), hi.max(z))))
-        })
+        self.depth
+            .data
+            .iter()
+            .filter(|z| valid_depth(**z))
+            .fold(None, |acc, &z| {
+                let z = z as f64;
+                Some(acc.map_or((z, z), |(lo, hi): (f64, f64)| (lo.min(z), hi.max(z))))
+            })
     }
 }
 
 /// Source pixel coordinate seen by target pixel (x, y) under the same pose:
 /// u = cx + (x - cx') fx / fx' (and likewise v).
 pub fn source_point(src: &Intrinsics, dst: &Intrinsics, x: f64, y: f64) -> [f64; 2] {
-    [src.cx + (x - dst.cx) * (src.fx / dst.fx), src.cy + (y - dst.cy) * (src.fy / dst.fy)]
+    [
+        src.cx + (x - dst.cx) * (src.fx / dst.fx),
+        src.cy + (y - dst.cy) * (src.fy / dst.fy),
+    ]
 }
 
 /// How the GPU renders a refocus.
@@ -98,20 +109,33 @@ pub struct OutputSet {
 
 impl Default for OutputSet {
     fn default() -> Self {
-        OutputSet { rgb: true, depth: true, mask: true }
+        OutputSet {
+            rgb: true,
+            depth: true,
+            mask: true,
+        }
     }
 }
 
 impl OutputSet {
     /// Parse "rgb,depth,mask" (any subset, at least one).
     pub fn parse(list: &str) -> Result<Self> {
-        let mut out = OutputSet { rgb: false, depth: false, mask: false };
+        let mut out = OutputSet {
+            rgb: false,
+            depth: false,
+            mask: false,
+        };
         for item in list.split(',').map(str::trim).filter(|s| !s.is_empty()) {
             match item {
                 "rgb" => out.rgb = true,
                 "depth" => out.depth = true,
                 "mask" => out.mask = true,
-                _ => return Err(Error::param("outputs", format!("'{item}': expected rgb, depth or mask"))),
+                _ => {
+                    return Err(Error::param(
+                        "outputs",
+                        format!("'{item}': expected rgb, depth or mask"),
+                    ))
+                }
             }
         }
         if !(out.rgb || out.depth || out.mask) {

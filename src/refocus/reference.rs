@@ -70,10 +70,19 @@ pub fn bilinear_rgb(src: &RefocusSource, u: f64, v: f64) -> [f64; 3] {
     let texel = |x: i64, y: i64| {
         let (x, y) = (x.clamp(0, w - 1) as usize, y.clamp(0, h - 1) as usize);
         let o = (y * w as usize + x) * 3;
-        [src.rgb.data[o] as f64, src.rgb.data[o + 1] as f64, src.rgb.data[o + 2] as f64]
+        [
+            src.rgb.data[o] as f64,
+            src.rgb.data[o + 1] as f64,
+            src.rgb.data[o + 2] as f64,
+        ]
     };
     let (x0, y0) = (x0 as i64, y0 as i64);
-    let (c00, c10, c01, c11) = (texel(x0, y0), texel(x0 + 1, y0), texel(x0, y0 + 1), texel(x0 + 1, y0 + 1));
+    let (c00, c10, c01, c11) = (
+        texel(x0, y0),
+        texel(x0 + 1, y0),
+        texel(x0, y0 + 1),
+        texel(x0 + 1, y0 + 1),
+    );
     let mut out = [0.0; 3];
     for c in 0..3 {
         let top = c00[c] + (c10[c] - c00[c]) * fx;
@@ -85,7 +94,10 @@ pub fn bilinear_rgb(src: &RefocusSource, u: f64, v: f64) -> [f64; 3] {
 
 /// Reference refocus of `src` into `target` (same pose).
 pub fn refocus_reference(src: &RefocusSource, rule: &BreakRule, target: &PinholeCamera) -> ReferenceImage {
-    let grid = Grid { width: src.depth.width, height: src.depth.height };
+    let grid = Grid {
+        width: src.depth.width,
+        height: src.depth.height,
+    };
     let keep = grid.keep_mask(&src.depth.data, rule);
     let n = target.width as usize * target.height as usize;
     let mut out = ReferenceImage {
@@ -117,11 +129,19 @@ mod tests {
 
     fn source(w: u32, h: u32, depth: impl Fn(u32, u32) -> f32) -> RefocusSource {
         let rgb: Vec<u8> = (0..w * h * 3).map(|i| (i * 37 % 251) as u8).collect();
-        let d: Vec<f32> = (0..h).flat_map(|y| (0..w).map(move |x| (x, y))).map(|(x, y)| depth(x, y)).collect();
+        let d: Vec<f32> = (0..h)
+            .flat_map(|y| (0..w).map(move |x| (x, y)))
+            .map(|(x, y)| depth(x, y))
+            .collect();
         RefocusSource::new(
             RgbImage::new(w, h, rgb).unwrap(),
             DepthMap::new(w, h, d).unwrap(),
-            Intrinsics { fx: 100.0, fy: 90.0, cx: (w as f64 - 1.0) / 2.0, cy: (h as f64 - 1.0) / 2.0 },
+            Intrinsics {
+                fx: 100.0,
+                fy: 90.0,
+                cx: (w as f64 - 1.0) / 2.0,
+                cy: (h as f64 - 1.0) / 2.0,
+            },
         )
         .unwrap()
     }
@@ -129,7 +149,11 @@ mod tests {
     #[test]
     fn scale_one_reproduces_every_pixel_of_a_plane() {
         let src = source(7, 5, |x, y| 1.0 + 0.01 * x as f32 + 0.02 * y as f32);
-        let cam = PinholeCamera { k: src.k, width: 7, height: 5 };
+        let cam = PinholeCamera {
+            k: src.k,
+            width: 7,
+            height: 5,
+        };
         let r = refocus_reference(&src, &BreakRule::default(), &cam);
         for i in 0..35 {
             assert!(r.mask[i]);
@@ -143,7 +167,12 @@ mod tests {
     #[test]
     fn depth_of_a_slanted_plane_is_exact_between_vertices() {
         // Plane Z = 2 + 0.1 X: back-projected vertices lie on it, so every interior point does too.
-        let k = Intrinsics { fx: 100.0, fy: 90.0, cx: 3.0, cy: 2.0 };
+        let k = Intrinsics {
+            fx: 100.0,
+            fy: 90.0,
+            cx: 3.0,
+            cy: 2.0,
+        };
         let plane = |u: f64| 2.0 / (1.0 - 0.1 * (u - k.cx) / k.fx); // Z solving Z = 2 + 0.1 (u-cx) Z / fx
         let src = source(7, 5, |x, _| plane(x as f64) as f32);
         let grid = Grid { width: 7, height: 5 };
@@ -158,7 +187,11 @@ mod tests {
     #[test]
     fn wide_angle_leaves_the_uncovered_border_empty_and_keeps_discontinuities_open() {
         let src = source(8, 8, |x, _| if x < 4 { 1.0 } else { 3.0 });
-        let mut cam = PinholeCamera { k: src.k, width: 8, height: 8 };
+        let mut cam = PinholeCamera {
+            k: src.k,
+            width: 8,
+            height: 8,
+        };
         cam.k.fx *= 0.5;
         cam.k.fy *= 0.5;
         let r = refocus_reference(&src, &BreakRule::default(), &cam);

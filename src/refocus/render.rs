@@ -25,7 +25,12 @@ const TRI_TEX_WIDTH: u32 = 4096;
 /// so pixel centres on an edge always reach that test.
 const EXPAND_PX: f32 = 1.0 / 32.0;
 
-const IDENTITY: [[f64; 4]; 4] = [[1.0, 0.0, 0.0, 0.0], [0.0, 1.0, 0.0, 0.0], [0.0, 0.0, 1.0, 0.0], [0.0, 0.0, 0.0, 1.0]];
+const IDENTITY: [[f64; 4]; 4] = [
+    [1.0, 0.0, 0.0, 0.0],
+    [0.0, 1.0, 0.0, 0.0],
+    [0.0, 0.0, 1.0, 0.0],
+    [0.0, 0.0, 0.0, 1.0],
+];
 
 /// One refocused view. Images are top-down whatever the row-order convention.
 pub struct RefocusOutput {
@@ -73,7 +78,10 @@ impl Refocuser {
         let (w, h) = (src.rgb.width, src.rgb.height);
         let max = gpu.max_image_side();
         if w > max || h > max {
-            return Err(Error::param("source size", format!("{w}x{h} exceeds this GPU's limit of {max}")));
+            return Err(Error::param(
+                "source size",
+                format!("{w}x{h} exceeds this GPU's limit of {max}"),
+            ));
         }
         let grid = Grid { width: w, height: h };
         let keep = grid.keep_mask(&src.depth.data, rule);
@@ -88,9 +96,18 @@ impl Refocuser {
                 let program = Program::new(
                     gpu,
                     &defines,
-                    &[(glow::VERTEX_SHADER, "fullscreen.vert", FULLSCREEN_VERT), (glow::FRAGMENT_SHADER, "refocus/fullscreen.frag", &frag)],
+                    &[
+                        (glow::VERTEX_SHADER, "fullscreen.vert", FULLSCREEN_VERT),
+                        (glow::FRAGMENT_SHADER, "refocus/fullscreen.frag", &frag),
+                    ],
                 )?;
-                let keep = Texture::new(gpu, grid.cells_x() as u32, grid.cells_y() as u32, TextureFormat::R8Ui, Some(&keep))?;
+                let keep = Texture::new(
+                    gpu,
+                    grid.cells_x() as u32,
+                    grid.cells_y() as u32,
+                    TextureFormat::R8Ui,
+                    Some(&keep),
+                )?;
                 (program, Geometry::Fullscreen { keep })
             }
             Method::Mesh => {
@@ -99,7 +116,10 @@ impl Refocuser {
                 let program = Program::new(
                     gpu,
                     &defines,
-                    &[(glow::VERTEX_SHADER, "refocus/mesh.vert", &vert), (glow::FRAGMENT_SHADER, "refocus/mesh.frag", &frag)],
+                    &[
+                        (glow::VERTEX_SHADER, "refocus/mesh.vert", &vert),
+                        (glow::FRAGMENT_SHADER, "refocus/mesh.frag", &frag),
+                    ],
                 )?;
                 let codes = grid.kept_triangles(&keep);
                 let count = codes.len();
@@ -116,13 +136,24 @@ impl Refocuser {
                     let mut padded = codes;
                     padded.resize(rows * TRI_TEX_WIDTH as usize, 0);
                     let bytes: Vec<u8> = padded.iter().flat_map(|c| c.to_ne_bytes()).collect();
-                    Some(Texture::new(gpu, TRI_TEX_WIDTH, rows as u32, TextureFormat::R32Ui, Some(&bytes))?)
+                    Some(Texture::new(
+                        gpu,
+                        TRI_TEX_WIDTH,
+                        rows as u32,
+                        TextureFormat::R32Ui,
+                        Some(&bytes),
+                    )?)
                 };
                 (program, Geometry::Mesh { tris, count })
             }
         };
         let rgb = if outputs.rgb {
-            let rgba: Vec<u8> = src.rgb.data.chunks_exact(3).flat_map(|p| [p[0], p[1], p[2], 255]).collect();
+            let rgba: Vec<u8> = src
+                .rgb
+                .data
+                .chunks_exact(3)
+                .flat_map(|p| [p[0], p[1], p[2], 255])
+                .collect();
             Some(Texture::new(gpu, w, h, TextureFormat::Rgba8, Some(&rgba))?)
         } else {
             None
@@ -132,7 +163,10 @@ impl Refocuser {
         // Every kept vertex lies in [min, max] of the valid depths; the factor 2 leaves room for
         // the expanded border of each triangle (which the vertex shader keeps within it).
         let planes = match src.depth_range() {
-            Some((lo, hi)) => DepthPlanes { near: 0.25 * lo, far: 4.0 * hi },
+            Some((lo, hi)) => DepthPlanes {
+                near: 0.25 * lo,
+                far: 4.0 * hi,
+            },
             None => DepthPlanes { near: 1.0, far: 2.0 },
         };
         Ok(Refocuser {
@@ -163,7 +197,12 @@ impl Refocuser {
         if !reuse {
             self.framebuffer = None; // free the old one before allocating
             let o = self.outputs;
-            let slot = |want: bool, format| want.then_some(Attachment { format, clear: [0.0; 4] });
+            let slot = |want: bool, format| {
+                want.then_some(Attachment {
+                    format,
+                    clear: [0.0; 4],
+                })
+            };
             let attachments = [
                 slot(o.rgb, TextureFormat::Rgba8),
                 slot(o.depth, TextureFormat::R32F),
@@ -275,11 +314,17 @@ impl Refocuser {
         }
         if let Some(t) = &fb.colors[1] {
             let bytes = top_down(t.read()?, w, h, 4, flip);
-            let z = bytes.chunks_exact(4).map(|b| f32::from_ne_bytes([b[0], b[1], b[2], b[3]])).collect();
+            let z = bytes
+                .chunks_exact(4)
+                .map(|b| f32::from_ne_bytes([b[0], b[1], b[2], b[3]]))
+                .collect();
             outputs.1 = Some(DepthMap::new(w, h, z)?);
         }
         if let Some(t) = &fb.colors[2] {
-            let m = top_down(t.read()?, w, h, 1, flip).into_iter().map(|v| (v >= 128) as u8).collect();
+            let m = top_down(t.read()?, w, h, 1, flip)
+                .into_iter()
+                .map(|v| (v >= 128) as u8)
+                .collect();
             outputs.2 = Some(Mask::new(w, h, m)?);
         }
         fb.unbind();

@@ -29,19 +29,25 @@ fn inputs(dir: &Path, w: u32, h: u32) -> (PathBuf, PathBuf) {
 
 fn refocus(rgb: &Path, depth: &Path, out: &Path, extra: &[&str]) -> Output {
     let mut c = bin();
-    c.args(["refocus", "--fx", "40", "--fy", "40", "--cx", "15.5", "--cy", "11.5", "--rgb"])
-        .arg(rgb)
-        .arg("--depth")
-        .arg(depth)
-        .arg("--out-dir")
-        .arg(out)
-        .args(extra);
+    c.args([
+        "refocus", "--fx", "40", "--fy", "40", "--cx", "15.5", "--cy", "11.5", "--rgb",
+    ])
+    .arg(rgb)
+    .arg("--depth")
+    .arg(depth)
+    .arg("--out-dir")
+    .arg(out)
+    .args(extra);
     c.output().expect("run viewsynth")
 }
 
 fn files_in(dir: &Path) -> Vec<String> {
     let mut v: Vec<String> = std::fs::read_dir(dir)
-        .map(|r| r.filter_map(|e| e.ok()).map(|e| e.file_name().to_string_lossy().into_owned()).collect())
+        .map(|r| {
+            r.filter_map(|e| e.ok())
+                .map(|e| e.file_name().to_string_lossy().into_owned())
+                .collect()
+        })
         .unwrap_or_default();
     v.sort();
     v
@@ -52,17 +58,30 @@ fn refocus_writes_requested_files_and_a_manifest() {
     let d = scratch("ok");
     let (rgb, depth) = inputs(&d, 32, 24);
     let out = d.join("out");
-    let o = refocus(&rgb, &depth, &out, &["--zoom-range", "0.5,2", "--depth-format", "exr,npy"]);
+    let o = refocus(
+        &rgb,
+        &depth,
+        &out,
+        &["--zoom-range", "0.5,2", "--depth-format", "exr,npy"],
+    );
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
     let files = files_in(&out);
     assert_eq!(
         files,
         [
-            "manifest.json", "s0.5_depth.exr", "s0.5_depth.npy", "s0.5_mask.png", "s0.5_rgb.png",
-            "s2_depth.exr", "s2_depth.npy", "s2_mask.png", "s2_rgb.png"
+            "manifest.json",
+            "s0.5_depth.exr",
+            "s0.5_depth.npy",
+            "s0.5_mask.png",
+            "s0.5_rgb.png",
+            "s2_depth.exr",
+            "s2_depth.npy",
+            "s2_mask.png",
+            "s2_rgb.png"
         ]
     );
-    let manifest: serde_json::Value = serde_json::from_slice(&std::fs::read(out.join("manifest.json")).unwrap()).unwrap();
+    let manifest: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(out.join("manifest.json")).unwrap()).unwrap();
     assert_eq!(manifest["outputs"][1]["intrinsics"]["fx"], 80.0);
     let z = io::load_depth(&out.join("s2_depth.npy"), &Default::default()).unwrap();
     assert_eq!((z.width, z.height), (32, 24));
@@ -76,9 +95,15 @@ fn refocus_writes_requested_files_and_a_manifest() {
 fn assert_clean_failure(o: &Output, needle: &str, out: &Path) {
     let err = String::from_utf8_lossy(&o.stderr);
     assert_eq!(o.status.code(), Some(1), "stderr: {err}");
-    assert!(err.contains("error:") && err.contains(needle), "expected '{needle}' in: {err}");
+    assert!(
+        err.contains("error:") && err.contains(needle),
+        "expected '{needle}' in: {err}"
+    );
     assert!(!err.contains("panicked"), "{err}");
-    let left: Vec<String> = files_in(out).into_iter().filter(|f| !f.starts_with(".viewsynth-write-test")).collect();
+    let left: Vec<String> = files_in(out)
+        .into_iter()
+        .filter(|f| !f.starts_with(".viewsynth-write-test"))
+        .collect();
     assert!(left.is_empty(), "left behind: {left:?}");
 }
 
@@ -103,18 +128,44 @@ fn bad_input_fails_cleanly() {
     std::fs::write(&corrupt, b"\x89PNG\r\n\x1a\nthis is not a png").unwrap();
     assert_clean_failure(&refocus(&corrupt, &depth, &out, &[]), "corrupt.png", &out);
 
-    assert_clean_failure(&refocus(&rgb, &depth, &out, &["--width-out", "16385", "--height-out", "10"]), "width", &out);
-    assert_clean_failure(&refocus(&rgb, &depth, &out, &["--zoom-range", "0"]), "focal scale", &out);
+    assert_clean_failure(
+        &refocus(&rgb, &depth, &out, &["--width-out", "16385", "--height-out", "10"]),
+        "width",
+        &out,
+    );
+    assert_clean_failure(
+        &refocus(&rgb, &depth, &out, &["--zoom-range", "0"]),
+        "focal scale",
+        &out,
+    );
     assert_clean_failure(&refocus(&rgb, &depth, &out, &["--tau-rel=-1"]), "tau-rel", &out);
-    assert_clean_failure(&refocus(&rgb, &depth, &out, &["--outputs", "rgb,normals"]), "outputs", &out);
+    assert_clean_failure(
+        &refocus(&rgb, &depth, &out, &["--outputs", "rgb,normals"]),
+        "outputs",
+        &out,
+    );
 
     // Non-finite and non-positive intrinsics.
-    for (flag, value, needle) in [("--fx", "0", "fx"), ("--fy", "-3", "fy"), ("--cx", "nan", "cx"), ("--fx", "inf", "fx")] {
+    for (flag, value, needle) in [
+        ("--fx", "0", "fx"),
+        ("--fy", "-3", "fy"),
+        ("--cx", "nan", "cx"),
+        ("--fx", "inf", "fx"),
+    ] {
         let mut c = bin();
         let mut args = vec!["refocus", "--fx", "40", "--fy", "40", "--cx", "15.5", "--cy", "11.5"];
         let pos = args.iter().position(|a| *a == flag).unwrap();
         args[pos + 1] = value;
-        let o = c.args(&args).arg("--rgb").arg(&rgb).arg("--depth").arg(&depth).arg("--out-dir").arg(&out).output().unwrap();
+        let o = c
+            .args(&args)
+            .arg("--rgb")
+            .arg(&rgb)
+            .arg("--depth")
+            .arg(&depth)
+            .arg("--out-dir")
+            .arg(&out)
+            .output()
+            .unwrap();
         assert_clean_failure(&o, needle, &out);
     }
 

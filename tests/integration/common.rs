@@ -19,7 +19,11 @@ pub fn data_dir() -> PathBuf {
     let dir = std::env::var_os("VIEWSYNTH_DATA_DIR")
         .map(PathBuf::from)
         .unwrap_or_else(|| PathBuf::from(concat!(env!("CARGO_MANIFEST_DIR"), "/../shared/data")));
-    assert!(dir.is_dir(), "test data missing: {} (set VIEWSYNTH_DATA_DIR)", dir.display());
+    assert!(
+        dir.is_dir(),
+        "test data missing: {} (set VIEWSYNTH_DATA_DIR)",
+        dir.display()
+    );
     dir
 }
 
@@ -30,21 +34,47 @@ pub fn real_frame(name: &str) -> RefocusSource {
         "TUM" => (
             "TUM_color.png",
             "TUM_depth.png",
-            DepthDecode { scale: Some(5000.0), ..Default::default() },
-            Intrinsics { fx: 525.0, fy: 525.0, cx: 319.5, cy: 239.5 },
+            DepthDecode {
+                scale: Some(5000.0),
+                ..Default::default()
+            },
+            Intrinsics {
+                fx: 525.0,
+                fy: 525.0,
+                cx: 319.5,
+                cy: 239.5,
+            },
         ),
         "SUN" => (
             "SUN_color.jpg",
             "SUN_depth.png",
-            DepthDecode { scale: Some(1000.0), sun_rgbd_bit_rotate: true, ..Default::default() },
-            Intrinsics { fx: 570.0, fy: 570.0, cx: 320.0, cy: 240.0 },
+            DepthDecode {
+                scale: Some(1000.0),
+                sun_rgbd_bit_rotate: true,
+                ..Default::default()
+            },
+            Intrinsics {
+                fx: 570.0,
+                fy: 570.0,
+                cx: 320.0,
+                cy: 240.0,
+            },
         ),
         "NYU" => (
             "NYU_color.ppm",
             "NYU_depth.pgm",
             // Raw Kinect values, little-endian despite the PGM header; converted below.
-            DepthDecode { scale: Some(1.0), swap_bytes: true, ..Default::default() },
-            Intrinsics { fx: 518.9, fy: 519.5, cx: 325.6, cy: 253.7 },
+            DepthDecode {
+                scale: Some(1.0),
+                swap_bytes: true,
+                ..Default::default()
+            },
+            Intrinsics {
+                fx: 518.9,
+                fy: 519.5,
+                cx: 325.6,
+                cy: 253.7,
+            },
         ),
         _ => panic!("unknown frame {name}"),
     };
@@ -53,7 +83,11 @@ pub fn real_frame(name: &str) -> RefocusSource {
     if name == "NYU" {
         // The data README: raw 2047 = invalid, metres = 351.3 / (1092.5 - raw).
         for z in depth.data.iter_mut() {
-            *z = if *z >= 2047.0 || *z <= 0.0 { 0.0 } else { (351.3 / (1092.5 - *z as f64)) as f32 };
+            *z = if *z >= 2047.0 || *z <= 0.0 {
+                0.0
+            } else {
+                (351.3 / (1092.5 - *z as f64)) as f32
+            };
         }
     }
     RefocusSource::new(rgb, depth, k).expect("valid frame")
@@ -66,7 +100,13 @@ pub fn synthetic(width: u32, height: u32) -> RefocusSource {
 }
 
 pub fn mask_bools(out: &RefocusOutput) -> Vec<bool> {
-    out.mask.as_ref().expect("mask requested").data.iter().map(|v| *v != 0).collect()
+    out.mask
+        .as_ref()
+        .expect("mask requested")
+        .data
+        .iter()
+        .map(|v| *v != 0)
+        .collect()
 }
 
 pub fn compare(out: &RefocusOutput, reference: &ReferenceImage) -> Agreement {
@@ -97,8 +137,14 @@ pub fn dump_on_failure(tag: &str, out: &RefocusOutput, reference: &ReferenceImag
         let _ = io::save_mask_png(&dir.join(format!("{tag}_gpu_mask.png")), m);
     }
     let ref_rgb: Vec<u8> = reference.rgb.iter().flat_map(|c| c.map(metrics::quantize_u8)).collect();
-    let _ = io::save_rgb(&dir.join(format!("{tag}_ref_rgb.png")), &io::RgbImage::new(w, h, ref_rgb).unwrap());
+    let _ = io::save_rgb(
+        &dir.join(format!("{tag}_ref_rgb.png")),
+        &io::RgbImage::new(w, h, ref_rgb).unwrap(),
+    );
     let ref_mask: Vec<u8> = reference.mask.iter().map(|m| *m as u8).collect();
-    let _ = io::save_mask_png(&dir.join(format!("{tag}_ref_mask.png")), &io::Mask::new(w, h, ref_mask).unwrap());
+    let _ = io::save_mask_png(
+        &dir.join(format!("{tag}_ref_mask.png")),
+        &io::Mask::new(w, h, ref_mask).unwrap(),
+    );
     dir
 }

@@ -20,12 +20,29 @@ const SCALES: [f64; 7] = [0.25, 0.5, 0.75, 1.0, 1.5, 2.0, 4.0];
 fn check_source(name: &str, src: &RefocusSource) {
     let g = gpu();
     let cam = src.camera();
-    let sizes = [None, Some((cam.width * 4 / 5, cam.height * 5 / 6)), Some((cam.width + 160, cam.height + 120))];
+    let sizes = [
+        None,
+        Some((cam.width * 4 / 5, cam.height * 5 / 6)),
+        Some((cam.width + 160, cam.height + 120)),
+    ];
     for method in [Method::Fullscreen, Method::Mesh] {
-        let mut r = Refocuser::new(&g, src, &BreakRule::default(), method, OutputSet::default(), Conventions::default())
-            .expect("refocuser");
+        let mut r = Refocuser::new(
+            &g,
+            src,
+            &BreakRule::default(),
+            method,
+            OutputSet::default(),
+            Conventions::default(),
+        )
+        .expect("refocuser");
         for size in sizes {
-            let targets = TargetSpec { scales: SCALES.to_vec(), size, principal: None }.targets(&cam).unwrap();
+            let targets = TargetSpec {
+                scales: SCALES.to_vec(),
+                size,
+                principal: None,
+            }
+            .targets(&cam)
+            .unwrap();
             for (s, target) in SCALES.iter().zip(&targets) {
                 let out = r.render(target).expect("render");
                 let reference = reference(src, target);
@@ -38,7 +55,10 @@ fn check_source(name: &str, src: &RefocusSource) {
                 }
                 let covered = reference.mask.iter().filter(|m| **m).count();
                 assert!(a.common > 0 || covered == 0, "{tag}: nothing in common");
-                assert!(out.depth.as_ref().unwrap().data.iter().all(|z| z.is_finite()), "{tag}: non-finite depth");
+                assert!(
+                    out.depth.as_ref().unwrap().data.iter().all(|z| z.is_finite()),
+                    "{tag}: non-finite depth"
+                );
             }
         }
     }
@@ -72,8 +92,15 @@ fn scale_one_reproduces_the_input_on_every_pixel_of_a_kept_triangle() {
         let cam: PinholeCamera = src.camera();
         let reference = reference(&src, &cam);
         for method in [Method::Fullscreen, Method::Mesh] {
-            let mut r = Refocuser::new(&g, &src, &BreakRule::default(), method, OutputSet::default(), Conventions::default())
-                .unwrap();
+            let mut r = Refocuser::new(
+                &g,
+                &src,
+                &BreakRule::default(),
+                method,
+                OutputSet::default(),
+                Conventions::default(),
+            )
+            .unwrap();
             let out = r.render(&cam).unwrap();
             let mask = mask_bools(&out);
             let rgb = &out.rgb.as_ref().unwrap().data;
@@ -84,10 +111,17 @@ fn scale_one_reproduces_the_input_on_every_pixel_of_a_kept_triangle() {
                 assert_eq!(mask[i], reference.mask[i], "{name} {method:?} pixel {i}");
                 if reference.mask[i] {
                     kept += 1;
-                    assert_eq!(&rgb[i * 3..i * 3 + 3], &src.rgb.data[i * 3..i * 3 + 3], "{name} {method:?} colour {i}");
+                    assert_eq!(
+                        &rgb[i * 3..i * 3 + 3],
+                        &src.rgb.data[i * 3..i * 3 + 3],
+                        "{name} {method:?} colour {i}"
+                    );
                     let (z, z0) = (depth[i], src.depth.data[i]);
                     // f32 interpolation at a vertex: within a few ulps of the input.
-                    assert!((z - z0).abs() <= 4.0 * f32::EPSILON * z0, "{name} {method:?} depth {i}: {z} vs {z0}");
+                    assert!(
+                        (z - z0).abs() <= 4.0 * f32::EPSILON * z0,
+                        "{name} {method:?} depth {i}: {z} vs {z0}"
+                    );
                 }
             }
             assert!(kept > mask.len() / 2, "{name}: most pixels belong to kept triangles");
@@ -99,9 +133,31 @@ fn scale_one_reproduces_the_input_on_every_pixel_of_a_kept_triangle() {
 fn fullscreen_and_mesh_paths_agree() {
     let g = gpu();
     let src = real_frame("TUM");
-    let targets = TargetSpec { scales: vec![0.6, 1.0, 1.7], size: None, principal: None }.targets(&src.camera()).unwrap();
-    let mut fast = Refocuser::new(&g, &src, &BreakRule::default(), Method::Fullscreen, OutputSet::default(), Conventions::default()).unwrap();
-    let mut mesh = Refocuser::new(&g, &src, &BreakRule::default(), Method::Mesh, OutputSet::default(), Conventions::default()).unwrap();
+    let targets = TargetSpec {
+        scales: vec![0.6, 1.0, 1.7],
+        size: None,
+        principal: None,
+    }
+    .targets(&src.camera())
+    .unwrap();
+    let mut fast = Refocuser::new(
+        &g,
+        &src,
+        &BreakRule::default(),
+        Method::Fullscreen,
+        OutputSet::default(),
+        Conventions::default(),
+    )
+    .unwrap();
+    let mut mesh = Refocuser::new(
+        &g,
+        &src,
+        &BreakRule::default(),
+        Method::Mesh,
+        OutputSet::default(),
+        Conventions::default(),
+    )
+    .unwrap();
     for t in &targets {
         let (a, b) = (fast.render(t).unwrap(), mesh.render(t).unwrap());
         let (ma, mb) = (mask_bools(&a), mask_bools(&b));

@@ -9,13 +9,33 @@ use viewsynth::refocus::{BreakRule, Method, OutputSet, RefocusSource, Refocuser}
 
 fn source(w: u32, h: u32, depth: Vec<f32>) -> RefocusSource {
     let rgb: Vec<u8> = (0..w * h * 3).map(|i| (i * 53 % 256) as u8).collect();
-    let k = Intrinsics { fx: 0.8 * w as f64, fy: 0.8 * w as f64, cx: (w as f64 - 1.0) / 2.0, cy: (h as f64 - 1.0) / 2.0 };
-    RefocusSource::new(RgbImage::new(w, h, rgb).unwrap(), DepthMap::new(w, h, depth).unwrap(), k).unwrap()
+    let k = Intrinsics {
+        fx: 0.8 * w as f64,
+        fy: 0.8 * w as f64,
+        cx: (w as f64 - 1.0) / 2.0,
+        cy: (h as f64 - 1.0) / 2.0,
+    };
+    RefocusSource::new(
+        RgbImage::new(w, h, rgb).unwrap(),
+        DepthMap::new(w, h, depth).unwrap(),
+        k,
+    )
+    .unwrap()
 }
 
-fn each_method(src: &RefocusSource, scales: &[f64], check: impl Fn(&str, &viewsynth::refocus::RefocusOutput, &PinholeCamera)) {
+fn each_method(
+    src: &RefocusSource,
+    scales: &[f64],
+    check: impl Fn(&str, &viewsynth::refocus::RefocusOutput, &PinholeCamera),
+) {
     let g = gpu();
-    let targets = TargetSpec { scales: scales.to_vec(), size: None, principal: None }.targets(&src.camera()).unwrap();
+    let targets = TargetSpec {
+        scales: scales.to_vec(),
+        size: None,
+        principal: None,
+    }
+    .targets(&src.camera())
+    .unwrap();
     for method in [Method::Fullscreen, Method::Mesh] {
         for conv in [Conventions::default(), Conventions::all()[7]] {
             let mut r = Refocuser::new(&g, src, &BreakRule::default(), method, OutputSet::default(), conv).unwrap();
@@ -53,7 +73,10 @@ fn one_pixel_image_is_a_valid_mesh_of_two_half_cells() {
 fn nan_inf_negative_and_zero_depth_are_holes_and_never_reach_the_output() {
     let (w, h) = (48, 40);
     let mut depth: Vec<f32> = (0..w * h).map(|i| 1.0 + 0.001 * (i % w) as f32).collect();
-    for (i, bad) in [f32::NAN, f32::INFINITY, f32::NEG_INFINITY, -1.0, 0.0, -0.0].into_iter().enumerate() {
+    for (i, bad) in [f32::NAN, f32::INFINITY, f32::NEG_INFINITY, -1.0, 0.0, -0.0]
+        .into_iter()
+        .enumerate()
+    {
         for y in 0..4 {
             for x in 0..4 {
                 depth[(5 + 6 * i / 2 + y) * w as usize + 4 + 20 * (i % 2) + x] = bad;
@@ -75,8 +98,15 @@ fn nan_inf_negative_and_zero_depth_are_holes_and_never_reach_the_output() {
 fn depth_from_millimetres_to_a_hundred_kilometres_in_one_frame() {
     // Left half 1 mm .. right half 100 km, each half a smooth ramp: near/far ratio 1e8.
     let (w, h) = (64, 32);
-    let depth: Vec<f32> =
-        (0..w * h).map(|i| if i % w < w / 2 { 0.001 * (1.0 + 0.002 * (i % w) as f32) } else { 1e5 * (1.0 + 0.001 * (i % w) as f32) }).collect();
+    let depth: Vec<f32> = (0..w * h)
+        .map(|i| {
+            if i % w < w / 2 {
+                0.001 * (1.0 + 0.002 * (i % w) as f32)
+            } else {
+                1e5 * (1.0 + 0.001 * (i % w) as f32)
+            }
+        })
+        .collect();
     let src = source(w, h, depth);
     each_method(&src, &[0.05, 0.5, 1.0, 2.0, 20.0], |tag, out, t| {
         let reference = reference(&src, t);
@@ -92,7 +122,10 @@ fn extreme_focal_scales_match_the_reference() {
     let src = synthetic(160, 120);
     each_method(&src, &[0.05, 0.1, 10.0, 20.0], |tag, out, t| {
         let a = compare(out, &reference(&src, t));
-        assert!(a.max_abs_depth <= 1e-5 && a.mask_iou >= 0.999 && a.psnr_db >= 60.0, "{tag}: {a:?}");
+        assert!(
+            a.max_abs_depth <= 1e-5 && a.mask_iou >= 0.999 && a.psnr_db >= 60.0,
+            "{tag}: {a:?}"
+        );
     });
 }
 
@@ -106,7 +139,11 @@ fn only_requested_outputs_are_produced() {
         for method in [Method::Fullscreen, Method::Mesh] {
             let mut r = Refocuser::new(&g, &src, &BreakRule::default(), method, set, Conventions::default()).unwrap();
             let out = r.render(&cam).unwrap();
-            assert_eq!((out.rgb.is_some(), out.depth.is_some(), out.mask.is_some()), (set.rgb, set.depth, set.mask), "{list}");
+            assert_eq!(
+                (out.rgb.is_some(), out.depth.is_some(), out.mask.is_some()),
+                (set.rgb, set.depth, set.mask),
+                "{list}"
+            );
         }
     }
     assert!(OutputSet::parse("").is_err() && OutputSet::parse("rgb,normals").is_err());
