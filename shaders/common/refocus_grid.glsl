@@ -7,10 +7,10 @@ uniform sampler2D u_src_depth;  // R32F source view-space Z in metres, row 0 = t
 uniform ivec2 u_src_size;       // W, H
 uniform vec4 u_src_k;           // fx, fy, cx, cy of the source
 
-// Closed-triangle tolerance in cell units: pixel centres exactly on an edge are covered by
-// both neighbours whatever the rasteriser's fill rule or the row order. 1e-3 is well above
-// the f32 error of the source coordinates (~1e-5 px) and widens coverage by at most 1e-3 px.
-const float CELL_EPS = 1e-3;
+// Closed-triangle tolerance in cell units (grid.rs CELL_EPS): pixel centres exactly on an edge
+// are covered by both neighbours whatever the rasteriser's fill rule or the row order. Local
+// coordinates come from doubles, so f32 rounding (~6e-8) is all it has to absorb.
+const float CELL_EPS = 1e-5;
 
 float vertex_pos(int i, int n) {
     return i <= 0 ? -0.5 : (i > n ? float(n) - 0.5 : float(i - 1));

@@ -57,10 +57,7 @@ float tri_depth(vec2 ab, int tri, vec3 z) {
 
 // Bilinear source colour at continuous pixel coordinate uv (pixel centres at integers), in f32
 // with texelFetch: fixed-function filtering has only ~8 bits of weight precision.
-vec3 bilinear_rgb(dvec2 uv) {
-    dvec2 f0 = floor(uv);
-    vec2 t = vec2(uv - f0);
-    ivec2 i0 = ivec2(f0);
+vec3 bilinear_rgb_at(ivec2 i0, vec2 t) {
     ivec2 hi = u_src_size - 1;
     vec3 c00 = texelFetch(u_src_rgb, clamp(i0, ivec2(0), hi), 0).rgb;
     vec3 c10 = texelFetch(u_src_rgb, clamp(i0 + ivec2(1, 0), ivec2(0), hi), 0).rgb;
@@ -69,4 +66,9 @@ vec3 bilinear_rgb(dvec2 uv) {
     vec3 top = mix(c00, c10, t.x);
     vec3 bottom = mix(c01, c11, t.x);
     return mix(top, bottom, t.y);
+}
+
+vec3 bilinear_rgb(dvec2 uv) {
+    dvec2 f0 = floor(uv);
+    return bilinear_rgb_at(ivec2(f0), vec2(uv - f0));
 }

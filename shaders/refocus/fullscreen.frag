@@ -2,63 +2,73 @@
 // source image and evaluates the same kept triangles analytically (1/Z is affine over a
 // triangle in the source image), giving the mesh path's output in one full-screen pass.
 
-uniform usampler2D u_keep;  // R8UI per cell: bit 0 tri1 kept, bit 1 tri2 kept; (W+1) x (H+1)
+// R8UI per cell, (W+1) x (H+1): 1 tri1 kept, 2 tri2 kept, 4 left edge, 8 top edge, 16 top-left
+// vertex covered by some kept triangle (grid.rs coverage_flags).
+uniform usampler2D u_keep;
+// Per target column / image row (see grid.rs axis_lookup): cell, local coordinate, on-border
+// flag; cell < 0 outside the mesh. Located in f64 on the CPU:
+// the mapping is separable, and doubles per pixel cost llvmpipe more than the rest of the pass.
+uniform sampler2D u_cols;   // RGBA32F, W' x 1
+uniform sampler2D u_rows;   // RGBA32F, H' x 1
 
 layout(location = 0) out vec4 o_rgb;
 layout(location = 1) out float o_depth;
 layout(location = 2) out float o_mask;
 
-// Nearest Z over the kept triangles of cell c containing uv; `best` if none is nearer.
-float cell_depth(ivec2 c, dvec2 uv, float best) {
+// Z of the kept surface at local point ab of cell c, or NONE. Inside a kept triangle: exact.
+// On the cell's left/top border (a point there is always given to the right/lower cell), the
+// edge and vertex flags say whether any kept triangle, this cell's or a neighbour's, holds it;
+// its Z then interpolates 1/Z along that edge. One cell per pixel: llvmpipe runs every branch
+// under a mask, so testing neighbour cells would cost their fetches on every pixel.
+const float NONE = 3.0e38;
+
+float surface_depth(ivec2 c, vec2 ab, bvec2 border) {
     uint bits = texelFetch(u_keep, c, 0).r;
-    if (bits == 0u) {
-        return best;
-    }
-    vec2 ab = cell_local(c, uv);
     float z00 = vertex_depth(c);
+    float z10 = vertex_depth(c + ivec2(1, 0));
+    float z01 = vertex_depth(c + ivec2(0, 1));
     float z11 = vertex_depth(c + ivec2(1, 1));
-    if ((bits & 1u) != 0u && inside_tri(ab, 0)) {
-        best = min(best, tri_depth(ab, 0, vec3(z00, vertex_depth(c + ivec2(1, 0)), z11)));
+    bool in1 = (bits & 1u) != 0u && inside_tri(ab, 0);
+    bool in2 = (bits & 2u) != 0u && inside_tri(ab, 1);
+    if (in1 || in2) {
+        return in1 ? tri_depth(ab, 0, vec3(z00, z10, z11)) : tri_depth(ab, 1, vec3(z00, z11, z01));
     }
-    if ((bits & 2u) != 0u && inside_tri(ab, 1)) {
-        best = min(best, tri_depth(ab, 1, vec3(z00, z11, vertex_depth(c + ivec2(0, 1)))));
+    if (border.x && border.y) {
+        return (bits & 16u) != 0u ? z00 : NONE;
     }
-    return best;
+    if (border.x) {
+        return (bits & 4u) != 0u ? 1.0 / mix(1.0 / z00, 1.0 / z01, clamp(ab.y, 0.0, 1.0)) : NONE;
+    }
+    if (border.y) {
+        return (bits & 8u) != 0u ? 1.0 / mix(1.0 / z00, 1.0 / z10, clamp(ab.x, 0.0, 1.0)) : NONE;
+    }
+    return NONE;
 }
 
 void main() {
-    dvec2 uv = same_pose_source_point();
+#if ROWS_TOP_DOWN
+    int row = int(gl_FragCoord.y);
+#else
+    int row = u_dst_height - 1 - int(gl_FragCoord.y);
+#endif
+    vec4 cx = texelFetch(u_cols, ivec2(int(gl_FragCoord.x), 0), 0);
+    vec4 cy = texelFetch(u_rows, ivec2(row, 0), 0);
 
     o_rgb = vec4(0.0);
     o_depth = 0.0;
     o_mask = 0.0;
-    dvec2 lo = dvec2(-0.5 - 0.5 * CELL_EPS);
-    dvec2 hi = dvec2(u_src_size) - 0.5 + 0.5 * CELL_EPS;
-    if (any(lessThan(uv, lo)) || any(greaterThan(uv, hi))) {
+    if (cx.x < 0.0 || cy.x < 0.0) {
         return;
     }
-    ivec2 c0 = clamp(ivec2(floor(uv)) + 1, ivec2(0), u_src_size);
-    vec2 ab = cell_local(c0, uv);
-    // Neighbour cells matter only for points on (or within CELL_EPS of) a cell border.
-    ivec2 step = ivec2(ab.x <= CELL_EPS ? -1 : (ab.x >= 1.0 - CELL_EPS ? 1 : 0),
-                       ab.y <= CELL_EPS ? -1 : (ab.y >= 1.0 - CELL_EPS ? 1 : 0));
-    ivec2 c1 = clamp(c0 + step, ivec2(0), u_src_size);
-    const float NONE = 3.0e38;
-    float z = cell_depth(c0, uv, NONE);
-    if (c1.x != c0.x) {
-        z = cell_depth(ivec2(c1.x, c0.y), uv, z);
-    }
-    if (c1.y != c0.y) {
-        z = cell_depth(ivec2(c0.x, c1.y), uv, z);
-        if (c1.x != c0.x) {
-            z = cell_depth(c1, uv, z);
-        }
-    }
+    ivec2 c0 = ivec2(cx.x, cy.x);
+    float z = surface_depth(c0, vec2(cx.y, cy.y), bvec2(cx.z != 0.0, cy.z != 0.0));
     if (z >= NONE) {
         return;
     }
 #if WANT_RGB
-    o_rgb = vec4(bilinear_rgb(uv), 1.0);
+    // Cell c spans source pixels c - 1 .. c (clamped at the border ring), exactly the bilinear
+    // footprint of its points, with the local coordinate as weight.
+    o_rgb = vec4(bilinear_rgb_at(c0 - 1, vec2(cx.y, cy.y)), 1.0);
 #endif
     o_depth = z;
     o_mask = 1.0;

@@ -11,6 +11,7 @@ pub enum TextureFormat {
     R8,
     R8Ui,
     R32F,
+    Rgba32F,
     R32Ui,
     Depth32F,
 }
@@ -22,6 +23,7 @@ impl TextureFormat {
             TextureFormat::R8 => glow::R8,
             TextureFormat::R8Ui => glow::R8UI,
             TextureFormat::R32F => glow::R32F,
+            TextureFormat::Rgba32F => glow::RGBA32F,
             TextureFormat::R32Ui => glow::R32UI,
             TextureFormat::Depth32F => glow::DEPTH_COMPONENT32F,
         }
@@ -33,6 +35,7 @@ impl TextureFormat {
             TextureFormat::R8 => (glow::RED, glow::UNSIGNED_BYTE, 1),
             TextureFormat::R8Ui => (glow::RED_INTEGER, glow::UNSIGNED_BYTE, 1),
             TextureFormat::R32F => (glow::RED, glow::FLOAT, 4),
+            TextureFormat::Rgba32F => (glow::RGBA, glow::FLOAT, 16),
             TextureFormat::R32Ui => (glow::RED_INTEGER, glow::UNSIGNED_INT, 4),
             TextureFormat::Depth32F => (glow::DEPTH_COMPONENT, glow::FLOAT, 4),
         }

@@ -66,6 +66,12 @@ pub struct Grid {
 
 pub const TRI1: u8 = 1;
 pub const TRI2: u8 = 2;
+/// The cell's left edge (vertex column i, rows j..j+1) belongs to a kept triangle.
+pub const LEFT_EDGE: u8 = 4;
+/// The cell's top edge (vertex row j, columns i..i+1) belongs to a kept triangle.
+pub const TOP_EDGE: u8 = 8;
+/// The cell's corner vertex (i, j) belongs to a kept triangle.
+pub const VERTEX: u8 = 16;
 
 impl Grid {
     /// Source coordinate of vertex column (or row) `i` along an axis of `n` pixels.
@@ -125,6 +131,41 @@ impl Grid {
         out
     }
 
+    /// The keep mask plus, per cell, whether its left edge, top edge and top-left vertex belong
+    /// to any kept triangle (of this cell or a neighbour). With these, a point on a cell border
+    /// is decided from one cell, which is what the full-screen pass reads.
+    pub fn coverage_flags(&self, keep: &[u8]) -> Vec<u8> {
+        let (cx, cy) = (self.cells_x() as i64, self.cells_y() as i64);
+        let at = |i: i64, j: i64| {
+            if i < 0 || j < 0 || i >= cx || j >= cy {
+                0
+            } else {
+                keep[(j * cx + i) as usize]
+            }
+        };
+        let mut out = keep.to_vec();
+        for j in 0..cy {
+            for i in 0..cx {
+                let mut bits = at(i, j);
+                // Left edge: tri2 of this cell (v00-v01), tri1 of the left cell (v10-v11).
+                if bits & TRI2 != 0 || at(i - 1, j) & TRI1 != 0 {
+                    bits |= LEFT_EDGE;
+                }
+                // Top edge: tri1 of this cell (v00-v10), tri2 of the cell above (v01-v11).
+                if bits & TRI1 != 0 || at(i, j - 1) & TRI2 != 0 {
+                    bits |= TOP_EDGE;
+                }
+                // Vertex (i, j): v00 here, v11 up-left (both), v10 of the left cell (tri1), v01
+                // of the cell above (tri2).
+                if at(i, j) != 0 || at(i - 1, j - 1) != 0 || at(i - 1, j) & TRI1 != 0 || at(i, j - 1) & TRI2 != 0 {
+                    bits |= VERTEX;
+                }
+                out[(j * cx + i) as usize] = bits;
+            }
+        }
+        out
+    }
+
     /// Kept triangles as codes `(cell_index << 1) | (tri2 ? 1 : 0)`, for the mesh path.
     pub fn kept_triangles(&self, keep: &[u8]) -> Vec<u32> {
         let mut out = Vec::with_capacity(keep.len());
@@ -138,6 +179,43 @@ impl Grid {
         }
         out
     }
+}
+
+/// Closed-triangle tolerance in cell units, shared with the shaders (CELL_EPS): it only has to
+/// absorb the f32 rounding of cell-local coordinates computed in double (~6e-8), and a point
+/// within it of a border is valued on that border, so it also bounds that depth error
+/// (1e-5 x the depth change across the cell).
+pub const CELL_EPS: f64 = 1e-5;
+
+/// Same-pose lookup along one axis, for the full-screen path: for each target column (or row)
+/// x, the source coordinate u = c_src + (x - c_dst) * ratio is located in f64 and stored as
+/// [cell, local coordinate in it, 1 if u lies on (within CELL_EPS of) the cell's left/top
+/// border else 0, unused]; cell = -1 where u is outside the mesh. A point on a border between
+/// two cells is always given to the right/lower cell, so one cell's coverage flags decide it.
+/// The mapping is separable: W' + H' of these replace per-pixel double arithmetic.
+pub fn axis_lookup(n_src: u32, c_src: f64, c_dst: f64, ratio: f64, n_dst: u32) -> Vec<[f32; 4]> {
+    let n = n_src as i64;
+    let local = |u: f64, i: i64| {
+        let x0 = Grid::vertex_pos(i, n_src);
+        (u - x0) / (Grid::vertex_pos(i + 1, n_src) - x0)
+    };
+    (0..n_dst)
+        .map(|x| {
+            let u = c_src + (x as f64 - c_dst) * ratio;
+            let (lo, hi) = (-0.5 - 0.5 * CELL_EPS, n as f64 - 0.5 + 0.5 * CELL_EPS);
+            if !(u >= lo && u <= hi) {
+                return [-1.0, 0.0, 0.0, 0.0];
+            }
+            let mut i = ((u.floor() as i64) + 1).clamp(0, n);
+            let mut a = local(u, i);
+            if a >= 1.0 - CELL_EPS && i < n {
+                i += 1;
+                a = local(u, i);
+            }
+            let border = (a <= CELL_EPS) as u8;
+            [i as f32, a as f32, border as f32, 0.0]
+        })
+        .collect()
 }
 
 #[cfg(test)]
@@ -157,6 +235,25 @@ mod tests {
             [Grid::vertex_pos(0, 1), Grid::vertex_pos(1, 1), Grid::vertex_pos(2, 1)],
             [-0.5, 0.0, 0.5]
         );
+    }
+
+    #[test]
+    fn axis_lookup_locates_cells_and_neighbours() {
+        // 4 source pixels, same centre, scale 1: target x sits on vertex x + 1, i.e. on the left
+        // border of cell x + 1 and the right border of cell x.
+        let t = axis_lookup(4, 1.5, 1.5, 1.0, 4);
+        assert_eq!(t[0], [1.0, 0.0, 1.0, 0.0]);
+        assert_eq!(t[3], [4.0, 0.0, 1.0, 0.0]);
+        // Half scale: x = 0 maps to u = -1.5 (outside), x = 1 to u = 0.5 (inside cell 1).
+        let t = axis_lookup(4, 1.5, 1.5, 2.0, 4);
+        assert_eq!(t[0][0], -1.0);
+        assert_eq!(t[1], [1.0, 0.5, 0.0, 0.0]);
+        // Just below a border: handed to the next cell, on its left border.
+        let t = axis_lookup(4, 1.0 - 1e-7, 0.0, 1.0, 1);
+        assert_eq!((t[0][0], t[0][2]), (2.0, 1.0));
+        // The border ring: u = -0.25 is in the half-width cell 0 at a = 0.5.
+        let t = axis_lookup(4, 1.5, 1.75, 1.0, 1);
+        assert_eq!(t[0], [0.0, 0.5, 0.0, 0.0]);
     }
 
     #[test]
@@ -200,5 +297,16 @@ mod tests {
         assert_eq!(keep[2 * 4 + 1], TRI2);
         assert_eq!(keep[2 * 4 + 2], 0);
         assert_eq!(g.kept_triangles(&keep).len(), 2 * 16 - 6);
+        // The hole's vertex (2, 2) still belongs to tri1 of cell (2, 1) (its v01? no: tri1 is
+        // v00 v10 v11) -- it belongs to no kept triangle: every triangle touching it is gone.
+        let flags = g.coverage_flags(&keep);
+        assert_eq!(flags[2 * 4 + 2] & VERTEX, 0);
+        // Vertex (1, 1) is shared by intact cells: covered. The left edge of cell (2, 1)
+        // (column 2, rows 1..2) is v10-v11 of cell (1, 1) (gone) and v00-v01 of cell (2, 1)
+        // (tri2, gone): not covered.
+        assert_ne!(flags[4 + 1] & VERTEX, 0);
+        assert_eq!(flags[4 + 2] & LEFT_EDGE, 0);
+        // The top edge of cell (2, 1) is v00-v10 of its kept tri1: covered.
+        assert_ne!(flags[4 + 2] & TOP_EDGE, 0);
     }
 }

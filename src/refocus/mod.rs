@@ -12,7 +12,7 @@ pub mod job;
 pub mod reference;
 mod render;
 
-pub use grid::{valid_depth, BreakRule, Grid};
+pub use grid::{axis_lookup, valid_depth, BreakRule, Grid};
 pub use render::{RefocusOutput, Refocuser};
 
 use crate::camera::{Intrinsics, PinholeCamera, MAX_IMAGE_SIDE};

@@ -1,7 +1,7 @@
 //! GPU refocus: shared inputs (source colour, depth and the kept triangles) are uploaded once;
 //! each target renders into a framebuffer holding only the requested attachments.
 
-use super::grid::Grid;
+use super::grid::{axis_lookup, Grid};
 use super::{Method, OutputSet, RefocusSource};
 use crate::camera::{clip_from_view_opencv, PinholeCamera};
 use crate::convention::{Conventions, DepthPlanes, RowOrder};
@@ -101,12 +101,13 @@ impl Refocuser {
                         (glow::FRAGMENT_SHADER, "refocus/fullscreen.frag", &frag),
                     ],
                 )?;
+                let flags = grid.coverage_flags(&keep);
                 let keep = Texture::new(
                     gpu,
                     grid.cells_x() as u32,
                     grid.cells_y() as u32,
                     TextureFormat::R8Ui,
-                    Some(&keep),
+                    Some(&flags),
                 )?;
                 (program, Geometry::Fullscreen { keep })
             }
@@ -231,6 +232,22 @@ impl Refocuser {
         let gl = gpu.gl();
         let fb = self.framebuffer.as_ref().expect("framebuffer allocated above");
         let p = &self.program;
+        // Per-target lookups of the full-screen path, created before any texture unit is bound
+        // (creating a texture binds it on the active unit).
+        let lookups = match &self.geometry {
+            Geometry::Fullscreen { .. } => {
+                let (sw, sh) = (self.source.width, self.source.height);
+                let (sk, tk) = (&self.source.k, &target.k);
+                let cols = axis_lookup(sw, sk.cx, tk.cx, sk.fx / tk.fx, target.width);
+                let rows = axis_lookup(sh, sk.cy, tk.cy, sk.fy / tk.fy, target.height);
+                let bytes = |t: &[[f32; 4]]| -> Vec<u8> { t.iter().flatten().flat_map(|v| v.to_ne_bytes()).collect() };
+                Some((
+                    Texture::new(&gpu, target.width, 1, TextureFormat::Rgba32F, Some(&bytes(&cols)))?,
+                    Texture::new(&gpu, target.height, 1, TextureFormat::Rgba32F, Some(&bytes(&rows)))?,
+                ))
+            }
+            Geometry::Mesh { .. } => None,
+        };
         let timer = GpuTimer::start(&gpu);
         fb.bind_and_clear(clear_depth);
         p.bind();
@@ -260,6 +277,12 @@ impl Refocuser {
         match &self.geometry {
             Geometry::Fullscreen { keep } => {
                 keep.bind(2);
+                if let Some((cols, rows)) = &lookups {
+                    cols.bind(3);
+                    rows.bind(4);
+                }
+                p.set_i32("u_cols", 3);
+                p.set_i32("u_rows", 4);
                 // SAFETY: one full-screen triangle; no depth buffer is attached.
                 unsafe {
                     gl.disable(glow::DEPTH_TEST);

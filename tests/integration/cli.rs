@@ -183,3 +183,16 @@ fn info_reports_the_renderer() {
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
     assert!(text.contains("renderer:") && text.contains("GL version:"), "{text}");
 }
+
+#[test]
+fn missing_libegl_is_a_clear_error_not_a_crash() {
+    // A directory whose libEGL.so.1 is not a shared library shadows the system one.
+    let d = scratch("no-egl");
+    for name in ["libEGL.so.1", "libEGL.so"] {
+        std::fs::write(d.join(name), b"not an ELF file").unwrap();
+    }
+    let o = bin().arg("info").env("LD_LIBRARY_PATH", &d).output().unwrap();
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(1), "{err}");
+    assert!(err.contains("libEGL") && !err.contains("panicked"), "{err}");
+}
