@@ -1,32 +1,22 @@
-// Fragment-stage helpers of the refocus grid: the exact source point of a pixel, the closed
-// triangle test, exact depth and f32 bilinear colour.
+// Fragment-stage helpers of the refocus grid: the closed triangle test, exact depth and f32
+// bilinear colour.
 
-// Same-pose mapping target pixel -> source pixel, u = cx + (u' - cx') fx / fx', evaluated in
-// double: in f32 a coordinate near 600 px carries ~6e-5 px of error, which across a cell with a
-// 5 % depth step is 1.5e-6 relative depth error. Doubles arrive as hi + lo float pairs.
-uniform vec2 u_src_c_hi, u_src_c_lo;  // cx, cy
-uniform vec2 u_dst_c_hi, u_dst_c_lo;  // cx', cy'
-uniform vec2 u_ratio_hi, u_ratio_lo;  // fx / fx', fy / fy'
+// Per target column / image row (grid.rs axis_lookup): [cell, local coordinate in it, 1 if on
+// the cell's left/top border, -]; cell < 0 outside the mesh. The same-pose map from target pixel
+// to source point is separable, so it is located in f64 on the CPU: f32 at u ~ 600 px would be
+// off by 6e-5 px, and per-pixel doubles cost llvmpipe more than the rest of the pass.
+uniform sampler2D u_cols;  // RGBA32F, W' x 1
+uniform sampler2D u_rows;  // RGBA32F, H' x 1
 uniform int u_dst_height;
 
-dvec2 same_pose_source_point() {
+void pixel_lookups(out vec4 col, out vec4 row) {
 #if ROWS_TOP_DOWN
-    double v_dst = double(gl_FragCoord.y) - 0.5;
+    int y = int(gl_FragCoord.y);
 #else
-    double v_dst = double(u_dst_height) - double(gl_FragCoord.y) - 0.5;
+    int y = u_dst_height - 1 - int(gl_FragCoord.y);
 #endif
-    dvec2 dst = dvec2(double(gl_FragCoord.x) - 0.5, v_dst);
-    dvec2 src_c = dvec2(u_src_c_hi) + dvec2(u_src_c_lo);
-    dvec2 dst_c = dvec2(u_dst_c_hi) + dvec2(u_dst_c_lo);
-    dvec2 ratio = dvec2(u_ratio_hi) + dvec2(u_ratio_lo);
-    return src_c + (dst - dst_c) * ratio;
-}
-
-// Cell-local coordinates (a, b) of source point uv in cell c (small, so f32 is enough).
-vec2 cell_local(ivec2 c, dvec2 uv) {
-    dvec2 p0 = dvec2(vertex_pos(c.x, u_src_size.x), vertex_pos(c.y, u_src_size.y));
-    dvec2 p1 = dvec2(vertex_pos(c.x + 1, u_src_size.x), vertex_pos(c.y + 1, u_src_size.y));
-    return vec2((uv - p0) / (p1 - p0));
+    col = texelFetch(u_cols, ivec2(int(gl_FragCoord.x), 0), 0);
+    row = texelFetch(u_rows, ivec2(y, 0), 0);
 }
 
 // Is local point ab inside triangle `tri` (0 = tri1, 1 = tri2), closed, within CELL_EPS?
@@ -66,9 +56,4 @@ vec3 bilinear_rgb_at(ivec2 i0, vec2 t) {
     vec3 top = mix(c00, c10, t.x);
     vec3 bottom = mix(c01, c11, t.x);
     return mix(top, bottom, t.y);
-}
-
-vec3 bilinear_rgb(dvec2 uv) {
-    dvec2 f0 = floor(uv);
-    return bilinear_rgb_at(ivec2(f0), vec2(uv - f0));
 }

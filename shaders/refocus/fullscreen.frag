@@ -5,11 +5,6 @@
 // R8UI per cell, (W+1) x (H+1): 1 tri1 kept, 2 tri2 kept, 4 left edge, 8 top edge, 16 top-left
 // vertex covered by some kept triangle (grid.rs coverage_flags).
 uniform usampler2D u_keep;
-// Per target column / image row (see grid.rs axis_lookup): cell, local coordinate, on-border
-// flag; cell < 0 outside the mesh. Located in f64 on the CPU:
-// the mapping is separable, and doubles per pixel cost llvmpipe more than the rest of the pass.
-uniform sampler2D u_cols;   // RGBA32F, W' x 1
-uniform sampler2D u_rows;   // RGBA32F, H' x 1
 
 layout(location = 0) out vec4 o_rgb;
 layout(location = 1) out float o_depth;
@@ -46,13 +41,8 @@ float surface_depth(ivec2 c, vec2 ab, bvec2 border) {
 }
 
 void main() {
-#if ROWS_TOP_DOWN
-    int row = int(gl_FragCoord.y);
-#else
-    int row = u_dst_height - 1 - int(gl_FragCoord.y);
-#endif
-    vec4 cx = texelFetch(u_cols, ivec2(int(gl_FragCoord.x), 0), 0);
-    vec4 cy = texelFetch(u_rows, ivec2(row, 0), 0);
+    vec4 cx, cy;
+    pixel_lookups(cx, cy);
 
     o_rgb = vec4(0.0);
     o_depth = 0.0;

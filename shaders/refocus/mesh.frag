@@ -1,35 +1,40 @@
-// The rasteriser only finds candidate (pixel, triangle) pairs: colour and depth come from the
-// exact source point of the pixel centre evaluated on the fragment's own triangle, so they match
-// the full-screen path and the f64 reference (interpolated UVs would not: seed 003's approach
-// loses ~20 dB there).
-
-uniform mat4 u_target_from_source;
+// The rasteriser only proposes (pixel, triangle) pairs: the pixel centre's exact source point
+// (from the f64 per-column/row lookups, as in the full-screen pass) is tested against the
+// fragment's own closed triangle and valued there. Interpolated attributes would carry the
+// rasteriser's 1/256 px vertex snapping, and interpolated UVs (seed 003) are not even exact in
+// exact arithmetic for a focal change.
 
 flat in ivec3 v_cell;
-flat in vec3 v_corner_z;
 
 layout(location = 0) out vec4 o_rgb;
 layout(location = 1) out float o_depth;
 layout(location = 2) out float o_mask;
 
+// Local coordinate in cell `own` of a point given as (cell, local) by the lookup.
+float own_local(float lookup_cell, float lookup_local, int own, int n) {
+    int lc = int(lookup_cell);
+    float x0 = vertex_pos(lc, n);
+    float w = vertex_pos(lc + 1, n) - x0;
+    float own_x0 = vertex_pos(own, n);
+    return ((x0 - own_x0) + lookup_local * w) / (vertex_pos(own + 1, n) - own_x0);
+}
+
 void main() {
-    // The rasteriser's interpolation is only as exact as its vertex snapping (1/256 px), so the
-    // source point is recomputed from the pixel centre; this refocus is same-pose.
-    dvec2 uv = same_pose_source_point();
-    vec2 ab = cell_local(v_cell.xy, uv);
-    if (!inside_tri(ab, v_cell.z)) {
+    vec4 cx, cy;
+    pixel_lookups(cx, cy);
+    ivec2 c = v_cell.xy;
+    vec2 ab = vec2(own_local(cx.x, cx.y, c.x, u_src_size.x), own_local(cy.x, cy.y, c.y, u_src_size.y));
+    if (cx.x < 0.0 || cy.x < 0.0 || !inside_tri(ab, v_cell.z)) {
         discard;
     }
-    float z_src = tri_depth(ab, v_cell.z, v_corner_z);
-    vec3 p_src = vec3(vec2(uv - dvec2(u_src_k.zw)) / u_src_k.xy * z_src, z_src);
-    // Target view-space Z: row 2 of the view transform (z_src itself for a same-pose refocus).
-    vec4 row_z = vec4(u_target_from_source[0][2], u_target_from_source[1][2],
-                      u_target_from_source[2][2], u_target_from_source[3][2]);
+    vec3 z = v_cell.z == 0 ? vec3(vertex_depth(c), vertex_depth(c + ivec2(1, 0)), vertex_depth(c + ivec2(1, 1)))
+                           : vec3(vertex_depth(c), vertex_depth(c + ivec2(1, 1)), vertex_depth(c + ivec2(0, 1)));
 #if WANT_RGB
-    o_rgb = vec4(bilinear_rgb(uv), 1.0);
+    // The cell spans source pixels c - 1 .. c (clamped at the border ring): the bilinear footprint.
+    o_rgb = vec4(bilinear_rgb_at(c - 1, clamp(ab, 0.0, 1.0)), 1.0);
 #else
     o_rgb = vec4(0.0);
 #endif
-    o_depth = dot(row_z, vec4(p_src, 1.0));
+    o_depth = tri_depth(ab, v_cell.z, z);
     o_mask = 1.0;
 }

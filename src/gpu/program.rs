@@ -104,14 +104,6 @@ impl Program {
                 .uniform_4_f32(self.location(name).as_ref(), v[0], v[1], v[2], v[3])
         }
     }
-    /// A double-precision vec2 as the float pair `{name}_hi` + `{name}_lo` (glow has no f64
-    /// uniforms); the shader rebuilds it as dvec2(hi) + dvec2(lo), good to ~48 bits.
-    pub fn set_dvec2_split(&self, name: &str, v: [f64; 2]) {
-        let hi = [v[0] as f32, v[1] as f32];
-        let lo = [(v[0] - hi[0] as f64) as f32, (v[1] - hi[1] as f64) as f32];
-        self.set_vec2(&format!("{name}_hi"), hi);
-        self.set_vec2(&format!("{name}_lo"), lo);
-    }
     /// A 4x4 matrix given row-major (as written on paper); uploaded transposed for GLSL.
     pub fn set_mat4_rows(&self, name: &str, rows: &[[f64; 4]; 4]) {
         let mut cols = [0f32; 16];

@@ -25,13 +25,6 @@ const TRI_TEX_WIDTH: u32 = 4096;
 /// so pixel centres on an edge always reach that test.
 const EXPAND_PX: f32 = 1.0 / 32.0;
 
-const IDENTITY: [[f64; 4]; 4] = [
-    [1.0, 0.0, 0.0, 0.0],
-    [0.0, 1.0, 0.0, 0.0],
-    [0.0, 0.0, 1.0, 0.0],
-    [0.0, 0.0, 0.0, 1.0],
-];
-
 /// One refocused view. Images are top-down whatever the row-order convention.
 pub struct RefocusOutput {
     pub camera: PinholeCamera,
@@ -232,22 +225,15 @@ impl Refocuser {
         let gl = gpu.gl();
         let fb = self.framebuffer.as_ref().expect("framebuffer allocated above");
         let p = &self.program;
-        // Per-target lookups of the full-screen path, created before any texture unit is bound
-        // (creating a texture binds it on the active unit).
-        let lookups = match &self.geometry {
-            Geometry::Fullscreen { .. } => {
-                let (sw, sh) = (self.source.width, self.source.height);
-                let (sk, tk) = (&self.source.k, &target.k);
-                let cols = axis_lookup(sw, sk.cx, tk.cx, sk.fx / tk.fx, target.width);
-                let rows = axis_lookup(sh, sk.cy, tk.cy, sk.fy / tk.fy, target.height);
-                let bytes = |t: &[[f32; 4]]| -> Vec<u8> { t.iter().flatten().flat_map(|v| v.to_ne_bytes()).collect() };
-                Some((
-                    Texture::new(&gpu, target.width, 1, TextureFormat::Rgba32F, Some(&bytes(&cols)))?,
-                    Texture::new(&gpu, target.height, 1, TextureFormat::Rgba32F, Some(&bytes(&rows)))?,
-                ))
-            }
-            Geometry::Mesh { .. } => None,
-        };
+        let sk = &self.source.k;
+        let tk = &target.k;
+        // The pixel -> source-point map in f64, per column and per row (it is separable), created
+        // before any texture unit is bound (creating a texture binds it on the active unit).
+        let cols = axis_lookup(self.source.width, sk.cx, tk.cx, sk.fx / tk.fx, target.width);
+        let rows = axis_lookup(self.source.height, sk.cy, tk.cy, sk.fy / tk.fy, target.height);
+        let bytes = |t: &[[f32; 4]]| -> Vec<u8> { t.iter().flatten().flat_map(|v| v.to_ne_bytes()).collect() };
+        let cols = Texture::new(&gpu, target.width, 1, TextureFormat::Rgba32F, Some(&bytes(&cols)))?;
+        let rows = Texture::new(&gpu, target.height, 1, TextureFormat::Rgba32F, Some(&bytes(&rows)))?;
         let timer = GpuTimer::start(&gpu);
         fb.bind_and_clear(clear_depth);
         p.bind();
@@ -256,13 +242,15 @@ impl Refocuser {
             rgb.bind(0);
         }
         self.depth.bind(1);
+        cols.bind(3);
+        rows.bind(4);
         p.set_i32("u_src_rgb", 0);
         p.set_i32("u_src_depth", 1);
         p.set_i32("u_keep", 2);
         p.set_i32("u_tris", 2);
+        p.set_i32("u_cols", 3);
+        p.set_i32("u_rows", 4);
         p.set_ivec2("u_src_size", [self.source.width as i32, self.source.height as i32]);
-        let sk = &self.source.k;
-        let tk = &target.k;
         // SAFETY: plain state setting on the current context.
         unsafe {
             gl.disable(glow::BLEND);
@@ -270,19 +258,10 @@ impl Refocuser {
             gl.disable(glow::STENCIL_TEST);
         }
         p.set_vec4("u_src_k", [sk.fx as f32, sk.fy as f32, sk.cx as f32, sk.cy as f32]);
-        p.set_dvec2_split("u_src_c", [sk.cx, sk.cy]);
-        p.set_dvec2_split("u_dst_c", [tk.cx, tk.cy]);
-        p.set_dvec2_split("u_ratio", [sk.fx / tk.fx, sk.fy / tk.fy]);
         p.set_i32("u_dst_height", target.height as i32);
         match &self.geometry {
             Geometry::Fullscreen { keep } => {
                 keep.bind(2);
-                if let Some((cols, rows)) = &lookups {
-                    cols.bind(3);
-                    rows.bind(4);
-                }
-                p.set_i32("u_cols", 3);
-                p.set_i32("u_rows", 4);
                 // SAFETY: one full-screen triangle; no depth buffer is attached.
                 unsafe {
                     gl.disable(glow::DEPTH_TEST);
@@ -292,7 +271,8 @@ impl Refocuser {
             Geometry::Mesh { tris, count } => {
                 let m = clip_from_view_opencv(target, &self.planes, &conv);
                 p.set_mat4_rows("u_clip_from_target", &m);
-                p.set_mat4_rows("u_target_from_source", &IDENTITY);
+                let (a, b) = self.planes.clip_z_coefficients(&conv);
+                p.set_vec2("u_clip_z", [a as f32, b as f32]);
                 p.set_vec2("u_dst_size", [target.width as f32, target.height as f32]);
                 p.set_f32("u_expand_px", EXPAND_PX);
                 let depth_mode = match conv.ndc_depth {
