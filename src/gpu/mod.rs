@@ -1,6 +1,7 @@
 //! GPU layer: an EGL context and RAII wrappers over raw glow handles. Nothing outside this
 //! folder touches a raw GL handle.
 
+mod buffer;
 mod egl;
 mod framebuffer;
 mod program;
@@ -8,6 +9,7 @@ mod texture;
 mod timer;
 mod vertex_array;
 
+pub use buffer::IndexBuffer;
 pub use egl::{DeviceChoice, EglContext, GpuInfo};
 pub use framebuffer::{Attachment, Framebuffer};
 pub use program::Program;

@@ -166,6 +166,61 @@ impl Grid {
         out
     }
 
+    /// Vertices (W+2) x (H+2) whose six incident triangles are all kept (the outer ring never
+    /// is: its outside neighbours do not exist).
+    pub fn surrounded_vertices(&self, keep: &[u8]) -> Vec<bool> {
+        let (cx, cy) = (self.cells_x() as i64, self.cells_y() as i64);
+        let at = |i: i64, j: i64| {
+            if i < 0 || j < 0 || i >= cx || j >= cy {
+                0
+            } else {
+                keep[(j * cx + i) as usize]
+            }
+        };
+        let both = TRI1 | TRI2;
+        let mut out = vec![false; ((cx + 1) * (cy + 1)) as usize];
+        for j in 0..=cy {
+            for i in 0..=cx {
+                out[(j * (cx + 1) + i) as usize] = at(i, j) == both
+                    && at(i - 1, j - 1) == both
+                    && at(i - 1, j) & TRI1 != 0
+                    && at(i, j - 1) & TRI2 != 0;
+            }
+        }
+        out
+    }
+
+    /// Grid vertex ids (i + j (W+2)) of the corners of triangle `code`, in the order tri1:
+    /// v00 v10 v11, tri2: v00 v11 v01 (the order the shaders use).
+    pub fn triangle_vertices(&self, code: u32) -> [u32; 3] {
+        let cells_x = self.cells_x() as u32;
+        let (cell, tri2) = (code >> 1, code & 1 == 1);
+        let (i, j) = (cell % cells_x, cell / cells_x);
+        let row = cells_x + 1;
+        let v = |di: u32, dj: u32| (j + dj) * row + i + di;
+        if tri2 {
+            [v(0, 0), v(1, 1), v(0, 1)]
+        } else {
+            [v(0, 0), v(1, 0), v(1, 1)]
+        }
+    }
+
+    /// Kept triangles split into interior ones (every corner surrounded by kept triangles: a
+    /// pixel centre the rasteriser gives them lies in a kept triangle whatever the fill rule)
+    /// and boundary ones (the rest), as codes.
+    pub fn split_kept_triangles(&self, keep: &[u8]) -> (Vec<u32>, Vec<u32>) {
+        let surrounded = self.surrounded_vertices(keep);
+        let (mut interior, mut boundary) = (Vec::new(), Vec::new());
+        for code in self.kept_triangles(keep) {
+            if self.triangle_vertices(code).iter().all(|&v| surrounded[v as usize]) {
+                interior.push(code);
+            } else {
+                boundary.push(code);
+            }
+        }
+        (interior, boundary)
+    }
+
     /// Kept triangles as codes `(cell_index << 1) | (tri2 ? 1 : 0)`, for the mesh path.
     pub fn kept_triangles(&self, keep: &[u8]) -> Vec<u32> {
         let mut out = Vec::with_capacity(keep.len());
@@ -308,5 +363,17 @@ mod tests {
         assert_eq!(flags[4 + 2] & LEFT_EDGE, 0);
         // The top edge of cell (2, 1) is v00-v10 of its kept tri1: covered.
         assert_ne!(flags[4 + 2] & TOP_EDGE, 0);
+
+        // Interior triangles: all corners surrounded. Only vertices (2..=3, 2..=3) minus those
+        // touching the hole's broken triangles are surrounded here; every interior triangle's
+        // corners are, and interior + boundary = kept.
+        let (interior, boundary) = g.split_kept_triangles(&keep);
+        assert_eq!(interior.len() + boundary.len(), g.kept_triangles(&keep).len());
+        let surrounded = g.surrounded_vertices(&keep);
+        assert!(!surrounded[0] && !surrounded[2 * 5 + 2]);
+        for code in &interior {
+            assert!(g.triangle_vertices(*code).iter().all(|v| surrounded[*v as usize]));
+        }
+        assert_eq!(g.triangle_vertices(((4 + 2) << 1) | 1), [5 + 2, 2 * 5 + 3, 2 * 5 + 2]);
     }
 }

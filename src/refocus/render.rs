@@ -2,8 +2,9 @@
 //! each target renders into a framebuffer holding only the requested attachments.
 
 use super::grid::{axis_lookup, Grid};
+use super::mesh::{MeshPass, TRI_TEX_WIDTH};
 use super::{Method, OutputSet, RefocusSource};
-use crate::camera::{clip_from_view_opencv, PinholeCamera};
+use crate::camera::PinholeCamera;
 use crate::convention::{Conventions, DepthPlanes, RowOrder};
 use crate::error::{Error, Result};
 use crate::gpu::{Attachment, Framebuffer, Gpu, GpuTimer, Program, Texture, TextureFormat, Timing, VertexArray};
@@ -15,15 +16,6 @@ const GRID_GLSL: &str = include_str!("../../shaders/common/refocus_grid.glsl");
 const SAMPLE_GLSL: &str = include_str!("../../shaders/common/refocus_sample.glsl");
 const FULLSCREEN_VERT: &str = include_str!("../../shaders/common/fullscreen.vert");
 const FULLSCREEN_FRAG: &str = include_str!("../../shaders/refocus/fullscreen.frag");
-const MESH_VERT: &str = include_str!("../../shaders/refocus/mesh.vert");
-const MESH_FRAG: &str = include_str!("../../shaders/refocus/mesh.frag");
-
-/// Width of the texture holding kept-triangle codes for vertex pulling.
-const TRI_TEX_WIDTH: u32 = 4096;
-/// How far (window pixels) the mesh path pushes each triangle out before the exact closed test
-/// in the fragment shader: above the rasteriser's vertex snapping (1/512 px at 8 subpixel bits)
-/// so pixel centres on an edge always reach that test.
-const EXPAND_PX: f32 = 1.0 / 32.0;
 
 /// One refocused view. Images are top-down whatever the row-order convention.
 pub struct RefocusOutput {
@@ -39,8 +31,8 @@ pub struct RefocusOutput {
 }
 
 enum Geometry {
-    Mesh { tris: Option<Texture>, count: usize },
-    Fullscreen { keep: Texture },
+    Mesh(MeshPass),
+    Fullscreen { program: Program, keep: Texture },
 }
 
 /// A source uploaded to the GPU, ready to render any number of targets.
@@ -50,7 +42,6 @@ pub struct Refocuser {
     outputs: OutputSet,
     source: PinholeCamera,
     planes: DepthPlanes,
-    program: Program,
     rgb: Option<Texture>,
     depth: Texture,
     geometry: Geometry,
@@ -83,7 +74,7 @@ impl Refocuser {
             conv.glsl_defines(),
             outputs.rgb as u8
         );
-        let (program, geometry) = match method {
+        let geometry = match method {
             Method::Fullscreen => {
                 let frag = format!("{GRID_GLSL}\n{SAMPLE_GLSL}\n{FULLSCREEN_FRAG}");
                 let program = Program::new(
@@ -95,51 +86,11 @@ impl Refocuser {
                     ],
                 )?;
                 let flags = grid.coverage_flags(&keep);
-                let keep = Texture::new(
-                    gpu,
-                    grid.cells_x() as u32,
-                    grid.cells_y() as u32,
-                    TextureFormat::R8Ui,
-                    Some(&flags),
-                )?;
-                (program, Geometry::Fullscreen { keep })
+                let (cx, cy) = (grid.cells_x() as u32, grid.cells_y() as u32);
+                let keep = Texture::new(gpu, cx, cy, TextureFormat::R8Ui, Some(&flags))?;
+                Geometry::Fullscreen { program, keep }
             }
-            Method::Mesh => {
-                let vert = format!("{GRID_GLSL}\n{MESH_VERT}");
-                let frag = format!("{GRID_GLSL}\n{SAMPLE_GLSL}\n{MESH_FRAG}");
-                let program = Program::new(
-                    gpu,
-                    &defines,
-                    &[
-                        (glow::VERTEX_SHADER, "refocus/mesh.vert", &vert),
-                        (glow::FRAGMENT_SHADER, "refocus/mesh.frag", &frag),
-                    ],
-                )?;
-                let codes = grid.kept_triangles(&keep);
-                let count = codes.len();
-                let tris = if count == 0 {
-                    None
-                } else {
-                    let rows = count.div_ceil(TRI_TEX_WIDTH as usize);
-                    if rows > max as usize || count.checked_mul(3).is_none_or(|v| v > i32::MAX as usize) {
-                        return Err(Error::param(
-                            "source size",
-                            format!("{count} triangles exceed the mesh path's limit; use the full-screen method"),
-                        ));
-                    }
-                    let mut padded = codes;
-                    padded.resize(rows * TRI_TEX_WIDTH as usize, 0);
-                    let bytes: Vec<u8> = padded.iter().flat_map(|c| c.to_ne_bytes()).collect();
-                    Some(Texture::new(
-                        gpu,
-                        TRI_TEX_WIDTH,
-                        rows as u32,
-                        TextureFormat::R32Ui,
-                        Some(&bytes),
-                    )?)
-                };
-                (program, Geometry::Mesh { tris, count })
-            }
+            Method::Mesh => Geometry::Mesh(MeshPass::new(gpu, &grid, &keep, &defines, GRID_GLSL, SAMPLE_GLSL)?),
         };
         let rgb = if outputs.rgb {
             let rgba: Vec<u8> = src
@@ -169,7 +120,6 @@ impl Refocuser {
             outputs,
             source: src.camera(),
             planes,
-            program,
             rgb,
             depth,
             geometry,
@@ -181,7 +131,7 @@ impl Refocuser {
     /// Number of kept triangles (mesh path) for reports.
     pub fn triangle_count(&self) -> Option<usize> {
         match &self.geometry {
-            Geometry::Mesh { count, .. } => Some(*count),
+            Geometry::Mesh(mesh) => Some(mesh.triangle_count()),
             Geometry::Fullscreen { .. } => None,
         }
     }
@@ -202,7 +152,7 @@ impl Refocuser {
                 slot(o.depth, TextureFormat::R32F),
                 slot(o.mask, TextureFormat::R8),
             ];
-            let with_depth = matches!(self.geometry, Geometry::Mesh { .. });
+            let with_depth = matches!(self.geometry, Geometry::Mesh(_));
             self.framebuffer = Some(Framebuffer::new(&self.gpu, w, h, &attachments, with_depth)?);
         }
         Ok(self.framebuffer.as_ref().expect("framebuffer allocated above"))
@@ -224,7 +174,6 @@ impl Refocuser {
         let gpu = self.gpu.clone();
         let gl = gpu.gl();
         let fb = self.framebuffer.as_ref().expect("framebuffer allocated above");
-        let p = &self.program;
         let sk = &self.source.k;
         let tk = &target.k;
         // The pixel -> source-point map in f64, per column and per row (it is separable), created
@@ -234,33 +183,39 @@ impl Refocuser {
         let bytes = |t: &[[f32; 4]]| -> Vec<u8> { t.iter().flatten().flat_map(|v| v.to_ne_bytes()).collect() };
         let cols = Texture::new(&gpu, target.width, 1, TextureFormat::Rgba32F, Some(&bytes(&cols)))?;
         let rows = Texture::new(&gpu, target.height, 1, TextureFormat::Rgba32F, Some(&bytes(&rows)))?;
+        let programs: Vec<&Program> = match &self.geometry {
+            Geometry::Fullscreen { program, .. } => vec![program],
+            Geometry::Mesh(mesh) => mesh.programs().to_vec(),
+        };
         let timer = GpuTimer::start(&gpu);
         fb.bind_and_clear(clear_depth);
-        p.bind();
-        self.vao.bind();
         if let Some(rgb) = &self.rgb {
             rgb.bind(0);
         }
         self.depth.bind(1);
         cols.bind(3);
         rows.bind(4);
-        p.set_i32("u_src_rgb", 0);
-        p.set_i32("u_src_depth", 1);
-        p.set_i32("u_keep", 2);
-        p.set_i32("u_tris", 2);
-        p.set_i32("u_cols", 3);
-        p.set_i32("u_rows", 4);
-        p.set_ivec2("u_src_size", [self.source.width as i32, self.source.height as i32]);
+        for p in programs {
+            p.bind();
+            p.set_i32("u_src_rgb", 0);
+            p.set_i32("u_src_depth", 1);
+            p.set_i32("u_keep", 2);
+            p.set_i32("u_cols", 3);
+            p.set_i32("u_rows", 4);
+            p.set_ivec2("u_src_size", [self.source.width as i32, self.source.height as i32]);
+            p.set_vec4("u_src_k", [sk.fx as f32, sk.fy as f32, sk.cx as f32, sk.cy as f32]);
+            p.set_i32("u_dst_height", target.height as i32);
+        }
         // SAFETY: plain state setting on the current context.
         unsafe {
             gl.disable(glow::BLEND);
             gl.disable(glow::CULL_FACE);
             gl.disable(glow::STENCIL_TEST);
         }
-        p.set_vec4("u_src_k", [sk.fx as f32, sk.fy as f32, sk.cx as f32, sk.cy as f32]);
-        p.set_i32("u_dst_height", target.height as i32);
         match &self.geometry {
-            Geometry::Fullscreen { keep } => {
+            Geometry::Fullscreen { program, keep } => {
+                program.bind();
+                self.vao.bind();
                 keep.bind(2);
                 // SAFETY: one full-screen triangle; no depth buffer is attached.
                 unsafe {
@@ -268,40 +223,7 @@ impl Refocuser {
                     gl.draw_arrays(glow::TRIANGLES, 0, 3);
                 }
             }
-            Geometry::Mesh { tris, count } => {
-                let m = clip_from_view_opencv(target, &self.planes, &conv);
-                p.set_mat4_rows("u_clip_from_target", &m);
-                let (a, b) = self.planes.clip_z_coefficients(&conv);
-                p.set_vec2("u_clip_z", [a as f32, b as f32]);
-                p.set_vec2("u_dst_size", [target.width as f32, target.height as f32]);
-                p.set_f32("u_expand_px", EXPAND_PX);
-                let depth_mode = match conv.ndc_depth {
-                    crate::convention::NdcDepthRange::MinusOneToOne => glow::NEGATIVE_ONE_TO_ONE,
-                    crate::convention::NdcDepthRange::ZeroToOne => glow::ZERO_TO_ONE,
-                };
-                gpu.clip_control(glow::LOWER_LEFT, depth_mode);
-                // SAFETY: depth state and a non-indexed draw of 3 vertices per kept triangle.
-                unsafe {
-                    gl.enable(glow::DEPTH_TEST);
-                    // No near/far clipping: with a 1e8 depth ratio, standard-Z f32 puts far
-                    // surfaces on the far plane, where clipping would drop them. Depth precision
-                    // may then only affect which of two overlapping surfaces wins.
-                    gl.enable(glow::DEPTH_CLAMP);
-                    gl.depth_mask(true);
-                    gl.depth_range_f64(0.0, 1.0);
-                    // LEQUAL/GEQUAL: at a 1e8 depth ratio standard-Z f32 rounds far surfaces onto
-                    // the clear value itself, which a strict test would reject.
-                    gl.depth_func(if conv.reversed_z { glow::GEQUAL } else { glow::LEQUAL });
-                    if let Some(t) = tris {
-                        t.bind(2);
-                        gl.draw_arrays(glow::TRIANGLES, 0, (*count * 3) as i32);
-                    }
-                }
-                // Leave the default clip control for whoever draws next.
-                gpu.clip_control(glow::LOWER_LEFT, glow::NEGATIVE_ONE_TO_ONE);
-                // SAFETY: state reset.
-                unsafe { gl.disable(glow::DEPTH_CLAMP) };
-            }
+            Geometry::Mesh(mesh) => mesh.draw(&gpu, &self.vao, &self.source, target, &self.planes, &conv, 2),
         }
         gpu.check("refocus draw")?;
         let render = timer.stop();

@@ -1,7 +1,8 @@
-// Grid mesh by vertex pulling: vertex 3t + k is corner k of kept triangle t, whose code
-// (cell << 1 | tri) comes from u_tris. Each vertex sees its whole triangle, so it pushes itself
-// out by u_expand_px (window pixels) along the corner's bisector; the fragment shader then keeps
-// exactly the closed triangle, so coverage does not depend on the fill rule or the row order.
+// Boundary triangles of the grid mesh (a corner touches a dropped triangle or the outer ring),
+// by vertex pulling: vertex 3t + k is corner k of triangle t, whose code (cell << 1 | tri) comes
+// from u_tris. Each vertex sees its whole triangle, so it pushes itself out by u_expand_px
+// (window pixels) along the corner's bisector; the fragment shader then keeps exactly the
+// closed triangle, so coverage does not depend on the fill rule or the row order.
 //
 // Same pose: a source pixel (u, v) projects to the same target pixel whatever its depth, so
 // corners are projected with Z = 1 through the target projection (w = 1: the map is affine)
