@@ -45,15 +45,29 @@ float tri_depth(vec2 ab, int tri, vec3 z) {
     return 1.0 / dot(w, 1.0 / z);
 }
 
-// Bilinear source colour at continuous pixel coordinate uv (pixel centres at integers), in f32
-// with texelFetch: fixed-function filtering has only ~8 bits of weight precision.
-vec3 bilinear_rgb_at(ivec2 i0, vec2 t) {
-    ivec2 hi = u_src_size - 1;
-    vec3 c00 = texelFetch(u_src_rgb, clamp(i0, ivec2(0), hi), 0).rgb;
-    vec3 c10 = texelFetch(u_src_rgb, clamp(i0 + ivec2(1, 0), ivec2(0), hi), 0).rgb;
-    vec3 c01 = texelFetch(u_src_rgb, clamp(i0 + ivec2(0, 1), ivec2(0), hi), 0).rgb;
-    vec3 c11 = texelFetch(u_src_rgb, clamp(i0 + ivec2(1, 1), ivec2(0), hi), 0).rgb;
-    vec3 top = mix(c00, c10, t.x);
-    vec3 bottom = mix(c01, c11, t.x);
-    return mix(top, bottom, t.y);
+// One textureGather fetches a cell's 2x2 footprint: cell c spans source pixels c - 1 .. c
+// (clamp-to-edge gives the border ring). The gather point is the footprint's centre, half a
+// texel away from any footprint decision. Gather order: x (0,1), y (1,1), z (1,0), w (0,0).
+vec2 cell_gather_point(ivec2 c) {
+    return vec2(c) / vec2(u_src_size);
+}
+
+// Source depths at the cell's corners, as (z00, z10, z01, z11).
+vec4 cell_depths(ivec2 c) {
+    vec4 g = textureGather(u_src_depth, cell_gather_point(c), 0);
+    return vec4(g.w, g.z, g.x, g.y);
+}
+
+// Bilinear source colour over cell c at local weights t, in f32 (fixed-function filtering has
+// only ~8 bits of weight precision; gathers return the texels exactly).
+vec3 cell_rgb(ivec2 c, vec2 t) {
+    vec2 p = cell_gather_point(c);
+    vec4 r = textureGather(u_src_rgb, p, 0);
+    vec4 g = textureGather(u_src_rgb, p, 1);
+    vec4 b = textureGather(u_src_rgb, p, 2);
+    vec3 c00 = vec3(r.w, g.w, b.w);
+    vec3 c10 = vec3(r.z, g.z, b.z);
+    vec3 c01 = vec3(r.x, g.x, b.x);
+    vec3 c11 = vec3(r.y, g.y, b.y);
+    return mix(mix(c00, c10, t.x), mix(c01, c11, t.x), t.y);
 }

@@ -19,10 +19,8 @@ const float NONE = 3.0e38;
 
 float surface_depth(ivec2 c, vec2 ab, bvec2 border) {
     uint bits = texelFetch(u_keep, c, 0).r;
-    float z00 = vertex_depth(c);
-    float z10 = vertex_depth(c + ivec2(1, 0));
-    float z01 = vertex_depth(c + ivec2(0, 1));
-    float z11 = vertex_depth(c + ivec2(1, 1));
+    vec4 zc = cell_depths(c);
+    float z00 = zc.x, z10 = zc.y, z01 = zc.z, z11 = zc.w;
     bool in1 = (bits & 1u) != 0u && inside_tri(ab, 0);
     bool in2 = (bits & 2u) != 0u && inside_tri(ab, 1);
     if (in1 || in2) {
@@ -58,7 +56,7 @@ void main() {
 #if WANT_RGB
     // Cell c spans source pixels c - 1 .. c (clamped at the border ring), exactly the bilinear
     // footprint of its points, with the local coordinate as weight.
-    o_rgb = vec4(bilinear_rgb_at(c0 - 1, vec2(cx.y, cy.y)), 1.0);
+    o_rgb = vec4(cell_rgb(c0, clamp(vec2(cx.y, cy.y), 0.0, 1.0)), 1.0);
 #endif
     o_depth = z;
     o_mask = 1.0;

@@ -27,11 +27,11 @@ void main() {
     if (cx.x < 0.0 || cy.x < 0.0 || !inside_tri(ab, v_cell.z)) {
         discard;
     }
-    vec3 z = v_cell.z == 0 ? vec3(vertex_depth(c), vertex_depth(c + ivec2(1, 0)), vertex_depth(c + ivec2(1, 1)))
-                           : vec3(vertex_depth(c), vertex_depth(c + ivec2(1, 1)), vertex_depth(c + ivec2(0, 1)));
+    vec4 zc = cell_depths(c);
+    vec3 z = v_cell.z == 0 ? zc.xyw : zc.xwz;
 #if WANT_RGB
     // The cell spans source pixels c - 1 .. c (clamped at the border ring): the bilinear footprint.
-    o_rgb = vec4(bilinear_rgb_at(c - 1, clamp(ab, 0.0, 1.0)), 1.0);
+    o_rgb = vec4(cell_rgb(c, clamp(ab, 0.0, 1.0)), 1.0);
 #else
     o_rgb = vec4(0.0);
 #endif

@@ -13,10 +13,10 @@ void main() {
     ivec2 c = ivec2(cx.x, cy.x);
     vec2 ab = clamp(vec2(cx.y, cy.y), 0.0, 1.0);
     int tri = ab.x >= ab.y ? 0 : 1;
-    vec3 z = tri == 0 ? vec3(vertex_depth(c), vertex_depth(c + ivec2(1, 0)), vertex_depth(c + ivec2(1, 1)))
-                      : vec3(vertex_depth(c), vertex_depth(c + ivec2(1, 1)), vertex_depth(c + ivec2(0, 1)));
+    vec4 zc = cell_depths(c);
+    vec3 z = tri == 0 ? zc.xyw : zc.xwz;
 #if WANT_RGB
-    o_rgb = vec4(bilinear_rgb_at(c - 1, ab), 1.0);
+    o_rgb = vec4(cell_rgb(c, ab), 1.0);
 #else
     o_rgb = vec4(0.0);
 #endif

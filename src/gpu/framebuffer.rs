@@ -114,6 +114,36 @@ impl Framebuffer {
         }
     }
 
+    /// Read colour attachment `index` back with glReadPixels (rows in memory order, row 0 =
+    /// framebuffer row 0); None for an empty slot. On llvmpipe this is several times faster
+    /// than glGetTexImage on the same texture.
+    pub fn read_color(&self, index: usize) -> Result<Option<Vec<u8>>> {
+        let Some(t) = self.colors.get(index).and_then(|t| t.as_ref()) else {
+            return Ok(None);
+        };
+        let (fmt, ty, bpp) = t.format.transfer();
+        let mut out = vec![0u8; self.width as usize * self.height as usize * bpp];
+        let gl = self.gpu.gl();
+        // SAFETY: the buffer is exactly width x height texels of this format; pack alignment 1.
+        unsafe {
+            gl.bind_framebuffer(glow::READ_FRAMEBUFFER, Some(self.raw));
+            gl.read_buffer(glow::COLOR_ATTACHMENT0 + index as u32);
+            gl.pixel_store_i32(glow::PACK_ALIGNMENT, 1);
+            gl.read_pixels(
+                0,
+                0,
+                self.width as i32,
+                self.height as i32,
+                fmt,
+                ty,
+                glow::PixelPackData::Slice(Some(&mut out)),
+            );
+            gl.bind_framebuffer(glow::READ_FRAMEBUFFER, None);
+        }
+        self.gpu.check("framebuffer readback")?;
+        Ok(Some(out))
+    }
+
     pub fn unbind(&self) {
         // SAFETY: binding the default framebuffer is always valid.
         unsafe { self.gpu.gl().bind_framebuffer(glow::FRAMEBUFFER, None) }

@@ -29,7 +29,7 @@ impl TextureFormat {
         }
     }
     /// (format, type, bytes per texel) for transfers.
-    fn transfer(self) -> (u32, u32, usize) {
+    pub(crate) fn transfer(self) -> (u32, u32, usize) {
         match self {
             TextureFormat::Rgba8 => (glow::RGBA, glow::UNSIGNED_BYTE, 4),
             TextureFormat::R8 => (glow::RED, glow::UNSIGNED_BYTE, 1),

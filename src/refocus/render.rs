@@ -232,21 +232,21 @@ impl Refocuser {
         let (w, h) = (target.width, target.height);
         let flip = conv.row_order == RowOrder::BottomUp;
         let mut outputs = (None, None, None);
-        if let Some(t) = &fb.colors[0] {
-            let rgba = top_down(t.read()?, w, h, 4, flip);
+        if let Some(data) = fb.read_color(0)? {
+            let rgba = top_down(data, w, h, 4, flip);
             let rgb = rgba.chunks_exact(4).flat_map(|p| [p[0], p[1], p[2]]).collect();
             outputs.0 = Some(RgbImage::new(w, h, rgb)?);
         }
-        if let Some(t) = &fb.colors[1] {
-            let bytes = top_down(t.read()?, w, h, 4, flip);
+        if let Some(data) = fb.read_color(1)? {
+            let bytes = top_down(data, w, h, 4, flip);
             let z = bytes
                 .chunks_exact(4)
                 .map(|b| f32::from_ne_bytes([b[0], b[1], b[2], b[3]]))
                 .collect();
             outputs.1 = Some(DepthMap::new(w, h, z)?);
         }
-        if let Some(t) = &fb.colors[2] {
-            let m = top_down(t.read()?, w, h, 1, flip)
+        if let Some(data) = fb.read_color(2)? {
+            let m = top_down(data, w, h, 1, flip)
                 .into_iter()
                 .map(|v| (v >= 128) as u8)
                 .collect();
