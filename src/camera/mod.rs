@@ -1,7 +1,10 @@
 //! Camera models: pinhole intrinsics and the projections built from them.
 
 mod intrinsics;
+pub mod mat4;
+pub mod pose;
 mod projection;
 
 pub use intrinsics::{Intrinsics, PinholeCamera, MAX_IMAGE_SIDE};
+pub use pose::{gl_projection, Pose};
 pub use projection::clip_from_view_opencv;
