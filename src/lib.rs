@@ -11,6 +11,7 @@
 pub mod bench;
 pub mod camera;
 pub mod convention;
+pub mod cyclopean;
 pub mod demo;
 pub mod error;
 pub mod gpu;

@@ -1,0 +1,199 @@
+//! cyclopean: the middle (spectator) view of a stereo pair from each eye's colour and depth,
+//! without rendering a third camera (seed 000).
+//!
+//! For each middle pixel the middle ray is walked to the surface each eye saw: start at the
+//! fixation depth, project into the eye, read its depth there, reconstruct that surface point,
+//! and take its middle-view depth as the next guess. The seed stops after one such step
+//! ([`Method::Seed`]); [`Method::Refine`] iterates and then checks that the surface found really
+//! projects onto this middle pixel, which rejects disoccluded samples the seed would smear.
+//! Left/right conflicts are resolved by middle-space depth (hard threshold or soft blend, with an
+//! optional dominant eye).
+//!
+//! - [`reference`]: the f64 CPU twin; [`render`]: the GPU pass (shaders/cyclopean/gather.frag).
+//! - [`scene_frame`]: a stereo frame of the built-in scene under any conventions, for tests,
+//!   the demo and the report.
+
+pub mod reference;
+pub mod render;
+pub mod scene_frame;
+
+use crate::camera::mat4::{self, Mat4};
+use crate::convention::Conventions;
+use crate::error::{Error, Result};
+use crate::io::{DepthMap, RgbImage};
+use serde::{Deserialize, Serialize};
+
+/// What the eye depth maps hold.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum DepthKind {
+    /// Window depth from the depth buffer, in [0, 1], under the frame's conventions; background
+    /// is the far value (1, or 0 with reversed-Z).
+    Device,
+    /// Linear view-space distance along the eye's viewing direction (GL: -z_eye), metres;
+    /// background is 0, NaN or Inf. Answers the seed's closing question: both are accepted.
+    ViewZ,
+}
+
+/// One eye: colour, depth (rows top-down) and the GL matrices it was rendered with.
+#[derive(Debug, Clone)]
+pub struct EyeInput {
+    pub color: RgbImage,
+    pub depth: DepthMap,
+    /// World -> GL eye space.
+    pub view: Mat4,
+    /// GL eye space -> clip, matching the frame's conventions (y flipped for top-down rows).
+    pub proj: Mat4,
+}
+
+/// A stereo frame.
+#[derive(Debug, Clone)]
+pub struct StereoFrame {
+    pub left: EyeInput,
+    pub right: EyeInput,
+    pub depth_kind: DepthKind,
+    pub conv: Conventions,
+}
+
+/// The middle (preview) camera: GL view and projection, and the output size.
+#[derive(Debug, Clone, Copy)]
+pub struct MiddleCamera {
+    pub view: Mat4,
+    pub proj: Mat4,
+    pub width: u32,
+    pub height: u32,
+}
+
+impl MiddleCamera {
+    /// The seed's middle camera: origin halfway between the gaze origins, head orientation
+    /// (`head_rotation` columns = head x, y, z axes in world, GL convention: -z forward).
+    pub fn from_gaze(
+        gaze_left: [f64; 3],
+        gaze_right: [f64; 3],
+        head_rotation: [[f64; 3]; 3],
+        proj: Mat4,
+        width: u32,
+        height: u32,
+    ) -> Result<Self> {
+        let e = [0.0, 1.0, 2.0].map(|i: f64| 0.5 * (gaze_left[i as usize] + gaze_right[i as usize]));
+        let r = head_rotation;
+        let world_from_head: Mat4 = [
+            [r[0][0], r[0][1], r[0][2], e[0]],
+            [r[1][0], r[1][1], r[1][2], e[1]],
+            [r[2][0], r[2][1], r[2][2], e[2]],
+            [0.0, 0.0, 0.0, 1.0],
+        ];
+        let view = mat4::inverse(&world_from_head).ok_or_else(|| Error::param("head rotation", "singular"))?;
+        Ok(MiddleCamera { view, proj, width, height })
+    }
+}
+
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum Method {
+    /// Seed 000 as written: one reconstruction step from the fixation depth.
+    Seed,
+    /// `steps` reconstruction steps, then a check that the surface found projects onto this
+    /// middle pixel (within half a pixel per step of slack); eyes failing it are dropped.
+    Refine { steps: u32 },
+}
+
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum Blend {
+    /// Depth disagreement above the threshold takes the nearer eye, else the mean (seed 5.3).
+    Hard,
+    /// mix(nearer eye, mean, saturate(1 - dz / threshold)) (seed 8).
+    Soft,
+}
+
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum Eye {
+    Left,
+    Right,
+}
+
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct CyclopeanParams {
+    pub method: Method,
+    pub blend: Blend,
+    /// Middle-space depth disagreement (metres) above which the eyes are treated as seeing
+    /// different surfaces. The seed suggests clamp(0.02 |zFix|, 0.02, 0.25).
+    pub z_threshold: f64,
+    /// Weight of the dominant eye where both are blended (0.5 each when None).
+    pub dominant: Option<(Eye, f64)>,
+    /// Initial depth guess: the fixation point's distance along the middle view axis (> 0).
+    pub fixation_distance: f64,
+}
+
+impl CyclopeanParams {
+    pub fn seed(fixation_distance: f64) -> Self {
+        CyclopeanParams {
+            method: Method::Seed,
+            blend: Blend::Hard,
+            z_threshold: (0.02 * fixation_distance).clamp(0.02, 0.25),
+            dominant: None,
+            fixation_distance,
+        }
+    }
+
+    pub fn validate(&self) -> Result<()> {
+        if !(self.fixation_distance.is_finite() && self.fixation_distance > 0.0) {
+            return Err(Error::param("fixation distance", format!("{} must be finite and > 0", self.fixation_distance)));
+        }
+        if !(self.z_threshold.is_finite() && self.z_threshold > 0.0) {
+            return Err(Error::param("z-threshold", format!("{} must be finite and > 0", self.z_threshold)));
+        }
+        if let Some((_, w)) = self.dominant {
+            if !(0.0..=1.0).contains(&w) {
+                return Err(Error::param("dominant eye weight", format!("{w} outside [0, 1]")));
+            }
+        }
+        if let Method::Refine { steps } = self.method {
+            if steps == 0 || steps > 16 {
+                return Err(Error::param("refine steps", format!("{steps} outside 1..=16")));
+            }
+        }
+        Ok(())
+    }
+
+    pub(crate) fn steps(&self) -> u32 {
+        match self.method {
+            Method::Seed => 1,
+            Method::Refine { steps } => steps,
+        }
+    }
+}
+
+/// The middle view. Rows top-down.
+#[derive(Debug, Clone)]
+pub struct CyclopeanOutput {
+    pub color: RgbImage,
+    /// Middle view-space distance (metres) of the surface shown; 0 where no eye had one.
+    pub depth: DepthMap,
+    /// Per pixel, bit 0: the left eye contributed, bit 1: the right eye. 0 = invalid (the seed's
+    /// fallback colour, the mean of both eyes at the same uv, is still written).
+    pub sources: Vec<u8>,
+}
+
+impl StereoFrame {
+    pub fn validate(&self) -> Result<()> {
+        for (name, eye) in [("left", &self.left), ("right", &self.right)] {
+            if (eye.color.width, eye.color.height) != (eye.depth.width, eye.depth.height) {
+                return Err(Error::SizeMismatch {
+                    message: format!(
+                        "{name} eye: colour {}x{} vs depth {}x{}",
+                        eye.color.width, eye.color.height, eye.depth.width, eye.depth.height
+                    ),
+                });
+            }
+            for (what, m) in [("view", &eye.view), ("projection", &eye.proj)] {
+                if m.iter().flatten().any(|v| !v.is_finite()) || mat4::inverse(m).is_none() {
+                    return Err(Error::param(format!("{name} {what} matrix"), "not finite or not invertible"));
+                }
+            }
+        }
+        Ok(())
+    }
+}

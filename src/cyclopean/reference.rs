@@ -1,0 +1,252 @@
+//! Float64 CPU twin of the cyclopean pass (shaders/cyclopean/gather.frag): same steps, same
+//! texel choices. Images are handled in memory order (row 0 = framebuffer row 0 under the
+//! frame's row order) exactly as the GPU sees its textures, and converted at the end.
+
+use super::{Blend, CyclopeanOutput, CyclopeanParams, DepthKind, Eye, EyeInput, MiddleCamera, StereoFrame};
+use crate::camera::mat4::{self, Mat4};
+use crate::convention::{NdcDepthRange, RowOrder};
+use crate::error::Result;
+use crate::io::{DepthMap, RgbImage};
+
+/// Device depth within this of the far value is background (seed 3.1).
+pub const FAR_EPS: f64 = 1e-6;
+
+/// An eye prepared for sampling: rows in memory order, inverse matrices.
+struct Eye64<'a> {
+    input: &'a EyeInput,
+    flip: bool,
+    inv_view: Mat4,
+    inv_proj: Mat4,
+}
+
+impl Eye64<'_> {
+    fn size(&self) -> (i64, i64) {
+        (self.input.color.width as i64, self.input.color.height as i64)
+    }
+    /// Image row of memory row `y`.
+    fn image_row(&self, y: i64) -> i64 {
+        if self.flip {
+            self.size().1 - 1 - y
+        } else {
+            y
+        }
+    }
+    fn depth_at(&self, x: i64, y: i64) -> f64 {
+        let (w, _) = self.size();
+        self.input.depth.data[(self.image_row(y) * w + x) as usize] as f64
+    }
+    fn color_at(&self, x: i64, y: i64) -> [f64; 3] {
+        let (w, h) = self.size();
+        let (x, y) = (x.clamp(0, w - 1), y.clamp(0, h - 1));
+        let o = ((self.image_row(y) * w + x) * 3) as usize;
+        let d = &self.input.color.data;
+        [d[o] as f64, d[o + 1] as f64, d[o + 2] as f64]
+    }
+    /// Bilinear colour at uv in [0, 1]^2 (texel centres at (i + 0.5) / size), clamp to edge.
+    fn bilinear(&self, uv: [f64; 2]) -> [f64; 3] {
+        let (w, h) = self.size();
+        let t = [uv[0] * w as f64 - 0.5, uv[1] * h as f64 - 0.5];
+        let (x0, y0) = (t[0].floor(), t[1].floor());
+        let (fx, fy) = (t[0] - x0, t[1] - y0);
+        let (x0, y0) = (x0 as i64, y0 as i64);
+        let (c00, c10, c01, c11) =
+            (self.color_at(x0, y0), self.color_at(x0 + 1, y0), self.color_at(x0, y0 + 1), self.color_at(x0 + 1, y0 + 1));
+        let mut out = [0.0; 3];
+        for c in 0..3 {
+            let top = c00[c] + (c10[c] - c00[c]) * fx;
+            let bottom = c01[c] + (c11[c] - c01[c]) * fx;
+            out[c] = top + (bottom - top) * fy;
+        }
+        out
+    }
+}
+
+/// NDC z where rays are unprojected: inside the depth range under every convention.
+pub const RAY_NDC_Z: f64 = 0.5;
+
+/// View-space direction through NDC (x, y) of projection inverse `inv_proj`, scaled so that its
+/// GL z is -1 (unit distance along the view axis).
+fn view_ray(inv_proj: &Mat4, ndc: [f64; 2]) -> [f64; 3] {
+    let p = mat4::transform_point(inv_proj, [ndc[0], ndc[1], RAY_NDC_Z]);
+    [p[0] / -p[2], p[1] / -p[2], -1.0]
+}
+
+/// Result of walking one eye along a middle ray.
+#[derive(Debug, Clone, Copy)]
+pub struct EyeSample {
+    pub valid: bool,
+    pub color: [f64; 3],
+    /// Middle view-space distance of the surface found.
+    pub z_middle: f64,
+}
+
+struct Ctx<'a> {
+    frame: &'a StereoFrame,
+    mid: &'a MiddleCamera,
+    inv_view_m: Mat4,
+    params: &'a CyclopeanParams,
+}
+
+impl Ctx<'_> {
+    fn walk(&self, eye: &Eye64, ray_m: [f64; 3], pixel: [f64; 2]) -> EyeSample {
+        let invalid = EyeSample { valid: false, color: [0.0; 3], z_middle: 0.0 };
+        let (w, h) = eye.size();
+        let mut z = self.params.fixation_distance;
+        let mut uv = [0.0; 2];
+        let mut world = [0.0; 3];
+        for _ in 0..self.params.steps() {
+            let guess = mat4::transform_point(&self.inv_view_m, [ray_m[0] * z, ray_m[1] * z, ray_m[2] * z]);
+            let clip = mat4::transform(&mat4::mul(&eye.input.proj, &eye.input.view), [guess[0], guess[1], guess[2], 1.0]);
+            if !(clip[3] > 0.0) {
+                return invalid;
+            }
+            let ndc = [clip[0] / clip[3], clip[1] / clip[3]];
+            uv = [ndc[0] * 0.5 + 0.5, ndc[1] * 0.5 + 0.5];
+            if !(uv[0] >= 0.0 && uv[0] <= 1.0 && uv[1] >= 0.0 && uv[1] <= 1.0) {
+                return invalid;
+            }
+            let tx = ((uv[0] * w as f64).floor() as i64).clamp(0, w - 1);
+            let ty = ((uv[1] * h as f64).floor() as i64).clamp(0, h - 1);
+            let d = eye.depth_at(tx, ty);
+            let view = match self.frame.depth_kind {
+                DepthKind::Device => {
+                    let conv = &self.frame.conv;
+                    let ok = d.is_finite() && if conv.reversed_z { d > FAR_EPS } else { d < 1.0 - FAR_EPS };
+                    if !ok {
+                        return invalid;
+                    }
+                    let ndc_z = match conv.ndc_depth {
+                        NdcDepthRange::MinusOneToOne => d * 2.0 - 1.0,
+                        NdcDepthRange::ZeroToOne => d,
+                    };
+                    mat4::transform_point(&eye.inv_proj, [ndc[0], ndc[1], ndc_z])
+                }
+                DepthKind::ViewZ => {
+                    if !(d.is_finite() && d > 0.0) {
+                        return invalid;
+                    }
+                    let r = view_ray(&eye.inv_proj, ndc);
+                    [r[0] * d, r[1] * d, r[2] * d]
+                }
+            };
+            world = mat4::transform_point(&eye.inv_view, view);
+            z = -mat4::transform_point(&self.mid.view, world)[2];
+            if !(z.is_finite() && z > 0.0) {
+                return invalid;
+            }
+        }
+        if let super::Method::Refine { .. } = self.params.method {
+            // The surface found must lie on this middle pixel's ray: project it back.
+            let clip = mat4::transform(&mat4::mul(&self.mid.proj, &self.mid.view), [world[0], world[1], world[2], 1.0]);
+            let px = [
+                (clip[0] / clip[3] * 0.5 + 0.5) * self.mid.width as f64,
+                (clip[1] / clip[3] * 0.5 + 0.5) * self.mid.height as f64,
+            ];
+            if !((px[0] - pixel[0]).abs() <= REFINE_TOLERANCE_PX && (px[1] - pixel[1]).abs() <= REFINE_TOLERANCE_PX) {
+                return invalid;
+            }
+        }
+        EyeSample { valid: true, color: eye.bilinear(uv), z_middle: z }
+    }
+}
+
+/// How far (middle pixels) a refined surface may project from the pixel that found it: the eye
+/// depth is read at the nearest texel, so the point can sit half an eye texel off the ray,
+/// which is up to about one middle pixel when the middle camera has a similar resolution.
+pub const REFINE_TOLERANCE_PX: f64 = 1.0;
+
+/// Resolve the two eyes' samples into colour, middle depth and source bits (shared rule).
+pub fn combine(l: &EyeSample, r: &EyeSample, params: &CyclopeanParams) -> Option<([f64; 3], f64, u8)> {
+    let w_left = match params.dominant {
+        Some((Eye::Left, w)) => w,
+        Some((Eye::Right, w)) => 1.0 - w,
+        None => 0.5,
+    };
+    match (l.valid, r.valid) {
+        (false, false) => None,
+        (true, false) => Some((l.color, l.z_middle, 1)),
+        (false, true) => Some((r.color, r.z_middle, 2)),
+        (true, true) => {
+            let mean = [0, 1, 2].map(|c| w_left * l.color[c] + (1.0 - w_left) * r.color[c]);
+            let (near, near_bit) = if l.z_middle <= r.z_middle { (l, 1) } else { (r, 2) };
+            let dz = (l.z_middle - r.z_middle).abs();
+            let z = l.z_middle.min(r.z_middle);
+            match params.blend {
+                Blend::Hard if dz > params.z_threshold => Some((near.color, z, near_bit)),
+                Blend::Hard => Some((mean, z, 3)),
+                Blend::Soft => {
+                    let t = (1.0 - dz / params.z_threshold).clamp(0.0, 1.0);
+                    let c = [0, 1, 2].map(|k| near.color[k] + (mean[k] - near.color[k]) * t);
+                    Some((c, z, if t > 0.0 { 3 } else { near_bit }))
+                }
+            }
+        }
+    }
+}
+
+/// Unquantised reference result (rows top-down).
+pub struct CyclopeanReference {
+    pub color: Vec<[f64; 3]>,
+    pub depth: Vec<f64>,
+    pub sources: Vec<u8>,
+}
+
+pub fn cyclopean_reference(frame: &StereoFrame, mid: &MiddleCamera, params: &CyclopeanParams) -> Result<CyclopeanReference> {
+    frame.validate()?;
+    params.validate()?;
+    let flip = frame.conv.row_order == RowOrder::BottomUp;
+    fn prep(input: &EyeInput, flip: bool) -> Result<Eye64<'_>> {
+        Ok(Eye64 {
+            input,
+            flip,
+            inv_view: mat4::inverse(&input.view).ok_or_else(|| crate::Error::param("eye view", "singular"))?,
+            inv_proj: mat4::inverse(&input.proj).ok_or_else(|| crate::Error::param("eye projection", "singular"))?,
+        })
+    }
+    let (left, right) = (prep(&frame.left, flip)?, prep(&frame.right, flip)?);
+    let ctx = Ctx {
+        frame,
+        mid,
+        inv_view_m: mat4::inverse(&mid.view).ok_or_else(|| crate::Error::param("middle view", "singular"))?,
+        params,
+    };
+    let inv_proj_m = mat4::inverse(&mid.proj).ok_or_else(|| crate::Error::param("middle projection", "singular"))?;
+    let (w, h) = (mid.width as usize, mid.height as usize);
+    let mut out = CyclopeanReference { color: vec![[0.0; 3]; w * h], depth: vec![0.0; w * h], sources: vec![0; w * h] };
+    for y_mem in 0..h {
+        let y_img = if flip { h - 1 - y_mem } else { y_mem };
+        for x in 0..w {
+            let pixel = [x as f64 + 0.5, y_mem as f64 + 0.5];
+            let uv = [pixel[0] / w as f64, pixel[1] / h as f64];
+            let ray = view_ray(&inv_proj_m, [uv[0] * 2.0 - 1.0, uv[1] * 2.0 - 1.0]);
+            let l = ctx.walk(&left, ray, pixel);
+            let r = ctx.walk(&right, ray, pixel);
+            let o = y_img * w + x;
+            match combine(&l, &r, params) {
+                Some((c, z, bits)) => {
+                    out.color[o] = c;
+                    out.depth[o] = z;
+                    out.sources[o] = bits;
+                }
+                None => {
+                    // The seed's fallback colour: both eyes at the same uv, averaged.
+                    let (a, b) = (left.bilinear(uv), right.bilinear(uv));
+                    out.color[o] = [0, 1, 2].map(|c| 0.5 * (a[c] + b[c]));
+                }
+            }
+        }
+    }
+    Ok(out)
+}
+
+impl CyclopeanReference {
+    /// Rounded to the output types (for writing or comparing as images).
+    pub fn to_output(&self, width: u32, height: u32) -> CyclopeanOutput {
+        CyclopeanOutput {
+            color: RgbImage::new(width, height, self.color.iter().flat_map(|c| c.map(crate::metrics::quantize_u8)).collect())
+                .expect("size matches"),
+            depth: DepthMap::new(width, height, self.depth.iter().map(|z| *z as f32).collect()).expect("size matches"),
+            sources: self.sources.clone(),
+        }
+    }
+}

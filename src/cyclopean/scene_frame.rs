@@ -1,0 +1,86 @@
+//! A stereo frame of the built-in scene, rendered exactly (f64 ray tracing) under any
+//! conventions, with the ray-traced middle view as ground truth.
+
+use super::{DepthKind, EyeInput, MiddleCamera, StereoFrame};
+use crate::camera::{gl_projection, PinholeCamera, Pose};
+use crate::convention::{Conventions, DepthPlanes};
+use crate::io::{DepthMap, RgbImage};
+use crate::scene;
+
+/// A parallel stereo rig: both eyes share the head's orientation, offset by ∓ipd/2 along its x.
+#[derive(Debug, Clone, Copy)]
+pub struct StereoRig {
+    pub camera: PinholeCamera,
+    pub ipd: f64,
+    /// The middle (cyclopean) camera's pose.
+    pub head: Pose,
+    pub planes: DepthPlanes,
+}
+
+impl StereoRig {
+    /// 64 mm IPD at the demo camera's pose, near 0.05 m, far 100 m.
+    pub fn demo(width: u32, height: u32) -> Self {
+        StereoRig {
+            camera: scene::demo_camera(width, height),
+            ipd: 0.064,
+            head: Pose::IDENTITY,
+            planes: DepthPlanes { near: 0.05, far: 100.0 },
+        }
+    }
+
+    pub fn eye_pose(&self, side: f64) -> Pose {
+        let r = &self.head.rotation;
+        let o = 0.5 * side * self.ipd;
+        let p = self.head.position;
+        Pose { rotation: *r, position: [p[0] + o * r[0][0], p[1] + o * r[1][0], p[2] + o * r[2][0]] }
+    }
+}
+
+/// Ground truth of the middle view.
+pub struct MiddleTruth {
+    pub color: RgbImage,
+    /// Middle view-space distance; 0 where the scene has no surface.
+    pub depth: DepthMap,
+}
+
+fn eye_input(rig: &StereoRig, pose: &Pose, conv: &Conventions, kind: DepthKind) -> EyeInput {
+    let (color, z) = scene::render_posed(&rig.camera, pose);
+    let depth = match kind {
+        DepthKind::ViewZ => z,
+        DepthKind::Device => {
+            let far = conv.clear_depth() as f32;
+            let data = z
+                .data
+                .iter()
+                .map(|&v| {
+                    if v > 0.0 {
+                        let ndc = rig.planes.ndc_z_of_view_z(conv, v as f64);
+                        DepthPlanes::window_depth_of_ndc_z(conv, ndc) as f32
+                    } else {
+                        far
+                    }
+                })
+                .collect();
+            DepthMap::new(z.width, z.height, data).expect("same size")
+        }
+    };
+    EyeInput { color, depth, view: pose.gl_view(), proj: gl_projection(&rig.camera, &rig.planes, conv) }
+}
+
+/// Left/right eyes, the middle camera (same intrinsics as the eyes) and its ground truth.
+pub fn scene_frame(rig: &StereoRig, conv: Conventions, kind: DepthKind) -> (StereoFrame, MiddleCamera, MiddleTruth) {
+    let frame = StereoFrame {
+        left: eye_input(rig, &rig.eye_pose(-1.0), &conv, kind),
+        right: eye_input(rig, &rig.eye_pose(1.0), &conv, kind),
+        depth_kind: kind,
+        conv,
+    };
+    let mid = MiddleCamera {
+        view: rig.head.gl_view(),
+        proj: gl_projection(&rig.camera, &rig.planes, &conv),
+        width: rig.camera.width,
+        height: rig.camera.height,
+    };
+    let (color, depth) = scene::render_posed(&rig.camera, &rig.head);
+    (frame, mid, MiddleTruth { color, depth })
+}
