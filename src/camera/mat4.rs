@@ -2,7 +2,12 @@
 
 pub type Mat4 = [[f64; 4]; 4];
 
-pub const IDENTITY: Mat4 = [[1.0, 0.0, 0.0, 0.0], [0.0, 1.0, 0.0, 0.0], [0.0, 0.0, 1.0, 0.0], [0.0, 0.0, 0.0, 1.0]];
+pub const IDENTITY: Mat4 = [
+    [1.0, 0.0, 0.0, 0.0],
+    [0.0, 1.0, 0.0, 0.0],
+    [0.0, 0.0, 1.0, 0.0],
+    [0.0, 0.0, 0.0, 1.0],
+];
 
 pub fn mul(a: &Mat4, b: &Mat4) -> Mat4 {
     let mut out = [[0.0; 4]; 4];
@@ -74,7 +79,12 @@ mod tests {
 
     #[test]
     fn inverse_times_matrix_is_identity() {
-        let m: Mat4 = [[2.0, 0.1, 0.0, 3.0], [0.0, 1.5, 0.2, -1.0], [0.3, 0.0, 1.0, 0.5], [0.0, 0.0, 0.0, 1.0]];
+        let m: Mat4 = [
+            [2.0, 0.1, 0.0, 3.0],
+            [0.0, 1.5, 0.2, -1.0],
+            [0.3, 0.0, 1.0, 0.5],
+            [0.0, 0.0, 0.0, 1.0],
+        ];
         let p = mul(&inverse(&m).unwrap(), &m);
         for (r, row) in p.iter().enumerate() {
             for (c, v) in row.iter().enumerate() {

@@ -4,6 +4,8 @@ mod intrinsics;
 pub mod mat4;
 pub mod pose;
 mod projection;
+pub mod stereo;
+pub mod vergence;
 
 pub use intrinsics::{Intrinsics, PinholeCamera, MAX_IMAGE_SIDE};
 pub use pose::{gl_projection, Pose};

@@ -16,19 +16,33 @@ pub struct Pose {
 }
 
 /// OpenCV view axes <-> GL eye axes.
-pub const CV_TO_GL: Mat4 = [[1.0, 0.0, 0.0, 0.0], [0.0, -1.0, 0.0, 0.0], [0.0, 0.0, -1.0, 0.0], [0.0, 0.0, 0.0, 1.0]];
+pub const CV_TO_GL: Mat4 = [
+    [1.0, 0.0, 0.0, 0.0],
+    [0.0, -1.0, 0.0, 0.0],
+    [0.0, 0.0, -1.0, 0.0],
+    [0.0, 0.0, 0.0, 1.0],
+];
 
 impl Pose {
-    pub const IDENTITY: Pose = Pose { rotation: [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]], position: [0.0; 3] };
+    pub const IDENTITY: Pose = Pose {
+        rotation: [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]],
+        position: [0.0; 3],
+    };
 
     pub fn at(position: [f64; 3]) -> Pose {
-        Pose { position, ..Pose::IDENTITY }
+        Pose {
+            position,
+            ..Pose::IDENTITY
+        }
     }
 
     /// Rotation about the world y axis (yaw, radians) at `position`.
     pub fn yawed(yaw: f64, position: [f64; 3]) -> Pose {
         let (s, c) = yaw.sin_cos();
-        Pose { rotation: [[c, 0.0, s], [0.0, 1.0, 0.0], [-s, 0.0, c]], position }
+        Pose {
+            rotation: [[c, 0.0, s], [0.0, 1.0, 0.0], [-s, 0.0, c]],
+            position,
+        }
     }
 
     /// World from OpenCV camera coordinates.
@@ -86,12 +100,25 @@ mod tests {
 
     #[test]
     fn gl_matrices_put_a_world_point_on_its_pixel() {
-        let cam = PinholeCamera { k: Intrinsics { fx: 300.0, fy: 310.0, cx: 63.5, cy: 47.5 }, width: 128, height: 96 };
+        let cam = PinholeCamera {
+            k: Intrinsics {
+                fx: 300.0,
+                fy: 310.0,
+                cx: 63.5,
+                cy: 47.5,
+            },
+            width: 128,
+            height: 96,
+        };
         let pose = Pose::yawed(0.3, [0.1, -0.2, 0.5]);
         let planes = DepthPlanes { near: 0.1, far: 100.0 };
         let world = {
             let d = pose.ray(&cam, 20.25, 70.5);
-            [pose.position[0] + 3.0 * d[0], pose.position[1] + 3.0 * d[1], pose.position[2] + 3.0 * d[2]]
+            [
+                pose.position[0] + 3.0 * d[0],
+                pose.position[1] + 3.0 * d[1],
+                pose.position[2] + 3.0 * d[2],
+            ]
         };
         for conv in Conventions::all() {
             let vp = mat4::mul(&gl_projection(&cam, &planes, &conv), &pose.gl_view());

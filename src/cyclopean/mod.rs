@@ -84,7 +84,12 @@ impl MiddleCamera {
             [0.0, 0.0, 0.0, 1.0],
         ];
         let view = mat4::inverse(&world_from_head).ok_or_else(|| Error::param("head rotation", "singular"))?;
-        Ok(MiddleCamera { view, proj, width, height })
+        Ok(MiddleCamera {
+            view,
+            proj,
+            width,
+            height,
+        })
     }
 }
 
@@ -94,7 +99,8 @@ pub enum Method {
     /// Seed 000 as written: one reconstruction step from the fixation depth.
     Seed,
     /// `steps` reconstruction steps, then a check that the surface found projects onto this
-    /// middle pixel (within half a pixel per step of slack); eyes failing it are dropped.
+    /// middle pixel (within `REFINE_TOLERANCE_PX`); eyes failing it are dropped. Colour is
+    /// filtered edge-aware: texels at another depth (beyond `z_threshold`) get no weight.
     Refine { steps: u32 },
 }
 
@@ -140,10 +146,16 @@ impl CyclopeanParams {
 
     pub fn validate(&self) -> Result<()> {
         if !(self.fixation_distance.is_finite() && self.fixation_distance > 0.0) {
-            return Err(Error::param("fixation distance", format!("{} must be finite and > 0", self.fixation_distance)));
+            return Err(Error::param(
+                "fixation distance",
+                format!("{} must be finite and > 0", self.fixation_distance),
+            ));
         }
         if !(self.z_threshold.is_finite() && self.z_threshold > 0.0) {
-            return Err(Error::param("z-threshold", format!("{} must be finite and > 0", self.z_threshold)));
+            return Err(Error::param(
+                "z-threshold",
+                format!("{} must be finite and > 0", self.z_threshold),
+            ));
         }
         if let Some((_, w)) = self.dominant {
             if !(0.0..=1.0).contains(&w) {
@@ -190,7 +202,10 @@ impl StereoFrame {
             }
             for (what, m) in [("view", &eye.view), ("projection", &eye.proj)] {
                 if m.iter().flatten().any(|v| !v.is_finite()) || mat4::inverse(m).is_none() {
-                    return Err(Error::param(format!("{name} {what} matrix"), "not finite or not invertible"));
+                    return Err(Error::param(
+                        format!("{name} {what} matrix"),
+                        "not finite or not invertible",
+                    ));
                 }
             }
         }

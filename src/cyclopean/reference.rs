@@ -4,7 +4,7 @@
 
 use super::{Blend, CyclopeanOutput, CyclopeanParams, DepthKind, Eye, EyeInput, MiddleCamera, StereoFrame};
 use crate::camera::mat4::{self, Mat4};
-use crate::convention::{NdcDepthRange, RowOrder};
+use crate::convention::{Conventions, NdcDepthRange, RowOrder};
 use crate::error::Result;
 use crate::io::{DepthMap, RgbImage};
 
@@ -43,21 +43,73 @@ impl Eye64<'_> {
         [d[o] as f64, d[o + 1] as f64, d[o + 2] as f64]
     }
     /// Bilinear colour at uv in [0, 1]^2 (texel centres at (i + 0.5) / size), clamp to edge.
-    fn bilinear(&self, uv: [f64; 2]) -> [f64; 3] {
+    /// With `edge_aware = Some((z, tolerance))`, texels whose view distance differs from z by
+    /// more than the tolerance get no weight (no colour bleeding across depth edges); the
+    /// texel holding uv always qualifies, so the weights never all vanish.
+    fn bilinear(&self, uv: [f64; 2], edge_aware: Option<(f64, f64, DepthKind, &Conventions)>) -> [f64; 3] {
         let (w, h) = self.size();
         let t = [uv[0] * w as f64 - 0.5, uv[1] * h as f64 - 0.5];
         let (x0, y0) = (t[0].floor(), t[1].floor());
         let (fx, fy) = (t[0] - x0, t[1] - y0);
         let (x0, y0) = (x0 as i64, y0 as i64);
-        let (c00, c10, c01, c11) =
-            (self.color_at(x0, y0), self.color_at(x0 + 1, y0), self.color_at(x0, y0 + 1), self.color_at(x0 + 1, y0 + 1));
+        let taps = [
+            (0, 0, (1.0 - fx) * (1.0 - fy)),
+            (1, 0, fx * (1.0 - fy)),
+            (0, 1, (1.0 - fx) * fy),
+            (1, 1, fx * fy),
+        ];
         let mut out = [0.0; 3];
-        for c in 0..3 {
-            let top = c00[c] + (c10[c] - c00[c]) * fx;
-            let bottom = c01[c] + (c11[c] - c01[c]) * fx;
-            out[c] = top + (bottom - top) * fy;
+        let mut total = 0.0;
+        for (dx, dy, weight) in taps {
+            let (x, y) = ((x0 + dx).clamp(0, w - 1), (y0 + dy).clamp(0, h - 1));
+            let keep = match edge_aware {
+                None => true,
+                Some((z, tol, kind, conv)) => self
+                    .view_distance(x, y, kind, conv)
+                    .is_some_and(|zt| (zt - z).abs() <= tol),
+            };
+            if keep {
+                let c = self.color_at(x, y);
+                for k in 0..3 {
+                    out[k] += weight * c[k];
+                }
+                total += weight;
+            }
         }
-        out
+        if total > 0.0 {
+            out.map(|v| v / total)
+        } else {
+            out
+        }
+    }
+
+    /// View-space distance stored at texel (x, y) (memory order), None for background.
+    fn view_distance(&self, x: i64, y: i64, kind: DepthKind, conv: &Conventions) -> Option<f64> {
+        let d = self.depth_at(x, y);
+        match kind {
+            DepthKind::ViewZ => (d.is_finite() && d > 0.0).then_some(d),
+            DepthKind::Device => {
+                let ok = d.is_finite()
+                    && if conv.reversed_z {
+                        d > FAR_EPS
+                    } else {
+                        d < 1.0 - FAR_EPS
+                    };
+                if !ok {
+                    return None;
+                }
+                let (w, h) = self.size();
+                let ndc = [
+                    (x as f64 + 0.5) / w as f64 * 2.0 - 1.0,
+                    (y as f64 + 0.5) / h as f64 * 2.0 - 1.0,
+                ];
+                let ndc_z = match conv.ndc_depth {
+                    NdcDepthRange::MinusOneToOne => d * 2.0 - 1.0,
+                    NdcDepthRange::ZeroToOne => d,
+                };
+                Some(-mat4::transform_point(&self.inv_proj, [ndc[0], ndc[1], ndc_z])[2])
+            }
+        }
     }
 }
 
@@ -89,15 +141,24 @@ struct Ctx<'a> {
 
 impl Ctx<'_> {
     fn walk(&self, eye: &Eye64, ray_m: [f64; 3], pixel: [f64; 2]) -> EyeSample {
-        let invalid = EyeSample { valid: false, color: [0.0; 3], z_middle: 0.0 };
+        let invalid = EyeSample {
+            valid: false,
+            color: [0.0; 3],
+            z_middle: 0.0,
+        };
         let (w, h) = eye.size();
         let mut z = self.params.fixation_distance;
         let mut uv = [0.0; 2];
         let mut world = [0.0; 3];
+        let mut texel = (0, 0);
         for _ in 0..self.params.steps() {
             let guess = mat4::transform_point(&self.inv_view_m, [ray_m[0] * z, ray_m[1] * z, ray_m[2] * z]);
-            let clip = mat4::transform(&mat4::mul(&eye.input.proj, &eye.input.view), [guess[0], guess[1], guess[2], 1.0]);
-            if !(clip[3] > 0.0) {
+            let clip = mat4::transform(
+                &mat4::mul(&eye.input.proj, &eye.input.view),
+                [guess[0], guess[1], guess[2], 1.0],
+            );
+            // Behind the eye (or NaN): w <= 0 fails `w > 0`.
+            if clip[3].partial_cmp(&0.0) != Some(std::cmp::Ordering::Greater) {
                 return invalid;
             }
             let ndc = [clip[0] / clip[3], clip[1] / clip[3]];
@@ -108,10 +169,16 @@ impl Ctx<'_> {
             let tx = ((uv[0] * w as f64).floor() as i64).clamp(0, w - 1);
             let ty = ((uv[1] * h as f64).floor() as i64).clamp(0, h - 1);
             let d = eye.depth_at(tx, ty);
+            texel = (tx, ty);
             let view = match self.frame.depth_kind {
                 DepthKind::Device => {
                     let conv = &self.frame.conv;
-                    let ok = d.is_finite() && if conv.reversed_z { d > FAR_EPS } else { d < 1.0 - FAR_EPS };
+                    let ok = d.is_finite()
+                        && if conv.reversed_z {
+                            d > FAR_EPS
+                        } else {
+                            d < 1.0 - FAR_EPS
+                        };
                     if !ok {
                         return invalid;
                     }
@@ -136,8 +203,22 @@ impl Ctx<'_> {
             }
         }
         if let super::Method::Refine { .. } = self.params.method {
-            // The surface found must lie on this middle pixel's ray: project it back.
-            let clip = mat4::transform(&mat4::mul(&self.mid.proj, &self.mid.view), [world[0], world[1], world[2], 1.0]);
+            // The surface sample found (at its texel centre, where the eye really measured it;
+            // reconstructing at uv would put it on the middle ray by construction) must project
+            // back onto this middle pixel.
+            let Some(z_eye) = eye.view_distance(texel.0, texel.1, self.frame.depth_kind, &self.frame.conv) else {
+                return invalid;
+            };
+            let centre = [
+                (texel.0 as f64 + 0.5) / w as f64 * 2.0 - 1.0,
+                (texel.1 as f64 + 0.5) / h as f64 * 2.0 - 1.0,
+            ];
+            let r = view_ray(&eye.inv_proj, centre);
+            let sample = mat4::transform_point(&eye.inv_view, [r[0] * z_eye, r[1] * z_eye, r[2] * z_eye]);
+            let clip = mat4::transform(
+                &mat4::mul(&self.mid.proj, &self.mid.view),
+                [sample[0], sample[1], sample[2], 1.0],
+            );
             let px = [
                 (clip[0] / clip[3] * 0.5 + 0.5) * self.mid.width as f64,
                 (clip[1] / clip[3] * 0.5 + 0.5) * self.mid.height as f64,
@@ -146,7 +227,18 @@ impl Ctx<'_> {
                 return invalid;
             }
         }
-        EyeSample { valid: true, color: eye.bilinear(uv), z_middle: z }
+        let edge_aware = match self.params.method {
+            super::Method::Seed => None,
+            super::Method::Refine { .. } => {
+                let z_eye = -mat4::transform_point(&eye.input.view, world)[2];
+                Some((z_eye, self.params.z_threshold, self.frame.depth_kind, &self.frame.conv))
+            }
+        };
+        EyeSample {
+            valid: true,
+            color: eye.bilinear(uv, edge_aware),
+            z_middle: z,
+        }
     }
 }
 
@@ -191,7 +283,11 @@ pub struct CyclopeanReference {
     pub sources: Vec<u8>,
 }
 
-pub fn cyclopean_reference(frame: &StereoFrame, mid: &MiddleCamera, params: &CyclopeanParams) -> Result<CyclopeanReference> {
+pub fn cyclopean_reference(
+    frame: &StereoFrame,
+    mid: &MiddleCamera,
+    params: &CyclopeanParams,
+) -> Result<CyclopeanReference> {
     frame.validate()?;
     params.validate()?;
     let flip = frame.conv.row_order == RowOrder::BottomUp;
@@ -212,7 +308,11 @@ pub fn cyclopean_reference(frame: &StereoFrame, mid: &MiddleCamera, params: &Cyc
     };
     let inv_proj_m = mat4::inverse(&mid.proj).ok_or_else(|| crate::Error::param("middle projection", "singular"))?;
     let (w, h) = (mid.width as usize, mid.height as usize);
-    let mut out = CyclopeanReference { color: vec![[0.0; 3]; w * h], depth: vec![0.0; w * h], sources: vec![0; w * h] };
+    let mut out = CyclopeanReference {
+        color: vec![[0.0; 3]; w * h],
+        depth: vec![0.0; w * h],
+        sources: vec![0; w * h],
+    };
     for y_mem in 0..h {
         let y_img = if flip { h - 1 - y_mem } else { y_mem };
         for x in 0..w {
@@ -230,7 +330,7 @@ pub fn cyclopean_reference(frame: &StereoFrame, mid: &MiddleCamera, params: &Cyc
                 }
                 None => {
                     // The seed's fallback colour: both eyes at the same uv, averaged.
-                    let (a, b) = (left.bilinear(uv), right.bilinear(uv));
+                    let (a, b) = (left.bilinear(uv, None), right.bilinear(uv, None));
                     out.color[o] = [0, 1, 2].map(|c| 0.5 * (a[c] + b[c]));
                 }
             }
@@ -243,8 +343,15 @@ impl CyclopeanReference {
     /// Rounded to the output types (for writing or comparing as images).
     pub fn to_output(&self, width: u32, height: u32) -> CyclopeanOutput {
         CyclopeanOutput {
-            color: RgbImage::new(width, height, self.color.iter().flat_map(|c| c.map(crate::metrics::quantize_u8)).collect())
-                .expect("size matches"),
+            color: RgbImage::new(
+                width,
+                height,
+                self.color
+                    .iter()
+                    .flat_map(|c| c.map(crate::metrics::quantize_u8))
+                    .collect(),
+            )
+            .expect("size matches"),
             depth: DepthMap::new(width, height, self.depth.iter().map(|z| *z as f32).collect()).expect("size matches"),
             sources: self.sources.clone(),
         }

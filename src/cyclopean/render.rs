@@ -1,1 +1,198 @@
-//! GPU cyclopean pass: one full-screen draw into colour, middle depth and source bits.
+//! GPU cyclopean pass: one full-screen draw (shaders/cyclopean/gather.frag) into colour,
+//! middle depth and source bits, read back top-down.
+
+use super::{Blend, CyclopeanOutput, CyclopeanParams, DepthKind, Eye, EyeInput, Method, MiddleCamera, StereoFrame};
+use crate::camera::mat4::{self, Mat4};
+use crate::convention::RowOrder;
+use crate::error::{Error, Result};
+use crate::gpu::{Attachment, Framebuffer, Gpu, GpuTimer, Program, Texture, TextureFormat, Timing, VertexArray};
+use crate::io::{DepthMap, RgbImage};
+
+const FULLSCREEN_VERT: &str = include_str!("../../shaders/common/fullscreen.vert");
+const GATHER_FRAG: &str = include_str!("../../shaders/cyclopean/gather.frag");
+
+struct EyeGpu {
+    color: Texture,
+    depth: Texture,
+    view: Mat4,
+    proj: Mat4,
+}
+
+/// Rows top-down -> memory order under the row-order convention.
+fn memory_rows(data: &[u8], row_bytes: usize, flip: bool) -> Vec<u8> {
+    if !flip {
+        return data.to_vec();
+    }
+    data.chunks_exact(row_bytes).rev().flatten().copied().collect()
+}
+
+fn upload_eye(gpu: &Gpu, eye: &EyeInput, flip: bool) -> Result<EyeGpu> {
+    let (w, h) = (eye.color.width, eye.color.height);
+    let rgba: Vec<u8> = eye
+        .color
+        .data
+        .chunks_exact(3)
+        .flat_map(|p| [p[0], p[1], p[2], 255])
+        .collect();
+    let depth: Vec<u8> = eye.depth.data.iter().flat_map(|z| z.to_ne_bytes()).collect();
+    Ok(EyeGpu {
+        color: Texture::new(
+            gpu,
+            w,
+            h,
+            TextureFormat::Rgba8,
+            Some(&memory_rows(&rgba, w as usize * 4, flip)),
+        )?,
+        depth: Texture::new(
+            gpu,
+            w,
+            h,
+            TextureFormat::R32F,
+            Some(&memory_rows(&depth, w as usize * 4, flip)),
+        )?,
+        view: eye.view,
+        proj: eye.proj,
+    })
+}
+
+/// A stereo frame on the GPU, ready to render middle views.
+pub struct CyclopeanRenderer {
+    gpu: Gpu,
+    program: Program,
+    params: CyclopeanParams,
+    flip: bool,
+    left: EyeGpu,
+    right: EyeGpu,
+    vao: VertexArray,
+    framebuffer: Option<Framebuffer>,
+}
+
+impl CyclopeanRenderer {
+    pub fn new(gpu: &Gpu, frame: &StereoFrame, params: CyclopeanParams) -> Result<Self> {
+        frame.validate()?;
+        params.validate()?;
+        let defines = format!(
+            "{}#define DEPTH_IS_DEVICE {}\n#define REFINE {}\n#define BLEND_SOFT {}\n",
+            frame.conv.glsl_defines(),
+            (frame.depth_kind == DepthKind::Device) as u8,
+            matches!(params.method, Method::Refine { .. }) as u8,
+            (params.blend == Blend::Soft) as u8,
+        );
+        let program = Program::new(
+            gpu,
+            &defines,
+            &[
+                (glow::VERTEX_SHADER, "fullscreen.vert", FULLSCREEN_VERT),
+                (glow::FRAGMENT_SHADER, "cyclopean/gather.frag", GATHER_FRAG),
+            ],
+        )?;
+        let flip = frame.conv.row_order == RowOrder::BottomUp;
+        Ok(CyclopeanRenderer {
+            gpu: gpu.clone(),
+            program,
+            params,
+            flip,
+            left: upload_eye(gpu, &frame.left, flip)?,
+            right: upload_eye(gpu, &frame.right, flip)?,
+            vao: VertexArray::new(gpu)?,
+            framebuffer: None,
+        })
+    }
+
+    pub fn render(&mut self, mid: &MiddleCamera) -> Result<(CyclopeanOutput, Timing)> {
+        let (w, h) = (mid.width, mid.height);
+        if w == 0 || h == 0 || w > self.gpu.max_image_side() || h > self.gpu.max_image_side() {
+            return Err(Error::param("middle size", format!("{w}x{h}")));
+        }
+        let inv = |m: &Mat4, what: &str| mat4::inverse(m).ok_or_else(|| Error::param(what.to_string(), "singular"));
+        if !matches!(&self.framebuffer, Some(f) if f.width == w && f.height == h) {
+            self.framebuffer = None;
+            let slot = |format| {
+                Some(Attachment {
+                    format,
+                    clear: [0.0; 4],
+                })
+            };
+            self.framebuffer = Some(Framebuffer::new(
+                &self.gpu,
+                w,
+                h,
+                &[
+                    slot(TextureFormat::Rgba8),
+                    slot(TextureFormat::R32F),
+                    slot(TextureFormat::R8),
+                ],
+                false,
+            )?);
+        }
+        let fb = self.framebuffer.as_ref().expect("allocated above");
+        let p = &self.program;
+        let timer = GpuTimer::start(&self.gpu);
+        fb.bind_and_clear(1.0);
+        p.bind();
+        self.vao.bind();
+        for (unit, t) in [&self.left.color, &self.right.color, &self.left.depth, &self.right.depth]
+            .into_iter()
+            .enumerate()
+        {
+            t.bind(unit as u32);
+        }
+        for (unit, name) in ["u_color_l", "u_color_r", "u_depth_l", "u_depth_r"]
+            .into_iter()
+            .enumerate()
+        {
+            p.set_i32(name, unit as i32);
+        }
+        for (suffix, eye) in [("l", &self.left), ("r", &self.right)] {
+            p.set_mat4_rows(&format!("u_view_proj_{suffix}"), &mat4::mul(&eye.proj, &eye.view));
+            p.set_mat4_rows(&format!("u_inv_view_{suffix}"), &inv(&eye.view, "eye view")?);
+            p.set_mat4_rows(&format!("u_inv_proj_{suffix}"), &inv(&eye.proj, "eye projection")?);
+            p.set_mat4_rows(&format!("u_view_{suffix}"), &eye.view);
+        }
+        p.set_mat4_rows("u_view_m", &mid.view);
+        p.set_mat4_rows("u_inv_view_m", &inv(&mid.view, "middle view")?);
+        p.set_mat4_rows("u_inv_proj_m", &inv(&mid.proj, "middle projection")?);
+        p.set_mat4_rows("u_view_proj_m", &mat4::mul(&mid.proj, &mid.view));
+        p.set_vec2("u_size_m", [w as f32, h as f32]);
+        p.set_f32("u_fixation", self.params.fixation_distance as f32);
+        p.set_f32("u_z_threshold", self.params.z_threshold as f32);
+        let w_left = match self.params.dominant {
+            Some((Eye::Left, wt)) => wt,
+            Some((Eye::Right, wt)) => 1.0 - wt,
+            None => 0.5,
+        };
+        p.set_f32("u_w_left", w_left as f32);
+        p.set_i32("u_steps", self.params.steps() as i32);
+        // SAFETY: one full-screen triangle into an FBO without depth buffer.
+        unsafe {
+            use glow::HasContext;
+            let gl = self.gpu.gl();
+            gl.disable(glow::DEPTH_TEST);
+            gl.disable(glow::BLEND);
+            gl.disable(glow::CULL_FACE);
+            gl.draw_arrays(glow::TRIANGLES, 0, 3);
+        }
+        self.gpu.check("cyclopean draw")?;
+        let timing = timer.stop();
+        let top_down = |data: Vec<u8>, bpp: usize| memory_rows(&data, w as usize * bpp, self.flip);
+        let rgba = top_down(fb.read_color(0)?.expect("colour attachment"), 4);
+        let depth = top_down(fb.read_color(1)?.expect("depth attachment"), 4);
+        let sources = top_down(fb.read_color(2)?.expect("sources attachment"), 1);
+        fb.unbind();
+        Ok((
+            CyclopeanOutput {
+                color: RgbImage::new(w, h, rgba.chunks_exact(4).flat_map(|p| [p[0], p[1], p[2]]).collect())?,
+                depth: DepthMap::new(
+                    w,
+                    h,
+                    depth
+                        .chunks_exact(4)
+                        .map(|b| f32::from_ne_bytes([b[0], b[1], b[2], b[3]]))
+                        .collect(),
+                )?,
+                sources,
+            },
+            timing,
+        ))
+    }
+}

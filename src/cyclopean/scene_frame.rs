@@ -32,7 +32,10 @@ impl StereoRig {
         let r = &self.head.rotation;
         let o = 0.5 * side * self.ipd;
         let p = self.head.position;
-        Pose { rotation: *r, position: [p[0] + o * r[0][0], p[1] + o * r[1][0], p[2] + o * r[2][0]] }
+        Pose {
+            rotation: *r,
+            position: [p[0] + o * r[0][0], p[1] + o * r[1][0], p[2] + o * r[2][0]],
+        }
     }
 }
 
@@ -64,7 +67,12 @@ fn eye_input(rig: &StereoRig, pose: &Pose, conv: &Conventions, kind: DepthKind) 
             DepthMap::new(z.width, z.height, data).expect("same size")
         }
     };
-    EyeInput { color, depth, view: pose.gl_view(), proj: gl_projection(&rig.camera, &rig.planes, conv) }
+    EyeInput {
+        color,
+        depth,
+        view: pose.gl_view(),
+        proj: gl_projection(&rig.camera, &rig.planes, conv),
+    }
 }
 
 /// Left/right eyes, the middle camera (same intrinsics as the eyes) and its ground truth.
