@@ -18,6 +18,8 @@ pub mod gpu;
 pub mod io;
 pub mod metrics;
 pub mod refocus;
+pub mod report;
 pub mod scene;
+pub mod ssim;
 
 pub use error::{Error, Result};
