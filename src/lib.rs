@@ -14,6 +14,7 @@ pub mod convention;
 pub mod cyclopean;
 pub mod demo;
 pub mod error;
+pub mod evaluation;
 pub mod gpu;
 pub mod io;
 pub mod metrics;

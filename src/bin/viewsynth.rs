@@ -42,6 +42,20 @@ enum Command {
         #[command(flatten)]
         gpu: GpuArgs,
     },
+    /// Measure every method's error against ground truth (built-in scene, and real data when
+    /// --data-dir holds ../shared/data's sets) next to its run time: report.{md,csv,svg}.
+    Report {
+        #[arg(long, default_value = "out/report")]
+        out_dir: PathBuf,
+        /// Folder with middlebury2003_cones/ and middlebury2003_teddy/ (skipped when absent).
+        #[arg(long)]
+        data_dir: Option<PathBuf>,
+        /// Timed repetitions per row (the median is reported).
+        #[arg(long, default_value_t = 3)]
+        repeats: usize,
+        #[command(flatten)]
+        gpu: GpuArgs,
+    },
     /// Benchmark refocus (mesh and full-screen paths) and print median timings.
     Bench {
         /// Sizes WxH to measure.
@@ -176,6 +190,12 @@ fn main() {
         Command::Refocus(args) => refocus(*args),
         Command::Demo { out_dir, gpu } => demo(&out_dir, &gpu),
         Command::Bench { sizes, repeats, gpu } => bench(&sizes, repeats, &gpu),
+        Command::Report {
+            out_dir,
+            data_dir,
+            repeats,
+            gpu,
+        } => report(&out_dir, data_dir.as_deref(), repeats, &gpu),
     };
     if let Err(e) = result {
         eprintln!("error: {e:#}");
@@ -331,6 +351,23 @@ fn demo(out_dir: &Path, gpu: &GpuArgs) -> Result<()> {
     let report = viewsynth::demo::run(&gpu, out_dir)?;
     println!("{}", std::fs::read_to_string(&report)?);
     println!("demo outputs and report written to {}", out_dir.display());
+    Ok(())
+}
+
+fn report(out_dir: &Path, data_dir: Option<&Path>, repeats: usize, gpu: &GpuArgs) -> Result<()> {
+    if let Some(d) = data_dir {
+        if !d.is_dir() {
+            bail!("--data-dir {}: not a directory", d.display());
+        }
+    }
+    let gpu = gpu.open()?;
+    let files = viewsynth::evaluation::run_report(&gpu, out_dir, data_dir, repeats)?;
+    if let Some(md) = files.iter().find(|p| p.extension().is_some_and(|e| e == "md")) {
+        println!("{}", std::fs::read_to_string(md)?);
+    }
+    for f in &files {
+        println!("wrote {}", f.display());
+    }
     Ok(())
 }
 
