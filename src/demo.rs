@@ -96,10 +96,48 @@ pub fn run(gpu: &Gpu, out_dir: &Path) -> Result<PathBuf> {
          longer lens would see); PSNR/IoU vs the f64 reference measure the GPU implementation.\n",
         gpu.info().renderer
     );
-    let path = out_dir.join("report.md");
+    let path = out_dir.join("refocus_check.md");
     io::atomic_write(&path, |w| {
         use std::io::Write;
         w.write_all(report.as_bytes()).map_err(|e| Error::io(&path, e))
     })?;
-    Ok(path)
+    cyclopean_outputs(gpu, &out_dir.join("cyclopean"))?;
+    let files = crate::evaluation::run_report(gpu, out_dir, None, 3)?;
+    Ok(files
+        .into_iter()
+        .find(|p| p.extension().is_some_and(|e| e == "md"))
+        .unwrap_or(path))
+}
+
+/// The built-in stereo pair (64 mm IPD, device depth, GL conventions), its ray-traced middle
+/// view, and the middle view of each cyclopean method.
+fn cyclopean_outputs(gpu: &Gpu, dir: &Path) -> Result<()> {
+    use crate::cyclopean::render::CyclopeanRenderer;
+    use crate::cyclopean::scene_frame::{scene_frame, StereoRig};
+    use crate::cyclopean::DepthKind;
+    std::fs::create_dir_all(dir).map_err(|e| Error::io(dir, e))?;
+    let rig = StereoRig::demo(640, 480);
+    let (frame, mid, truth) = scene_frame(&rig, Conventions::default(), DepthKind::Device);
+    io::save_rgb(&dir.join("left_rgb.png"), &frame.left.color)?;
+    io::save_rgb(&dir.join("right_rgb.png"), &frame.right.color)?;
+    io::save_depth_exr(&dir.join("left_device_depth.exr"), &frame.left.depth)?;
+    io::save_depth_exr(&dir.join("right_device_depth.exr"), &frame.right.depth)?;
+    io::save_rgb(&dir.join("middle_truth_rgb.png"), &truth.color)?;
+    for (name, params) in crate::evaluation::cyclopean_methods(3.0) {
+        let (out, _) = CyclopeanRenderer::new(gpu, &frame, params)?.render(&mid)?;
+        let stem: String = name
+            .chars()
+            .map(|c| if c.is_ascii_alphanumeric() { c } else { '_' })
+            .collect();
+        let stem = stem.split('_').filter(|s| !s.is_empty()).collect::<Vec<_>>().join("_");
+        io::save_rgb(&dir.join(format!("middle_{stem}_rgb.png")), &out.color)?;
+        io::save_depth_exr(&dir.join(format!("middle_{stem}_depth.exr")), &out.depth)?;
+        let mask = io::Mask::new(
+            mid.width,
+            mid.height,
+            out.sources.iter().map(|s| (*s != 0) as u8).collect(),
+        )?;
+        io::save_mask_png(&dir.join(format!("middle_{stem}_mask.png")), &mask)?;
+    }
+    Ok(())
 }

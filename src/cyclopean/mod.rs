@@ -13,6 +13,7 @@
 //! - [`scene_frame`]: a stereo frame of the built-in scene under any conventions, for tests,
 //!   the demo and the report.
 
+pub mod camera_file;
 pub mod disparity_frame;
 pub mod reference;
 pub mod render;

@@ -205,3 +205,78 @@ fn bad_parameters_are_errors_not_panics() {
         .expect("NaN matrix refused");
     assert!(err.to_string().contains("left view"), "{err}");
 }
+
+#[test]
+fn cli_renders_the_same_middle_view_as_the_library_from_files() {
+    let g = gpu();
+    let rig = StereoRig::demo(96, 72);
+    let conv = Conventions::all()[5];
+    let (frame, mid, _) = scene_frame(&rig, conv, DepthKind::Device);
+    let dir = std::env::temp_dir().join(format!("viewsynth-cyclopean-cli-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).unwrap();
+    for (name, eye) in [("left", &frame.left), ("right", &frame.right)] {
+        viewsynth::io::save_rgb(&dir.join(format!("{name}.png")), &eye.color).unwrap();
+        viewsynth::io::save_depth_exr(&dir.join(format!("{name}.exr")), &eye.depth).unwrap();
+    }
+    let cams = serde_json::json!({
+        "conventions": conv,
+        "depth_kind": "device",
+        "left": { "view": frame.left.view, "proj": frame.left.proj },
+        "right": { "view": frame.right.view, "proj": frame.right.proj },
+        "middle": { "proj": mid.proj, "width": mid.width, "height": mid.height, "view": mid.view },
+        "fixation_distance": 3.0
+    });
+    std::fs::write(dir.join("cams.json"), serde_json::to_string(&cams).unwrap()).unwrap();
+    let out = dir.join("out");
+    let o = std::process::Command::new(env!("CARGO_BIN_EXE_viewsynth"))
+        .args(["cyclopean", "--refine-steps", "3", "--left-rgb"])
+        .arg(dir.join("left.png"))
+        .arg("--left-depth")
+        .arg(dir.join("left.exr"))
+        .arg("--right-rgb")
+        .arg(dir.join("right.png"))
+        .arg("--right-depth")
+        .arg(dir.join("right.exr"))
+        .arg("--cameras")
+        .arg(dir.join("cams.json"))
+        .arg("--out-dir")
+        .arg(&out)
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let params = CyclopeanParams {
+        method: Method::Refine { steps: 3 },
+        ..CyclopeanParams::seed(3.0)
+    };
+    let (lib, _) = CyclopeanRenderer::new(&g, &frame, params)
+        .unwrap()
+        .render(&mid)
+        .unwrap();
+    assert_eq!(viewsynth::io::load_rgb(&out.join("middle_rgb.png")).unwrap(), lib.color);
+    let z = viewsynth::io::load_depth(&out.join("middle_depth.exr"), &Default::default()).unwrap();
+    assert_eq!(z, lib.depth);
+
+    // A camera file without fixation or gaze: a clear error naming what is missing.
+    let mut bad = cams.clone();
+    bad.as_object_mut().unwrap().remove("fixation_distance");
+    std::fs::write(dir.join("bad.json"), serde_json::to_string(&bad).unwrap()).unwrap();
+    let o = std::process::Command::new(env!("CARGO_BIN_EXE_viewsynth"))
+        .args(["cyclopean", "--left-rgb"])
+        .arg(dir.join("left.png"))
+        .arg("--left-depth")
+        .arg(dir.join("left.exr"))
+        .arg("--right-rgb")
+        .arg(dir.join("right.png"))
+        .arg("--right-depth")
+        .arg(dir.join("right.exr"))
+        .arg("--cameras")
+        .arg(dir.join("bad.json"))
+        .arg("--out-dir")
+        .arg(dir.join("out2"))
+        .output()
+        .unwrap();
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(1), "{err}");
+    assert!(err.contains("fixation_distance") && !err.contains("panicked"), "{err}");
+}

@@ -1,0 +1,175 @@
+//! The cameras of a stereo frame as a JSON file, for `viewsynth cyclopean`.
+//!
+//! ```json
+//! { "conventions": { "ndc_depth": "minus-one-to-one", "reversed_z": false, "row_order": "bottom-up" },
+//!   "depth_kind": "device",
+//!   "left":  { "view": [[1,0,0,0.032],[0,1,0,0],[0,0,1,0],[0,0,0,1]], "proj": [[..4], [..4], [..4], [..4]] },
+//!   "right": { "view": [..], "proj": [..] },
+//!   "middle": { "proj": [..], "width": 640, "height": 480 },
+//!   "gaze": { "left":  { "origin": [-0.032,0,0], "direction": [0.01,0,-1] },
+//!             "right": { "origin": [ 0.032,0,0], "direction": [-0.01,0,-1] } },
+//!   "head_rotation": [[1,0,0],[0,1,0],[0,0,1]],
+//!   "fixation_distance": null, "fixation_range": [0.1, 1000] }
+//! ```
+//! Matrices are row-major, GL style (world -> eye with -z forward; eye -> clip matching the
+//! conventions). The middle view is `middle.view` when given, else the seed's: origin halfway
+//! between the gaze origins, `head_rotation` (columns = head axes in world). The fixation
+//! distance is `fixation_distance` when given, else the vergence of the gaze rays
+//! (`camera::vergence::resolve_fixation`, with its documented fallbacks), measured along the
+//! middle view axis.
+
+use super::{DepthKind, MiddleCamera};
+use crate::camera::mat4::{self, Mat4};
+use crate::camera::vergence::{resolve_fixation, DepthRange, GazeRay};
+use crate::convention::Conventions;
+use crate::error::{Error, Result};
+use serde::Deserialize;
+use std::path::Path;
+
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct EyeCameras {
+    pub view: Mat4,
+    pub proj: Mat4,
+}
+
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct MiddleSpec {
+    pub proj: Mat4,
+    pub width: u32,
+    pub height: u32,
+    #[serde(default)]
+    pub view: Option<Mat4>,
+}
+
+#[derive(Debug, Clone, Copy, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Ray {
+    pub origin: [f64; 3],
+    pub direction: [f64; 3],
+}
+
+#[derive(Debug, Clone, Copy, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Gaze {
+    pub left: Ray,
+    pub right: Ray,
+}
+
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct CameraFile {
+    #[serde(default)]
+    pub conventions: Conventions,
+    pub depth_kind: DepthKind,
+    pub left: EyeCameras,
+    pub right: EyeCameras,
+    pub middle: MiddleSpec,
+    #[serde(default)]
+    pub gaze: Option<Gaze>,
+    #[serde(default)]
+    pub head_rotation: Option<[[f64; 3]; 3]>,
+    #[serde(default)]
+    pub fixation_distance: Option<f64>,
+    #[serde(default)]
+    pub fixation_range: Option<[f64; 2]>,
+}
+
+impl CameraFile {
+    pub fn load(path: &Path) -> Result<Self> {
+        let text = std::fs::read_to_string(path).map_err(|e| Error::io(path, e))?;
+        serde_json::from_str(&text).map_err(|e| Error::decode(path, e.to_string()))
+    }
+
+    /// The middle camera and the fixation distance along its view axis.
+    pub fn middle_and_fixation(&self) -> Result<(MiddleCamera, f64)> {
+        let m = &self.middle;
+        let gaze = self.gaze;
+        let view = match (m.view, gaze) {
+            (Some(v), _) => v,
+            (None, Some(g)) => {
+                MiddleCamera::from_gaze(
+                    g.left.origin,
+                    g.right.origin,
+                    self.head_rotation
+                        .unwrap_or([[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]]),
+                    m.proj,
+                    m.width,
+                    m.height,
+                )?
+                .view
+            }
+            (None, None) => {
+                return Err(Error::param(
+                    "middle.view",
+                    "give middle.view or gaze rays to derive it",
+                ))
+            }
+        };
+        let mid = MiddleCamera {
+            view,
+            proj: m.proj,
+            width: m.width,
+            height: m.height,
+        };
+        let fixation = match (self.fixation_distance, gaze) {
+            (Some(d), _) => d,
+            (None, Some(g)) => {
+                let [lo, hi] = self.fixation_range.unwrap_or([0.1, 1000.0]);
+                let range = DepthRange::new(lo, hi)?;
+                let ray = |r: Ray| GazeRay {
+                    origin: r.origin,
+                    direction: r.direction,
+                };
+                let f = resolve_fixation(&ray(g.left), &ray(g.right), &range, None, None)?;
+                let d = -mat4::transform_point(&view, f.point)[2];
+                if !(d.is_finite() && d > 0.0) {
+                    return Err(Error::param(
+                        "gaze",
+                        format!("fixation lies behind the middle camera ({d})"),
+                    ));
+                }
+                d
+            }
+            (None, None) => return Err(Error::param("fixation_distance", "give fixation_distance or gaze rays")),
+        };
+        Ok((mid, fixation))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn file(extra: &str) -> String {
+        let id = "[[1,0,0,0],[0,1,0,0],[0,0,1,0],[0,0,0,1]]";
+        let proj = "[[1,0,0,0],[0,1,0,0],[0,0,-1.001,-0.1],[0,0,-1,0]]";
+        format!(
+            r#"{{"depth_kind":"view-z","left":{{"view":{id},"proj":{proj}}},"right":{{"view":{id},"proj":{proj}}},
+               "middle":{{"proj":{proj},"width":8,"height":6}}{extra}}}"#
+        )
+    }
+
+    #[test]
+    fn fixation_from_converging_gaze_is_measured_along_the_middle_axis() {
+        // Eyes at x = -+0.03 looking at (0, 0, -2): fixation distance 2 from the midpoint.
+        let d = 0.03 / (0.03f64 * 0.03 + 4.0).sqrt();
+        let dz = -2.0 / (0.03f64 * 0.03 + 4.0).sqrt();
+        let text = file(&format!(
+            r#","gaze":{{"left":{{"origin":[-0.03,0,0],"direction":[{d},0,{dz}]}},"right":{{"origin":[0.03,0,0],"direction":[{},0,{dz}]}}}}"#,
+            -d
+        ));
+        let f: CameraFile = serde_json::from_str(&text).unwrap();
+        let (mid, fix) = f.middle_and_fixation().unwrap();
+        assert!((fix - 2.0).abs() < 1e-9, "{fix}");
+        assert_eq!(mid.width, 8);
+    }
+
+    #[test]
+    fn missing_fixation_and_unknown_fields_are_errors() {
+        let f: CameraFile = serde_json::from_str(&file("")).unwrap();
+        assert!(f.middle_and_fixation().unwrap_err().to_string().contains("middle.view"));
+        assert!(serde_json::from_str::<CameraFile>(&file(r#","bogus":1"#)).is_err());
+    }
+}
