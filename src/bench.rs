@@ -97,3 +97,31 @@ pub fn refocus_bench(gpu: &Gpu, sizes: &[(u32, u32)], repeats: usize) -> Result<
     let _ = std::fs::remove_dir_all(&tmp);
     Ok(t)
 }
+
+/// Median ms per middle frame from two eyes of `width` x `height` for each cyclopean method.
+pub fn cyclopean_bench(gpu: &Gpu, width: u32, height: u32, repeats: usize) -> Result<String> {
+    use crate::cyclopean::render::CyclopeanRenderer;
+    use crate::cyclopean::scene_frame::{scene_frame, StereoRig};
+    use crate::cyclopean::DepthKind;
+    let rig = StereoRig::demo(width, height);
+    let (frame, mid, _) = scene_frame(&rig, Conventions::default(), DepthKind::Device);
+    let mut t = format!(
+        "cyclopean benchmark on {}: 2 eyes {width}x{height} -> middle {width}x{height} ({repeats} repeats, medians)\n\n\
+         | method | setup ms | ms / middle frame (draw + readback) |\n|---|---|---|\n",
+        gpu.info().renderer
+    );
+    for (name, params) in crate::evaluation::cyclopean_methods(3.0) {
+        let t0 = Instant::now();
+        let mut r = CyclopeanRenderer::new(gpu, &frame, params)?;
+        r.render(&mid)?; // warm-up: shader JIT and framebuffer allocation
+        let setup = t0.elapsed().as_secs_f64() * 1e3;
+        let mut runs = Vec::new();
+        for _ in 0..repeats {
+            let t0 = Instant::now();
+            r.render(&mid)?;
+            runs.push(t0.elapsed().as_secs_f64() * 1e3);
+        }
+        writeln!(t, "| {name} | {setup:.1} | {:.1} |", median(runs)).expect("write to String");
+    }
+    Ok(t)
+}

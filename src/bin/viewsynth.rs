@@ -59,7 +59,8 @@ enum Command {
         #[command(flatten)]
         gpu: GpuArgs,
     },
-    /// Benchmark refocus (mesh and full-screen paths) and print median timings.
+    /// Benchmark refocus (mesh and full-screen paths) and cyclopean (2 x 1280x720 eyes) and print
+    /// median timings.
     Bench {
         /// Sizes WxH to measure.
         #[arg(long, value_delimiter = ',', default_value = "640x480,1280x720")]
@@ -518,7 +519,9 @@ fn bench(sizes: &[String], repeats: usize, gpu: &GpuArgs) -> Result<()> {
             .with_context(|| format!("--sizes '{s}': expected WxH"))?;
         parsed.push((w.parse::<u32>()?, h.parse::<u32>()?));
     }
-    let table = viewsynth::bench::refocus_bench(&gpu.open()?, &parsed, repeats.max(1))?;
+    let gpu = gpu.open()?;
+    let table = viewsynth::bench::refocus_bench(&gpu, &parsed, repeats.max(1))?;
     println!("{table}");
+    println!("{}", viewsynth::bench::cyclopean_bench(&gpu, 1280, 720, repeats.max(1))?);
     Ok(())
 }
