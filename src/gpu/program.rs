@@ -96,6 +96,14 @@ impl Program {
         // SAFETY: as above.
         unsafe { self.gpu.gl().uniform_2_f32(self.location(name).as_ref(), v[0], v[1]) }
     }
+    pub fn set_vec3(&self, name: &str, v: [f32; 3]) {
+        // SAFETY: as above.
+        unsafe {
+            self.gpu
+                .gl()
+                .uniform_3_f32(self.location(name).as_ref(), v[0], v[1], v[2])
+        }
+    }
     pub fn set_vec4(&self, name: &str, v: [f32; 4]) {
         // SAFETY: as above.
         unsafe {

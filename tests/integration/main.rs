@@ -8,3 +8,4 @@ mod gpu_context;
 mod refocus_accuracy;
 mod refocus_conventions;
 mod refocus_edge_cases;
+mod scene;

@@ -6,19 +6,16 @@
 //! discontinuities, slanted surfaces and texture at several frequencies. Any posed pinhole
 //! camera can look at it ([`render_posed`]), e.g. the eyes of a stereo rig.
 
+pub mod gpu;
+mod shapes;
+
+pub use shapes::{boxes_scene, builtin, demo_scene, Hit, Object, Scene, Shape, MAX_OBJECTS};
+
 use crate::camera::{PinholeCamera, Pose};
 use crate::io::{DepthMap, RgbImage};
 
-/// A ray hit: ray parameter, material index and world point.
-#[derive(Debug, Clone, Copy)]
-pub struct Hit {
-    pub t: f64,
-    pub material: u8,
-    pub p: [f64; 3],
-}
-
 /// Procedural texture, smooth enough that resampling error reflects geometry, not aliasing.
-fn shade(hit: &Hit) -> [f64; 3] {
+pub fn pattern_color(hit: &Hit) -> [f64; 3] {
     let [x, y, z] = hit.p;
     let stripes = |a: f64, f: f64| 0.5 + 0.5 * (a * f).sin();
     match hit.material {
@@ -48,58 +45,18 @@ fn shade(hit: &Hit) -> [f64; 3] {
     }
 }
 
-/// First surface hit along origin + t dir (t > 0), world coordinates.
+/// First surface hit of the demo scene along origin + t dir (t > 0), world coordinates.
 pub fn trace(origin: [f64; 3], dir: [f64; 3]) -> Option<Hit> {
-    let o = origin;
-    let at = |t: f64| [o[0] + dir[0] * t, o[1] + dir[1] * t, o[2] + dir[2] * t];
-    let mut best: Option<Hit> = None;
-    let mut take = |t: f64, material: u8| {
-        if t > 1e-9 && t.is_finite() && best.is_none_or(|b| t < b.t) {
-            best = Some(Hit { t, material, p: at(t) });
-        }
-    };
-    // Back wall z = 6 (bounded so wide views see past it: no hit -> invalid depth).
-    if dir[2] != 0.0 {
-        let t = (6.0 - o[2]) / dir[2];
-        let p = at(t);
-        if p[0].abs() < 5.0 && p[1] > -3.5 && p[1] < 1.2 {
-            take(t, 0);
-        }
-    }
-    // Floor y = 1.2, z in (0.5, 6).
-    if dir[1] != 0.0 {
-        let t = (1.2 - o[1]) / dir[1];
-        let p = at(t);
-        if p[2] > 0.5 && p[2] < 6.0 && p[0].abs() < 5.0 {
-            take(t, 1);
-        }
-    }
-    // Sphere centre (0.6, 0.2, 3.2), radius 0.7.
-    let c = [0.6 - o[0], 0.2 - o[1], 3.2 - o[2]];
-    let b = dir[0] * c[0] + dir[1] * c[1] + dir[2] * c[2];
-    let cc = c[0] * c[0] + c[1] * c[1] + c[2] * c[2] - 0.49;
-    let dd = dir[0] * dir[0] + dir[1] * dir[1] + dir[2] * dir[2];
-    let disc = b * b - dd * cc;
-    if disc >= 0.0 {
-        take((b - disc.sqrt()) / dd, 2);
-    }
-    // Tilted plate: plane through (-0.9, -0.1, 2.2), normal (0.35, 0, -1), |x+0.9|<0.5, |y+0.1|<0.6.
-    let n = [0.35, 0.0, -1.0];
-    let q = [-0.9, -0.1, 2.2];
-    let den = n[0] * dir[0] + n[2] * dir[2];
-    if den.abs() > 1e-12 {
-        let t = (n[0] * (q[0] - o[0]) + n[2] * (q[2] - o[2])) / den;
-        let p = at(t);
-        if (p[0] - q[0]).abs() < 0.5 && (p[1] - q[1]).abs() < 0.6 {
-            take(t, 3);
-        }
-    }
-    best
+    DEMO.with(|s| s.trace(origin, dir))
+}
+
+thread_local! {
+    static DEMO: Scene = shapes::demo_scene();
 }
 
 /// Colour (0..255, unrounded) of a hit.
 pub fn hit_color(hit: &Hit) -> [f64; 3] {
-    shade(hit)
+    pattern_color(hit)
 }
 
 /// Colour (rounded to 8 bits) and view-space Z of the scene seen by `cam` at the identity pose
@@ -109,8 +66,13 @@ pub fn render(cam: &PinholeCamera) -> (RgbImage, DepthMap) {
 }
 
 /// Colour (rounded to 8 bits) and view-space Z (OpenCV, distance along the optical axis) of the
-/// scene seen by `cam` at `pose`; 0 depth where no surface is hit. Rows top-down.
+/// demo scene seen by `cam` at `pose`; 0 depth where no surface is hit. Rows top-down.
 pub fn render_posed(cam: &PinholeCamera, pose: &Pose) -> (RgbImage, DepthMap) {
+    DEMO.with(|s| render_scene(s, cam, pose))
+}
+
+/// [`render_posed`] for any scene.
+pub fn render_scene(scene: &Scene, cam: &PinholeCamera, pose: &Pose) -> (RgbImage, DepthMap) {
     let (w, h) = (cam.width as usize, cam.height as usize);
     let mut rgb = vec![0u8; w * h * 3];
     let mut depth = vec![0f32; w * h];
@@ -118,10 +80,10 @@ pub fn render_posed(cam: &PinholeCamera, pose: &Pose) -> (RgbImage, DepthMap) {
         for x in 0..w {
             // The ray has unit view-space z, so its parameter t is the view-space Z.
             let dir = pose.ray(cam, x as f64, y as f64);
-            if let Some(hit) = trace(pose.position, dir) {
+            if let Some(hit) = scene.trace(pose.position, dir) {
                 let o = y * w + x;
                 depth[o] = hit.t as f32;
-                let c = shade(&hit);
+                let c = pattern_color(&hit);
                 for k in 0..3 {
                     rgb[o * 3 + k] = c[k].round().clamp(0.0, 255.0) as u8;
                 }

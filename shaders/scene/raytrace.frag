@@ -1,0 +1,131 @@
+// Ray tracer of a scene description (src/scene/shapes.rs; f64 twin: src/scene/gpu.rs
+// `trace_gl_reference`). One ray per pixel centre from the camera's inverse view-projection.
+// Outputs colour, view distance (GL: -z_eye; 0 on a miss) and window depth under the
+// conventions (the far value on a miss).
+
+const int MAX_OBJECTS = 32;
+uniform int u_count;
+uniform ivec2 u_kind[MAX_OBJECTS];  // x: 0 plane, 1 sphere, 2 cuboid; y: pattern
+uniform vec4 u_a[MAX_OBJECTS];      // plane point | sphere centre, radius | cuboid min
+uniform vec4 u_b[MAX_OBJECTS];      // plane normal | - | cuboid max
+uniform vec4 u_c[MAX_OBJECTS];      // plane bounds min
+uniform vec4 u_d[MAX_OBJECTS];      // plane bounds max
+uniform mat4 u_inv_view_proj;
+uniform mat4 u_view_proj;
+uniform mat4 u_view;
+uniform vec3 u_eye;
+uniform vec2 u_size;
+
+layout(location = 0) out vec4 o_color;
+layout(location = 1) out float o_view_z;
+layout(location = 2) out float o_device;
+
+const float RAY_NDC_Z = 0.5;
+const float NONE = 3.0e38;
+
+bool ok(float t) {
+    return t > 1e-9 && t < NONE;
+}
+
+float intersect(int i, vec3 o, vec3 d) {
+    int kind = u_kind[i].x;
+    if (kind == 0) {
+        vec3 n = u_b[i].xyz;
+        float den = dot(n, d);
+        if (abs(den) <= 1e-12) {
+            return NONE;
+        }
+        float t = dot(n, u_a[i].xyz - o) / den;
+        vec3 p = o + d * t;
+        bool inside = all(greaterThan(p, u_c[i].xyz)) && all(lessThan(p, u_d[i].xyz));
+        return ok(t) && inside ? t : NONE;
+    }
+    if (kind == 1) {
+        vec3 c = u_a[i].xyz - o;
+        float r = u_a[i].w;
+        float b = dot(d, c);
+        float dd = dot(d, d);
+        float disc = b * b - dd * (dot(c, c) - r * r);
+        if (disc < 0.0) {
+            return NONE;
+        }
+        float s = sqrt(disc);
+        float t0 = (b - s) / dd;
+        float t1 = (b + s) / dd;
+        return ok(t0) ? t0 : (ok(t1) ? t1 : NONE);
+    }
+    vec3 lo = u_a[i].xyz;
+    vec3 hi = u_b[i].xyz;
+    float t0 = -NONE;
+    float t1 = NONE;
+    for (int k = 0; k < 3; ++k) {
+        if (d[k] == 0.0) {
+            if (o[k] <= lo[k] || o[k] >= hi[k]) {
+                return NONE;
+            }
+            continue;
+        }
+        float a = (lo[k] - o[k]) / d[k];
+        float b = (hi[k] - o[k]) / d[k];
+        t0 = max(t0, min(a, b));
+        t1 = min(t1, max(a, b));
+    }
+    if (t0 > t1) {
+        return NONE;
+    }
+    return ok(t0) ? t0 : (ok(t1) ? t1 : NONE);
+}
+
+float stripes(float a, float f) {
+    return 0.5 + 0.5 * sin(a * f);
+}
+
+// Same patterns as src/scene/mod.rs pattern_color.
+vec3 pattern_color(int pattern, vec3 p) {
+    float x = p.x, y = p.y, z = p.z;
+    if (pattern == 0) {
+        return vec3(200.0 * stripes(x, 3.0) + 30.0, 120.0 * stripes(y, 5.0) + 60.0, 180.0 * stripes(x + y, 1.7) + 40.0);
+    }
+    if (pattern == 1) {
+        float checker = mod(floor(x * 2.0) + floor(z * 2.0), 2.0);
+        return vec3(90.0 + 100.0 * checker * stripes(x, 11.0), 80.0 + 60.0 * stripes(z, 4.0), 70.0 + 40.0 * checker);
+    }
+    if (pattern == 2) {
+        return vec3(230.0 * stripes(y, 9.0) + 20.0, 60.0 + 80.0 * stripes(x, 13.0), 40.0 + 30.0 * stripes(z, 7.0));
+    }
+    return vec3(40.0 + 200.0 * stripes(x - y, 20.0), 200.0 * stripes(y, 2.0) + 40.0, 90.0);
+}
+
+void main() {
+    vec2 ndc = gl_FragCoord.xy / u_size * 2.0 - 1.0;
+    vec4 q = u_inv_view_proj * vec4(ndc, RAY_NDC_Z, 1.0);
+    vec3 dir = q.xyz / q.w - u_eye;
+    float best = NONE;
+    int hit = -1;
+    for (int i = 0; i < u_count; ++i) {
+        float t = intersect(i, u_eye, dir);
+        if (t < best) {
+            best = t;
+            hit = i;
+        }
+    }
+    if (hit < 0) {
+        o_color = vec4(0.0);
+        o_view_z = 0.0;
+        o_device = NDC_Z_FAR;
+#if !NDC_ZERO_TO_ONE
+        o_device = 0.5 * (NDC_Z_FAR + 1.0);
+#endif
+        return;
+    }
+    vec3 p = u_eye + dir * best;
+    o_color = vec4(clamp(floor(pattern_color(u_kind[hit].y, p) + 0.5), 0.0, 255.0) / 255.0, 1.0);
+    o_view_z = -(u_view * vec4(p, 1.0)).z;
+    vec4 clip = u_view_proj * vec4(p, 1.0);
+    float ndc_z = clip.z / clip.w;
+#if NDC_ZERO_TO_ONE
+    o_device = ndc_z;
+#else
+    o_device = 0.5 * (ndc_z + 1.0);
+#endif
+}

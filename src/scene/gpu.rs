@@ -1,0 +1,256 @@
+//! The scene ray-traced on the GPU (shaders/scene/raytrace.frag) for any GL camera (view V,
+//! projection P, conventions), and its f64 twin with the same ray construction. Both give
+//! colour, view distance and window depth, rows top-down.
+
+use super::{pattern_color, Scene, Shape};
+use crate::camera::mat4::{self, Mat4};
+use crate::convention::{Conventions, DepthPlanes, RowOrder};
+use crate::error::{Error, Result};
+use crate::gpu::{Attachment, Framebuffer, Gpu, GpuTimer, Program, TextureFormat, Timing, VertexArray};
+use crate::io::{DepthMap, RgbImage};
+
+const FULLSCREEN_VERT: &str = include_str!("../../shaders/common/fullscreen.vert");
+const RAYTRACE_FRAG: &str = include_str!("../../shaders/scene/raytrace.frag");
+
+/// NDC z of the point each pixel's ray is built through (inside the range of every convention).
+pub const RAY_NDC_Z: f64 = 0.5;
+
+/// A GL camera: world -> eye `view`, eye -> clip `proj` (matching `conv`), image size.
+#[derive(Debug, Clone, Copy)]
+pub struct GlCamera {
+    pub view: Mat4,
+    pub proj: Mat4,
+    pub width: u32,
+    pub height: u32,
+    pub conv: Conventions,
+}
+
+/// A rendered view: colour, view distance (0 = miss) and window depth (far value = miss).
+#[derive(Debug, Clone)]
+pub struct SceneImage {
+    pub color: RgbImage,
+    pub view_z: DepthMap,
+    pub device_depth: DepthMap,
+}
+
+/// Centre of projection of a perspective view-projection: the point whose clip x, y and w are
+/// all 0 (null vector of those three rows, by cofactors). Not inv(V)'s origin: a stereo
+/// projection with a clip-space shift (seed 004) projects from the offset eye.
+pub fn projection_centre(vp: &Mat4) -> Option<[f64; 3]> {
+    let rows = [vp[0], vp[1], vp[3]];
+    let det3 = |c: [usize; 3]| {
+        let m = |r: usize, k: usize| rows[r][c[k]];
+        m(0, 0) * (m(1, 1) * m(2, 2) - m(1, 2) * m(2, 1)) - m(0, 1) * (m(1, 0) * m(2, 2) - m(1, 2) * m(2, 0))
+            + m(0, 2) * (m(1, 0) * m(2, 1) - m(1, 1) * m(2, 0))
+    };
+    let c = [det3([1, 2, 3]), -det3([0, 2, 3]), det3([0, 1, 3]), -det3([0, 1, 2])];
+    (c[3].abs() > 1e-300 && c.iter().all(|v| v.is_finite())).then(|| [c[0] / c[3], c[1] / c[3], c[2] / c[3]])
+}
+
+impl GlCamera {
+    fn matrices(&self) -> Result<(Mat4, Mat4, [f64; 3])> {
+        let vp = mat4::mul(&self.proj, &self.view);
+        let inv_vp = mat4::inverse(&vp).ok_or_else(|| Error::param("camera view-projection", "singular"))?;
+        let eye = projection_centre(&vp).ok_or_else(|| Error::param("camera projection", "not perspective"))?;
+        Ok((vp, inv_vp, eye))
+    }
+
+    /// Image row of framebuffer row `y`.
+    fn image_row(&self, y: u32) -> u32 {
+        match self.conv.row_order {
+            RowOrder::BottomUp => self.height - 1 - y,
+            RowOrder::TopDown => y,
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::camera::{gl_projection, Pose};
+
+    #[test]
+    fn projection_centre_of_a_posed_pinhole_is_its_position() {
+        let cam = crate::scene::demo_camera(64, 48);
+        let pose = Pose::yawed(0.4, [0.3, -0.2, 1.5]);
+        let planes = DepthPlanes {
+            near: 0.1,
+            far: f64::INFINITY,
+        };
+        for conv in Conventions::all() {
+            let vp = mat4::mul(&gl_projection(&cam, &planes, &conv), &pose.gl_view());
+            let c = projection_centre(&vp).unwrap();
+            for k in 0..3 {
+                assert!((c[k] - pose.position[k]).abs() < 1e-12, "{conv:?} {c:?}");
+            }
+        }
+    }
+}
+
+/// f64 twin of the shader: same rays, same rounding of colour to 8 bits.
+pub fn trace_gl_reference(scene: &Scene, cam: &GlCamera) -> Result<SceneImage> {
+    let (vp, inv_vp, eye) = cam.matrices()?;
+    let (w, h) = (cam.width as usize, cam.height as usize);
+    let mut color = vec![0u8; w * h * 3];
+    let mut view_z = vec![0f32; w * h];
+    let far = cam.conv.clear_depth() as f32;
+    let mut device = vec![far; w * h];
+    for y in 0..cam.height {
+        for x in 0..cam.width {
+            let ndc = [
+                (x as f64 + 0.5) / w as f64 * 2.0 - 1.0,
+                (y as f64 + 0.5) / h as f64 * 2.0 - 1.0,
+            ];
+            let q = mat4::transform_point(&inv_vp, [ndc[0], ndc[1], RAY_NDC_Z]);
+            let dir = [q[0] - eye[0], q[1] - eye[1], q[2] - eye[2]];
+            let Some(hit) = scene.trace(eye, dir) else { continue };
+            let o = cam.image_row(y) as usize * w + x as usize;
+            let c = pattern_color(&hit);
+            for k in 0..3 {
+                color[o * 3 + k] = c[k].round().clamp(0.0, 255.0) as u8;
+            }
+            view_z[o] = -mat4::transform_point(&cam.view, hit.p)[2] as f32;
+            let z = mat4::transform_point(&vp, hit.p)[2];
+            device[o] = DepthPlanes::window_depth_of_ndc_z(&cam.conv, z) as f32;
+        }
+    }
+    Ok(SceneImage {
+        color: RgbImage::new(cam.width, cam.height, color)?,
+        view_z: DepthMap::new(cam.width, cam.height, view_z)?,
+        device_depth: DepthMap::new(cam.width, cam.height, device)?,
+    })
+}
+
+/// A scene uploaded as uniforms, ready to render any GL camera.
+pub struct SceneRenderer {
+    gpu: Gpu,
+    scene: Scene,
+    programs: Vec<(Conventions, Program)>,
+    vao: VertexArray,
+}
+
+impl SceneRenderer {
+    pub fn new(gpu: &Gpu, scene: &Scene) -> Result<Self> {
+        scene.validate()?;
+        Ok(SceneRenderer {
+            gpu: gpu.clone(),
+            scene: scene.clone(),
+            programs: Vec::new(),
+            vao: VertexArray::new(gpu)?,
+        })
+    }
+
+    fn program(&mut self, conv: Conventions) -> Result<&Program> {
+        if let Some(i) = self.programs.iter().position(|(c, _)| *c == conv) {
+            return Ok(&self.programs[i].1);
+        }
+        let p = Program::new(
+            &self.gpu,
+            &conv.glsl_defines(),
+            &[
+                (glow::VERTEX_SHADER, "fullscreen.vert", FULLSCREEN_VERT),
+                (glow::FRAGMENT_SHADER, "scene/raytrace.frag", RAYTRACE_FRAG),
+            ],
+        )?;
+        self.programs.push((conv, p));
+        Ok(&self.programs.last().expect("just pushed").1)
+    }
+
+    pub fn render(&mut self, cam: &GlCamera) -> Result<(SceneImage, Timing)> {
+        let (vp, inv_vp, eye) = cam.matrices()?;
+        let (w, h) = (cam.width, cam.height);
+        let max = self.gpu.max_image_side();
+        if w == 0 || h == 0 || w > max || h > max {
+            return Err(Error::param("camera size", format!("{w}x{h} outside 1..={max}")));
+        }
+        let gpu = self.gpu.clone();
+        let slot = |format| {
+            Some(Attachment {
+                format,
+                clear: [0.0; 4],
+            })
+        };
+        let fb = Framebuffer::new(
+            &gpu,
+            w,
+            h,
+            &[
+                slot(TextureFormat::Rgba8),
+                slot(TextureFormat::R32F),
+                slot(TextureFormat::R32F),
+            ],
+            false,
+        )?;
+        let objects = self.scene.objects.clone();
+        let p = self.program(cam.conv)?;
+        let timer = GpuTimer::start(&gpu);
+        fb.bind_and_clear(1.0);
+        p.bind();
+        p.set_i32("u_count", objects.len() as i32);
+        for (i, o) in objects.iter().enumerate() {
+            let v4 = |v: [f64; 3], w: f64| [v[0] as f32, v[1] as f32, v[2] as f32, w as f32];
+            let (kind, a, b, c, d) = match o.shape {
+                Shape::Plane {
+                    point,
+                    normal,
+                    bounds_min,
+                    bounds_max,
+                } => (
+                    0,
+                    v4(point, 0.0),
+                    v4(normal, 0.0),
+                    v4(bounds_min, 0.0),
+                    v4(bounds_max, 0.0),
+                ),
+                Shape::Sphere { center, radius } => (1, v4(center, radius), [0.0; 4], [0.0; 4], [0.0; 4]),
+                Shape::Cuboid { min, max } => (2, v4(min, 0.0), v4(max, 0.0), [0.0; 4], [0.0; 4]),
+            };
+            p.set_ivec2(&format!("u_kind[{i}]"), [kind, o.pattern as i32]);
+            p.set_vec4(&format!("u_a[{i}]"), a);
+            p.set_vec4(&format!("u_b[{i}]"), b);
+            p.set_vec4(&format!("u_c[{i}]"), c);
+            p.set_vec4(&format!("u_d[{i}]"), d);
+        }
+        p.set_mat4_rows("u_inv_view_proj", &inv_vp);
+        p.set_mat4_rows("u_view_proj", &vp);
+        p.set_mat4_rows("u_view", &cam.view);
+        p.set_vec3("u_eye", [eye[0] as f32, eye[1] as f32, eye[2] as f32]);
+        p.set_vec2("u_size", [w as f32, h as f32]);
+        self.vao.bind();
+        // SAFETY: one full-screen triangle into an FBO without depth buffer.
+        unsafe {
+            use glow::HasContext;
+            let gl = gpu.gl();
+            gl.disable(glow::DEPTH_TEST);
+            gl.disable(glow::BLEND);
+            gl.draw_arrays(glow::TRIANGLES, 0, 3);
+        }
+        gpu.check("scene ray trace")?;
+        let timing = timer.stop();
+        let flip = cam.conv.row_order == RowOrder::BottomUp;
+        let rows = |data: Vec<u8>, bpp: usize| -> Vec<u8> {
+            if flip {
+                data.chunks_exact(w as usize * bpp).rev().flatten().copied().collect()
+            } else {
+                data
+            }
+        };
+        let floats = |b: Vec<u8>| {
+            b.chunks_exact(4)
+                .map(|c| f32::from_ne_bytes([c[0], c[1], c[2], c[3]]))
+                .collect()
+        };
+        let rgba = rows(fb.read_color(0)?.expect("colour"), 4);
+        let view_z = rows(fb.read_color(1)?.expect("view z"), 4);
+        let device = rows(fb.read_color(2)?.expect("device depth"), 4);
+        fb.unbind();
+        Ok((
+            SceneImage {
+                color: RgbImage::new(w, h, rgba.chunks_exact(4).flat_map(|p| [p[0], p[1], p[2]]).collect())?,
+                view_z: DepthMap::new(w, h, floats(view_z))?,
+                device_depth: DepthMap::new(w, h, floats(device))?,
+            },
+            timing,
+        ))
+    }
+}
