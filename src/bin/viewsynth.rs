@@ -37,6 +37,31 @@ enum Command {
     /// Synthesise the middle (spectator) view of a stereo pair from each eye's colour and depth.
     #[command(allow_negative_numbers = true)]
     Cyclopean(Box<CyclopeanArgs>),
+    /// Ray-trace a ground-truth scene (built-in or JSON) on the GPU from a stereo rig: left, right
+    /// and middle colour, view distance and device depth, and a cameras.json that
+    /// `viewsynth cyclopean` reads.
+    Scene {
+        /// `demo`, `boxes`, or a scene JSON file (src/scene/shapes.rs).
+        #[arg(long, default_value = "demo")]
+        scene: String,
+        #[arg(long, default_value_t = 640)]
+        width: u32,
+        #[arg(long, default_value_t = 480)]
+        height: u32,
+        /// Interocular distance in metres.
+        #[arg(long, default_value_t = 0.064)]
+        ipd: f64,
+        #[arg(long, value_enum, default_value = "gl")]
+        ndc: NdcArg,
+        #[arg(long)]
+        reversed_z: bool,
+        #[arg(long, value_enum, default_value = "bottom-up")]
+        rows: RowsArg,
+        #[arg(long, default_value = "out/scene")]
+        out_dir: PathBuf,
+        #[command(flatten)]
+        gpu: GpuArgs,
+    },
     /// Render the built-in scene, refocus it at 5 scales, synthesise the cyclopean middle view of
     /// a stereo pair with each method, and write every output plus the error/run-time report.
     Demo {
@@ -236,6 +261,20 @@ fn main() {
         Command::Refocus(args) => refocus(*args),
         Command::Cyclopean(args) => cyclopean(*args),
         Command::Demo { out_dir, gpu } => demo(&out_dir, &gpu),
+        Command::Scene {
+            scene,
+            width,
+            height,
+            ipd,
+            ndc,
+            reversed_z,
+            rows,
+            out_dir,
+            gpu,
+        } => {
+            let conv = conventions(ndc, reversed_z, rows);
+            render_scene(&scene, width, height, ipd, conv, &out_dir, &gpu)
+        }
         Command::Bench { sizes, repeats, gpu } => bench(&sizes, repeats, &gpu),
         Command::Report {
             out_dir,
@@ -309,17 +348,7 @@ fn refocus(a: RefocusArgs) -> Result<()> {
     rule.validate()?;
     let outputs = OutputSet::parse(&a.outputs)?;
     let depth_formats = parse_depth_formats(&a.depth_format)?;
-    let conv = Conventions {
-        ndc_depth: match a.ndc {
-            NdcArg::Gl => NdcDepthRange::MinusOneToOne,
-            NdcArg::Vulkan => NdcDepthRange::ZeroToOne,
-        },
-        reversed_z: a.reversed_z,
-        row_order: match a.rows {
-            RowsArg::BottomUp => RowOrder::BottomUp,
-            RowsArg::TopDown => RowOrder::TopDown,
-        },
-    };
+    let conv = conventions(a.ndc, a.reversed_z, a.rows);
     let method = match a.method {
         MethodArg::Mesh => Method::Mesh,
         MethodArg::Fullscreen => Method::Fullscreen,
@@ -490,6 +519,86 @@ fn cyclopean(a: CyclopeanArgs) -> Result<()> {
     Ok(())
 }
 
+fn conventions(ndc: NdcArg, reversed_z: bool, rows: RowsArg) -> Conventions {
+    Conventions {
+        ndc_depth: match ndc {
+            NdcArg::Gl => NdcDepthRange::MinusOneToOne,
+            NdcArg::Vulkan => NdcDepthRange::ZeroToOne,
+        },
+        reversed_z,
+        row_order: match rows {
+            RowsArg::BottomUp => RowOrder::BottomUp,
+            RowsArg::TopDown => RowOrder::TopDown,
+        },
+    }
+}
+
+fn render_scene(
+    name: &str,
+    width: u32,
+    height: u32,
+    ipd: f64,
+    conv: Conventions,
+    out_dir: &Path,
+    gpu: &GpuArgs,
+) -> Result<()> {
+    use viewsynth::camera::gl_projection;
+    use viewsynth::cyclopean::scene_frame::StereoRig;
+    use viewsynth::scene::gpu::{GlCamera, SceneRenderer};
+    use viewsynth::scene::{builtin, Scene};
+    let scene = if Path::new(name).extension().is_some_and(|e| e == "json") {
+        Scene::load(Path::new(name))?
+    } else {
+        builtin(name)?
+    };
+    if !(ipd.is_finite() && ipd >= 0.0) {
+        bail!("invalid ipd {ipd}: must be finite and >= 0");
+    }
+    let mut rig = StereoRig::demo(width, height);
+    rig.camera.validate("scene camera")?;
+    rig.ipd = ipd;
+    prepare_out_dir(out_dir)?;
+    let gpu = gpu.open()?;
+    let mut renderer = SceneRenderer::new(&gpu, &scene)?;
+    let proj = gl_projection(&rig.camera, &rig.planes, &conv);
+    let mut cams = serde_json::Map::new();
+    for (eye, side) in [("left", -1.0), ("right", 1.0), ("middle", 0.0)] {
+        let view = rig.eye_pose(side).gl_view();
+        let (img, timing) = renderer.render(&GlCamera {
+            view,
+            proj,
+            width,
+            height,
+            conv,
+        })?;
+        io::save_rgb(&out_dir.join(format!("{eye}_rgb.png")), &img.color)?;
+        io::save_depth_exr(&out_dir.join(format!("{eye}_view_z.exr")), &img.view_z)?;
+        io::save_depth_exr(&out_dir.join(format!("{eye}_device_depth.exr")), &img.device_depth)?;
+        let entry = if eye == "middle" {
+            serde_json::json!({ "view": view, "proj": proj, "width": width, "height": height })
+        } else {
+            serde_json::json!({ "view": view, "proj": proj })
+        };
+        cams.insert(eye.to_string(), entry);
+        println!("{eye}: {width}x{height} in {:.1} ms", timing.wall_ms);
+    }
+    cams.insert("conventions".into(), serde_json::to_value(conv)?);
+    cams.insert("depth_kind".into(), "device".into());
+    cams.insert("fixation_distance".into(), 3.0.into());
+    let path = out_dir.join("cameras.json");
+    let text = serde_json::to_string_pretty(&cams)?;
+    io::atomic_write(&path, |w| {
+        use std::io::Write;
+        w.write_all(text.as_bytes()).map_err(|e| viewsynth::Error::io(&path, e))
+    })?;
+    println!(
+        "scene '{}' written to {} (cameras.json feeds `viewsynth cyclopean`)",
+        scene.name,
+        out_dir.display()
+    );
+    Ok(())
+}
+
 fn parse_depth_formats(list: &str) -> Result<DepthFormats> {
     let mut f = DepthFormats { exr: false, npy: false };
     for item in list.split(',').map(str::trim) {
@@ -522,6 +631,9 @@ fn bench(sizes: &[String], repeats: usize, gpu: &GpuArgs) -> Result<()> {
     let gpu = gpu.open()?;
     let table = viewsynth::bench::refocus_bench(&gpu, &parsed, repeats.max(1))?;
     println!("{table}");
-    println!("{}", viewsynth::bench::cyclopean_bench(&gpu, 1280, 720, repeats.max(1))?);
+    println!(
+        "{}",
+        viewsynth::bench::cyclopean_bench(&gpu, 1280, 720, repeats.max(1))?
+    );
     Ok(())
 }
