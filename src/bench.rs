@@ -123,5 +123,22 @@ pub fn cyclopean_bench(gpu: &Gpu, width: u32, height: u32, repeats: usize) -> Re
         }
         writeln!(t, "| {name} | {setup:.1} | {:.1} |", median(runs)).expect("write to String");
     }
+    let t0 = Instant::now();
+    let mut warp = crate::cyclopean::forward::ForwardWarp::new(gpu, &frame, &crate::refocus::BreakRule::default())?;
+    warp.render(&mid)?;
+    let setup = t0.elapsed().as_secs_f64() * 1e3;
+    let mut runs = Vec::new();
+    for _ in 0..repeats {
+        let t0 = Instant::now();
+        warp.render(&mid)?;
+        runs.push(t0.elapsed().as_secs_f64() * 1e3);
+    }
+    writeln!(
+        t,
+        "| {} | {setup:.1} | {:.1} |",
+        crate::evaluation::FORWARD_NAME,
+        median(runs)
+    )
+    .expect("write to String");
     Ok(t)
 }

@@ -123,8 +123,13 @@ fn cyclopean_outputs(gpu: &Gpu, dir: &Path) -> Result<()> {
     io::save_depth_exr(&dir.join("left_device_depth.exr"), &frame.left.depth)?;
     io::save_depth_exr(&dir.join("right_device_depth.exr"), &frame.right.depth)?;
     io::save_rgb(&dir.join("middle_truth_rgb.png"), &truth.color)?;
+    let mut outputs = Vec::new();
     for (name, params) in crate::evaluation::cyclopean_methods(3.0) {
-        let (out, _) = CyclopeanRenderer::new(gpu, &frame, params)?.render(&mid)?;
+        outputs.push((name, CyclopeanRenderer::new(gpu, &frame, params)?.render(&mid)?.0));
+    }
+    let mut warp = crate::cyclopean::forward::ForwardWarp::new(gpu, &frame, &crate::refocus::BreakRule::default())?;
+    outputs.push((crate::evaluation::FORWARD_NAME, warp.render(&mid)?.0));
+    for (name, out) in outputs {
         let stem: String = name
             .chars()
             .map(|c| if c.is_ascii_alphanumeric() { c } else { '_' })

@@ -15,6 +15,7 @@
 
 pub mod camera_file;
 pub mod disparity_frame;
+pub mod forward;
 pub mod reference;
 pub mod render;
 pub mod scene_frame;

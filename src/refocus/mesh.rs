@@ -40,7 +40,8 @@ pub struct MeshPass {
     indexed_vao: VertexArray,
 }
 
-fn code_texture(gpu: &Gpu, codes: &[u32]) -> Result<Option<Texture>> {
+/// Kept-triangle codes as an R32UI texture `TRI_TEX_WIDTH` wide, for vertex pulling.
+pub fn code_texture(gpu: &Gpu, codes: &[u32]) -> Result<Option<Texture>> {
     if codes.is_empty() {
         return Ok(None);
     }

@@ -15,6 +15,7 @@ pub mod reference;
 mod render;
 
 pub use grid::{axis_lookup, valid_depth, BreakRule, Grid};
+pub use mesh::{code_texture, TRI_TEX_WIDTH};
 pub use render::{RefocusOutput, Refocuser};
 
 use crate::camera::{Intrinsics, PinholeCamera, MAX_IMAGE_SIDE};

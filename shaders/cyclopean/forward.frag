@@ -1,0 +1,45 @@
+// Colour of the warped eye at the exact eye position of this fragment's surface point.
+
+uniform sampler2D u_color;  // RGBA8 eye colour, memory order
+uniform int u_eye_bit;
+uniform int u_flip;
+
+flat in ivec3 v_cell;
+in vec3 v_eye_clip;
+in float v_middle_distance;
+
+layout(location = 0) out vec4 o_color;
+layout(location = 1) out float o_depth;
+layout(location = 2) out float o_sources;
+
+void main() {
+    ivec2 size = textureSize(u_color, 0);
+    vec2 uv = v_eye_clip.xy / v_eye_clip.z * 0.5 + 0.5;
+    // Closed-triangle test in the eye's grid (image rows, refocus cell convention).
+    vec2 img = uv * vec2(size) - 0.5;
+    if (u_flip == 1) {
+        img.y = float(size.y) - 1.0 - img.y;
+    }
+    ivec2 c = v_cell.xy;
+    vec2 origin = vec2(c.x <= 0 ? -0.5 : float(c.x - 1), c.y <= 0 ? -0.5 : float(c.y - 1));
+    vec2 end = vec2(c.x + 1 > size.x ? float(size.x) - 0.5 : float(c.x), c.y + 1 > size.y ? float(size.y) - 0.5 : float(c.y));
+    vec2 ab = (img - origin) / (end - origin);
+    const float EPS = 1e-3;
+    bool inside = v_cell.z == 0 ? (ab.y >= -EPS && ab.x <= 1.0 + EPS && ab.x >= ab.y - EPS)
+                                : (ab.x >= -EPS && ab.y <= 1.0 + EPS && ab.y >= ab.x - EPS);
+    if (!inside) {
+        discard;
+    }
+    vec2 t = uv * vec2(size) - 0.5;
+    vec2 f0 = floor(t);
+    vec2 fr = t - f0;
+    ivec2 i0 = ivec2(f0);
+    ivec2 hi = size - 1;
+    vec3 c00 = texelFetch(u_color, clamp(i0, ivec2(0), hi), 0).rgb;
+    vec3 c10 = texelFetch(u_color, clamp(i0 + ivec2(1, 0), ivec2(0), hi), 0).rgb;
+    vec3 c01 = texelFetch(u_color, clamp(i0 + ivec2(0, 1), ivec2(0), hi), 0).rgb;
+    vec3 c11 = texelFetch(u_color, clamp(i0 + ivec2(1, 1), ivec2(0), hi), 0).rgb;
+    o_color = vec4(mix(mix(c00, c10, fr.x), mix(c01, c11, fr.x), fr.y), 1.0);
+    o_depth = v_middle_distance;
+    o_sources = float(u_eye_bit) / 255.0;
+}

@@ -1,0 +1,106 @@
+// Forward warp of one eye into the middle camera. The eye's depth map is the refocus grid mesh
+// (half-pixel ring, discontinuities broken on the CPU), drawn by vertex pulling: vertex 3t + k
+// is corner k of kept triangle t (code = cell << 1 | tri from u_tris). A stereo warp is mostly a
+// horizontal shift, so middle pixel centres land exactly on mesh edges row after row; each
+// triangle is therefore pushed out by u_expand_px in the middle image (moved vertices stay on its
+// plane) and the fragment shader keeps exactly the closed triangle: coverage does not depend on
+// the fill rule or the row order. Eye clip (x, y, w) and the middle view distance are linear in
+// 3-D, so they interpolate exactly.
+
+uniform usampler2D u_tris;     // R32UI kept-triangle codes, TRI_TEX_WIDTH wide
+uniform sampler2D u_distance;  // R32F eye view distance, memory order (0 = invalid)
+uniform ivec2 u_eye_size;
+uniform mat4 u_inv_view_e, u_inv_proj_e, u_view_proj_e;
+uniform mat4 u_view_m, u_view_proj_m, u_inv_view_proj_m;
+uniform vec2 u_size_m;
+uniform int u_flip;            // 1 when memory rows are bottom-up
+uniform vec3 u_middle_centre;
+uniform float u_expand_px;
+// Relative push away from the middle camera for this eye's depth test only: where both eyes
+// saw the same surface their depths differ by float rounding, which the depth buffer would
+// resolve differently under each convention; the pushed eye wins only when nearer by more.
+uniform float u_depth_bias;
+
+flat out ivec3 v_cell;         // cell i, j (image grid coordinates) and triangle
+out vec3 v_eye_clip;           // eye clip (x, y, w)
+out float v_middle_distance;
+
+float vertex_pos(int i, int n) {
+    return i <= 0 ? -0.5 : (i > n ? float(n) - 0.5 : float(i - 1));
+}
+
+vec3 corner_world(ivec2 c) {
+    vec2 img = vec2(vertex_pos(c.x, u_eye_size.x), vertex_pos(c.y, u_eye_size.y));
+    ivec2 px = clamp(c - 1, ivec2(0), u_eye_size - 1);
+    if (u_flip == 1) {
+        img.y = float(u_eye_size.y) - 1.0 - img.y;
+        px.y = u_eye_size.y - 1 - px.y;
+    }
+    float dist = texelFetch(u_distance, px, 0).r;
+    vec2 ndc = (img + 0.5) / vec2(u_eye_size) * 2.0 - 1.0;
+    vec4 p = u_inv_proj_e * vec4(ndc, 0.5, 1.0);
+    vec3 ray = p.xyz / p.w;
+    ray /= -ray.z;
+    vec4 world = u_inv_view_e * vec4(ray * dist, 1.0);
+    return world.xyz / world.w;
+}
+
+vec2 window_xy(vec3 world) {
+    vec4 clip = u_view_proj_m * vec4(world, 1.0);
+    return (clip.xy / clip.w * 0.5 + 0.5) * u_size_m;
+}
+
+void main() {
+    int t = gl_VertexID / 3;
+    int k = gl_VertexID - 3 * t;
+    uint code = texelFetch(u_tris, ivec2(t % TRI_TEX_WIDTH, t / TRI_TEX_WIDTH), 0).r;
+    int cell = int(code >> 1u);
+    int tri = int(code & 1u);
+    int cells_x = u_eye_size.x + 1;
+    ivec2 c = ivec2(cell % cells_x, cell / cells_x);
+    ivec2 corners[3] = ivec2[3](c, tri == 0 ? c + ivec2(1, 0) : c + ivec2(1, 1),
+                                   tri == 0 ? c + ivec2(1, 1) : c + ivec2(0, 1));
+    vec3 p[3];
+    for (int n = 0; n < 3; ++n) {
+        p[n] = corner_world(corners[n]);
+    }
+    v_cell = ivec3(c, tri);
+    vec3 point = p[k];
+
+    vec4 clip0 = u_view_proj_m * vec4(p[0], 1.0);
+    vec4 clip1 = u_view_proj_m * vec4(p[1], 1.0);
+    vec4 clip2 = u_view_proj_m * vec4(p[2], 1.0);
+    if (clip0.w > 0.0 && clip1.w > 0.0 && clip2.w > 0.0) {
+        vec2 w0 = window_xy(p[k]);
+        vec2 wn = window_xy(p[(k + 1) % 3]);
+        vec2 wp = window_xy(p[(k + 2) % 3]);
+        vec2 e1 = wn - w0;
+        vec2 e2 = w0 - wp;
+        float area2 = e1.x * (wp.y - w0.y) - e1.y * (wp.x - w0.x);
+        float l1 = length(e1);
+        float l2 = length(e2);
+        if (abs(area2) > 0.0 && l1 > 0.0 && l2 > 0.0) {
+            float s = sign(area2);
+            vec2 n1 = s * vec2(e1.y, -e1.x) / l1;
+            vec2 n2 = s * vec2(e2.y, -e2.x) / l2;
+            vec2 w_new = w0 + u_expand_px * (n1 + n2) / max(1.0 + dot(n1, n2), 0.25);
+            // The middle ray through the moved point, met with the triangle's plane.
+            vec2 ndc = w_new / u_size_m * 2.0 - 1.0;
+            vec4 far_point = u_inv_view_proj_m * vec4(ndc, 0.5, 1.0);
+            vec3 dir = far_point.xyz / far_point.w - u_middle_centre;
+            vec3 nrm = cross(p[1] - p[0], p[2] - p[0]);
+            float den = dot(nrm, dir);
+            if (abs(den) > 1e-30) {
+                float tt = dot(nrm, p[0] - u_middle_centre) / den;
+                if (tt > 0.0) {
+                    point = u_middle_centre + dir * tt;
+                }
+            }
+        }
+    }
+    vec4 eye_clip = u_view_proj_e * vec4(point, 1.0);
+    v_eye_clip = eye_clip.xyw;
+    v_middle_distance = -(u_view_m * vec4(point, 1.0)).z;
+    vec3 pushed = u_middle_centre + (point - u_middle_centre) * (1.0 + u_depth_bias);
+    gl_Position = u_view_proj_m * vec4(pushed, 1.0);
+}

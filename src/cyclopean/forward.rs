@@ -1,0 +1,271 @@
+//! Forward warp, the mesh alternative to the gather: each eye's depth map becomes the refocus grid
+//! mesh (broken at depth discontinuities), is rendered into the middle camera with a depth test,
+//! and the two eyes merge by depth (nearest surface wins). Rasterised, so it has no fixation
+//! guess to get wrong and fills every pixel a kept triangle covers; its oracle is the
+//! ray-traced middle view (tests/integration/cyclopean.rs).
+
+use super::{CyclopeanOutput, DepthKind, EyeInput, MiddleCamera, StereoFrame};
+use crate::camera::mat4::{self, Mat4};
+use crate::convention::{NdcDepthRange, RowOrder};
+use crate::error::{Error, Result};
+use crate::gpu::{Attachment, Framebuffer, Gpu, GpuTimer, Program, Texture, TextureFormat, Timing, VertexArray};
+use crate::io::{DepthMap, RgbImage};
+use crate::refocus::{code_texture, TRI_TEX_WIDTH};
+use crate::refocus::{BreakRule, Grid};
+
+/// The right eye replaces the left only where it is nearer by more than this (relative): ties
+/// between the two views of one surface go to the left eye under every convention. Far above
+/// f32 depth-buffer resolution (~4e-6 relative at 6 m with standard Z and near 0.05 m).
+pub const RIGHT_EYE_DEPTH_BIAS: f32 = 1e-4;
+
+const FORWARD_VERT: &str = include_str!("../../shaders/cyclopean/forward.vert");
+const FORWARD_FRAG: &str = include_str!("../../shaders/cyclopean/forward.frag");
+
+/// View distance per eye pixel (rows top-down), 0 where the depth is background or invalid.
+pub fn eye_distances(eye: &EyeInput, kind: DepthKind, conv: &crate::convention::Conventions) -> Result<Vec<f32>> {
+    let inv_proj = mat4::inverse(&eye.proj).ok_or_else(|| Error::param("eye projection", "singular"))?;
+    let (w, h) = (eye.depth.width as usize, eye.depth.height as usize);
+    let mut out = vec![0f32; w * h];
+    for y in 0..h {
+        // NDC y of image row y under the row order.
+        let y_mem = if conv.row_order == RowOrder::BottomUp {
+            h - 1 - y
+        } else {
+            y
+        };
+        for x in 0..w {
+            let d = eye.depth.data[y * w + x] as f64;
+            out[y * w + x] = match kind {
+                DepthKind::ViewZ => {
+                    if d.is_finite() && d > 0.0 {
+                        d as f32
+                    } else {
+                        0.0
+                    }
+                }
+                DepthKind::Device => {
+                    let eps = super::reference::FAR_EPS;
+                    let ok = d.is_finite() && if conv.reversed_z { d > eps } else { d < 1.0 - eps };
+                    if !ok {
+                        0.0
+                    } else {
+                        let ndc = [
+                            (x as f64 + 0.5) / w as f64 * 2.0 - 1.0,
+                            (y_mem as f64 + 0.5) / h as f64 * 2.0 - 1.0,
+                        ];
+                        let z = match conv.ndc_depth {
+                            NdcDepthRange::MinusOneToOne => d * 2.0 - 1.0,
+                            NdcDepthRange::ZeroToOne => d,
+                        };
+                        let v = -mat4::transform_point(&inv_proj, [ndc[0], ndc[1], z])[2];
+                        if v.is_finite() && v > 0.0 {
+                            v as f32
+                        } else {
+                            0.0
+                        }
+                    }
+                }
+            };
+        }
+    }
+    Ok(out)
+}
+
+struct EyeMesh {
+    color: Texture,
+    distance: Texture,
+    tris: Option<Texture>,
+    count: usize,
+    view: Mat4,
+    proj: Mat4,
+    size: (u32, u32),
+}
+
+pub struct ForwardWarp {
+    gpu: Gpu,
+    program: Program,
+    eyes: [EyeMesh; 2],
+    conv: crate::convention::Conventions,
+    vao: VertexArray,
+}
+
+fn memory_rows(data: &[u8], row_bytes: usize, flip: bool) -> Vec<u8> {
+    if flip {
+        data.chunks_exact(row_bytes).rev().flatten().copied().collect()
+    } else {
+        data.to_vec()
+    }
+}
+
+impl ForwardWarp {
+    /// `rule` breaks the mesh at eye-depth discontinuities (the refocus rule on view distance).
+    pub fn new(gpu: &Gpu, frame: &StereoFrame, rule: &BreakRule) -> Result<Self> {
+        frame.validate()?;
+        rule.validate()?;
+        let flip = frame.conv.row_order == RowOrder::BottomUp;
+        let mesh = |eye: &EyeInput| -> Result<EyeMesh> {
+            let (w, h) = (eye.color.width, eye.color.height);
+            let dist = eye_distances(eye, frame.depth_kind, &frame.conv)?;
+            let grid = Grid { width: w, height: h };
+            let keep = grid.keep_mask(&dist, rule);
+            let codes = grid.kept_triangles(&keep);
+            let rgba: Vec<u8> = eye
+                .color
+                .data
+                .chunks_exact(3)
+                .flat_map(|p| [p[0], p[1], p[2], 255])
+                .collect();
+            let dbytes: Vec<u8> = dist.iter().flat_map(|z| z.to_ne_bytes()).collect();
+            Ok(EyeMesh {
+                color: Texture::new(
+                    gpu,
+                    w,
+                    h,
+                    TextureFormat::Rgba8,
+                    Some(&memory_rows(&rgba, w as usize * 4, flip)),
+                )?,
+                distance: Texture::new(
+                    gpu,
+                    w,
+                    h,
+                    TextureFormat::R32F,
+                    Some(&memory_rows(&dbytes, w as usize * 4, flip)),
+                )?,
+                tris: code_texture(gpu, &codes)?,
+                count: codes.len(),
+                view: eye.view,
+                proj: eye.proj,
+                size: (w, h),
+            })
+        };
+        let program = Program::new(
+            gpu,
+            &format!("{}#define TRI_TEX_WIDTH {TRI_TEX_WIDTH}\n", frame.conv.glsl_defines()),
+            &[
+                (glow::VERTEX_SHADER, "cyclopean/forward.vert", FORWARD_VERT),
+                (glow::FRAGMENT_SHADER, "cyclopean/forward.frag", FORWARD_FRAG),
+            ],
+        )?;
+        Ok(ForwardWarp {
+            gpu: gpu.clone(),
+            program,
+            eyes: [mesh(&frame.left)?, mesh(&frame.right)?],
+            conv: frame.conv,
+            vao: VertexArray::new(gpu)?,
+        })
+    }
+
+    pub fn render(&mut self, mid: &MiddleCamera) -> Result<(CyclopeanOutput, Timing)> {
+        let (w, h) = (mid.width, mid.height);
+        if w == 0 || h == 0 || w > self.gpu.max_image_side() || h > self.gpu.max_image_side() {
+            return Err(Error::param("middle size", format!("{w}x{h}")));
+        }
+        let slot = |format| {
+            Some(Attachment {
+                format,
+                clear: [0.0; 4],
+            })
+        };
+        let fb = Framebuffer::new(
+            &self.gpu,
+            w,
+            h,
+            &[
+                slot(TextureFormat::Rgba8),
+                slot(TextureFormat::R32F),
+                slot(TextureFormat::R8),
+            ],
+            true,
+        )?;
+        let p = &self.program;
+        let gpu = &self.gpu;
+        let timer = GpuTimer::start(gpu);
+        fb.bind_and_clear(self.conv.clear_depth() as f32);
+        p.bind();
+        self.vao.bind();
+        let flip = self.conv.row_order == RowOrder::BottomUp;
+        gpu.clip_control(
+            glow::LOWER_LEFT,
+            match self.conv.ndc_depth {
+                NdcDepthRange::MinusOneToOne => glow::NEGATIVE_ONE_TO_ONE,
+                NdcDepthRange::ZeroToOne => glow::ZERO_TO_ONE,
+            },
+        );
+        // SAFETY: depth state for the merge; restored below.
+        unsafe {
+            use glow::HasContext;
+            let gl = gpu.gl();
+            gl.enable(glow::DEPTH_TEST);
+            gl.enable(glow::DEPTH_CLAMP);
+            gl.depth_mask(true);
+            gl.depth_func(if self.conv.reversed_z {
+                glow::GEQUAL
+            } else {
+                glow::LEQUAL
+            });
+            gl.disable(glow::BLEND);
+            gl.disable(glow::CULL_FACE);
+        }
+        p.set_mat4_rows("u_view_m", &mid.view);
+        p.set_mat4_rows("u_view_proj_m", &mat4::mul(&mid.proj, &mid.view));
+        p.set_i32("u_flip", flip as i32);
+        let vp_m = mat4::mul(&mid.proj, &mid.view);
+        let centre = crate::scene::gpu::projection_centre(&vp_m)
+            .ok_or_else(|| Error::param("middle projection", "not perspective"))?;
+        p.set_vec3("u_middle_centre", centre.map(|v| v as f32));
+        p.set_i32("u_color", 0);
+        p.set_i32("u_distance", 1);
+        p.set_i32("u_tris", 2);
+        p.set_vec2("u_size_m", [w as f32, h as f32]);
+        p.set_f32("u_expand_px", 1.0 / 32.0);
+        let inv_vp_m = mat4::inverse(&mat4::mul(&mid.proj, &mid.view))
+            .ok_or_else(|| Error::param("middle view-projection", "singular"))?;
+        p.set_mat4_rows("u_inv_view_proj_m", &inv_vp_m);
+        for (bit, eye) in [(1, &self.eyes[0]), (2, &self.eyes[1])] {
+            let Some(tris) = &eye.tris else { continue };
+            let inv = |m: &Mat4, what: &str| mat4::inverse(m).ok_or_else(|| Error::param(what.to_string(), "singular"));
+            eye.color.bind(0);
+            eye.distance.bind(1);
+            p.set_mat4_rows("u_inv_view_e", &inv(&eye.view, "eye view")?);
+            p.set_mat4_rows("u_inv_proj_e", &inv(&eye.proj, "eye projection")?);
+            p.set_mat4_rows("u_view_proj_e", &mat4::mul(&eye.proj, &eye.view));
+            p.set_ivec2("u_eye_size", [eye.size.0 as i32, eye.size.1 as i32]);
+            p.set_i32("u_eye_bit", bit);
+            p.set_f32("u_depth_bias", if bit == 2 { RIGHT_EYE_DEPTH_BIAS } else { 0.0 });
+            tris.bind(2);
+            // SAFETY: 3 pulled vertices per kept triangle of this eye.
+            unsafe {
+                use glow::HasContext;
+                gpu.gl().draw_arrays(glow::TRIANGLES, 0, (eye.count * 3) as i32);
+            }
+        }
+        // SAFETY: state reset.
+        unsafe {
+            use glow::HasContext;
+            gpu.gl().disable(glow::DEPTH_CLAMP);
+        }
+        gpu.clip_control(glow::LOWER_LEFT, glow::NEGATIVE_ONE_TO_ONE);
+        gpu.check("forward warp")?;
+        let timing = timer.stop();
+        let rows = |data: Vec<u8>, bpp: usize| memory_rows(&data, w as usize * bpp, flip);
+        let rgba = rows(fb.read_color(0)?.expect("colour"), 4);
+        let depth = rows(fb.read_color(1)?.expect("depth"), 4);
+        let sources = rows(fb.read_color(2)?.expect("sources"), 1);
+        fb.unbind();
+        Ok((
+            CyclopeanOutput {
+                color: RgbImage::new(w, h, rgba.chunks_exact(4).flat_map(|p| [p[0], p[1], p[2]]).collect())?,
+                depth: DepthMap::new(
+                    w,
+                    h,
+                    depth
+                        .chunks_exact(4)
+                        .map(|b| f32::from_ne_bytes([b[0], b[1], b[2], b[3]]))
+                        .collect(),
+                )?,
+                sources,
+            },
+            timing,
+        ))
+    }
+}
