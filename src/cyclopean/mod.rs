@@ -19,6 +19,7 @@ pub mod forward;
 pub mod reference;
 pub mod render;
 pub mod scene_frame;
+pub mod temporal;
 
 use crate::camera::mat4::{self, Mat4};
 use crate::convention::Conventions;

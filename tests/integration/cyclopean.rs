@@ -327,3 +327,81 @@ fn cli_renders_the_same_middle_view_as_the_library_from_files() {
     assert_eq!(o.status.code(), Some(1), "{err}");
     assert!(err.contains("fixation_distance") && !err.contains("panicked"), "{err}");
 }
+
+#[test]
+fn temporal_accumulation_fills_disocclusions_from_the_previous_frame() {
+    // One eye only (the right eye's depth emptied), so the middle view has disocclusion holes
+    // beside foreground edges. The head moves 10 cm between frames: the first frame saw some of
+    // what the second misses. History must fill holes with the right surface (PSNR vs the
+    // ray-traced view on filled pixels), never add holes, and leave a static sequence unchanged.
+    use viewsynth::cyclopean::temporal::{TemporalAccumulator, FROM_HISTORY};
+    let g = gpu();
+    let conv = Conventions::all()[3];
+    let params = CyclopeanParams {
+        method: Method::Refine { steps: 3 },
+        ..CyclopeanParams::seed(3.0)
+    };
+    let frame_at = |x: f64| {
+        let mut rig = StereoRig::demo(320, 240);
+        rig.ipd = 0.2;
+        rig.head = viewsynth::camera::Pose::at([x, 0.0, 0.0]);
+        let (mut frame, mid, truth) = scene_frame(&rig, conv, DepthKind::Device);
+        frame
+            .right
+            .depth
+            .data
+            .iter_mut()
+            .for_each(|z| *z = conv.clear_depth() as f32);
+        let (out, _) = CyclopeanRenderer::new(&g, &frame, params)
+            .unwrap()
+            .render(&mid)
+            .unwrap();
+        (out, mid, truth)
+    };
+    let (a, mid_a, _) = frame_at(0.1);
+    let (b, mid_b, truth_b) = frame_at(0.0);
+    let mut acc = TemporalAccumulator::new(0.5, 0.02, conv).unwrap();
+    let first = acc.push(&a, &mid_a).unwrap();
+    assert_eq!(first.color, a.color, "the first frame passes through");
+    let filled = acc.push(&b, &mid_b).unwrap();
+    let holes_before = b.sources.iter().filter(|s| **s == 0).count();
+    let holes_after = filled.sources.iter().filter(|s| **s == 0).count();
+    let from_history: Vec<usize> = (0..filled.sources.len())
+        .filter(|&i| filled.sources[i] == FROM_HISTORY)
+        .collect();
+    assert!(
+        holes_before > 100 && holes_after < holes_before / 2,
+        "holes {holes_before} -> {holes_after}"
+    );
+    let (mut sq, mut n) = (0.0, 0);
+    for &i in &from_history {
+        if truth_b.depth.data[i] > 0.0 {
+            n += 1;
+            for c in 0..3 {
+                let d = filled.color.data[i * 3 + c] as f64 - truth_b.color.data[i * 3 + c] as f64;
+                sq += d * d;
+            }
+        }
+    }
+    let psnr = metrics::psnr_from_mse(sq / (3 * n.max(1)) as f64);
+    assert!(n > 50 && psnr > 20.0, "{n} filled pixels at {psnr:.1} dB");
+    assert!(filled.depth.data.iter().all(|z| z.is_finite()));
+
+    let mut still = TemporalAccumulator::new(0.5, 0.02, conv).unwrap();
+    still.push(&b, &mid_b).unwrap();
+    let again = still.push(&b, &mid_b).unwrap();
+    let changed = again
+        .color
+        .data
+        .iter()
+        .zip(&b.color.data)
+        .filter(|(x, y)| (**x as i32 - **y as i32).abs() > 1)
+        .count();
+    assert!(
+        changed * 1000 <= b.color.data.len(),
+        "a static sequence changed {changed} channels"
+    );
+    assert!(
+        TemporalAccumulator::new(0.0, 0.02, conv).is_err() && TemporalAccumulator::new(0.5, f64::NAN, conv).is_err()
+    );
+}

@@ -1,0 +1,151 @@
+//! Temporal accumulation over a sequence of middle views (seed 000 section 8, "TAA-lite"), in
+//! f64 on the CPU: the previous result is forward-projected into the current middle camera with
+//! its depth (nearest surface per pixel wins); where the current frame is valid and the history
+//! agrees in depth, colours are blended exponentially; where the current frame has a hole
+//! (disocclusion) the history fills it (source bit 4).
+
+use super::{CyclopeanOutput, MiddleCamera};
+use crate::camera::mat4;
+use crate::convention::{Conventions, RowOrder};
+use crate::error::{Error, Result};
+
+/// Source bit of pixels filled from the history.
+pub const FROM_HISTORY: u8 = 4;
+
+pub struct TemporalAccumulator {
+    /// Weight of the current frame where both are valid (1 = no accumulation).
+    alpha: f64,
+    /// Relative middle-distance disagreement above which history is rejected.
+    depth_tolerance: f64,
+    history: Option<(CyclopeanOutput, MiddleCamera)>,
+    conv: Conventions,
+}
+
+/// NDC of pixel (x, image row y) under the row order.
+fn pixel_ndc(x: usize, y: usize, w: usize, h: usize, conv: &Conventions) -> [f64; 2] {
+    let y_mem = if conv.row_order == RowOrder::BottomUp {
+        h - 1 - y
+    } else {
+        y
+    };
+    [
+        (x as f64 + 0.5) / w as f64 * 2.0 - 1.0,
+        (y_mem as f64 + 0.5) / h as f64 * 2.0 - 1.0,
+    ]
+}
+
+impl TemporalAccumulator {
+    pub fn new(alpha: f64, depth_tolerance: f64, conv: Conventions) -> Result<Self> {
+        if !(alpha > 0.0 && alpha <= 1.0) {
+            return Err(Error::param("temporal alpha", format!("{alpha} outside (0, 1]")));
+        }
+        if !(depth_tolerance.is_finite() && depth_tolerance > 0.0) {
+            return Err(Error::param(
+                "temporal depth tolerance",
+                format!("{depth_tolerance} must be > 0"),
+            ));
+        }
+        Ok(TemporalAccumulator {
+            alpha,
+            depth_tolerance,
+            history: None,
+            conv,
+        })
+    }
+
+    pub fn reset(&mut self) {
+        self.history = None;
+    }
+
+    /// Accumulate `current` (seen by `mid`) with the history; returns the accumulated frame,
+    /// which becomes the history.
+    pub fn push(&mut self, current: &CyclopeanOutput, mid: &MiddleCamera) -> Result<CyclopeanOutput> {
+        let (w, h) = (mid.width as usize, mid.height as usize);
+        if current.sources.len() != w * h || current.color.data.len() != w * h * 3 {
+            return Err(Error::SizeMismatch {
+                message: format!("frame does not match the middle camera's {w}x{h}"),
+            });
+        }
+        let mut out = current.clone();
+        if let Some((prev, prev_cam)) = &self.history {
+            let (hist_color, hist_z) = self.reproject(prev, prev_cam, mid)?;
+            for i in 0..w * h {
+                let hz = hist_z[i];
+                if !(hz.is_finite() && hz > 0.0) {
+                    continue;
+                }
+                let cz = current.depth.data[i] as f64;
+                if current.sources[i] != 0 && cz > 0.0 {
+                    if (hz - cz).abs() <= self.depth_tolerance * cz {
+                        for c in 0..3 {
+                            let v = self.alpha * current.color.data[i * 3 + c] as f64
+                                + (1.0 - self.alpha) * hist_color[i][c];
+                            out.color.data[i * 3 + c] = v.round().clamp(0.0, 255.0) as u8;
+                        }
+                    }
+                } else {
+                    for c in 0..3 {
+                        out.color.data[i * 3 + c] = hist_color[i][c].round().clamp(0.0, 255.0) as u8;
+                    }
+                    out.depth.data[i] = hz as f32;
+                    out.sources[i] = FROM_HISTORY;
+                }
+            }
+        }
+        self.history = Some((out.clone(), *mid));
+        Ok(out)
+    }
+
+    /// The previous frame splatted into the current camera: colour and middle distance per
+    /// pixel (distance 0 where nothing landed), nearest surface first.
+    fn reproject(
+        &self,
+        prev: &CyclopeanOutput,
+        prev_cam: &MiddleCamera,
+        mid: &MiddleCamera,
+    ) -> Result<(Vec<[f64; 3]>, Vec<f64>)> {
+        let singular = |what: &str| Error::param(what.to_string(), "singular");
+        let inv_proj = mat4::inverse(&prev_cam.proj).ok_or_else(|| singular("previous middle projection"))?;
+        let inv_view = mat4::inverse(&prev_cam.view).ok_or_else(|| singular("previous middle view"))?;
+        let vp = mat4::mul(&mid.proj, &mid.view);
+        let (pw, ph) = (prev_cam.width as usize, prev_cam.height as usize);
+        let (w, h) = (mid.width as usize, mid.height as usize);
+        let mut color = vec![[0.0; 3]; w * h];
+        let mut z = vec![0.0; w * h];
+        for y in 0..ph {
+            for x in 0..pw {
+                let i = y * pw + x;
+                let d = prev.depth.data[i] as f64;
+                if prev.sources[i] == 0 || !(d.is_finite() && d > 0.0) {
+                    continue;
+                }
+                let ndc = pixel_ndc(x, y, pw, ph, &self.conv);
+                let p = mat4::transform_point(&inv_proj, [ndc[0], ndc[1], 0.5]);
+                let view = [p[0] / -p[2] * d, p[1] / -p[2] * d, -d];
+                let world = mat4::transform_point(&inv_view, view);
+                let clip = mat4::transform(&vp, [world[0], world[1], world[2], 1.0]);
+                if clip[3].partial_cmp(&0.0) != Some(std::cmp::Ordering::Greater) {
+                    continue;
+                }
+                let wx = (clip[0] / clip[3] * 0.5 + 0.5) * w as f64;
+                let wy = (clip[1] / clip[3] * 0.5 + 0.5) * h as f64;
+                if !(wx >= 0.0 && wx < w as f64 && wy >= 0.0 && wy < h as f64) {
+                    continue;
+                }
+                let (tx, ty_mem) = (wx as usize, wy as usize);
+                let ty = if self.conv.row_order == RowOrder::BottomUp {
+                    h - 1 - ty_mem
+                } else {
+                    ty_mem
+                };
+                let o = ty * w + tx;
+                let dist = -mat4::transform_point(&mid.view, world)[2];
+                if z[o] == 0.0 || dist < z[o] {
+                    z[o] = dist;
+                    color[o] = [0, 1, 2].map(|c| prev.color.data[i * 3 + c] as f64);
+                }
+            }
+        }
+        Ok((color, z))
+    }
+}
