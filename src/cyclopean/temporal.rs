@@ -77,15 +77,14 @@ impl TemporalAccumulator {
                 let cz = current.depth.data[i] as f64;
                 if current.sources[i] != 0 && cz > 0.0 {
                     if (hz - cz).abs() <= self.depth_tolerance * cz {
-                        for c in 0..3 {
-                            let v = self.alpha * current.color.data[i * 3 + c] as f64
-                                + (1.0 - self.alpha) * hist_color[i][c];
+                        for (c, h) in hist_color[i].iter().enumerate() {
+                            let v = self.alpha * current.color.data[i * 3 + c] as f64 + (1.0 - self.alpha) * h;
                             out.color.data[i * 3 + c] = v.round().clamp(0.0, 255.0) as u8;
                         }
                     }
                 } else {
-                    for c in 0..3 {
-                        out.color.data[i * 3 + c] = hist_color[i][c].round().clamp(0.0, 255.0) as u8;
+                    for (c, h) in hist_color[i].iter().enumerate() {
+                        out.color.data[i * 3 + c] = h.round().clamp(0.0, 255.0) as u8;
                     }
                     out.depth.data[i] = hz as f32;
                     out.sources[i] = FROM_HISTORY;

@@ -64,29 +64,6 @@ impl GlCamera {
     }
 }
 
-#[cfg(test)]
-mod tests {
-    use super::*;
-    use crate::camera::{gl_projection, Pose};
-
-    #[test]
-    fn projection_centre_of_a_posed_pinhole_is_its_position() {
-        let cam = crate::scene::demo_camera(64, 48);
-        let pose = Pose::yawed(0.4, [0.3, -0.2, 1.5]);
-        let planes = DepthPlanes {
-            near: 0.1,
-            far: f64::INFINITY,
-        };
-        for conv in Conventions::all() {
-            let vp = mat4::mul(&gl_projection(&cam, &planes, &conv), &pose.gl_view());
-            let c = projection_centre(&vp).unwrap();
-            for k in 0..3 {
-                assert!((c[k] - pose.position[k]).abs() < 1e-12, "{conv:?} {c:?}");
-            }
-        }
-    }
-}
-
 /// f64 twin of the shader: same rays, same rounding of colour to 8 bits.
 pub fn trace_gl_reference(scene: &Scene, cam: &GlCamera) -> Result<SceneImage> {
     let (vp, inv_vp, eye) = cam.matrices()?;
@@ -252,5 +229,28 @@ impl SceneRenderer {
             },
             timing,
         ))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::camera::{gl_projection, Pose};
+
+    #[test]
+    fn projection_centre_of_a_posed_pinhole_is_its_position() {
+        let cam = crate::scene::demo_camera(64, 48);
+        let pose = Pose::yawed(0.4, [0.3, -0.2, 1.5]);
+        let planes = DepthPlanes {
+            near: 0.1,
+            far: f64::INFINITY,
+        };
+        for conv in Conventions::all() {
+            let vp = mat4::mul(&gl_projection(&cam, &planes, &conv), &pose.gl_view());
+            let c = projection_centre(&vp).unwrap();
+            for k in 0..3 {
+                assert!((c[k] - pose.position[k]).abs() < 1e-12, "{conv:?} {c:?}");
+            }
+        }
     }
 }
