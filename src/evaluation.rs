@@ -309,8 +309,72 @@ pub fn cyclopean_real_rows(gpu: &Gpu, data_dir: &Path, repeats: usize) -> Result
     Ok((rows, notes))
 }
 
+/// Cyclopean methods on a user case: a folder laid out like `viewsynth scene` writes it:
+/// `cameras.json`, `{left,right}_rgb.png`, `{left,right}_device_depth.exr` (or `_view_z.exr` when
+/// the camera file says `view-z`) and the reference middle view `middle_rgb.png`.
+pub fn cyclopean_case_rows(gpu: &Gpu, dir: &Path, repeats: usize) -> Result<Vec<ReportRow>> {
+    use crate::cyclopean::camera_file::CameraFile;
+    use crate::cyclopean::EyeInput;
+    let cams = CameraFile::load(&dir.join("cameras.json"))?;
+    let (mid, fixation) = cams.middle_and_fixation()?;
+    let suffix = match cams.depth_kind {
+        DepthKind::Device => "device_depth",
+        DepthKind::ViewZ => "view_z",
+    };
+    let eye = |name: &str, cam: &crate::cyclopean::camera_file::EyeCameras| -> Result<EyeInput> {
+        Ok(EyeInput {
+            color: io::load_rgb(&dir.join(format!("{name}_rgb.png")))?,
+            depth: io::load_depth(&dir.join(format!("{name}_{suffix}.exr")), &DepthDecode::default())?,
+            view: cam.view,
+            proj: cam.proj,
+        })
+    };
+    let frame = StereoFrame {
+        left: eye("left", &cams.left)?,
+        right: eye("right", &cams.right)?,
+        depth_kind: cams.depth_kind,
+        conv: cams.conventions,
+    };
+    let reference = io::load_rgb(&dir.join("middle_rgb.png"))?;
+    if (reference.width, reference.height) != (mid.width, mid.height) {
+        return Err(crate::Error::SizeMismatch {
+            message: format!(
+                "middle_rgb.png is {}x{}, the middle camera {}x{}",
+                reference.width, reference.height, mid.width, mid.height
+            ),
+        });
+    }
+    let mut runs = Vec::new();
+    for (name, params) in cyclopean_methods(fixation) {
+        runs.push((name, render_cyclopean(gpu, &frame, &mid, params, repeats)?));
+    }
+    let mut fw = ForwardWarp::new(gpu, &frame, &BreakRule::default())?;
+    runs.push((FORWARD_NAME, timed(repeats, || fw.render(&mid))?));
+    let scene = format!("case {}", dir.display());
+    let mut rows = Vec::new();
+    for (name, (out, t)) in runs {
+        let mask: Vec<bool> = out.sources.iter().map(|s| *s != 0).collect();
+        let mut row = ReportRow::new("cyclopean", scene.clone(), name, "vs middle_rgb.png", t.wall_ms);
+        row.gpu_ms = t.gpu_ms;
+        score(&out.color, None, &mask, &reference, None, &mut row);
+        rows.push(row);
+    }
+    Ok(rows)
+}
+
 /// Run everything and write report.{md,csv,svg} into `out_dir`.
 pub fn run_report(gpu: &Gpu, out_dir: &Path, data_dir: Option<&Path>, repeats: usize) -> Result<Vec<PathBuf>> {
+    run_report_with_cases(gpu, out_dir, data_dir, &[], repeats)
+}
+
+/// [`run_report`] plus user cases (see [`cyclopean_case_rows`]).
+pub fn run_report_with_cases(
+    gpu: &Gpu,
+    out_dir: &Path,
+    data_dir: Option<&Path>,
+    cases: &[PathBuf],
+    repeats: usize,
+) -> Result<Vec<PathBuf>> {
     std::fs::create_dir_all(out_dir).map_err(|e| crate::Error::io(out_dir, e))?;
     let mut rows = refocus_rows(gpu, repeats)?;
     rows.extend(cyclopean_scene_rows(gpu, repeats)?);
@@ -320,10 +384,16 @@ pub fn run_report(gpu: &Gpu, out_dir: &Path, data_dir: Option<&Path>, repeats: u
         "cyclopean seed = seed 000 as written (one step from the fixation depth); refine k = k steps, projection check, edge-aware colour; forward warp = each eye's depth mesh rendered into the middle camera, nearest surface wins. Fixation at 3 m (scene) / 1.5 m (Middlebury).".to_string(),
         "Wall time: median after a warm-up, glFinish included; GPU time only where timer queries are meaningful (not llvmpipe).".to_string(),
     ];
+    let (stitch, stitch_notes) = crate::stitch::stitch_rows(gpu, repeats)?;
+    rows.extend(stitch);
+    notes.extend(stitch_notes);
     if let Some(dir) = data_dir {
         let (real, real_notes) = cyclopean_real_rows(gpu, dir, repeats)?;
         rows.extend(real);
         notes.extend(real_notes);
+    }
+    for case in cases {
+        rows.extend(cyclopean_case_rows(gpu, case, repeats)?);
     }
     let report = Report {
         title: "viewsynth: error against run time".into(),

@@ -22,5 +22,6 @@ pub mod refocus;
 pub mod report;
 pub mod scene;
 pub mod ssim;
+pub mod stitch;
 
 pub use error::{Error, Result};

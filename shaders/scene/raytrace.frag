@@ -15,6 +15,14 @@ uniform mat4 u_view_proj;
 uniform mat4 u_view;
 uniform vec3 u_eye;
 uniform vec2 u_size;
+// Omni-directional stereo equirect camera instead of the GL camera (rows top-down, longitude 0
+// = +z, +90 deg = +x, row 0 = up = -y): each pixel's ray starts on the circle of radius
+// u_ods_radius (signed: -left, +right) tangent to its direction, faded to 0 towards the poles
+// from latitude u_ods_fade_start (same rule as src/stitch OdsRig).
+uniform int u_ods;
+uniform vec3 u_ods_centre;
+uniform float u_ods_radius;
+uniform float u_ods_fade_start;
 
 layout(location = 0) out vec4 o_color;
 layout(location = 1) out float o_view_z;
@@ -97,13 +105,25 @@ vec3 pattern_color(int pattern, vec3 p) {
 }
 
 void main() {
-    vec2 ndc = gl_FragCoord.xy / u_size * 2.0 - 1.0;
-    vec4 q = u_inv_view_proj * vec4(ndc, RAY_NDC_Z, 1.0);
-    vec3 dir = q.xyz / q.w - u_eye;
+    vec3 eye = u_eye;
+    vec3 dir;
+    if (u_ods == 1) {
+        const float PI = 3.14159265358979;
+        float lon = 2.0 * PI * gl_FragCoord.x / u_size.x - PI;
+        float lat = 0.5 * PI - PI * gl_FragCoord.y / u_size.y;
+        float x = clamp((abs(lat) - u_ods_fade_start) / (0.5 * PI - u_ods_fade_start), 0.0, 1.0);
+        float r = u_ods_radius * (1.0 - x * x * (3.0 - 2.0 * x));
+        eye = u_ods_centre + r * vec3(cos(lon), 0.0, -sin(lon));
+        dir = vec3(cos(lat) * sin(lon), -sin(lat), cos(lat) * cos(lon));
+    } else {
+        vec2 ndc = gl_FragCoord.xy / u_size * 2.0 - 1.0;
+        vec4 q = u_inv_view_proj * vec4(ndc, RAY_NDC_Z, 1.0);
+        dir = q.xyz / q.w - eye;
+    }
     float best = NONE;
     int hit = -1;
     for (int i = 0; i < u_count; ++i) {
-        float t = intersect(i, u_eye, dir);
+        float t = intersect(i, eye, dir);
         if (t < best) {
             best = t;
             hit = i;
@@ -118,8 +138,13 @@ void main() {
 #endif
         return;
     }
-    vec3 p = u_eye + dir * best;
+    vec3 p = eye + dir * best;
     o_color = vec4(clamp(floor(pattern_color(u_kind[hit].y, p) + 0.5), 0.0, 255.0) / 255.0, 1.0);
+    if (u_ods == 1) {
+        o_view_z = best;  // distance along the unit ray
+        o_device = 0.0;
+        return;
+    }
     o_view_z = -(u_view * vec4(p, 1.0)).z;
     vec4 clip = u_view_proj * vec4(p, 1.0);
     float ndc_z = clip.z / clip.w;

@@ -78,6 +78,11 @@ enum Command {
         /// Folder with middlebury2003_cones/ and middlebury2003_teddy/ (skipped when absent).
         #[arg(long)]
         data_dir: Option<PathBuf>,
+        /// A user cyclopean case with a reference middle view, laid out as `viewsynth scene`
+        /// writes it (cameras.json, {left,right}_rgb.png, *_device_depth.exr, middle_rgb.png).
+        /// Repeatable.
+        #[arg(long = "case")]
+        cases: Vec<PathBuf>,
         /// Timed repetitions per row (the median is reported).
         #[arg(long, default_value_t = 3)]
         repeats: usize,
@@ -279,9 +284,10 @@ fn main() {
         Command::Report {
             out_dir,
             data_dir,
+            cases,
             repeats,
             gpu,
-        } => report(&out_dir, data_dir.as_deref(), repeats, &gpu),
+        } => report(&out_dir, data_dir.as_deref(), &cases, repeats, &gpu),
     };
     if let Err(e) = result {
         eprintln!("error: {e:#}");
@@ -430,14 +436,14 @@ fn demo(out_dir: &Path, gpu: &GpuArgs) -> Result<()> {
     Ok(())
 }
 
-fn report(out_dir: &Path, data_dir: Option<&Path>, repeats: usize, gpu: &GpuArgs) -> Result<()> {
+fn report(out_dir: &Path, data_dir: Option<&Path>, cases: &[PathBuf], repeats: usize, gpu: &GpuArgs) -> Result<()> {
     if let Some(d) = data_dir {
         if !d.is_dir() {
             bail!("--data-dir {}: not a directory", d.display());
         }
     }
     let gpu = gpu.open()?;
-    let files = viewsynth::evaluation::run_report(&gpu, out_dir, data_dir, repeats)?;
+    let files = viewsynth::evaluation::run_report_with_cases(&gpu, out_dir, data_dir, cases, repeats)?;
     if let Some(md) = files.iter().find(|p| p.extension().is_some_and(|e| e == "md")) {
         println!("{}", std::fs::read_to_string(md)?);
     }
@@ -635,5 +641,6 @@ fn bench(sizes: &[String], repeats: usize, gpu: &GpuArgs) -> Result<()> {
         "{}",
         viewsynth::bench::cyclopean_bench(&gpu, 1280, 720, repeats.max(1))?
     );
+    println!("{}", viewsynth::stitch::stitch_bench(&gpu)?);
     Ok(())
 }

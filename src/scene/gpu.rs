@@ -98,6 +98,17 @@ pub fn trace_gl_reference(scene: &Scene, cam: &GlCamera) -> Result<SceneImage> {
     })
 }
 
+enum Camera<'a> {
+    Gl(&'a GlCamera),
+    Ods {
+        centre: [f64; 3],
+        radius: f64,
+        fade_start: f64,
+        width: u32,
+        height: u32,
+    },
+}
+
 /// A scene uploaded as uniforms, ready to render any GL camera.
 pub struct SceneRenderer {
     gpu: Gpu,
@@ -134,6 +145,68 @@ impl SceneRenderer {
     }
 
     pub fn render(&mut self, cam: &GlCamera) -> Result<(SceneImage, Timing)> {
+        self.render_with(Camera::Gl(cam))
+    }
+
+    /// An omni-directional stereo equirectangular view (rows top-down): colour and distance
+    /// along each pixel's ray (`view_z`), `device_depth` all 0. `radius` is the signed eye offset
+    /// (-ipd/2 left, +ipd/2 right), faded to 0 from latitude `fade_start` (radians) to the poles.
+    pub fn render_ods(
+        &mut self,
+        centre: [f64; 3],
+        radius: f64,
+        fade_start: f64,
+        width: u32,
+        height: u32,
+    ) -> Result<(SceneImage, Timing)> {
+        if !(centre.iter().all(|c| c.is_finite())
+            && radius.is_finite()
+            && (0.0..std::f64::consts::FRAC_PI_2).contains(&fade_start))
+        {
+            return Err(Error::param(
+                "ods camera",
+                format!("centre {centre:?}, radius {radius}, fade start {fade_start}"),
+            ));
+        }
+        self.render_with(Camera::Ods {
+            centre,
+            radius,
+            fade_start,
+            width,
+            height,
+        })
+    }
+
+    fn render_with(&mut self, camera: Camera) -> Result<(SceneImage, Timing)> {
+        let gl_default;
+        let (cam, ods) = match camera {
+            Camera::Gl(c) => (c, None),
+            Camera::Ods {
+                centre,
+                radius,
+                fade_start,
+                width,
+                height,
+            } => {
+                let conv = Conventions {
+                    row_order: RowOrder::TopDown,
+                    ..Conventions::default()
+                };
+                gl_default = GlCamera {
+                    view: mat4::IDENTITY,
+                    proj: [
+                        [1.0, 0.0, 0.0, 0.0],
+                        [0.0, 1.0, 0.0, 0.0],
+                        [0.0, 0.0, -1.0, -0.1],
+                        [0.0, 0.0, -1.0, 0.0],
+                    ],
+                    width,
+                    height,
+                    conv,
+                };
+                (&gl_default, Some((centre, radius, fade_start)))
+            }
+        };
         let (vp, inv_vp, eye) = cam.matrices()?;
         let (w, h) = (cam.width, cam.height);
         let max = self.gpu.max_image_side();
@@ -193,6 +266,12 @@ impl SceneRenderer {
         p.set_mat4_rows("u_view", &cam.view);
         p.set_vec3("u_eye", [eye[0] as f32, eye[1] as f32, eye[2] as f32]);
         p.set_vec2("u_size", [w as f32, h as f32]);
+        p.set_i32("u_ods", ods.is_some() as i32);
+        if let Some((centre, radius, fade)) = ods {
+            p.set_vec3("u_ods_centre", centre.map(|v| v as f32));
+            p.set_f32("u_ods_radius", radius as f32);
+            p.set_f32("u_ods_fade_start", fade as f32);
+        }
         self.vao.bind();
         // SAFETY: one full-screen triangle into an FBO without depth buffer.
         unsafe {

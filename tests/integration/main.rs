@@ -8,4 +8,5 @@ mod gpu_context;
 mod refocus_accuracy;
 mod refocus_conventions;
 mod refocus_edge_cases;
+mod stitch;
 mod scene;

@@ -124,3 +124,34 @@ fn gpu_projection_through_stereo_matrices_matches_f64() {
         }
     }
 }
+
+#[test]
+fn gpu_ods_equirect_matches_the_f64_ods_truth() {
+    // Same tolerance argument as above (f32 rays: silhouettes and pattern borders may flip).
+    use viewsynth::stitch::truth::ods_truth;
+    use viewsynth::stitch::{OdsRig, Side};
+    let g = gpu();
+    let rig = OdsRig::demo();
+    let mut r = SceneRenderer::new(&g, &builtin("demo").unwrap()).unwrap();
+    for (side, sign) in [(Side::Left, -1.0), (Side::Right, 1.0)] {
+        let truth = ods_truth(&rig, side, 256, 128).unwrap();
+        let (img, _) = r
+            .render_ods(
+                rig.centre,
+                sign * 0.5 * rig.ipd,
+                rig.pole_fade_start_deg.to_radians(),
+                256,
+                128,
+            )
+            .unwrap();
+        let n = truth.distance.len();
+        let mut odd = 0;
+        for i in 0..n {
+            let (zg, zr) = (img.view_z.data[i] as f64, truth.distance[i]);
+            let colour_ok = (0..3).all(|c| (img.color.data[i * 3 + c] as f64 - truth.color[i][c].round()).abs() <= 1.0);
+            let z_ok = (zg > 0.0) == (zr > 0.0) && (zr == 0.0 || ((zg - zr) / zr).abs() <= 2e-5);
+            odd += (!(colour_ok && z_ok)) as usize;
+        }
+        assert!(odd * 200 <= n, "{side:?}: {odd} of {n} pixels disagree");
+    }
+}

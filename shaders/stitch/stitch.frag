@@ -1,0 +1,234 @@
+// ODS equirect stitch of six over-wide cube faces, one eye per draw (seed 001 and the two
+// alternatives in src/stitch/mod.rs). The f64 twin is src/stitch/reference.rs: keep in step.
+// Defines: METHOD (0 blend, 1 border weight, 2 reproject), REPROJECT_STEPS.
+
+uniform sampler2D u_color;  // RGBA8 atlas: face k at columns [k n, (k + 1) n), rows top-down
+uniform sampler2D u_depth;  // R32F atlas, view Z, <= 0 / NaN / Inf = background
+uniform mat4 u_rot[6];      // world from face rotation (upper 3x3)
+uniform vec4 u_eye[6];      // face eyes (xyz)
+uniform float u_f;
+uniform float u_c;
+uniform int u_n;
+uniform vec4 u_centre;      // ODS circle centre (xyz)
+uniform float u_half_ipd;
+uniform float u_fade_start; // radians
+uniform float u_side;       // -1 left, +1 right
+uniform float u_overlap;    // radians
+uniform ivec2 u_size;       // equirect size per eye
+uniform int u_row0;         // first framebuffer row of this eye
+
+layout(location = 0) out vec4 o_color;
+
+const float FAR_DISTANCE = 500.0;
+const float PI = 3.14159265358979;
+const float TOLERANCE_PX = 1.5;
+const float AGREE_REL = 0.03;
+
+vec3 face_axis(int k) {
+    return vec3(u_rot[k][2][0], u_rot[k][2][1], u_rot[k][2][2]);
+}
+
+// Face pixel of a world direction; false unless in front of the face.
+bool project_dir(int k, vec3 v, out vec2 uv) {
+    vec3 q = v * mat3(u_rot[k]);  // R^T v
+    if (!(q.z > 1e-2 * length(q))) {
+        uv = vec2(0.0);
+        return false;
+    }
+    uv = u_f * q.xy / q.z + u_c;
+    return true;
+}
+
+bool project_point(int k, vec3 x, out vec2 uv) {
+    return project_dir(k, x - u_eye[k].xyz, uv);
+}
+
+bool inside(vec2 uv) {
+    float hi = float(u_n) - 0.5;
+    return all(greaterThanEqual(uv, vec2(-0.5))) && all(lessThanEqual(uv, vec2(hi)));
+}
+
+vec3 texel(int k, ivec2 t) {
+    t = clamp(t, ivec2(0), ivec2(u_n - 1));
+    return texelFetch(u_color, ivec2(t.x + k * u_n, t.y), 0).rgb * 255.0;
+}
+
+vec3 face_color(int k, vec2 uv) {
+    uv = clamp(uv, vec2(0.0), vec2(float(u_n - 1)));
+    vec2 i0 = floor(uv);
+    vec2 fr = uv - i0;
+    ivec2 t = ivec2(i0);
+    vec3 top = mix(texel(k, t), texel(k, t + ivec2(1, 0)), fr.x);
+    vec3 bottom = mix(texel(k, t + ivec2(0, 1)), texel(k, t + ivec2(1, 1)), fr.x);
+    return mix(top, bottom, fr.y);
+}
+
+// View Z at the nearest texel, or -1 for background.
+float face_depth(int k, vec2 uv) {
+    ivec2 t = clamp(ivec2(floor(uv + 0.5)), ivec2(0), ivec2(u_n - 1));
+    float z = texelFetch(u_depth, ivec2(t.x + k * u_n, t.y), 0).r;
+    return (!isnan(z) && !isinf(z) && z > 0.0) ? z : -1.0;
+}
+
+vec3 face_ray(int k, vec2 uv) {
+    return mat3(u_rot[k]) * vec3((uv - u_c) / u_f, 1.0);
+}
+
+vec3 unproject(int k, vec2 uv, float z) {
+    vec3 ray = face_ray(k, uv);
+    return z > 0.0 ? u_eye[k].xyz + ray * z : u_eye[k].xyz + normalize(ray) * FAR_DISTANCE;
+}
+
+vec3 plain(int k, vec3 d) {
+    vec2 uv;
+    return project_dir(k, d, uv) ? face_color(k, uv) : vec3(0.0);
+}
+
+struct Pair {
+    int primary, a, b;
+    float w;
+    bool in_band;
+};
+
+Pair pair_weight(vec3 d) {
+    float comp[6];
+    for (int k = 0; k < 6; ++k) {
+        comp[k] = dot(d, face_axis(k));
+    }
+    int p = 0;
+    for (int k = 1; k < 6; ++k) {
+        if (comp[k] > comp[p]) p = k;
+    }
+    int s = -1;
+    for (int k = 0; k < 6; ++k) {
+        if (k != p && k != (p ^ 1) && (s < 0 || comp[k] > comp[s])) s = k;
+    }
+    Pair r;
+    r.primary = p;
+    r.a = min(p, s);
+    r.b = max(p, s);
+    float gamma = atan(comp[r.b], comp[r.a]) - 0.25 * PI;
+    r.in_band = abs(gamma) < u_overlap;
+    r.w = r.in_band ? clamp(0.5 + gamma / (2.0 * u_overlap), 0.0, 1.0) : (p == r.b ? 1.0 : 0.0);
+    return r;
+}
+
+vec3 blend(Pair pw, vec3 d) {
+    return mix(plain(pw.a, d), plain(pw.b, d), pw.w);
+}
+
+// Seed 001 "stitch with border weight"; a = the seed's +Z face (cPos), b = its -X face (cPosMX).
+vec3 border_weight(int a, int b, float w, vec3 d) {
+    vec3 cpos = u_eye[a].xyz;
+    vec3 cposmx = u_eye[b].xyz;
+    vec3 wpos = cpos + d * FAR_DISTANCE;
+    vec2 pwz, pwx;
+    if (!project_point(a, wpos, pwz) || !project_point(b, wpos, pwx)) {
+        return mix(plain(a, d), plain(b, d), w);
+    }
+    float za = face_depth(a, pwz);
+    float zb = face_depth(b, pwx);
+    vec3 base_col = face_color(a, pwz);
+    vec3 col2_plain = face_color(b, pwx);
+    if (za < 0.0 && zb < 0.0) {
+        return (base_col + col2_plain) * 0.5;
+    }
+    vec3 dd = cpos - cposmx;
+    vec3 iwpos = unproject(b, pwx, zb);
+    vec3 iwpos2 = normalize((iwpos - cposmx) + dd) * FAR_DISTANCE + cpos;
+    vec3 wpos2 = iwpos * w + iwpos2 * (1.0 - w);
+    vec2 uv;
+    vec3 col2 = project_point(b, wpos2, uv) ? face_color(b, uv) : col2_plain;
+    vec3 iwzpos = unproject(a, pwz, za);
+    vec3 iwzpos2 = normalize((iwzpos - cpos) - dd) * FAR_DISTANCE + cposmx;
+    vec3 wzpos2 = iwzpos * (1.0 - w) + iwzpos2 * w;
+    vec3 col1 = project_point(a, wzpos2, uv) ? face_color(a, uv) : base_col;
+    vec3 col = col2 * w + col1 * (1.0 - w);
+    if (w < 0.5) {
+        float w2 = w / 0.5;
+        col = base_col * (1.0 - w2) + col * w2;
+    }
+    return col;
+}
+
+// kind: 0 invalid, 1 background, 2 surface.
+struct Candidate {
+    int kind;
+    float t;
+    vec3 color;
+};
+
+Candidate walk(int k, vec3 o, vec3 d) {
+    Candidate invalid = Candidate(0, 0.0, vec3(0.0));
+    vec2 uv;
+    if (!project_dir(k, d, uv)) {
+        return invalid;
+    }
+    float z0 = face_depth(k, uv);
+    float t = z0 > 0.0 ? dot(unproject(k, uv, z0) - o, d) : FAR_DISTANCE;
+    for (int step = 0; step <= REPROJECT_STEPS; ++step) {
+        if (!(t > 1e-6)) {
+            return invalid;
+        }
+        if (!project_point(k, o + d * t, uv) || !inside(uv)) {
+            return invalid;
+        }
+        float z = face_depth(k, uv);
+        if (z < 0.0) {
+            return Candidate(1, 0.0, face_color(k, uv));
+        }
+        vec3 y = unproject(k, uv, z);
+        vec3 yo = y - o;
+        float t_new = dot(yo, d);
+        if (step == REPROJECT_STEPS) {
+            vec3 perp = yo - d * t_new;
+            if (length(perp) > TOLERANCE_PX * length(y - u_eye[k].xyz) / u_f) {
+                return invalid;
+            }
+            return Candidate(2, t_new, face_color(k, uv));
+        }
+        t = t_new;
+    }
+    return invalid;
+}
+
+vec3 reproject(Pair pw, vec3 o, vec3 d) {
+    Candidate ca = walk(pw.a, o, d);
+    Candidate cb = walk(pw.b, o, d);
+    float wa = 1.0 - pw.w;
+    float wb = pw.w;
+    if (ca.kind == 2 && cb.kind == 2) {
+        if (abs(ca.t - cb.t) <= AGREE_REL * min(ca.t, cb.t)) {
+            return ca.color * wa + cb.color * wb;
+        }
+        return ca.t <= cb.t ? ca.color : cb.color;
+    }
+    if (ca.kind == 2) return ca.color;
+    if (cb.kind == 2) return cb.color;
+    float total = (ca.kind == 1 ? wa : 0.0) + (cb.kind == 1 ? wb : 0.0);
+    vec3 sum = (ca.kind == 1 ? ca.color * wa : vec3(0.0)) + (cb.kind == 1 ? cb.color * wb : vec3(0.0));
+    if (total > 0.0) return sum / total;
+    if (ca.kind == 1 && cb.kind == 1) return 0.5 * (ca.color + cb.color);
+    if (ca.kind == 1) return ca.color;
+    if (cb.kind == 1) return cb.color;
+    return blend(pw, d);
+}
+
+void main() {
+    vec2 px = vec2(floor(gl_FragCoord.x), floor(gl_FragCoord.y) - float(u_row0));
+    float lon = 2.0 * PI * (px.x + 0.5) / float(u_size.x) - PI;
+    float lat = 0.5 * PI - PI * (px.y + 0.5) / float(u_size.y);
+    float fx = clamp((abs(lat) - u_fade_start) / (0.5 * PI - u_fade_start), 0.0, 1.0);
+    float r = u_side * u_half_ipd * (1.0 - fx * fx * (3.0 - 2.0 * fx));
+    vec3 o = u_centre.xyz + r * vec3(cos(lon), 0.0, -sin(lon));
+    vec3 d = vec3(cos(lat) * sin(lon), -sin(lat), cos(lat) * cos(lon));
+    Pair pw = pair_weight(d);
+#if METHOD == 0
+    vec3 c = blend(pw, d);
+#elif METHOD == 1
+    vec3 c = pw.in_band ? border_weight(pw.a, pw.b, pw.w, d) : plain(pw.primary, d);
+#else
+    vec3 c = reproject(pw, o, d);
+#endif
+    o_color = vec4(clamp(c, 0.0, 255.0) / 255.0, 1.0);
+}

@@ -1,0 +1,197 @@
+//! GPU stitch: both eyes' faces uploaded once as atlases (face k at columns [k n, (k + 1) n):
+//! GLSL cannot index a sampler array per pixel), one full-screen draw per eye into a
+//! W x 2H top-bottom target (left eye in rows 0..H, read back top-down as stored).
+
+use super::{face_camera, CubeFace, FaceSet, Method, Side, StitchParams, REPROJECT_STEPS};
+use crate::error::{Error, Result};
+use crate::gpu::{Attachment, Framebuffer, Gpu, GpuTimer, Program, Texture, TextureFormat, Timing, VertexArray};
+use crate::io::RgbImage;
+
+const FULLSCREEN_VERT: &str = include_str!("../../shaders/common/fullscreen.vert");
+const STITCH_FRAG: &str = include_str!("../../shaders/stitch/stitch.frag");
+
+struct EyeAtlas {
+    color: Texture,
+    depth: Texture,
+    set_meta: (Side, [[f64; 3]; 6]),
+}
+
+fn upload(gpu: &Gpu, set: &FaceSet) -> Result<EyeAtlas> {
+    let n = set.size() as usize;
+    let (mut rgba, mut depth) = (vec![0u8; 6 * n * n * 4], vec![0u8; 6 * n * n * 4]);
+    for (k, face) in set.faces.iter().enumerate() {
+        for y in 0..n {
+            for x in 0..n {
+                let (s, d) = (y * n + x, y * 6 * n + k * n + x);
+                rgba[d * 4..d * 4 + 3].copy_from_slice(&face.color.data[s * 3..s * 3 + 3]);
+                rgba[d * 4 + 3] = 255;
+                depth[d * 4..d * 4 + 4].copy_from_slice(&face.depth.data[s].to_ne_bytes());
+            }
+        }
+    }
+    let (w, h) = (6 * n as u32, n as u32);
+    Ok(EyeAtlas {
+        color: Texture::new(gpu, w, h, TextureFormat::Rgba8, Some(&rgba))?,
+        depth: Texture::new(gpu, w, h, TextureFormat::R32F, Some(&depth))?,
+        set_meta: (set.side, CubeFace::ALL.map(|f| f.pose(&set.rig, set.side).position)),
+    })
+}
+
+/// A stereo face capture on the GPU, ready to stitch with any method.
+pub struct StitchRenderer {
+    gpu: Gpu,
+    programs: Vec<Program>,
+    vao: VertexArray,
+    left: EyeAtlas,
+    right: EyeAtlas,
+    template: FaceSet,
+    framebuffer: Option<Framebuffer>,
+}
+
+impl StitchRenderer {
+    /// `left` and `right` must share rig, FOV and face size.
+    pub fn new(gpu: &Gpu, left: &FaceSet, right: &FaceSet) -> Result<Self> {
+        left.validate()?;
+        right.validate()?;
+        if left.side != Side::Left || right.side != Side::Right {
+            return Err(Error::param(
+                "face sets",
+                "expected the left eye's then the right eye's",
+            ));
+        }
+        if left.rig != right.rig || left.fov_deg != right.fov_deg || left.size() != right.size() {
+            return Err(Error::param("face sets", "left and right differ in rig, FOV or size"));
+        }
+        if 6 * left.size() > gpu.max_image_side() {
+            return Err(Error::param(
+                "face size",
+                format!(
+                    "6 x {} exceeds the GPU's {} texture side",
+                    left.size(),
+                    gpu.max_image_side()
+                ),
+            ));
+        }
+        let mut programs = Vec::new();
+        for m in Method::ALL {
+            let defines = format!(
+                "#define METHOD {}\n#define REPROJECT_STEPS {}\n",
+                m.index(),
+                REPROJECT_STEPS
+            );
+            programs.push(Program::new(
+                gpu,
+                &defines,
+                &[
+                    (glow::VERTEX_SHADER, "fullscreen.vert", FULLSCREEN_VERT),
+                    (glow::FRAGMENT_SHADER, "stitch/stitch.frag", STITCH_FRAG),
+                ],
+            )?);
+        }
+        Ok(StitchRenderer {
+            gpu: gpu.clone(),
+            programs,
+            vao: VertexArray::new(gpu)?,
+            left: upload(gpu, left)?,
+            right: upload(gpu, right)?,
+            template: left.clone_meta(),
+            framebuffer: None,
+        })
+    }
+
+    /// Top-bottom stereo equirect (left eye on top), `params.width` x `2 params.height`.
+    pub fn render(&mut self, params: &StitchParams) -> Result<(RgbImage, Timing)> {
+        params.validate(&self.template)?;
+        let (w, h) = (params.width, params.height);
+        if w > self.gpu.max_image_side() || 2 * h > self.gpu.max_image_side() {
+            return Err(Error::param(
+                "equirect size",
+                format!("{w}x{} too large for this GPU", 2 * h),
+            ));
+        }
+        if !matches!(&self.framebuffer, Some(f) if f.width == w && f.height == 2 * h) {
+            self.framebuffer = None;
+            self.framebuffer = Some(Framebuffer::new(
+                &self.gpu,
+                w,
+                2 * h,
+                &[Some(Attachment {
+                    format: TextureFormat::Rgba8,
+                    clear: [0.0; 4],
+                })],
+                false,
+            )?);
+        }
+        let fb = self.framebuffer.as_ref().expect("allocated above");
+        let p = &self.programs[params.method.index() as usize];
+        let set = &self.template;
+        let n = self.left.color.height;
+        let cam = face_camera(n, set.fov_deg);
+        let timer = GpuTimer::start(&self.gpu);
+        fb.bind_and_clear(1.0);
+        p.bind();
+        self.vao.bind();
+        p.set_i32("u_color", 0);
+        p.set_i32("u_depth", 1);
+        for (k, f) in CubeFace::ALL.iter().enumerate() {
+            let r = f.rotation();
+            let rows = [
+                [r[0][0], r[0][1], r[0][2], 0.0],
+                [r[1][0], r[1][1], r[1][2], 0.0],
+                [r[2][0], r[2][1], r[2][2], 0.0],
+                [0.0, 0.0, 0.0, 1.0],
+            ];
+            p.set_mat4_rows(&format!("u_rot[{k}]"), &rows);
+        }
+        p.set_f32("u_f", cam.k.fx as f32);
+        p.set_f32("u_c", cam.k.cx as f32);
+        p.set_i32("u_n", n as i32);
+        let c = set.rig.centre;
+        p.set_vec4("u_centre", [c[0] as f32, c[1] as f32, c[2] as f32, 1.0]);
+        p.set_f32("u_half_ipd", (0.5 * set.rig.ipd) as f32);
+        p.set_f32("u_fade_start", set.rig.pole_fade_start_deg.to_radians() as f32);
+        p.set_f32("u_overlap", params.overlap_deg.to_radians() as f32);
+        p.set_ivec2("u_size", [w as i32, h as i32]);
+        // SAFETY: fixed-function state this pass depends on; no depth buffer, no blending.
+        unsafe {
+            use glow::HasContext;
+            let gl = self.gpu.gl();
+            gl.disable(glow::DEPTH_TEST);
+            gl.disable(glow::BLEND);
+            gl.disable(glow::CULL_FACE);
+        }
+        for (row0, eye) in [(0, &self.left), (h, &self.right)] {
+            eye.color.bind(0);
+            eye.depth.bind(1);
+            p.set_f32("u_side", eye.set_meta.0.sign() as f32);
+            for (k, e) in eye.set_meta.1.iter().enumerate() {
+                p.set_vec4(&format!("u_eye[{k}]"), [e[0] as f32, e[1] as f32, e[2] as f32, 1.0]);
+            }
+            p.set_i32("u_row0", row0 as i32);
+            // SAFETY: one full-screen triangle into this eye's half of the FBO.
+            unsafe {
+                use glow::HasContext;
+                let gl = self.gpu.gl();
+                gl.viewport(0, row0 as i32, w as i32, h as i32);
+                gl.draw_arrays(glow::TRIANGLES, 0, 3);
+            }
+        }
+        self.gpu.check("stitch draw")?;
+        let rgba = fb.read_color(0)?.expect("colour attachment");
+        fb.unbind();
+        let timing = timer.stop();
+        let rgb = rgba.chunks_exact(4).flat_map(|p| [p[0], p[1], p[2]]).collect();
+        Ok((RgbImage::new(w, 2 * h, rgb)?, timing))
+    }
+}
+
+impl FaceSet {
+    fn clone_meta(&self) -> FaceSet {
+        FaceSet {
+            rig: self.rig,
+            side: self.side,
+            fov_deg: self.fov_deg,
+            faces: Vec::new(),
+        }
+    }
+}
