@@ -106,6 +106,21 @@ impl Conventions {
     }
 }
 
+impl RowOrder {
+    /// Convert between top-down image rows and this order's memory rows (the same operation
+    /// both ways: a row flip for bottom-up, nothing for top-down). `row_bytes` is one row.
+    pub fn convert_rows(self, mut data: Vec<u8>, row_bytes: usize) -> Vec<u8> {
+        if self == RowOrder::BottomUp && row_bytes > 0 {
+            let h = data.len() / row_bytes;
+            for y in 0..h / 2 {
+                let (a, b) = data.split_at_mut((h - 1 - y) * row_bytes);
+                a[y * row_bytes..(y + 1) * row_bytes].swap_with_slice(&mut b[..row_bytes]);
+            }
+        }
+        data
+    }
+}
+
 fn ndc_to_window_depth(range: NdcDepthRange, z_ndc: f64) -> f64 {
     match range {
         NdcDepthRange::MinusOneToOne => 0.5 * (z_ndc + 1.0),
@@ -208,6 +223,15 @@ mod tests {
         let rev_b = planes.ndc_z_of_view_z_f32(&vk(true), 10_010.0);
         assert_eq!(std_a, std_b, "standard Z is expected to collapse here");
         assert!(rev_a > rev_b, "reversed Z must order them: {rev_a} vs {rev_b}");
+    }
+
+    #[test]
+    fn row_conversion_flips_bottom_up_only_and_is_its_own_inverse() {
+        let img: Vec<u8> = (0..12).collect(); // 3 rows of 4 bytes
+        assert_eq!(RowOrder::TopDown.convert_rows(img.clone(), 4), img);
+        let flipped = RowOrder::BottomUp.convert_rows(img.clone(), 4);
+        assert_eq!(flipped, vec![8, 9, 10, 11, 4, 5, 6, 7, 0, 1, 2, 3]);
+        assert_eq!(RowOrder::BottomUp.convert_rows(flipped, 4), img);
     }
 
     #[test]

@@ -9,7 +9,6 @@ use crate::camera::mat4::{self, Mat4};
 use crate::convention::{NdcDepthRange, RowOrder};
 use crate::error::{Error, Result};
 use crate::gpu::{Attachment, Framebuffer, Gpu, GpuTimer, Program, Texture, TextureFormat, Timing, VertexArray};
-use crate::io::{DepthMap, RgbImage};
 use crate::refocus::{code_texture, TRI_TEX_WIDTH};
 use crate::refocus::{BreakRule, Grid};
 
@@ -34,38 +33,15 @@ pub fn eye_distances(eye: &EyeInput, kind: DepthKind, conv: &crate::convention::
             y
         };
         for x in 0..w {
+            let ndc = [
+                (x as f64 + 0.5) / w as f64 * 2.0 - 1.0,
+                (y_mem as f64 + 0.5) / h as f64 * 2.0 - 1.0,
+            ];
             let d = eye.depth.data[y * w + x] as f64;
-            out[y * w + x] = match kind {
-                DepthKind::ViewZ => {
-                    if d.is_finite() && d > 0.0 {
-                        d as f32
-                    } else {
-                        0.0
-                    }
-                }
-                DepthKind::Device => {
-                    let eps = super::reference::FAR_EPS;
-                    let ok = d.is_finite() && if conv.reversed_z { d > eps } else { d < 1.0 - eps };
-                    if !ok {
-                        0.0
-                    } else {
-                        let ndc = [
-                            (x as f64 + 0.5) / w as f64 * 2.0 - 1.0,
-                            (y_mem as f64 + 0.5) / h as f64 * 2.0 - 1.0,
-                        ];
-                        let z = match conv.ndc_depth {
-                            NdcDepthRange::MinusOneToOne => d * 2.0 - 1.0,
-                            NdcDepthRange::ZeroToOne => d,
-                        };
-                        let v = -mat4::transform_point(&inv_proj, [ndc[0], ndc[1], z])[2];
-                        if v.is_finite() && v > 0.0 {
-                            v as f32
-                        } else {
-                            0.0
-                        }
-                    }
-                }
-            };
+            out[y * w + x] = super::reference::stored_view_point(d, ndc, kind, conv, &inv_proj)
+                .map(|p| -p[2])
+                .filter(|v| v.is_finite() && *v > 0.0)
+                .unwrap_or(0.0) as f32;
         }
     }
     Ok(out)
@@ -89,20 +65,11 @@ pub struct ForwardWarp {
     vao: VertexArray,
 }
 
-fn memory_rows(data: &[u8], row_bytes: usize, flip: bool) -> Vec<u8> {
-    if flip {
-        data.chunks_exact(row_bytes).rev().flatten().copied().collect()
-    } else {
-        data.to_vec()
-    }
-}
-
 impl ForwardWarp {
     /// `rule` breaks the mesh at eye-depth discontinuities (the refocus rule on view distance).
     pub fn new(gpu: &Gpu, frame: &StereoFrame, rule: &BreakRule) -> Result<Self> {
         frame.validate()?;
         rule.validate()?;
-        let flip = frame.conv.row_order == RowOrder::BottomUp;
         let mesh = |eye: &EyeInput| -> Result<EyeMesh> {
             let (w, h) = (eye.color.width, eye.color.height);
             let dist = eye_distances(eye, frame.depth_kind, &frame.conv)?;
@@ -122,14 +89,14 @@ impl ForwardWarp {
                     w,
                     h,
                     TextureFormat::Rgba8,
-                    Some(&memory_rows(&rgba, w as usize * 4, flip)),
+                    Some(&frame.conv.row_order.convert_rows(rgba, w as usize * 4)),
                 )?,
                 distance: Texture::new(
                     gpu,
                     w,
                     h,
                     TextureFormat::R32F,
-                    Some(&memory_rows(&dbytes, w as usize * 4, flip)),
+                    Some(&frame.conv.row_order.convert_rows(dbytes, w as usize * 4)),
                 )?,
                 tris: code_texture(gpu, &codes)?,
                 count: codes.len(),
@@ -247,25 +214,8 @@ impl ForwardWarp {
         gpu.clip_control(glow::LOWER_LEFT, glow::NEGATIVE_ONE_TO_ONE);
         gpu.check("forward warp")?;
         let timing = timer.stop();
-        let rows = |data: Vec<u8>, bpp: usize| memory_rows(&data, w as usize * bpp, flip);
-        let rgba = rows(fb.read_color(0)?.expect("colour"), 4);
-        let depth = rows(fb.read_color(1)?.expect("depth"), 4);
-        let sources = rows(fb.read_color(2)?.expect("sources"), 1);
+        let out = super::render::read_output(&fb, self.conv.row_order)?;
         fb.unbind();
-        Ok((
-            CyclopeanOutput {
-                color: RgbImage::new(w, h, rgba.chunks_exact(4).flat_map(|p| [p[0], p[1], p[2]]).collect())?,
-                depth: DepthMap::new(
-                    w,
-                    h,
-                    depth
-                        .chunks_exact(4)
-                        .map(|b| f32::from_ne_bytes([b[0], b[1], b[2], b[3]]))
-                        .collect(),
-                )?,
-                sources,
-            },
-            timing,
-        ))
+        Ok((out, timing))
     }
 }

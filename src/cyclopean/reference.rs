@@ -85,30 +85,50 @@ impl Eye64<'_> {
 
     /// View-space distance stored at texel (x, y) (memory order), None for background.
     fn view_distance(&self, x: i64, y: i64, kind: DepthKind, conv: &Conventions) -> Option<f64> {
-        let d = self.depth_at(x, y);
-        match kind {
-            DepthKind::ViewZ => (d.is_finite() && d > 0.0).then_some(d),
-            DepthKind::Device => {
-                let ok = d.is_finite()
-                    && if conv.reversed_z {
-                        d > FAR_EPS
-                    } else {
-                        d < 1.0 - FAR_EPS
-                    };
-                if !ok {
-                    return None;
-                }
-                let (w, h) = self.size();
-                let ndc = [
-                    (x as f64 + 0.5) / w as f64 * 2.0 - 1.0,
-                    (y as f64 + 0.5) / h as f64 * 2.0 - 1.0,
-                ];
-                let ndc_z = match conv.ndc_depth {
-                    NdcDepthRange::MinusOneToOne => d * 2.0 - 1.0,
-                    NdcDepthRange::ZeroToOne => d,
-                };
-                Some(-mat4::transform_point(&self.inv_proj, [ndc[0], ndc[1], ndc_z])[2])
+        let (w, h) = self.size();
+        let ndc = [
+            (x as f64 + 0.5) / w as f64 * 2.0 - 1.0,
+            (y as f64 + 0.5) / h as f64 * 2.0 - 1.0,
+        ];
+        stored_view_point(self.depth_at(x, y), ndc, kind, conv, &self.inv_proj).map(|p| -p[2])
+    }
+}
+
+/// The eye view-space point a stored depth `d` describes at NDC (x, y): device depth unprojected
+/// through the eye's inverse projection, or a view distance along the pixel's ray. None for
+/// background (device depth within FAR_EPS of the far value, distance <= 0) and non-finite values.
+pub(crate) fn stored_view_point(
+    d: f64,
+    ndc: [f64; 2],
+    kind: DepthKind,
+    conv: &Conventions,
+    inv_proj: &Mat4,
+) -> Option<[f64; 3]> {
+    if !d.is_finite() {
+        return None;
+    }
+    match kind {
+        DepthKind::Device => {
+            let background = if conv.reversed_z {
+                d <= FAR_EPS
+            } else {
+                d >= 1.0 - FAR_EPS
+            };
+            if background {
+                return None;
             }
+            let ndc_z = match conv.ndc_depth {
+                NdcDepthRange::MinusOneToOne => d * 2.0 - 1.0,
+                NdcDepthRange::ZeroToOne => d,
+            };
+            Some(mat4::transform_point(inv_proj, [ndc[0], ndc[1], ndc_z]))
+        }
+        DepthKind::ViewZ => {
+            if d <= 0.0 {
+                return None;
+            }
+            let r = view_ray(inv_proj, ndc);
+            Some([r[0] * d, r[1] * d, r[2] * d])
         }
     }
 }
@@ -170,31 +190,8 @@ impl Ctx<'_> {
             let ty = ((uv[1] * h as f64).floor() as i64).clamp(0, h - 1);
             let d = eye.depth_at(tx, ty);
             texel = (tx, ty);
-            let view = match self.frame.depth_kind {
-                DepthKind::Device => {
-                    let conv = &self.frame.conv;
-                    let ok = d.is_finite()
-                        && if conv.reversed_z {
-                            d > FAR_EPS
-                        } else {
-                            d < 1.0 - FAR_EPS
-                        };
-                    if !ok {
-                        return invalid;
-                    }
-                    let ndc_z = match conv.ndc_depth {
-                        NdcDepthRange::MinusOneToOne => d * 2.0 - 1.0,
-                        NdcDepthRange::ZeroToOne => d,
-                    };
-                    mat4::transform_point(&eye.inv_proj, [ndc[0], ndc[1], ndc_z])
-                }
-                DepthKind::ViewZ => {
-                    if !(d.is_finite() && d > 0.0) {
-                        return invalid;
-                    }
-                    let r = view_ray(&eye.inv_proj, ndc);
-                    [r[0] * d, r[1] * d, r[2] * d]
-                }
+            let Some(view) = stored_view_point(d, ndc, self.frame.depth_kind, &self.frame.conv, &eye.inv_proj) else {
+                return invalid;
             };
             world = mat4::transform_point(&eye.inv_view, view);
             z = -mat4::transform_point(&self.mid.view, world)[2];

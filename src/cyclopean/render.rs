@@ -18,15 +18,7 @@ struct EyeGpu {
     proj: Mat4,
 }
 
-/// Rows top-down -> memory order under the row-order convention.
-fn memory_rows(data: &[u8], row_bytes: usize, flip: bool) -> Vec<u8> {
-    if !flip {
-        return data.to_vec();
-    }
-    data.chunks_exact(row_bytes).rev().flatten().copied().collect()
-}
-
-fn upload_eye(gpu: &Gpu, eye: &EyeInput, flip: bool) -> Result<EyeGpu> {
+fn upload_eye(gpu: &Gpu, eye: &EyeInput, rows: RowOrder) -> Result<EyeGpu> {
     let (w, h) = (eye.color.width, eye.color.height);
     let rgba: Vec<u8> = eye
         .color
@@ -41,14 +33,14 @@ fn upload_eye(gpu: &Gpu, eye: &EyeInput, flip: bool) -> Result<EyeGpu> {
             w,
             h,
             TextureFormat::Rgba8,
-            Some(&memory_rows(&rgba, w as usize * 4, flip)),
+            Some(&rows.convert_rows(rgba, w as usize * 4)),
         )?,
         depth: Texture::new(
             gpu,
             w,
             h,
             TextureFormat::R32F,
-            Some(&memory_rows(&depth, w as usize * 4, flip)),
+            Some(&rows.convert_rows(depth, w as usize * 4)),
         )?,
         view: eye.view,
         proj: eye.proj,
@@ -60,7 +52,7 @@ pub struct CyclopeanRenderer {
     gpu: Gpu,
     program: Program,
     params: CyclopeanParams,
-    flip: bool,
+    rows: RowOrder,
     left: EyeGpu,
     right: EyeGpu,
     vao: VertexArray,
@@ -86,14 +78,13 @@ impl CyclopeanRenderer {
                 (glow::FRAGMENT_SHADER, "cyclopean/gather.frag", GATHER_FRAG),
             ],
         )?;
-        let flip = frame.conv.row_order == RowOrder::BottomUp;
         Ok(CyclopeanRenderer {
             gpu: gpu.clone(),
             program,
             params,
-            flip,
-            left: upload_eye(gpu, &frame.left, flip)?,
-            right: upload_eye(gpu, &frame.right, flip)?,
+            rows: frame.conv.row_order,
+            left: upload_eye(gpu, &frame.left, frame.conv.row_order)?,
+            right: upload_eye(gpu, &frame.right, frame.conv.row_order)?,
             vao: VertexArray::new(gpu)?,
             framebuffer: None,
         })
@@ -174,25 +165,32 @@ impl CyclopeanRenderer {
         }
         self.gpu.check("cyclopean draw")?;
         let timing = timer.stop();
-        let top_down = |data: Vec<u8>, bpp: usize| memory_rows(&data, w as usize * bpp, self.flip);
-        let rgba = top_down(fb.read_color(0)?.expect("colour attachment"), 4);
-        let depth = top_down(fb.read_color(1)?.expect("depth attachment"), 4);
-        let sources = top_down(fb.read_color(2)?.expect("sources attachment"), 1);
+        let out = read_output(fb, self.rows)?;
         fb.unbind();
-        Ok((
-            CyclopeanOutput {
-                color: RgbImage::new(w, h, rgba.chunks_exact(4).flat_map(|p| [p[0], p[1], p[2]]).collect())?,
-                depth: DepthMap::new(
-                    w,
-                    h,
-                    depth
-                        .chunks_exact(4)
-                        .map(|b| f32::from_ne_bytes([b[0], b[1], b[2], b[3]]))
-                        .collect(),
-                )?,
-                sources,
-            },
-            timing,
-        ))
+        Ok((out, timing))
     }
+}
+
+/// Read a middle-view framebuffer (RGBA8 colour, R32F depth, R8 source bits) back top-down.
+pub(crate) fn read_output(fb: &Framebuffer, rows: RowOrder) -> Result<CyclopeanOutput> {
+    let (w, h) = (fb.width, fb.height);
+    let read = |i: usize, bpp: usize| -> Result<Vec<u8>> {
+        let data = fb
+            .read_color(i)?
+            .ok_or_else(|| Error::Gl(format!("middle framebuffer lacks attachment {i}")))?;
+        Ok(rows.convert_rows(data, w as usize * bpp))
+    };
+    let (rgba, depth, sources) = (read(0, 4)?, read(1, 4)?, read(2, 1)?);
+    Ok(CyclopeanOutput {
+        color: RgbImage::new(w, h, rgba.chunks_exact(4).flat_map(|p| [p[0], p[1], p[2]]).collect())?,
+        depth: DepthMap::new(
+            w,
+            h,
+            depth
+                .chunks_exact(4)
+                .map(|b| f32::from_ne_bytes([b[0], b[1], b[2], b[3]]))
+                .collect(),
+        )?,
+        sources,
+    })
 }

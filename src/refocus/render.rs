@@ -5,7 +5,7 @@ use super::grid::{axis_lookup, Grid};
 use super::mesh::{MeshPass, TRI_TEX_WIDTH};
 use super::{Method, OutputSet, RefocusSource};
 use crate::camera::PinholeCamera;
-use crate::convention::{Conventions, DepthPlanes, RowOrder};
+use crate::convention::{Conventions, DepthPlanes};
 use crate::error::{Error, Result};
 use crate::gpu::{Attachment, Framebuffer, Gpu, GpuTimer, Program, Texture, TextureFormat, Timing, VertexArray};
 use crate::io::{DepthMap, Mask, RgbImage};
@@ -230,15 +230,14 @@ impl Refocuser {
 
         let t0 = Instant::now();
         let (w, h) = (target.width, target.height);
-        let flip = conv.row_order == RowOrder::BottomUp;
         let mut outputs = (None, None, None);
         if let Some(data) = fb.read_color(0)? {
-            let rgba = top_down(data, w, h, 4, flip);
+            let rgba = conv.row_order.convert_rows(data, w as usize * 4);
             let rgb = rgba.chunks_exact(4).flat_map(|p| [p[0], p[1], p[2]]).collect();
             outputs.0 = Some(RgbImage::new(w, h, rgb)?);
         }
         if let Some(data) = fb.read_color(1)? {
-            let bytes = top_down(data, w, h, 4, flip);
+            let bytes = conv.row_order.convert_rows(data, w as usize * 4);
             let z = bytes
                 .chunks_exact(4)
                 .map(|b| f32::from_ne_bytes([b[0], b[1], b[2], b[3]]))
@@ -246,7 +245,9 @@ impl Refocuser {
             outputs.1 = Some(DepthMap::new(w, h, z)?);
         }
         if let Some(data) = fb.read_color(2)? {
-            let m = top_down(data, w, h, 1, flip)
+            let m = conv
+                .row_order
+                .convert_rows(data, w as usize)
                 .into_iter()
                 .map(|v| (v >= 128) as u8)
                 .collect();
@@ -262,17 +263,4 @@ impl Refocuser {
             readback_ms: t0.elapsed().as_secs_f64() * 1e3,
         })
     }
-}
-
-/// Rows in memory order -> top-down image rows.
-fn top_down(mut data: Vec<u8>, w: u32, h: u32, bytes_per_pixel: usize, flip: bool) -> Vec<u8> {
-    if flip {
-        let row = w as usize * bytes_per_pixel;
-        let h = h as usize;
-        for y in 0..h / 2 {
-            let (a, b) = data.split_at_mut((h - 1 - y) * row);
-            a[y * row..(y + 1) * row].swap_with_slice(&mut b[..row]);
-        }
-    }
-    data
 }

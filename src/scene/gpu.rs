@@ -283,14 +283,7 @@ impl SceneRenderer {
         }
         gpu.check("scene ray trace")?;
         let timing = timer.stop();
-        let flip = cam.conv.row_order == RowOrder::BottomUp;
-        let rows = |data: Vec<u8>, bpp: usize| -> Vec<u8> {
-            if flip {
-                data.chunks_exact(w as usize * bpp).rev().flatten().copied().collect()
-            } else {
-                data
-            }
-        };
+        let rows = |data: Vec<u8>, bpp: usize| cam.conv.row_order.convert_rows(data, w as usize * bpp);
         let floats = |b: Vec<u8>| {
             b.chunks_exact(4)
                 .map(|c| f32::from_ne_bytes([c[0], c[1], c[2], c[3]]))
