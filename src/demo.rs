@@ -102,6 +102,8 @@ pub fn run(gpu: &Gpu, out_dir: &Path) -> Result<PathBuf> {
         w.write_all(report.as_bytes()).map_err(|e| Error::io(&path, e))
     })?;
     cyclopean_outputs(gpu, &out_dir.join("cyclopean"))?;
+    reproject_outputs(gpu, &out_dir.join("reproject"))?;
+    stitch_outputs(gpu, &out_dir.join("stitch"))?;
     let files = crate::evaluation::run_report(gpu, out_dir, None, 3)?;
     Ok(files
         .into_iter()
@@ -143,6 +145,73 @@ fn cyclopean_outputs(gpu: &Gpu, dir: &Path) -> Result<()> {
             out.sources.iter().map(|s| (*s != 0) as u8).collect(),
         )?;
         io::save_mask_png(&dir.join(format!("middle_{stem}_mask.png")), &mask)?;
+    }
+    Ok(())
+}
+
+/// Left eye -> right eye of the built-in stereo pair with each reprojection method, beside the
+/// ray-traced right eye.
+fn reproject_outputs(gpu: &Gpu, dir: &Path) -> Result<()> {
+    use crate::reproject::render::Reprojector;
+    use crate::reproject::rows::scene_cases;
+    use crate::reproject::{Method, ReprojectParams};
+    std::fs::create_dir_all(dir).map_err(|e| Error::io(dir, e))?;
+    let case = scene_cases(
+        640,
+        480,
+        0.064,
+        Conventions::default(),
+        crate::cyclopean::DepthKind::Device,
+    )?
+    .into_iter()
+    .next()
+    .ok_or_else(|| Error::param("reproject demo", "no scene case"))?;
+    io::save_rgb(&dir.join("right_truth_rgb.png"), &case.truth)?;
+    for (name, method) in [
+        ("shift_walk", Method::Shift { steps: 3 }),
+        ("shift_scan", Method::ShiftScan),
+        ("gather3d", Method::Gather3d { steps: 3 }),
+    ] {
+        let (out, _) = Reprojector::new(gpu, &case.source, &case.geometry, ReprojectParams::new(method))?.render()?;
+        io::save_rgb(&dir.join(format!("right_{name}_rgb.png")), &out.color)?;
+        io::save_depth_exr(&dir.join(format!("right_{name}_depth.exr")), &out.depth)?;
+        let mask = io::Mask::new(
+            out.color.width,
+            out.color.height,
+            out.mask.iter().map(|m| (*m != 0) as u8).collect(),
+        )?;
+        io::save_mask_png(&dir.join(format!("right_{name}_mask.png")), &mask)?;
+    }
+    Ok(())
+}
+
+/// Top-bottom stereo equirect (left eye on top) of the built-in scene from 6 over-wide faces
+/// per eye, with each stitching method.
+fn stitch_outputs(gpu: &Gpu, dir: &Path) -> Result<()> {
+    use crate::stitch::faces::scene_faces;
+    use crate::stitch::render::StitchRenderer;
+    use crate::stitch::{Method, OdsRig, Side, StitchParams};
+    std::fs::create_dir_all(dir).map_err(|e| Error::io(dir, e))?;
+    let rig = OdsRig::demo();
+    let overlap = 10.0;
+    let (left, right) = (
+        scene_faces(&rig, Side::Left, 256, 90.0 + 2.0 * overlap)?,
+        scene_faces(&rig, Side::Right, 256, 90.0 + 2.0 * overlap)?,
+    );
+    let mut r = StitchRenderer::new(gpu, &left, &right)?;
+    for method in Method::ALL {
+        let (img, _) = r.render(&StitchParams {
+            method,
+            overlap_deg: overlap,
+            width: 1024,
+            height: 512,
+        })?;
+        let stem: String = method
+            .label()
+            .chars()
+            .map(|c| if c.is_ascii_alphanumeric() { c } else { '_' })
+            .collect();
+        io::save_rgb(&dir.join(format!("ods_{stem}_top_bottom.png")), &img)?;
     }
     Ok(())
 }

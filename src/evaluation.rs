@@ -384,6 +384,9 @@ pub fn run_report_with_cases(
         "cyclopean seed = seed 000 as written (one step from the fixation depth); refine k = k steps, projection check, edge-aware colour; forward warp = each eye's depth mesh rendered into the middle camera, nearest surface wins. Fixation at 3 m (scene) / 1.5 m (Middlebury).".to_string(),
         "Wall time: median after a warm-up, glFinish included; GPU time only where timer queries are meaningful (not llvmpipe).".to_string(),
     ];
+    let (reproject, reproject_notes) = crate::reproject::reproject_rows(gpu, data_dir, repeats)?;
+    rows.extend(reproject);
+    notes.extend(reproject_notes);
     let (stitch, stitch_notes) = crate::stitch::stitch_rows(gpu, repeats)?;
     rows.extend(stitch);
     notes.extend(stitch_notes);

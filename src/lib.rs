@@ -20,6 +20,7 @@ pub mod io;
 pub mod metrics;
 pub mod refocus;
 pub mod report;
+pub mod reproject;
 pub mod scene;
 pub mod ssim;
 pub mod stitch;

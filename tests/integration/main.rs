@@ -8,5 +8,6 @@ mod gpu_context;
 mod refocus_accuracy;
 mod refocus_conventions;
 mod refocus_edge_cases;
-mod stitch;
+mod reproject;
 mod scene;
+mod stitch;

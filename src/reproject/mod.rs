@@ -1,0 +1,586 @@
+//! reproject: one eye (or the centre view) to another view of a parallel stereo rig, from colour
+//! and depth, with disocclusions left invalid (no hole filling). Issue 4 part 1, seeds 002/004.
+//!
+//! Methods ([`Method`]):
+//! - [`Method::Shift`]: seed 002's texture-space shift as a gather. Source column s lands at
+//!   `f(s) = s + a - b q(s)` in the target (q = 1/Z; [`ShiftModel`] holds a, b in pixels). A
+//!   target pixel u walks the row to a fixed point `s <- u - a + b q(s)` (k steps), once from the
+//!   zero-parallax guess s = u and once from the near bound (largest q in the frame), and
+//!   accepts a walk's end only if a source segment [j, j+1] next to it covers u.
+//! - [`Method::ShiftScan`]: the exact shift gather: every segment of the row whose source
+//!   position can reach u (the frame's q range bounds it) is tested; all of them cover u.
+//! - [`Method::Gather3d`]: the cyclopean 3-D walk (`crate::cyclopean`, unchanged) with the
+//!   target as the "middle camera" and the source as the only eye (the other eye has no valid
+//!   depth), run twice: from the zero-parallax (or mid-range) distance and from the nearest
+//!   depth of the frame; the nearer result that passes cyclopean's 1 px projection check wins.
+//!
+//! Coverage and occlusion rule of the shift methods (a depth-tested 1-D mesh warp, evaluated as
+//! a gather): source texels j and j+1 (same row, both with valid depth) form a segment from
+//! f(j) to f(j+1) that covers target column u when u lies between them. Inverse depth and colour
+//! are interpolated linearly along it (1/Z is affine along a row for a plane). A segment is a
+//! *hole* (an unseen surface) when its depths differ by more than `tau_rel` of the nearer one (a
+//! depth edge) or when it folds over (f(j+1) <= f(j): the target would see it from behind, so
+//! something the source did not see is in front). Where the edge lies between the two samples is
+//! unknown, so a hole also covers the gap (j, j+1) mapped at either end's depth, i.e. one pixel
+//! beyond each end: pixels that might see either side stay invalid. When several segments cover u the one with the
+//! largest interpolated q (the nearest) wins (at equal q a real surface beats a hole); if that is
+//! a hole, u stays invalid (disocclusion), so a farther surface never shows through the gap.
+//! Since s = u - a + b q, the nearest candidate is also the first met from the near side.
+//!
+//! Degenerate inputs: depth NaN, +-inf, <= 0 (view Z), the far value (device depth), or a
+//! disparity that is not finite and > 0 is invalid and never covers. Zero separation gives the
+//! identity map. A point behind the camera cannot be stored (Z > 0 is required). All outputs
+//! are finite: 0 colour and depth where the mask is 0.
+
+pub mod npz;
+pub mod reference;
+pub mod render;
+pub mod rows;
+
+pub use rows::reproject_rows;
+
+use crate::camera::mat4::{self, Mat4};
+use crate::camera::stereo::{Eye, StereoParams};
+use crate::camera::{gl_projection, PinholeCamera, Pose};
+use crate::convention::{Conventions, DepthPlanes, NdcDepthRange};
+use crate::cyclopean::{DepthKind, EyeInput, MiddleCamera, StereoFrame};
+use crate::error::{Error, Result};
+use crate::io::{DepthMap, RgbImage};
+
+/// What the source depth map holds.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum DepthInput {
+    /// View-space Z (distance along the optical axis), metres.
+    ViewZ,
+    /// Window depth in [0, 1] from a depth buffer under the source's conventions, written with
+    /// these planes; the far value (1, or 0 with reversed-Z) is background.
+    Device { planes: DepthPlanes },
+    /// Disparity in pixels of a rectified pair: Z = baseline * focal / (d + doffs) (Middlebury
+    /// 2014). Valid iff finite and d > 0 (Middlebury 2003 stores 0 for unknown).
+    Disparity { focal_px: f64, baseline: f64, doffs: f64 },
+}
+
+/// Device depth within this of the far value is background (same rule as cyclopean).
+pub const FAR_EPS: f64 = crate::cyclopean::reference::FAR_EPS;
+
+impl DepthInput {
+    pub fn validate(&self) -> Result<()> {
+        match *self {
+            DepthInput::ViewZ => Ok(()),
+            DepthInput::Device { planes } => {
+                if !(planes.near.is_finite() && planes.near > 0.0 && planes.far > planes.near) {
+                    return Err(Error::param(
+                        "depth planes",
+                        format!("near {} / far {}: need 0 < near < far", planes.near, planes.far),
+                    ));
+                }
+                Ok(())
+            }
+            DepthInput::Disparity {
+                focal_px,
+                baseline,
+                doffs,
+            } => {
+                if !(focal_px.is_finite() && focal_px > 0.0 && baseline.is_finite() && baseline > 0.0) {
+                    return Err(Error::param(
+                        "disparity focal/baseline",
+                        format!("{focal_px} px, {baseline}: both must be finite and > 0"),
+                    ));
+                }
+                if !doffs.is_finite() {
+                    return Err(Error::param("doffs", format!("{doffs} is not finite")));
+                }
+                Ok(())
+            }
+        }
+    }
+
+    /// (alpha, beta) with q = 1/Z = alpha * stored + beta for the affine kinds (device depth:
+    /// 1/Z is affine in NDC z; disparity: (d + doffs) / (f B)); None for view Z (q = 1/stored).
+    pub fn affine_inverse_depth(&self, conv: &Conventions) -> Option<(f64, f64)> {
+        match *self {
+            DepthInput::ViewZ => None,
+            DepthInput::Device { planes } => {
+                // z_ndc = A + B / Z  =>  q = (z_ndc - A) / B, z_ndc = 2 d - 1 or d.
+                let (a, b) = planes.clip_z_coefficients(conv);
+                Some(match conv.ndc_depth {
+                    NdcDepthRange::MinusOneToOne => (2.0 / b, (-1.0 - a) / b),
+                    NdcDepthRange::ZeroToOne => (1.0 / b, -a / b),
+                })
+            }
+            DepthInput::Disparity {
+                focal_px,
+                baseline,
+                doffs,
+            } => {
+                let fb = focal_px * baseline;
+                Some((1.0 / fb, doffs / fb))
+            }
+        }
+    }
+
+    /// Inverse depth of a stored value in f64, None where invalid (the shared validity rule).
+    pub fn inverse_depth(&self, conv: &Conventions, stored: f64) -> Option<f64> {
+        if !stored.is_finite() {
+            return None;
+        }
+        let q = match self {
+            DepthInput::ViewZ => 1.0 / stored,
+            DepthInput::Device { .. } => {
+                let background = if conv.reversed_z {
+                    stored <= FAR_EPS
+                } else {
+                    stored >= 1.0 - FAR_EPS
+                };
+                if background {
+                    return None;
+                }
+                let (al, be) = self.affine_inverse_depth(conv)?;
+                al * stored + be
+            }
+            DepthInput::Disparity { .. } => {
+                if stored <= 0.0 {
+                    return None;
+                }
+                let (al, be) = self.affine_inverse_depth(conv)?;
+                al * stored + be
+            }
+        };
+        (q.is_finite() && q > 0.0).then_some(q)
+    }
+}
+
+/// The source view: colour and depth (rows top-down), what the depth holds, and the
+/// conventions it was produced under (device depth, and the GPU pass's row order).
+#[derive(Debug, Clone)]
+pub struct ReprojectSource {
+    pub color: RgbImage,
+    pub depth: DepthMap,
+    pub depth_kind: DepthInput,
+    pub conv: Conventions,
+}
+
+impl ReprojectSource {
+    pub fn validate(&self) -> Result<()> {
+        if (self.color.width, self.color.height) != (self.depth.width, self.depth.height) {
+            return Err(Error::SizeMismatch {
+                message: format!(
+                    "reproject source: colour {}x{} vs depth {}x{}",
+                    self.color.width, self.color.height, self.depth.width, self.depth.height
+                ),
+            });
+        }
+        if self.color.width < 2 {
+            return Err(Error::param("source width", "at least 2 columns are needed"));
+        }
+        self.depth_kind.validate()
+    }
+
+    /// Per-pixel inverse depth (rows top-down), None where invalid.
+    pub fn inverse_depths(&self) -> Vec<Option<f64>> {
+        self.depth
+            .data
+            .iter()
+            .map(|&d| self.depth_kind.inverse_depth(&self.conv, d as f64))
+            .collect()
+    }
+
+    /// (min, max) inverse depth over valid pixels, None when no pixel is valid.
+    pub fn inverse_depth_range(&self) -> Option<(f64, f64)> {
+        self.inverse_depths()
+            .into_iter()
+            .flatten()
+            .fold(None, |acc, q| match acc {
+                None => Some((q, q)),
+                Some((lo, hi)) => Some((f64::min(lo, q), f64::max(hi, q))),
+            })
+    }
+}
+
+/// The shift between two views of a parallel rig in pixels: source column s at inverse depth q
+/// lands at `s + a - b q` in the target, on the same row.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ShiftModel {
+    pub a_px: f64,
+    pub b_px: f64,
+}
+
+fn side(view: Option<Eye>) -> f64 {
+    view.map_or(0.0, Eye::side)
+}
+
+impl ShiftModel {
+    /// Seed 002 with seed 004's separation S and convergence c on an image `width` pixels wide:
+    /// texture x moves by `(side_to - side_from) / 2 * S (1 - c / Z)`
+    /// ([`crate::camera::stereo::reproject_texture_x`]); times `width` in pixels (a texture-space
+    /// difference; the half-texel centre offset cancels). `None` is the centre view.
+    pub fn seed(params: &StereoParams, width: u32, from: Option<Eye>, to: Option<Eye>) -> Self {
+        let k = 0.5 * (side(to) - side(from)) * width as f64 * params.separation();
+        ShiftModel {
+            a_px: k,
+            b_px: k * params.convergence(),
+        }
+    }
+
+    /// A rectified rig in pixels: eyes `baseline` apart, focal length `focal_px`, and the
+    /// principal points differing by `doffs` (cx_right - cx_left, Middlebury 2014). Left to
+    /// right: x_right = x_left + doffs - f B / Z = x_left - d. The centre view is halfway.
+    pub fn rectified(focal_px: f64, baseline: f64, doffs: f64, from: Option<Eye>, to: Option<Eye>) -> Result<Self> {
+        if !(focal_px.is_finite() && focal_px > 0.0 && baseline.is_finite() && baseline >= 0.0 && doffs.is_finite()) {
+            return Err(Error::param(
+                "rectified rig",
+                format!("focal {focal_px} px, baseline {baseline}, doffs {doffs}: need f > 0, B >= 0, all finite"),
+            ));
+        }
+        let k = 0.5 * (side(to) - side(from));
+        Ok(ShiftModel {
+            a_px: k * doffs,
+            b_px: k * focal_px * baseline,
+        })
+    }
+
+    pub fn validate(&self) -> Result<()> {
+        if !(self.a_px.is_finite() && self.b_px.is_finite()) {
+            return Err(Error::param("shift model", format!("{self:?} is not finite")));
+        }
+        Ok(())
+    }
+
+    /// Target column of source column `s` at inverse depth `q`.
+    pub fn forward(&self, s: f64, q: f64) -> f64 {
+        s + self.a_px - self.b_px * q
+    }
+}
+
+/// Where the target view is.
+// A plain value built once per job: boxing the matrices would only add indirection.
+#[allow(clippy::large_enum_variant)]
+#[derive(Debug, Clone, Copy)]
+pub enum Geometry {
+    /// A parallel rig: the target has the source's intrinsics with cx moved by `a_px`, and sits
+    /// `b_px / fx` along the source camera's x axis (so that u_t = u_s + a - b / Z).
+    Rig { camera: PinholeCamera, shift: ShiftModel },
+    /// Full GL matrices (world -> GL eye, eye -> clip under the source's conventions) of the
+    /// source and the target camera. Only [`Method::Gather3d`] takes them.
+    Matrices {
+        source_view: Mat4,
+        source_proj: Mat4,
+        target: MiddleCamera,
+    },
+}
+
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Method {
+    /// Fixed-point walk along the row, `steps` steps from the zero-parallax guess and from the
+    /// near bound, each end verified by segment coverage; the nearer verified one wins.
+    Shift { steps: u32 },
+    /// Exact: every segment the frame's depth range allows is tested; the nearest cover wins.
+    ShiftScan,
+    /// The cyclopean 3-D walk with one eye (refine with `steps`, projection check), from two
+    /// starts (zero parallax, nearest depth); the nearer verified result wins.
+    Gather3d { steps: u32 },
+}
+
+impl Method {
+    pub fn label(&self) -> String {
+        match self {
+            Method::Shift { steps } => format!("shift walk {steps}"),
+            Method::ShiftScan => "shift scan".to_string(),
+            Method::Gather3d { steps } => format!("3-D gather {steps}"),
+        }
+    }
+}
+
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ReprojectParams {
+    pub method: Method,
+    /// A segment breaks where |Z_j - Z_j+1| > tau_rel * min(Z) (i.e. |q_j - q_j+1| > tau_rel * min(q)).
+    pub tau_rel: f64,
+}
+
+impl ReprojectParams {
+    pub fn new(method: Method) -> Self {
+        ReprojectParams { method, tau_rel: 0.05 }
+    }
+
+    pub fn validate(&self) -> Result<()> {
+        if !(self.tau_rel.is_finite() && self.tau_rel >= 0.0) {
+            return Err(Error::param(
+                "tau_rel",
+                format!("{} must be finite and >= 0", self.tau_rel),
+            ));
+        }
+        match self.method {
+            Method::Shift { steps } | Method::Gather3d { steps } if steps == 0 || steps > 16 => {
+                Err(Error::param("steps", format!("{steps} outside 1..=16")))
+            }
+            _ => Ok(()),
+        }
+    }
+}
+
+/// The target view, rows top-down.
+#[derive(Debug, Clone)]
+pub struct ReprojectOutput {
+    /// 0 where the mask is 0.
+    pub color: RgbImage,
+    /// Target view Z in metres; 0 where the mask is 0.
+    pub depth: DepthMap,
+    /// 255 valid, 0 invalid (disocclusion, outside the source, invalid source depth).
+    pub mask: Vec<u8>,
+}
+
+impl ReprojectOutput {
+    pub fn coverage(&self) -> f64 {
+        self.mask.iter().filter(|m| **m != 0).count() as f64 / self.mask.len().max(1) as f64
+    }
+}
+
+/// Source depth as cyclopean input: device depth stays device depth (same conventions), the
+/// rest becomes view Z (0 = invalid).
+fn cyclopean_depth(src: &ReprojectSource) -> (DepthMap, DepthKind) {
+    match src.depth_kind {
+        DepthInput::Device { .. } => (src.depth.clone(), DepthKind::Device),
+        _ => {
+            let data = src
+                .inverse_depths()
+                .into_iter()
+                .map(|q| q.map_or(0.0, |q| (1.0 / q) as f32))
+                .collect();
+            (
+                DepthMap {
+                    width: src.depth.width,
+                    height: src.depth.height,
+                    data,
+                },
+                DepthKind::ViewZ,
+            )
+        }
+    }
+}
+
+/// Planes for the GL projections of the 3-D path (only device depth depends on them).
+fn planes_of(kind: &DepthInput) -> DepthPlanes {
+    match kind {
+        DepthInput::Device { planes } => *planes,
+        _ => DepthPlanes { near: 0.01, far: 1e4 },
+    }
+}
+
+/// The one-eye stereo frame and target camera of [`Method::Gather3d`]: the source is the left
+/// eye; the right eye is a copy with no valid depth, so the cyclopean walk never takes it.
+pub fn one_eye_frame(src: &ReprojectSource, geometry: &Geometry) -> Result<(StereoFrame, MiddleCamera)> {
+    src.validate()?;
+    let (depth, kind) = cyclopean_depth(src);
+    let (view, proj, target) = match *geometry {
+        Geometry::Rig { camera, shift } => {
+            shift.validate()?;
+            camera.validate("rig camera")?;
+            if (camera.width, camera.height) != (src.color.width, src.color.height) {
+                return Err(Error::SizeMismatch {
+                    message: format!(
+                        "rig camera {}x{} vs source {}x{}",
+                        camera.width, camera.height, src.color.width, src.color.height
+                    ),
+                });
+            }
+            let planes = planes_of(&src.depth_kind);
+            let mut tcam = camera;
+            tcam.k.cx += shift.a_px;
+            // OpenCV x of the target in the source frame: u_t = u_s - fx t / Z + a.
+            let t = shift.b_px / camera.k.fx;
+            let target = MiddleCamera {
+                view: Pose::at([t, 0.0, 0.0]).gl_view(),
+                proj: gl_projection(&tcam, &planes, &src.conv),
+                width: camera.width,
+                height: camera.height,
+            };
+            (
+                Pose::IDENTITY.gl_view(),
+                gl_projection(&camera, &planes, &src.conv),
+                target,
+            )
+        }
+        Geometry::Matrices {
+            source_view,
+            source_proj,
+            target,
+        } => {
+            for (what, m) in [("target view", &target.view), ("target projection", &target.proj)] {
+                if m.iter().flatten().any(|v| !v.is_finite()) || mat4::inverse(m).is_none() {
+                    return Err(Error::param(what, "not finite or not invertible"));
+                }
+            }
+            (source_view, source_proj, target)
+        }
+    };
+    let far = match kind {
+        DepthKind::Device => src.conv.clear_depth() as f32,
+        DepthKind::ViewZ => 0.0,
+    };
+    let eye = EyeInput {
+        color: src.color.clone(),
+        depth,
+        view,
+        proj,
+    };
+    let mut empty = eye.clone();
+    empty.depth.data.iter_mut().for_each(|z| *z = far);
+    let frame = StereoFrame {
+        left: eye,
+        right: empty,
+        depth_kind: kind,
+        conv: src.conv,
+    };
+    frame.validate()?;
+    Ok((frame, target))
+}
+
+/// Initial distance of the 3-D walk: the zero-parallax distance b / a where it lies inside the
+/// frame's depth range, else the harmonic middle of that range.
+pub fn fixation_distance(src: &ReprojectSource, geometry: &Geometry) -> f64 {
+    let (q_lo, q_hi) = src.inverse_depth_range().unwrap_or((1.0, 1.0));
+    if let Geometry::Rig { shift, .. } = geometry {
+        if shift.a_px != 0.0 {
+            let q0 = shift.a_px / shift.b_px;
+            if q0.is_finite() && q0 >= q_lo && q0 <= q_hi {
+                return 1.0 / q0;
+            }
+        }
+    }
+    2.0 / (q_lo + q_hi)
+}
+
+/// Cyclopean parameters of the two walks of [`Method::Gather3d`]: from the fixation distance
+/// above and from the nearest depth of the frame (1 / q_max). The cyclopean walk converges to
+/// one fixed point of its start; starting also from the near side finds a foreground surface
+/// the first walk slides past, and [`merge_nearer`] keeps the nearer verified result.
+pub fn gather3d_params(
+    src: &ReprojectSource,
+    geometry: &Geometry,
+    steps: u32,
+) -> [crate::cyclopean::CyclopeanParams; 2] {
+    let fix = fixation_distance(src, geometry);
+    let near = src.inverse_depth_range().map_or(fix, |(_, q_hi)| 1.0 / q_hi);
+    [fix, near].map(|f| crate::cyclopean::CyclopeanParams {
+        method: crate::cyclopean::Method::Refine { steps },
+        ..crate::cyclopean::CyclopeanParams::seed(f)
+    })
+}
+
+/// Per pixel, whether the second of two results replaces the first: it is valid and the first
+/// is not, or both are and it is strictly nearer (ties keep the first).
+pub fn merge_nearer(first: (bool, f64), second: (bool, f64)) -> bool {
+    second.0 && (!first.0 || second.1 < first.1)
+}
+
+/// Checks shared by both implementations; returns the shift model for the shift methods.
+pub(crate) fn check(
+    src: &ReprojectSource,
+    geometry: &Geometry,
+    params: &ReprojectParams,
+) -> Result<Option<ShiftModel>> {
+    src.validate()?;
+    params.validate()?;
+    match (params.method, geometry) {
+        (Method::Gather3d { .. }, _) => Ok(None),
+        (_, Geometry::Rig { camera, shift }) => {
+            shift.validate()?;
+            if (camera.width, camera.height) != (src.color.width, src.color.height) {
+                return Err(Error::SizeMismatch {
+                    message: format!(
+                        "rig camera {}x{} vs source {}x{}",
+                        camera.width, camera.height, src.color.width, src.color.height
+                    ),
+                });
+            }
+            Ok(Some(*shift))
+        }
+        (_, Geometry::Matrices { .. }) => Err(Error::param(
+            "method",
+            "the shift methods need a parallel rig (Geometry::Rig); use Gather3d with full matrices",
+        )),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::camera::stereo::reproject_texture_x;
+
+    #[test]
+    fn seed_model_matches_reproject_texture_x_in_pixels() {
+        let p = StereoParams::new(0.03, 2.5).unwrap();
+        let w = 640u32;
+        let views = [Some(Eye::Left), None, Some(Eye::Right)];
+        for from in views {
+            for to in views {
+                let m = ShiftModel::seed(&p, w, from, to);
+                for (u, z) in [(10.0, 0.7), (320.0, 2.5), (600.25, 40.0)] {
+                    let tex = (u + 0.5) / w as f64;
+                    let want = reproject_texture_x(tex, from, to, 0.03, 2.5, z).unwrap() * w as f64 - 0.5;
+                    let got = m.forward(u, 1.0 / z);
+                    assert!((got - want).abs() < 1e-9, "{from:?}->{to:?}: {got} vs {want}");
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn rectified_model_is_middlebury_disparity() {
+        let (f, b, doffs) = (994.978, 0.193001, 31.086);
+        let m = ShiftModel::rectified(f, b, doffs, Some(Eye::Left), Some(Eye::Right)).unwrap();
+        let kind = DepthInput::Disparity {
+            focal_px: f,
+            baseline: b,
+            doffs,
+        };
+        let conv = Conventions::default();
+        for d in [7.19, 30.0, 59.91] {
+            let q = kind.inverse_depth(&conv, d).unwrap();
+            assert!((m.forward(400.0, q) - (400.0 - d)).abs() < 1e-9);
+        }
+        for bad in [0.0, -1.0, f64::INFINITY, f64::NAN] {
+            assert!(kind.inverse_depth(&conv, bad).is_none(), "{bad}");
+        }
+        assert!(ShiftModel::rectified(0.0, b, doffs, None, Some(Eye::Right)).is_err());
+    }
+
+    #[test]
+    fn device_depth_inverse_is_exact_under_every_convention() {
+        let planes = DepthPlanes { near: 0.05, far: 100.0 };
+        let kind = DepthInput::Device { planes };
+        for conv in Conventions::all() {
+            for z in [0.06, 1.0, 6.0, 90.0] {
+                let ndc = planes.ndc_z_of_view_z(&conv, z);
+                let d = DepthPlanes::window_depth_of_ndc_z(&conv, ndc);
+                let q = kind.inverse_depth(&conv, d).unwrap();
+                assert!((q * z - 1.0).abs() < 1e-9, "{conv:?} {z}: {}", 1.0 / q);
+            }
+            assert!(kind.inverse_depth(&conv, conv.clear_depth()).is_none());
+        }
+    }
+
+    #[test]
+    fn bad_parameters_are_errors() {
+        assert!(ReprojectParams::new(Method::Shift { steps: 0 }).validate().is_err());
+        assert!(ReprojectParams::new(Method::Gather3d { steps: 17 }).validate().is_err());
+        let p = ReprojectParams {
+            tau_rel: f64::NAN,
+            ..ReprojectParams::new(Method::ShiftScan)
+        };
+        assert!(p.validate().is_err());
+        assert!(DepthInput::Device {
+            planes: DepthPlanes { near: 0.0, far: 1.0 }
+        }
+        .validate()
+        .is_err());
+        assert!(DepthInput::Disparity {
+            focal_px: 1.0,
+            baseline: 1.0,
+            doffs: f64::NAN
+        }
+        .validate()
+        .is_err());
+    }
+}

@@ -1,0 +1,243 @@
+//! GPU reprojection: the shift gathers as one full-screen pass (shaders/reproject/shift.frag),
+//! the 3-D gather through the cyclopean renderer with one eye. Output rows top-down.
+
+use super::merge_nearer;
+use super::reference::SCAN_MARGIN;
+use super::{
+    check, gather3d_params, one_eye_frame, DepthInput, Geometry, Method, ReprojectOutput, ReprojectParams,
+    ReprojectSource, ShiftModel,
+};
+use crate::convention::RowOrder;
+use crate::cyclopean::render::CyclopeanRenderer;
+use crate::cyclopean::MiddleCamera;
+use crate::error::{Error, Result};
+use crate::gpu::{Attachment, Framebuffer, Gpu, GpuTimer, Program, Texture, TextureFormat, Timing, VertexArray};
+use crate::io::{DepthMap, RgbImage};
+
+const FULLSCREEN_VERT: &str = include_str!("../../shaders/common/fullscreen.vert");
+const SHIFT_FRAG: &str = include_str!("../../shaders/reproject/shift.frag");
+
+/// Rows top-down <-> memory order under the row-order convention (an involution).
+fn memory_rows(data: &[u8], row_bytes: usize, flip: bool) -> Vec<u8> {
+    if !flip {
+        return data.to_vec();
+    }
+    data.chunks_exact(row_bytes).rev().flatten().copied().collect()
+}
+
+struct ShiftPass {
+    program: Program,
+    color: Texture,
+    depth: Texture,
+    vao: VertexArray,
+    framebuffer: Framebuffer,
+    model: ShiftModel,
+    alpha_beta: (f64, f64),
+    q_range: Option<(f64, f64)>,
+}
+
+enum Pass {
+    Shift(Box<ShiftPass>),
+    Gather3d(Box<([CyclopeanRenderer; 2], MiddleCamera)>),
+}
+
+/// A source view on the GPU, ready to render its reprojection.
+pub struct Reprojector {
+    gpu: Gpu,
+    params: ReprojectParams,
+    flip: bool,
+    width: u32,
+    height: u32,
+    pass: Pass,
+}
+
+impl Reprojector {
+    pub fn new(gpu: &Gpu, src: &ReprojectSource, geometry: &Geometry, params: ReprojectParams) -> Result<Self> {
+        let model = check(src, geometry, &params)?;
+        let flip = src.conv.row_order == RowOrder::BottomUp;
+        let (w, h) = (src.color.width, src.color.height);
+        let pass = match (model, params.method) {
+            (None, Method::Gather3d { steps }) => {
+                let (frame, target) = one_eye_frame(src, geometry)?;
+                let [p0, p1] = gather3d_params(src, geometry, steps);
+                let r = [
+                    CyclopeanRenderer::new(gpu, &frame, p0)?,
+                    CyclopeanRenderer::new(gpu, &frame, p1)?,
+                ];
+                Pass::Gather3d(Box::new((r, target)))
+            }
+            (Some(model), _) => {
+                let depth_mode = match src.depth_kind {
+                    DepthInput::ViewZ => 0,
+                    DepthInput::Device { .. } => 1,
+                    DepthInput::Disparity { .. } => 2,
+                };
+                let defines = format!(
+                    "{}#define DEPTH_MODE {depth_mode}\n#define SCAN {}\n#define SCAN_MARGIN {SCAN_MARGIN}\n",
+                    src.conv.glsl_defines(),
+                    (params.method == Method::ShiftScan) as u8,
+                );
+                let program = Program::new(
+                    gpu,
+                    &defines,
+                    &[
+                        (glow::VERTEX_SHADER, "fullscreen.vert", FULLSCREEN_VERT),
+                        (glow::FRAGMENT_SHADER, "reproject/shift.frag", SHIFT_FRAG),
+                    ],
+                )?;
+                let rgba: Vec<u8> = src
+                    .color
+                    .data
+                    .chunks_exact(3)
+                    .flat_map(|p| [p[0], p[1], p[2], 255])
+                    .collect();
+                let depth: Vec<u8> = src.depth.data.iter().flat_map(|z| z.to_ne_bytes()).collect();
+                let slot = |format| {
+                    Some(Attachment {
+                        format,
+                        clear: [0.0; 4],
+                    })
+                };
+                Pass::Shift(Box::new(ShiftPass {
+                    program,
+                    color: Texture::new(
+                        gpu,
+                        w,
+                        h,
+                        TextureFormat::Rgba8,
+                        Some(&memory_rows(&rgba, w as usize * 4, flip)),
+                    )?,
+                    depth: Texture::new(
+                        gpu,
+                        w,
+                        h,
+                        TextureFormat::R32F,
+                        Some(&memory_rows(&depth, w as usize * 4, flip)),
+                    )?,
+                    vao: VertexArray::new(gpu)?,
+                    framebuffer: Framebuffer::new(
+                        gpu,
+                        w,
+                        h,
+                        &[
+                            slot(TextureFormat::Rgba8),
+                            slot(TextureFormat::R32F),
+                            slot(TextureFormat::R8),
+                        ],
+                        false,
+                    )?,
+                    model,
+                    alpha_beta: src.depth_kind.affine_inverse_depth(&src.conv).unwrap_or((0.0, 0.0)),
+                    q_range: src.inverse_depth_range(),
+                }))
+            }
+            (None, _) => return Err(Error::param("method", "shift method without a shift model")),
+        };
+        Ok(Reprojector {
+            gpu: gpu.clone(),
+            params,
+            flip,
+            width: w,
+            height: h,
+            pass,
+        })
+    }
+
+    /// Render the target view (colour, target depth, mask) and the pass's timing.
+    pub fn render(&mut self) -> Result<(ReprojectOutput, Timing)> {
+        match &mut self.pass {
+            Pass::Gather3d(g) => {
+                let (r, target) = (&mut g.0, &g.1);
+                let (a, ta) = r[0].render(target)?;
+                let (b, tb) = r[1].render(target)?;
+                let timing = Timing {
+                    gpu_ms: ta.gpu_ms.zip(tb.gpu_ms).map(|(x, y)| x + y),
+                    wall_ms: ta.wall_ms + tb.wall_ms,
+                };
+                let n = a.sources.len();
+                let (mut color, mut depth, mut mask) = (vec![0u8; n * 3], vec![0f32; n], vec![0u8; n]);
+                for i in 0..n {
+                    let first = (a.sources[i] != 0, a.depth.data[i] as f64);
+                    let second = (b.sources[i] != 0, b.depth.data[i] as f64);
+                    let o = if merge_nearer(first, second) { &b } else { &a };
+                    let z = o.depth.data[i];
+                    if o.sources[i] != 0 && z.is_finite() {
+                        color[i * 3..i * 3 + 3].copy_from_slice(&o.color.data[i * 3..i * 3 + 3]);
+                        depth[i] = z;
+                        mask[i] = 255;
+                    }
+                }
+                Ok((
+                    ReprojectOutput {
+                        color: RgbImage::new(target.width, target.height, color)?,
+                        depth: DepthMap::new(target.width, target.height, depth)?,
+                        mask,
+                    },
+                    timing,
+                ))
+            }
+            Pass::Shift(s) => {
+                let (w, h) = (self.width, self.height);
+                let p = &s.program;
+                let fb = &s.framebuffer;
+                let timer = GpuTimer::start(&self.gpu);
+                fb.bind_and_clear(1.0);
+                p.bind();
+                s.vao.bind();
+                s.color.bind(0);
+                s.depth.bind(1);
+                p.set_i32("u_color", 0);
+                p.set_i32("u_depth", 1);
+                p.set_f32("u_a", s.model.a_px as f32);
+                p.set_f32("u_b", s.model.b_px as f32);
+                p.set_f32("u_alpha", s.alpha_beta.0 as f32);
+                p.set_f32("u_beta", s.alpha_beta.1 as f32);
+                // No valid depth: q_max = 0 makes every pixel invalid.
+                let (q_min, q_max) = s.q_range.unwrap_or((0.0, 0.0));
+                p.set_f32("u_q_min", q_min as f32);
+                p.set_f32("u_q_max", q_max as f32);
+                p.set_f32("u_tau_rel", self.params.tau_rel as f32);
+                let steps = match self.params.method {
+                    Method::Shift { steps } => steps,
+                    _ => 0,
+                };
+                p.set_i32("u_steps", steps as i32);
+                // SAFETY: one full-screen triangle into an FBO without depth buffer.
+                unsafe {
+                    use glow::HasContext;
+                    let gl = self.gpu.gl();
+                    gl.disable(glow::DEPTH_TEST);
+                    gl.disable(glow::BLEND);
+                    gl.disable(glow::CULL_FACE);
+                    gl.draw_arrays(glow::TRIANGLES, 0, 3);
+                }
+                self.gpu.check("reproject shift draw")?;
+                let timing = timer.stop();
+                let read = |i: usize, bpp: usize| -> Result<Vec<u8>> {
+                    let data = fb
+                        .read_color(i)?
+                        .ok_or_else(|| Error::Gl(format!("reproject: attachment {i} missing")))?;
+                    Ok(memory_rows(&data, w as usize * bpp, self.flip))
+                };
+                let (rgba, depth, mask) = (read(0, 4)?, read(1, 4)?, read(2, 1)?);
+                fb.unbind();
+                Ok((
+                    ReprojectOutput {
+                        color: RgbImage::new(w, h, rgba.chunks_exact(4).flat_map(|p| [p[0], p[1], p[2]]).collect())?,
+                        depth: DepthMap::new(
+                            w,
+                            h,
+                            depth
+                                .chunks_exact(4)
+                                .map(|b| f32::from_ne_bytes([b[0], b[1], b[2], b[3]]))
+                                .map(|z| if z.is_finite() { z } else { 0.0 })
+                                .collect(),
+                        )?,
+                        mask,
+                    },
+                    timing,
+                ))
+            }
+        }
+    }
+}
