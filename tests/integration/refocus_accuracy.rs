@@ -26,6 +26,7 @@ fn check_source(name: &str, src: &RefocusSource) {
         Some((cam.width + 160, cam.height + 120)),
     ];
     for method in [Method::Fullscreen, Method::Mesh] {
+        let (mut worst_depth, mut worst_psnr, mut worst_iou) = (0f64, f64::INFINITY, 1f64);
         let mut r = Refocuser::new(
             &g,
             src,
@@ -53,6 +54,9 @@ fn check_source(name: &str, src: &RefocusSource) {
                     let dir = dump_on_failure(&tag, &out, &reference);
                     panic!("{tag}: {a:?} (images in {})", dir.display());
                 }
+                worst_depth = worst_depth.max(a.max_abs_depth);
+                worst_psnr = worst_psnr.min(a.psnr_db);
+                worst_iou = worst_iou.min(a.mask_iou);
                 let covered = reference.mask.iter().filter(|m| **m).count();
                 assert!(a.common > 0 || covered == 0, "{tag}: nothing in common");
                 assert!(
@@ -61,6 +65,8 @@ fn check_source(name: &str, src: &RefocusSource) {
                 );
             }
         }
+        // Shown with --nocapture: the worst case over 7 scales x 3 output sizes.
+        eprintln!("{name} {method:?}: max depth error {worst_depth:.2e} m, min PSNR {worst_psnr:.1} dB, min IoU {worst_iou:.6}");
     }
 }
 
