@@ -186,8 +186,13 @@ pub fn cyclopean_scene_rows(gpu: &Gpu, repeats: usize) -> Result<Vec<ReportRow>>
         rig.ipd = ipd;
         for conv in depth_conventions() {
             let (frame, mid, truth) = scene_frame(&rig, conv, DepthKind::Device);
+            let mut runs = Vec::new();
             for (name, params) in cyclopean_methods(3.0) {
-                let (out, t) = render_cyclopean(gpu, &frame, &mid, params, repeats)?;
+                runs.push((name, render_cyclopean(gpu, &frame, &mid, params, repeats)?));
+            }
+            let mut fw = ForwardWarp::new(gpu, &frame, &BreakRule::default())?;
+            runs.push((FORWARD_NAME, timed(repeats, || fw.render(&mid))?));
+            for (name, (out, t)) in runs {
                 let mask: Vec<bool> = out
                     .sources
                     .iter()
