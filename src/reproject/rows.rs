@@ -268,6 +268,46 @@ fn row(case: &Case, scene: &str, params: ReprojectParams, out: &ReprojectOutput,
     (r, s)
 }
 
+/// The general mesh warp of the foundation (the cyclopean forward warp with the source as the
+/// only eye and the target as the middle camera), for comparison with the shift methods.
+pub fn mesh_warp_timed(gpu: &Gpu, case: &Case, repeats: usize) -> Result<(ReprojectOutput, Timing)> {
+    let (frame, target) = super::one_eye_frame(&case.source, &case.geometry)?;
+    let mut warp = crate::cyclopean::forward::ForwardWarp::new(gpu, &frame, &crate::refocus::BreakRule::default())?;
+    warp.render(&target)?; // warm-up
+    let mut runs = Vec::new();
+    for _ in 0..repeats.max(1) {
+        runs.push(warp.render(&target)?);
+    }
+    runs.sort_by(|a, b| a.1.wall_ms.total_cmp(&b.1.wall_ms));
+    let (out, t) = runs.swap_remove(runs.len() / 2);
+    let mask = out.sources.iter().map(|s| if *s != 0 { 255 } else { 0 }).collect();
+    Ok((
+        ReprojectOutput {
+            color: out.color,
+            depth: out.depth,
+            mask,
+        },
+        t,
+    ))
+}
+
+fn mesh_row(case: &Case, scene: &str, out: &ReprojectOutput, t: Timing) -> (ReportRow, Score) {
+    let s = score(out, case);
+    let mut r = ReportRow::new(
+        "reproject",
+        scene,
+        "mesh warp (foundation mesh path)",
+        case.name.clone(),
+        t.wall_ms,
+    );
+    r.gpu_ms = t.gpu_ms;
+    r.psnr_db = Some(s.psnr_db);
+    r.ssim = s.ssim;
+    r.coverage = Some(s.coverage);
+    r.depth_rel_mean = s.depth_rel_mean;
+    (r, s)
+}
+
 /// Rows for `viewsynth report`: the built-in scene at 640x480 (64 mm and 200 mm baselines, left
 /// eye with device depth and centre view -> right eye, against the ray-traced right eye), and,
 /// with `data_dir`, Middlebury 2014 Motorcycle and 2003 Teddy against their real right views.
@@ -285,6 +325,10 @@ pub fn reproject_rows(gpu: &Gpu, data_dir: Option<&Path>, repeats: usize) -> Res
                 r.setting = format!("{}, ipd {:.0} mm", case.name, ipd * 1e3);
                 rows.push(r);
             }
+            let (out, t) = mesh_warp_timed(gpu, &case, repeats)?;
+            let (mut r, _) = mesh_row(&case, "builtin:demo 640x480", &out, t);
+            r.setting = format!("{}, ipd {:.0} mm", case.name, ipd * 1e3);
+            rows.push(r);
         }
     }
     if let Some(dir) = data_dir {
@@ -303,6 +347,17 @@ pub fn reproject_rows(gpu: &Gpu, data_dir: Option<&Path>, repeats: usize) -> Res
                 ));
                 rows.push(r);
             }
+            let (out, t) = mesh_warp_timed(gpu, &case, repeats)?;
+            let (mut r, s) = mesh_row(&case, &case.name, &out, t);
+            r.setting = "PSNR vs the real right view on pixels marked valid".into();
+            notes.push(format!(
+                "{}, mesh warp: PSNR {:.2} dB on the {:.1} % of pixels marked valid, {:.1} ms",
+                case.name,
+                s.psnr_db,
+                s.coverage * 100.0,
+                t.wall_ms
+            ));
+            rows.push(r);
         }
     }
     Ok((rows, notes))
