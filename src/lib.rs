@@ -25,4 +25,7 @@ pub mod scene;
 pub mod ssim;
 pub mod stitch;
 
+#[cfg(test)]
+mod test_rng;
+
 pub use error::{Error, Result};

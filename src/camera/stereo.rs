@@ -437,21 +437,7 @@ mod tests {
     use super::*;
     use crate::convention::NdcDepthRange;
 
-    /// xorshift64* with a fixed seed: deterministic, no dependency.
-    struct Rng(u64);
-
-    impl Rng {
-        fn next_u64(&mut self) -> u64 {
-            self.0 ^= self.0 >> 12;
-            self.0 ^= self.0 << 25;
-            self.0 ^= self.0 >> 27;
-            self.0.wrapping_mul(0x2545_F491_4F6C_DD1D)
-        }
-        /// Uniform in [lo, hi).
-        fn range(&mut self, lo: f64, hi: f64) -> f64 {
-            lo + (hi - lo) * ((self.next_u64() >> 11) as f64 / (1u64 << 53) as f64)
-        }
-    }
+    use crate::test_rng::Rng;
 
     fn cases(rng: &mut Rng) -> Vec<(Frustum, DepthPlanes, StereoParams)> {
         let mut out = Vec::new();

@@ -351,19 +351,15 @@ mod tests {
 
     const U: f64 = f64::EPSILON / 2.0;
 
-    /// xorshift64* with a fixed seed: deterministic, no dependency.
-    struct Rng(u64);
+    use crate::test_rng::Rng;
 
-    impl Rng {
-        fn next_u64(&mut self) -> u64 {
-            self.0 ^= self.0 >> 12;
-            self.0 ^= self.0 << 25;
-            self.0 ^= self.0 >> 27;
-            self.0.wrapping_mul(0x2545_F491_4F6C_DD1D)
-        }
-        fn range(&mut self, lo: f64, hi: f64) -> f64 {
-            lo + (hi - lo) * ((self.next_u64() >> 11) as f64 / (1u64 << 53) as f64)
-        }
+    /// Random directions and frames on top of the shared test generator.
+    trait Geometry {
+        fn unit(&mut self) -> [f64; 3];
+        fn frame(&mut self) -> [[f64; 3]; 3];
+    }
+
+    impl Geometry for Rng {
         fn unit(&mut self) -> [f64; 3] {
             loop {
                 let v = [self.range(-1.0, 1.0), self.range(-1.0, 1.0), self.range(-1.0, 1.0)];

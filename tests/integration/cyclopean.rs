@@ -275,22 +275,26 @@ fn cli_renders_the_same_middle_view_as_the_library_from_files() {
         "fixation_distance": 3.0
     });
     std::fs::write(dir.join("cams.json"), serde_json::to_string(&cams).unwrap()).unwrap();
+    // The binary on the files written above, with `cameras` and `--refine-steps 3`.
+    let run = |cameras: &str, out: &std::path::Path| {
+        std::process::Command::new(env!("CARGO_BIN_EXE_viewsynth"))
+            .args(["cyclopean", "--refine-steps", "3", "--left-rgb"])
+            .arg(dir.join("left.png"))
+            .arg("--left-depth")
+            .arg(dir.join("left.exr"))
+            .arg("--right-rgb")
+            .arg(dir.join("right.png"))
+            .arg("--right-depth")
+            .arg(dir.join("right.exr"))
+            .arg("--cameras")
+            .arg(dir.join(cameras))
+            .arg("--out-dir")
+            .arg(out)
+            .output()
+            .unwrap()
+    };
     let out = dir.join("out");
-    let o = std::process::Command::new(env!("CARGO_BIN_EXE_viewsynth"))
-        .args(["cyclopean", "--refine-steps", "3", "--left-rgb"])
-        .arg(dir.join("left.png"))
-        .arg("--left-depth")
-        .arg(dir.join("left.exr"))
-        .arg("--right-rgb")
-        .arg(dir.join("right.png"))
-        .arg("--right-depth")
-        .arg(dir.join("right.exr"))
-        .arg("--cameras")
-        .arg(dir.join("cams.json"))
-        .arg("--out-dir")
-        .arg(&out)
-        .output()
-        .unwrap();
+    let o = run("cams.json", &out);
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
     let params = CyclopeanParams {
         method: Method::Refine { steps: 3 },
@@ -308,21 +312,7 @@ fn cli_renders_the_same_middle_view_as_the_library_from_files() {
     let mut bad = cams.clone();
     bad.as_object_mut().unwrap().remove("fixation_distance");
     std::fs::write(dir.join("bad.json"), serde_json::to_string(&bad).unwrap()).unwrap();
-    let o = std::process::Command::new(env!("CARGO_BIN_EXE_viewsynth"))
-        .args(["cyclopean", "--left-rgb"])
-        .arg(dir.join("left.png"))
-        .arg("--left-depth")
-        .arg(dir.join("left.exr"))
-        .arg("--right-rgb")
-        .arg(dir.join("right.png"))
-        .arg("--right-depth")
-        .arg(dir.join("right.exr"))
-        .arg("--cameras")
-        .arg(dir.join("bad.json"))
-        .arg("--out-dir")
-        .arg(dir.join("out2"))
-        .output()
-        .unwrap();
+    let o = run("bad.json", &dir.join("out2"));
     let err = String::from_utf8_lossy(&o.stderr);
     assert_eq!(o.status.code(), Some(1), "{err}");
     assert!(err.contains("fixation_distance") && !err.contains("panicked"), "{err}");
