@@ -426,8 +426,8 @@ fn bad_inputs_are_errors_not_panics() {
 fn report_rows_cover_every_method_case_and_dataset() {
     let g = gpu();
     let (rows, notes) = viewsynth::reproject::reproject_rows(&g, Some(&data_dir()), 3).unwrap();
-    // 2 baselines x 3 scene cases x 3 methods, then 2 real pairs x 3 methods.
-    assert_eq!(rows.len(), 2 * 3 * 3 + 2 * 3);
+    // 2 baselines x 3 scene cases x (3 methods + the mesh warp), then 2 real pairs x 4.
+    assert_eq!(rows.len(), 2 * 3 * 4 + 2 * 4);
     for r in &rows {
         println!(
             "| {} | {} | {} | {:.2} | {:.2} % | {:.1} |",
