@@ -8,7 +8,6 @@ use crate::error::{Error, Result};
 use crate::gpu::{Attachment, Framebuffer, Gpu, GpuTimer, Program, Texture, TextureFormat, Timing, VertexArray};
 use crate::io::{DepthMap, RgbImage};
 
-const FULLSCREEN_VERT: &str = include_str!("../../shaders/common/fullscreen.vert");
 const GATHER_FRAG: &str = include_str!("../../shaders/cyclopean/gather.frag");
 
 struct EyeGpu {
@@ -70,14 +69,7 @@ impl CyclopeanRenderer {
             matches!(params.method, Method::Refine { .. }) as u8,
             (params.blend == Blend::Soft) as u8,
         );
-        let program = Program::new(
-            gpu,
-            &defines,
-            &[
-                (glow::VERTEX_SHADER, "fullscreen.vert", FULLSCREEN_VERT),
-                (glow::FRAGMENT_SHADER, "cyclopean/gather.frag", GATHER_FRAG),
-            ],
-        )?;
+        let program = Program::fullscreen(gpu, &defines, "cyclopean/gather.frag", GATHER_FRAG)?;
         Ok(CyclopeanRenderer {
             gpu: gpu.clone(),
             program,

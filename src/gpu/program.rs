@@ -68,6 +68,20 @@ impl Program {
         }
     }
 
+    /// A full-screen pass: the shared one-triangle vertex shader and `frag` (named `name` in
+    /// compile errors).
+    pub fn fullscreen(gpu: &Gpu, defines: &str, name: &str, frag: &str) -> Result<Self> {
+        const FULLSCREEN_VERT: &str = include_str!("../../shaders/common/fullscreen.vert");
+        Program::new(
+            gpu,
+            defines,
+            &[
+                (glow::VERTEX_SHADER, "fullscreen.vert", FULLSCREEN_VERT),
+                (glow::FRAGMENT_SHADER, name, frag),
+            ],
+        )
+    }
+
     pub fn bind(&self) {
         // SAFETY: valid program handle.
         unsafe { self.gpu.gl().use_program(Some(self.raw)) }

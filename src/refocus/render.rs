@@ -14,7 +14,6 @@ use std::time::Instant;
 
 const GRID_GLSL: &str = include_str!("../../shaders/common/refocus_grid.glsl");
 const SAMPLE_GLSL: &str = include_str!("../../shaders/common/refocus_sample.glsl");
-const FULLSCREEN_VERT: &str = include_str!("../../shaders/common/fullscreen.vert");
 const FULLSCREEN_FRAG: &str = include_str!("../../shaders/refocus/fullscreen.frag");
 
 /// One refocused view. Images are top-down whatever the row-order convention.
@@ -77,14 +76,7 @@ impl Refocuser {
         let geometry = match method {
             Method::Fullscreen => {
                 let frag = format!("{GRID_GLSL}\n{SAMPLE_GLSL}\n{FULLSCREEN_FRAG}");
-                let program = Program::new(
-                    gpu,
-                    &defines,
-                    &[
-                        (glow::VERTEX_SHADER, "fullscreen.vert", FULLSCREEN_VERT),
-                        (glow::FRAGMENT_SHADER, "refocus/fullscreen.frag", &frag),
-                    ],
-                )?;
+                let program = Program::fullscreen(gpu, &defines, "refocus/fullscreen.frag", &frag)?;
                 let flags = grid.coverage_flags(&keep);
                 let (cx, cy) = (grid.cells_x() as u32, grid.cells_y() as u32);
                 let keep = Texture::new(gpu, cx, cy, TextureFormat::R8Ui, Some(&flags))?;

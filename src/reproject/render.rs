@@ -14,7 +14,6 @@ use crate::error::{Error, Result};
 use crate::gpu::{Attachment, Framebuffer, Gpu, GpuTimer, Program, Texture, TextureFormat, Timing, VertexArray};
 use crate::io::{DepthMap, RgbImage};
 
-const FULLSCREEN_VERT: &str = include_str!("../../shaders/common/fullscreen.vert");
 const SHIFT_FRAG: &str = include_str!("../../shaders/reproject/shift.frag");
 
 /// Rows top-down <-> memory order under the row-order convention (an involution).
@@ -77,14 +76,7 @@ impl Reprojector {
                     src.conv.glsl_defines(),
                     (params.method == Method::ShiftScan) as u8,
                 );
-                let program = Program::new(
-                    gpu,
-                    &defines,
-                    &[
-                        (glow::VERTEX_SHADER, "fullscreen.vert", FULLSCREEN_VERT),
-                        (glow::FRAGMENT_SHADER, "reproject/shift.frag", SHIFT_FRAG),
-                    ],
-                )?;
+                let program = Program::fullscreen(gpu, &defines, "reproject/shift.frag", SHIFT_FRAG)?;
                 let rgba: Vec<u8> = src
                     .color
                     .data

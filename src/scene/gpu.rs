@@ -9,7 +9,6 @@ use crate::error::{Error, Result};
 use crate::gpu::{Attachment, Framebuffer, Gpu, GpuTimer, Program, TextureFormat, Timing, VertexArray};
 use crate::io::{DepthMap, RgbImage};
 
-const FULLSCREEN_VERT: &str = include_str!("../../shaders/common/fullscreen.vert");
 const RAYTRACE_FRAG: &str = include_str!("../../shaders/scene/raytrace.frag");
 
 /// NDC z of the point each pixel's ray is built through (inside the range of every convention).
@@ -132,14 +131,7 @@ impl SceneRenderer {
         if let Some(i) = self.programs.iter().position(|(c, _)| *c == conv) {
             return Ok(&self.programs[i].1);
         }
-        let p = Program::new(
-            &self.gpu,
-            &conv.glsl_defines(),
-            &[
-                (glow::VERTEX_SHADER, "fullscreen.vert", FULLSCREEN_VERT),
-                (glow::FRAGMENT_SHADER, "scene/raytrace.frag", RAYTRACE_FRAG),
-            ],
-        )?;
+        let p = Program::fullscreen(&self.gpu, &conv.glsl_defines(), "scene/raytrace.frag", RAYTRACE_FRAG)?;
         self.programs.push((conv, p));
         Ok(&self.programs.last().expect("just pushed").1)
     }

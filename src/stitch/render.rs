@@ -7,7 +7,6 @@ use crate::error::{Error, Result};
 use crate::gpu::{Attachment, Framebuffer, Gpu, GpuTimer, Program, Texture, TextureFormat, Timing, VertexArray};
 use crate::io::RgbImage;
 
-const FULLSCREEN_VERT: &str = include_str!("../../shaders/common/fullscreen.vert");
 const STITCH_FRAG: &str = include_str!("../../shaders/stitch/stitch.frag");
 
 struct EyeAtlas {
@@ -79,14 +78,7 @@ impl StitchRenderer {
                 m.index(),
                 REPROJECT_STEPS
             );
-            programs.push(Program::new(
-                gpu,
-                &defines,
-                &[
-                    (glow::VERTEX_SHADER, "fullscreen.vert", FULLSCREEN_VERT),
-                    (glow::FRAGMENT_SHADER, "stitch/stitch.frag", STITCH_FRAG),
-                ],
-            )?);
+            programs.push(Program::fullscreen(gpu, &defines, "stitch/stitch.frag", STITCH_FRAG)?);
         }
         Ok(StitchRenderer {
             gpu: gpu.clone(),
