@@ -155,25 +155,36 @@ enum RgbFormatArg {
 #[derive(Args)]
 struct RefocusArgs {
     /// Source colour (PNG, JPEG, PPM, EXR).
-    #[arg(long)]
-    rgb: PathBuf,
+    #[arg(long, required_unless_present = "batch")]
+    rgb: Option<PathBuf>,
     /// Source metric depth, view-space Z (EXR, NPY f32/f64/u16, 16-bit PNG/PGM with --depth-scale, PFM).
+    #[arg(long, required_unless_present = "batch")]
+    depth: Option<PathBuf>,
+    /// Refocus every frame of a CSV/JSON manifest (columns rgb,depth,fx,fy,cx,cy[,depth_scale,name];
+    /// see src/refocus/batch.rs) into <out-dir>/<name>/, with one GL context, files encoded on
+    /// writer threads, and resume.
+    #[arg(long, conflicts_with_all = ["rgb", "depth"])]
+    batch: Option<PathBuf>,
+    /// With --batch: render frames that already have a manifest.json again.
     #[arg(long)]
-    depth: PathBuf,
+    no_resume: bool,
+    /// With --batch: threads encoding files while the GPU renders (0 = none).
+    #[arg(long, default_value_t = 1)]
+    writer_threads: usize,
     /// Raw units per metre for integer depth (5000 for TUM, 1000 for NYU/SUN); divides float depth too when given.
     #[arg(long)]
     depth_scale: Option<f64>,
     /// SUN RGB-D PNG depth: rotate the 16-bit value right by 3 bits before scaling.
     #[arg(long)]
     sun_bit_rotate: bool,
-    #[arg(long)]
-    fx: f64,
-    #[arg(long)]
-    fy: f64,
-    #[arg(long)]
-    cx: f64,
-    #[arg(long)]
-    cy: f64,
+    #[arg(long, required_unless_present = "batch")]
+    fx: Option<f64>,
+    #[arg(long, required_unless_present = "batch")]
+    fy: Option<f64>,
+    #[arg(long, required_unless_present = "batch")]
+    cx: Option<f64>,
+    #[arg(long, required_unless_present = "batch")]
+    cy: Option<f64>,
     #[arg(long)]
     out_dir: PathBuf,
     /// Target focal lengths fx' in pixels (fy' keeps the source fy/fx).
@@ -339,13 +350,17 @@ fn info(gpu: &GpuArgs, json: bool) -> Result<()> {
 }
 
 fn refocus(a: RefocusArgs) -> Result<()> {
+    if let Some(manifest) = a.batch.clone() {
+        return refocus_batch(&manifest, a);
+    }
     // Everything that can be checked before touching the GPU or the output directory is.
-    let k = Intrinsics {
-        fx: a.fx,
-        fy: a.fy,
-        cx: a.cx,
-        cy: a.cy,
+    // (clap requires these without --batch.)
+    let (Some(rgb_path), Some(depth_path), Some(fx), Some(fy), Some(cx), Some(cy)) =
+        (a.rgb.clone(), a.depth.clone(), a.fx, a.fy, a.cx, a.cy)
+    else {
+        bail!("--rgb, --depth, --fx, --fy, --cx and --cy are required without --batch");
     };
+    let k = Intrinsics { fx, fy, cx, cy };
     k.validate("source intrinsics")?;
     let rule = BreakRule {
         tau_rel: a.tau_rel,
@@ -364,15 +379,15 @@ fn refocus(a: RefocusArgs) -> Result<()> {
         RgbFormatArg::Jpeg => RgbFormat::Jpeg,
         RgbFormatArg::Exr => RgbFormat::Exr,
     };
-    let rgb = io::load_rgb(&a.rgb)?;
+    let rgb = io::load_rgb(&rgb_path)?;
     let decode = DepthDecode {
         scale: a.depth_scale,
         sun_rgbd_bit_rotate: a.sun_bit_rotate,
         ..Default::default()
     };
-    let depth = io::load_depth(&a.depth, &decode)?;
-    let src =
-        RefocusSource::new(rgb, depth, k).with_context(|| format!("{} and {}", a.rgb.display(), a.depth.display()))?;
+    let depth = io::load_depth(&depth_path, &decode)?;
+    let src = RefocusSource::new(rgb, depth, k)
+        .with_context(|| format!("{} and {}", rgb_path.display(), depth_path.display()))?;
     let scales = match &a.focal_list {
         Some(list) => TargetSpec::scales_from_focal_list(&k, list),
         None => a.zoom_range.clone(),
@@ -602,6 +617,63 @@ fn render_scene(
         scene.name,
         out_dir.display()
     );
+    Ok(())
+}
+
+fn refocus_batch(manifest: &Path, a: RefocusArgs) -> Result<()> {
+    use viewsynth::refocus::batch::{load_manifest, run_batch, BatchOptions};
+    if a.focal_list.is_some() {
+        bail!("--focal-list is per frame; with --batch give --zoom-range scales");
+    }
+    let frames = load_manifest(manifest)?;
+    let opts = BatchOptions {
+        scales: a.zoom_range.clone(),
+        size: a.width_out.zip(a.height_out),
+        principal: a.cx_out.zip(a.cy_out),
+        rule: BreakRule {
+            tau_rel: a.tau_rel,
+            tau_abs: a.tau_abs,
+        },
+        method: match a.method {
+            MethodArg::Mesh => Method::Mesh,
+            MethodArg::Fullscreen => Method::Fullscreen,
+        },
+        outputs: OutputSet::parse(&a.outputs)?,
+        conv: conventions(a.ndc, a.reversed_z, a.rows),
+        rgb_format: match a.rgb_format {
+            RgbFormatArg::Png => RgbFormat::Png,
+            RgbFormatArg::Jpeg => RgbFormat::Jpeg,
+            RgbFormatArg::Exr => RgbFormat::Exr,
+        },
+        depth_formats: parse_depth_formats(&a.depth_format)?,
+        resume: !a.no_resume,
+        writer_threads: a.writer_threads,
+    };
+    opts.rule.validate()?;
+    prepare_out_dir(&a.out_dir)?;
+    let gpu = a.gpu.open()?;
+    let bar = indicatif::ProgressBar::new(frames.len() as u64);
+    let summary = run_batch(&gpu, &frames, &a.out_dir, &opts, || bar.inc(1))?;
+    bar.finish_and_clear();
+    println!(
+        "{} frames: {} rendered, {} already done (resume), {} failed; {:.1} s, {:.2} frames/s",
+        frames.len(),
+        summary.rendered,
+        summary.skipped,
+        summary.failed.len(),
+        summary.wall_s,
+        summary.rendered as f64 / summary.wall_s.max(1e-9)
+    );
+    if !summary.failed.is_empty() {
+        for (name, e) in &summary.failed {
+            eprintln!("failed: {name}: {e}");
+        }
+        bail!(
+            "{} of {} frames failed (listed above); the others completed",
+            summary.failed.len(),
+            frames.len()
+        );
+    }
     Ok(())
 }
 

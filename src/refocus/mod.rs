@@ -8,6 +8,7 @@
 //! - [`reference`]: the float64 CPU twin both are tested against.
 //! - [`job`]: targets from focal lists or zoom scales, file outputs and the manifest.
 
+pub mod batch;
 mod grid;
 pub mod job;
 mod mesh;

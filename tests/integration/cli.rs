@@ -196,3 +196,72 @@ fn missing_libegl_is_a_clear_error_not_a_crash() {
     assert_eq!(o.status.code(), Some(1), "{err}");
     assert!(err.contains("libEGL") && !err.contains("panicked"), "{err}");
 }
+
+#[test]
+fn batch_reports_a_corrupt_frame_completes_the_rest_and_resumes() {
+    let d = scratch("batch");
+    let mut lines = vec!["name,rgb,depth,fx,fy,cx,cy".to_string()];
+    for i in 0..3 {
+        let sub = d.join(format!("f{i}"));
+        std::fs::create_dir_all(&sub).unwrap();
+        let (rgb, depth) = inputs(&sub, 32, 24);
+        if i == 1 {
+            std::fs::write(&rgb, b"\x89PNG\r\n\x1a\nbroken").unwrap();
+        }
+        lines.push(format!(
+            "frame{i},{},{},40,40,15.5,11.5",
+            rgb.display(),
+            depth.display()
+        ));
+    }
+    let manifest = d.join("frames.csv");
+    std::fs::write(&manifest, lines.join("\n")).unwrap();
+    let run = |out: &Path, extra: &[&str]| {
+        bin()
+            .args(["refocus", "--zoom-range", "0.5,2", "--batch"])
+            .arg(&manifest)
+            .arg("--out-dir")
+            .arg(out)
+            .args(extra)
+            .output()
+            .unwrap()
+    };
+    let out = d.join("out");
+    let o = run(&out, &[]);
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(1), "{err}");
+    assert!(
+        err.contains("failed: frame1") && err.contains("rgb.png") && !err.contains("panicked"),
+        "{err}"
+    );
+    for ok in ["frame0", "frame2"] {
+        assert!(out.join(ok).join("manifest.json").is_file(), "{ok} not finished");
+        assert!(out.join(ok).join("s2_rgb.png").is_file());
+    }
+    assert!(!out.join("frame1").join("manifest.json").exists());
+    let before = std::fs::read(out.join("frame2").join("s0.5_depth.exr")).unwrap();
+
+    // Repair the frame and resume: only it is rendered; finished frames are left alone.
+    let (rgb, _) = inputs(&d.join("f1"), 32, 24);
+    assert!(rgb.is_file());
+    let o = run(&out, &[]);
+    let text = String::from_utf8_lossy(&o.stdout);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    assert!(text.contains("1 rendered, 2 already done"), "{text}");
+    assert_eq!(
+        std::fs::read(out.join("frame2").join("s0.5_depth.exr")).unwrap(),
+        before
+    );
+
+    // Writing on the render thread gives byte-identical files.
+    let serial = d.join("serial");
+    let o = run(&serial, &["--writer-threads", "0"]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    for f in ["s0.5_rgb.png", "s2_depth.exr", "s2_mask.png"] {
+        assert_eq!(
+            std::fs::read(serial.join("frame1").join(f)).unwrap(),
+            std::fs::read(out.join("frame1").join(f)).unwrap(),
+            "{f}"
+        );
+    }
+}
