@@ -196,6 +196,19 @@ fn write_frame(job: WriteJob, opts: &BatchOptions) -> Result<()> {
     Ok(())
 }
 
+/// An interrupted run (a signal cannot run cleanup) may leave `atomic_write` temporaries
+/// (`.{file}.tmp-{pid}-{n}`) in an unfinished frame's folder; they are removed before it is
+/// rendered again. Final names are never partial either way.
+fn remove_stale_temporaries(dir: &Path) {
+    let Ok(entries) = std::fs::read_dir(dir) else { return };
+    for e in entries.flatten() {
+        let name = e.file_name().to_string_lossy().into_owned();
+        if name.starts_with('.') && name.contains(".tmp-") {
+            let _ = std::fs::remove_file(e.path());
+        }
+    }
+}
+
 /// Render one frame's targets (errors name the frame's files).
 fn render_frame(gpu: &Gpu, frame: &BatchFrame, opts: &BatchOptions) -> Result<(Vec<(f64, RefocusOutput)>, Manifest)> {
     let decode = DepthDecode {
@@ -269,6 +282,7 @@ pub fn run_batch(
                 progress();
                 continue;
             }
+            remove_stale_temporaries(&dir);
             match render_frame(gpu, frame, opts) {
                 Ok((outputs, manifest)) => {
                     summary.rendered += 1;

@@ -241,7 +241,10 @@ fn batch_reports_a_corrupt_frame_completes_the_rest_and_resumes() {
     assert!(!out.join("frame1").join("manifest.json").exists());
     let before = std::fs::read(out.join("frame2").join("s0.5_depth.exr")).unwrap();
 
-    // Repair the frame and resume: only it is rendered; finished frames are left alone.
+    // Repair the frame and resume: only it is rendered; finished frames are left alone, and a
+    // temporary left by an interrupted write in the unfinished frame is cleared.
+    std::fs::create_dir_all(out.join("frame1")).unwrap();
+    std::fs::write(out.join("frame1").join(".s2_rgb.png.tmp-1-1"), b"partial").unwrap();
     let (rgb, _) = inputs(&d.join("f1"), 32, 24);
     assert!(rgb.is_file());
     let o = run(&out, &[]);
