@@ -10,6 +10,7 @@
 
 pub mod bench;
 pub mod camera;
+pub mod compare;
 pub mod convention;
 pub mod cyclopean;
 pub mod demo;

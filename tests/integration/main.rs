@@ -3,6 +3,7 @@
 
 mod cli;
 mod common;
+mod compare;
 mod cyclopean;
 mod gpu_context;
 mod refocus_accuracy;
