@@ -146,15 +146,7 @@ impl CyclopeanRenderer {
         };
         p.set_f32("u_w_left", w_left as f32);
         p.set_i32("u_steps", self.params.steps() as i32);
-        // SAFETY: one full-screen triangle into an FBO without depth buffer.
-        unsafe {
-            use glow::HasContext;
-            let gl = self.gpu.gl();
-            gl.disable(glow::DEPTH_TEST);
-            gl.disable(glow::BLEND);
-            gl.disable(glow::CULL_FACE);
-            gl.draw_arrays(glow::TRIANGLES, 0, 3);
-        }
+        self.vao.draw_fullscreen();
         self.gpu.check("cyclopean draw")?;
         let timing = timer.stop();
         let out = read_output(fb, self.rows)?;

@@ -21,6 +21,22 @@ impl VertexArray {
         // SAFETY: valid handle.
         unsafe { self.gpu.gl().bind_vertex_array(Some(self.raw)) }
     }
+
+    /// Draw the one full-screen triangle of shaders/common/fullscreen.vert with the bound
+    /// program, setting the state such a pass relies on: no depth test, blending, culling or
+    /// stencil.
+    pub fn draw_fullscreen(&self) {
+        let gl = self.gpu.gl();
+        // SAFETY: valid VAO; three vertices generated in the vertex shader, no buffers read.
+        unsafe {
+            gl.bind_vertex_array(Some(self.raw));
+            gl.disable(glow::DEPTH_TEST);
+            gl.disable(glow::BLEND);
+            gl.disable(glow::CULL_FACE);
+            gl.disable(glow::STENCIL_TEST);
+            gl.draw_arrays(glow::TRIANGLES, 0, 3);
+        }
+    }
 }
 
 impl Drop for VertexArray {

@@ -209,11 +209,7 @@ impl Refocuser {
                 program.bind();
                 self.vao.bind();
                 keep.bind(2);
-                // SAFETY: one full-screen triangle; no depth buffer is attached.
-                unsafe {
-                    gl.disable(glow::DEPTH_TEST);
-                    gl.draw_arrays(glow::TRIANGLES, 0, 3);
-                }
+                self.vao.draw_fullscreen();
             }
             Geometry::Mesh(mesh) => mesh.draw(&gpu, &self.vao, &self.source, target, &self.planes, &conv, 2),
         }

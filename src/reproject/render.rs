@@ -194,15 +194,7 @@ impl Reprojector {
                     _ => 0,
                 };
                 p.set_i32("u_steps", steps as i32);
-                // SAFETY: one full-screen triangle into an FBO without depth buffer.
-                unsafe {
-                    use glow::HasContext;
-                    let gl = self.gpu.gl();
-                    gl.disable(glow::DEPTH_TEST);
-                    gl.disable(glow::BLEND);
-                    gl.disable(glow::CULL_FACE);
-                    gl.draw_arrays(glow::TRIANGLES, 0, 3);
-                }
+                s.vao.draw_fullscreen();
                 self.gpu.check("reproject shift draw")?;
                 let timing = timer.stop();
                 let read = |i: usize, bpp: usize| -> Result<Vec<u8>> {

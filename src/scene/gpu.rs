@@ -265,14 +265,7 @@ impl SceneRenderer {
             p.set_f32("u_ods_fade_start", fade as f32);
         }
         self.vao.bind();
-        // SAFETY: one full-screen triangle into an FBO without depth buffer.
-        unsafe {
-            use glow::HasContext;
-            let gl = gpu.gl();
-            gl.disable(glow::DEPTH_TEST);
-            gl.disable(glow::BLEND);
-            gl.draw_arrays(glow::TRIANGLES, 0, 3);
-        }
+        self.vao.draw_fullscreen();
         gpu.check("scene ray trace")?;
         let timing = timer.stop();
         let rows = |data: Vec<u8>, bpp: usize| cam.conv.row_order.convert_rows(data, w as usize * bpp);
