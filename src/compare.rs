@@ -51,10 +51,11 @@ fn to_top_down(color: &RgbImage, rows: RowOrder) -> RgbImage {
 
 /// View distance per pixel (top-down), NaN where invalid.
 fn view_z(depth: &DepthMap, storage: DepthStorage, conv: &Conventions) -> Vec<f64> {
-    let bytes: Vec<u8> = depth.data.iter().flat_map(|v| v.to_ne_bytes()).collect();
+    let bytes: Vec<u8> = crate::gpu::pixels::f32_to_bytes(&depth.data);
     let rows = conv.row_order.convert_rows(bytes, depth.width as usize * 4);
-    rows.chunks_exact(4)
-        .map(|b| f32::from_ne_bytes([b[0], b[1], b[2], b[3]]) as f64)
+    crate::gpu::pixels::bytes_to_f32(&rows)
+        .into_iter()
+        .map(|d| d as f64)
         .map(|d| match storage {
             DepthStorage::ViewZ => {
                 if d.is_finite() && d > 0.0 {

@@ -76,13 +76,8 @@ impl ForwardWarp {
             let grid = Grid { width: w, height: h };
             let keep = grid.keep_mask(&dist, rule);
             let codes = grid.kept_triangles(&keep);
-            let rgba: Vec<u8> = eye
-                .color
-                .data
-                .chunks_exact(3)
-                .flat_map(|p| [p[0], p[1], p[2], 255])
-                .collect();
-            let dbytes: Vec<u8> = dist.iter().flat_map(|z| z.to_ne_bytes()).collect();
+            let rgba: Vec<u8> = crate::gpu::pixels::rgb_to_rgba(&eye.color.data);
+            let dbytes: Vec<u8> = crate::gpu::pixels::f32_to_bytes(&dist);
             Ok(EyeMesh {
                 color: Texture::new(
                     gpu,

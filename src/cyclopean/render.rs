@@ -19,13 +19,8 @@ struct EyeGpu {
 
 fn upload_eye(gpu: &Gpu, eye: &EyeInput, rows: RowOrder) -> Result<EyeGpu> {
     let (w, h) = (eye.color.width, eye.color.height);
-    let rgba: Vec<u8> = eye
-        .color
-        .data
-        .chunks_exact(3)
-        .flat_map(|p| [p[0], p[1], p[2], 255])
-        .collect();
-    let depth: Vec<u8> = eye.depth.data.iter().flat_map(|z| z.to_ne_bytes()).collect();
+    let rgba: Vec<u8> = crate::gpu::pixels::rgb_to_rgba(&eye.color.data);
+    let depth: Vec<u8> = crate::gpu::pixels::f32_to_bytes(&eye.depth.data);
     Ok(EyeGpu {
         color: Texture::new(
             gpu,
@@ -166,15 +161,8 @@ pub(crate) fn read_output(fb: &Framebuffer, rows: RowOrder) -> Result<CyclopeanO
     };
     let (rgba, depth, sources) = (read(0, 4)?, read(1, 4)?, read(2, 1)?);
     Ok(CyclopeanOutput {
-        color: RgbImage::new(w, h, rgba.chunks_exact(4).flat_map(|p| [p[0], p[1], p[2]]).collect())?,
-        depth: DepthMap::new(
-            w,
-            h,
-            depth
-                .chunks_exact(4)
-                .map(|b| f32::from_ne_bytes([b[0], b[1], b[2], b[3]]))
-                .collect(),
-        )?,
+        color: RgbImage::new(w, h, crate::gpu::pixels::rgba_to_rgb(&rgba))?,
+        depth: DepthMap::new(w, h, crate::gpu::pixels::bytes_to_f32(&depth))?,
         sources,
     })
 }

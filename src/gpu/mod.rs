@@ -4,6 +4,7 @@
 mod buffer;
 mod egl;
 mod framebuffer;
+pub mod pixels;
 mod program;
 mod texture;
 mod timer;

@@ -85,17 +85,12 @@ impl Refocuser {
             Method::Mesh => Geometry::Mesh(MeshPass::new(gpu, &grid, &keep, &defines, GRID_GLSL, SAMPLE_GLSL)?),
         };
         let rgb = if outputs.rgb {
-            let rgba: Vec<u8> = src
-                .rgb
-                .data
-                .chunks_exact(3)
-                .flat_map(|p| [p[0], p[1], p[2], 255])
-                .collect();
+            let rgba: Vec<u8> = crate::gpu::pixels::rgb_to_rgba(&src.rgb.data);
             Some(Texture::new(gpu, w, h, TextureFormat::Rgba8, Some(&rgba))?)
         } else {
             None
         };
-        let depth_bytes: Vec<u8> = src.depth.data.iter().flat_map(|z| z.to_ne_bytes()).collect();
+        let depth_bytes: Vec<u8> = crate::gpu::pixels::f32_to_bytes(&src.depth.data);
         let depth = Texture::new(gpu, w, h, TextureFormat::R32F, Some(&depth_bytes))?;
         // Every kept vertex lies in [min, max] of the valid depths; the factor 2 leaves room for
         // the expanded border of each triangle (which the vertex shader keeps within it).
@@ -221,15 +216,12 @@ impl Refocuser {
         let mut outputs = (None, None, None);
         if let Some(data) = fb.read_color(0)? {
             let rgba = conv.row_order.convert_rows(data, w as usize * 4);
-            let rgb = rgba.chunks_exact(4).flat_map(|p| [p[0], p[1], p[2]]).collect();
+            let rgb = crate::gpu::pixels::rgba_to_rgb(&rgba);
             outputs.0 = Some(RgbImage::new(w, h, rgb)?);
         }
         if let Some(data) = fb.read_color(1)? {
             let bytes = conv.row_order.convert_rows(data, w as usize * 4);
-            let z = bytes
-                .chunks_exact(4)
-                .map(|b| f32::from_ne_bytes([b[0], b[1], b[2], b[3]]))
-                .collect();
+            let z = crate::gpu::pixels::bytes_to_f32(&bytes);
             outputs.1 = Some(DepthMap::new(w, h, z)?);
         }
         if let Some(data) = fb.read_color(2)? {

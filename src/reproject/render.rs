@@ -77,13 +77,8 @@ impl Reprojector {
                     (params.method == Method::ShiftScan) as u8,
                 );
                 let program = Program::fullscreen(gpu, &defines, "reproject/shift.frag", SHIFT_FRAG)?;
-                let rgba: Vec<u8> = src
-                    .color
-                    .data
-                    .chunks_exact(3)
-                    .flat_map(|p| [p[0], p[1], p[2], 255])
-                    .collect();
-                let depth: Vec<u8> = src.depth.data.iter().flat_map(|z| z.to_ne_bytes()).collect();
+                let rgba: Vec<u8> = crate::gpu::pixels::rgb_to_rgba(&src.color.data);
+                let depth: Vec<u8> = crate::gpu::pixels::f32_to_bytes(&src.depth.data);
                 let slot = |format| {
                     Some(Attachment {
                         format,
@@ -207,13 +202,12 @@ impl Reprojector {
                 fb.unbind();
                 Ok((
                     ReprojectOutput {
-                        color: RgbImage::new(w, h, rgba.chunks_exact(4).flat_map(|p| [p[0], p[1], p[2]]).collect())?,
+                        color: RgbImage::new(w, h, crate::gpu::pixels::rgba_to_rgb(&rgba))?,
                         depth: DepthMap::new(
                             w,
                             h,
-                            depth
-                                .chunks_exact(4)
-                                .map(|b| f32::from_ne_bytes([b[0], b[1], b[2], b[3]]))
+                            crate::gpu::pixels::bytes_to_f32(&depth)
+                                .into_iter()
                                 .map(|z| if z.is_finite() { z } else { 0.0 })
                                 .collect(),
                         )?,

@@ -269,18 +269,14 @@ impl SceneRenderer {
         gpu.check("scene ray trace")?;
         let timing = timer.stop();
         let rows = |data: Vec<u8>, bpp: usize| cam.conv.row_order.convert_rows(data, w as usize * bpp);
-        let floats = |b: Vec<u8>| {
-            b.chunks_exact(4)
-                .map(|c| f32::from_ne_bytes([c[0], c[1], c[2], c[3]]))
-                .collect()
-        };
+        let floats = |b: Vec<u8>| crate::gpu::pixels::bytes_to_f32(&b);
         let rgba = rows(fb.read_color(0)?.expect("colour"), 4);
         let view_z = rows(fb.read_color(1)?.expect("view z"), 4);
         let device = rows(fb.read_color(2)?.expect("device depth"), 4);
         fb.unbind();
         Ok((
             SceneImage {
-                color: RgbImage::new(w, h, rgba.chunks_exact(4).flat_map(|p| [p[0], p[1], p[2]]).collect())?,
+                color: RgbImage::new(w, h, crate::gpu::pixels::rgba_to_rgb(&rgba))?,
                 view_z: DepthMap::new(w, h, floats(view_z))?,
                 device_depth: DepthMap::new(w, h, floats(device))?,
             },

@@ -172,7 +172,7 @@ impl StitchRenderer {
         let rgba = fb.read_color(0)?.expect("colour attachment");
         fb.unbind();
         let timing = timer.stop();
-        let rgb = rgba.chunks_exact(4).flat_map(|p| [p[0], p[1], p[2]]).collect();
+        let rgb = crate::gpu::pixels::rgba_to_rgb(&rgba);
         Ok((RgbImage::new(w, 2 * h, rgb)?, timing))
     }
 }
