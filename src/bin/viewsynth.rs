@@ -51,12 +51,8 @@ enum Command {
         /// Interocular distance in metres.
         #[arg(long, default_value_t = 0.064)]
         ipd: f64,
-        #[arg(long, value_enum, default_value = "gl")]
-        ndc: NdcArg,
-        #[arg(long)]
-        reversed_z: bool,
-        #[arg(long, value_enum, default_value = "bottom-up")]
-        rows: RowsArg,
+        #[command(flatten)]
+        conv: ConventionArgs,
         #[arg(long, default_value = "out/scene")]
         out_dir: PathBuf,
         #[command(flatten)]
@@ -126,6 +122,23 @@ impl GpuArgs {
             ),
         };
         Ok(Gpu::new(choice)?)
+    }
+}
+
+/// The convention switches of a rendering command.
+#[derive(Args, Clone, Copy)]
+struct ConventionArgs {
+    #[arg(long, value_enum, default_value = "gl")]
+    ndc: NdcArg,
+    #[arg(long)]
+    reversed_z: bool,
+    #[arg(long, value_enum, default_value = "bottom-up")]
+    rows: RowsArg,
+}
+
+impl ConventionArgs {
+    fn conventions(&self) -> Conventions {
+        conventions(self.ndc, self.reversed_z, self.rows)
     }
 }
 
@@ -222,12 +235,8 @@ struct RefocusArgs {
     depth_format: String,
     #[arg(long, value_enum, default_value = "fullscreen")]
     method: MethodArg,
-    #[arg(long, value_enum, default_value = "gl")]
-    ndc: NdcArg,
-    #[arg(long)]
-    reversed_z: bool,
-    #[arg(long, value_enum, default_value = "bottom-up")]
-    rows: RowsArg,
+    #[command(flatten)]
+    conv: ConventionArgs,
     #[command(flatten)]
     gpu: GpuArgs,
 }
@@ -335,13 +344,11 @@ fn main() {
             width,
             height,
             ipd,
-            ndc,
-            reversed_z,
-            rows,
+            conv,
             out_dir,
             gpu,
         } => {
-            let conv = conventions(ndc, reversed_z, rows);
+            let conv = conv.conventions();
             render_scene(&scene, width, height, ipd, conv, &out_dir, &gpu)
         }
         Command::Bench { sizes, repeats, gpu } => bench(&sizes, repeats, &gpu),
@@ -422,7 +429,7 @@ fn refocus(a: RefocusArgs) -> Result<()> {
     rule.validate()?;
     let outputs = OutputSet::parse(&a.outputs)?;
     let depth_formats = parse_depth_formats(&a.depth_format)?;
-    let conv = conventions(a.ndc, a.reversed_z, a.rows);
+    let conv = a.conv.conventions();
     let method = match a.method {
         MethodArg::Mesh => Method::Mesh,
         MethodArg::Fullscreen => Method::Fullscreen,
@@ -692,7 +699,7 @@ fn refocus_batch(manifest: &Path, a: RefocusArgs) -> Result<()> {
             MethodArg::Fullscreen => Method::Fullscreen,
         },
         outputs: OutputSet::parse(&a.outputs)?,
-        conv: conventions(a.ndc, a.reversed_z, a.rows),
+        conv: a.conv.conventions(),
         rgb_format: match a.rgb_format {
             RgbFormatArg::Png => RgbFormat::Png,
             RgbFormatArg::Jpeg => RgbFormat::Jpeg,
