@@ -25,6 +25,7 @@ pub mod reproject;
 pub mod scene;
 pub mod ssim;
 pub mod stitch;
+pub mod stress;
 
 #[cfg(test)]
 mod test_rng;

@@ -101,6 +101,23 @@ enum Command {
         #[command(flatten)]
         gpu: GpuArgs,
     },
+    /// Sweep stiff and extreme cases of every capability (focal scales 0.05..20, 1 mm..100 km,
+    /// near/far 1e-7, standard vs reversed-Z, NaN/Inf depth, 1x1 to the largest image, parallel
+    /// gaze, zero IPD, ...): GPU f32 against the f64 reference, as a table with the first failing
+    /// case. Exits 1 if any case fails.
+    Stress {
+        /// Smaller images and sub-cases (what the test suite runs).
+        #[arg(long)]
+        quick: bool,
+        /// Capabilities to sweep.
+        #[arg(long, value_delimiter = ',', default_value = "camera,refocus,cyclopean,reproject,stitch")]
+        only: Vec<String>,
+        /// Also write the rows as JSON here.
+        #[arg(long)]
+        json: Option<PathBuf>,
+        #[command(flatten)]
+        gpu: GpuArgs,
+    },
 }
 
 #[derive(Args, Clone)]
@@ -352,6 +369,7 @@ fn main() {
             render_scene(&scene, width, height, ipd, conv, &out_dir, &gpu)
         }
         Command::Bench { sizes, repeats, gpu } => bench(&sizes, repeats, &gpu),
+        Command::Stress { quick, only, json, gpu } => stress(quick, &only, json.as_deref(), &gpu),
         Command::Report {
             out_dir,
             data_dir,
@@ -829,5 +847,28 @@ fn bench(sizes: &[String], repeats: usize, gpu: &GpuArgs) -> Result<()> {
         viewsynth::bench::cyclopean_bench(&gpu, 1280, 720, repeats.max(1))?
     );
     println!("{}", viewsynth::stitch::stitch_bench(&gpu)?);
+    Ok(())
+}
+
+fn stress(quick: bool, only: &[String], json: Option<&Path>, gpu: &GpuArgs) -> Result<()> {
+    let caps: Vec<&str> = only.iter().map(|s| s.trim()).filter(|s| !s.is_empty()).collect();
+    if let Some(bad) = caps.iter().find(|c| !viewsynth::stress::CAPABILITIES.contains(c)) {
+        anyhow::bail!(
+            "--only '{bad}': expected a list of {}",
+            viewsynth::stress::CAPABILITIES.join(", ")
+        );
+    }
+    let gpu = gpu.open()?;
+    let rows = viewsynth::stress::run_stress(&gpu, &caps, viewsynth::stress::StressOptions { quick })?;
+    println!("{}", viewsynth::stress::table(&rows));
+    if let Some(path) = json {
+        viewsynth::io::atomic_write(path, |w| {
+            serde_json::to_writer_pretty(w, &rows).map_err(|e| viewsynth::Error::param("json", e.to_string()))
+        })
+        .with_context(|| format!("writing {}", path.display()))?;
+    }
+    if let Some(r) = viewsynth::stress::first_failure(&rows) {
+        anyhow::bail!("stress case failed: {} / {} ({})", r.capability, r.case, r.worst);
+    }
     Ok(())
 }

@@ -60,10 +60,18 @@ impl Refocuser {
         rule.validate()?;
         let (w, h) = (src.rgb.width, src.rgb.height);
         let max = gpu.max_image_side();
-        if w > max || h > max {
+        // The grid's cells include a half-pixel border ring: (w + 1) x (h + 1) of them, each a
+        // texel of the coverage texture, so the source side is one less than the GPU's limit.
+        if w >= max || h >= max {
             return Err(Error::param(
                 "source size",
-                format!("{w}x{h} exceeds this GPU's limit of {max}"),
+                format!(
+                    "{w}x{h}: its grid needs {}x{} cells (one per pixel plus the border ring) but this GPU's \
+                     texture limit is {max}; sources up to {} px per side",
+                    w + 1,
+                    h + 1,
+                    max - 1
+                ),
             ));
         }
         let grid = Grid { width: w, height: h };
