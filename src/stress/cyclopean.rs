@@ -75,6 +75,7 @@ fn sweep(gpu: &Gpu, case: &str, cases: &[Case], fixation: f64, tol: Tolerance, n
                 &RefPixels {
                     valid: reference.sources.iter().map(|s| *s != 0).collect(),
                     class: Some(&reference.sources),
+                    ties: None,
                     depth: Some(&reference.depth),
                     rgb: &reference.color,
                 },
@@ -116,7 +117,11 @@ pub fn rows(gpu: &Gpu, opts: StressOptions) -> Result<Vec<StressRow>> {
         for (convs, label, is_fine) in [(&lossy, "standard Z or GL range", false), (&fine, "reversed-Z [0,1]", true)] {
             let b = bound(is_fine, DepthKind::Device, SCENE_Z_MAX, near);
             let by_design = !is_fine && b > 1e-4;
-            let tol = Tolerance::new(b, if by_design { 1.0 } else { 1e-3 }, if by_design { 1.0 } else { 1e-3 });
+            let tol = if by_design {
+                Tolerance::lost_by_design(b)
+            } else {
+                Tolerance::new(b, 1e-3, 1e-3)
+            };
             let note = if by_design {
                 format!(
                     "precision lost by design: f32 device depth holds Z to ~eps Z / near = {:.1} % at {SCENE_Z_MAX} m; \
@@ -152,7 +157,7 @@ pub fn rows(gpu: &Gpu, opts: StressOptions) -> Result<Vec<StressRow>> {
 
     let mut rig = StereoRig::demo(w, h);
     rig.ipd = 0.2;
-    for (fixation, label) in [(1e-4, "fixation 0.1 mm (convergence near zero)"), (1e6, "fixation 1000 km (parallel gaze)")] {
+    for (fixation, label) in [(1e-4, "fixation 0.1 mm (convergence near zero; nothing is reached)"), (1e6, "fixation 1000 km (parallel gaze)")] {
         rows.push(sweep(
             gpu,
             label,
@@ -186,11 +191,13 @@ pub fn rows(gpu: &Gpu, opts: StressOptions) -> Result<Vec<StressRow>> {
         "invalid eye depth is no surface: the other eye or nothing",
     )?);
 
-    // The middle camera 1.5 m ahead of the eyes: much of what they saw is behind it.
+    // The middle camera ~1.5 m ahead of the eyes: much of what they saw is behind it. Not at a
+    // round offset: at (0, 0, 0.5) with fixation 3 m the first guesses project exactly onto texel
+    // rows (a scale of 3 / 3.5), and f32 and f64 break those ties apart on ~2 % of pixels.
     let mut cases = scene_cases(&rig, &two, DepthKind::ViewZ);
     for c in &mut cases {
         c.mid.view = Pose {
-            position: [0.0, 0.0, 1.5],
+            position: [0.0123, -0.0071, 1.4629],
             ..Pose::IDENTITY
         }
         .gl_view();

@@ -12,7 +12,7 @@
 //!   ties that the tie window does not cover: 0.1 %.
 
 use super::{test_texture, GpuPixels, RefPixels, StressOptions, StressRow, Tally, Tolerance, EPS32};
-use crate::camera::{Intrinsics, MAX_IMAGE_SIDE};
+use crate::camera::{Intrinsics, PinholeCamera, MAX_IMAGE_SIDE};
 use crate::convention::Conventions;
 use crate::error::Result;
 use crate::gpu::Gpu;
@@ -66,6 +66,7 @@ fn sweep(gpu: &Gpu, case: &str, src: &RefocusSource, scales: &[f64], note: &str)
                     &RefPixels {
                         valid: reference.mask.clone(),
                         class: None,
+                        ties: Some(ties(src, t)),
                         depth: Some(&reference.depth),
                         rgb: &reference.rgb,
                     },
@@ -75,6 +76,25 @@ fn sweep(gpu: &Gpu, case: &str, src: &RefocusSource, scales: &[f64], note: &str)
         }
     }
     Ok(StressRow::from_tally("refocus", case, tally, TOL, note))
+}
+
+/// Target pixels whose exact source point lies on a grid line or a cell diagonal (within f64
+/// rounding of the mapping): which closed triangle owns them is a tie that f32 and f64 may break
+/// differently (e.g. scale 3 maps every third pixel onto exact thirds of a cell).
+fn ties(src: &RefocusSource, t: &PinholeCamera) -> Vec<bool> {
+    const EPS: f64 = 1e-9;
+    let near = |a: f64| (a - a.round()).abs() < EPS;
+    let mut out = Vec::with_capacity((t.width * t.height) as usize);
+    for y in 0..t.height {
+        for x in 0..t.width {
+            let [u, v] = crate::refocus::source_point(&src.k, &t.k, x as f64, y as f64);
+            let (fu, fv) = (u - u.floor(), v - v.floor());
+            out.push(
+                near(2.0 * u) || near(2.0 * v) || (fu - fv).abs() < EPS || (fu + fv - 1.0).abs() < EPS,
+            );
+        }
+    }
+    out
 }
 
 pub fn rows(gpu: &Gpu, opts: StressOptions) -> Result<Vec<StressRow>> {

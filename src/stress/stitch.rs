@@ -56,6 +56,7 @@ fn sweep(gpu: &Gpu, case: &str, cases: &[Case], note: &str) -> Result<StressRow>
                     &RefPixels {
                         valid: vec![true; n],
                         class: None,
+                        ties: None,
                         depth: None,
                         rgb: &reference,
                     },
