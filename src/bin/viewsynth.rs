@@ -37,6 +37,15 @@ enum Command {
     /// Synthesise the middle (spectator) view of a stereo pair from each eye's colour and depth.
     #[command(allow_negative_numbers = true)]
     Cyclopean(Box<CyclopeanArgs>),
+    /// Reproject one view of a parallel stereo rig (left eye, centre view or right eye) to the
+    /// other eye(s) from colour + depth (view Z, device depth or disparity); disocclusions stay
+    /// invalid (mask 0), nothing is hole-filled.
+    #[command(allow_negative_numbers = true)]
+    Reproject(Box<ReprojectArgs>),
+    /// Stitch an omni-directional stereo (ODS) 360 equirect (top-bottom, left eye on top) from
+    /// six over-wide cube faces per eye: the built-in scene's, or your own from --faces DIR.
+    #[command(allow_negative_numbers = true)]
+    Stitch(Box<StitchArgs>),
     /// Ray-trace a ground-truth scene (built-in or JSON) on the GPU from a stereo rig: left, right
     /// and middle colour, view distance and device depth, and a cameras.json that
     /// `viewsynth cyclopean` reads.
@@ -348,12 +357,191 @@ struct CyclopeanArgs {
     gpu: GpuArgs,
 }
 
+#[derive(Clone, Copy, ValueEnum, PartialEq)]
+enum ReprojectDepthArg {
+    /// View-space Z (distance along the optical axis) in metres; <= 0, NaN, inf = no depth.
+    #[value(alias = "metric")]
+    ViewZ,
+    /// Window depth in [0, 1] from a depth buffer, written with --near/--far under --ndc,
+    /// --reversed-z; the far value is background.
+    Device,
+    /// Disparity in pixels of a rectified pair (Middlebury): Z = baseline * focal / (d + doffs);
+    /// d <= 0 = unknown.
+    Disparity,
+}
+
+#[derive(Clone, Copy, ValueEnum, PartialEq)]
+enum FromArg {
+    Left,
+    #[value(alias = "center")]
+    Centre,
+    Right,
+}
+
+#[derive(Clone, Copy, ValueEnum, PartialEq)]
+enum ToArg {
+    Left,
+    Right,
+    /// Both eyes (from the centre view only).
+    Both,
+}
+
+#[derive(Clone, Copy, ValueEnum)]
+enum ReprojectMethodArg {
+    /// Fixed-point walk along the row (--steps) from two starts, verified by segment coverage.
+    Shift,
+    /// Exact: every segment the frame's depth range allows is tested, the nearest wins.
+    ShiftScan,
+    /// The cyclopean 3-D walk with one eye (--steps), from two starts.
+    Gather3d,
+}
+
+#[derive(Args)]
+struct ReprojectArgs {
+    /// Source colour (PNG, JPEG, PPM, EXR), rows top-down.
+    #[arg(long, visible_alias = "rgb")]
+    color: PathBuf,
+    /// Source depth (EXR, NPY, 16-bit PNG/PGM with --depth-scale, PFM), holding --depth-kind.
+    #[arg(long)]
+    depth: PathBuf,
+    #[arg(long, value_enum, default_value = "view-z")]
+    depth_kind: ReprojectDepthArg,
+    /// Raw units per unit of the depth file for integer files (1000 for mm, 4 for Middlebury 2003
+    /// disparity PGMs); divides float depth too when given.
+    #[arg(long)]
+    depth_scale: Option<f64>,
+    /// Near plane (metres) the device depth was written with (--depth-kind device).
+    #[arg(long)]
+    near: Option<f64>,
+    /// Far plane (metres; may be inf) the device depth was written with (--depth-kind device).
+    #[arg(long)]
+    far: Option<f64>,
+    /// Source intrinsics in pixels.
+    #[arg(long)]
+    fx: f64,
+    #[arg(long)]
+    fy: f64,
+    #[arg(long)]
+    cx: f64,
+    #[arg(long)]
+    cy: f64,
+    /// Rectified rig: distance between the eyes in metres (x_right = x_left + doffs - f B / Z).
+    /// Also the baseline of --depth-kind disparity.
+    #[arg(long)]
+    baseline: Option<f64>,
+    /// Focal length (pixels) of the rectified rig and of disparity (default: --fx).
+    #[arg(long)]
+    focal: Option<f64>,
+    /// cx_right - cx_left in pixels (Middlebury's doffs) of the rectified rig and of disparity.
+    #[arg(long, default_value_t = 0.0)]
+    doffs: f64,
+    /// Seed 004's rig instead of --baseline: separation = interaxial / screen width (texture
+    /// units; the eyes move +-S/2 (1 - c/Z) in texture x), with --convergence.
+    #[arg(long, requires = "convergence")]
+    separation: Option<f64>,
+    /// Zero-parallax distance c in metres (with --separation).
+    #[arg(long, requires = "separation")]
+    convergence: Option<f64>,
+    /// The source view.
+    #[arg(long, value_enum, default_value = "left")]
+    from: FromArg,
+    /// The target view(s).
+    #[arg(long, value_enum, default_value = "right")]
+    to: ToArg,
+    #[arg(long, value_enum, default_value = "shift-scan")]
+    method: ReprojectMethodArg,
+    /// Steps of the shift walk / 3-D gather (1..=16).
+    #[arg(long, default_value_t = 3)]
+    steps: u32,
+    /// A row segment breaks (an unseen surface) where |Z_a - Z_b| > tau_rel * min(Z_a, Z_b).
+    #[arg(long, default_value_t = 0.05)]
+    tau_rel: f64,
+    /// Outputs per target: any of rgb (or color), depth, mask.
+    #[arg(long, default_value = "rgb,depth,mask")]
+    outputs: String,
+    #[arg(long, value_enum, default_value = "png")]
+    rgb_format: RgbFormatArg,
+    /// Depth file formats: exr, npy or both.
+    #[arg(long, default_value = "exr")]
+    depth_format: String,
+    /// Writes <target>_rgb.png, <target>_depth.exr, <target>_mask.png (target = left, right).
+    #[arg(long)]
+    out_dir: PathBuf,
+    #[command(flatten)]
+    conv: ConventionArgs,
+    #[command(flatten)]
+    gpu: GpuArgs,
+}
+
+#[derive(Clone, Copy, ValueEnum)]
+enum StitchMethodArg {
+    /// Linear feather over the overlap.
+    Blend,
+    /// Seed 001's stitch with border weight.
+    BorderWeight,
+    /// Depth-aware reprojection along the ODS ray.
+    Reproject,
+}
+
+#[derive(Args)]
+struct StitchArgs {
+    /// Ray-trace the faces of a built-in scene (only `demo`, the scene of the ODS rig).
+    #[arg(long, required_unless_present = "faces", conflicts_with = "faces")]
+    scene: Option<String>,
+    /// Folder with the 12 faces: {left,right}_{pz,nz,px,nx,up,down}.png (colour) and
+    /// {left,right}_{pz,nz,px,nx,up,down}_depth.exr (view-space Z, 0/NaN/inf = background);
+    /// see README for the poses and orientations.
+    #[arg(long)]
+    faces: Option<PathBuf>,
+    /// Face field of view in degrees, in (90, 178) (default 90 + 2 x overlap).
+    #[arg(long)]
+    fov: Option<f64>,
+    /// Seam band half-width in degrees, in (0, (fov - 90) / 2] (default (fov - 90) / 2 with
+    /// --fov, else 10).
+    #[arg(long)]
+    overlap: Option<f64>,
+    #[arg(long, value_enum, default_value = "reproject")]
+    method: StitchMethodArg,
+    /// Equirect width per eye.
+    #[arg(long, default_value_t = 2048)]
+    width: u32,
+    /// Equirect height per eye (the top-bottom image is twice as high).
+    #[arg(long, default_value_t = 1024)]
+    height: u32,
+    /// Face side in pixels with --scene.
+    #[arg(long, default_value_t = 512)]
+    face_size: u32,
+    /// Interpupillary distance (metres, the faces' units).
+    #[arg(long, default_value_t = 0.064)]
+    ipd: f64,
+    /// Latitude (deg) above which the eye radius fades to 0 at the poles.
+    #[arg(long, default_value_t = 45.0)]
+    pole_fade: f64,
+    /// Raw units per metre for integer face depth files.
+    #[arg(long)]
+    depth_scale: Option<f64>,
+    /// Also write each eye's equirect (ods_left.png, ods_right.png).
+    #[arg(long)]
+    per_eye: bool,
+    /// With --scene: ray-trace the ODS ground truth and print PSNR on the seam band and the
+    /// whole image.
+    #[arg(long)]
+    truth: bool,
+    /// Writes ods_top_bottom.png (left eye on top).
+    #[arg(long)]
+    out_dir: PathBuf,
+    #[command(flatten)]
+    gpu: GpuArgs,
+}
+
 fn main() {
     let cli = Cli::parse();
     let result = match cli.command {
         Command::Info { gpu, json } => info(&gpu, json),
         Command::Refocus(args) => refocus(*args),
         Command::Cyclopean(args) => cyclopean(*args),
+        Command::Reproject(args) => reproject(*args),
+        Command::Stitch(args) => stitch(*args),
         Command::Compare(args) => compare(*args),
         Command::Demo { out_dir, gpu } => demo(&out_dir, &gpu),
         Command::Scene {
@@ -869,6 +1057,439 @@ fn stress(quick: bool, only: &[String], json: Option<&Path>, gpu: &GpuArgs) -> R
     }
     if let Some(r) = viewsynth::stress::first_failure(&rows) {
         anyhow::bail!("stress case failed: {} / {} ({})", r.capability, r.case, r.worst);
+    }
+    Ok(())
+}
+
+/// An output file and the function writing it.
+type WriteJob<'a> = (PathBuf, Box<dyn FnOnce(&Path) -> viewsynth::Result<()> + 'a>);
+
+/// Writes every file or none: on the first failure the files already written are removed
+/// (each write is atomic, so no partial file exists under a final name either).
+fn write_all_or_none(jobs: Vec<WriteJob<'_>>) -> Result<Vec<PathBuf>> {
+    let mut written = Vec::new();
+    for (path, write) in jobs {
+        if let Err(e) = write(&path) {
+            for p in &written {
+                let _ = std::fs::remove_file(p);
+            }
+            return Err(e.into());
+        }
+        written.push(path);
+    }
+    Ok(written)
+}
+
+fn ms_text(t: &viewsynth::gpu::Timing) -> String {
+    match t.gpu_ms {
+        Some(g) => format!("{:.1} ms wall, {g:.1} ms GPU", t.wall_ms),
+        None => format!("{:.1} ms wall", t.wall_ms),
+    }
+}
+
+fn reproject(a: ReprojectArgs) -> Result<()> {
+    use std::time::Instant;
+    use viewsynth::camera::stereo::{Eye, StereoParams};
+    use viewsynth::camera::PinholeCamera;
+    use viewsynth::convention::DepthPlanes;
+    use viewsynth::reproject::render::Reprojector;
+    use viewsynth::reproject::{DepthInput, Geometry, Method as RMethod, ReprojectParams, ReprojectSource, ShiftModel};
+
+    // Everything that can be checked before reading files, touching the GPU or the output
+    // directory is.
+    let k = Intrinsics {
+        fx: a.fx,
+        fy: a.fy,
+        cx: a.cx,
+        cy: a.cy,
+    };
+    k.validate("source intrinsics")?;
+    let from = match a.from {
+        FromArg::Left => Some(Eye::Left),
+        FromArg::Centre => None,
+        FromArg::Right => Some(Eye::Right),
+    };
+    let targets = match (a.from, a.to) {
+        (FromArg::Centre, ToArg::Both) => vec![Eye::Left, Eye::Right],
+        (_, ToArg::Both) => bail!("--to both needs --from centre (from an eye, the only other view is the other eye)"),
+        (FromArg::Left, ToArg::Left) | (FromArg::Right, ToArg::Right) => {
+            bail!("--to is the source view itself (--from): nothing to reproject")
+        }
+        (_, ToArg::Left) => vec![Eye::Left],
+        (_, ToArg::Right) => vec![Eye::Right],
+    };
+    let focal = a.focal.unwrap_or(a.fx);
+    let depth_kind = match a.depth_kind {
+        ReprojectDepthArg::ViewZ => DepthInput::ViewZ,
+        ReprojectDepthArg::Device => {
+            let (Some(near), Some(far)) = (a.near, a.far) else {
+                bail!("--depth-kind device needs --near and --far (the planes the depth buffer was written with)");
+            };
+            let kind = DepthInput::Device {
+                planes: DepthPlanes { near, far },
+            };
+            kind.validate().context("--near/--far")?;
+            kind
+        }
+        ReprojectDepthArg::Disparity => {
+            let Some(baseline) = a.baseline else {
+                bail!("--depth-kind disparity needs --baseline (metres; Z = baseline * focal / (d + doffs))");
+            };
+            let kind = DepthInput::Disparity {
+                focal_px: focal,
+                baseline,
+                doffs: a.doffs,
+            };
+            kind.validate()
+                .context("--depth-kind disparity: --focal/--baseline/--doffs")?;
+            kind
+        }
+    };
+    if a.depth_kind != ReprojectDepthArg::Device && (a.near.is_some() || a.far.is_some()) {
+        bail!("--near/--far apply to --depth-kind device only");
+    }
+    let seed = match (a.separation, a.convergence) {
+        (Some(s), Some(c)) => Some(StereoParams::new(s, c).context("--separation/--convergence")?),
+        _ => None,
+    };
+    if seed.is_none() && a.baseline.is_none() {
+        bail!("give the rig: --baseline B (rectified, metres) or --separation S --convergence C (seed 004)");
+    }
+    let method = match a.method {
+        ReprojectMethodArg::Shift => RMethod::Shift { steps: a.steps },
+        ReprojectMethodArg::ShiftScan => RMethod::ShiftScan,
+        ReprojectMethodArg::Gather3d => RMethod::Gather3d { steps: a.steps },
+    };
+    let params = ReprojectParams {
+        method,
+        tau_rel: a.tau_rel,
+    };
+    params.validate().context("--steps/--tau-rel")?;
+    let outputs = OutputSet::parse(&a.outputs.replace("colour", "rgb").replace("color", "rgb"))?;
+    let depth_formats = parse_depth_formats(&a.depth_format)?;
+    let rgb_ext = match a.rgb_format {
+        RgbFormatArg::Png => "png",
+        RgbFormatArg::Jpeg => "jpg",
+        RgbFormatArg::Exr => "exr",
+    };
+    let conv = a.conv.conventions();
+
+    let decode = DepthDecode {
+        scale: a.depth_scale,
+        ..Default::default()
+    };
+    let src = ReprojectSource {
+        color: io::load_rgb(&a.color)?,
+        depth: io::load_depth(&a.depth, &decode)?,
+        depth_kind,
+        conv,
+    };
+    src.validate()
+        .with_context(|| format!("{} and {}", a.color.display(), a.depth.display()))?;
+    if src.inverse_depth_range().is_none() {
+        bail!(
+            "{}: no pixel holds valid depth as --depth-kind {} (check --depth-kind, --depth-scale, --near/--far, conventions)",
+            a.depth.display(),
+            a.depth_kind.to_possible_value().map_or_else(String::new, |v| v.get_name().to_string())
+        );
+    }
+    let camera = PinholeCamera {
+        k,
+        width: src.color.width,
+        height: src.color.height,
+    };
+    camera.validate("source intrinsics")?;
+    let mut geometries = Vec::new();
+    for &to in &targets {
+        let shift = match (&seed, a.baseline) {
+            (Some(p), _) => ShiftModel::seed(p, camera.width, from, Some(to)),
+            (None, Some(b)) => {
+                ShiftModel::rectified(focal, b, a.doffs, from, Some(to)).context("--focal/--baseline/--doffs")?
+            }
+            (None, None) => unreachable!("checked above"),
+        };
+        shift.validate()?;
+        geometries.push(Geometry::Rig { camera, shift });
+    }
+    prepare_out_dir(&a.out_dir)?;
+
+    let gpu = a.gpu.open()?;
+    let mut results = Vec::new();
+    for (&to, geometry) in targets.iter().zip(&geometries) {
+        let t0 = Instant::now();
+        let mut r = Reprojector::new(&gpu, &src, geometry, params)?;
+        let setup_ms = t0.elapsed().as_secs_f64() * 1e3;
+        let (out, timing) = r.render()?;
+        results.push((to, out, timing, setup_ms));
+    }
+    let mut jobs: Vec<WriteJob> = Vec::new();
+    for (to, out, _, _) in &results {
+        let name = eye_name(Some(*to));
+        if outputs.rgb {
+            jobs.push((
+                a.out_dir.join(format!("{name}_rgb.{rgb_ext}")),
+                Box::new(move |p: &Path| io::save_rgb(p, &out.color)),
+            ));
+        }
+        if outputs.depth && depth_formats.exr {
+            jobs.push((
+                a.out_dir.join(format!("{name}_depth.exr")),
+                Box::new(move |p: &Path| io::save_depth_exr(p, &out.depth)),
+            ));
+        }
+        if outputs.depth && depth_formats.npy {
+            jobs.push((
+                a.out_dir.join(format!("{name}_depth.npy")),
+                Box::new(move |p: &Path| io::save_depth_npy(p, &out.depth)),
+            ));
+        }
+        if outputs.mask {
+            jobs.push((
+                a.out_dir.join(format!("{name}_mask.png")),
+                Box::new(move |p: &Path| {
+                    let bits = out.mask.iter().map(|m| (*m != 0) as u8).collect();
+                    io::save_mask_png(p, &io::Mask::new(out.color.width, out.color.height, bits)?)
+                }),
+            ));
+        }
+    }
+    let written = write_all_or_none(jobs)?;
+    for (to, out, timing, setup_ms) in &results {
+        println!(
+            "{} -> {} ({}): {}x{}, coverage {:.2} %, render {} (setup + shader compile {setup_ms:.1} ms)",
+            eye_name(from),
+            eye_name(Some(*to)),
+            params.method.label(),
+            out.color.width,
+            out.color.height,
+            out.coverage() * 100.0,
+            ms_text(timing),
+        );
+    }
+    let names: Vec<String> = written
+        .iter()
+        .filter_map(|p| p.file_name().map(|n| n.to_string_lossy().into_owned()))
+        .collect();
+    println!("wrote {} in {}", names.join(", "), a.out_dir.display());
+    Ok(())
+}
+
+fn eye_name(view: Option<viewsynth::camera::stereo::Eye>) -> &'static str {
+    use viewsynth::camera::stereo::Eye;
+    match view {
+        Some(Eye::Left) => "left",
+        Some(Eye::Right) => "right",
+        None => "centre",
+    }
+}
+
+/// File name tags of the cube faces in `--faces DIR`, in [`viewsynth::stitch::CubeFace::ALL`]
+/// order (+Z, -Z, up, down, +X, -X).
+const FACE_TAGS: [&str; 6] = ["pz", "nz", "up", "down", "px", "nx"];
+const FACE_COLOR_EXTS: [&str; 5] = ["png", "jpg", "jpeg", "ppm", "exr"];
+const FACE_DEPTH_EXTS: [&str; 4] = ["exr", "npy", "pfm", "png"];
+
+/// `dir/stem.ext` for the first extension that exists; the error names the first candidate.
+fn find_face_file(dir: &Path, stem: &str, exts: &[&str], what: &str) -> Result<PathBuf> {
+    for e in exts {
+        let p = dir.join(format!("{stem}.{e}"));
+        if p.is_file() {
+            return Ok(p);
+        }
+    }
+    bail!(
+        "--faces: missing {} ({what}; also looked for .{})",
+        dir.join(format!("{stem}.{}", exts[0])).display(),
+        exts[1..].join(", .")
+    )
+}
+
+fn stitch(a: StitchArgs) -> Result<()> {
+    use std::time::Instant;
+    use viewsynth::stitch::eval::{score_eyes, split_top_bottom};
+    use viewsynth::stitch::faces::{faces_from_images, scene_faces};
+    use viewsynth::stitch::render::StitchRenderer;
+    use viewsynth::stitch::truth::ods_truth;
+    use viewsynth::stitch::{seam_band_mask, CubeFace, FaceSet, Method as SMethod, OdsRig, Side, StitchParams};
+
+    if let (None, Some(o)) = (a.fov, a.overlap) {
+        if !(o > 0.0 && o < 44.0) {
+            bail!("--overlap {o}: must be in (0, 44) degrees (faces of 90 + 2 x overlap; or give --fov)");
+        }
+    }
+    let (fov, overlap) = match (a.fov, a.overlap) {
+        (None, None) => (110.0, 10.0),
+        (Some(f), None) => (f, 0.5 * (f - 90.0)),
+        (None, Some(o)) => (90.0 + 2.0 * o, o),
+        (Some(f), Some(o)) => (f, o),
+    };
+    if !(fov > 90.0 && fov < 178.0) {
+        bail!("--fov {fov}: the face field of view must be in (90, 178) degrees");
+    }
+    let rig = match &a.scene {
+        Some(name) if name == "demo" => OdsRig {
+            ipd: a.ipd,
+            pole_fade_start_deg: a.pole_fade,
+            ..OdsRig::demo()
+        },
+        Some(name) => {
+            bail!("--scene '{name}': only the built-in `demo` scene has cube faces (use --faces DIR for your own)")
+        }
+        // The circle centre only translates the face eyes and the ODS rays together.
+        None => OdsRig {
+            centre: [0.0; 3],
+            ipd: a.ipd,
+            pole_fade_start_deg: a.pole_fade,
+        },
+    };
+    rig.validate().context("--ipd/--pole-fade")?;
+    if a.truth && a.scene.is_none() {
+        bail!("--truth needs --scene demo (the ground truth is ray-traced from the built-in scene)");
+    }
+    let method = match a.method {
+        StitchMethodArg::Blend => SMethod::Blend,
+        StitchMethodArg::BorderWeight => SMethod::BorderWeight,
+        StitchMethodArg::Reproject => SMethod::Reproject,
+    };
+    let params = StitchParams {
+        method,
+        overlap_deg: overlap,
+        width: a.width,
+        height: a.height,
+    };
+    let template = FaceSet {
+        rig,
+        side: Side::Left,
+        fov_deg: fov,
+        faces: Vec::new(),
+    };
+    params.validate(&template).context("--overlap/--fov/--width/--height")?;
+    if 2 * a.height as u64 > viewsynth::io::MAX_DIMENSION as u64 {
+        bail!(
+            "--height {}: the top-bottom image ({} rows) exceeds {}",
+            a.height,
+            2 * a.height,
+            viewsynth::io::MAX_DIMENSION
+        );
+    }
+
+    let t0 = Instant::now();
+    let (left, right, source) = if let Some(dir) = &a.faces {
+        if !dir.is_dir() {
+            bail!("--faces {}: not a directory", dir.display());
+        }
+        let decode = DepthDecode {
+            scale: a.depth_scale,
+            ..Default::default()
+        };
+        let load = |side: Side| -> Result<FaceSet> {
+            let eye = match side {
+                Side::Left => "left",
+                Side::Right => "right",
+            };
+            let mut images = Vec::new();
+            for (face, tag) in CubeFace::ALL.iter().zip(FACE_TAGS) {
+                let what = format!("the {eye} eye's {} face", face.label());
+                let c = find_face_file(
+                    dir,
+                    &format!("{eye}_{tag}"),
+                    &FACE_COLOR_EXTS,
+                    &format!("colour of {what}"),
+                )?;
+                let d = find_face_file(
+                    dir,
+                    &format!("{eye}_{tag}_depth"),
+                    &FACE_DEPTH_EXTS,
+                    &format!("view-space Z of {what}"),
+                )?;
+                images.push((io::load_rgb(&c)?, io::load_depth(&d, &decode)?));
+            }
+            faces_from_images(&rig, side, fov, images).with_context(|| format!("--faces {}: {eye} eye", dir.display()))
+        };
+        let (l, r) = (load(Side::Left)?, load(Side::Right)?);
+        if l.size() != r.size() {
+            bail!(
+                "--faces {}: size mismatch: left faces {n}x{n}, right faces {m}x{m}",
+                dir.display(),
+                n = l.size(),
+                m = r.size()
+            );
+        }
+        let what = format!("loaded 12 faces of {n}x{n} from {}", dir.display(), n = l.size());
+        (l, r, what)
+    } else {
+        let n = a.face_size;
+        let l = scene_faces(&rig, Side::Left, n, fov).context("--face-size")?;
+        let r = scene_faces(&rig, Side::Right, n, fov).context("--face-size")?;
+        (l, r, format!("ray-traced 12 faces of {n}x{n} (CPU)"))
+    };
+    let faces_ms = t0.elapsed().as_secs_f64() * 1e3;
+    prepare_out_dir(&a.out_dir)?;
+
+    let gpu = a.gpu.open()?;
+    let t0 = Instant::now();
+    let mut renderer = StitchRenderer::new(&gpu, &left, &right)?;
+    let setup_ms = t0.elapsed().as_secs_f64() * 1e3;
+    let (img, timing) = renderer.render(&params)?;
+    let eyes = if a.per_eye {
+        let half = img.data.len() / 2;
+        Some([
+            io::RgbImage::new(a.width, a.height, img.data[..half].to_vec())?,
+            io::RgbImage::new(a.width, a.height, img.data[half..].to_vec())?,
+        ])
+    } else {
+        None
+    };
+    let mut jobs: Vec<WriteJob> = vec![(
+        a.out_dir.join("ods_top_bottom.png"),
+        Box::new(|p: &Path| io::save_rgb(p, &img)),
+    )];
+    if let Some([l, r]) = &eyes {
+        jobs.push((
+            a.out_dir.join("ods_left.png"),
+            Box::new(move |p: &Path| io::save_rgb(p, l)),
+        ));
+        jobs.push((
+            a.out_dir.join("ods_right.png"),
+            Box::new(move |p: &Path| io::save_rgb(p, r)),
+        ));
+    }
+    let written = write_all_or_none(jobs)?;
+    println!("faces: {source}, FOV {fov} deg, in {faces_ms:.0} ms");
+    println!("upload + shader compile {setup_ms:.1} ms");
+    println!(
+        "stitch ({}, overlap {overlap} deg, IPD {} m): {}x{} per eye, top-bottom {}x{}, render {}",
+        method.label(),
+        rig.ipd,
+        a.width,
+        a.height,
+        img.width,
+        img.height,
+        ms_text(&timing)
+    );
+    if a.truth {
+        let t0 = Instant::now();
+        let (tl, tr) = std::thread::scope(|s| {
+            let l = s.spawn(|| ods_truth(&rig, Side::Left, a.width, a.height));
+            let r = ods_truth(&rig, Side::Right, a.width, a.height);
+            (l.join().expect("ODS truth does not panic"), r)
+        });
+        let (tl, tr) = (tl?, tr?);
+        let [el, er] = split_top_bottom(&img);
+        let band = seam_band_mask(a.width, a.height, overlap);
+        let s = score_eyes([&el, &er], [&tl, &tr], &band);
+        println!(
+            "vs ODS ground truth (ray-traced in {:.0} ms): seam band PSNR {:.2} dB (MAE {:.2}, {} px per eye), whole image PSNR {:.2} dB (MAE {:.2})",
+            t0.elapsed().as_secs_f64() * 1e3,
+            s.seam_psnr_db,
+            s.seam_mae,
+            s.seam_pixels,
+            s.whole_psnr_db,
+            s.whole_mae
+        );
+    }
+    for p in &written {
+        println!("wrote {}", p.display());
     }
     Ok(())
 }

@@ -6,11 +6,11 @@ use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 use viewsynth::io::{self, DepthMap, RgbImage};
 
-fn bin() -> Command {
+pub(crate) fn bin() -> Command {
     Command::new(env!("CARGO_BIN_EXE_viewsynth"))
 }
 
-fn scratch(name: &str) -> PathBuf {
+pub(crate) fn scratch(name: &str) -> PathBuf {
     let d = std::env::temp_dir().join(format!("viewsynth-cli-{}-{name}", std::process::id()));
     let _ = std::fs::remove_dir_all(&d);
     std::fs::create_dir_all(&d).unwrap();
@@ -41,7 +41,7 @@ fn refocus(rgb: &Path, depth: &Path, out: &Path, extra: &[&str]) -> Output {
     c.output().expect("run viewsynth")
 }
 
-fn files_in(dir: &Path) -> Vec<String> {
+pub(crate) fn files_in(dir: &Path) -> Vec<String> {
     let mut v: Vec<String> = std::fs::read_dir(dir)
         .map(|r| {
             r.filter_map(|e| e.ok())
@@ -92,7 +92,7 @@ fn refocus_writes_requested_files_and_a_manifest() {
     assert_eq!(files_in(&only_depth), ["manifest.json", "s1_depth.exr"]);
 }
 
-fn assert_clean_failure(o: &Output, needle: &str, out: &Path) {
+pub(crate) fn assert_clean_failure(o: &Output, needle: &str, out: &Path) {
     let err = String::from_utf8_lossy(&o.stderr);
     assert_eq!(o.status.code(), Some(1), "stderr: {err}");
     assert!(
