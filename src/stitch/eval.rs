@@ -16,7 +16,18 @@ use std::time::Instant;
 /// Overlap widths (deg) evaluated; faces have FOV = 90 + 2 overlap.
 pub const OVERLAPS_DEG: [f64; 3] = [5.0, 10.0, 20.0];
 
-/// Colour error of a stereo equirect against the truth of both eyes.
+/// Truth ray distance (m) below which a seam pixel counts as near in [`StitchScore`].
+pub const NEAR_DISTANCE: f64 = 3.0;
+
+/// Colour error of a stereo equirect against the truth of both eyes (all averaged over both).
+///
+/// Besides PSNR and MAE: SSIM (Wang et al. 2004 on BT.601 luma, [`crate::ssim`], windows
+/// centred in the region, unrounded colour); `edge_mae`, the mean absolute difference of the luma
+/// gradients (central differences, longitude wrapping), which a misplaced or doubled edge raises;
+/// and `sharpness`, the summed luma gradient magnitude over the truth's (1 = as crisp as the
+/// truth; an average of two displaced images, the "double image" of a plain blend, is below 1).
+/// The seam band is also split by the truth's ray distance: near (a hit closer than
+/// [`NEAR_DISTANCE`]) and far (farther hits and background).
 #[derive(Debug, Clone, Copy, Default, serde::Serialize)]
 pub struct StitchScore {
     pub seam_psnr_db: f64,
@@ -24,12 +35,35 @@ pub struct StitchScore {
     pub whole_psnr_db: f64,
     pub whole_mae: f64,
     pub seam_pixels: usize,
+    pub seam_ssim: f64,
+    pub whole_ssim: f64,
+    pub seam_edge_mae: f64,
+    pub seam_sharpness: f64,
+    pub seam_near_psnr_db: f64,
+    pub seam_far_psnr_db: f64,
+    pub seam_near_pixels: usize,
+}
+
+fn luma(c: &[f64; 3]) -> f64 {
+    0.299 * c[0] + 0.587 * c[1] + 0.114 * c[2]
+}
+
+/// Luma gradient (d/du with longitude wrap, d/dv clamped) at pixel i of a w x h plane.
+fn gradient(y: &[f64], w: usize, h: usize, i: usize) -> [f64; 2] {
+    let (u, v) = (i % w, i / w);
+    let (l, r) = (v * w + (u + w - 1) % w, v * w + (u + 1) % w);
+    let (t, b) = (v.saturating_sub(1) * w + u, (v + 1).min(h - 1) * w + u);
+    [0.5 * (y[r] - y[l]), 0.5 * (y[b] - y[t])]
 }
 
 /// Score eye images (colour per pixel, 0..255) against the truth; `band` is one eye's mask.
 pub fn score_eyes(eyes: [&[[f64; 3]]; 2], truth: [&OdsTruth; 2], band: &[bool]) -> StitchScore {
-    let (mut sq, mut ab, mut n) = ([0.0; 2], [0.0; 2], [0usize; 2]);
+    // Regions: 0 seam, 1 whole, 2 seam near, 3 seam far.
+    let (mut sq, mut ab, mut n) = ([0.0; 4], [0.0; 4], [0usize; 4]);
+    let (mut edge, mut grad_out, mut grad_truth) = (0.0, 0.0, 0.0);
+    let (mut ssim, mut n_ssim) = ([0.0; 2], [0usize; 2]);
     for (eye, t) in eyes.iter().zip(truth) {
+        let (w, h) = (t.width as usize, t.height as usize);
         for (i, (c, tc)) in eye.iter().zip(&t.color).enumerate() {
             let (mut s, mut a) = (0.0, 0.0);
             for k in 0..3 {
@@ -37,7 +71,8 @@ pub fn score_eyes(eyes: [&[[f64; 3]]; 2], truth: [&OdsTruth; 2], band: &[bool]) 
                 s += d * d;
                 a += d.abs();
             }
-            for (r, inside) in [(0, band[i]), (1, true)] {
+            let near = t.distance[i] > 0.0 && t.distance[i] < NEAR_DISTANCE;
+            for (r, inside) in [(0, band[i]), (1, true), (2, band[i] && near), (3, band[i] && !near)] {
                 if inside {
                     sq[r] += s;
                     ab[r] += a;
@@ -45,15 +80,43 @@ pub fn score_eyes(eyes: [&[[f64; 3]]; 2], truth: [&OdsTruth; 2], band: &[bool]) 
                 }
             }
         }
+        let (yo, yt): (Vec<f64>, Vec<f64>) = eye.iter().zip(&t.color).map(|(c, tc)| (luma(c), luma(tc))).unzip();
+        for i in (0..w * h).filter(|&i| band[i]) {
+            let (go, gt) = (gradient(&yo, w, h, i), gradient(&yt, w, h, i));
+            edge += 0.5 * ((go[0] - gt[0]).abs() + (go[1] - gt[1]).abs());
+            grad_out += go[0].hypot(go[1]);
+            grad_truth += gt[0].hypot(gt[1]);
+        }
+        let kernel = crate::ssim::gaussian_kernel(crate::ssim::WINDOW, crate::ssim::SIGMA);
+        for (r, mask) in [(0, Some(band)), (1, None)] {
+            if let Some(v) = crate::ssim::ssim_luma(&yo, &yt, w, h, &kernel, mask) {
+                ssim[r] += v;
+                n_ssim[r] += 1;
+            }
+        }
     }
     let mse = |r: usize| sq[r] / (3 * n[r].max(1)) as f64;
     let mae = |r: usize| ab[r] / (3 * n[r].max(1)) as f64;
+    let ssim_mean = |r: usize| {
+        if n_ssim[r] > 0 {
+            ssim[r] / n_ssim[r] as f64
+        } else {
+            f64::NAN
+        }
+    };
     StitchScore {
         seam_psnr_db: metrics::psnr_from_mse(mse(0)),
         seam_mae: mae(0),
         whole_psnr_db: metrics::psnr_from_mse(mse(1)),
         whole_mae: mae(1),
         seam_pixels: n[0] / 2,
+        seam_ssim: ssim_mean(0),
+        whole_ssim: ssim_mean(1),
+        seam_edge_mae: edge / n[0].max(1) as f64,
+        seam_sharpness: grad_out / grad_truth.max(1e-30),
+        seam_near_psnr_db: metrics::psnr_from_mse(mse(2)),
+        seam_far_psnr_db: metrics::psnr_from_mse(mse(3)),
+        seam_near_pixels: n[2] / 2,
     }
 }
 
@@ -75,8 +138,10 @@ fn median(mut v: Vec<f64>) -> f64 {
 
 /// Rows for `viewsynth report`: per overlap (5, 10, 20 deg) and method, one row over the seam
 /// band and one over the whole image (PSNR against the ray-traced ODS truth, both eyes), with
-/// the GPU time of the stereo stitch (median of `repeats` after a warm-up, readback included).
-/// Faces 256 x 256, equirect 1024 x 512 per eye. Notes carry a Markdown table with MAE.
+/// the GPU time of the stereo stitch (median of `repeats` after a warm-up, readback included),
+/// and SSIM over the same region. Faces 256 x 256, equirect 1024 x 512 per eye. Notes carry a
+/// Markdown table with MAE, the seam band's edge error and sharpness ([`StitchScore`]) and its
+/// PSNR split by truth distance.
 pub fn stitch_rows(gpu: &Gpu, repeats: usize) -> Result<(Vec<ReportRow>, Vec<String>)> {
     let rig = OdsRig::demo();
     let (n, w, h) = (256, 1024, 512);
@@ -84,7 +149,8 @@ pub fn stitch_rows(gpu: &Gpu, repeats: usize) -> Result<(Vec<ReportRow>, Vec<Str
     let mut rows = Vec::new();
     let mut table = String::from(
         "stitch (ODS, IPD 0.064, faces 256^2, equirect 1024x512 per eye, both eyes)\n\n\
-         | overlap | method | seam PSNR dB | seam MAE | whole PSNR dB | whole MAE | ms |\n|---|---|---|---|---|---|---|\n",
+         | overlap | method | seam PSNR dB | seam MAE | whole PSNR dB | whole MAE | ms | seam SSIM | whole SSIM | seam edge MAE | seam sharpness | seam near PSNR dB | seam far PSNR dB |\n\
+         |---|---|---|---|---|---|---|---|---|---|---|---|---|\n",
     );
     for overlap in OVERLAPS_DEG {
         let fov = 90.0 + 2.0 * overlap;
@@ -107,7 +173,10 @@ pub fn stitch_rows(gpu: &Gpu, repeats: usize) -> Result<(Vec<ReportRow>, Vec<Str
             let ms = median(times);
             let eyes = split_top_bottom(&img);
             let s = score_eyes([&eyes[0], &eyes[1]], [&truth[0], &truth[1]], &band);
-            for (region, psnr) in [("seam", s.seam_psnr_db), ("whole", s.whole_psnr_db)] {
+            for (region, psnr, ssim) in [
+                ("seam", s.seam_psnr_db, s.seam_ssim),
+                ("whole", s.whole_psnr_db, s.whole_ssim),
+            ] {
                 let mut row = ReportRow::new(
                     "stitch",
                     "builtin:ods 1024x512",
@@ -116,16 +185,23 @@ pub fn stitch_rows(gpu: &Gpu, repeats: usize) -> Result<(Vec<ReportRow>, Vec<Str
                     ms,
                 );
                 row.psnr_db = Some(psnr);
+                row.ssim = Some(ssim);
                 rows.push(row);
             }
             let _ = writeln!(
                 table,
-                "| {overlap} | {} | {:.2} | {:.2} | {:.2} | {:.2} | {ms:.1} |",
+                "| {overlap} | {} | {:.2} | {:.2} | {:.2} | {:.2} | {ms:.1} | {:.4} | {:.4} | {:.3} | {:.3} | {:.2} | {:.2} |",
                 method.label(),
                 s.seam_psnr_db,
                 s.seam_mae,
                 s.whole_psnr_db,
-                s.whole_mae
+                s.whole_mae,
+                s.seam_ssim,
+                s.whole_ssim,
+                s.seam_edge_mae,
+                s.seam_sharpness,
+                s.seam_near_psnr_db,
+                s.seam_far_psnr_db
             );
         }
     }

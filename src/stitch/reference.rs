@@ -159,6 +159,17 @@ fn blend(faces: &[Face], pw: &PairWeight, d: V3) -> V3 {
     mix3(faces[pw.a].plain(d), faces[pw.b].plain(d), pw.w)
 }
 
+/// The seed's far guess of where surface point `iw`, seen by the face whose eye is `from`, would
+/// appear to the other face's eye `to`: `normalize((iw - from) + (to - from)) * FAR_DISTANCE + to`.
+/// With from = cPosMX, to = cPos this is the seed's `iwPos2` (`(iwPos - cPosMX) + dd`,
+/// dd = cPos - cPosMX); with from = cPos, to = cPosMX its `iwzPos2` (`(iwzPos - cPos) - dd`).
+/// Seen from `from`, the guess lies (within |to - from| / FAR_DISTANCE rad) along the direction
+/// in which `to` sees the point at the same range, `to + (iw - from)`: sampling the `from` face
+/// there warps it to the other eye, assuming the surface keeps its range.
+fn far_guess(iw: V3, from: V3, to: V3) -> V3 {
+    add(scale(normalize(add(sub(iw, from), sub(to, from))), FAR_DISTANCE), to)
+}
+
 /// Seed 001 "stitch with border weight" for one pixel of a pair's band: A is the seed's +Z face
 /// (eye cPos), B its -X face (eye cPosMX). Projections behind a face fall back to that face's
 /// sample at wPos.
@@ -174,13 +185,12 @@ fn border_weight(a: &Face, b: &Face, w: f64, d: V3) -> V3 {
     if za.is_none() && zb.is_none() {
         return scale(add(base_col, col2_plain), 0.5);
     }
-    let dd = sub(cpos, cposmx);
     let iwpos = b.unproject(pwx, zb);
-    let iwpos2 = add(scale(normalize(add(sub(iwpos, cposmx), dd)), FAR_DISTANCE), cpos);
+    let iwpos2 = far_guess(iwpos, cposmx, cpos);
     let wpos2 = add(scale(iwpos, w), scale(iwpos2, 1.0 - w));
     let col2 = b.project_point(wpos2).map_or(col2_plain, |uv| b.color(uv));
     let iwzpos = a.unproject(pwz, za);
-    let iwzpos2 = add(scale(normalize(sub(sub(iwzpos, cpos), dd)), FAR_DISTANCE), cposmx);
+    let iwzpos2 = far_guess(iwzpos, cpos, cposmx);
     let wzpos2 = add(scale(iwzpos, 1.0 - w), scale(iwzpos2, w));
     let col1 = a.project_point(wzpos2).map_or(base_col, |uv| a.color(uv));
     let mut col = add(scale(col2, w), scale(col1, 1.0 - w));
@@ -267,4 +277,27 @@ pub fn stitch_reference(set: &FaceSet, params: &StitchParams) -> Result<Vec<V3>>
         }
     }
     Ok(out)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn angle(a: V3, b: V3) -> f64 {
+        dot(normalize(a), normalize(b)).clamp(-1.0, 1.0).acos()
+    }
+
+    #[test]
+    fn the_seed_far_guess_warps_a_face_towards_the_other_eye() {
+        // Left-eye +Z (cPos) and -X (cPosMX) face eyes of the demo rig, a surface ~1.5 m away.
+        let (cpos, cposmx) = ([-0.032, 0.0, 1.6], [0.0, 0.0, 1.632]);
+        let x = [-1.2, 0.3, 2.5];
+        for (from, to) in [(cposmx, cpos), (cpos, cposmx)] {
+            let seen = sub(far_guess(x, from, to), from);
+            let want = sub(add(to, sub(x, from)), from);
+            // dd with the other sign would be off by ~2 |dd| / range = 0.04 rad.
+            assert!(angle(seen, want) < 1e-4, "{}", angle(seen, want));
+            assert!(angle(seen, sub(x, from)) > 1e-2);
+        }
+    }
 }
