@@ -119,7 +119,11 @@ enum Command {
         #[arg(long)]
         quick: bool,
         /// Capabilities to sweep.
-        #[arg(long, value_delimiter = ',', default_value = "camera,refocus,cyclopean,reproject,stitch")]
+        #[arg(
+            long,
+            value_delimiter = ',',
+            default_value = "camera,refocus,cyclopean,reproject,stitch"
+        )]
         only: Vec<String>,
         /// Also write the rows as JSON here.
         #[arg(long)]

@@ -169,7 +169,11 @@ fn parallax_row() -> StressRow {
         pass: non_finite == 0 && stats.is_none_or(|s| s.max <= tol.depth_rel) && refused,
         note: format!(
             "error in units of S (1 + c/Z); S = 0 gives exactly 0; Z <= 0 or NaN {}",
-            if refused { "is refused with an error" } else { "was NOT refused" }
+            if refused {
+                "is refused with an error"
+            } else {
+                "was NOT refused"
+            }
         ),
     }
 }

@@ -19,7 +19,7 @@ use crate::convention::{Conventions, DepthPlanes, NdcDepthRange};
 use crate::cyclopean::reference::cyclopean_reference;
 use crate::cyclopean::render::CyclopeanRenderer;
 use crate::cyclopean::scene_frame::{scene_frame, StereoRig};
-use crate::cyclopean::{CyclopeanParams, DepthKind, MiddleCamera, Method, StereoFrame};
+use crate::cyclopean::{CyclopeanParams, DepthKind, Method, MiddleCamera, StereoFrame};
 use crate::error::Result;
 use crate::gpu::Gpu;
 use crate::io::RgbImage;
@@ -114,7 +114,10 @@ pub fn rows(gpu: &Gpu, opts: StressOptions) -> Result<Vec<StressRow>> {
         rig.ipd = 0.2;
         rig.planes = DepthPlanes { near, far: 100.0 };
         let ratio = near / rig.planes.far;
-        for (convs, label, is_fine) in [(&lossy, "standard Z or GL range", false), (&fine, "reversed-Z [0,1]", true)] {
+        for (convs, label, is_fine) in [
+            (&lossy, "standard Z or GL range", false),
+            (&fine, "reversed-Z [0,1]", true),
+        ] {
             let b = bound(is_fine, DepthKind::Device, SCENE_Z_MAX, near);
             let by_design = !is_fine && b > 1e-4;
             let tol = if by_design {
@@ -157,7 +160,10 @@ pub fn rows(gpu: &Gpu, opts: StressOptions) -> Result<Vec<StressRow>> {
 
     let mut rig = StereoRig::demo(w, h);
     rig.ipd = 0.2;
-    for (fixation, label) in [(1e-4, "fixation 0.1 mm (convergence near zero; nothing is reached)"), (1e6, "fixation 1000 km (parallel gaze)")] {
+    for (fixation, label) in [
+        (1e-4, "fixation 0.1 mm (convergence near zero; nothing is reached)"),
+        (1e6, "fixation 1000 km (parallel gaze)"),
+    ] {
         rows.push(sweep(
             gpu,
             label,
@@ -228,7 +234,11 @@ pub fn rows(gpu: &Gpu, opts: StressOptions) -> Result<Vec<StressRow>> {
                     1e5 * (1.0 + 0.001 * x)
                 };
             }
-            eye.color = RgbImage::new(eye.color.width, eye.color.height, test_texture(eye.color.width, eye.color.height))?;
+            eye.color = RgbImage::new(
+                eye.color.width,
+                eye.color.height,
+                test_texture(eye.color.width, eye.color.height),
+            )?;
         }
         cases.push(Case {
             tag: conv.label(),
@@ -259,11 +269,19 @@ pub fn rows(gpu: &Gpu, opts: StressOptions) -> Result<Vec<StressRow>> {
             mid,
         });
     }
-    rows.push(sweep(gpu, &format!("middle view 1x1 and {max}x2"), &cases, 3.0, view_z_tol, "")?);
+    rows.push(sweep(
+        gpu,
+        &format!("middle view 1x1 and {max}x2"),
+        &cases,
+        3.0,
+        view_z_tol,
+        "",
+    )?);
     let (frame, mut mid, _) = scene_frame(&rig, all[7], DepthKind::ViewZ);
     mid.width = max + 1;
     mid.height = 1;
-    let r = CyclopeanRenderer::new(gpu, &frame, CyclopeanParams::seed(3.0)).and_then(|mut r| r.render(&mid).map(|_| ()));
+    let r =
+        CyclopeanRenderer::new(gpu, &frame, CyclopeanParams::seed(3.0)).and_then(|mut r| r.render(&mid).map(|_| ()));
     rows.push(refused("cyclopean", max + 1, r));
     Ok(rows)
 }

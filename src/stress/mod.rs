@@ -150,7 +150,8 @@ impl Tally {
             }
             if let (Some(zg), Some(zr)) = (gpu.depth, reference.depth) {
                 let rel = (zg[i] as f64 - zr[i]).abs() / zr[i].abs().max(f64::MIN_POSITIVE);
-                if !(rel <= tol.other_surface()) {
+                // NaN (a non-finite GPU depth) counts as another surface too.
+                if rel.is_nan() || rel > tol.other_surface() {
                     decisions += 1;
                     continue;
                 }
@@ -201,7 +202,7 @@ impl StressRow {
         let pass = t.non_finite == 0
             && (tol.by_design
                 || t.decisions as f64 <= tol.decisions * n
-            && t.colour_off as f64 <= tol.colour * n
+                    && t.colour_off as f64 <= tol.colour * n
                     && stats.is_none_or(|s| s.max <= tol.depth_rel));
         StressRow {
             capability,
@@ -289,9 +290,9 @@ pub fn table(rows: &[StressRow]) -> String {
          bound | NaN/Inf | worst sub-case | result | note |\n|---|---|---|---|---|---|---|---|---|---|---|---|---|\n",
     );
     for r in rows {
-        let (max, p99, p50) = r
-            .depth_rel
-            .map_or(("-".into(), "-".into(), "-".into()), |st| (sci(st.max), sci(st.p99), sci(st.p50)));
+        let (max, p99, p50) = r.depth_rel.map_or(("-".into(), "-".into(), "-".into()), |st| {
+            (sci(st.max), sci(st.p99), sci(st.p50))
+        });
         let decided = if r.ties > 0 {
             format!("{} (+{} on exact ties)", r.decisions, r.ties)
         } else {

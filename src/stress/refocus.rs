@@ -30,7 +30,10 @@ fn source(w: u32, h: u32, depth: impl Fn(u32, u32) -> f32) -> Result<RefocusSour
         cx: (w as f64 - 1.0) / 2.0,
         cy: (h as f64 - 1.0) / 2.0,
     };
-    let depth = (0..h).flat_map(|y| (0..w).map(move |x| (x, y))).map(|(x, y)| depth(x, y)).collect();
+    let depth = (0..h)
+        .flat_map(|y| (0..w).map(move |x| (x, y)))
+        .map(|(x, y)| depth(x, y))
+        .collect();
     RefocusSource::new(RgbImage::new(w, h, test_texture(w, h))?, DepthMap::new(w, h, depth)?, k)
 }
 
@@ -89,9 +92,7 @@ fn ties(src: &RefocusSource, t: &PinholeCamera) -> Vec<bool> {
         for x in 0..t.width {
             let [u, v] = crate::refocus::source_point(&src.k, &t.k, x as f64, y as f64);
             let (fu, fv) = (u - u.floor(), v - v.floor());
-            out.push(
-                near(2.0 * u) || near(2.0 * v) || (fu - fv).abs() < EPS || (fu + fv - 1.0).abs() < EPS,
-            );
+            out.push(near(2.0 * u) || near(2.0 * v) || (fu - fv).abs() < EPS || (fu + fv - 1.0).abs() < EPS);
         }
     }
     out
@@ -182,7 +183,13 @@ pub fn rows(gpu: &Gpu, opts: StressOptions) -> Result<Vec<StressRow>> {
     // The grid has a cell per pixel plus a border ring: (w + 1) cells must fit a texture.
     let max = (gpu.max_image_side() - 1).min(MAX_IMAGE_SIDE);
     let src = source(max, 2, |x, _| 1.0 + 1e-4 * x as f32)?;
-    rows.push(sweep(gpu, &format!("{max}x2 image (largest side)"), &src, &[0.5, 1.0], "")?);
+    rows.push(sweep(
+        gpu,
+        &format!("{max}x2 image (largest side)"),
+        &src,
+        &[0.5, 1.0],
+        "",
+    )?);
 
     let too_big = source(max + 1, 1, |_, _| 1.0).and_then(|src| {
         Refocuser::new(

@@ -113,8 +113,17 @@ fn scene_case(w: u32, h: u32, ipd: f64, planes: DepthPlanes, conv: Conventions, 
 }
 
 /// A synthetic source: test texture, depth from `depth`, stored as `kind`.
-fn synthetic(w: u32, h: u32, kind: DepthInput, conv: Conventions, depth: impl Fn(u32, u32) -> f32) -> Result<ReprojectSource> {
-    let data = (0..h).flat_map(|y| (0..w).map(move |x| (x, y))).map(|(x, y)| depth(x, y)).collect();
+fn synthetic(
+    w: u32,
+    h: u32,
+    kind: DepthInput,
+    conv: Conventions,
+    depth: impl Fn(u32, u32) -> f32,
+) -> Result<ReprojectSource> {
+    let data = (0..h)
+        .flat_map(|y| (0..w).map(move |x| (x, y)))
+        .map(|(x, y)| depth(x, y))
+        .collect();
     Ok(ReprojectSource {
         color: RgbImage::new(w, h, test_texture(w, h))?,
         depth: DepthMap::new(w, h, data)?,
@@ -189,7 +198,11 @@ pub fn rows(gpu: &Gpu, opts: StressOptions) -> Result<Vec<StressRow>> {
                 &format!(
                     "device depth, near/far {:.0e}, {}",
                     near / 100.0,
-                    if precise { "reversed-Z [0,1]" } else { "standard Z or GL range" }
+                    if precise {
+                        "reversed-Z [0,1]"
+                    } else {
+                        "standard Z or GL range"
+                    }
                 ),
                 &cases,
                 tol,
@@ -203,7 +216,10 @@ pub fn rows(gpu: &Gpu, opts: StressOptions) -> Result<Vec<StressRow>> {
     for conv in two {
         for (label, shift) in [
             ("S=0", seed_shift(w, 0.0, 1.0)?),
-            ("B=0", ShiftModel::rectified(100.0, 0.0, 0.0, Some(Eye::Left), Some(Eye::Right))?),
+            (
+                "B=0",
+                ShiftModel::rectified(100.0, 0.0, 0.0, Some(Eye::Left), Some(Eye::Right))?,
+            ),
         ] {
             cases.push(Case {
                 tag: format!("{} {label}", conv.label()),
@@ -215,7 +231,13 @@ pub fn rows(gpu: &Gpu, opts: StressOptions) -> Result<Vec<StressRow>> {
             });
         }
     }
-    rows.push(sweep(gpu, "zero separation / zero IPD", &cases, view_z, "the identity")?);
+    rows.push(sweep(
+        gpu,
+        "zero separation / zero IPD",
+        &cases,
+        view_z,
+        "the identity",
+    )?);
 
     let mut cases = Vec::new();
     for conv in two {

@@ -26,7 +26,10 @@ struct Case {
 
 fn faces(rig: &OdsRig, n: u32, overlap_deg: f64) -> Result<(FaceSet, FaceSet)> {
     let fov = 90.0 + 2.0 * overlap_deg;
-    Ok((scene_faces(rig, Side::Left, n, fov)?, scene_faces(rig, Side::Right, n, fov)?))
+    Ok((
+        scene_faces(rig, Side::Left, n, fov)?,
+        scene_faces(rig, Side::Right, n, fov)?,
+    ))
 }
 
 fn sweep(gpu: &Gpu, case: &str, cases: &[Case], note: &str) -> Result<StressRow> {
@@ -122,24 +125,20 @@ pub fn rows(gpu: &Gpu, opts: StressOptions) -> Result<Vec<StressRow>> {
     rows.push(sweep(
         gpu,
         "equirect 1x1 and 3x2, faces 2x2",
-        &[
-            case("1x1", &rig, 10.0, 1, 1)?,
-            case("3x2", &rig, 10.0, 3, 2)?,
-            {
-                let (left, right) = (
-                    scene_faces(&rig, Side::Left, 2, 110.0)?,
-                    scene_faces(&rig, Side::Right, 2, 110.0)?,
-                );
-                Case {
-                    tag: "faces2".into(),
-                    left,
-                    right,
-                    overlap_deg: 10.0,
-                    width: 16,
-                    height: 8,
-                }
-            },
-        ],
+        &[case("1x1", &rig, 10.0, 1, 1)?, case("3x2", &rig, 10.0, 3, 2)?, {
+            let (left, right) = (
+                scene_faces(&rig, Side::Left, 2, 110.0)?,
+                scene_faces(&rig, Side::Right, 2, 110.0)?,
+            );
+            Case {
+                tag: "faces2".into(),
+                left,
+                right,
+                overlap_deg: 10.0,
+                width: 16,
+                height: 8,
+            }
+        }],
         "",
     )?);
 

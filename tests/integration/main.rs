@@ -13,3 +13,4 @@ mod refocus_edge_cases;
 mod reproject;
 mod scene;
 mod stitch;
+mod stress;
