@@ -7,6 +7,11 @@
 //!   q = alpha d + beta: 8 eps Z_max / near except under reversed-Z with the [0, 1] range (as
 //!   cyclopean); at near/far 1e-7 under standard Z that is lost by design.
 //! - decisions (mask, or another surface won): 0.1 % of pixels; colour > 1 level: 0.1 %.
+//!
+//! Constants are generic (IPD 0.2011 m, doffs 3.4771, ...): round ones map source columns
+//! exactly onto target pixel centres or texel borders, where f32 and f64 break ties apart.
+//! Ties that remain by nature (a 100 km surface moving by less than an f32 ulp) are counted
+//! apart ([`shift_ties`]).
 
 use super::refocus::refused;
 use super::{test_texture, GpuPixels, RefPixels, StressOptions, StressRow, Tally, Tolerance, EPS32};
@@ -183,7 +188,7 @@ pub fn rows(gpu: &Gpu, opts: StressOptions) -> Result<Vec<StressRow>> {
             };
             let cases = convs
                 .iter()
-                .map(|&c| scene_case(w, h, 0.2, planes, c, DepthKind::Device))
+                .map(|&c| scene_case(w, h, 0.2011, planes, c, DepthKind::Device))
                 .collect::<Result<Vec<_>>>()?;
             let note = if by_design {
                 format!(
