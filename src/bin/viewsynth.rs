@@ -199,6 +199,31 @@ enum RgbFormatArg {
     Exr,
 }
 
+/// Which outputs to write and in which file formats (refocus, batch and reproject).
+#[derive(Args, Clone)]
+struct FileOutputArgs {
+    /// Outputs to produce: any of rgb (or color), depth, mask.
+    #[arg(long, default_value = "rgb,depth,mask")]
+    outputs: String,
+    #[arg(long, value_enum, default_value = "png")]
+    rgb_format: RgbFormatArg,
+    /// Depth file formats: exr, npy or both.
+    #[arg(long, default_value = "exr")]
+    depth_format: String,
+}
+
+impl FileOutputArgs {
+    fn parse(&self) -> Result<(OutputSet, RgbFormat, DepthFormats)> {
+        let outputs = OutputSet::parse(&self.outputs.replace("colour", "rgb").replace("color", "rgb"))?;
+        let rgb = match self.rgb_format {
+            RgbFormatArg::Png => RgbFormat::Png,
+            RgbFormatArg::Jpeg => RgbFormat::Jpeg,
+            RgbFormatArg::Exr => RgbFormat::Exr,
+        };
+        Ok((outputs, rgb, parse_depth_formats(&self.depth_format)?))
+    }
+}
+
 #[derive(Args)]
 struct RefocusArgs {
     /// Source colour (PNG, JPEG, PPM, EXR).
@@ -255,14 +280,8 @@ struct RefocusArgs {
     cx_out: Option<f64>,
     #[arg(long, requires = "cx_out")]
     cy_out: Option<f64>,
-    /// Outputs to produce: any of rgb, depth, mask.
-    #[arg(long, default_value = "rgb,depth,mask")]
-    outputs: String,
-    #[arg(long, value_enum, default_value = "png")]
-    rgb_format: RgbFormatArg,
-    /// Depth file formats: exr, npy or both.
-    #[arg(long, default_value = "exr")]
-    depth_format: String,
+    #[command(flatten)]
+    files: FileOutputArgs,
     #[arg(long, value_enum, default_value = "fullscreen")]
     method: MethodArg,
     #[command(flatten)]
@@ -460,14 +479,8 @@ struct ReprojectArgs {
     /// A row segment breaks (an unseen surface) where |Z_a - Z_b| > tau_rel * min(Z_a, Z_b).
     #[arg(long, default_value_t = 0.05)]
     tau_rel: f64,
-    /// Outputs per target: any of rgb (or color), depth, mask.
-    #[arg(long, default_value = "rgb,depth,mask")]
-    outputs: String,
-    #[arg(long, value_enum, default_value = "png")]
-    rgb_format: RgbFormatArg,
-    /// Depth file formats: exr, npy or both.
-    #[arg(long, default_value = "exr")]
-    depth_format: String,
+    #[command(flatten)]
+    files: FileOutputArgs,
     /// Writes <target>_rgb.png, <target>_depth.exr, <target>_mask.png (target = left, right).
     #[arg(long)]
     out_dir: PathBuf,
@@ -637,17 +650,11 @@ fn refocus(a: RefocusArgs) -> Result<()> {
         tau_abs: a.tau_abs,
     };
     rule.validate()?;
-    let outputs = OutputSet::parse(&a.outputs)?;
-    let depth_formats = parse_depth_formats(&a.depth_format)?;
+    let (outputs, rgb_format, depth_formats) = a.files.parse()?;
     let conv = a.conv.conventions();
     let method = match a.method {
         MethodArg::Mesh => Method::Mesh,
         MethodArg::Fullscreen => Method::Fullscreen,
-    };
-    let rgb_format = match a.rgb_format {
-        RgbFormatArg::Png => RgbFormat::Png,
-        RgbFormatArg::Jpeg => RgbFormat::Jpeg,
-        RgbFormatArg::Exr => RgbFormat::Exr,
     };
     let rgb = io::load_rgb(&rgb_path)?;
     let decode = DepthDecode {
@@ -896,6 +903,7 @@ fn refocus_batch(manifest: &Path, a: RefocusArgs) -> Result<()> {
         bail!("--focal-list is per frame; with --batch give --zoom-range scales");
     }
     let frames = load_manifest(manifest)?;
+    let (outputs, rgb_format, depth_formats) = a.files.parse()?;
     let opts = BatchOptions {
         scales: a.zoom_range.clone(),
         size: a.width_out.zip(a.height_out),
@@ -908,14 +916,10 @@ fn refocus_batch(manifest: &Path, a: RefocusArgs) -> Result<()> {
             MethodArg::Mesh => Method::Mesh,
             MethodArg::Fullscreen => Method::Fullscreen,
         },
-        outputs: OutputSet::parse(&a.outputs)?,
+        outputs,
         conv: a.conv.conventions(),
-        rgb_format: match a.rgb_format {
-            RgbFormatArg::Png => RgbFormat::Png,
-            RgbFormatArg::Jpeg => RgbFormat::Jpeg,
-            RgbFormatArg::Exr => RgbFormat::Exr,
-        },
-        depth_formats: parse_depth_formats(&a.depth_format)?,
+        rgb_format,
+        depth_formats,
         resume: !a.no_resume,
         writer_threads: a.writer_threads,
     };
@@ -1169,13 +1173,8 @@ fn reproject(a: ReprojectArgs) -> Result<()> {
         tau_rel: a.tau_rel,
     };
     params.validate().context("--steps/--tau-rel")?;
-    let outputs = OutputSet::parse(&a.outputs.replace("colour", "rgb").replace("color", "rgb"))?;
-    let depth_formats = parse_depth_formats(&a.depth_format)?;
-    let rgb_ext = match a.rgb_format {
-        RgbFormatArg::Png => "png",
-        RgbFormatArg::Jpeg => "jpg",
-        RgbFormatArg::Exr => "exr",
-    };
+    let (outputs, rgb_format, depth_formats) = a.files.parse()?;
+    let rgb_ext = rgb_format.extension();
     let conv = a.conv.conventions();
 
     let decode = DepthDecode {
