@@ -1,6 +1,6 @@
 //! viewsynth: headless GPU view synthesis from RGB-D and stereo images.
 //!
-//! Library first: every capability is a typed API here; `src/bin/viewsynth.rs` is a thin CLI.
+//! Library first: every capability is a typed API here; `src/bin/viewsynth/` is a thin CLI (one file per command).
 //! - [`gpu`]: EGL context and RAII GL resources.
 //! - [`convention`]: NDC depth range, reversed-Z and row order as runtime switches.
 //! - [`camera`]: intrinsics and projections.

@@ -1,0 +1,117 @@
+//! `viewsynth cyclopean`: arguments and the call into viewsynth::cyclopean.
+
+use super::*;
+
+#[derive(Clone, Copy, ValueEnum)]
+pub(crate) enum BlendArg {
+    Hard,
+    Soft,
+}
+
+#[derive(Args)]
+pub(crate) struct CyclopeanArgs {
+    #[arg(long)]
+    left_rgb: PathBuf,
+    /// Left depth: device (window) depth or view distance, as `depth_kind` in the camera file.
+    #[arg(long)]
+    left_depth: PathBuf,
+    #[arg(long)]
+    right_rgb: PathBuf,
+    #[arg(long)]
+    right_depth: PathBuf,
+    /// Camera JSON: per-eye view/projection, middle projection and size, gaze or fixation,
+    /// conventions, depth kind (see src/cyclopean/camera_file.rs).
+    #[arg(long)]
+    cameras: PathBuf,
+    /// Raw units per unit of depth for integer depth files.
+    #[arg(long)]
+    depth_scale: Option<f64>,
+    /// 0 = the seed's single step; k >= 1 = k-step refinement with projection check.
+    #[arg(long, default_value_t = 3)]
+    refine_steps: u32,
+    #[arg(long, value_enum, default_value = "hard")]
+    blend: BlendArg,
+    /// Middle-space depth disagreement (metres) treated as different surfaces (default: the
+    /// seed's clamp(0.02 * fixation, 0.02, 0.25)).
+    #[arg(long)]
+    z_threshold: Option<f64>,
+    /// Dominant eye and its blend weight, e.g. `left:0.7`.
+    #[arg(long)]
+    dominant: Option<String>,
+    #[arg(long)]
+    out_dir: PathBuf,
+    #[command(flatten)]
+    gpu: GpuArgs,
+}
+
+pub(crate) fn cyclopean(a: CyclopeanArgs) -> Result<()> {
+    use viewsynth::cyclopean::camera_file::CameraFile;
+    use viewsynth::cyclopean::render::CyclopeanRenderer;
+    use viewsynth::cyclopean::{Blend, CyclopeanParams, Eye, EyeInput, Method as CMethod, StereoFrame};
+    let cams = CameraFile::load(&a.cameras)?;
+    let (mid, fixation) = cams.middle_and_fixation()?;
+    let mut params = CyclopeanParams::seed(fixation);
+    if a.refine_steps > 0 {
+        params.method = CMethod::Refine { steps: a.refine_steps };
+    }
+    params.blend = match a.blend {
+        BlendArg::Hard => Blend::Hard,
+        BlendArg::Soft => Blend::Soft,
+    };
+    if let Some(t) = a.z_threshold {
+        params.z_threshold = t;
+    }
+    if let Some(d) = &a.dominant {
+        let (eye, w) = d
+            .split_once(':')
+            .with_context(|| format!("--dominant '{d}': expected left:W or right:W"))?;
+        let eye = match eye {
+            "left" => Eye::Left,
+            "right" => Eye::Right,
+            _ => bail!("--dominant '{d}': eye must be left or right"),
+        };
+        params.dominant = Some((eye, w.parse().with_context(|| format!("--dominant '{d}': weight"))?));
+    }
+    params.validate()?;
+    let decode = DepthDecode {
+        scale: a.depth_scale,
+        ..Default::default()
+    };
+    let eye = |rgb: &Path, depth: &Path, cam: &viewsynth::cyclopean::camera_file::EyeCameras| -> Result<EyeInput> {
+        Ok(EyeInput {
+            color: io::load_rgb(rgb)?,
+            depth: io::load_depth(depth, &decode)?,
+            view: cam.view,
+            proj: cam.proj,
+        })
+    };
+    let frame = StereoFrame {
+        left: eye(&a.left_rgb, &a.left_depth, &cams.left)?,
+        right: eye(&a.right_rgb, &a.right_depth, &cams.right)?,
+        depth_kind: cams.depth_kind,
+        conv: cams.conventions,
+    };
+    frame.validate()?;
+    prepare_out_dir(&a.out_dir)?;
+    let gpu = a.gpu.open()?;
+    let (out, timing) = CyclopeanRenderer::new(&gpu, &frame, params)?.render(&mid)?;
+    io::save_rgb(&a.out_dir.join("middle_rgb.png"), &out.color)?;
+    io::save_depth_exr(&a.out_dir.join("middle_depth.exr"), &out.depth)?;
+    let mask = io::Mask::new(
+        mid.width,
+        mid.height,
+        out.sources.iter().map(|s| (*s != 0) as u8).collect(),
+    )?;
+    io::save_mask_png(&a.out_dir.join("middle_mask.png"), &mask)?;
+    let valid = out.sources.iter().filter(|s| **s != 0).count();
+    println!(
+        "middle view {}x{}: fixation {:.3} m, {:.1} % valid, render {:.1} ms; wrote middle_rgb.png, middle_depth.exr, middle_mask.png in {}",
+        mid.width,
+        mid.height,
+        fixation,
+        valid as f64 / out.sources.len() as f64 * 100.0,
+        timing.wall_ms,
+        a.out_dir.display()
+    );
+    Ok(())
+}

@@ -1,0 +1,442 @@
+//! viewsynth command line: parse and validate arguments, call the library. anyhow lives here only.
+
+use anyhow::{bail, Context, Result};
+use clap::{Args, Parser, Subcommand, ValueEnum};
+use std::path::{Path, PathBuf};
+use viewsynth::camera::Intrinsics;
+use viewsynth::convention::{Conventions, NdcDepthRange, RowOrder};
+use viewsynth::gpu::{DeviceChoice, Gpu};
+use viewsynth::io::{self, DepthDecode};
+use viewsynth::refocus::job::{self, DepthFormats, Manifest, RgbFormat, TargetSpec};
+use viewsynth::refocus::{BreakRule, Method, OutputSet, RefocusSource, Refocuser};
+
+mod compare;
+mod cyclopean;
+mod refocus;
+mod reproject;
+mod scene;
+mod stitch;
+
+use compare::{compare, CompareArgs};
+use cyclopean::{cyclopean, CyclopeanArgs};
+use refocus::{refocus, RefocusArgs};
+use reproject::{reproject, ReprojectArgs};
+use scene::render_scene;
+use stitch::{stitch, StitchArgs};
+
+#[derive(Parser)]
+#[command(
+    name = "viewsynth",
+    version,
+    about = "Headless GPU view synthesis from RGB-D and stereo images"
+)]
+struct Cli {
+    #[command(subcommand)]
+    command: Command,
+}
+
+#[derive(Subcommand)]
+enum Command {
+    /// Print the GPU, GL version, EGL platform/device and limits this machine renders with.
+    Info {
+        #[command(flatten)]
+        gpu: GpuArgs,
+        /// Print JSON instead of text.
+        #[arg(long)]
+        json: bool,
+    },
+    /// Re-render RGB + metric depth at other focal lengths (same pose).
+    #[command(allow_negative_numbers = true)]
+    Refocus(Box<RefocusArgs>),
+    /// Synthesise the middle (spectator) view of a stereo pair from each eye's colour and depth.
+    #[command(allow_negative_numbers = true)]
+    Cyclopean(Box<CyclopeanArgs>),
+    /// Reproject one view of a parallel stereo rig (left eye, centre view or right eye) to the
+    /// other eye(s) from colour + depth (view Z, device depth or disparity); disocclusions stay
+    /// invalid (mask 0), nothing is hole-filled.
+    #[command(allow_negative_numbers = true)]
+    Reproject(Box<ReprojectArgs>),
+    /// Stitch an omni-directional stereo (ODS) 360 equirect (top-bottom, left eye on top) from
+    /// six over-wide cube faces per eye: the built-in scene's, or your own from --faces DIR.
+    #[command(allow_negative_numbers = true)]
+    Stitch(Box<StitchArgs>),
+    /// Ray-trace a ground-truth scene (built-in or JSON) on the GPU from a stereo rig: left, right
+    /// and middle colour, view distance and device depth, and a cameras.json that
+    /// `viewsynth cyclopean` reads.
+    Scene {
+        /// `demo`, `boxes`, or a scene JSON file (src/scene/shapes.rs).
+        #[arg(long, default_value = "demo")]
+        scene: String,
+        #[arg(long, default_value_t = 640)]
+        width: u32,
+        #[arg(long, default_value_t = 480)]
+        height: u32,
+        /// Interocular distance in metres.
+        #[arg(long, default_value_t = 0.064)]
+        ipd: f64,
+        #[command(flatten)]
+        conv: ConventionArgs,
+        #[arg(long, default_value = "out/scene")]
+        out_dir: PathBuf,
+        #[command(flatten)]
+        gpu: GpuArgs,
+    },
+    /// Compare two renderings (e.g. ours and a Vulkan renderer's) after converting row order,
+    /// NDC depth range, reversed-Z and device vs linear depth; names a convention that fits far
+    /// better than the declared one. Writes a diff image.
+    Compare(Box<CompareArgs>),
+    /// Render the built-in scene, refocus it at 5 scales, synthesise the cyclopean middle view of
+    /// a stereo pair with each method, and write every output plus the error/run-time report.
+    Demo {
+        #[arg(long, default_value = "out/demo")]
+        out_dir: PathBuf,
+        #[command(flatten)]
+        gpu: GpuArgs,
+    },
+    /// Measure every method's error against ground truth (built-in scene, and real data when
+    /// --data-dir holds ../shared/data's sets) next to its run time: report.{md,csv,svg}.
+    Report {
+        #[arg(long, default_value = "out/report")]
+        out_dir: PathBuf,
+        /// Folder with middlebury2003_cones/ and middlebury2003_teddy/ (skipped when absent).
+        #[arg(long)]
+        data_dir: Option<PathBuf>,
+        /// A user cyclopean case with a reference middle view, laid out as `viewsynth scene`
+        /// writes it (cameras.json, {left,right}_rgb.png, *_device_depth.exr, middle_rgb.png).
+        /// Repeatable.
+        #[arg(long = "case")]
+        cases: Vec<PathBuf>,
+        /// Timed repetitions per row (the median is reported).
+        #[arg(long, default_value_t = 3)]
+        repeats: usize,
+        #[command(flatten)]
+        gpu: GpuArgs,
+    },
+    /// Benchmark refocus (mesh and full-screen paths) and cyclopean (2 x 1280x720 eyes) and print
+    /// median timings.
+    Bench {
+        /// Sizes WxH to measure.
+        #[arg(long, value_delimiter = ',', default_value = "640x480,1280x720")]
+        sizes: Vec<String>,
+        /// Repetitions per measurement (the median is reported).
+        #[arg(long, default_value_t = 7)]
+        repeats: usize,
+        #[command(flatten)]
+        gpu: GpuArgs,
+    },
+    /// Sweep stiff and extreme cases of every capability (focal scales 0.05..20, 1 mm..100 km,
+    /// near/far 1e-7, standard vs reversed-Z, NaN/Inf depth, 1x1 to the largest image, parallel
+    /// gaze, zero IPD, ...): GPU f32 against the f64 reference, as a table with the first failing
+    /// case. Exits 1 if any case fails.
+    Stress {
+        /// Smaller images and sub-cases (what the test suite runs).
+        #[arg(long)]
+        quick: bool,
+        /// Capabilities to sweep.
+        #[arg(
+            long,
+            value_delimiter = ',',
+            default_value = "camera,refocus,cyclopean,reproject,stitch"
+        )]
+        only: Vec<String>,
+        /// Also write the rows as JSON here.
+        #[arg(long)]
+        json: Option<PathBuf>,
+        #[command(flatten)]
+        gpu: GpuArgs,
+    },
+}
+
+#[derive(Args, Clone)]
+struct GpuArgs {
+    /// EGL device: auto (CUDA_VISIBLE_DEVICES match, else first device, else Mesa
+    /// surfaceless), an index from `viewsynth info`, or `surfaceless`.
+    #[arg(long, default_value = "auto")]
+    device: String,
+}
+
+impl GpuArgs {
+    fn open(&self) -> Result<Gpu> {
+        let choice = match self.device.as_str() {
+            "auto" => DeviceChoice::Auto,
+            "surfaceless" => DeviceChoice::Surfaceless,
+            n => DeviceChoice::Index(
+                n.parse()
+                    .with_context(|| format!("--device '{n}': expected auto, surfaceless or an index"))?,
+            ),
+        };
+        Ok(Gpu::new(choice)?)
+    }
+}
+
+/// The convention switches of a rendering command.
+#[derive(Args, Clone, Copy)]
+struct ConventionArgs {
+    #[arg(long, value_enum, default_value = "gl")]
+    ndc: NdcArg,
+    #[arg(long)]
+    reversed_z: bool,
+    #[arg(long, value_enum, default_value = "bottom-up")]
+    rows: RowsArg,
+}
+
+impl ConventionArgs {
+    fn conventions(&self) -> Conventions {
+        conventions(self.ndc, self.reversed_z, self.rows)
+    }
+}
+
+#[derive(Clone, Copy, ValueEnum)]
+enum NdcArg {
+    /// OpenGL: NDC z in [-1, 1].
+    Gl,
+    /// Vulkan/D3D: NDC z in [0, 1].
+    Vulkan,
+}
+
+#[derive(Clone, Copy, ValueEnum)]
+enum RowsArg {
+    BottomUp,
+    TopDown,
+}
+
+#[derive(Clone, Copy, ValueEnum)]
+enum RgbFormatArg {
+    Png,
+    Jpeg,
+    Exr,
+}
+
+/// Which outputs to write and in which file formats (refocus, batch and reproject).
+#[derive(Args, Clone)]
+struct FileOutputArgs {
+    /// Outputs to produce: any of rgb (or color), depth, mask.
+    #[arg(long, default_value = "rgb,depth,mask")]
+    outputs: String,
+    #[arg(long, value_enum, default_value = "png")]
+    rgb_format: RgbFormatArg,
+    /// Depth file formats: exr, npy or both.
+    #[arg(long, default_value = "exr")]
+    depth_format: String,
+}
+
+impl FileOutputArgs {
+    fn parse(&self) -> Result<(OutputSet, RgbFormat, DepthFormats)> {
+        let outputs = OutputSet::parse(&self.outputs.replace("colour", "rgb").replace("color", "rgb"))?;
+        let rgb = match self.rgb_format {
+            RgbFormatArg::Png => RgbFormat::Png,
+            RgbFormatArg::Jpeg => RgbFormat::Jpeg,
+            RgbFormatArg::Exr => RgbFormat::Exr,
+        };
+        Ok((outputs, rgb, parse_depth_formats(&self.depth_format)?))
+    }
+}
+
+fn main() {
+    let cli = Cli::parse();
+    let result = match cli.command {
+        Command::Info { gpu, json } => info(&gpu, json),
+        Command::Refocus(args) => refocus(*args),
+        Command::Cyclopean(args) => cyclopean(*args),
+        Command::Reproject(args) => reproject(*args),
+        Command::Stitch(args) => stitch(*args),
+        Command::Compare(args) => compare(*args),
+        Command::Demo { out_dir, gpu } => demo(&out_dir, &gpu),
+        Command::Scene {
+            scene,
+            width,
+            height,
+            ipd,
+            conv,
+            out_dir,
+            gpu,
+        } => {
+            let conv = conv.conventions();
+            render_scene(&scene, width, height, ipd, conv, &out_dir, &gpu)
+        }
+        Command::Bench { sizes, repeats, gpu } => bench(&sizes, repeats, &gpu),
+        Command::Stress { quick, only, json, gpu } => stress(quick, &only, json.as_deref(), &gpu),
+        Command::Report {
+            out_dir,
+            data_dir,
+            cases,
+            repeats,
+            gpu,
+        } => report(&out_dir, data_dir.as_deref(), &cases, repeats, &gpu),
+    };
+    if let Err(e) = result {
+        eprintln!("error: {e:#}");
+        std::process::exit(1);
+    }
+}
+
+fn info(gpu: &GpuArgs, json: bool) -> Result<()> {
+    let gpu = gpu.open()?;
+    let i = gpu.info();
+    if json {
+        println!("{}", serde_json::to_string_pretty(i)?);
+        return Ok(());
+    }
+    println!("vendor:      {}", i.vendor);
+    println!("renderer:    {}", i.renderer);
+    println!(
+        "GL version:  {} (core {}.{}), GLSL {}",
+        i.version, i.gl_major, i.gl_minor, i.glsl_version
+    );
+    println!("EGL:         {} via {} platform", i.egl_version, i.platform);
+    let dev = i.device_index.map_or("-".to_string(), |d| d.to_string());
+    println!(
+        "device:      {dev} of {} ({})",
+        i.device_count,
+        i.device_file.as_deref().unwrap_or("no DRM file")
+    );
+    println!(
+        "device ext:  {}",
+        if i.device_extensions.is_empty() {
+            "-"
+        } else {
+            &i.device_extensions
+        }
+    );
+    println!(
+        "limits:      max texture {}, max viewport {}x{}",
+        i.max_texture_size, i.max_viewport[0], i.max_viewport[1]
+    );
+    println!(
+        "GPU timers:  {}",
+        if i.gpu_timers_meaningful {
+            "yes"
+        } else {
+            "no (wall clock with glFinish)"
+        }
+    );
+    Ok(())
+}
+
+fn demo(out_dir: &Path, gpu: &GpuArgs) -> Result<()> {
+    let gpu = gpu.open()?;
+    let report = viewsynth::demo::run(&gpu, out_dir)?;
+    println!("{}", std::fs::read_to_string(&report)?);
+    println!("demo outputs and report written to {}", out_dir.display());
+    Ok(())
+}
+
+fn report(out_dir: &Path, data_dir: Option<&Path>, cases: &[PathBuf], repeats: usize, gpu: &GpuArgs) -> Result<()> {
+    if let Some(d) = data_dir {
+        if !d.is_dir() {
+            bail!("--data-dir {}: not a directory", d.display());
+        }
+    }
+    let gpu = gpu.open()?;
+    let files = viewsynth::evaluation::run_report_with_cases(&gpu, out_dir, data_dir, cases, repeats)?;
+    if let Some(md) = files.iter().find(|p| p.extension().is_some_and(|e| e == "md")) {
+        println!("{}", std::fs::read_to_string(md)?);
+    }
+    for f in &files {
+        println!("wrote {}", f.display());
+    }
+    Ok(())
+}
+
+fn conventions(ndc: NdcArg, reversed_z: bool, rows: RowsArg) -> Conventions {
+    Conventions {
+        ndc_depth: match ndc {
+            NdcArg::Gl => NdcDepthRange::MinusOneToOne,
+            NdcArg::Vulkan => NdcDepthRange::ZeroToOne,
+        },
+        reversed_z,
+        row_order: match rows {
+            RowsArg::BottomUp => RowOrder::BottomUp,
+            RowsArg::TopDown => RowOrder::TopDown,
+        },
+    }
+}
+
+fn parse_depth_formats(list: &str) -> Result<DepthFormats> {
+    let mut f = DepthFormats { exr: false, npy: false };
+    for item in list.split(',').map(str::trim) {
+        match item {
+            "exr" => f.exr = true,
+            "npy" => f.npy = true,
+            _ => bail!("invalid depth-format '{item}': expected exr, npy or exr,npy"),
+        }
+    }
+    Ok(f)
+}
+
+fn prepare_out_dir(dir: &Path) -> Result<()> {
+    std::fs::create_dir_all(dir).with_context(|| format!("cannot create output directory {}", dir.display()))?;
+    // Probe writability now rather than after minutes of rendering.
+    let probe = dir.join(format!(".viewsynth-write-test-{}", std::process::id()));
+    std::fs::write(&probe, b"").with_context(|| format!("output directory {} is not writable", dir.display()))?;
+    let _ = std::fs::remove_file(probe);
+    Ok(())
+}
+
+fn bench(sizes: &[String], repeats: usize, gpu: &GpuArgs) -> Result<()> {
+    let mut parsed = Vec::new();
+    for s in sizes {
+        let (w, h) = s
+            .split_once('x')
+            .with_context(|| format!("--sizes '{s}': expected WxH"))?;
+        parsed.push((w.parse::<u32>()?, h.parse::<u32>()?));
+    }
+    let gpu = gpu.open()?;
+    let table = viewsynth::bench::refocus_bench(&gpu, &parsed, repeats.max(1))?;
+    println!("{table}");
+    println!(
+        "{}",
+        viewsynth::bench::cyclopean_bench(&gpu, 1280, 720, repeats.max(1))?
+    );
+    println!("{}", viewsynth::stitch::stitch_bench(&gpu)?);
+    Ok(())
+}
+
+fn stress(quick: bool, only: &[String], json: Option<&Path>, gpu: &GpuArgs) -> Result<()> {
+    let caps: Vec<&str> = only.iter().map(|s| s.trim()).filter(|s| !s.is_empty()).collect();
+    if let Some(bad) = caps.iter().find(|c| !viewsynth::stress::CAPABILITIES.contains(c)) {
+        anyhow::bail!(
+            "--only '{bad}': expected a list of {}",
+            viewsynth::stress::CAPABILITIES.join(", ")
+        );
+    }
+    let gpu = gpu.open()?;
+    let rows = viewsynth::stress::run_stress(&gpu, &caps, viewsynth::stress::StressOptions { quick })?;
+    println!("{}", viewsynth::stress::table(&rows));
+    if let Some(path) = json {
+        viewsynth::io::atomic_write(path, |w| {
+            serde_json::to_writer_pretty(w, &rows).map_err(|e| viewsynth::Error::param("json", e.to_string()))
+        })
+        .with_context(|| format!("writing {}", path.display()))?;
+    }
+    if let Some(r) = viewsynth::stress::first_failure(&rows) {
+        anyhow::bail!("stress case failed: {} / {} ({})", r.capability, r.case, r.worst);
+    }
+    Ok(())
+}
+
+/// An output file and the function writing it.
+type WriteJob<'a> = (PathBuf, Box<dyn FnOnce(&Path) -> viewsynth::Result<()> + 'a>);
+
+/// Writes every file or none: on the first failure the files already written are removed
+/// (each write is atomic, so no partial file exists under a final name either).
+fn write_all_or_none(jobs: Vec<WriteJob<'_>>) -> Result<Vec<PathBuf>> {
+    let mut written = Vec::new();
+    for (path, write) in jobs {
+        if let Err(e) = write(&path) {
+            for p in &written {
+                let _ = std::fs::remove_file(p);
+            }
+            return Err(e.into());
+        }
+        written.push(path);
+    }
+    Ok(written)
+}
+
+fn ms_text(t: &viewsynth::gpu::Timing) -> String {
+    match t.gpu_ms {
+        Some(g) => format!("{:.1} ms wall, {g:.1} ms GPU", t.wall_ms),
+        None => format!("{:.1} ms wall", t.wall_ms),
+    }
+}

@@ -1,0 +1,304 @@
+//! `viewsynth reproject`: arguments and the call into viewsynth::reproject.
+
+use super::*;
+
+#[derive(Clone, Copy, ValueEnum, PartialEq)]
+pub(crate) enum ReprojectDepthArg {
+    /// View-space Z (distance along the optical axis) in metres; <= 0, NaN, inf = no depth.
+    #[value(alias = "metric")]
+    ViewZ,
+    /// Window depth in [0, 1] from a depth buffer, written with --near/--far under --ndc,
+    /// --reversed-z; the far value is background.
+    Device,
+    /// Disparity in pixels of a rectified pair (Middlebury): Z = baseline * focal / (d + doffs);
+    /// d <= 0 = unknown.
+    Disparity,
+}
+
+#[derive(Clone, Copy, ValueEnum, PartialEq)]
+pub(crate) enum FromArg {
+    Left,
+    #[value(alias = "center")]
+    Centre,
+    Right,
+}
+
+#[derive(Clone, Copy, ValueEnum, PartialEq)]
+pub(crate) enum ToArg {
+    Left,
+    Right,
+    /// Both eyes (from the centre view only).
+    Both,
+}
+
+#[derive(Clone, Copy, ValueEnum)]
+pub(crate) enum ReprojectMethodArg {
+    /// Fixed-point walk along the row (--steps) from two starts, verified by segment coverage.
+    Shift,
+    /// Exact: every segment the frame's depth range allows is tested, the nearest wins.
+    ShiftScan,
+    /// The cyclopean 3-D walk with one eye (--steps), from two starts.
+    Gather3d,
+}
+
+#[derive(Args)]
+pub(crate) struct ReprojectArgs {
+    /// Source colour (PNG, JPEG, PPM, EXR), rows top-down.
+    #[arg(long, visible_alias = "rgb")]
+    color: PathBuf,
+    /// Source depth (EXR, NPY, 16-bit PNG/PGM with --depth-scale, PFM), holding --depth-kind.
+    #[arg(long)]
+    depth: PathBuf,
+    #[arg(long, value_enum, default_value = "view-z")]
+    depth_kind: ReprojectDepthArg,
+    /// Raw units per unit of the depth file for integer files (1000 for mm, 4 for Middlebury 2003
+    /// disparity PGMs); divides float depth too when given.
+    #[arg(long)]
+    depth_scale: Option<f64>,
+    /// Near plane (metres) the device depth was written with (--depth-kind device).
+    #[arg(long)]
+    near: Option<f64>,
+    /// Far plane (metres; may be inf) the device depth was written with (--depth-kind device).
+    #[arg(long)]
+    far: Option<f64>,
+    /// Source intrinsics in pixels.
+    #[arg(long)]
+    fx: f64,
+    #[arg(long)]
+    fy: f64,
+    #[arg(long)]
+    cx: f64,
+    #[arg(long)]
+    cy: f64,
+    /// Rectified rig: distance between the eyes in metres (x_right = x_left + doffs - f B / Z).
+    /// Also the baseline of --depth-kind disparity.
+    #[arg(long)]
+    baseline: Option<f64>,
+    /// Focal length (pixels) of the rectified rig and of disparity (default: --fx).
+    #[arg(long)]
+    focal: Option<f64>,
+    /// cx_right - cx_left in pixels (Middlebury's doffs) of the rectified rig and of disparity.
+    #[arg(long, default_value_t = 0.0)]
+    doffs: f64,
+    /// Seed 004's rig instead of --baseline: separation = interaxial / screen width (texture
+    /// units; the eyes move +-S/2 (1 - c/Z) in texture x), with --convergence.
+    #[arg(long, requires = "convergence")]
+    separation: Option<f64>,
+    /// Zero-parallax distance c in metres (with --separation).
+    #[arg(long, requires = "separation")]
+    convergence: Option<f64>,
+    /// The source view.
+    #[arg(long, value_enum, default_value = "left")]
+    from: FromArg,
+    /// The target view(s).
+    #[arg(long, value_enum, default_value = "right")]
+    to: ToArg,
+    #[arg(long, value_enum, default_value = "shift-scan")]
+    method: ReprojectMethodArg,
+    /// Steps of the shift walk / 3-D gather (1..=16).
+    #[arg(long, default_value_t = 3)]
+    steps: u32,
+    /// A row segment breaks (an unseen surface) where |Z_a - Z_b| > tau_rel * min(Z_a, Z_b).
+    #[arg(long, default_value_t = 0.05)]
+    tau_rel: f64,
+    #[command(flatten)]
+    files: FileOutputArgs,
+    /// Writes <target>_rgb.png, <target>_depth.exr, <target>_mask.png (target = left, right).
+    #[arg(long)]
+    out_dir: PathBuf,
+    #[command(flatten)]
+    conv: ConventionArgs,
+    #[command(flatten)]
+    gpu: GpuArgs,
+}
+
+pub(crate) fn reproject(a: ReprojectArgs) -> Result<()> {
+    use std::time::Instant;
+    use viewsynth::camera::stereo::{Eye, StereoParams};
+    use viewsynth::camera::PinholeCamera;
+    use viewsynth::convention::DepthPlanes;
+    use viewsynth::reproject::render::Reprojector;
+    use viewsynth::reproject::{DepthInput, Geometry, Method as RMethod, ReprojectParams, ReprojectSource, ShiftModel};
+
+    // Everything that can be checked before reading files, touching the GPU or the output
+    // directory is.
+    let k = Intrinsics {
+        fx: a.fx,
+        fy: a.fy,
+        cx: a.cx,
+        cy: a.cy,
+    };
+    k.validate("source intrinsics")?;
+    let from = match a.from {
+        FromArg::Left => Some(Eye::Left),
+        FromArg::Centre => None,
+        FromArg::Right => Some(Eye::Right),
+    };
+    let targets = match (a.from, a.to) {
+        (FromArg::Centre, ToArg::Both) => vec![Eye::Left, Eye::Right],
+        (_, ToArg::Both) => bail!("--to both needs --from centre (from an eye, the only other view is the other eye)"),
+        (FromArg::Left, ToArg::Left) | (FromArg::Right, ToArg::Right) => {
+            bail!("--to is the source view itself (--from): nothing to reproject")
+        }
+        (_, ToArg::Left) => vec![Eye::Left],
+        (_, ToArg::Right) => vec![Eye::Right],
+    };
+    let focal = a.focal.unwrap_or(a.fx);
+    let depth_kind = match a.depth_kind {
+        ReprojectDepthArg::ViewZ => DepthInput::ViewZ,
+        ReprojectDepthArg::Device => {
+            let (Some(near), Some(far)) = (a.near, a.far) else {
+                bail!("--depth-kind device needs --near and --far (the planes the depth buffer was written with)");
+            };
+            let kind = DepthInput::Device {
+                planes: DepthPlanes { near, far },
+            };
+            kind.validate().context("--near/--far")?;
+            kind
+        }
+        ReprojectDepthArg::Disparity => {
+            let Some(baseline) = a.baseline else {
+                bail!("--depth-kind disparity needs --baseline (metres; Z = baseline * focal / (d + doffs))");
+            };
+            let kind = DepthInput::Disparity {
+                focal_px: focal,
+                baseline,
+                doffs: a.doffs,
+            };
+            kind.validate()
+                .context("--depth-kind disparity: --focal/--baseline/--doffs")?;
+            kind
+        }
+    };
+    if a.depth_kind != ReprojectDepthArg::Device && (a.near.is_some() || a.far.is_some()) {
+        bail!("--near/--far apply to --depth-kind device only");
+    }
+    let seed = match (a.separation, a.convergence) {
+        (Some(s), Some(c)) => Some(StereoParams::new(s, c).context("--separation/--convergence")?),
+        _ => None,
+    };
+    if seed.is_none() && a.baseline.is_none() {
+        bail!("give the rig: --baseline B (rectified, metres) or --separation S --convergence C (seed 004)");
+    }
+    let method = match a.method {
+        ReprojectMethodArg::Shift => RMethod::Shift { steps: a.steps },
+        ReprojectMethodArg::ShiftScan => RMethod::ShiftScan,
+        ReprojectMethodArg::Gather3d => RMethod::Gather3d { steps: a.steps },
+    };
+    let params = ReprojectParams {
+        method,
+        tau_rel: a.tau_rel,
+    };
+    params.validate().context("--steps/--tau-rel")?;
+    let (outputs, rgb_format, depth_formats) = a.files.parse()?;
+    let rgb_ext = rgb_format.extension();
+    let conv = a.conv.conventions();
+
+    let decode = DepthDecode {
+        scale: a.depth_scale,
+        ..Default::default()
+    };
+    let src = ReprojectSource {
+        color: io::load_rgb(&a.color)?,
+        depth: io::load_depth(&a.depth, &decode)?,
+        depth_kind,
+        conv,
+    };
+    src.validate()
+        .with_context(|| format!("{} and {}", a.color.display(), a.depth.display()))?;
+    if src.inverse_depth_range().is_none() {
+        bail!(
+            "{}: no pixel holds valid depth as --depth-kind {} (check --depth-kind, --depth-scale, --near/--far, conventions)",
+            a.depth.display(),
+            a.depth_kind.to_possible_value().map_or_else(String::new, |v| v.get_name().to_string())
+        );
+    }
+    let camera = PinholeCamera {
+        k,
+        width: src.color.width,
+        height: src.color.height,
+    };
+    camera.validate("source intrinsics")?;
+    let mut geometries = Vec::new();
+    for &to in &targets {
+        let shift = match (&seed, a.baseline) {
+            (Some(p), _) => ShiftModel::seed(p, camera.width, from, Some(to)),
+            (None, Some(b)) => {
+                ShiftModel::rectified(focal, b, a.doffs, from, Some(to)).context("--focal/--baseline/--doffs")?
+            }
+            (None, None) => unreachable!("checked above"),
+        };
+        shift.validate()?;
+        geometries.push(Geometry::Rig { camera, shift });
+    }
+    prepare_out_dir(&a.out_dir)?;
+
+    let gpu = a.gpu.open()?;
+    let mut results = Vec::new();
+    for (&to, geometry) in targets.iter().zip(&geometries) {
+        let t0 = Instant::now();
+        let mut r = Reprojector::new(&gpu, &src, geometry, params)?;
+        let setup_ms = t0.elapsed().as_secs_f64() * 1e3;
+        let (out, timing) = r.render()?;
+        results.push((to, out, timing, setup_ms));
+    }
+    let mut jobs: Vec<WriteJob> = Vec::new();
+    for (to, out, _, _) in &results {
+        let name = eye_name(Some(*to));
+        if outputs.rgb {
+            jobs.push((
+                a.out_dir.join(format!("{name}_rgb.{rgb_ext}")),
+                Box::new(move |p: &Path| io::save_rgb(p, &out.color)),
+            ));
+        }
+        if outputs.depth && depth_formats.exr {
+            jobs.push((
+                a.out_dir.join(format!("{name}_depth.exr")),
+                Box::new(move |p: &Path| io::save_depth_exr(p, &out.depth)),
+            ));
+        }
+        if outputs.depth && depth_formats.npy {
+            jobs.push((
+                a.out_dir.join(format!("{name}_depth.npy")),
+                Box::new(move |p: &Path| io::save_depth_npy(p, &out.depth)),
+            ));
+        }
+        if outputs.mask {
+            jobs.push((
+                a.out_dir.join(format!("{name}_mask.png")),
+                Box::new(move |p: &Path| {
+                    let bits = out.mask.iter().map(|m| (*m != 0) as u8).collect();
+                    io::save_mask_png(p, &io::Mask::new(out.color.width, out.color.height, bits)?)
+                }),
+            ));
+        }
+    }
+    let written = write_all_or_none(jobs)?;
+    for (to, out, timing, setup_ms) in &results {
+        println!(
+            "{} -> {} ({}): {}x{}, coverage {:.2} %, render {} (setup + shader compile {setup_ms:.1} ms)",
+            eye_name(from),
+            eye_name(Some(*to)),
+            params.method.label(),
+            out.color.width,
+            out.color.height,
+            out.coverage() * 100.0,
+            ms_text(timing),
+        );
+    }
+    let names: Vec<String> = written
+        .iter()
+        .filter_map(|p| p.file_name().map(|n| n.to_string_lossy().into_owned()))
+        .collect();
+    println!("wrote {} in {}", names.join(", "), a.out_dir.display());
+    Ok(())
+}
+
+pub(crate) fn eye_name(view: Option<viewsynth::camera::stereo::Eye>) -> &'static str {
+    use viewsynth::camera::stereo::Eye;
+    match view {
+        Some(Eye::Left) => "left",
+        Some(Eye::Right) => "right",
+        None => "centre",
+    }
+}

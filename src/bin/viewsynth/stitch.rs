@@ -1,0 +1,275 @@
+//! `viewsynth stitch`: arguments, the face-folder convention and the call into viewsynth::stitch.
+
+use super::*;
+
+#[derive(Clone, Copy, ValueEnum)]
+pub(crate) enum StitchMethodArg {
+    /// Linear feather over the overlap.
+    Blend,
+    /// Seed 001's stitch with border weight.
+    BorderWeight,
+    /// Depth-aware reprojection along the ODS ray.
+    Reproject,
+}
+
+#[derive(Args)]
+pub(crate) struct StitchArgs {
+    /// Ray-trace the faces of a built-in scene (only `demo`, the scene of the ODS rig).
+    #[arg(long, required_unless_present = "faces", conflicts_with = "faces")]
+    scene: Option<String>,
+    /// Folder with the 12 faces: {left,right}_{pz,nz,px,nx,up,down}.png (colour) and
+    /// {left,right}_{pz,nz,px,nx,up,down}_depth.exr (view-space Z, 0/NaN/inf = background);
+    /// see README for the poses and orientations.
+    #[arg(long)]
+    faces: Option<PathBuf>,
+    /// Face field of view in degrees, in (90, 178) (default 90 + 2 x overlap).
+    #[arg(long)]
+    fov: Option<f64>,
+    /// Seam band half-width in degrees, in (0, (fov - 90) / 2] (default (fov - 90) / 2 with
+    /// --fov, else 10).
+    #[arg(long)]
+    overlap: Option<f64>,
+    #[arg(long, value_enum, default_value = "reproject")]
+    method: StitchMethodArg,
+    /// Equirect width per eye.
+    #[arg(long, default_value_t = 2048)]
+    width: u32,
+    /// Equirect height per eye (the top-bottom image is twice as high).
+    #[arg(long, default_value_t = 1024)]
+    height: u32,
+    /// Face side in pixels with --scene.
+    #[arg(long, default_value_t = 512)]
+    face_size: u32,
+    /// Interpupillary distance (metres, the faces' units).
+    #[arg(long, default_value_t = 0.064)]
+    ipd: f64,
+    /// Latitude (deg) above which the eye radius fades to 0 at the poles.
+    #[arg(long, default_value_t = 45.0)]
+    pole_fade: f64,
+    /// Raw units per metre for integer face depth files.
+    #[arg(long)]
+    depth_scale: Option<f64>,
+    /// Also write each eye's equirect (ods_left.png, ods_right.png).
+    #[arg(long)]
+    per_eye: bool,
+    /// With --scene: ray-trace the ODS ground truth and print PSNR on the seam band and the
+    /// whole image.
+    #[arg(long)]
+    truth: bool,
+    /// Writes ods_top_bottom.png (left eye on top).
+    #[arg(long)]
+    out_dir: PathBuf,
+    #[command(flatten)]
+    gpu: GpuArgs,
+}
+
+/// File name tags of the cube faces in `--faces DIR`, in [`viewsynth::stitch::CubeFace::ALL`]
+/// order (+Z, -Z, up, down, +X, -X).
+pub(crate) const FACE_TAGS: [&str; 6] = ["pz", "nz", "up", "down", "px", "nx"];
+pub(crate) const FACE_COLOR_EXTS: [&str; 5] = ["png", "jpg", "jpeg", "ppm", "exr"];
+pub(crate) const FACE_DEPTH_EXTS: [&str; 4] = ["exr", "npy", "pfm", "png"];
+
+/// `dir/stem.ext` for the first extension that exists; the error names the first candidate.
+pub(crate) fn find_face_file(dir: &Path, stem: &str, exts: &[&str], what: &str) -> Result<PathBuf> {
+    for e in exts {
+        let p = dir.join(format!("{stem}.{e}"));
+        if p.is_file() {
+            return Ok(p);
+        }
+    }
+    bail!(
+        "--faces: missing {} ({what}; also looked for .{})",
+        dir.join(format!("{stem}.{}", exts[0])).display(),
+        exts[1..].join(", .")
+    )
+}
+
+pub(crate) fn stitch(a: StitchArgs) -> Result<()> {
+    use std::time::Instant;
+    use viewsynth::stitch::eval::{score_eyes, split_top_bottom};
+    use viewsynth::stitch::faces::{faces_from_images, scene_faces};
+    use viewsynth::stitch::render::StitchRenderer;
+    use viewsynth::stitch::truth::ods_truth;
+    use viewsynth::stitch::{seam_band_mask, CubeFace, FaceSet, Method as SMethod, OdsRig, Side, StitchParams};
+
+    if let (None, Some(o)) = (a.fov, a.overlap) {
+        if !(o > 0.0 && o < 44.0) {
+            bail!("--overlap {o}: must be in (0, 44) degrees (faces of 90 + 2 x overlap; or give --fov)");
+        }
+    }
+    let (fov, overlap) = match (a.fov, a.overlap) {
+        (None, None) => (110.0, 10.0),
+        (Some(f), None) => (f, 0.5 * (f - 90.0)),
+        (None, Some(o)) => (90.0 + 2.0 * o, o),
+        (Some(f), Some(o)) => (f, o),
+    };
+    if !(fov > 90.0 && fov < 178.0) {
+        bail!("--fov {fov}: the face field of view must be in (90, 178) degrees");
+    }
+    let rig = match &a.scene {
+        Some(name) if name == "demo" => OdsRig {
+            ipd: a.ipd,
+            pole_fade_start_deg: a.pole_fade,
+            ..OdsRig::demo()
+        },
+        Some(name) => {
+            bail!("--scene '{name}': only the built-in `demo` scene has cube faces (use --faces DIR for your own)")
+        }
+        // The circle centre only translates the face eyes and the ODS rays together.
+        None => OdsRig {
+            centre: [0.0; 3],
+            ipd: a.ipd,
+            pole_fade_start_deg: a.pole_fade,
+        },
+    };
+    rig.validate().context("--ipd/--pole-fade")?;
+    if a.truth && a.scene.is_none() {
+        bail!("--truth needs --scene demo (the ground truth is ray-traced from the built-in scene)");
+    }
+    let method = match a.method {
+        StitchMethodArg::Blend => SMethod::Blend,
+        StitchMethodArg::BorderWeight => SMethod::BorderWeight,
+        StitchMethodArg::Reproject => SMethod::Reproject,
+    };
+    let params = StitchParams {
+        method,
+        overlap_deg: overlap,
+        width: a.width,
+        height: a.height,
+    };
+    let template = FaceSet {
+        rig,
+        side: Side::Left,
+        fov_deg: fov,
+        faces: Vec::new(),
+    };
+    params.validate(&template).context("--overlap/--fov/--width/--height")?;
+    if 2 * a.height as u64 > viewsynth::io::MAX_DIMENSION as u64 {
+        bail!(
+            "--height {}: the top-bottom image ({} rows) exceeds {}",
+            a.height,
+            2 * a.height,
+            viewsynth::io::MAX_DIMENSION
+        );
+    }
+
+    let t0 = Instant::now();
+    let (left, right, source) = if let Some(dir) = &a.faces {
+        if !dir.is_dir() {
+            bail!("--faces {}: not a directory", dir.display());
+        }
+        let decode = DepthDecode {
+            scale: a.depth_scale,
+            ..Default::default()
+        };
+        let load = |side: Side| -> Result<FaceSet> {
+            let eye = match side {
+                Side::Left => "left",
+                Side::Right => "right",
+            };
+            let mut images = Vec::new();
+            for (face, tag) in CubeFace::ALL.iter().zip(FACE_TAGS) {
+                let what = format!("the {eye} eye's {} face", face.label());
+                let c = find_face_file(
+                    dir,
+                    &format!("{eye}_{tag}"),
+                    &FACE_COLOR_EXTS,
+                    &format!("colour of {what}"),
+                )?;
+                let d = find_face_file(
+                    dir,
+                    &format!("{eye}_{tag}_depth"),
+                    &FACE_DEPTH_EXTS,
+                    &format!("view-space Z of {what}"),
+                )?;
+                images.push((io::load_rgb(&c)?, io::load_depth(&d, &decode)?));
+            }
+            faces_from_images(&rig, side, fov, images).with_context(|| format!("--faces {}: {eye} eye", dir.display()))
+        };
+        let (l, r) = (load(Side::Left)?, load(Side::Right)?);
+        if l.size() != r.size() {
+            bail!(
+                "--faces {}: size mismatch: left faces {n}x{n}, right faces {m}x{m}",
+                dir.display(),
+                n = l.size(),
+                m = r.size()
+            );
+        }
+        let what = format!("loaded 12 faces of {n}x{n} from {}", dir.display(), n = l.size());
+        (l, r, what)
+    } else {
+        let n = a.face_size;
+        let l = scene_faces(&rig, Side::Left, n, fov).context("--face-size")?;
+        let r = scene_faces(&rig, Side::Right, n, fov).context("--face-size")?;
+        (l, r, format!("ray-traced 12 faces of {n}x{n} (CPU)"))
+    };
+    let faces_ms = t0.elapsed().as_secs_f64() * 1e3;
+    prepare_out_dir(&a.out_dir)?;
+
+    let gpu = a.gpu.open()?;
+    let t0 = Instant::now();
+    let mut renderer = StitchRenderer::new(&gpu, &left, &right)?;
+    let setup_ms = t0.elapsed().as_secs_f64() * 1e3;
+    let (img, timing) = renderer.render(&params)?;
+    let eyes = if a.per_eye {
+        let half = img.data.len() / 2;
+        Some([
+            io::RgbImage::new(a.width, a.height, img.data[..half].to_vec())?,
+            io::RgbImage::new(a.width, a.height, img.data[half..].to_vec())?,
+        ])
+    } else {
+        None
+    };
+    let mut jobs: Vec<WriteJob> = vec![(
+        a.out_dir.join("ods_top_bottom.png"),
+        Box::new(|p: &Path| io::save_rgb(p, &img)),
+    )];
+    if let Some([l, r]) = &eyes {
+        jobs.push((
+            a.out_dir.join("ods_left.png"),
+            Box::new(move |p: &Path| io::save_rgb(p, l)),
+        ));
+        jobs.push((
+            a.out_dir.join("ods_right.png"),
+            Box::new(move |p: &Path| io::save_rgb(p, r)),
+        ));
+    }
+    let written = write_all_or_none(jobs)?;
+    println!("faces: {source}, FOV {fov} deg, in {faces_ms:.0} ms");
+    println!("upload + shader compile {setup_ms:.1} ms");
+    println!(
+        "stitch ({}, overlap {overlap} deg, IPD {} m): {}x{} per eye, top-bottom {}x{}, render {}",
+        method.label(),
+        rig.ipd,
+        a.width,
+        a.height,
+        img.width,
+        img.height,
+        ms_text(&timing)
+    );
+    if a.truth {
+        let t0 = Instant::now();
+        let (tl, tr) = std::thread::scope(|s| {
+            let l = s.spawn(|| ods_truth(&rig, Side::Left, a.width, a.height));
+            let r = ods_truth(&rig, Side::Right, a.width, a.height);
+            (l.join().expect("ODS truth does not panic"), r)
+        });
+        let (tl, tr) = (tl?, tr?);
+        let [el, er] = split_top_bottom(&img);
+        let band = seam_band_mask(a.width, a.height, overlap);
+        let s = score_eyes([&el, &er], [&tl, &tr], &band);
+        println!(
+            "vs ODS ground truth (ray-traced in {:.0} ms): seam band PSNR {:.2} dB (MAE {:.2}, {} px per eye), whole image PSNR {:.2} dB (MAE {:.2})",
+            t0.elapsed().as_secs_f64() * 1e3,
+            s.seam_psnr_db,
+            s.seam_mae,
+            s.seam_pixels,
+            s.whole_psnr_db,
+            s.whole_mae
+        );
+    }
+    for p in &written {
+        println!("wrote {}", p.display());
+    }
+    Ok(())
+}
