@@ -3,7 +3,16 @@
 
 use super::{face_camera, CubeFace, FaceImage, FaceSet, OdsRig, Side};
 use crate::error::{Error, Result};
-use crate::io::{DepthMap, RgbImage};
+use crate::io::{self, DepthDecode, DepthMap, RgbImage};
+use std::path::{Path, PathBuf};
+
+/// File name tags of the faces in a face folder, in [`CubeFace::ALL`] order (+Z, -Z, up, down,
+/// +X, -X).
+pub const FACE_TAGS: [&str; 6] = ["pz", "nz", "up", "down", "px", "nx"];
+/// Colour file extensions tried in a face folder, in this order.
+pub const FACE_COLOR_EXTS: [&str; 5] = ["png", "jpg", "jpeg", "ppm", "exr"];
+/// Depth (view-space Z) file extensions tried in a face folder, in this order.
+pub const FACE_DEPTH_EXTS: [&str; 4] = ["exr", "npy", "pfm", "png"];
 use crate::scene;
 
 /// The six faces of `side`, N x N, FOV `fov_deg`, from the f64 ray tracer: colour rounded to
@@ -58,4 +67,55 @@ pub fn faces_from_images(rig: &OdsRig, side: Side, fov_deg: f64, images: Vec<(Rg
     };
     set.validate()?;
     Ok(set)
+}
+
+/// `dir/stem.ext` for the first extension of `exts` that exists; the error names the first
+/// candidate and what it should hold.
+fn find_face_file(dir: &Path, stem: &str, exts: &[&str], what: &str) -> Result<PathBuf> {
+    exts.iter()
+        .map(|e| dir.join(format!("{stem}.{e}")))
+        .find(|p| p.is_file())
+        .ok_or_else(|| {
+            Error::io(
+                dir.join(format!("{stem}.{}", exts[0])),
+                std::io::Error::new(
+                    std::io::ErrorKind::NotFound,
+                    format!("missing {what} (also looked for .{})", exts[1..].join(", .")),
+                ),
+            )
+        })
+}
+
+/// The six faces of `side` from a face folder: colour `{left,right}_{tag}.{png,jpg,jpeg,ppm,exr}`
+/// and view-space Z `{left,right}_{tag}_depth.{exr,npy,pfm,png}` ([`FACE_TAGS`]; integer depth
+/// decoded with `decode`), rendered with the poses [`CubeFace::pose`] gives for `rig`.
+pub fn load_face_dir(dir: &Path, rig: &OdsRig, side: Side, fov_deg: f64, decode: &DepthDecode) -> Result<FaceSet> {
+    if !dir.is_dir() {
+        return Err(Error::io(
+            dir,
+            std::io::Error::new(std::io::ErrorKind::NotFound, "not a directory"),
+        ));
+    }
+    let eye = match side {
+        Side::Left => "left",
+        Side::Right => "right",
+    };
+    let mut images = Vec::new();
+    for (face, tag) in CubeFace::ALL.iter().zip(FACE_TAGS) {
+        let what = format!("the {eye} eye's {} face", face.label());
+        let c = find_face_file(
+            dir,
+            &format!("{eye}_{tag}"),
+            &FACE_COLOR_EXTS,
+            &format!("colour of {what}"),
+        )?;
+        let d = find_face_file(
+            dir,
+            &format!("{eye}_{tag}_depth"),
+            &FACE_DEPTH_EXTS,
+            &format!("view-space Z of {what}"),
+        )?;
+        images.push((io::load_rgb(&c)?, io::load_depth(&d, decode)?));
+    }
+    faces_from_images(rig, side, fov_deg, images)
 }

@@ -63,34 +63,13 @@ pub(crate) struct StitchArgs {
     gpu: GpuArgs,
 }
 
-/// File name tags of the cube faces in `--faces DIR`, in [`viewsynth::stitch::CubeFace::ALL`]
-/// order (+Z, -Z, up, down, +X, -X).
-pub(crate) const FACE_TAGS: [&str; 6] = ["pz", "nz", "up", "down", "px", "nx"];
-pub(crate) const FACE_COLOR_EXTS: [&str; 5] = ["png", "jpg", "jpeg", "ppm", "exr"];
-pub(crate) const FACE_DEPTH_EXTS: [&str; 4] = ["exr", "npy", "pfm", "png"];
-
-/// `dir/stem.ext` for the first extension that exists; the error names the first candidate.
-pub(crate) fn find_face_file(dir: &Path, stem: &str, exts: &[&str], what: &str) -> Result<PathBuf> {
-    for e in exts {
-        let p = dir.join(format!("{stem}.{e}"));
-        if p.is_file() {
-            return Ok(p);
-        }
-    }
-    bail!(
-        "--faces: missing {} ({what}; also looked for .{})",
-        dir.join(format!("{stem}.{}", exts[0])).display(),
-        exts[1..].join(", .")
-    )
-}
-
 pub(crate) fn stitch(a: StitchArgs) -> Result<()> {
     use std::time::Instant;
     use viewsynth::stitch::eval::{score_eyes, split_top_bottom};
-    use viewsynth::stitch::faces::{faces_from_images, scene_faces};
+    use viewsynth::stitch::faces::{load_face_dir, scene_faces};
     use viewsynth::stitch::render::StitchRenderer;
     use viewsynth::stitch::truth::ods_truth;
-    use viewsynth::stitch::{seam_band_mask, CubeFace, FaceSet, Method as SMethod, OdsRig, Side, StitchParams};
+    use viewsynth::stitch::{seam_band_mask, FaceSet, Method as SMethod, OdsRig, Side, StitchParams};
 
     if let (None, Some(o)) = (a.fov, a.overlap) {
         if !(o > 0.0 && o < 44.0) {
@@ -162,29 +141,8 @@ pub(crate) fn stitch(a: StitchArgs) -> Result<()> {
             scale: a.depth_scale,
             ..Default::default()
         };
-        let load = |side: Side| -> Result<FaceSet> {
-            let eye = match side {
-                Side::Left => "left",
-                Side::Right => "right",
-            };
-            let mut images = Vec::new();
-            for (face, tag) in CubeFace::ALL.iter().zip(FACE_TAGS) {
-                let what = format!("the {eye} eye's {} face", face.label());
-                let c = find_face_file(
-                    dir,
-                    &format!("{eye}_{tag}"),
-                    &FACE_COLOR_EXTS,
-                    &format!("colour of {what}"),
-                )?;
-                let d = find_face_file(
-                    dir,
-                    &format!("{eye}_{tag}_depth"),
-                    &FACE_DEPTH_EXTS,
-                    &format!("view-space Z of {what}"),
-                )?;
-                images.push((io::load_rgb(&c)?, io::load_depth(&d, &decode)?));
-            }
-            faces_from_images(&rig, side, fov, images).with_context(|| format!("--faces {}: {eye} eye", dir.display()))
+        let load = |side: Side| {
+            load_face_dir(dir, &rig, side, fov, &decode).with_context(|| format!("--faces {}", dir.display()))
         };
         let (l, r) = (load(Side::Left)?, load(Side::Right)?);
         if l.size() != r.size() {
