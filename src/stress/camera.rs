@@ -15,7 +15,7 @@
 //!   nearer-parallel gazes take the documented fallback (max depth), never NaN.
 
 use super::{Stats, StressOptions, StressRow, Tolerance, EPS32};
-use crate::camera::stereo::{mono_projection_gl, parallax, Frustum};
+use crate::camera::stereo::{mono_projection_gl, parallax, CullingKind, Frustum, StereoCullingFrustum};
 use crate::camera::vergence::{resolve_fixation, DepthRange, FixationSource, GazeRay};
 use crate::convention::{Conventions, DepthPlanes, NdcDepthRange, RowOrder};
 use crate::error::Result;
@@ -118,6 +118,58 @@ fn depth_round_trip(planes: DepthPlanes, conv: Conventions, samples: usize) -> R
         pass,
         note,
     })
+}
+
+/// Points on the near plane store exactly the near value; nearer ones fall outside the depth
+/// range and points on or behind the eye plane get clip w <= 0: the GPU clips both before any
+/// division, so nothing non-finite reaches a depth buffer. The screen-window culling frustum
+/// rejects points behind its apex.
+fn near_plane_row() -> Result<StressRow> {
+    let frustum = Frustum::from_fov_y(60f64.to_radians(), 1.5)?;
+    let planes = DepthPlanes { near: 0.05, far: 100.0 };
+    let mut broken = Vec::new();
+    for conv in depth_conventions() {
+        let m = mono_projection_gl(&frustum, &planes, &conv)?.map(|v| v as f32);
+        let tag = conv.label();
+        let near_value = conv.ndc_z_near_far().0;
+        let near_window = match conv.ndc_depth {
+            NdcDepthRange::MinusOneToOne => 0.5 * near_value + 0.5,
+            NdcDepthRange::ZeroToOne => near_value,
+        };
+        let d = window_depth_f32(&m, &conv, planes.near) as f64;
+        if (d - near_window).abs() > 2.0 * EPS32 {
+            broken.push(format!("{tag}: Z = near stores {d}, not {near_window}"));
+        }
+        let d = window_depth_f32(&m, &conv, 0.999 * planes.near) as f64;
+        if (0.0..=1.0).contains(&d) {
+            broken.push(format!("{tag}: Z = 0.999 near stores {d}, inside the depth range"));
+        }
+        for z in [0.0f32, -1.0, -1e6] {
+            let w = m[11] * -z + m[15];
+            if w > 0.0 {
+                broken.push(format!("{tag}: Z = {z} has clip w = {w} > 0"));
+            }
+        }
+    }
+    let params = crate::camera::stereo::StereoParams::new(0.03, 2.0)?;
+    let cull = StereoCullingFrustum::new(&frustum, &params, CullingKind::ScreenWindow);
+    if [[0.0, 0.0, -1.0], [0.0, 0.0, -1e6], [0.0, 0.0, 0.0]]
+        .iter()
+        .any(|p| cull.contains(*p))
+    {
+        broken.push("the screen-window culling frustum holds a point behind the eye".into());
+    }
+    Ok(StressRow::rule(
+        "camera",
+        "near plane and behind the camera (4 depth conventions, culling)",
+        broken.is_empty(),
+        if broken.is_empty() {
+            "Z = near stores the near value (2 eps); nearer falls outside [0,1]; Z <= 0 gets w <= 0 (clipped); culled"
+                .to_string()
+        } else {
+            broken.join("; ")
+        },
+    ))
 }
 
 fn parallax_row() -> StressRow {
@@ -262,6 +314,7 @@ pub fn rows(opts: StressOptions) -> Result<Vec<StressRow>> {
             rows.push(depth_round_trip(planes, conv, samples)?);
         }
     }
+    rows.push(near_plane_row()?);
     rows.push(parallax_row());
     rows.push(vergence_row()?);
     Ok(rows)
