@@ -173,11 +173,15 @@ fn reproject_outputs(gpu: &Gpu, dir: &Path) -> Result<()> {
         ("gather3d", Method::Gather3d { steps: 3 }),
     ] {
         let (out, _) = Reprojector::new(gpu, &case.source, &case.geometry, ReprojectParams::new(method))?.render()?;
-        io::save_rgb(&dir.join(format!("right_{name}_rgb.png")), &out.color)?;
-        io::save_depth_exr(&dir.join(format!("right_{name}_depth.exr")), &out.depth)?;
+        let (color, depth) = (
+            out.color.as_ref().expect("colour requested"),
+            out.depth.as_ref().expect("depth requested"),
+        );
+        io::save_rgb(&dir.join(format!("right_{name}_rgb.png")), color)?;
+        io::save_depth_exr(&dir.join(format!("right_{name}_depth.exr")), depth)?;
         let mask = io::Mask::new(
-            out.color.width,
-            out.color.height,
+            color.width,
+            color.height,
             out.mask.iter().map(|m| (*m != 0) as u8).collect(),
         )?;
         io::save_mask_png(&dir.join(format!("right_{name}_mask.png")), &mask)?;

@@ -291,16 +291,39 @@ impl Method {
     }
 }
 
+/// Which target images to produce. The mask always is (it is what coverage is measured on);
+/// colour and depth get no attachment and no readback when not requested.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct ReprojectOutputs {
+    pub color: bool,
+    pub depth: bool,
+}
+
+impl Default for ReprojectOutputs {
+    fn default() -> Self {
+        ReprojectOutputs {
+            color: true,
+            depth: true,
+        }
+    }
+}
+
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct ReprojectParams {
     pub method: Method,
+    /// Colour and/or depth (default both).
+    pub outputs: ReprojectOutputs,
     /// A segment breaks where |Z_j - Z_j+1| > tau_rel * min(Z) (i.e. |q_j - q_j+1| > tau_rel * min(q)).
     pub tau_rel: f64,
 }
 
 impl ReprojectParams {
     pub fn new(method: Method) -> Self {
-        ReprojectParams { method, tau_rel: 0.05 }
+        ReprojectParams {
+            method,
+            outputs: ReprojectOutputs::default(),
+            tau_rel: 0.05,
+        }
     }
 
     pub fn validate(&self) -> Result<()> {
@@ -322,10 +345,10 @@ impl ReprojectParams {
 /// The target view, rows top-down.
 #[derive(Debug, Clone)]
 pub struct ReprojectOutput {
-    /// 0 where the mask is 0.
-    pub color: RgbImage,
-    /// Target view Z in metres; 0 where the mask is 0.
-    pub depth: DepthMap,
+    /// 0 where the mask is 0; None when not requested.
+    pub color: Option<RgbImage>,
+    /// Target view Z in metres; 0 where the mask is 0; None when not requested.
+    pub depth: Option<DepthMap>,
     /// 255 valid, 0 invalid (disocclusion, outside the source, invalid source depth).
     pub mask: Vec<u8>,
 }

@@ -27,17 +27,22 @@ pub struct ReprojectReference {
 }
 
 impl ReprojectReference {
+    /// Rounded to the output types (colour and depth both present).
     pub fn to_output(&self) -> Result<ReprojectOutput> {
         Ok(ReprojectOutput {
-            color: RgbImage::new(
+            color: Some(RgbImage::new(
                 self.width,
                 self.height,
                 self.color
                     .iter()
                     .flat_map(|c| c.map(crate::metrics::quantize_u8))
                     .collect(),
-            )?,
-            depth: DepthMap::new(self.width, self.height, self.depth.iter().map(|z| *z as f32).collect())?,
+            )?),
+            depth: Some(DepthMap::new(
+                self.width,
+                self.height,
+                self.depth.iter().map(|z| *z as f32).collect(),
+            )?),
             mask: self.mask.iter().map(|m| if *m { 255 } else { 0 }).collect(),
         })
     }

@@ -79,8 +79,8 @@ impl Reprojector {
                 let program = Program::fullscreen(gpu, &defines, "reproject/shift.frag", SHIFT_FRAG)?;
                 let rgba: Vec<u8> = crate::gpu::pixels::rgb_to_rgba(&src.color.data);
                 let depth: Vec<u8> = crate::gpu::pixels::f32_to_bytes(&src.depth.data);
-                let slot = |format| {
-                    Some(Attachment {
+                let slot = |wanted: bool, format| {
+                    wanted.then_some(Attachment {
                         format,
                         clear: [0.0; 4],
                     })
@@ -107,9 +107,9 @@ impl Reprojector {
                         w,
                         h,
                         &[
-                            slot(TextureFormat::Rgba8),
-                            slot(TextureFormat::R32F),
-                            slot(TextureFormat::R8),
+                            slot(params.outputs.color, TextureFormat::Rgba8),
+                            slot(params.outputs.depth, TextureFormat::R32F),
+                            slot(true, TextureFormat::R8),
                         ],
                         false,
                     )?,
@@ -154,10 +154,18 @@ impl Reprojector {
                         mask[i] = 255;
                     }
                 }
+                // The two walks are merged by depth, so the cyclopean passes always produce it.
+                let outputs = self.params.outputs;
                 Ok((
                     ReprojectOutput {
-                        color: RgbImage::new(target.width, target.height, color)?,
-                        depth: DepthMap::new(target.width, target.height, depth)?,
+                        color: outputs
+                            .color
+                            .then(|| RgbImage::new(target.width, target.height, color))
+                            .transpose()?,
+                        depth: outputs
+                            .depth
+                            .then(|| DepthMap::new(target.width, target.height, depth))
+                            .transpose()?,
                         mask,
                     },
                     timing,
@@ -192,25 +200,31 @@ impl Reprojector {
                 s.vao.draw_fullscreen();
                 self.gpu.check("reproject shift draw")?;
                 let timing = timer.stop();
-                let read = |i: usize, bpp: usize| -> Result<Vec<u8>> {
-                    let data = fb
+                let read = |i: usize, bpp: usize| -> Result<Option<Vec<u8>>> {
+                    Ok(fb
                         .read_color(i)?
-                        .ok_or_else(|| Error::Gl(format!("reproject: attachment {i} missing")))?;
-                    Ok(memory_rows(&data, w as usize * bpp, self.flip))
+                        .map(|data| memory_rows(&data, w as usize * bpp, self.flip)))
                 };
-                let (rgba, depth, mask) = (read(0, 4)?, read(1, 4)?, read(2, 1)?);
+                let (rgba, depth) = (read(0, 4)?, read(1, 4)?);
+                let mask = read(2, 1)?.ok_or_else(|| Error::Gl("reproject: mask attachment missing".into()))?;
                 fb.unbind();
                 Ok((
                     ReprojectOutput {
-                        color: RgbImage::new(w, h, crate::gpu::pixels::rgba_to_rgb(&rgba))?,
-                        depth: DepthMap::new(
-                            w,
-                            h,
-                            crate::gpu::pixels::bytes_to_f32(&depth)
-                                .into_iter()
-                                .map(|z| if z.is_finite() { z } else { 0.0 })
-                                .collect(),
-                        )?,
+                        color: rgba
+                            .map(|d| RgbImage::new(w, h, crate::gpu::pixels::rgba_to_rgb(&d)))
+                            .transpose()?,
+                        depth: depth
+                            .map(|d| {
+                                DepthMap::new(
+                                    w,
+                                    h,
+                                    crate::gpu::pixels::bytes_to_f32(&d)
+                                        .into_iter()
+                                        .map(|z| if z.is_finite() { z } else { 0.0 })
+                                        .collect(),
+                                )
+                            })
+                            .transpose()?,
                         mask,
                     },
                     timing,

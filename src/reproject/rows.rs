@@ -209,7 +209,17 @@ pub struct Score {
     pub depth_rel_mean: Option<f64>,
 }
 
-pub fn score(out: &ReprojectOutput, case: &Case) -> Score {
+/// Scores of an output against its case's truth; needs the colour (and depth where the case
+/// has a true depth).
+pub fn score(out: &ReprojectOutput, case: &Case) -> Result<Score> {
+    let color = out
+        .color
+        .as_ref()
+        .ok_or_else(|| crate::Error::param("outputs", "scoring needs the colour output"))?;
+    let depth = match (&case.truth_depth, &out.depth) {
+        (Some(_), None) => return Err(crate::Error::param("outputs", "scoring needs the depth output")),
+        (_, d) => d.as_ref(),
+    };
     let mask: Vec<bool> = out
         .mask
         .iter()
@@ -220,29 +230,23 @@ pub fn score(out: &ReprojectOutput, case: &Case) -> Score {
     for (i, _) in mask.iter().enumerate().filter(|(_, m)| **m) {
         n += 1;
         for c in 0..3 {
-            let d = out.color.data[i * 3 + c] as f64 - case.truth.data[i * 3 + c] as f64;
+            let d = color.data[i * 3 + c] as f64 - case.truth.data[i * 3 + c] as f64;
             sq += d * d;
         }
-        if let Some(t) = &case.truth_depth {
-            let (z, t) = (out.depth.data[i] as f64, t.data[i] as f64);
+        if let (Some(t), Some(z)) = (&case.truth_depth, depth) {
+            let (z, t) = (z.data[i] as f64, t.data[i] as f64);
             drel += (z - t).abs() / t;
             nz += 1;
         }
     }
     let total = mask.len().max(1) as f64;
-    Score {
+    Ok(Score {
         psnr_db: metrics::psnr_from_mse(sq / (3 * n.max(1)) as f64),
         coverage: out.coverage(),
         scored: n as f64 / total,
-        ssim: ssim::ssim_rgb(
-            &out.color.data,
-            &case.truth.data,
-            out.color.width,
-            out.color.height,
-            Some(&mask),
-        ),
+        ssim: ssim::ssim_rgb(&color.data, &case.truth.data, color.width, color.height, Some(&mask)),
         depth_rel_mean: (nz > 0).then(|| drel / nz as f64),
-    }
+    })
 }
 
 /// Median of `repeats` runs after one warm-up (shader JIT, allocations).
@@ -257,15 +261,21 @@ pub fn run_timed(gpu: &Gpu, case: &Case, params: ReprojectParams, repeats: usize
     Ok(runs.swap_remove(runs.len() / 2))
 }
 
-fn row(case: &Case, scene: &str, params: ReprojectParams, out: &ReprojectOutput, t: Timing) -> (ReportRow, Score) {
-    let s = score(out, case);
+fn row(
+    case: &Case,
+    scene: &str,
+    params: ReprojectParams,
+    out: &ReprojectOutput,
+    t: Timing,
+) -> Result<(ReportRow, Score)> {
+    let s = score(out, case)?;
     let mut r = ReportRow::new("reproject", scene, params.method.label(), case.name.clone(), t.wall_ms);
     r.gpu_ms = t.gpu_ms;
     r.psnr_db = Some(s.psnr_db);
     r.ssim = s.ssim;
     r.coverage = Some(s.coverage);
     r.depth_rel_mean = s.depth_rel_mean;
-    (r, s)
+    Ok((r, s))
 }
 
 /// The general mesh warp of the foundation (the cyclopean forward warp with the source as the
@@ -283,16 +293,16 @@ pub fn mesh_warp_timed(gpu: &Gpu, case: &Case, repeats: usize) -> Result<(Reproj
     let mask = out.sources.iter().map(|s| if *s != 0 { 255 } else { 0 }).collect();
     Ok((
         ReprojectOutput {
-            color: out.color,
-            depth: out.depth,
+            color: Some(out.color),
+            depth: Some(out.depth),
             mask,
         },
         t,
     ))
 }
 
-fn mesh_row(case: &Case, scene: &str, out: &ReprojectOutput, t: Timing) -> (ReportRow, Score) {
-    let s = score(out, case);
+fn mesh_row(case: &Case, scene: &str, out: &ReprojectOutput, t: Timing) -> Result<(ReportRow, Score)> {
+    let s = score(out, case)?;
     let mut r = ReportRow::new(
         "reproject",
         scene,
@@ -305,7 +315,7 @@ fn mesh_row(case: &Case, scene: &str, out: &ReprojectOutput, t: Timing) -> (Repo
     r.ssim = s.ssim;
     r.coverage = Some(s.coverage);
     r.depth_rel_mean = s.depth_rel_mean;
-    (r, s)
+    Ok((r, s))
 }
 
 /// Rows for `viewsynth report`: the built-in scene at 640x480 (64 mm and 200 mm baselines, left
@@ -321,12 +331,12 @@ pub fn reproject_rows(gpu: &Gpu, data_dir: Option<&Path>, repeats: usize) -> Res
         for case in scene_cases(640, 480, ipd, conv, DepthKind::Device)? {
             for params in methods() {
                 let (out, t) = run_timed(gpu, &case, params, repeats)?;
-                let (mut r, _) = row(&case, "builtin:demo 640x480", params, &out, t);
+                let (mut r, _) = row(&case, "builtin:demo 640x480", params, &out, t)?;
                 r.setting = format!("{}, ipd {:.0} mm", case.name, ipd * 1e3);
                 rows.push(r);
             }
             let (out, t) = mesh_warp_timed(gpu, &case, repeats)?;
-            let (mut r, _) = mesh_row(&case, "builtin:demo 640x480", &out, t);
+            let (mut r, _) = mesh_row(&case, "builtin:demo 640x480", &out, t)?;
             r.setting = format!("{}, ipd {:.0} mm", case.name, ipd * 1e3);
             rows.push(r);
         }
@@ -335,7 +345,7 @@ pub fn reproject_rows(gpu: &Gpu, data_dir: Option<&Path>, repeats: usize) -> Res
         for case in [motorcycle_case(dir, conv)?, teddy_case(dir, conv)?] {
             for params in methods() {
                 let (out, t) = run_timed(gpu, &case, params, repeats)?;
-                let (mut r, s) = row(&case, &case.name, params, &out, t);
+                let (mut r, s) = row(&case, &case.name, params, &out, t)?;
                 r.setting = "PSNR vs the real right view on pixels marked valid".into();
                 notes.push(format!(
                     "{}, {}: PSNR {:.2} dB on the {:.1} % of pixels marked valid, {:.1} ms",
@@ -348,7 +358,7 @@ pub fn reproject_rows(gpu: &Gpu, data_dir: Option<&Path>, repeats: usize) -> Res
                 rows.push(r);
             }
             let (out, t) = mesh_warp_timed(gpu, &case, repeats)?;
-            let (mut r, s) = mesh_row(&case, &case.name, &out, t);
+            let (mut r, s) = mesh_row(&case, &case.name, &out, t)?;
             r.setting = "PSNR vs the real right view on pixels marked valid".into();
             notes.push(format!(
                 "{}, mesh warp: PSNR {:.2} dB on the {:.1} % of pixels marked valid, {:.1} ms",

@@ -53,8 +53,8 @@ fn sweep(gpu: &Gpu, case: &str, cases: &[Case], tol: Tolerance, note: &str) -> R
                 &GpuPixels {
                     valid: out.mask.iter().map(|m| *m != 0).collect(),
                     class: None,
-                    depth: Some(&out.depth.data),
-                    rgb: &out.color.data,
+                    depth: out.depth.as_ref().map(|d| d.data.as_slice()),
+                    rgb: &out.color.as_ref().expect("colour requested").data,
                 },
                 &RefPixels {
                     valid: reference.mask.clone(),

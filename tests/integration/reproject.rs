@@ -26,7 +26,7 @@ use viewsynth::reproject::reference::{reproject_reference, ReprojectReference};
 use viewsynth::reproject::render::Reprojector;
 use viewsynth::reproject::rows::{methods, motorcycle_case, run_timed, scene_cases, score, teddy_case, Case};
 use viewsynth::reproject::{
-    DepthInput, Geometry, Method, ReprojectOutput, ReprojectParams, ReprojectSource, ShiftModel,
+    DepthInput, Geometry, Method, ReprojectOutput, ReprojectOutputs, ReprojectParams, ReprojectSource, ShiftModel,
 };
 
 const DEPTH_REL_TOL: f64 = 3e-5;
@@ -35,24 +35,25 @@ const DEPTH_REL_TOL: f64 = 3e-5;
 /// the tolerance); colour off by > 1 level; max relative depth error on the agreeing pixels)
 fn disagreement(out: &ReprojectOutput, r: &ReprojectReference) -> (usize, usize, f64) {
     let (mut decided, mut col, mut z) = (0, 0, 0f64);
+    let (color, depth) = (out.color.as_ref().unwrap(), out.depth.as_ref().unwrap());
     for i in 0..r.mask.len() {
-        assert!(out.depth.data[i].is_finite(), "pixel {i}: non-finite depth");
+        assert!(depth.data[i].is_finite(), "pixel {i}: non-finite depth");
         if (out.mask[i] != 0) != r.mask[i] {
             decided += 1;
             continue;
         }
         if !r.mask[i] {
-            assert!(out.depth.data[i] == 0.0 && out.color.data[i * 3..i * 3 + 3] == [0, 0, 0]);
+            assert!(depth.data[i] == 0.0 && color.data[i * 3..i * 3 + 3] == [0, 0, 0]);
             continue;
         }
-        let rel = (out.depth.data[i] as f64 - r.depth[i]).abs() / r.depth[i];
+        let rel = (depth.data[i] as f64 - r.depth[i]).abs() / r.depth[i];
         if rel > DEPTH_REL_TOL {
             decided += 1;
             continue;
         }
         z = z.max(rel);
         let e = (0..3)
-            .map(|c| metrics::quantization_error(out.color.data[i * 3 + c], r.color[i][c]))
+            .map(|c| metrics::quantization_error(color.data[i * 3 + c], r.color[i][c]))
             .max()
             .unwrap_or(0);
         col += (e > 1) as usize;
@@ -104,9 +105,11 @@ fn gpu_matches_the_f64_reference_under_every_convention_and_depth_kind() {
                             let diff = out.mask.iter().zip(&b.mask).filter(|(a, b)| a != b).count();
                             let z = out
                                 .depth
+                                .as_ref()
+                                .unwrap()
                                 .data
                                 .iter()
-                                .zip(&b.depth.data)
+                                .zip(&b.depth.as_ref().unwrap().data)
                                 .filter(|(a, b)| **a > 0.0 && **b > 0.0)
                                 .map(|(a, b)| ((a - b) / b).abs())
                                 .fold(0f32, f32::max);
@@ -135,7 +138,7 @@ fn scene_left_and_centre_to_right_against_the_ray_traced_right_eye() {
             let (mut scan_psnr, mut walk_psnr) = (None, None);
             for params in methods() {
                 let (out, t) = run_timed(&g, &case, params, 3).unwrap();
-                let s = score(&out, &case);
+                let s = score(&out, &case).unwrap();
                 println!(
                     "scene 640x480 ipd {:.0} mm, {}, {}: PSNR {:.2} dB on {:.1} % scored, coverage {:.2} %, depth rel {:.2e}, {:.1} ms",
                     ipd * 1e3,
@@ -186,7 +189,7 @@ fn middlebury_motorcycle_and_teddy_left_to_right() {
     ] {
         for params in methods() {
             let (out, t) = run_timed(&g, &case, params, 1).unwrap();
-            let s = score(&out, &case);
+            let s = score(&out, &case).unwrap();
             println!(
                 "{}, {}: PSNR {:.2} dB on valid pixels, coverage {:.2} %, {:.1} ms",
                 case.name,
@@ -201,7 +204,7 @@ fn middlebury_motorcycle_and_teddy_left_to_right() {
                 case.name,
                 params.method.label()
             );
-            assert!(out.depth.data.iter().all(|z| z.is_finite()));
+            assert!(out.depth.as_ref().unwrap().data.iter().all(|z| z.is_finite()));
         }
         // The GPU still matches the reference on real data (inf/0 disparities included).
         for params in [
@@ -285,7 +288,12 @@ fn zero_separation_is_the_identity_and_degenerate_depth_is_masked_never_nan() {
                 .render()
                 .unwrap();
             assert!(out.mask.iter().all(|m| *m == 255), "{}", params.method.label());
-            assert_eq!(out.color.data, src.color.data, "{}", params.method.label());
+            assert_eq!(
+                out.color.as_ref().unwrap().data,
+                src.color.data,
+                "{}",
+                params.method.label()
+            );
         }
     }
     // Tiny convergence (S c -> 0, large +S shift): finite, pixels shifted out of view invalid.
@@ -299,7 +307,7 @@ fn zero_separation_is_the_identity_and_degenerate_depth_is_masked_never_nan() {
         .unwrap()
         .render()
         .unwrap();
-    assert!(out.depth.data.iter().all(|z| z.is_finite()));
+    assert!(out.depth.as_ref().unwrap().data.iter().all(|z| z.is_finite()));
     // NaN, +-inf, 0 and negative (behind the camera) depths: never valid, never NaN out.
     let bad = plane_source(w, h, |x, y| match (x + y) % 6 {
         0 => f32::NAN,
@@ -315,7 +323,13 @@ fn zero_separation_is_the_identity_and_degenerate_depth_is_masked_never_nan() {
             .unwrap()
             .render()
             .unwrap();
-        assert!(out.depth.data.iter().all(|z| z.is_finite() && *z >= 0.0));
+        assert!(out
+            .depth
+            .as_ref()
+            .unwrap()
+            .data
+            .iter()
+            .all(|z| z.is_finite() && *z >= 0.0));
         let (m, _, z) = disagreement(&out, &reference);
         assert!(
             m == 0 && z <= DEPTH_REL_TOL,
@@ -330,7 +344,7 @@ fn zero_separation_is_the_identity_and_degenerate_depth_is_masked_never_nan() {
             .unwrap()
             .render()
             .unwrap();
-        assert!(out.mask.iter().all(|m| *m == 0) && out.depth.data.iter().all(|z| *z == 0.0));
+        assert!(out.mask.iter().all(|m| *m == 0) && out.depth.as_ref().unwrap().data.iter().all(|z| *z == 0.0));
     }
 }
 
@@ -351,7 +365,7 @@ fn the_nearer_surface_wins_where_two_map_to_one_pixel() {
         // Strip lands at 20 - 10 = 10 .. 17; background at x - 2.5.
         for x in 10..=17 {
             assert_eq!(out.mask[x], 255, "{} x={x}", params.method.label());
-            let z = out.depth.data[x];
+            let z = out.depth.as_ref().unwrap().data[x];
             assert!((z - 1.0).abs() < 1e-5, "{} x={x}: z = {z}", params.method.label());
         }
         // Right of the strip: disocclusion (background 20..27 hidden in the left view).
@@ -481,7 +495,7 @@ fn full_eye_matrices_drive_the_3d_gather_like_the_rig() {
         diff * 1000 <= out.mask.len(),
         "matrices vs rig: {diff} mask differences"
     );
-    let s = score(&out, case);
+    let s = score(&out, case).unwrap();
     // Measured 36.2 dB on 90.1 % at this size and baseline.
     assert!(s.psnr_db > 33.0 && s.coverage > 0.85, "{s:?}");
 }
@@ -501,7 +515,7 @@ fn mesh_warp_comparison_matches_the_ray_traced_right_eye_under_every_convention(
             .next()
             .unwrap();
         let (out, _) = mesh_warp_timed(&g, &case, 1).unwrap();
-        let s = score(&out, &case);
+        let s = score(&out, &case).unwrap();
         assert!(
             s.psnr_db > 35.0 && s.coverage > 0.85,
             "{}: {:.2} dB, {:.3}",
@@ -509,16 +523,52 @@ fn mesh_warp_comparison_matches_the_ray_traced_right_eye_under_every_convention(
             s.psnr_db,
             s.coverage
         );
-        assert!(out.depth.data.iter().all(|z| z.is_finite()));
+        assert!(out.depth.as_ref().unwrap().data.iter().all(|z| z.is_finite()));
         match &first {
-            None => first = Some(out.color.data.clone()),
+            None => first = Some(out.color.as_ref().unwrap().data.clone()),
             Some(b) => {
                 let diff = b
                     .iter()
-                    .zip(&out.color.data)
+                    .zip(&out.color.as_ref().unwrap().data)
                     .filter(|(x, y)| (**x as i32 - **y as i32).abs() > 1)
                     .count();
                 assert!(diff * 1000 <= b.len(), "{}: {diff} channels differ", conv.label());
+            }
+        }
+    }
+}
+
+#[test]
+fn unrequested_colour_and_depth_get_no_attachment_and_no_readback() {
+    // Pay only for what is asked: no attachment and no readback for colour or depth when not
+    // requested; what is produced is identical to the full render.
+    let g = gpu();
+    let case = scene_cases(64, 48, 0.064, Conventions::default(), DepthKind::ViewZ)
+        .unwrap()
+        .remove(0);
+    for full in methods() {
+        let (all, _) = Reprojector::new(&g, &case.source, &case.geometry, full)
+            .unwrap()
+            .render()
+            .unwrap();
+        for (color, depth) in [(false, false), (true, false), (false, true)] {
+            let params = ReprojectParams {
+                outputs: ReprojectOutputs { color, depth },
+                ..full
+            };
+            let (out, _) = Reprojector::new(&g, &case.source, &case.geometry, params)
+                .unwrap()
+                .render()
+                .unwrap();
+            let tag = format!("{} color={color} depth={depth}", full.method.label());
+            assert_eq!(out.mask, all.mask, "{tag}");
+            assert_eq!(out.color.is_some(), color, "{tag}");
+            assert_eq!(out.depth.is_some(), depth, "{tag}");
+            if let Some(c) = &out.color {
+                assert_eq!(c.data, all.color.as_ref().unwrap().data, "{tag}");
+            }
+            if let Some(d) = &out.depth {
+                assert_eq!(d.data, all.depth.as_ref().unwrap().data, "{tag}");
             }
         }
     }

@@ -118,7 +118,9 @@ pub(crate) fn reproject(a: ReprojectArgs) -> Result<()> {
     use viewsynth::camera::PinholeCamera;
     use viewsynth::convention::DepthPlanes;
     use viewsynth::reproject::render::Reprojector;
-    use viewsynth::reproject::{DepthInput, Geometry, Method as RMethod, ReprojectParams, ReprojectSource, ShiftModel};
+    use viewsynth::reproject::{
+        DepthInput, Geometry, Method as RMethod, ReprojectOutputs, ReprojectParams, ReprojectSource, ShiftModel,
+    };
 
     // Everything that can be checked before reading files, touching the GPU or the output
     // directory is.
@@ -185,12 +187,17 @@ pub(crate) fn reproject(a: ReprojectArgs) -> Result<()> {
         ReprojectMethodArg::ShiftScan => RMethod::ShiftScan,
         ReprojectMethodArg::Gather3d => RMethod::Gather3d { steps: a.steps },
     };
+    let (outputs, rgb_format, depth_formats) = a.files.parse()?;
+    // The mask is always rendered: the coverage printed below is measured on it.
     let params = ReprojectParams {
         method,
+        outputs: ReprojectOutputs {
+            color: outputs.rgb,
+            depth: outputs.depth,
+        },
         tau_rel: a.tau_rel,
     };
     params.validate().context("--steps/--tau-rel")?;
-    let (outputs, rgb_format, depth_formats) = a.files.parse()?;
     let rgb_ext = rgb_format.extension();
     let conv = a.conv.conventions();
 
@@ -245,22 +252,22 @@ pub(crate) fn reproject(a: ReprojectArgs) -> Result<()> {
     let mut jobs: Vec<WriteJob> = Vec::new();
     for (to, out, _, _) in &results {
         let name = eye_name(Some(*to));
-        if outputs.rgb {
+        if let Some(color) = &out.color {
             jobs.push((
                 a.out_dir.join(format!("{name}_rgb.{rgb_ext}")),
-                Box::new(move |p: &Path| io::save_rgb(p, &out.color)),
+                Box::new(move |p: &Path| io::save_rgb(p, color)),
             ));
         }
-        if outputs.depth && depth_formats.exr {
+        if let Some(depth) = out.depth.as_ref().filter(|_| depth_formats.exr) {
             jobs.push((
                 a.out_dir.join(format!("{name}_depth.exr")),
-                Box::new(move |p: &Path| io::save_depth_exr(p, &out.depth)),
+                Box::new(move |p: &Path| io::save_depth_exr(p, depth)),
             ));
         }
-        if outputs.depth && depth_formats.npy {
+        if let Some(depth) = out.depth.as_ref().filter(|_| depth_formats.npy) {
             jobs.push((
                 a.out_dir.join(format!("{name}_depth.npy")),
-                Box::new(move |p: &Path| io::save_depth_npy(p, &out.depth)),
+                Box::new(move |p: &Path| io::save_depth_npy(p, depth)),
             ));
         }
         if outputs.mask {
@@ -268,7 +275,7 @@ pub(crate) fn reproject(a: ReprojectArgs) -> Result<()> {
                 a.out_dir.join(format!("{name}_mask.png")),
                 Box::new(move |p: &Path| {
                     let bits = out.mask.iter().map(|m| (*m != 0) as u8).collect();
-                    io::save_mask_png(p, &io::Mask::new(out.color.width, out.color.height, bits)?)
+                    io::save_mask_png(p, &io::Mask::new(camera.width, camera.height, bits)?)
                 }),
             ));
         }
@@ -280,8 +287,8 @@ pub(crate) fn reproject(a: ReprojectArgs) -> Result<()> {
             eye_name(from),
             eye_name(Some(*to)),
             params.method.label(),
-            out.color.width,
-            out.color.height,
+            camera.width,
+            camera.height,
             out.coverage() * 100.0,
             ms_text(timing),
         );
