@@ -167,6 +167,37 @@ impl DepthPlanes {
         (a as f32 * view_z + b as f32) / view_z
     }
 
+    /// The planes of a GL-style perspective projection (row-major, GL eye space -> clip, clip
+    /// w = -z_eye) made under `conv`: its depth row gives z_ndc = -m[2][2] + m[2][3] / Z, which
+    /// is inverted at the near and far NDC values of `conv` (far = inf where the row never
+    /// reaches it).
+    ///
+    /// Errors: not a perspective projection (w row other than (0, 0, -1, 0), depth row that
+    /// depends on x or y), or planes that are not 0 < near < far.
+    pub fn from_gl_projection(m: &[[f64; 4]; 4], conv: &Conventions) -> crate::Result<DepthPlanes> {
+        let perspective = m[3] == [0.0, 0.0, -1.0, 0.0] && m[2][0] == 0.0 && m[2][1] == 0.0;
+        if !perspective || !m.iter().flatten().all(|v| v.is_finite()) {
+            return Err(crate::Error::param(
+                "projection",
+                "not a finite GL perspective projection (w row (0, 0, -1, 0), depth row in z and w only)",
+            ));
+        }
+        let (a, b) = (-m[2][2], m[2][3]);
+        let (zn, zf) = conv.ndc_z_near_far();
+        let near = b / (zn - a);
+        let far = if zf == a { f64::INFINITY } else { b / (zf - a) };
+        if !(near.is_finite() && near > 0.0 && far > near) {
+            return Err(crate::Error::param(
+                "projection",
+                format!(
+                    "its depth row gives near {near}, far {far} under {}: not 0 < near < far",
+                    conv.label()
+                ),
+            ));
+        }
+        Ok(DepthPlanes { near, far })
+    }
+
     /// Window depth (what a depth buffer stores) of an NDC z.
     pub fn window_depth_of_ndc_z(conv: &Conventions, ndc_z: f64) -> f64 {
         ndc_to_window_depth(conv.ndc_depth, ndc_z)
@@ -191,6 +222,31 @@ mod tests {
                 assert!((back - z).abs() / z < 1e-10, "{conv:?} z={z} back={back}");
             }
         }
+    }
+
+    #[test]
+    fn planes_come_back_from_the_gl_projection_under_every_convention() {
+        let cam = crate::scene::demo_camera(64, 48);
+        for conv in Conventions::all() {
+            for planes in [
+                DepthPlanes { near: 0.05, far: 100.0 },
+                DepthPlanes {
+                    near: 1e-3,
+                    far: f64::INFINITY,
+                },
+            ] {
+                let m = crate::camera::gl_projection(&cam, &planes, &conv);
+                let back = DepthPlanes::from_gl_projection(&m, &conv).unwrap();
+                assert!((back.near / planes.near - 1.0).abs() < 1e-12, "{conv:?} {back:?}");
+                assert!(
+                    back.far == planes.far || (back.far / planes.far - 1.0).abs() < 1e-9,
+                    "{conv:?} {back:?}"
+                );
+            }
+        }
+        let mut ortho = crate::camera::mat4::IDENTITY;
+        ortho[2][2] = -0.1;
+        assert!(DepthPlanes::from_gl_projection(&ortho, &Conventions::default()).is_err());
     }
 
     #[test]

@@ -61,15 +61,20 @@ pub(crate) struct ReprojectArgs {
     /// Far plane (metres; may be inf) the device depth was written with (--depth-kind device).
     #[arg(long)]
     far: Option<f64>,
-    /// Source intrinsics in pixels.
-    #[arg(long)]
-    fx: f64,
-    #[arg(long)]
-    fy: f64,
-    #[arg(long)]
-    cx: f64,
-    #[arg(long)]
-    cy: f64,
+    /// Source intrinsics in pixels (with a rig).
+    #[arg(long, required_unless_present = "cameras")]
+    fx: Option<f64>,
+    #[arg(long, required_unless_present = "cameras")]
+    fy: Option<f64>,
+    #[arg(long, required_unless_present = "cameras")]
+    cx: Option<f64>,
+    #[arg(long, required_unless_present = "cameras")]
+    cy: Option<f64>,
+    /// Full eye matrices instead of a rig: a cameras.json as `viewsynth scene` writes it (left
+    /// and right GL view and projection, conventions, depth kind: those of the file apply).
+    /// The source is --from's eye, the target the other eye; --method gather3d only.
+    #[arg(long, conflicts_with_all = ["fx", "fy", "cx", "cy", "baseline", "separation", "near", "far", "focal"])]
+    cameras: Option<PathBuf>,
     /// Rectified rig: distance between the eyes in metres (x_right = x_left + doffs - f B / Z).
     /// Also the baseline of --depth-kind disparity.
     #[arg(long)]
@@ -112,24 +117,117 @@ pub(crate) struct ReprojectArgs {
     gpu: GpuArgs,
 }
 
+/// What a reprojection run renders: the source, where it is, and each target with its geometry.
+struct Setup {
+    src: viewsynth::reproject::ReprojectSource,
+    from: Option<viewsynth::camera::stereo::Eye>,
+    targets: Vec<(viewsynth::camera::stereo::Eye, viewsynth::reproject::Geometry)>,
+}
+
 pub(crate) fn reproject(a: ReprojectArgs) -> Result<()> {
     use std::time::Instant;
+    use viewsynth::reproject::render::Reprojector;
+    use viewsynth::reproject::{Method as RMethod, ReprojectOutputs, ReprojectParams};
+
+    let method = match a.method {
+        ReprojectMethodArg::Shift => RMethod::Shift { steps: a.steps },
+        ReprojectMethodArg::ShiftScan => RMethod::ShiftScan,
+        ReprojectMethodArg::Gather3d => RMethod::Gather3d { steps: a.steps },
+    };
+    let (outputs, rgb_format, depth_formats) = a.files.parse()?;
+    // The mask is always rendered: the coverage printed below is measured on it.
+    let params = ReprojectParams {
+        method,
+        outputs: ReprojectOutputs {
+            color: outputs.rgb,
+            depth: outputs.depth,
+        },
+        tau_rel: a.tau_rel,
+    };
+    params.validate().context("--steps/--tau-rel")?;
+    let rgb_ext = rgb_format.extension();
+    // Everything that can be checked before touching the GPU or the output directory is.
+    let Setup { src, from, targets } = match &a.cameras {
+        Some(path) => cameras_setup(&a, path)?,
+        None => rig_setup(&a)?,
+    };
+    let (width, height) = (src.color.width, src.color.height);
+    prepare_out_dir(&a.out_dir)?;
+
+    let gpu = a.gpu.open()?;
+    let mut results = Vec::new();
+    for (to, geometry) in &targets {
+        let t0 = Instant::now();
+        let mut r = Reprojector::new(&gpu, &src, geometry, params)?;
+        let setup_ms = t0.elapsed().as_secs_f64() * 1e3;
+        let (out, timing) = r.render()?;
+        results.push((*to, out, timing, setup_ms));
+    }
+    let mut jobs: Vec<WriteJob> = Vec::new();
+    for (to, out, _, _) in &results {
+        let name = eye_name(Some(*to));
+        if let Some(color) = &out.color {
+            jobs.push((
+                a.out_dir.join(format!("{name}_rgb.{rgb_ext}")),
+                Box::new(move |p: &Path| io::save_rgb(p, color)),
+            ));
+        }
+        if let Some(depth) = out.depth.as_ref().filter(|_| depth_formats.exr) {
+            jobs.push((
+                a.out_dir.join(format!("{name}_depth.exr")),
+                Box::new(move |p: &Path| io::save_depth_exr(p, depth)),
+            ));
+        }
+        if let Some(depth) = out.depth.as_ref().filter(|_| depth_formats.npy) {
+            jobs.push((
+                a.out_dir.join(format!("{name}_depth.npy")),
+                Box::new(move |p: &Path| io::save_depth_npy(p, depth)),
+            ));
+        }
+        if outputs.mask {
+            jobs.push((
+                a.out_dir.join(format!("{name}_mask.png")),
+                Box::new(move |p: &Path| {
+                    let bits = out.mask.iter().map(|m| (*m != 0) as u8).collect();
+                    io::save_mask_png(p, &io::Mask::new(width, height, bits)?)
+                }),
+            ));
+        }
+    }
+    let written = write_all_or_none(jobs)?;
+    for (to, out, timing, setup_ms) in &results {
+        println!(
+            "{} -> {} ({}): {}x{}, coverage {:.2} %, render {} (setup + shader compile {setup_ms:.1} ms)",
+            eye_name(from),
+            eye_name(Some(*to)),
+            params.method.label(),
+            width,
+            height,
+            out.coverage() * 100.0,
+            ms_text(timing),
+        );
+    }
+    let names: Vec<String> = written
+        .iter()
+        .filter_map(|p| p.file_name().map(|n| n.to_string_lossy().into_owned()))
+        .collect();
+    println!("wrote {} in {}", names.join(", "), a.out_dir.display());
+    Ok(())
+}
+
+/// The source and its targets on a parallel rig (rectified or seed 004) from intrinsics.
+fn rig_setup(a: &ReprojectArgs) -> Result<Setup> {
     use viewsynth::camera::stereo::{Eye, StereoParams};
     use viewsynth::camera::PinholeCamera;
     use viewsynth::convention::DepthPlanes;
-    use viewsynth::reproject::render::Reprojector;
-    use viewsynth::reproject::{
-        DepthInput, Geometry, Method as RMethod, ReprojectOutputs, ReprojectParams, ReprojectSource, ShiftModel,
-    };
+    use viewsynth::reproject::{DepthInput, Geometry, ReprojectSource, ShiftModel};
 
     // Everything that can be checked before reading files, touching the GPU or the output
     // directory is.
-    let k = Intrinsics {
-        fx: a.fx,
-        fy: a.fy,
-        cx: a.cx,
-        cy: a.cy,
+    let (Some(fx), Some(fy), Some(cx), Some(cy)) = (a.fx, a.fy, a.cx, a.cy) else {
+        bail!("give the source intrinsics --fx --fy --cx --cy (or --cameras FILE)");
     };
+    let k = Intrinsics { fx, fy, cx, cy };
     k.validate("source intrinsics")?;
     let from = match a.from {
         FromArg::Left => Some(Eye::Left),
@@ -145,7 +243,7 @@ pub(crate) fn reproject(a: ReprojectArgs) -> Result<()> {
         (_, ToArg::Left) => vec![Eye::Left],
         (_, ToArg::Right) => vec![Eye::Right],
     };
-    let focal = a.focal.unwrap_or(a.fx);
+    let focal = a.focal.unwrap_or(fx);
     let depth_kind = match a.depth_kind {
         ReprojectDepthArg::ViewZ => DepthInput::ViewZ,
         ReprojectDepthArg::Device => {
@@ -182,25 +280,7 @@ pub(crate) fn reproject(a: ReprojectArgs) -> Result<()> {
     if seed.is_none() && a.baseline.is_none() {
         bail!("give the rig: --baseline B (rectified, metres) or --separation S --convergence C (seed 004)");
     }
-    let method = match a.method {
-        ReprojectMethodArg::Shift => RMethod::Shift { steps: a.steps },
-        ReprojectMethodArg::ShiftScan => RMethod::ShiftScan,
-        ReprojectMethodArg::Gather3d => RMethod::Gather3d { steps: a.steps },
-    };
-    let (outputs, rgb_format, depth_formats) = a.files.parse()?;
-    // The mask is always rendered: the coverage printed below is measured on it.
-    let params = ReprojectParams {
-        method,
-        outputs: ReprojectOutputs {
-            color: outputs.rgb,
-            depth: outputs.depth,
-        },
-        tau_rel: a.tau_rel,
-    };
-    params.validate().context("--steps/--tau-rel")?;
-    let rgb_ext = rgb_format.extension();
     let conv = a.conv.conventions();
-
     let decode = DepthDecode {
         scale: a.depth_scale,
         ..Default::default()
@@ -236,69 +316,84 @@ pub(crate) fn reproject(a: ReprojectArgs) -> Result<()> {
             (None, None) => unreachable!("checked above"),
         };
         shift.validate()?;
-        geometries.push(Geometry::Rig { camera, shift });
+        geometries.push((to, Geometry::Rig { camera, shift }));
     }
-    prepare_out_dir(&a.out_dir)?;
+    Ok(Setup {
+        src,
+        from,
+        targets: geometries,
+    })
+}
 
-    let gpu = a.gpu.open()?;
-    let mut results = Vec::new();
-    for (&to, geometry) in targets.iter().zip(&geometries) {
-        let t0 = Instant::now();
-        let mut r = Reprojector::new(&gpu, &src, geometry, params)?;
-        let setup_ms = t0.elapsed().as_secs_f64() * 1e3;
-        let (out, timing) = r.render()?;
-        results.push((to, out, timing, setup_ms));
+/// The source eye and the other eye from full GL matrices (`--cameras`, 3-D gather only).
+fn cameras_setup(a: &ReprojectArgs, path: &Path) -> Result<Setup> {
+    use viewsynth::camera::stereo::Eye;
+    use viewsynth::convention::DepthPlanes;
+    use viewsynth::cyclopean::camera_file::CameraFile;
+    use viewsynth::cyclopean::{DepthKind, MiddleCamera};
+    use viewsynth::reproject::{DepthInput, Geometry, ReprojectSource};
+
+    let (from, to) = match a.from {
+        FromArg::Left => (Eye::Left, Eye::Right),
+        FromArg::Right => (Eye::Right, Eye::Left),
+        FromArg::Centre => bail!("--cameras holds the two eyes: --from left or right"),
+    };
+    let to_ok = matches!((a.to, to), (ToArg::Left, Eye::Left) | (ToArg::Right, Eye::Right));
+    if !to_ok {
+        bail!("--cameras: the target is the other eye (--to {})", eye_name(Some(to)));
     }
-    let mut jobs: Vec<WriteJob> = Vec::new();
-    for (to, out, _, _) in &results {
-        let name = eye_name(Some(*to));
-        if let Some(color) = &out.color {
-            jobs.push((
-                a.out_dir.join(format!("{name}_rgb.{rgb_ext}")),
-                Box::new(move |p: &Path| io::save_rgb(p, color)),
-            ));
-        }
-        if let Some(depth) = out.depth.as_ref().filter(|_| depth_formats.exr) {
-            jobs.push((
-                a.out_dir.join(format!("{name}_depth.exr")),
-                Box::new(move |p: &Path| io::save_depth_exr(p, depth)),
-            ));
-        }
-        if let Some(depth) = out.depth.as_ref().filter(|_| depth_formats.npy) {
-            jobs.push((
-                a.out_dir.join(format!("{name}_depth.npy")),
-                Box::new(move |p: &Path| io::save_depth_npy(p, depth)),
-            ));
-        }
-        if outputs.mask {
-            jobs.push((
-                a.out_dir.join(format!("{name}_mask.png")),
-                Box::new(move |p: &Path| {
-                    let bits = out.mask.iter().map(|m| (*m != 0) as u8).collect();
-                    io::save_mask_png(p, &io::Mask::new(camera.width, camera.height, bits)?)
-                }),
-            ));
-        }
+    if !matches!(a.method, ReprojectMethodArg::Gather3d) {
+        bail!("--cameras (full eye matrices) needs --method gather3d: the shift methods need a parallel rig");
     }
-    let written = write_all_or_none(jobs)?;
-    for (to, out, timing, setup_ms) in &results {
-        println!(
-            "{} -> {} ({}): {}x{}, coverage {:.2} %, render {} (setup + shader compile {setup_ms:.1} ms)",
-            eye_name(from),
-            eye_name(Some(*to)),
-            params.method.label(),
-            camera.width,
-            camera.height,
-            out.coverage() * 100.0,
-            ms_text(timing),
+    let file = CameraFile::load(path)?;
+    let (source, target) = match from {
+        Eye::Left => (&file.left, &file.right),
+        Eye::Right => (&file.right, &file.left),
+    };
+    let conv = file.conventions;
+    let depth_kind = match file.depth_kind {
+        DepthKind::ViewZ => DepthInput::ViewZ,
+        DepthKind::Device => DepthInput::Device {
+            planes: DepthPlanes::from_gl_projection(&source.proj, &conv)
+                .with_context(|| format!("{}: {} projection", path.display(), eye_name(Some(from))))?,
+        },
+    };
+    let decode = DepthDecode {
+        scale: a.depth_scale,
+        ..Default::default()
+    };
+    let src = ReprojectSource {
+        color: io::load_rgb(&a.color)?,
+        depth: io::load_depth(&a.depth, &decode)?,
+        depth_kind,
+        conv,
+    };
+    src.validate()
+        .with_context(|| format!("{} and {}", a.color.display(), a.depth.display()))?;
+    if src.inverse_depth_range().is_none() {
+        bail!(
+            "{}: no pixel holds valid depth as {:?} depth under {} (from {})",
+            a.depth.display(),
+            file.depth_kind,
+            conv.label(),
+            path.display()
         );
     }
-    let names: Vec<String> = written
-        .iter()
-        .filter_map(|p| p.file_name().map(|n| n.to_string_lossy().into_owned()))
-        .collect();
-    println!("wrote {} in {}", names.join(", "), a.out_dir.display());
-    Ok(())
+    let geometry = Geometry::Matrices {
+        source_view: source.view,
+        source_proj: source.proj,
+        target: MiddleCamera {
+            view: target.view,
+            proj: target.proj,
+            width: src.color.width,
+            height: src.color.height,
+        },
+    };
+    Ok(Setup {
+        src,
+        from: Some(from),
+        targets: vec![(to, geometry)],
+    })
 }
 
 pub(crate) fn eye_name(view: Option<viewsynth::camera::stereo::Eye>) -> &'static str {
