@@ -2,7 +2,7 @@
 // alternatives in src/stitch/mod.rs). The f64 twin is src/stitch/reference.rs: keep in step.
 // Defines: METHOD (0 blend, 1 border weight, 2 reproject), REPROJECT_STEPS.
 
-uniform sampler2D u_color;  // RGBA8 atlas: face k at columns [k n, (k + 1) n), rows top-down
+uniform sampler2D u_color;  // RGBA8 atlas: face k at columns [k n, (k + 1) n), rows in memory order
 uniform sampler2D u_depth;  // R32F atlas, view Z, <= 0 / NaN / Inf = background
 uniform mat4 u_rot[6];      // world from face rotation (upper 3x3)
 uniform vec4 u_eye[6];      // face eyes (xyz)
@@ -48,9 +48,18 @@ bool inside(vec2 uv) {
     return all(greaterThanEqual(uv, vec2(-0.5))) && all(lessThanEqual(uv, vec2(hi)));
 }
 
+// Atlas texel of face k's texel t (t.y counted from the face's top row).
+ivec2 atlas(int k, ivec2 t) {
+#if ROWS_TOP_DOWN
+    return ivec2(t.x + k * u_n, t.y);
+#else
+    return ivec2(t.x + k * u_n, u_n - 1 - t.y);
+#endif
+}
+
 vec3 texel(int k, ivec2 t) {
     t = clamp(t, ivec2(0), ivec2(u_n - 1));
-    return texelFetch(u_color, ivec2(t.x + k * u_n, t.y), 0).rgb * 255.0;
+    return texelFetch(u_color, atlas(k, t), 0).rgb * 255.0;
 }
 
 vec3 face_color(int k, vec2 uv) {
@@ -66,7 +75,7 @@ vec3 face_color(int k, vec2 uv) {
 // View Z at the nearest texel, or -1 for background.
 float face_depth(int k, vec2 uv) {
     ivec2 t = clamp(ivec2(floor(uv + 0.5)), ivec2(0), ivec2(u_n - 1));
-    float z = texelFetch(u_depth, ivec2(t.x + k * u_n, t.y), 0).r;
+    float z = texelFetch(u_depth, atlas(k, t), 0).r;
     return (!isnan(z) && !isinf(z) && z > 0.0) ? z : -1.0;
 }
 
@@ -215,7 +224,11 @@ vec3 reproject(Pair pw, vec3 o, vec3 d) {
 }
 
 void main() {
+    // Equirect pixel (column, row from the top) of this fragment in its eye's half.
     vec2 px = vec2(floor(gl_FragCoord.x), floor(gl_FragCoord.y) - float(u_row0));
+#if !ROWS_TOP_DOWN
+    px.y = float(u_size.y - 1) - px.y;
+#endif
     float lon = 2.0 * PI * (px.x + 0.5) / float(u_size.x) - PI;
     float lat = 0.5 * PI - PI * (px.y + 0.5) / float(u_size.y);
     float fx = clamp((abs(lat) - u_fade_start) / (0.5 * PI - u_fade_start), 0.0, 1.0);

@@ -2,8 +2,10 @@
 //! assembled from images loaded elsewhere ([`faces_from_images`]).
 
 use super::{face_camera, CubeFace, FaceImage, FaceSet, OdsRig, Side};
+use crate::convention::Conventions;
 use crate::error::{Error, Result};
 use crate::io::{self, DepthDecode, DepthMap, RgbImage};
+use crate::reproject::DepthInput;
 use std::path::{Path, PathBuf};
 
 /// File name tags of the faces in a face folder, in [`CubeFace::ALL`] order (+Z, -Z, up, down,
@@ -69,6 +71,29 @@ pub fn faces_from_images(rig: &OdsRig, side: Side, fov_deg: f64, images: Vec<(Rg
     Ok(set)
 }
 
+/// Face depth as view Z (what the stitch reads) from what a face file holds: view Z passes
+/// through; device depth under `conv` (written with its planes) is converted in f64, the far
+/// value and anything invalid becoming 0 (background). Disparity has no meaning for a face.
+pub fn view_z_of(depth: &DepthMap, kind: &DepthInput, conv: &Conventions) -> Result<DepthMap> {
+    kind.validate()?;
+    match kind {
+        DepthInput::ViewZ => Ok(depth.clone()),
+        DepthInput::Device { .. } => DepthMap::new(
+            depth.width,
+            depth.height,
+            depth
+                .data
+                .iter()
+                .map(|&d| kind.inverse_depth(conv, d as f64).map_or(0.0, |q| (1.0 / q) as f32))
+                .collect(),
+        ),
+        DepthInput::Disparity { .. } => Err(Error::param(
+            "face depth kind",
+            "disparity has no meaning for a cube face: give view Z or device depth",
+        )),
+    }
+}
+
 /// `dir/stem.ext` for the first extension of `exts` that exists; the error names the first
 /// candidate and what it should hold.
 fn find_face_file(dir: &Path, stem: &str, exts: &[&str], what: &str) -> Result<PathBuf> {
@@ -88,8 +113,17 @@ fn find_face_file(dir: &Path, stem: &str, exts: &[&str], what: &str) -> Result<P
 
 /// The six faces of `side` from a face folder: colour `{left,right}_{tag}.{png,jpg,jpeg,ppm,exr}`
 /// and view-space Z `{left,right}_{tag}_depth.{exr,npy,pfm,png}` ([`FACE_TAGS`]; integer depth
-/// decoded with `decode`), rendered with the poses [`CubeFace::pose`] gives for `rig`.
-pub fn load_face_dir(dir: &Path, rig: &OdsRig, side: Side, fov_deg: f64, decode: &DepthDecode) -> Result<FaceSet> {
+/// decoded with `decode`; device depth converted with [`view_z_of`]), rendered with the poses
+/// [`CubeFace::pose`] gives for `rig`.
+pub fn load_face_dir(
+    dir: &Path,
+    rig: &OdsRig,
+    side: Side,
+    fov_deg: f64,
+    decode: &DepthDecode,
+    kind: &DepthInput,
+    conv: &Conventions,
+) -> Result<FaceSet> {
     if !dir.is_dir() {
         return Err(Error::io(
             dir,
@@ -115,7 +149,11 @@ pub fn load_face_dir(dir: &Path, rig: &OdsRig, side: Side, fov_deg: f64, decode:
             &FACE_DEPTH_EXTS,
             &format!("view-space Z of {what}"),
         )?;
-        images.push((io::load_rgb(&c)?, io::load_depth(&d, decode)?));
+        let depth = view_z_of(&io::load_depth(&d, decode)?, kind, conv).map_err(|e| match e {
+            Error::InvalidParameter { name, message } => Error::decode(&d, format!("{name}: {message}")),
+            other => other,
+        })?;
+        images.push((io::load_rgb(&c)?, depth));
     }
     faces_from_images(rig, side, fov_deg, images)
 }

@@ -1,8 +1,10 @@
 //! GPU stitch: both eyes' faces uploaded once as atlases (face k at columns [k n, (k + 1) n):
 //! GLSL cannot index a sampler array per pixel), one full-screen draw per eye into a
-//! W x 2H top-bottom target (left eye in rows 0..H, read back top-down as stored).
+//! W x 2H top-bottom target (left eye on top), rows in the memory order of the row-order
+//! convention, read back top-down.
 
 use super::{face_camera, CubeFace, FaceSet, Method, Side, StitchParams, REPROJECT_STEPS};
+use crate::convention::{Conventions, RowOrder};
 use crate::error::{Error, Result};
 use crate::gpu::{Attachment, Framebuffer, Gpu, GpuTimer, Program, Texture, TextureFormat, Timing, VertexArray};
 use crate::io::RgbImage;
@@ -15,13 +17,18 @@ struct EyeAtlas {
     set_meta: (Side, [[f64; 3]; 6]),
 }
 
-fn upload(gpu: &Gpu, set: &FaceSet) -> Result<EyeAtlas> {
+/// The six faces side by side in one atlas per channel, rows in memory order under `rows`.
+fn upload(gpu: &Gpu, set: &FaceSet, rows: RowOrder) -> Result<EyeAtlas> {
     let n = set.size() as usize;
     let (mut rgba, mut depth) = (vec![0u8; 6 * n * n * 4], vec![0u8; 6 * n * n * 4]);
     for (k, face) in set.faces.iter().enumerate() {
         for y in 0..n {
+            let my = match rows {
+                RowOrder::TopDown => y,
+                RowOrder::BottomUp => n - 1 - y,
+            };
             for x in 0..n {
-                let (s, d) = (y * n + x, y * 6 * n + k * n + x);
+                let (s, d) = (y * n + x, my * 6 * n + k * n + x);
                 rgba[d * 4..d * 4 + 3].copy_from_slice(&face.color.data[s * 3..s * 3 + 3]);
                 rgba[d * 4 + 3] = 255;
                 depth[d * 4..d * 4 + 4].copy_from_slice(&face.depth.data[s].to_ne_bytes());
@@ -39,6 +46,7 @@ fn upload(gpu: &Gpu, set: &FaceSet) -> Result<EyeAtlas> {
 /// A stereo face capture on the GPU, ready to stitch with any method.
 pub struct StitchRenderer {
     gpu: Gpu,
+    conv: Conventions,
     programs: Vec<Program>,
     vao: VertexArray,
     left: EyeAtlas,
@@ -48,8 +56,16 @@ pub struct StitchRenderer {
 }
 
 impl StitchRenderer {
-    /// `left` and `right` must share rig, FOV and face size.
+    /// `left` and `right` must share rig, FOV and face size. Default conventions.
     pub fn new(gpu: &Gpu, left: &FaceSet, right: &FaceSet) -> Result<Self> {
+        Self::with_conventions(gpu, left, right, Conventions::default())
+    }
+
+    /// As [`Self::new`], with the GPU-side row order of `conv` (faces and the equirect are
+    /// stored and rendered in that memory order; the output is top-down either way). The NDC
+    /// range and reversed-Z do not reach this pass: face depth is view Z (convert device depth
+    /// with [`super::faces::view_z_of`]) and there is no depth buffer.
+    pub fn with_conventions(gpu: &Gpu, left: &FaceSet, right: &FaceSet, conv: Conventions) -> Result<Self> {
         left.validate()?;
         right.validate()?;
         if left.side != Side::Left || right.side != Side::Right {
@@ -74,7 +90,8 @@ impl StitchRenderer {
         let mut programs = Vec::new();
         for m in Method::ALL {
             let defines = format!(
-                "#define METHOD {}\n#define REPROJECT_STEPS {}\n",
+                "{}#define METHOD {}\n#define REPROJECT_STEPS {}\n",
+                conv.glsl_defines(),
                 m.index(),
                 REPROJECT_STEPS
             );
@@ -82,10 +99,11 @@ impl StitchRenderer {
         }
         Ok(StitchRenderer {
             gpu: gpu.clone(),
+            conv,
             programs,
             vao: VertexArray::new(gpu)?,
-            left: upload(gpu, left)?,
-            right: upload(gpu, right)?,
+            left: upload(gpu, left, conv.row_order)?,
+            right: upload(gpu, right, conv.row_order)?,
             template: left.clone_meta(),
             framebuffer: None,
         })
@@ -152,7 +170,12 @@ impl StitchRenderer {
             gl.disable(glow::BLEND);
             gl.disable(glow::CULL_FACE);
         }
-        for (row0, eye) in [(0, &self.left), (h, &self.right)] {
+        // Left eye on top of the image: bottom-up memory holds it in the upper half of the rows.
+        let (left_row0, right_row0) = match self.conv.row_order {
+            RowOrder::TopDown => (0, h),
+            RowOrder::BottomUp => (h, 0),
+        };
+        for (row0, eye) in [(left_row0, &self.left), (right_row0, &self.right)] {
             eye.color.bind(0);
             eye.depth.bind(1);
             p.set_f32("u_side", eye.set_meta.0.sign() as f32);
@@ -172,7 +195,7 @@ impl StitchRenderer {
         let rgba = fb.read_color(0)?.expect("colour attachment");
         fb.unbind();
         let timing = timer.stop();
-        let rgb = crate::gpu::pixels::rgba_to_rgb(&rgba);
+        let rgb = crate::gpu::pixels::rgba_to_rgb(&self.conv.row_order.convert_rows(rgba, w as usize * 4));
         Ok((RgbImage::new(w, 2 * h, rgb)?, timing))
     }
 }

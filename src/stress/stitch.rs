@@ -6,6 +6,7 @@
 //! test): at most 0.5 % of pixels may be off by more than one level. The output is colour only.
 
 use super::{GpuPixels, RefPixels, StressOptions, StressRow, Tally, Tolerance};
+use crate::convention::Conventions;
 use crate::error::Result;
 use crate::gpu::Gpu;
 use crate::stitch::faces::scene_faces;
@@ -35,36 +36,38 @@ fn faces(rig: &OdsRig, n: u32, overlap_deg: f64) -> Result<(FaceSet, FaceSet)> {
 fn sweep(gpu: &Gpu, case: &str, cases: &[Case], note: &str) -> Result<StressRow> {
     let mut tally = Tally::default();
     for c in cases {
-        let mut renderer = StitchRenderer::new(gpu, &c.left, &c.right)?;
-        for method in Method::ALL {
-            let params = StitchParams {
-                method,
-                overlap_deg: c.overlap_deg,
-                width: c.width,
-                height: c.height,
-            };
-            let (tb, _) = renderer.render(&params)?;
-            let half = (c.width * c.height * 3) as usize;
-            for (eye, set, data) in [("L", &c.left, &tb.data[..half]), ("R", &c.right, &tb.data[half..])] {
-                let reference = stitch_reference(set, &params)?;
-                let n = reference.len();
-                tally.add(
-                    &format!("{} {} {eye}", c.tag, method.label()),
-                    &GpuPixels {
-                        valid: vec![true; n],
-                        class: None,
-                        depth: None,
-                        rgb: data,
-                    },
-                    &RefPixels {
-                        valid: vec![true; n],
-                        class: None,
-                        ties: None,
-                        depth: None,
-                        rgb: &reference,
-                    },
-                    &TOL,
-                );
+        for conv in [Conventions::default(), Conventions::all()[7]] {
+            let mut renderer = StitchRenderer::with_conventions(gpu, &c.left, &c.right, conv)?;
+            for method in Method::ALL {
+                let params = StitchParams {
+                    method,
+                    overlap_deg: c.overlap_deg,
+                    width: c.width,
+                    height: c.height,
+                };
+                let (tb, _) = renderer.render(&params)?;
+                let half = (c.width * c.height * 3) as usize;
+                for (eye, set, data) in [("L", &c.left, &tb.data[..half]), ("R", &c.right, &tb.data[half..])] {
+                    let reference = stitch_reference(set, &params)?;
+                    let n = reference.len();
+                    tally.add(
+                        &format!("{} {} {} {eye}", c.tag, conv.label(), method.label()),
+                        &GpuPixels {
+                            valid: vec![true; n],
+                            class: None,
+                            depth: None,
+                            rgb: data,
+                        },
+                        &RefPixels {
+                            valid: vec![true; n],
+                            class: None,
+                            ties: None,
+                            depth: None,
+                            rgb: &reference,
+                        },
+                        &TOL,
+                    );
+                }
             }
         }
     }

@@ -448,14 +448,102 @@ fn stitch_scene_demo_writes_the_stereo_equirect_the_library_renders() {
 /// Writes the demo rig's faces with the documented names: {eye}_{pz,nz,up,down,px,nx}.png and
 /// {eye}_{..}_depth.exr.
 fn write_faces(dir: &Path, fov: f64) {
+    write_faces_as(dir, fov, None);
+}
+
+/// As [`write_faces`], depth stored as f32 window depth under `device` (planes, conventions)
+/// when given.
+fn write_faces_as(dir: &Path, fov: f64, device: Option<(viewsynth::convention::DepthPlanes, Conventions)>) {
     let rig = OdsRig::demo();
     for (side, eye) in [(Side::Left, "left"), (Side::Right, "right")] {
         let set = scene_faces(&rig, side, N, fov).unwrap();
         for (face, tag) in set.faces.iter().zip(["pz", "nz", "up", "down", "px", "nx"]) {
             io::save_rgb(&dir.join(format!("{eye}_{tag}.png")), &face.color).unwrap();
-            io::save_depth_exr(&dir.join(format!("{eye}_{tag}_depth.exr")), &face.depth).unwrap();
+            let mut depth = face.depth.clone();
+            if let Some((planes, conv)) = device {
+                for z in depth.data.iter_mut() {
+                    *z = if *z > 0.0 {
+                        let ndc = planes.ndc_z_of_view_z(&conv, *z as f64);
+                        viewsynth::convention::DepthPlanes::window_depth_of_ndc_z(&conv, ndc) as f32
+                    } else {
+                        conv.clear_depth() as f32
+                    };
+                }
+            }
+            io::save_depth_exr(&dir.join(format!("{eye}_{tag}_depth.exr")), &depth).unwrap();
         }
     }
+}
+
+#[test]
+fn stitch_faces_with_device_depth_under_vulkan_reversed_z() {
+    use viewsynth::convention::DepthPlanes;
+    let d = scratch("st-device");
+    let (zf, df) = (d.join("z-faces"), d.join("device-faces"));
+    std::fs::create_dir_all(&zf).unwrap();
+    std::fs::create_dir_all(&df).unwrap();
+    write_faces(&zf, 110.0);
+    let conv = Conventions::all()[7];
+    write_faces_as(&df, 110.0, Some((DepthPlanes { near: 0.05, far: 100.0 }, conv)));
+    let size = ["--width", &EW.to_string(), "--height", &EH.to_string(), "--fov", "110"].map(String::from);
+    let (a, b) = (d.join("out-z"), d.join("out-device"));
+    ok(&bin()
+        .args(["stitch", "--faces", s(&zf), "--out-dir", s(&a)])
+        .args(&size)
+        .output()
+        .unwrap());
+    let device = [
+        "--depth-kind",
+        "device",
+        "--near",
+        "0.05",
+        "--far",
+        "100",
+        "--ndc",
+        "vulkan",
+        "--reversed-z",
+        "--rows",
+        "top-down",
+    ];
+    ok(&bin()
+        .args(["stitch", "--faces", s(&df), "--out-dir", s(&b)])
+        .args(device)
+        .args(&size)
+        .output()
+        .unwrap());
+    let (x, y) = (
+        io::load_rgb(&a.join("ods_top_bottom.png")).unwrap(),
+        io::load_rgb(&b.join("ods_top_bottom.png")).unwrap(),
+    );
+    // Reversed-Z [0,1] float depth holds view Z to ~1e-7: only a discrete choice on a tie may
+    // flip (the 0.5 % allowed GPU vs f64).
+    let off = x
+        .data
+        .chunks_exact(3)
+        .zip(y.data.chunks_exact(3))
+        .filter(|(p, q)| p.iter().zip(q.iter()).any(|(u, v)| u.abs_diff(*v) > 1))
+        .count();
+    assert!(off * 200 <= (EW * EH * 2) as usize, "{off} pixels differ");
+    // Device depth needs its planes; view Z takes none.
+    let bad = d.join("bad");
+    let o = bin()
+        .args([
+            "stitch",
+            "--faces",
+            s(&df),
+            "--depth-kind",
+            "device",
+            "--out-dir",
+            s(&bad),
+        ])
+        .output()
+        .unwrap();
+    assert_clean_failure(&o, "--near and --far", &bad);
+    let o = bin()
+        .args(["stitch", "--faces", s(&zf), "--near", "0.1", "--out-dir", s(&bad)])
+        .output()
+        .unwrap();
+    assert_clean_failure(&o, "--depth-kind device only", &bad);
 }
 
 #[test]

@@ -10,6 +10,7 @@
 //! at most 0.5 % of pixels may be off by more than 1 level; the rest must round the same.
 
 use crate::common::gpu;
+use viewsynth::convention::Conventions;
 use viewsynth::stitch::eval::{score_eyes, split_top_bottom, StitchScore};
 use viewsynth::stitch::faces::{faces_from_images, scene_faces};
 use viewsynth::stitch::reference::stitch_reference;
@@ -307,4 +308,107 @@ fn print_stitch_report_and_bench() {
     let (_, notes) = viewsynth::stitch::stitch_rows(&g, 3).unwrap();
     println!("{}", notes.join("\n"));
     println!("{}", viewsynth::stitch::stitch_bench(&g).unwrap());
+}
+
+#[test]
+fn output_does_not_depend_on_the_row_order_or_depth_conventions() {
+    // The pass stores faces and the equirect in each convention's memory order; after readback
+    // the images must be identical (row flips are exact; NDC range and reversed-Z do not reach
+    // this pass).
+    let g = gpu();
+    let (l, r) = faces(10.0);
+    let reference: Vec<_> = Method::ALL
+        .iter()
+        .map(|&m| {
+            StitchRenderer::with_conventions(&g, &l, &r, Conventions::all()[0])
+                .unwrap()
+                .render(&params(m, 10.0))
+                .unwrap()
+                .0
+        })
+        .collect();
+    for conv in Conventions::all() {
+        let mut renderer = StitchRenderer::with_conventions(&g, &l, &r, conv).unwrap();
+        for (m, want) in Method::ALL.iter().zip(&reference) {
+            let (img, _) = renderer.render(&params(*m, 10.0)).unwrap();
+            assert!(
+                img == *want,
+                "{} {m:?}: differs from {}",
+                conv.label(),
+                Conventions::all()[0].label()
+            );
+        }
+    }
+}
+
+#[test]
+fn device_depth_faces_convert_to_view_z_and_stitch_alike() {
+    // Faces whose depth is stored as f32 window depth: converted back to view Z the relative
+    // error is ~eps under reversed-Z [0,1] and ~eps Z / near otherwise (<= 8 eps (1 + 10 / 0.05)
+    // = 1e-4 for the scene's <= 10 m at near 0.05), so the stitched image may differ only where
+    // a depth lands on the other side of a discrete choice (the 0.5 % of the GPU-vs-f64 test).
+    use viewsynth::convention::DepthPlanes;
+    use viewsynth::io::DepthMap;
+    use viewsynth::reproject::DepthInput;
+    use viewsynth::stitch::faces::view_z_of;
+    let g = gpu();
+    let (l, r) = faces(10.0);
+    let planes = DepthPlanes { near: 0.05, far: 100.0 };
+    let kind = DepthInput::Device { planes };
+    let (want, _) = StitchRenderer::new(&g, &l, &r)
+        .unwrap()
+        .render(&params(Method::Reproject, 10.0))
+        .unwrap();
+    for conv in [Conventions::default(), Conventions::all()[7]] {
+        let convert = |set: &FaceSet| -> FaceSet {
+            let mut out = set.clone();
+            for face in &mut out.faces {
+                let device: Vec<f32> = face
+                    .depth
+                    .data
+                    .iter()
+                    .map(|&z| {
+                        if z > 0.0 {
+                            let ndc = planes.ndc_z_of_view_z(&conv, z as f64);
+                            DepthPlanes::window_depth_of_ndc_z(&conv, ndc) as f32
+                        } else {
+                            conv.clear_depth() as f32
+                        }
+                    })
+                    .collect();
+                let stored = DepthMap::new(face.depth.width, face.depth.height, device).unwrap();
+                let back = view_z_of(&stored, &kind, &conv).unwrap();
+                for (a, b) in face.depth.data.iter().zip(&back.data) {
+                    if *a > 0.0 {
+                        assert!(((b - a) / a).abs() <= 1e-4, "{}: {a} -> {b}", conv.label());
+                    } else {
+                        assert_eq!(*b, 0.0, "{}: background must stay background", conv.label());
+                    }
+                }
+                face.depth = back;
+            }
+            out
+        };
+        let (img, _) = StitchRenderer::new(&g, &convert(&l), &convert(&r))
+            .unwrap()
+            .render(&params(Method::Reproject, 10.0))
+            .unwrap();
+        let off = img
+            .data
+            .chunks_exact(3)
+            .zip(want.data.chunks_exact(3))
+            .filter(|(p, q)| p.iter().zip(q.iter()).any(|(u, v)| u.abs_diff(*v) > 1))
+            .count();
+        assert!(
+            off * 200 <= (W * H * 2) as usize,
+            "{}: {off} pixels differ",
+            conv.label()
+        );
+    }
+    let disparity = DepthInput::Disparity {
+        focal_px: 100.0,
+        baseline: 0.1,
+        doffs: 0.0,
+    };
+    assert!(view_z_of(&l.faces[0].depth, &disparity, &Conventions::default()).is_err());
 }

@@ -12,6 +12,15 @@ pub(crate) enum StitchMethodArg {
     Reproject,
 }
 
+#[derive(Clone, Copy, ValueEnum, PartialEq)]
+pub(crate) enum FaceDepthArg {
+    /// View-space Z in metres; 0 / NaN / inf = background.
+    #[value(alias = "metric")]
+    ViewZ,
+    /// Window depth in [0, 1] from a depth buffer; the far value is background.
+    Device,
+}
+
 #[derive(Args)]
 pub(crate) struct StitchArgs {
     /// Ray-trace the faces of a built-in scene (only `demo`, the scene of the ODS rig).
@@ -49,6 +58,19 @@ pub(crate) struct StitchArgs {
     /// Raw units per metre for integer face depth files.
     #[arg(long)]
     depth_scale: Option<f64>,
+    /// What the face depth files hold (with --faces): view-z, or device depth written with
+    /// --near/--far under --ndc and --reversed-z (converted to view Z before stitching).
+    #[arg(long, value_enum, default_value = "view-z")]
+    depth_kind: FaceDepthArg,
+    /// Near plane of device-depth faces (metres).
+    #[arg(long)]
+    near: Option<f64>,
+    /// Far plane of device-depth faces (metres; may be inf).
+    #[arg(long)]
+    far: Option<f64>,
+    /// Conventions of device-depth faces; the row order also sets the GPU pass's memory order.
+    #[command(flatten)]
+    conv: ConventionArgs,
     /// Also write each eye's equirect (ods_left.png, ods_right.png).
     #[arg(long)]
     per_eye: bool,
@@ -65,6 +87,8 @@ pub(crate) struct StitchArgs {
 
 pub(crate) fn stitch(a: StitchArgs) -> Result<()> {
     use std::time::Instant;
+    use viewsynth::convention::DepthPlanes;
+    use viewsynth::reproject::DepthInput;
     use viewsynth::stitch::eval::{score_eyes, split_top_bottom};
     use viewsynth::stitch::faces::{load_face_dir, scene_faces};
     use viewsynth::stitch::render::StitchRenderer;
@@ -132,6 +156,25 @@ pub(crate) fn stitch(a: StitchArgs) -> Result<()> {
         );
     }
 
+    let conv = a.conv.conventions();
+    let depth_kind = match (a.depth_kind, a.near, a.far) {
+        (FaceDepthArg::ViewZ, None, None) => DepthInput::ViewZ,
+        (FaceDepthArg::ViewZ, _, _) => bail!("--near/--far apply to --depth-kind device only"),
+        (FaceDepthArg::Device, Some(near), Some(far)) => {
+            let kind = DepthInput::Device {
+                planes: DepthPlanes { near, far },
+            };
+            kind.validate().context("--near/--far")?;
+            kind
+        }
+        (FaceDepthArg::Device, _, _) => {
+            bail!("--depth-kind device needs --near and --far (the planes the faces' depth was written with)")
+        }
+    };
+    if a.faces.is_none() && a.depth_kind != FaceDepthArg::ViewZ {
+        bail!("--depth-kind applies to --faces (the built-in scene's faces hold view Z)");
+    }
+
     let t0 = Instant::now();
     let (left, right, source) = if let Some(dir) = &a.faces {
         if !dir.is_dir() {
@@ -142,7 +185,8 @@ pub(crate) fn stitch(a: StitchArgs) -> Result<()> {
             ..Default::default()
         };
         let load = |side: Side| {
-            load_face_dir(dir, &rig, side, fov, &decode).with_context(|| format!("--faces {}", dir.display()))
+            load_face_dir(dir, &rig, side, fov, &decode, &depth_kind, &conv)
+                .with_context(|| format!("--faces {}", dir.display()))
         };
         let (l, r) = (load(Side::Left)?, load(Side::Right)?);
         if l.size() != r.size() {
@@ -166,7 +210,7 @@ pub(crate) fn stitch(a: StitchArgs) -> Result<()> {
 
     let gpu = a.gpu.open()?;
     let t0 = Instant::now();
-    let mut renderer = StitchRenderer::new(&gpu, &left, &right)?;
+    let mut renderer = StitchRenderer::with_conventions(&gpu, &left, &right, conv)?;
     let setup_ms = t0.elapsed().as_secs_f64() * 1e3;
     let (img, timing) = renderer.render(&params)?;
     let eyes = if a.per_eye {
