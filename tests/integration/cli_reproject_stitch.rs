@@ -770,4 +770,10 @@ fn reproject_with_full_eye_matrices_from_a_cameras_file() {
     ]
     .concat());
     assert_clean_failure(&o, "--from left or right", &bad);
+    let o = run(&[
+        &common[..],
+        &["--method", "gather3d", "--reversed-z", "--out-dir", s(&bad)],
+    ]
+    .concat());
+    assert_clean_failure(&o, "come from the file", &bad);
 }

@@ -345,6 +345,10 @@ fn cameras_setup(a: &ReprojectArgs, path: &Path) -> Result<Setup> {
     if !matches!(a.method, ReprojectMethodArg::Gather3d) {
         bail!("--cameras (full eye matrices) needs --method gather3d: the shift methods need a parallel rig");
     }
+    // The file carries both; a flag that differs from its default would be silently overridden.
+    if a.depth_kind != ReprojectDepthArg::ViewZ || a.conv.conventions() != Conventions::default() {
+        bail!("--cameras: the depth kind and the conventions come from the file; drop --depth-kind/--ndc/--reversed-z/--rows");
+    }
     let file = CameraFile::load(path)?;
     let (source, target) = match from {
         Eye::Left => (&file.left, &file.right),
