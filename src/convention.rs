@@ -168,7 +168,7 @@ impl DepthPlanes {
     }
 
     /// The planes of a GL-style perspective projection (row-major, GL eye space -> clip, clip
-    /// w = -z_eye) made under `conv`: its depth row gives z_ndc = -m[2][2] + m[2][3] / Z, which
+    /// w = -z_eye) made under `conv`: its depth row gives z_ndc = -m\[2\]\[2\] + m\[2\]\[3\] / Z, which
     /// is inverted at the near and far NDC values of `conv` (far = inf where the row never
     /// reaches it).
     ///

@@ -9,7 +9,7 @@
 //! Left/right conflicts are resolved by middle-space depth (hard threshold or soft blend, with an
 //! optional dominant eye).
 //!
-//! - [`reference`]: the f64 CPU twin; [`render`]: the GPU pass (shaders/cyclopean/gather.frag).
+//! - [`reference`](mod@reference): the f64 CPU twin; [`render`]: the GPU pass (shaders/cyclopean/gather.frag).
 //! - [`scene_frame`]: a stereo frame of the built-in scene under any conventions, for tests,
 //!   the demo and the report.
 

@@ -1,11 +1,11 @@
 //! refocus: one RGB image + metric depth + intrinsics -> RGB, metric depth and validity mask at
 //! other focal lengths, same pose. No hole filling: what the source did not see stays invalid.
 //!
-//! - [`grid`]: the 2.5D grid mesh and its break rule, shared by every path.
-//! - [`render`]: the GPU refocus (uploads, framebuffer, readback) and its full-screen pass, which
+//! - `grid`: the 2.5D grid mesh and its break rule, shared by every path.
+//! - `render`: the GPU refocus (uploads, framebuffer, readback) and its full-screen pass, which
 //!   evaluates the kept triangles analytically per pixel (same pose only); `mesh`: the mesh pass,
 //!   the same triangles rasterised into the MRT framebuffer with a depth test.
-//! - [`reference`]: the float64 CPU twin both are tested against.
+//! - [`reference`](mod@reference): the float64 CPU twin both are tested against.
 //! - [`job`]: targets from focal lists or zoom scales, file outputs and the manifest.
 
 pub mod batch;

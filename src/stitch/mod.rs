@@ -73,7 +73,7 @@
 //! [`FAR_DISTANCE`] along its ray.
 //!
 //! - [`faces`]: faces from the ray-traced scene, or from images; [`truth`]: the ODS ground
-//!   truth; [`reference`]: the f64 stitch; [`render`]: the GPU pass (shaders/stitch/stitch.frag);
+//!   truth; [`reference`](mod@reference): the f64 stitch; [`render`]: the GPU pass (shaders/stitch/stitch.frag);
 //!   [`eval`]: report rows and the benchmark.
 
 pub mod eval;

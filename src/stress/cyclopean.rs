@@ -12,7 +12,7 @@
 //!   follow the lost depth and are reported, not bounded.
 //! - colour: as refocus, 0.1 % beyond one level.
 //!
-//! Rig values are generic on purpose ([`IPD`], [`FIXATION`]): with round ones (IPD 0.2 m,
+//! Rig values are generic on purpose (`IPD`, `FIXATION`): with round ones (IPD 0.2 m,
 //! fixation 3 m) on the scene's axis-aligned planes at round distances, projected points land
 //! exactly on texel borders, where f32 and f64 break the tie apart (measured at 256x192 with
 //! refine 3: 250 of 49 152 pixels; 0 with the values below). A disagreement here is an error,

@@ -11,7 +11,7 @@
 //! Constants are generic (IPD 0.2011 m, doffs 3.4771, ...): round ones map source columns
 //! exactly onto target pixel centres or texel borders, where f32 and f64 break ties apart.
 //! Ties that remain by nature (a 100 km surface moving by less than an f32 ulp) are counted
-//! apart ([`shift_ties`]).
+//! apart (`shift_ties`).
 
 use super::refocus::refused;
 use super::{test_texture, GpuPixels, RefPixels, StressOptions, StressRow, Tally, Tolerance, EPS32};
