@@ -137,8 +137,8 @@ fn cyclopean_outputs(gpu: &Gpu, dir: &Path) -> Result<()> {
             .map(|c| if c.is_ascii_alphanumeric() { c } else { '_' })
             .collect();
         let stem = stem.split('_').filter(|s| !s.is_empty()).collect::<Vec<_>>().join("_");
-        io::save_rgb(&dir.join(format!("middle_{stem}_rgb.png")), &out.color)?;
-        io::save_depth_exr(&dir.join(format!("middle_{stem}_depth.exr")), &out.depth)?;
+        io::save_rgb(&dir.join(format!("middle_{stem}_rgb.png")), out.color()?)?;
+        io::save_depth_exr(&dir.join(format!("middle_{stem}_depth.exr")), out.depth()?)?;
         let mask = io::Mask::new(
             mid.width,
             mid.height,

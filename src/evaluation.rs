@@ -212,8 +212,8 @@ pub fn cyclopean_scene_rows(gpu: &Gpu, repeats: usize) -> Result<Vec<ReportRow>>
                 let mut row = ReportRow::new("cyclopean", "builtin:demo 640x480", name, setting, t.wall_ms);
                 row.gpu_ms = t.gpu_ms;
                 score(
-                    &out.color,
-                    Some(&out.depth),
+                    out.color()?,
+                    Some(out.depth()?),
                     &mask,
                     &truth.color,
                     Some(&truth.depth),
@@ -272,7 +272,7 @@ pub fn cyclopean_real_rows(gpu: &Gpu, data_dir: &Path, repeats: usize) -> Result
             "disparity, nominal f*B",
             t.wall_ms,
         );
-        score(&out.color, None, &mask, &truth, None, &mut row);
+        score(out.color()?, None, &mask, &truth, None, &mut row);
         rows.push(row);
     }
     let (l, r) = middlebury(&data_dir.join("middlebury2003_teddy"))?;
@@ -300,9 +300,9 @@ pub fn cyclopean_real_rows(gpu: &Gpu, data_dir: &Path, repeats: usize) -> Result
             "PSNR = L->M vs R->M agreement",
             t.wall_ms,
         );
-        score(&lm.color, None, &common, &rm.color, None, &mut row);
+        score(lm.color()?, None, &common, rm.color()?, None, &mut row);
         row.coverage = Some(both.sources.iter().filter(|s| **s != 0).count() as f64 / both.sources.len() as f64);
-        let nan = both.depth.data.iter().any(|z| !z.is_finite());
+        let nan = both.depth()?.data.iter().any(|z| !z.is_finite());
         notes.push(format!(
             "Teddy, {name}: coverage {:.1} % (both eyes), L->M and R->M both valid on {:.1} %, agreement PSNR {:.2} dB, non-finite depth: {nan}",
             row.coverage.unwrap_or(0.0) * 100.0,
@@ -361,7 +361,7 @@ pub fn cyclopean_case_rows(gpu: &Gpu, dir: &Path, repeats: usize) -> Result<Vec<
         let mask: Vec<bool> = out.sources.iter().map(|s| *s != 0).collect();
         let mut row = ReportRow::new("cyclopean", scene.clone(), name, "vs middle_rgb.png", t.wall_ms);
         row.gpu_ms = t.gpu_ms;
-        score(&out.color, None, &mask, &reference, None, &mut row);
+        score(out.color()?, None, &mask, &reference, None, &mut row);
         rows.push(row);
     }
     Ok(rows)

@@ -182,15 +182,51 @@ impl CyclopeanParams {
     }
 }
 
+/// Which middle-view images to produce. The source bits always are (they are the validity of
+/// the others and cost one byte per pixel); colour and depth not requested get no attachment and
+/// no readback.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct CyclopeanOutputs {
+    pub color: bool,
+    pub depth: bool,
+}
+
+impl Default for CyclopeanOutputs {
+    fn default() -> Self {
+        CyclopeanOutputs {
+            color: true,
+            depth: true,
+        }
+    }
+}
+
 /// The middle view. Rows top-down.
 #[derive(Debug, Clone)]
 pub struct CyclopeanOutput {
-    pub color: RgbImage,
-    /// Middle view-space distance (metres) of the surface shown; 0 where no eye had one.
-    pub depth: DepthMap,
+    /// None when not requested.
+    pub color: Option<RgbImage>,
+    /// Middle view-space distance (metres) of the surface shown; 0 where no eye had one. None
+    /// when not requested.
+    pub depth: Option<DepthMap>,
     /// Per pixel, bit 0: the left eye contributed, bit 1: the right eye. 0 = invalid (the seed's
     /// fallback colour, the mean of both eyes at the same uv, is still written).
     pub sources: Vec<u8>,
+}
+
+impl CyclopeanOutput {
+    /// The colour image; an error when it was not requested.
+    pub fn color(&self) -> Result<&RgbImage> {
+        self.color
+            .as_ref()
+            .ok_or_else(|| Error::param("outputs", "the middle view's colour was not requested"))
+    }
+
+    /// The middle depth; an error when it was not requested.
+    pub fn depth(&self) -> Result<&DepthMap> {
+        self.depth
+            .as_ref()
+            .ok_or_else(|| Error::param("outputs", "the middle view's depth was not requested"))
+    }
 }
 
 impl StereoFrame {

@@ -340,16 +340,20 @@ impl CyclopeanReference {
     /// Rounded to the output types (for writing or comparing as images).
     pub fn to_output(&self, width: u32, height: u32) -> CyclopeanOutput {
         CyclopeanOutput {
-            color: RgbImage::new(
-                width,
-                height,
-                self.color
-                    .iter()
-                    .flat_map(|c| c.map(crate::metrics::quantize_u8))
-                    .collect(),
-            )
-            .expect("size matches"),
-            depth: DepthMap::new(width, height, self.depth.iter().map(|z| *z as f32).collect()).expect("size matches"),
+            color: Some(
+                RgbImage::new(
+                    width,
+                    height,
+                    self.color
+                        .iter()
+                        .flat_map(|c| c.map(crate::metrics::quantize_u8))
+                        .collect(),
+                )
+                .expect("size matches"),
+            ),
+            depth: Some(
+                DepthMap::new(width, height, self.depth.iter().map(|z| *z as f32).collect()).expect("size matches"),
+            ),
             sources: self.sources.clone(),
         }
     }

@@ -1,7 +1,10 @@
 //! GPU cyclopean pass: one full-screen draw (shaders/cyclopean/gather.frag) into colour,
 //! middle depth and source bits, read back top-down.
 
-use super::{Blend, CyclopeanOutput, CyclopeanParams, DepthKind, Eye, EyeInput, Method, MiddleCamera, StereoFrame};
+use super::{
+    Blend, CyclopeanOutput, CyclopeanOutputs, CyclopeanParams, DepthKind, Eye, EyeInput, Method, MiddleCamera,
+    StereoFrame,
+};
 use crate::camera::mat4::{self, Mat4};
 use crate::convention::RowOrder;
 use crate::error::{Error, Result};
@@ -46,6 +49,7 @@ pub struct CyclopeanRenderer {
     gpu: Gpu,
     program: Program,
     params: CyclopeanParams,
+    outputs: CyclopeanOutputs,
     rows: RowOrder,
     left: EyeGpu,
     right: EyeGpu,
@@ -54,7 +58,18 @@ pub struct CyclopeanRenderer {
 }
 
 impl CyclopeanRenderer {
+    /// All outputs (colour, depth, source bits).
     pub fn new(gpu: &Gpu, frame: &StereoFrame, params: CyclopeanParams) -> Result<Self> {
+        Self::with_outputs(gpu, frame, params, CyclopeanOutputs::default())
+    }
+
+    /// Only the requested colour/depth (the source bits always).
+    pub fn with_outputs(
+        gpu: &Gpu,
+        frame: &StereoFrame,
+        params: CyclopeanParams,
+        outputs: CyclopeanOutputs,
+    ) -> Result<Self> {
         frame.validate()?;
         params.validate()?;
         let defines = format!(
@@ -69,6 +84,7 @@ impl CyclopeanRenderer {
             gpu: gpu.clone(),
             program,
             params,
+            outputs,
             rows: frame.conv.row_order,
             left: upload_eye(gpu, &frame.left, frame.conv.row_order)?,
             right: upload_eye(gpu, &frame.right, frame.conv.row_order)?,
@@ -85,8 +101,8 @@ impl CyclopeanRenderer {
         let inv = |m: &Mat4, what: &str| mat4::inverse(m).ok_or_else(|| Error::param(what.to_string(), "singular"));
         if !matches!(&self.framebuffer, Some(f) if f.width == w && f.height == h) {
             self.framebuffer = None;
-            let slot = |format| {
-                Some(Attachment {
+            let slot = |wanted: bool, format| {
+                wanted.then_some(Attachment {
                     format,
                     clear: [0.0; 4],
                 })
@@ -96,9 +112,9 @@ impl CyclopeanRenderer {
                 w,
                 h,
                 &[
-                    slot(TextureFormat::Rgba8),
-                    slot(TextureFormat::R32F),
-                    slot(TextureFormat::R8),
+                    slot(self.outputs.color, TextureFormat::Rgba8),
+                    slot(self.outputs.depth, TextureFormat::R32F),
+                    slot(true, TextureFormat::R8),
                 ],
                 false,
             )?);
@@ -150,19 +166,21 @@ impl CyclopeanRenderer {
     }
 }
 
-/// Read a middle-view framebuffer (RGBA8 colour, R32F depth, R8 source bits) back top-down.
+/// Read a middle-view framebuffer (RGBA8 colour, R32F depth, R8 source bits) back top-down;
+/// colour and depth only where the framebuffer has them.
 pub(crate) fn read_output(fb: &Framebuffer, rows: RowOrder) -> Result<CyclopeanOutput> {
     let (w, h) = (fb.width, fb.height);
-    let read = |i: usize, bpp: usize| -> Result<Vec<u8>> {
-        let data = fb
-            .read_color(i)?
-            .ok_or_else(|| Error::Gl(format!("middle framebuffer lacks attachment {i}")))?;
-        Ok(rows.convert_rows(data, w as usize * bpp))
+    let read = |i: usize, bpp: usize| -> Result<Option<Vec<u8>>> {
+        Ok(fb.read_color(i)?.map(|data| rows.convert_rows(data, w as usize * bpp)))
     };
-    let (rgba, depth, sources) = (read(0, 4)?, read(1, 4)?, read(2, 1)?);
+    let sources = read(2, 1)?.ok_or_else(|| Error::Gl("middle framebuffer lacks the source bits".into()))?;
     Ok(CyclopeanOutput {
-        color: RgbImage::new(w, h, crate::gpu::pixels::rgba_to_rgb(&rgba))?,
-        depth: DepthMap::new(w, h, crate::gpu::pixels::bytes_to_f32(&depth))?,
+        color: read(0, 4)?
+            .map(|rgba| RgbImage::new(w, h, crate::gpu::pixels::rgba_to_rgb(&rgba)))
+            .transpose()?,
+        depth: read(1, 4)?
+            .map(|d| DepthMap::new(w, h, crate::gpu::pixels::bytes_to_f32(&d)))
+            .transpose()?,
         sources,
     })
 }

@@ -34,6 +34,17 @@ fn pixel_ndc(x: usize, y: usize, w: usize, h: usize, conv: &Conventions) -> [f64
     ]
 }
 
+/// Colour and depth of a middle view: the accumulation needs both.
+fn color_and_depth(out: &CyclopeanOutput) -> Result<(&crate::io::RgbImage, &crate::io::DepthMap)> {
+    match (&out.color, &out.depth) {
+        (Some(c), Some(d)) => Ok((c, d)),
+        _ => Err(Error::param(
+            "temporal accumulation",
+            "needs the colour and depth outputs of the middle view",
+        )),
+    }
+}
+
 impl TemporalAccumulator {
     pub fn new(alpha: f64, depth_tolerance: f64, conv: Conventions) -> Result<Self> {
         if !(alpha > 0.0 && alpha <= 1.0) {
@@ -61,12 +72,13 @@ impl TemporalAccumulator {
     /// which becomes the history.
     pub fn push(&mut self, current: &CyclopeanOutput, mid: &MiddleCamera) -> Result<CyclopeanOutput> {
         let (w, h) = (mid.width as usize, mid.height as usize);
-        if current.sources.len() != w * h || current.color.data.len() != w * h * 3 {
+        let (cur_color, cur_depth) = color_and_depth(current)?;
+        if current.sources.len() != w * h || cur_color.data.len() != w * h * 3 {
             return Err(Error::SizeMismatch {
                 message: format!("frame does not match the middle camera's {w}x{h}"),
             });
         }
-        let mut out = current.clone();
+        let (mut color, mut depth, mut sources) = (cur_color.clone(), cur_depth.clone(), current.sources.clone());
         if let Some((prev, prev_cam)) = &self.history {
             let (hist_color, hist_z) = self.reproject(prev, prev_cam, mid)?;
             for i in 0..w * h {
@@ -74,23 +86,28 @@ impl TemporalAccumulator {
                 if !(hz.is_finite() && hz > 0.0) {
                     continue;
                 }
-                let cz = current.depth.data[i] as f64;
+                let cz = cur_depth.data[i] as f64;
                 if current.sources[i] != 0 && cz > 0.0 {
                     if (hz - cz).abs() <= self.depth_tolerance * cz {
                         for (c, h) in hist_color[i].iter().enumerate() {
-                            let v = self.alpha * current.color.data[i * 3 + c] as f64 + (1.0 - self.alpha) * h;
-                            out.color.data[i * 3 + c] = v.round().clamp(0.0, 255.0) as u8;
+                            let v = self.alpha * cur_color.data[i * 3 + c] as f64 + (1.0 - self.alpha) * h;
+                            color.data[i * 3 + c] = v.round().clamp(0.0, 255.0) as u8;
                         }
                     }
                 } else {
                     for (c, h) in hist_color[i].iter().enumerate() {
-                        out.color.data[i * 3 + c] = h.round().clamp(0.0, 255.0) as u8;
+                        color.data[i * 3 + c] = h.round().clamp(0.0, 255.0) as u8;
                     }
-                    out.depth.data[i] = hz as f32;
-                    out.sources[i] = FROM_HISTORY;
+                    depth.data[i] = hz as f32;
+                    sources[i] = FROM_HISTORY;
                 }
             }
         }
+        let out = CyclopeanOutput {
+            color: Some(color),
+            depth: Some(depth),
+            sources,
+        };
         self.history = Some((out.clone(), *mid));
         Ok(out)
     }
@@ -103,6 +120,7 @@ impl TemporalAccumulator {
         prev_cam: &MiddleCamera,
         mid: &MiddleCamera,
     ) -> Result<(Vec<[f64; 3]>, Vec<f64>)> {
+        let (prev_color, prev_depth) = color_and_depth(prev)?;
         let singular = |what: &str| Error::param(what.to_string(), "singular");
         let inv_proj = mat4::inverse(&prev_cam.proj).ok_or_else(|| singular("previous middle projection"))?;
         let inv_view = mat4::inverse(&prev_cam.view).ok_or_else(|| singular("previous middle view"))?;
@@ -114,7 +132,7 @@ impl TemporalAccumulator {
         for y in 0..ph {
             for x in 0..pw {
                 let i = y * pw + x;
-                let d = prev.depth.data[i] as f64;
+                let d = prev_depth.data[i] as f64;
                 if prev.sources[i] == 0 || !(d.is_finite() && d > 0.0) {
                     continue;
                 }
@@ -141,7 +159,7 @@ impl TemporalAccumulator {
                 let dist = -mat4::transform_point(&mid.view, world)[2];
                 if z[o] == 0.0 || dist < z[o] {
                     z[o] = dist;
-                    color[o] = [0, 1, 2].map(|c| prev.color.data[i * 3 + c] as f64);
+                    color[o] = [0, 1, 2].map(|c| prev_color.data[i * 3 + c] as f64);
                 }
             }
         }

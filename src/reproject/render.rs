@@ -9,7 +9,7 @@ use super::{
 };
 use crate::convention::RowOrder;
 use crate::cyclopean::render::CyclopeanRenderer;
-use crate::cyclopean::MiddleCamera;
+use crate::cyclopean::{CyclopeanOutputs, MiddleCamera};
 use crate::error::{Error, Result};
 use crate::gpu::{Attachment, Framebuffer, Gpu, GpuTimer, Program, Texture, TextureFormat, Timing, VertexArray};
 use crate::io::{DepthMap, RgbImage};
@@ -59,9 +59,15 @@ impl Reprojector {
             (None, Method::Gather3d { steps }) => {
                 let (frame, target) = one_eye_frame(src, geometry)?;
                 let [p0, p1] = gather3d_params(src, geometry, steps);
+                // The two walks are merged by depth, so depth is always rendered; colour only
+                // when asked for.
+                let wanted = CyclopeanOutputs {
+                    color: params.outputs.color,
+                    depth: true,
+                };
                 let r = [
-                    CyclopeanRenderer::new(gpu, &frame, p0)?,
-                    CyclopeanRenderer::new(gpu, &frame, p1)?,
+                    CyclopeanRenderer::with_outputs(gpu, &frame, p0, wanted)?,
+                    CyclopeanRenderer::with_outputs(gpu, &frame, p1, wanted)?,
                 ];
                 Pass::Gather3d(Box::new((r, target)))
             }
@@ -143,18 +149,25 @@ impl Reprojector {
                 };
                 let n = a.sources.len();
                 let (mut color, mut depth, mut mask) = (vec![0u8; n * 3], vec![0f32; n], vec![0u8; n]);
+                let (za, zb) = (a.depth()?, b.depth()?);
+                let (ca, cb) = (a.color.as_ref(), b.color.as_ref());
                 for i in 0..n {
-                    let first = (a.sources[i] != 0, a.depth.data[i] as f64);
-                    let second = (b.sources[i] != 0, b.depth.data[i] as f64);
-                    let o = if merge_nearer(first, second) { &b } else { &a };
-                    let z = o.depth.data[i];
-                    if o.sources[i] != 0 && z.is_finite() {
-                        color[i * 3..i * 3 + 3].copy_from_slice(&o.color.data[i * 3..i * 3 + 3]);
-                        depth[i] = z;
+                    let first = (a.sources[i] != 0, za.data[i] as f64);
+                    let second = (b.sources[i] != 0, zb.data[i] as f64);
+                    let (sources, z, c) = if merge_nearer(first, second) {
+                        (&b.sources, zb, cb)
+                    } else {
+                        (&a.sources, za, ca)
+                    };
+                    let zi = z.data[i];
+                    if sources[i] != 0 && zi.is_finite() {
+                        if let Some(c) = c {
+                            color[i * 3..i * 3 + 3].copy_from_slice(&c.data[i * 3..i * 3 + 3]);
+                        }
+                        depth[i] = zi;
                         mask[i] = 255;
                     }
                 }
-                // The two walks are merged by depth, so the cyclopean passes always produce it.
                 let outputs = self.params.outputs;
                 Ok((
                     ReprojectOutput {

@@ -293,8 +293,8 @@ pub fn mesh_warp_timed(gpu: &Gpu, case: &Case, repeats: usize) -> Result<(Reproj
     let mask = out.sources.iter().map(|s| if *s != 0 { 255 } else { 0 }).collect();
     Ok((
         ReprojectOutput {
-            color: Some(out.color),
-            depth: Some(out.depth),
+            color: out.color,
+            depth: out.depth,
             mask,
         },
         t,

@@ -79,8 +79,8 @@ fn sweep(gpu: &Gpu, case: &str, cases: &[Case], fixation: f64, tol: Tolerance, n
                 &GpuPixels {
                     valid: out.sources.iter().map(|s| *s != 0).collect(),
                     class: Some(&out.sources),
-                    depth: Some(&out.depth.data),
-                    rgb: &out.color.data,
+                    depth: Some(&out.depth()?.data),
+                    rgb: &out.color()?.data,
                 },
                 &RefPixels {
                     valid: reference.sources.iter().map(|s| *s != 0).collect(),

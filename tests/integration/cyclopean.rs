@@ -47,14 +47,14 @@ fn disagreement(out: &CyclopeanOutput, r: &CyclopeanReference) -> (usize, usize,
             continue;
         }
         let e = (0..3)
-            .map(|c| metrics::quantization_error(out.color.data[i * 3 + c], r.color[i][c]))
+            .map(|c| metrics::quantization_error(out.color().unwrap().data[i * 3 + c], r.color[i][c]))
             .max()
             .unwrap();
         col += (e > 1) as usize;
         if r.sources[i] != 0 {
-            z = z.max((out.depth.data[i] as f64 - r.depth[i]).abs() / r.depth[i]);
+            z = z.max((out.depth().unwrap().data[i] as f64 - r.depth[i]).abs() / r.depth[i]);
         }
-        assert!(out.depth.data[i].is_finite(), "pixel {i}: non-finite depth");
+        assert!(out.depth().unwrap().data[i].is_finite(), "pixel {i}: non-finite depth");
     }
     (src, col, z)
 }
@@ -103,17 +103,19 @@ fn output_does_not_depend_on_the_convention() {
                     let tag = format!("{} {kind:?} {name}", conv.label());
                     let src = out.sources.iter().zip(&b.sources).filter(|(a, b)| a != b).count();
                     let col = out
-                        .color
+                        .color()
+                        .unwrap()
                         .data
                         .iter()
-                        .zip(&b.color.data)
+                        .zip(&b.color().unwrap().data)
                         .filter(|(a, b)| (**a as i32 - **b as i32).abs() > 1)
                         .count();
                     let z = out
-                        .depth
+                        .depth()
+                        .unwrap()
                         .data
                         .iter()
-                        .zip(&b.depth.data)
+                        .zip(&b.depth().unwrap().data)
                         .map(|(a, b)| if *b > 0.0 { ((a - b) / b).abs() } else { (a - b).abs() })
                         .fold(0f32, f32::max);
                     let n = out.sources.len();
@@ -136,7 +138,7 @@ fn psnr_vs_truth(out: &CyclopeanOutput, truth: &MiddleTruth) -> (f64, f64) {
         if out.sources[i] != 0 && truth.depth.data[i] > 0.0 {
             n += 1;
             for c in 0..3 {
-                let d = out.color.data[i * 3 + c] as f64 - truth.color.data[i * 3 + c] as f64;
+                let d = out.color().unwrap().data[i * 3 + c] as f64 - truth.color.data[i * 3 + c] as f64;
                 sq += d * d;
             }
         }
@@ -190,13 +192,17 @@ fn forward_warp_is_convention_independent_and_beats_the_seed() {
             .unwrap()
             .render(&mid)
             .unwrap();
-        assert!(out.depth.data.iter().all(|z| z.is_finite()));
+        assert!(out.depth().unwrap().data.iter().all(|z| z.is_finite()));
         if let Some(b) = &base {
             let n = out.sources.len();
             let diff = (0..n)
                 .filter(|&i| {
                     out.sources[i] != b.sources[i]
-                        || (0..3).any(|c| (out.color.data[i * 3 + c] as i32 - b.color.data[i * 3 + c] as i32).abs() > 1)
+                        || (0..3).any(|c| {
+                            (out.color().unwrap().data[i * 3 + c] as i32 - b.color().unwrap().data[i * 3 + c] as i32)
+                                .abs()
+                                > 1
+                        })
                 })
                 .count();
             assert!(
@@ -304,9 +310,40 @@ fn cli_renders_the_same_middle_view_as_the_library_from_files() {
         .unwrap()
         .render(&mid)
         .unwrap();
-    assert_eq!(viewsynth::io::load_rgb(&out.join("middle_rgb.png")).unwrap(), lib.color);
+    assert_eq!(
+        viewsynth::io::load_rgb(&out.join("middle_rgb.png")).unwrap(),
+        *lib.color().unwrap()
+    );
     let z = viewsynth::io::load_depth(&out.join("middle_depth.exr"), &Default::default()).unwrap();
-    assert_eq!(z, lib.depth);
+    assert_eq!(z, *lib.depth().unwrap());
+
+    // Only the mask asked for: only the mask written, the same as the full run's.
+    let only_mask = dir.join("only-mask");
+    let o = std::process::Command::new(env!("CARGO_BIN_EXE_viewsynth"))
+        .args(["cyclopean", "--refine-steps", "3", "--outputs", "mask", "--left-rgb"])
+        .arg(dir.join("left.png"))
+        .arg("--left-depth")
+        .arg(dir.join("left.exr"))
+        .arg("--right-rgb")
+        .arg(dir.join("right.png"))
+        .arg("--right-depth")
+        .arg(dir.join("right.exr"))
+        .arg("--cameras")
+        .arg(dir.join("cams.json"))
+        .arg("--out-dir")
+        .arg(&only_mask)
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let names: Vec<_> = std::fs::read_dir(&only_mask)
+        .unwrap()
+        .map(|e| e.unwrap().file_name().into_string().unwrap())
+        .collect();
+    assert_eq!(names, ["middle_mask.png"]);
+    assert_eq!(
+        std::fs::read(only_mask.join("middle_mask.png")).unwrap(),
+        std::fs::read(out.join("middle_mask.png")).unwrap()
+    );
 
     // A camera file without fixation or gaze: a clear error naming what is missing.
     let mut bad = cams.clone();
@@ -368,30 +405,79 @@ fn temporal_accumulation_fills_disocclusions_from_the_previous_frame() {
         if truth_b.depth.data[i] > 0.0 {
             n += 1;
             for c in 0..3 {
-                let d = filled.color.data[i * 3 + c] as f64 - truth_b.color.data[i * 3 + c] as f64;
+                let d = filled.color().unwrap().data[i * 3 + c] as f64 - truth_b.color.data[i * 3 + c] as f64;
                 sq += d * d;
             }
         }
     }
     let psnr = metrics::psnr_from_mse(sq / (3 * n.max(1)) as f64);
     assert!(n > 50 && psnr > 20.0, "{n} filled pixels at {psnr:.1} dB");
-    assert!(filled.depth.data.iter().all(|z| z.is_finite()));
+    assert!(filled.depth().unwrap().data.iter().all(|z| z.is_finite()));
 
     let mut still = TemporalAccumulator::new(0.5, 0.02, conv).unwrap();
     still.push(&b, &mid_b).unwrap();
     let again = still.push(&b, &mid_b).unwrap();
     let changed = again
-        .color
+        .color()
+        .unwrap()
         .data
         .iter()
-        .zip(&b.color.data)
+        .zip(&b.color().unwrap().data)
         .filter(|(x, y)| (**x as i32 - **y as i32).abs() > 1)
         .count();
     assert!(
-        changed * 1000 <= b.color.data.len(),
+        changed * 1000 <= b.color().unwrap().data.len(),
         "a static sequence changed {changed} channels"
     );
     assert!(
         TemporalAccumulator::new(0.0, 0.02, conv).is_err() && TemporalAccumulator::new(0.5, f64::NAN, conv).is_err()
     );
+}
+
+#[test]
+fn unrequested_colour_and_depth_get_no_attachment_and_no_readback() {
+    use viewsynth::cyclopean::CyclopeanOutputs;
+    let g = gpu();
+    let (frame, mid, _) = scene_frame(&StereoRig::demo(64, 48), Conventions::all()[7], DepthKind::Device);
+    let params = CyclopeanParams {
+        method: Method::Refine { steps: 3 },
+        ..CyclopeanParams::seed(3.0)
+    };
+    let (all, _) = CyclopeanRenderer::new(&g, &frame, params)
+        .unwrap()
+        .render(&mid)
+        .unwrap();
+    for (color, depth) in [(false, false), (true, false), (false, true)] {
+        let (out, _) = CyclopeanRenderer::with_outputs(&g, &frame, params, CyclopeanOutputs { color, depth })
+            .unwrap()
+            .render(&mid)
+            .unwrap();
+        let tag = format!("color={color} depth={depth}");
+        assert_eq!(out.sources, all.sources, "{tag}");
+        assert_eq!(out.color.is_some(), color, "{tag}");
+        assert_eq!(out.depth.is_some(), depth, "{tag}");
+        if let Some(c) = &out.color {
+            assert_eq!(c, all.color().unwrap(), "{tag}");
+        }
+        if let Some(d) = &out.depth {
+            assert_eq!(d, all.depth().unwrap(), "{tag}");
+        }
+        assert!(out.color().is_ok() == color && out.depth().is_ok() == depth, "{tag}");
+    }
+    // Temporal accumulation needs both and says so.
+    let (partial, _) = CyclopeanRenderer::with_outputs(
+        &g,
+        &frame,
+        params,
+        CyclopeanOutputs {
+            color: true,
+            depth: false,
+        },
+    )
+    .unwrap()
+    .render(&mid)
+    .unwrap();
+    let mut taa = viewsynth::cyclopean::temporal::TemporalAccumulator::new(0.2, 0.05, Conventions::all()[7]).unwrap();
+    let err = taa.push(&partial, &mid).unwrap_err();
+    assert!(err.to_string().contains("colour and depth"), "{err}");
 }

@@ -38,6 +38,11 @@ pub(crate) struct CyclopeanArgs {
     /// Dominant eye and its blend weight, e.g. `left:0.7`.
     #[arg(long)]
     dominant: Option<String>,
+    /// Outputs to write: any of rgb (or color), depth, mask. Colour and depth not listed are
+    /// neither rendered into an attachment nor read back.
+    #[arg(long, default_value = "rgb,depth,mask")]
+    outputs: String,
+    /// Writes middle_rgb.png, middle_depth.exr, middle_mask.png (those in --outputs).
     #[arg(long)]
     out_dir: PathBuf,
     #[command(flatten)]
@@ -47,7 +52,10 @@ pub(crate) struct CyclopeanArgs {
 pub(crate) fn cyclopean(a: CyclopeanArgs) -> Result<()> {
     use viewsynth::cyclopean::camera_file::CameraFile;
     use viewsynth::cyclopean::render::CyclopeanRenderer;
-    use viewsynth::cyclopean::{Blend, CyclopeanParams, Eye, EyeInput, Method as CMethod, StereoFrame};
+    use viewsynth::cyclopean::{
+        Blend, CyclopeanOutputs, CyclopeanParams, Eye, EyeInput, Method as CMethod, StereoFrame,
+    };
+    let outputs = OutputSet::parse(&a.outputs.replace("colour", "rgb").replace("color", "rgb"))?;
     let cams = CameraFile::load(&a.cameras)?;
     let (mid, fixation) = cams.middle_and_fixation()?;
     let mut params = CyclopeanParams::seed(fixation);
@@ -94,23 +102,49 @@ pub(crate) fn cyclopean(a: CyclopeanArgs) -> Result<()> {
     frame.validate()?;
     prepare_out_dir(&a.out_dir)?;
     let gpu = a.gpu.open()?;
-    let (out, timing) = CyclopeanRenderer::new(&gpu, &frame, params)?.render(&mid)?;
-    io::save_rgb(&a.out_dir.join("middle_rgb.png"), &out.color)?;
-    io::save_depth_exr(&a.out_dir.join("middle_depth.exr"), &out.depth)?;
+    let wanted = CyclopeanOutputs {
+        color: outputs.rgb,
+        depth: outputs.depth,
+    };
+    let (out, timing) = CyclopeanRenderer::with_outputs(&gpu, &frame, params, wanted)?.render(&mid)?;
     let mask = io::Mask::new(
         mid.width,
         mid.height,
         out.sources.iter().map(|s| (*s != 0) as u8).collect(),
     )?;
-    io::save_mask_png(&a.out_dir.join("middle_mask.png"), &mask)?;
+    let mut jobs: Vec<WriteJob> = Vec::new();
+    if let Some(color) = &out.color {
+        jobs.push((
+            a.out_dir.join("middle_rgb.png"),
+            Box::new(move |p: &Path| io::save_rgb(p, color)),
+        ));
+    }
+    if let Some(depth) = &out.depth {
+        jobs.push((
+            a.out_dir.join("middle_depth.exr"),
+            Box::new(move |p: &Path| io::save_depth_exr(p, depth)),
+        ));
+    }
+    if outputs.mask {
+        jobs.push((
+            a.out_dir.join("middle_mask.png"),
+            Box::new(|p: &Path| io::save_mask_png(p, &mask)),
+        ));
+    }
+    let written = write_all_or_none(jobs)?;
+    let names: Vec<String> = written
+        .iter()
+        .filter_map(|p| p.file_name().map(|n| n.to_string_lossy().into_owned()))
+        .collect();
     let valid = out.sources.iter().filter(|s| **s != 0).count();
     println!(
-        "middle view {}x{}: fixation {:.3} m, {:.1} % valid, render {:.1} ms; wrote middle_rgb.png, middle_depth.exr, middle_mask.png in {}",
+        "middle view {}x{}: fixation {:.3} m, {:.1} % valid, render {:.1} ms; wrote {} in {}",
         mid.width,
         mid.height,
         fixation,
         valid as f64 / out.sources.len() as f64 * 100.0,
         timing.wall_ms,
+        names.join(", "),
         a.out_dir.display()
     );
     Ok(())
