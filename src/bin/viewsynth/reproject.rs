@@ -215,12 +215,38 @@ pub(crate) fn reproject(a: ReprojectArgs) -> Result<()> {
     Ok(())
 }
 
+/// The source colour and depth from --color/--depth, checked to agree in size and to hold
+/// valid depth as `what` says.
+fn load_source(
+    a: &ReprojectArgs,
+    depth_kind: viewsynth::reproject::DepthInput,
+    conv: Conventions,
+    what: &str,
+) -> Result<viewsynth::reproject::ReprojectSource> {
+    let decode = DepthDecode {
+        scale: a.depth_scale,
+        ..Default::default()
+    };
+    let src = viewsynth::reproject::ReprojectSource {
+        color: io::load_rgb(&a.color)?,
+        depth: io::load_depth(&a.depth, &decode)?,
+        depth_kind,
+        conv,
+    };
+    src.validate()
+        .with_context(|| format!("{} and {}", a.color.display(), a.depth.display()))?;
+    if src.inverse_depth_range().is_none() {
+        bail!("{}: no pixel holds valid depth as {what}", a.depth.display());
+    }
+    Ok(src)
+}
+
 /// The source and its targets on a parallel rig (rectified or seed 004) from intrinsics.
 fn rig_setup(a: &ReprojectArgs) -> Result<Setup> {
     use viewsynth::camera::stereo::{Eye, StereoParams};
     use viewsynth::camera::PinholeCamera;
     use viewsynth::convention::DepthPlanes;
-    use viewsynth::reproject::{DepthInput, Geometry, ReprojectSource, ShiftModel};
+    use viewsynth::reproject::{DepthInput, Geometry, ShiftModel};
 
     // Everything that can be checked before reading files, touching the GPU or the output
     // directory is.
@@ -281,25 +307,13 @@ fn rig_setup(a: &ReprojectArgs) -> Result<Setup> {
         bail!("give the rig: --baseline B (rectified, metres) or --separation S --convergence C (seed 004)");
     }
     let conv = a.conv.conventions();
-    let decode = DepthDecode {
-        scale: a.depth_scale,
-        ..Default::default()
-    };
-    let src = ReprojectSource {
-        color: io::load_rgb(&a.color)?,
-        depth: io::load_depth(&a.depth, &decode)?,
-        depth_kind,
-        conv,
-    };
-    src.validate()
-        .with_context(|| format!("{} and {}", a.color.display(), a.depth.display()))?;
-    if src.inverse_depth_range().is_none() {
-        bail!(
-            "{}: no pixel holds valid depth as --depth-kind {} (check --depth-kind, --depth-scale, --near/--far, conventions)",
-            a.depth.display(),
-            a.depth_kind.to_possible_value().map_or_else(String::new, |v| v.get_name().to_string())
-        );
-    }
+    let what = format!(
+        "--depth-kind {} (check --depth-kind, --depth-scale, --near/--far, conventions)",
+        a.depth_kind
+            .to_possible_value()
+            .map_or_else(String::new, |v| v.get_name().to_string())
+    );
+    let src = load_source(a, depth_kind, conv, &what)?;
     let camera = PinholeCamera {
         k,
         width: src.color.width,
@@ -331,7 +345,7 @@ fn cameras_setup(a: &ReprojectArgs, path: &Path) -> Result<Setup> {
     use viewsynth::convention::DepthPlanes;
     use viewsynth::cyclopean::camera_file::CameraFile;
     use viewsynth::cyclopean::{DepthKind, MiddleCamera};
-    use viewsynth::reproject::{DepthInput, Geometry, ReprojectSource};
+    use viewsynth::reproject::{DepthInput, Geometry};
 
     let (from, to) = match a.from {
         FromArg::Left => (Eye::Left, Eye::Right),
@@ -362,27 +376,13 @@ fn cameras_setup(a: &ReprojectArgs, path: &Path) -> Result<Setup> {
                 .with_context(|| format!("{}: {} projection", path.display(), eye_name(Some(from))))?,
         },
     };
-    let decode = DepthDecode {
-        scale: a.depth_scale,
-        ..Default::default()
-    };
-    let src = ReprojectSource {
-        color: io::load_rgb(&a.color)?,
-        depth: io::load_depth(&a.depth, &decode)?,
-        depth_kind,
-        conv,
-    };
-    src.validate()
-        .with_context(|| format!("{} and {}", a.color.display(), a.depth.display()))?;
-    if src.inverse_depth_range().is_none() {
-        bail!(
-            "{}: no pixel holds valid depth as {:?} depth under {} (from {})",
-            a.depth.display(),
-            file.depth_kind,
-            conv.label(),
-            path.display()
-        );
-    }
+    let what = format!(
+        "{:?} depth under {} (from {})",
+        file.depth_kind,
+        conv.label(),
+        path.display()
+    );
+    let src = load_source(a, depth_kind, conv, &what)?;
     let geometry = Geometry::Matrices {
         source_view: source.view,
         source_proj: source.proj,
