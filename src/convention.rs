@@ -70,6 +70,13 @@ impl Conventions {
         }
     }
 
+    /// Reversed-Z with the [0, 1] range: the one combination where float window depth keeps its
+    /// relative precision at every distance (the others store ~1 - near/Z or go through
+    /// 2 d - 1, whose absolute precision limits Z to ~eps Z / near).
+    pub fn float_depth_keeps_relative_precision(&self) -> bool {
+        self.reversed_z && self.ndc_depth == NdcDepthRange::ZeroToOne
+    }
+
     /// Window depth the depth buffer is cleared to (the far value).
     pub fn clear_depth(&self) -> f64 {
         ndc_to_window_depth(self.ndc_depth, self.ndc_z_near_far().1)

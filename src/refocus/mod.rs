@@ -122,7 +122,7 @@ impl Default for OutputSet {
 }
 
 impl OutputSet {
-    /// Parse "rgb,depth,mask" (any subset, at least one).
+    /// Parse "rgb,depth,mask" (any subset, at least one; "color"/"colour" name rgb).
     pub fn parse(list: &str) -> Result<Self> {
         let mut out = OutputSet {
             rgb: false,
@@ -131,7 +131,7 @@ impl OutputSet {
         };
         for item in list.split(',').map(str::trim).filter(|s| !s.is_empty()) {
             match item {
-                "rgb" => out.rgb = true,
+                "rgb" | "color" | "colour" => out.rgb = true,
                 "depth" => out.depth = true,
                 "mask" => out.mask = true,
                 _ => {

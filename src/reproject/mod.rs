@@ -119,6 +119,20 @@ impl DepthInput {
         }
     }
 
+    /// View Z (0 where invalid) of every stored value, converted in f64 through
+    /// [`Self::inverse_depth`].
+    pub fn view_z_map(&self, conv: &Conventions, depth: &DepthMap) -> DepthMap {
+        DepthMap {
+            width: depth.width,
+            height: depth.height,
+            data: depth
+                .data
+                .iter()
+                .map(|&d| self.inverse_depth(conv, d as f64).map_or(0.0, |q| (1.0 / q) as f32))
+                .collect(),
+        }
+    }
+
     /// Inverse depth of a stored value in f64, None where invalid (the shared validity rule).
     pub fn inverse_depth(&self, conv: &Conventions, stored: f64) -> Option<f64> {
         if !stored.is_finite() {
@@ -364,21 +378,7 @@ impl ReprojectOutput {
 fn cyclopean_depth(src: &ReprojectSource) -> (DepthMap, DepthKind) {
     match src.depth_kind {
         DepthInput::Device { .. } => (src.depth.clone(), DepthKind::Device),
-        _ => {
-            let data = src
-                .inverse_depths()
-                .into_iter()
-                .map(|q| q.map_or(0.0, |q| (1.0 / q) as f32))
-                .collect();
-            (
-                DepthMap {
-                    width: src.depth.width,
-                    height: src.depth.height,
-                    data,
-                },
-                DepthKind::ViewZ,
-            )
-        }
+        _ => (src.depth_kind.view_z_map(&src.conv, &src.depth), DepthKind::ViewZ),
     }
 }
 

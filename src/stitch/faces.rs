@@ -78,15 +78,7 @@ pub fn view_z_of(depth: &DepthMap, kind: &DepthInput, conv: &Conventions) -> Res
     kind.validate()?;
     match kind {
         DepthInput::ViewZ => Ok(depth.clone()),
-        DepthInput::Device { .. } => DepthMap::new(
-            depth.width,
-            depth.height,
-            depth
-                .data
-                .iter()
-                .map(|&d| kind.inverse_depth(conv, d as f64).map_or(0.0, |q| (1.0 / q) as f32))
-                .collect(),
-        ),
+        DepthInput::Device { .. } => Ok(kind.view_z_map(conv, depth)),
         DepthInput::Disparity { .. } => Err(Error::param(
             "face depth kind",
             "disparity has no meaning for a cube face: give view Z or device depth",

@@ -27,10 +27,6 @@ fn depth_conventions() -> Vec<Conventions> {
         .collect()
 }
 
-fn precise(conv: &Conventions) -> bool {
-    conv.reversed_z && conv.ndc_depth == NdcDepthRange::ZeroToOne
-}
-
 /// Window depth of view distance `z` as the GPU computes and stores it (f32 throughout).
 fn window_depth_f32(m: &[f32; 16], conv: &Conventions, z: f64) -> f32 {
     let ze = -(z as f32);
@@ -76,7 +72,7 @@ fn depth_round_trip(planes: DepthPlanes, conv: Conventions, samples: usize) -> R
         }
         errs.push(rel);
     }
-    let lossy = !precise(&conv);
+    let lossy = !conv.float_depth_keeps_relative_precision();
     let bound = if lossy {
         8.0 * EPS32 * (1.0 + far_eff / planes.near)
     } else {

@@ -21,7 +21,7 @@
 use super::refocus::refused;
 use super::{test_texture, GpuPixels, RefPixels, StressOptions, StressRow, Tally, Tolerance, EPS32};
 use crate::camera::{Pose, MAX_IMAGE_SIDE};
-use crate::convention::{Conventions, DepthPlanes, NdcDepthRange};
+use crate::convention::{Conventions, DepthPlanes};
 use crate::cyclopean::reference::cyclopean_reference;
 use crate::cyclopean::render::CyclopeanRenderer;
 use crate::cyclopean::scene_frame::{scene_frame, StereoRig};
@@ -46,12 +46,6 @@ fn methods(fixation: f64) -> [(&'static str, CyclopeanParams); 2] {
             },
         ),
     ]
-}
-
-/// Reversed-Z with the [0, 1] range: the one convention where float device depth keeps its
-/// relative precision at every distance.
-fn precise(conv: &Conventions) -> bool {
-    conv.reversed_z && conv.ndc_depth == NdcDepthRange::ZeroToOne
 }
 
 fn bound(conv_precise: bool, kind: DepthKind, z_max: f64, near: f64) -> f64 {
@@ -116,7 +110,8 @@ const SCENE_Z_MAX: f64 = 8.0;
 pub fn rows(gpu: &Gpu, opts: StressOptions) -> Result<Vec<StressRow>> {
     let (w, h) = if opts.quick { (96, 72) } else { (256, 192) };
     let all = Conventions::all();
-    let (fine, lossy): (Vec<Conventions>, Vec<Conventions>) = all.iter().partition(|c| precise(c));
+    let (fine, lossy): (Vec<Conventions>, Vec<Conventions>) =
+        all.iter().partition(|c| c.float_depth_keeps_relative_precision());
     let mut rows = Vec::new();
 
     for near in [0.05, 1e-5] {

@@ -17,7 +17,7 @@ use super::refocus::refused;
 use super::{test_texture, GpuPixels, RefPixels, StressOptions, StressRow, Tally, Tolerance, EPS32};
 use crate::camera::stereo::{Eye, StereoParams};
 use crate::camera::{Intrinsics, PinholeCamera, MAX_IMAGE_SIDE};
-use crate::convention::{Conventions, DepthPlanes, NdcDepthRange};
+use crate::convention::{Conventions, DepthPlanes};
 use crate::cyclopean::scene_frame::{scene_frame, StereoRig};
 use crate::cyclopean::DepthKind;
 use crate::error::Result;
@@ -172,7 +172,7 @@ pub fn rows(gpu: &Gpu, opts: StressOptions) -> Result<Vec<StressRow>> {
             let convs: Vec<Conventions> = all
                 .iter()
                 .copied()
-                .filter(|c| (c.reversed_z && c.ndc_depth == NdcDepthRange::ZeroToOne) == precise)
+                .filter(|c| c.float_depth_keeps_relative_precision() == precise)
                 .collect();
             let z_max = 8.0;
             let b = if precise {

@@ -55,7 +55,7 @@ pub(crate) fn cyclopean(a: CyclopeanArgs) -> Result<()> {
     use viewsynth::cyclopean::{
         Blend, CyclopeanOutputs, CyclopeanParams, Eye, EyeInput, Method as CMethod, StereoFrame,
     };
-    let outputs = OutputSet::parse(&a.outputs.replace("colour", "rgb").replace("color", "rgb"))?;
+    let outputs = OutputSet::parse(&a.outputs)?;
     let cams = CameraFile::load(&a.cameras)?;
     let (mid, fixation) = cams.middle_and_fixation()?;
     let mut params = CyclopeanParams::seed(fixation);
@@ -132,10 +132,6 @@ pub(crate) fn cyclopean(a: CyclopeanArgs) -> Result<()> {
         ));
     }
     let written = write_all_or_none(jobs)?;
-    let names: Vec<String> = written
-        .iter()
-        .filter_map(|p| p.file_name().map(|n| n.to_string_lossy().into_owned()))
-        .collect();
     let valid = out.sources.iter().filter(|s| **s != 0).count();
     println!(
         "middle view {}x{}: fixation {:.3} m, {:.1} % valid, render {:.1} ms; wrote {} in {}",
@@ -144,7 +140,7 @@ pub(crate) fn cyclopean(a: CyclopeanArgs) -> Result<()> {
         fixation,
         valid as f64 / out.sources.len() as f64 * 100.0,
         timing.wall_ms,
-        names.join(", "),
+        file_names(&written),
         a.out_dir.display()
     );
     Ok(())

@@ -222,7 +222,7 @@ struct FileOutputArgs {
 
 impl FileOutputArgs {
     fn parse(&self) -> Result<(OutputSet, RgbFormat, DepthFormats)> {
-        let outputs = OutputSet::parse(&self.outputs.replace("colour", "rgb").replace("color", "rgb"))?;
+        let outputs = OutputSet::parse(&self.outputs)?;
         let rgb = match self.rgb_format {
             RgbFormatArg::Png => RgbFormat::Png,
             RgbFormatArg::Jpeg => RgbFormat::Jpeg,
@@ -432,6 +432,15 @@ fn write_all_or_none(jobs: Vec<WriteJob<'_>>) -> Result<Vec<PathBuf>> {
         written.push(path);
     }
     Ok(written)
+}
+
+/// The file names of written outputs, comma-separated, for the closing message.
+fn file_names(paths: &[PathBuf]) -> String {
+    let names: Vec<String> = paths
+        .iter()
+        .filter_map(|p| p.file_name().map(|n| n.to_string_lossy().into_owned()))
+        .collect();
+    names.join(", ")
 }
 
 fn ms_text(t: &viewsynth::gpu::Timing) -> String {

@@ -207,11 +207,7 @@ pub(crate) fn reproject(a: ReprojectArgs) -> Result<()> {
             ms_text(timing),
         );
     }
-    let names: Vec<String> = written
-        .iter()
-        .filter_map(|p| p.file_name().map(|n| n.to_string_lossy().into_owned()))
-        .collect();
-    println!("wrote {} in {}", names.join(", "), a.out_dir.display());
+    println!("wrote {} in {}", file_names(&written), a.out_dir.display());
     Ok(())
 }
 
