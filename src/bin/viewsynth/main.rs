@@ -434,6 +434,18 @@ fn write_all_or_none(jobs: Vec<WriteJob<'_>>) -> Result<Vec<PathBuf>> {
     Ok(written)
 }
 
+/// Device depth written with `--near`/`--far` (`what` names the depth in the error).
+fn device_depth(near: Option<f64>, far: Option<f64>, what: &str) -> Result<viewsynth::reproject::DepthInput> {
+    let (Some(near), Some(far)) = (near, far) else {
+        bail!("--depth-kind device needs --near and --far (the planes {what} was written with)");
+    };
+    let kind = viewsynth::reproject::DepthInput::Device {
+        planes: viewsynth::convention::DepthPlanes { near, far },
+    };
+    kind.validate().context("--near/--far")?;
+    Ok(kind)
+}
+
 /// The file names of written outputs, comma-separated, for the closing message.
 fn file_names(paths: &[PathBuf]) -> String {
     let names: Vec<String> = paths

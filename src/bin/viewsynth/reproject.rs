@@ -241,7 +241,6 @@ fn load_source(
 fn rig_setup(a: &ReprojectArgs) -> Result<Setup> {
     use viewsynth::camera::stereo::{Eye, StereoParams};
     use viewsynth::camera::PinholeCamera;
-    use viewsynth::convention::DepthPlanes;
     use viewsynth::reproject::{DepthInput, Geometry, ShiftModel};
 
     // Everything that can be checked before reading files, touching the GPU or the output
@@ -268,16 +267,7 @@ fn rig_setup(a: &ReprojectArgs) -> Result<Setup> {
     let focal = a.focal.unwrap_or(fx);
     let depth_kind = match a.depth_kind {
         ReprojectDepthArg::ViewZ => DepthInput::ViewZ,
-        ReprojectDepthArg::Device => {
-            let (Some(near), Some(far)) = (a.near, a.far) else {
-                bail!("--depth-kind device needs --near and --far (the planes the depth buffer was written with)");
-            };
-            let kind = DepthInput::Device {
-                planes: DepthPlanes { near, far },
-            };
-            kind.validate().context("--near/--far")?;
-            kind
-        }
+        ReprojectDepthArg::Device => device_depth(a.near, a.far, "the depth buffer")?,
         ReprojectDepthArg::Disparity => {
             let Some(baseline) = a.baseline else {
                 bail!("--depth-kind disparity needs --baseline (metres; Z = baseline * focal / (d + doffs))");

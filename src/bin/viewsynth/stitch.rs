@@ -87,7 +87,6 @@ pub(crate) struct StitchArgs {
 
 pub(crate) fn stitch(a: StitchArgs) -> Result<()> {
     use std::time::Instant;
-    use viewsynth::convention::DepthPlanes;
     use viewsynth::reproject::DepthInput;
     use viewsynth::stitch::eval::{score_eyes, split_top_bottom};
     use viewsynth::stitch::faces::{load_face_dir, scene_faces};
@@ -160,16 +159,7 @@ pub(crate) fn stitch(a: StitchArgs) -> Result<()> {
     let depth_kind = match (a.depth_kind, a.near, a.far) {
         (FaceDepthArg::ViewZ, None, None) => DepthInput::ViewZ,
         (FaceDepthArg::ViewZ, _, _) => bail!("--near/--far apply to --depth-kind device only"),
-        (FaceDepthArg::Device, Some(near), Some(far)) => {
-            let kind = DepthInput::Device {
-                planes: DepthPlanes { near, far },
-            };
-            kind.validate().context("--near/--far")?;
-            kind
-        }
-        (FaceDepthArg::Device, _, _) => {
-            bail!("--depth-kind device needs --near and --far (the planes the faces' depth was written with)")
-        }
+        (FaceDepthArg::Device, near, far) => device_depth(near, far, "the faces' depth")?,
     };
     if a.faces.is_none() && a.depth_kind != FaceDepthArg::ViewZ {
         bail!("--depth-kind applies to --faces (the built-in scene's faces hold view Z)");
