@@ -9,6 +9,10 @@ uniform sampler2D u_cols;  // RGBA32F, W' x 1
 uniform sampler2D u_rows;  // RGBA32F, H' x 1
 uniform int u_dst_height;
 
+// The mask attachment is R8 (normalised): 1/255 stores the byte 1, the in-memory mask's
+// "valid", so its readback is the mask as it is, with no per-pixel conversion.
+const float MASK_SET = 1.0 / 255.0;
+
 void pixel_lookups(out vec4 col, out vec4 row) {
 #if ROWS_TOP_DOWN
     int y = int(gl_FragCoord.y);

@@ -59,5 +59,5 @@ void main() {
     o_rgb = vec4(cell_rgb(c0, clamp(vec2(cx.y, cy.y), 0.0, 1.0)), 1.0);
 #endif
     o_depth = z;
-    o_mask = 1.0;
+    o_mask = MASK_SET;
 }

@@ -36,5 +36,5 @@ void main() {
     o_rgb = vec4(0.0);
 #endif
     o_depth = tri_depth(ab, v_cell.z, z);
-    o_mask = 1.0;
+    o_mask = MASK_SET;
 }

@@ -21,5 +21,5 @@ void main() {
     o_rgb = vec4(0.0);
 #endif
     o_depth = tri_depth(ab, tri, z);
-    o_mask = 1.0;
+    o_mask = MASK_SET;
 }

@@ -1,6 +1,7 @@
 //! Framebuffers with multiple render targets (MRT) and an optional float depth buffer.
 
-use super::{Gpu, Texture, TextureFormat};
+use super::{Gpu, PendingRead, ReadFormat, Texture, TextureFormat};
+use std::cell::RefCell;
 use crate::error::{Error, Result};
 use glow::HasContext;
 
@@ -22,6 +23,9 @@ pub struct Framebuffer {
     pub depth: Option<Texture>,
     pub width: u32,
     pub height: u32,
+    /// Companion of the same attachments that reads with flipped rows are blitted into;
+    /// created on the first such read and kept.
+    flipped: RefCell<Option<Box<Framebuffer>>>,
 }
 
 impl Framebuffer {
@@ -56,8 +60,10 @@ impl Framebuffer {
                 depth,
                 width,
                 height,
+                flipped: RefCell::new(None),
             };
             gl.bind_framebuffer(glow::FRAMEBUFFER, Some(raw));
+            super::label(gl, glow::FRAMEBUFFER, raw.0.get(), "viewsynth framebuffer");
             let mut draw = Vec::new();
             for (i, t) in fb.colors.iter().enumerate() {
                 let at = glow::COLOR_ATTACHMENT0 + i as u32;
@@ -114,34 +120,78 @@ impl Framebuffer {
         }
     }
 
-    /// Read colour attachment `index` back with glReadPixels (rows in memory order, row 0 =
-    /// framebuffer row 0); None for an empty slot. On llvmpipe this is several times faster
-    /// than glGetTexImage on the same texture.
+    /// Read colour attachment `index` back (rows in memory order, row 0 = framebuffer row 0,
+    /// the texture's own transfer layout); None for an empty slot. Goes through the streaming
+    /// readback and waits for it: callers that can overlap work use [`Framebuffer::read_async`].
     pub fn read_color(&self, index: usize) -> Result<Option<Vec<u8>>> {
         let Some(t) = self.colors.get(index).and_then(|t| t.as_ref()) else {
             return Ok(None);
         };
-        let (fmt, ty, bpp) = t.format.transfer();
-        let mut out = vec![0u8; self.width as usize * self.height as usize * bpp];
-        let gl = self.gpu.gl();
-        // SAFETY: the buffer is exactly width x height texels of this format; pack alignment 1.
-        unsafe {
-            gl.bind_framebuffer(glow::READ_FRAMEBUFFER, Some(self.raw));
-            gl.read_buffer(glow::COLOR_ATTACHMENT0 + index as u32);
-            gl.pixel_store_i32(glow::PACK_ALIGNMENT, 1);
-            gl.read_pixels(
-                0,
-                0,
-                self.width as i32,
-                self.height as i32,
-                fmt,
-                ty,
-                glow::PixelPackData::Slice(Some(&mut out)),
-            );
-            gl.bind_framebuffer(glow::READ_FRAMEBUFFER, None);
+        let (format, ty, bytes_per_pixel) = t.format.transfer();
+        let layout = ReadFormat {
+            format,
+            ty,
+            bytes_per_pixel,
+        };
+        match self.read_async(index, layout, false)? {
+            Some(read) => Ok(Some(read.finish()?)),
+            None => Ok(None),
         }
-        self.gpu.check("framebuffer readback")?;
-        Ok(Some(out))
+    }
+
+    /// Queue a read of colour attachment `index` in `layout` (which may pack channels, e.g.
+    /// RGB out of RGBA8) into a pooled pixel-pack buffer; None for an empty slot. With
+    /// `flip_rows` the rows arrive bottom row first: the attachment is first blitted upside down
+    /// into a companion framebuffer on the GPU, so the CPU never reorders rows.
+    pub fn read_async(&self, index: usize, layout: ReadFormat, flip_rows: bool) -> Result<Option<PendingRead>> {
+        if self.colors.get(index).and_then(|t| t.as_ref()).is_none() {
+            return Ok(None);
+        }
+        let gl = self.gpu.gl();
+        let at = glow::COLOR_ATTACHMENT0 + index as u32;
+        let (w, h) = (self.width as i32, self.height as i32);
+        let source = if flip_rows {
+            let mut flipped = self.flipped.borrow_mut();
+            if flipped.is_none() {
+                let attachments: Vec<Option<Attachment>> = self
+                    .colors
+                    .iter()
+                    .map(|t| {
+                        t.as_ref().map(|t| Attachment {
+                            format: t.format,
+                            clear: [0.0; 4],
+                        })
+                    })
+                    .collect();
+                *flipped = Some(Box::new(Framebuffer::new(&self.gpu, self.width, self.height, &attachments, false)?));
+            }
+            let target = flipped.as_ref().expect("created above").raw;
+            let mut draw = vec![glow::NONE; self.colors.len()];
+            draw[index] = at;
+            // SAFETY: both framebuffers are complete and of the same size and formats; the
+            // blit copies attachment `index` with its rows reversed.
+            unsafe {
+                gl.bind_framebuffer(glow::READ_FRAMEBUFFER, Some(self.raw));
+                gl.read_buffer(at);
+                gl.bind_framebuffer(glow::DRAW_FRAMEBUFFER, Some(target));
+                gl.draw_buffers(&draw);
+                gl.disable(glow::SCISSOR_TEST);
+                gl.blit_framebuffer(0, 0, w, h, 0, h, w, 0, glow::COLOR_BUFFER_BIT, glow::NEAREST);
+                gl.bind_framebuffer(glow::DRAW_FRAMEBUFFER, None);
+            }
+            target
+        } else {
+            self.raw
+        };
+        // SAFETY: valid framebuffer with attachment `index` present.
+        unsafe {
+            gl.bind_framebuffer(glow::READ_FRAMEBUFFER, Some(source));
+            gl.read_buffer(at);
+        }
+        let read = PendingRead::queue(&self.gpu, self.width, self.height, layout);
+        // SAFETY: unbinding is always valid.
+        unsafe { gl.bind_framebuffer(glow::READ_FRAMEBUFFER, None) };
+        Ok(Some(read?))
     }
 
     pub fn unbind(&self) {

@@ -6,6 +6,7 @@ mod egl;
 mod framebuffer;
 pub mod pixels;
 mod program;
+mod readback;
 mod texture;
 mod timer;
 mod vertex_array;
@@ -14,36 +15,54 @@ pub use buffer::IndexBuffer;
 pub use egl::{DeviceChoice, EglContext, GpuInfo};
 pub use framebuffer::{Attachment, Framebuffer};
 pub use program::Program;
+pub use readback::{PendingRead, ReadFormat};
 pub use texture::{Texture, TextureFormat};
-pub use timer::{GpuTimer, Timing};
+pub use timer::{DeferredTimer, GpuTimer, Timing};
 pub use vertex_array::VertexArray;
 
 use crate::error::{Error, Result};
 use glow::HasContext;
+use std::cell::RefCell;
 use std::rc::Rc;
 
 /// A shared handle to the current GL context. Resources keep one so the context outlives them.
 #[derive(Clone)]
-pub struct Gpu(Rc<EglContext>);
+pub struct Gpu(Rc<GpuInner>);
+
+/// The context and the per-context pools of reusable objects (readback buffers, queries).
+pub(crate) struct GpuInner {
+    ctx: EglContext,
+    readback: RefCell<readback::ReadbackPool>,
+}
+
+impl Drop for GpuInner {
+    fn drop(&mut self) {
+        // Pooled objects go while the context is still alive (it is dropped after this).
+        self.readback.borrow_mut().clear(&self.ctx.gl);
+    }
+}
 
 impl Gpu {
     pub fn new(choice: DeviceChoice) -> Result<Self> {
         let ctx = EglContext::new(choice)?;
-        Ok(Gpu(Rc::new(ctx)))
+        Ok(Gpu(Rc::new(GpuInner {
+            ctx,
+            readback: RefCell::default(),
+        })))
     }
 
     pub fn gl(&self) -> &glow::Context {
-        &self.0.gl
+        &self.0.ctx.gl
     }
 
     pub fn info(&self) -> &GpuInfo {
-        &self.0.info
+        &self.0.ctx.info
     }
 
     /// `glClipControl(origin, depth)`: not in glow, loaded through eglGetProcAddress.
     pub fn clip_control(&self, origin: u32, depth: u32) {
         // SAFETY: GL 4.5 entry point with two enum arguments; the context is current.
-        unsafe { (self.0.clip_control)(origin, depth) }
+        unsafe { (self.0.ctx.clip_control)(origin, depth) }
     }
 
     /// Fail on any pending GL error, naming what was being done.
@@ -68,4 +87,10 @@ impl Gpu {
         // SAFETY: no arguments.
         unsafe { self.gl().finish() }
     }
+}
+
+/// Name a GL object for debuggers (RenderDoc, apitrace); KHR_debug is core since GL 4.3.
+pub(crate) fn label(gl: &glow::Context, kind: u32, raw: u32, name: &str) {
+    // SAFETY: `raw` names a live object of `kind` on the current context.
+    unsafe { gl.object_label(kind, raw, Some(name)) }
 }

@@ -4,10 +4,15 @@
 use super::Gpu;
 use crate::error::{Error, Result};
 use glow::HasContext;
+use std::cell::RefCell;
+use std::collections::HashMap;
 
 pub struct Program {
     gpu: Gpu,
     raw: glow::Program,
+    /// Uniform locations by name, looked up once: a steady stream of frames then costs no
+    /// glGetUniformLocation.
+    locations: RefCell<HashMap<String, Option<glow::UniformLocation>>>,
 }
 
 const VERSION: &str = "#version 450 core\n";
@@ -61,9 +66,11 @@ impl Program {
                 let names: Vec<_> = stages.iter().map(|s| s.1).collect();
                 return Err(Error::Gl(format!("linking {}: {log}", names.join(" + "))));
             }
+            super::label(gl, glow::PROGRAM, program.0.get(), stages.first().map_or("program", |s| s.1));
             Ok(Program {
                 gpu: gpu.clone(),
                 raw: program,
+                locations: RefCell::default(),
             })
         }
     }
@@ -88,8 +95,13 @@ impl Program {
     }
 
     fn location(&self, name: &str) -> Option<glow::UniformLocation> {
+        if let Some(l) = self.locations.borrow().get(name) {
+            return l.clone();
+        }
         // SAFETY: valid program handle.
-        unsafe { self.gpu.gl().get_uniform_location(self.raw, name) }
+        let l = unsafe { self.gpu.gl().get_uniform_location(self.raw, name) };
+        self.locations.borrow_mut().insert(name.to_string(), l.clone());
+        l
     }
 
     /// Set uniforms by name on the bound program. Unknown names are ignored (the GLSL compiler

@@ -77,6 +77,7 @@ impl Texture {
         unsafe {
             let raw = gl.create_texture().map_err(Error::Gl)?;
             gl.bind_texture(glow::TEXTURE_2D, Some(raw));
+            super::label(gl, glow::TEXTURE, raw.0.get(), "viewsynth texture");
             gl.tex_storage_2d(glow::TEXTURE_2D, 1, format.internal(), width as i32, height as i32);
             for (p, v) in [
                 (glow::TEXTURE_MIN_FILTER, glow::NEAREST),
@@ -111,6 +112,38 @@ impl Texture {
             gpu.check("texture allocation")?;
             Ok(tex)
         }
+    }
+
+    /// Replace the whole content (same size and format) without reallocating: streams of
+    /// same-sized frames reuse one texture.
+    pub fn upload(&self, data: &[u8]) -> Result<()> {
+        let (fmt, ty, bpp) = self.format.transfer();
+        let need = self.width as usize * self.height as usize * bpp;
+        if data.len() != need {
+            return Err(Error::Gl(format!(
+                "texture upload: {} bytes given, {need} needed",
+                data.len()
+            )));
+        }
+        let gl = self.gpu.gl();
+        // SAFETY: the texture has storage of exactly this size; data length checked above.
+        unsafe {
+            gl.bind_texture(glow::TEXTURE_2D, Some(self.raw));
+            gl.pixel_store_i32(glow::UNPACK_ALIGNMENT, 1);
+            gl.tex_sub_image_2d(
+                glow::TEXTURE_2D,
+                0,
+                0,
+                0,
+                self.width as i32,
+                self.height as i32,
+                fmt,
+                ty,
+                glow::PixelUnpackData::Slice(Some(data)),
+            );
+            gl.bind_texture(glow::TEXTURE_2D, None);
+        }
+        self.gpu.check("texture upload")
     }
 
     /// Bind to texture unit `unit`.

@@ -28,6 +28,8 @@ const EXPAND_PX: f32 = 1.0 / 32.0;
 /// longer holds: every triangle then takes the boundary path.
 const MIN_INTERIOR_SCALE: f64 = 1.0 / 64.0;
 
+/// The mesh path's programs (compiled once per context and settings) and the current source's
+/// geometry (replaced when the source changes).
 pub struct MeshPass {
     interior_program: Program,
     boundary_program: Program,
@@ -68,7 +70,8 @@ pub fn code_texture(gpu: &Gpu, codes: &[u32]) -> Result<Option<Texture>> {
 }
 
 impl MeshPass {
-    pub fn new(gpu: &Gpu, grid: &Grid, keep: &[u8], defines: &str, grid_glsl: &str, sample_glsl: &str) -> Result<Self> {
+    /// Compile the programs; no geometry yet (see [`MeshPass::set_geometry`]).
+    pub fn new(gpu: &Gpu, defines: &str, grid_glsl: &str, sample_glsl: &str) -> Result<Self> {
         let program = |name: &str, vert: &str, frag: &str| {
             Program::new(
                 gpu,
@@ -83,28 +86,42 @@ impl MeshPass {
                 ],
             )
         };
+        Ok(MeshPass {
+            interior_program: program("refocus/mesh_interior", INTERIOR_VERT, INTERIOR_FRAG)?,
+            boundary_program: program("refocus/mesh_boundary", BOUNDARY_VERT, BOUNDARY_FRAG)?,
+            interior: None,
+            all_as_boundary: None,
+            boundary: None,
+            interior_count: 0,
+            boundary_count: 0,
+            indexed_vao: VertexArray::new(gpu)?,
+        })
+    }
+
+    /// Upload the kept triangles of a new source (its index buffer and code textures).
+    pub fn set_geometry(&mut self, gpu: &Gpu, grid: &Grid, keep: &[u8]) -> Result<()> {
         let (interior, boundary) = grid.split_kept_triangles(keep);
         let indices: Vec<u32> = interior.iter().flat_map(|&c| grid.triangle_vertices(c)).collect();
         let mut all = boundary.clone();
         all.extend_from_slice(&interior);
-        Ok(MeshPass {
-            interior_program: program("refocus/mesh_interior", INTERIOR_VERT, INTERIOR_FRAG)?,
-            boundary_program: program("refocus/mesh_boundary", BOUNDARY_VERT, BOUNDARY_FRAG)?,
-            interior: if indices.is_empty() {
-                None
-            } else {
-                Some(IndexBuffer::new(gpu, &indices)?)
-            },
-            all_as_boundary: if interior.is_empty() {
-                None
-            } else {
-                code_texture(gpu, &all)?
-            },
-            boundary: code_texture(gpu, &boundary)?,
-            interior_count: interior.len(),
-            boundary_count: boundary.len(),
-            indexed_vao: VertexArray::new(gpu)?,
-        })
+        // Free the previous source's buffers before allocating the new ones.
+        self.interior = None;
+        self.all_as_boundary = None;
+        self.boundary = None;
+        self.interior = if indices.is_empty() {
+            None
+        } else {
+            Some(IndexBuffer::new(gpu, &indices)?)
+        };
+        self.all_as_boundary = if interior.is_empty() {
+            None
+        } else {
+            code_texture(gpu, &all)?
+        };
+        self.boundary = code_texture(gpu, &boundary)?;
+        self.interior_count = interior.len();
+        self.boundary_count = boundary.len();
+        Ok(())
     }
 
     pub fn triangle_count(&self) -> usize {

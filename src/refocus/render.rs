@@ -1,13 +1,23 @@
-//! GPU refocus: shared inputs (source colour, depth and the kept triangles) are uploaded once;
-//! each target renders into a framebuffer holding only the requested attachments.
+//! GPU refocus. The programs are compiled once per `Refocuser`; a source (colour, depth and
+//! the kept triangles) is uploaded into textures that the next source of the same size reuses;
+//! each target renders into a framebuffer (kept per output size) holding only the requested
+//! attachments, and its outputs are read back through the streaming readback of `gpu`: the row
+//! order and the RGB packing happen on the GPU, the mapped bytes are the images' bytes.
+//!
+//! [`Refocuser::submit`] queues a target and returns at once; [`PendingRefocus::wait`] maps its
+//! outputs later, so a caller can keep several targets (and frames) in flight.
+//! [`Refocuser::render`] is the two in a row.
 
 use super::grid::{axis_lookup, Grid};
 use super::mesh::{MeshPass, TRI_TEX_WIDTH};
-use super::{Method, OutputSet, RefocusSource};
+use super::{BreakRule, Method, OutputSet, RefocusSource};
 use crate::camera::PinholeCamera;
-use crate::convention::{Conventions, DepthPlanes};
+use crate::convention::{Conventions, DepthPlanes, RowOrder};
 use crate::error::{Error, Result};
-use crate::gpu::{Attachment, Framebuffer, Gpu, GpuTimer, Program, Texture, TextureFormat, Timing, VertexArray};
+use crate::gpu::{
+    Attachment, DeferredTimer, Framebuffer, Gpu, PendingRead, Program, ReadFormat, Texture, TextureFormat, Timing,
+    VertexArray,
+};
 use crate::io::{DepthMap, Mask, RgbImage};
 use glow::HasContext;
 use std::time::Instant;
@@ -16,6 +26,9 @@ const GRID_GLSL: &str = include_str!("../../shaders/common/refocus_grid.glsl");
 const SAMPLE_GLSL: &str = include_str!("../../shaders/common/refocus_sample.glsl");
 const FULLSCREEN_FRAG: &str = include_str!("../../shaders/refocus/fullscreen.frag");
 
+/// Output sizes whose framebuffers are kept (a batch uses one; a sweep over sizes a few).
+const KEEP_TARGET_SIZES: usize = 4;
+
 /// One refocused view. Images are top-down whatever the row-order convention.
 pub struct RefocusOutput {
     pub camera: PinholeCamera,
@@ -23,41 +36,152 @@ pub struct RefocusOutput {
     /// View-space Z in metres, 0 where invalid.
     pub depth: Option<DepthMap>,
     pub mask: Option<Mask>,
-    /// Draw time (GPU timer where meaningful; wall clock with glFinish always).
+    /// `wall_ms`: host time to record the draw and queue the reads (no wait); `gpu_ms`: the
+    /// draw's GPU time from a timer query read after the fence, where the driver's timers are
+    /// meaningful.
     pub render: Timing,
-    /// Readback and conversion to top-down images.
+    /// Host time spent waiting for the GPU and mapping the outputs (on a software renderer the
+    /// rasterisation itself happens here).
     pub readback_ms: f64,
 }
 
 enum Geometry {
     Mesh(MeshPass),
-    Fullscreen { program: Program, keep: Texture },
+    Fullscreen { program: Program, keep: Option<Texture> },
 }
 
-/// A source uploaded to the GPU, ready to render any number of targets.
+/// The uploaded source.
+struct Source {
+    camera: PinholeCamera,
+    planes: DepthPlanes,
+    rgb: Option<Texture>,
+    depth: Texture,
+}
+
+/// A framebuffer of one output size and the per-target lookup textures of that size.
+struct TargetSlot {
+    framebuffer: Framebuffer,
+    cols: Texture,
+    rows: Texture,
+}
+
+/// Programs compiled for one set of settings, ready to take any number of sources and targets.
 pub struct Refocuser {
     gpu: Gpu,
     conv: Conventions,
     outputs: OutputSet,
-    source: PinholeCamera,
-    planes: DepthPlanes,
-    rgb: Option<Texture>,
-    depth: Texture,
+    rule: BreakRule,
+    source: Option<Source>,
     geometry: Geometry,
     vao: VertexArray,
-    framebuffer: Option<Framebuffer>,
+    /// Most recently used last.
+    slots: Vec<TargetSlot>,
+}
+
+/// A target queued on the GPU: its outputs arrive through [`PendingRefocus::wait`]. Tied to
+/// the GL thread.
+pub struct PendingRefocus {
+    camera: PinholeCamera,
+    rgb: Option<PendingRead>,
+    depth: Option<PendingRead>,
+    mask: Option<PendingRead>,
+    timer: DeferredTimer,
+    submit_ms: f64,
+}
+
+impl PendingRefocus {
+    /// Whether every output has arrived (never blocks).
+    pub fn is_ready(&self) -> bool {
+        [&self.rgb, &self.depth, &self.mask]
+            .into_iter()
+            .flatten()
+            .all(PendingRead::is_ready)
+    }
+
+    /// Wait for the outputs and hand them out: one copy out of each mapped buffer, no
+    /// per-pixel conversion (the GPU packed RGB, flipped rows and wrote the mask as 0/1).
+    pub fn wait(self) -> Result<RefocusOutput> {
+        let t0 = Instant::now();
+        let (w, h) = (self.camera.width, self.camera.height);
+        let rgb = match self.rgb {
+            Some(r) => Some(RgbImage::new(w, h, r.finish()?)?),
+            None => None,
+        };
+        let depth = match self.depth {
+            Some(r) => Some(DepthMap::new(w, h, r.finish_f32()?)?),
+            None => None,
+        };
+        let mask = match self.mask {
+            Some(r) => Some(Mask::new(w, h, r.finish()?)?),
+            None => None,
+        };
+        let readback_ms = t0.elapsed().as_secs_f64() * 1e3;
+        Ok(RefocusOutput {
+            camera: self.camera,
+            rgb,
+            depth,
+            mask,
+            render: Timing {
+                gpu_ms: self.timer.read_ms(),
+                wall_ms: self.submit_ms,
+            },
+            readback_ms,
+        })
+    }
 }
 
 impl Refocuser {
+    /// Compile the programs and upload `src`.
     pub fn new(
         gpu: &Gpu,
         src: &RefocusSource,
-        rule: &super::BreakRule,
+        rule: &BreakRule,
+        method: Method,
+        outputs: OutputSet,
+        conv: Conventions,
+    ) -> Result<Self> {
+        let mut r = Refocuser::with_settings(gpu, rule, method, outputs, conv)?;
+        r.set_source(src)?;
+        Ok(r)
+    }
+
+    /// Compile the programs for these settings; a source comes with [`Refocuser::set_source`].
+    pub fn with_settings(
+        gpu: &Gpu,
+        rule: &BreakRule,
         method: Method,
         outputs: OutputSet,
         conv: Conventions,
     ) -> Result<Self> {
         rule.validate()?;
+        let defines = format!(
+            "{}#define WANT_RGB {}\n#define TRI_TEX_WIDTH {TRI_TEX_WIDTH}\n",
+            conv.glsl_defines(),
+            outputs.rgb as u8
+        );
+        let geometry = match method {
+            Method::Fullscreen => {
+                let frag = format!("{GRID_GLSL}\n{SAMPLE_GLSL}\n{FULLSCREEN_FRAG}");
+                let program = Program::fullscreen(gpu, &defines, "refocus/fullscreen.frag", &frag)?;
+                Geometry::Fullscreen { program, keep: None }
+            }
+            Method::Mesh => Geometry::Mesh(MeshPass::new(gpu, &defines, GRID_GLSL, SAMPLE_GLSL)?),
+        };
+        Ok(Refocuser {
+            gpu: gpu.clone(),
+            conv,
+            outputs,
+            rule: *rule,
+            source: None,
+            geometry,
+            vao: VertexArray::new(gpu)?,
+            slots: Vec::new(),
+        })
+    }
+
+    /// Upload a new source, reusing the previous source's textures when the size matches.
+    pub fn set_source(&mut self, src: &RefocusSource) -> Result<()> {
+        let gpu = self.gpu.clone();
         let (w, h) = (src.rgb.width, src.rgb.height);
         let max = gpu.max_image_side();
         // The grid's cells include a half-pixel border ring: (w + 1) x (h + 1) of them, each a
@@ -75,31 +199,42 @@ impl Refocuser {
             ));
         }
         let grid = Grid { width: w, height: h };
-        let keep = grid.keep_mask(&src.depth.data, rule);
-        let defines = format!(
-            "{}#define WANT_RGB {}\n#define TRI_TEX_WIDTH {TRI_TEX_WIDTH}\n",
-            conv.glsl_defines(),
-            outputs.rgb as u8
-        );
-        let geometry = match method {
-            Method::Fullscreen => {
-                let frag = format!("{GRID_GLSL}\n{SAMPLE_GLSL}\n{FULLSCREEN_FRAG}");
-                let program = Program::fullscreen(gpu, &defines, "refocus/fullscreen.frag", &frag)?;
+        let keep = grid.keep_mask(&src.depth.data, &self.rule);
+        let same_size = self.source.as_ref().is_some_and(|s| s.camera.width == w && s.camera.height == h);
+        let previous = if same_size { self.source.take() } else { None };
+        self.source = None; // free a differently sized source before allocating
+        match &mut self.geometry {
+            Geometry::Fullscreen { keep: keep_tex, .. } => {
                 let flags = grid.coverage_flags(&keep);
                 let (cx, cy) = (grid.cells_x() as u32, grid.cells_y() as u32);
-                let keep = Texture::new(gpu, cx, cy, TextureFormat::R8Ui, Some(&flags))?;
-                Geometry::Fullscreen { program, keep }
+                match keep_tex {
+                    Some(t) if (t.width, t.height) == (cx, cy) => t.upload(&flags)?,
+                    _ => {
+                        *keep_tex = None;
+                        *keep_tex = Some(Texture::new(&gpu, cx, cy, TextureFormat::R8Ui, Some(&flags))?);
+                    }
+                }
             }
-            Method::Mesh => Geometry::Mesh(MeshPass::new(gpu, &grid, &keep, &defines, GRID_GLSL, SAMPLE_GLSL)?),
+            Geometry::Mesh(mesh) => mesh.set_geometry(&gpu, &grid, &keep)?,
+        }
+        let rgba: Option<Vec<u8>> = self.outputs.rgb.then(|| crate::gpu::pixels::rgb_to_rgba(&src.rgb.data));
+        let depth_bytes: &[u8] = bytemuck::cast_slice(&src.depth.data);
+        let (rgb, depth) = match previous {
+            Some(p) => {
+                if let (Some(t), Some(d)) = (&p.rgb, &rgba) {
+                    t.upload(d)?;
+                }
+                p.depth.upload(depth_bytes)?;
+                (p.rgb, p.depth)
+            }
+            None => (
+                match &rgba {
+                    Some(d) => Some(Texture::new(&gpu, w, h, TextureFormat::Rgba8, Some(d))?),
+                    None => None,
+                },
+                Texture::new(&gpu, w, h, TextureFormat::R32F, Some(depth_bytes))?,
+            ),
         };
-        let rgb = if outputs.rgb {
-            let rgba: Vec<u8> = crate::gpu::pixels::rgb_to_rgba(&src.rgb.data);
-            Some(Texture::new(gpu, w, h, TextureFormat::Rgba8, Some(&rgba))?)
-        } else {
-            None
-        };
-        let depth_bytes: Vec<u8> = crate::gpu::pixels::f32_to_bytes(&src.depth.data);
-        let depth = Texture::new(gpu, w, h, TextureFormat::R32F, Some(&depth_bytes))?;
         // Every kept vertex lies in [min, max] of the valid depths; the factor 2 leaves room for
         // the expanded border of each triangle (which the vertex shader keeps within it).
         let planes = match src.depth_range() {
@@ -109,18 +244,13 @@ impl Refocuser {
             },
             None => DepthPlanes { near: 1.0, far: 2.0 },
         };
-        Ok(Refocuser {
-            gpu: gpu.clone(),
-            conv,
-            outputs,
-            source: src.camera(),
+        self.source = Some(Source {
+            camera: src.camera(),
             planes,
             rgb,
             depth,
-            geometry,
-            vao: VertexArray::new(gpu)?,
-            framebuffer: None,
-        })
+        });
+        Ok(())
     }
 
     /// Number of kept triangles (mesh path) for reports.
@@ -131,10 +261,19 @@ impl Refocuser {
         }
     }
 
-    fn framebuffer(&mut self, w: u32, h: u32) -> Result<&Framebuffer> {
-        let reuse = matches!(&self.framebuffer, Some(f) if f.width == w && f.height == h);
-        if !reuse {
-            self.framebuffer = None; // free the old one before allocating
+    /// The slot for output size w x h, most recently used last; allocated on first use.
+    fn slot(&mut self, w: u32, h: u32) -> Result<&TargetSlot> {
+        if let Some(i) = self
+            .slots
+            .iter()
+            .position(|s| (s.framebuffer.width, s.framebuffer.height) == (w, h))
+        {
+            let s = self.slots.remove(i);
+            self.slots.push(s);
+        } else {
+            if self.slots.len() >= KEEP_TARGET_SIZES {
+                self.slots.remove(0); // free the least recently used before allocating
+            }
             let o = self.outputs;
             let slot = |want: bool, format| {
                 want.then_some(Attachment {
@@ -148,13 +287,22 @@ impl Refocuser {
                 slot(o.mask, TextureFormat::R8),
             ];
             let with_depth = matches!(self.geometry, Geometry::Mesh(_));
-            self.framebuffer = Some(Framebuffer::new(&self.gpu, w, h, &attachments, with_depth)?);
+            let framebuffer = Framebuffer::new(&self.gpu, w, h, &attachments, with_depth)?;
+            let cols = Texture::new(&self.gpu, w, 1, TextureFormat::Rgba32F, None)?;
+            let rows = Texture::new(&self.gpu, h, 1, TextureFormat::Rgba32F, None)?;
+            self.slots.push(TargetSlot { framebuffer, cols, rows });
         }
-        Ok(self.framebuffer.as_ref().expect("framebuffer allocated above"))
+        Ok(self.slots.last().expect("pushed above"))
     }
 
     /// Render `target` (same pose as the source) and read back the requested outputs.
     pub fn render(&mut self, target: &PinholeCamera) -> Result<RefocusOutput> {
+        self.submit(target)?.wait()
+    }
+
+    /// Record the draw of `target` and queue the reads of its outputs; returns without waiting.
+    pub fn submit(&mut self, target: &PinholeCamera) -> Result<PendingRefocus> {
+        let t0 = Instant::now();
         target.validate("target camera")?;
         let max = self.gpu.max_image_side();
         if target.width > max || target.height > max {
@@ -163,33 +311,37 @@ impl Refocuser {
                 format!("{}x{} exceeds this GPU's limit of {max}", target.width, target.height),
             ));
         }
+        let Some(source) = &self.source else {
+            return Err(Error::param("refocus source", "no source uploaded (set_source)"));
+        };
+        let (src_cam, planes) = (source.camera, source.planes);
         let conv = self.conv;
         let clear_depth = conv.clear_depth() as f32;
-        self.framebuffer(target.width, target.height)?;
         let gpu = self.gpu.clone();
         let gl = gpu.gl();
-        let fb = self.framebuffer.as_ref().expect("framebuffer allocated above");
-        let sk = &self.source.k;
-        let tk = &target.k;
-        // The pixel -> source-point map in f64, per column and per row (it is separable), created
-        // before any texture unit is bound (creating a texture binds it on the active unit).
-        let cols = axis_lookup(self.source.width, sk.cx, tk.cx, sk.fx / tk.fx, target.width);
-        let rows = axis_lookup(self.source.height, sk.cy, tk.cy, sk.fy / tk.fy, target.height);
-        let bytes = |t: &[[f32; 4]]| -> Vec<u8> { t.iter().flatten().flat_map(|v| v.to_ne_bytes()).collect() };
-        let cols = Texture::new(&gpu, target.width, 1, TextureFormat::Rgba32F, Some(&bytes(&cols)))?;
-        let rows = Texture::new(&gpu, target.height, 1, TextureFormat::Rgba32F, Some(&bytes(&rows)))?;
+        let sk = src_cam.k;
+        let tk = target.k;
+        // The pixel -> source-point map in f64, per column and per row (it is separable).
+        let cols = axis_lookup(src_cam.width, sk.cx, tk.cx, sk.fx / tk.fx, target.width);
+        let rows = axis_lookup(src_cam.height, sk.cy, tk.cy, sk.fy / tk.fy, target.height);
+        self.slot(target.width, target.height)?;
+        let slot = self.slots.last().expect("slot allocated above");
+        slot.cols.upload(bytemuck::cast_slice(&cols))?;
+        slot.rows.upload(bytemuck::cast_slice(&rows))?;
+        let source = self.source.as_ref().expect("checked above");
+        let fb = &slot.framebuffer;
         let programs: Vec<&Program> = match &self.geometry {
             Geometry::Fullscreen { program, .. } => vec![program],
             Geometry::Mesh(mesh) => mesh.programs().to_vec(),
         };
-        let timer = GpuTimer::start(&gpu);
+        let mut timer = DeferredTimer::begin(&gpu);
         fb.bind_and_clear(clear_depth);
-        if let Some(rgb) = &self.rgb {
+        if let Some(rgb) = &source.rgb {
             rgb.bind(0);
         }
-        self.depth.bind(1);
-        cols.bind(3);
-        rows.bind(4);
+        source.depth.bind(1);
+        slot.cols.bind(3);
+        slot.rows.bind(4);
         for p in programs {
             p.bind();
             p.set_i32("u_src_rgb", 0);
@@ -197,7 +349,7 @@ impl Refocuser {
             p.set_i32("u_keep", 2);
             p.set_i32("u_cols", 3);
             p.set_i32("u_rows", 4);
-            p.set_ivec2("u_src_size", [self.source.width as i32, self.source.height as i32]);
+            p.set_ivec2("u_src_size", [src_cam.width as i32, src_cam.height as i32]);
             p.set_vec4("u_src_k", [sk.fx as f32, sk.fy as f32, sk.cx as f32, sk.cy as f32]);
             p.set_i32("u_dst_height", target.height as i32);
         }
@@ -211,44 +363,27 @@ impl Refocuser {
             Geometry::Fullscreen { program, keep } => {
                 program.bind();
                 self.vao.bind();
-                keep.bind(2);
+                keep.as_ref().expect("uploaded with the source").bind(2);
                 self.vao.draw_fullscreen();
             }
-            Geometry::Mesh(mesh) => mesh.draw(&gpu, &self.vao, &self.source, target, &self.planes, &conv, 2),
+            Geometry::Mesh(mesh) => mesh.draw(&gpu, &self.vao, &src_cam, target, &planes, &conv, 2),
         }
+        timer.end();
         gpu.check("refocus draw")?;
-        let render = timer.stop();
-
-        let t0 = Instant::now();
-        let (w, h) = (target.width, target.height);
-        let mut outputs = (None, None, None);
-        if let Some(data) = fb.read_color(0)? {
-            let rgba = conv.row_order.convert_rows(data, w as usize * 4);
-            let rgb = crate::gpu::pixels::rgba_to_rgb(&rgba);
-            outputs.0 = Some(RgbImage::new(w, h, rgb)?);
-        }
-        if let Some(data) = fb.read_color(1)? {
-            let bytes = conv.row_order.convert_rows(data, w as usize * 4);
-            let z = crate::gpu::pixels::bytes_to_f32(&bytes);
-            outputs.1 = Some(DepthMap::new(w, h, z)?);
-        }
-        if let Some(data) = fb.read_color(2)? {
-            let m = conv
-                .row_order
-                .convert_rows(data, w as usize)
-                .into_iter()
-                .map(|v| (v >= 128) as u8)
-                .collect();
-            outputs.2 = Some(Mask::new(w, h, m)?);
-        }
-        fb.unbind();
-        Ok(RefocusOutput {
+        // Files are top-down: under the GL row order the GPU flips while copying.
+        let flip = conv.row_order == RowOrder::BottomUp;
+        let pending = PendingRefocus {
             camera: *target,
-            rgb: outputs.0,
-            depth: outputs.1,
-            mask: outputs.2,
-            render,
-            readback_ms: t0.elapsed().as_secs_f64() * 1e3,
+            rgb: fb.read_async(0, ReadFormat::RGB8, flip)?,
+            depth: fb.read_async(1, ReadFormat::R32F, flip)?,
+            mask: fb.read_async(2, ReadFormat::R8, flip)?,
+            timer,
+            submit_ms: 0.0,
+        };
+        fb.unbind();
+        Ok(PendingRefocus {
+            submit_ms: t0.elapsed().as_secs_f64() * 1e3,
+            ..pending
         })
     }
 }
