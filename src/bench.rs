@@ -5,7 +5,7 @@
 use crate::convention::Conventions;
 use crate::error::Result;
 use crate::gpu::Gpu;
-use crate::refocus::job::{self, DepthFormats, RgbFormat, TargetSpec};
+use crate::refocus::job::{self, FileFormats, TargetSpec};
 use crate::refocus::{reference, BreakRule, Method, OutputSet, RefocusSource, Refocuser};
 use crate::scene;
 use std::fmt::Write as _;
@@ -61,7 +61,7 @@ pub fn refocus_bench(gpu: &Gpu, sizes: &[(u32, u32)], repeats: usize) -> Result<
                 let t0 = Instant::now();
                 for (s, target) in SCALES.iter().zip(&targets) {
                     let out = r.render(target)?;
-                    job::write_output(&tmp, *s, &out, &outputs, RgbFormat::Png, DepthFormats::default())?;
+                    job::write_output(&tmp, *s, &out, &FileFormats { outputs, ..Default::default() })?;
                 }
                 with_io.push(t0.elapsed().as_secs_f64() * 1e3);
             }

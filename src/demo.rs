@@ -6,7 +6,7 @@ use crate::convention::Conventions;
 use crate::error::{Error, Result};
 use crate::gpu::Gpu;
 use crate::metrics;
-use crate::refocus::job::{self, DepthFormats, RgbFormat};
+use crate::refocus::job::{self, FileFormats};
 use crate::refocus::{reference, BreakRule, Method, OutputSet, RefocusSource, Refocuser};
 use crate::{io, scene};
 use std::fmt::Write as _;
@@ -45,7 +45,7 @@ pub fn run(gpu: &Gpu, out_dir: &Path) -> Result<PathBuf> {
         let mut r = Refocuser::new(gpu, &src, &rule, method, outputs, Conventions::default())?;
         for (scale, target) in DEMO_SCALES.iter().zip(&targets) {
             let out = r.render(target)?;
-            job::write_output(&dir, *scale, &out, &outputs, RgbFormat::Png, DepthFormats::default())?;
+            job::write_output(&dir, *scale, &out, &FileFormats { outputs, ..Default::default() })?;
             let (gt_rgb, gt_depth) = scene::render(target);
             let mask: Vec<bool> = out
                 .mask

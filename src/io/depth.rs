@@ -85,10 +85,15 @@ pub fn load_depth(path: &Path, decode: &DepthDecode) -> Result<DepthMap> {
 
 /// Writes one f32 channel named "Z", ZIP compressed, rows top-down.
 pub fn save_depth_exr(path: &Path, depth: &DepthMap) -> Result<()> {
+    save_depth_exr_with(path, depth, super::ExrCompression::default())
+}
+
+/// [`save_depth_exr`] with a chosen compression.
+pub fn save_depth_exr_with(path: &Path, depth: &DepthMap, compression: super::ExrCompression) -> Result<()> {
     encode_dims(path, depth.width, depth.height, 1, depth.data.len())?;
     atomic_write(path, |out| {
         let channels = vec![("Z", depth.data.clone())];
-        write_f32_channels(path, out, depth.width, depth.height, channels)
+        write_f32_channels(path, out, depth.width, depth.height, channels, compression)
     })
 }
 
@@ -262,7 +267,7 @@ mod tests {
         let dir = scratch_dir("depth-exr-ambiguous");
         let path = dir.join("d.exr");
         atomic_write(&path, |out| {
-            write_f32_channels(&path, out, 1, 1, vec![("alpha", vec![1.0]), ("beta", vec![2.0])])
+            write_f32_channels(&path, out, 1, 1, vec![("alpha", vec![1.0]), ("beta", vec![2.0])], crate::io::ExrCompression::default())
         })
         .unwrap();
         let err = load_depth(&path, &DepthDecode::default()).unwrap_err().to_string();

@@ -5,7 +5,7 @@ use std::io::{BufWriter, Cursor};
 use std::path::Path;
 
 use exr::prelude::{
-    AnyChannel, AnyChannels, Encoding, FlatSamples, Image, Layer, LayerAttributes, MetaData, ReadChannels, ReadLayers,
+    AnyChannel, AnyChannels, FlatSamples, Image, Layer, LayerAttributes, MetaData, ReadChannels, ReadLayers,
     SmallVec, WritableImage,
 };
 
@@ -98,6 +98,7 @@ pub(crate) fn write_f32_channels(
     width: u32,
     height: u32,
     channels: Vec<(&str, Vec<f32>)>,
+    compression: super::ExrCompression,
 ) -> Result<()> {
     let list: SmallVec<[AnyChannel<FlatSamples>; 4]> = channels
         .into_iter()
@@ -106,7 +107,7 @@ pub(crate) fn write_f32_channels(
     let layer = Layer::new(
         (width as usize, height as usize),
         LayerAttributes::default(),
-        Encoding::SMALL_LOSSLESS,
+        compression.exr_encoding(),
         AnyChannels::sort(list),
     );
     Image::from_layer(layer).write().to_buffered(out).map_err(|e| match e {

@@ -2,7 +2,7 @@
 
 use std::path::Path;
 
-use image::codecs::png::PngEncoder;
+use image::codecs::png::{FilterType, PngEncoder};
 use image::{ExtendedColorType, ImageEncoder, ImageFormat};
 
 use super::atomic::atomic_write;
@@ -12,10 +12,15 @@ use crate::error::{Error, Result};
 
 /// Writes 8-bit gray: 0 -> 0, any nonzero value -> 255.
 pub fn save_mask_png(path: &Path, mask: &Mask) -> Result<()> {
+    save_mask_png_with(path, mask, super::PngCompression::default())
+}
+
+/// [`save_mask_png`] with a chosen compression.
+pub fn save_mask_png_with(path: &Path, mask: &Mask, compression: super::PngCompression) -> Result<()> {
     encode_dims(path, mask.width, mask.height, 1, mask.data.len())?;
     let bytes: Vec<u8> = mask.data.iter().map(|&v| if v == 0 { 0 } else { 255 }).collect();
     atomic_write(path, |out| {
-        PngEncoder::new(out)
+        PngEncoder::new_with_quality(out, compression.image_type(), FilterType::Adaptive)
             .write_image(&bytes, mask.width, mask.height, ExtendedColorType::L8)
             .map_err(|e| Error::encode(path, e.to_string()))
     })

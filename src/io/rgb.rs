@@ -3,7 +3,7 @@
 use std::path::Path;
 
 use image::codecs::jpeg::JpegEncoder;
-use image::codecs::png::PngEncoder;
+use image::codecs::png::{FilterType, PngEncoder};
 use image::{ExtendedColorType, ImageEncoder};
 
 use super::atomic::atomic_write;
@@ -37,12 +37,17 @@ pub fn load_rgb(path: &Path) -> Result<RgbImage> {
 /// Saves by extension (case-insensitive): `.png`, `.jpg`/`.jpeg` (quality 95), or `.exr`
 /// (three f32 channels R, G, B holding `v / 255`, linear, no sRGB decoding, ZIP compressed).
 pub fn save_rgb(path: &Path, img: &RgbImage) -> Result<()> {
+    save_rgb_with(path, img, &super::Encoding::default())
+}
+
+/// [`save_rgb`] with chosen PNG/EXR compression.
+pub fn save_rgb_with(path: &Path, img: &RgbImage, encoding: &super::Encoding) -> Result<()> {
     let ext = lowercase_extension(path);
     encode_dims(path, img.width, img.height, 3, img.data.len())?;
     let (w, h) = (img.width, img.height);
     match ext.as_str() {
         "png" => atomic_write(path, |out| {
-            PngEncoder::new(out)
+            PngEncoder::new_with_quality(out, encoding.png.image_type(), FilterType::Adaptive)
                 .write_image(&img.data, w, h, ExtendedColorType::Rgb8)
                 .map_err(|e| Error::encode(path, e.to_string()))
         }),
@@ -61,7 +66,7 @@ pub fn save_rgb(path: &Path, img: &RgbImage) -> Result<()> {
                     .collect()
             };
             let channels = vec![("R", plane(0)), ("G", plane(1)), ("B", plane(2))];
-            atomic_write(path, |out| write_f32_channels(path, out, w, h, channels))
+            atomic_write(path, |out| write_f32_channels(path, out, w, h, channels, encoding.exr))
         }
         _ => Err(Error::encode(
             path,

@@ -1,6 +1,10 @@
-//! Batch refocus for dataset work: many frames, one GL context, file encoding on writer threads
-//! while the GPU renders the next frame, resume by skipping frames already finished, and a
-//! summary that lists failed frames while the others complete.
+//! Batch refocus for dataset work, pipelined: a pool decodes frames, the GL thread uploads
+//! each into the same textures and queues its targets, the previous frame's outputs are
+//! mapped while the GPU renders the next, and a pool encodes files. Queues between the stages
+//! are bounded, so memory stays flat (see [`BatchSummary::frames_in_flight`]). Resume skips
+//! frames whose manifest records the same settings and whose files are all there; `--shard`
+//! takes a deterministic share of the manifest. A failed frame is listed while the others
+//! complete.
 //!
 //! Manifest: CSV with a header naming the columns `rgb,depth,fx,fy,cx,cy` and optionally
 //! `depth_scale`, `name` (no quoting: paths with commas need JSON), or a JSON array of objects
@@ -8,16 +12,17 @@
 //! Each frame writes into `<out>/<name>/`; its `manifest.json` is written last, atomically, and
 //! marks the frame finished.
 
-use super::job::{self, DepthFormats, Manifest, RgbFormat, TargetSpec};
-use super::{BreakRule, Method, OutputSet, RefocusOutput, RefocusSource, Refocuser};
+use super::job::{self, FileFormats, Manifest, TargetSpec};
+use super::{BreakRule, Method, PendingRefocus, RefocusOutput, RefocusSource, Refocuser};
 use crate::camera::Intrinsics;
 use crate::convention::Conventions;
 use crate::error::{Error, Result};
 use crate::gpu::Gpu;
 use crate::io::{self, DepthDecode};
-use serde::Deserialize;
+use serde::{Deserialize, Serialize};
 use std::path::{Path, PathBuf};
-use std::sync::mpsc;
+use std::sync::atomic::{AtomicUsize, Ordering};
+use std::sync::{mpsc, Arc, Mutex};
 use std::time::Instant;
 
 #[derive(Debug, Clone, PartialEq, Deserialize)]
@@ -95,6 +100,8 @@ pub fn load_manifest(path: &Path) -> Result<Vec<BatchFrame>> {
 }
 
 fn parse_csv(path: &Path, text: &str) -> Result<Vec<BatchFrame>> {
+    // Spreadsheet exports start with a byte-order mark.
+    let text = text.strip_prefix('\u{feff}').unwrap_or(text);
     let mut lines = text
         .lines()
         .enumerate()
@@ -144,6 +151,32 @@ fn parse_csv(path: &Path, text: &str) -> Result<Vec<BatchFrame>> {
     Ok(frames)
 }
 
+/// Most threads either pool may have: beyond this a batch gains nothing and only risks
+/// exhausting the process's threads.
+pub const MAX_JOBS: usize = 256;
+
+/// A deterministic share of a manifest: frames whose index i has i % count == index.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+pub struct Shard {
+    /// 0-based (a Kubernetes indexed Job's JOB_COMPLETION_INDEX; a Slurm array from 0).
+    pub index: usize,
+    pub count: usize,
+}
+
+impl std::str::FromStr for Shard {
+    type Err = Error;
+    /// "K/N" with 0 <= K < N.
+    fn from_str(s: &str) -> Result<Self> {
+        let bad = || Error::param("shard", format!("'{s}': expected K/N with 0 <= K < N, e.g. 0/4"));
+        let (k, n) = s.split_once('/').ok_or_else(bad)?;
+        let (index, count): (usize, usize) = (k.trim().parse().map_err(|_| bad())?, n.trim().parse().map_err(|_| bad())?);
+        if count == 0 || index >= count {
+            return Err(bad());
+        }
+        Ok(Shard { index, count })
+    }
+}
+
 /// Everything a batch applies to each frame.
 #[derive(Debug, Clone)]
 pub struct BatchOptions {
@@ -152,23 +185,50 @@ pub struct BatchOptions {
     pub principal: Option<(f64, f64)>,
     pub rule: BreakRule,
     pub method: Method,
-    pub outputs: OutputSet,
     pub conv: Conventions,
-    pub rgb_format: RgbFormat,
-    pub depth_formats: DepthFormats,
-    /// Skip frames whose manifest.json already exists.
+    pub files: FileFormats,
+    /// Skip frames already finished with the same settings.
     pub resume: bool,
-    /// Threads encoding files while the GPU renders; 0 writes on the render thread.
-    pub writer_threads: usize,
+    /// Threads in each CPU pool (decode, encode); 0 runs every stage in turn on the GL thread
+    /// (the synchronous baseline).
+    pub jobs: usize,
+    pub shard: Option<Shard>,
 }
 
-#[derive(Debug, Clone, Default)]
+/// Per-frame milliseconds of each stage, in completion order.
+#[derive(Debug, Clone, Default, Serialize)]
+pub struct StageTimes {
+    /// Reading and decoding colour and depth (a decode thread).
+    pub decode: Vec<f64>,
+    /// Break rule, coverage flags and texture uploads (GL thread).
+    pub upload: Vec<f64>,
+    /// Recording the draws and queueing the reads of every target (GL thread).
+    pub render: Vec<f64>,
+    /// Waiting for the GPU and mapping the outputs (GL thread; a software renderer rasterises
+    /// here).
+    pub readback: Vec<f64>,
+    /// Encoding and writing the files and the manifest (an encode thread).
+    pub encode: Vec<f64>,
+    /// GL thread idle: waiting for a decoded frame or for room in the encode queue.
+    pub wait: Vec<f64>,
+    /// GPU time of the draws (timer queries read after the fence) where the driver's timers
+    /// are meaningful.
+    pub gpu_render: Vec<f64>,
+}
+
+#[derive(Debug, Clone, Default, Serialize)]
 pub struct BatchSummary {
     pub rendered: usize,
     pub skipped: usize,
+    /// Frames outside this shard.
+    pub other_shards: usize,
     /// (frame name, error) for every frame that failed; the others completed.
     pub failed: Vec<(String, String)>,
     pub wall_s: f64,
+    pub stages: StageTimes,
+    /// Most frames held in memory at once: decoded and queued, on the GL thread, mapped and
+    /// queued for encoding, being encoded.
+    pub frames_in_flight: usize,
 }
 
 struct WriteJob {
@@ -178,60 +238,166 @@ struct WriteJob {
     manifest: Manifest,
 }
 
-fn write_frame(job: WriteJob, opts: &BatchOptions) -> Result<()> {
+/// What a frame's manifest records of the settings that produced it: a rerun with anything
+/// different (inputs changed on disk, other scales, outputs, formats, conventions) redoes it.
+fn frame_settings(frame: &BatchFrame, opts: &BatchOptions) -> serde_json::Value {
+    let stamp = |p: &Path| -> serde_json::Value {
+        match std::fs::metadata(p) {
+            Ok(m) => {
+                let mtime = m
+                    .modified()
+                    .ok()
+                    .and_then(|t| t.duration_since(std::time::UNIX_EPOCH).ok())
+                    .map(|d| d.as_nanos().to_string());
+                serde_json::json!({ "path": p.to_string_lossy(), "bytes": m.len(), "mtime_ns": mtime })
+            }
+            Err(_) => serde_json::json!({ "path": p.to_string_lossy() }),
+        }
+    };
+    serde_json::json!({
+        "rgb": stamp(&frame.rgb),
+        "depth": stamp(&frame.depth),
+        "intrinsics": [frame.fx, frame.fy, frame.cx, frame.cy],
+        "depth_scale": frame.depth_scale,
+        "sun_bit_rotate": frame.sun_bit_rotate,
+        "scales": opts.scales,
+        "size": opts.size,
+        "principal": opts.principal,
+        "break_rule": opts.rule,
+        "method": opts.method,
+        "conventions": opts.conv,
+        "files": opts.files,
+    })
+}
+
+/// A frame is finished when its manifest was written with the same settings and every file it
+/// lists is there with the size it recorded.
+fn frame_finished(dir: &Path, settings: &serde_json::Value) -> bool {
+    let path = dir.join("manifest.json");
+    // A manifest is a few kB; anything far larger is not ours.
+    if std::fs::metadata(&path).map_or(true, |m| !m.is_file() || m.len() > 16 << 20) {
+        return false;
+    }
+    let Ok(text) = std::fs::read_to_string(&path) else { return false };
+    let Ok(m) = serde_json::from_str::<serde_json::Value>(&text) else { return false };
+    if m.get("settings") != Some(settings) {
+        return false;
+    }
+    let Some(files) = m.get("files").and_then(|f| f.as_array()) else { return false };
+    !files.is_empty()
+        && files.iter().all(|f| {
+            let (Some(name), Some(bytes)) = (f.get("name").and_then(|v| v.as_str()), f.get("bytes").and_then(|v| v.as_u64()))
+            else {
+                return false;
+            };
+            // Names are ours (scale tags); refuse anything that would leave the folder.
+            !name.contains('/')
+                && !name.starts_with('.')
+                && std::fs::symlink_metadata(dir.join(name)).is_ok_and(|m| m.is_file() && m.len() == bytes)
+        })
+}
+
+/// Refuse a frame folder that is not a plain folder inside the output folder (a symlink would
+/// send the outputs elsewhere).
+fn check_frame_dir(dir: &Path) -> Result<()> {
+    match std::fs::symlink_metadata(dir) {
+        Ok(m) if m.file_type().is_symlink() => Err(Error::param(
+            "frame folder",
+            format!("{} is a symbolic link; outputs are only written inside --out-dir", dir.display()),
+        )),
+        Ok(m) if !m.is_dir() => Err(Error::param(
+            "frame folder",
+            format!("{} exists and is not a folder", dir.display()),
+        )),
+        _ => Ok(()),
+    }
+}
+
+fn write_frame(job: WriteJob, files: &FileFormats) -> Result<()> {
+    check_frame_dir(&job.dir)?;
     std::fs::create_dir_all(&job.dir).map_err(|e| Error::io(&job.dir, e))?;
+    // The frame is unfinished from here until its new manifest is in place.
+    let manifest_path = job.dir.join("manifest.json");
+    match std::fs::remove_file(&manifest_path) {
+        Err(e) if e.kind() != std::io::ErrorKind::NotFound => return Err(Error::io(&manifest_path, e)),
+        _ => {}
+    }
     let mut manifest = job.manifest;
     for (scale, out) in &job.outputs {
-        manifest.outputs.push(job::write_output(
-            &job.dir,
-            *scale,
-            out,
-            &opts.outputs,
-            opts.rgb_format,
-            opts.depth_formats,
-        )?);
+        manifest.outputs.push(job::write_output(&job.dir, *scale, out, files)?);
     }
+    manifest.files = job::file_records(&job.dir, &manifest.outputs)?;
     // Last: its presence marks the frame finished for resume.
     job::write_manifest(&job.dir, &manifest)?;
     Ok(())
 }
 
 /// An interrupted run (a signal cannot run cleanup) may leave `atomic_write` temporaries
-/// (`.{file}.tmp-{pid}-{n}`) in an unfinished frame's folder; they are removed before it is
-/// rendered again. Final names are never partial either way.
+/// (`.{file}.tmp-{pid}-{n}`) in an unfinished frame's folder. Only those of processes that no
+/// longer run are removed: another batch writing into the same folder keeps its own.
 fn remove_stale_temporaries(dir: &Path) {
     let Ok(entries) = std::fs::read_dir(dir) else { return };
     for e in entries.flatten() {
         let name = e.file_name().to_string_lossy().into_owned();
-        if name.starts_with('.') && name.contains(".tmp-") {
+        let Some((_, tail)) = name.rsplit_once(".tmp-") else { continue };
+        let Some(pid) = tail.split('-').next().and_then(|p| p.parse::<u32>().ok()) else { continue };
+        let alive = pid == std::process::id() || Path::new(&format!("/proc/{pid}")).exists();
+        if name.starts_with('.') && !alive {
             let _ = std::fs::remove_file(e.path());
         }
     }
 }
 
-/// Render one frame's targets (errors name the frame's files).
-fn render_frame(gpu: &Gpu, frame: &BatchFrame, opts: &BatchOptions) -> Result<(Vec<(f64, RefocusOutput)>, Manifest)> {
+/// Read and validate one frame's inputs (errors name the frame's files).
+fn decode_frame(frame: &BatchFrame) -> Result<RefocusSource> {
     let decode = DepthDecode {
         scale: frame.depth_scale,
         sun_rgbd_bit_rotate: frame.sun_bit_rotate,
         ..Default::default()
     };
-    let src = RefocusSource::new(
+    RefocusSource::new(
         io::load_rgb(&frame.rgb)?,
         io::load_depth(&frame.depth, &decode)?,
         frame.intrinsics(),
-    )?;
+    )
+}
+
+fn ms_since(t: Instant) -> f64 {
+    t.elapsed().as_secs_f64() * 1e3
+}
+
+/// A frame on the GL thread: uploaded, its targets queued.
+struct InFlight {
+    name: String,
+    dir: PathBuf,
+    scales: Vec<f64>,
+    pending: Vec<PendingRefocus>,
+    manifest: Manifest,
+}
+
+/// Upload a decoded frame and queue all its targets.
+fn submit_frame(
+    refocuser: &mut Refocuser,
+    gpu: &Gpu,
+    name: String,
+    dir: PathBuf,
+    src: &RefocusSource,
+    settings: serde_json::Value,
+    opts: &BatchOptions,
+    stages: &mut StageTimes,
+) -> Result<InFlight> {
+    let t0 = Instant::now();
     let targets = TargetSpec {
         scales: opts.scales.clone(),
         size: opts.size,
         principal: opts.principal,
     }
     .targets(&src.camera())?;
-    let mut r = Refocuser::new(gpu, &src, &opts.rule, opts.method, opts.outputs, opts.conv)?;
-    let mut outs = Vec::new();
-    for (s, t) in opts.scales.iter().zip(&targets) {
-        outs.push((*s, r.render(t)?));
-    }
+    refocuser.set_source(src)?;
+    stages.upload.push(ms_since(t0));
+    let t0 = Instant::now();
+    let pending = targets.iter().map(|t| refocuser.submit(t)).collect::<Result<Vec<_>>>()?;
+    stages.render.push(ms_since(t0));
     let manifest = Manifest {
         tool: format!("viewsynth {}", env!("CARGO_PKG_VERSION")),
         source: src.camera(),
@@ -240,9 +406,45 @@ fn render_frame(gpu: &Gpu, frame: &BatchFrame, opts: &BatchOptions) -> Result<(V
         conventions: opts.conv,
         renderer: gpu.info().renderer.clone(),
         notes: job::MANIFEST_NOTES.to_string(),
+        settings: Some(settings),
+        files: Vec::new(),
         outputs: Vec::new(),
     };
-    Ok((outs, manifest))
+    Ok(InFlight {
+        name,
+        dir,
+        scales: opts.scales.clone(),
+        pending,
+        manifest,
+    })
+}
+
+/// Wait for a frame's outputs (the GPU is by now busy with the next frame).
+fn collect_frame(f: InFlight, stages: &mut StageTimes) -> std::result::Result<WriteJob, (String, Error)> {
+    let t0 = Instant::now();
+    let mut outputs = Vec::with_capacity(f.pending.len());
+    let mut gpu_ms = None;
+    for (s, p) in f.scales.iter().zip(f.pending) {
+        match p.wait() {
+            Ok(o) => {
+                if let Some(g) = o.render.gpu_ms {
+                    *gpu_ms.get_or_insert(0.0) += g;
+                }
+                outputs.push((*s, o));
+            }
+            Err(e) => return Err((f.name, e)),
+        }
+    }
+    stages.readback.push(ms_since(t0));
+    if let Some(g) = gpu_ms {
+        stages.gpu_render.push(g);
+    }
+    Ok(WriteJob {
+        name: f.name,
+        dir: f.dir,
+        outputs,
+        manifest: f.manifest,
+    })
 }
 
 /// Run the batch. `progress` is called once per frame (rendered, skipped or failed).
@@ -256,62 +458,163 @@ pub fn run_batch(
     if opts.scales.is_empty() {
         return Err(Error::param("scales", "no focal scale given"));
     }
+    if opts.jobs > MAX_JOBS {
+        return Err(Error::param("jobs", format!("{} exceeds the limit of {MAX_JOBS}", opts.jobs)));
+    }
     opts.rule.validate()?;
     std::fs::create_dir_all(out_dir).map_err(|e| Error::io(out_dir, e))?;
-    let t0 = Instant::now();
+    let t_start = Instant::now();
     let mut summary = BatchSummary::default();
-    let (result_tx, result_rx) = mpsc::channel::<(String, Result<()>)>();
+    // The frames this run renders: its shard, less those finished with the same settings.
+    let mut todo = Vec::new();
+    for (i, frame) in frames.iter().enumerate() {
+        if opts.shard.is_some_and(|s| i % s.count != s.index) {
+            summary.other_shards += 1;
+            continue;
+        }
+        let name = frame.name.clone().unwrap_or_default();
+        let dir = out_dir.join(&name);
+        let settings = frame_settings(frame, opts);
+        if opts.resume && frame_finished(&dir, &settings) {
+            summary.skipped += 1;
+            progress();
+            continue;
+        }
+        remove_stale_temporaries(&dir);
+        todo.push((frame, name, dir, settings));
+    }
+    let mut refocuser = Refocuser::with_settings(gpu, &opts.rule, opts.method, opts.files.outputs, opts.conv)?;
+    let files = opts.files;
+    let mut stages = StageTimes::default();
+
+    if opts.jobs == 0 {
+        // The synchronous baseline: each stage in turn on this thread.
+        for (frame, name, dir, settings) in todo {
+            let t0 = Instant::now();
+            let result = decode_frame(frame).and_then(|src| {
+                stages.decode.push(ms_since(t0));
+                submit_frame(&mut refocuser, gpu, name.clone(), dir, &src, settings, opts, &mut stages)
+            });
+            let result = result.map_err(|e| (name.clone(), e)).and_then(|f| collect_frame(f, &mut stages));
+            match result.and_then(|job| {
+                let t0 = Instant::now();
+                let r = write_frame(job, &files).map_err(|e| (name.clone(), e));
+                stages.encode.push(ms_since(t0));
+                r
+            }) {
+                Ok(()) => summary.rendered += 1,
+                Err((n, e)) => summary.failed.push((n, e.to_string())),
+            }
+            progress();
+        }
+        summary.frames_in_flight = 1;
+        summary.stages = stages;
+        summary.wall_s = t_start.elapsed().as_secs_f64();
+        return Ok(summary);
+    }
+
+    let jobs = opts.jobs;
+    // Decoded frames waiting for the GL thread, and frames waiting for an encoder: `jobs` each.
+    summary.frames_in_flight = jobs + 2 + 2 * jobs;
+    let next = AtomicUsize::new(0);
+    let (result_tx, result_rx) = mpsc::channel::<(String, Result<()>, f64)>();
     std::thread::scope(|scope| {
-        // A bounded queue keeps memory flat: the renderer waits when writers fall behind.
-        let (job_tx, job_rx) = mpsc::sync_channel::<WriteJob>(opts.writer_threads.max(1) * 2);
-        let job_rx = std::sync::Arc::new(std::sync::Mutex::new(job_rx));
-        for _ in 0..opts.writer_threads {
+        let (decoded_tx, decoded_rx) = mpsc::sync_channel::<(usize, Result<RefocusSource>, f64)>(jobs);
+        for _ in 0..jobs {
+            let (tx, next, todo) = (decoded_tx.clone(), &next, &todo);
+            scope.spawn(move || loop {
+                let i = next.fetch_add(1, Ordering::Relaxed);
+                let Some((frame, ..)) = todo.get(i) else { break };
+                let t0 = Instant::now();
+                let src = decode_frame(frame);
+                if tx.send((i, src, ms_since(t0))).is_err() {
+                    break;
+                }
+            });
+        }
+        drop(decoded_tx);
+        let (job_tx, job_rx) = mpsc::sync_channel::<WriteJob>(jobs);
+        let job_rx = Arc::new(Mutex::new(job_rx));
+        for _ in 0..jobs {
             let (rx, tx) = (job_rx.clone(), result_tx.clone());
             scope.spawn(move || loop {
                 let next = rx.lock().map(|r| r.recv());
                 let Ok(Ok(job)) = next else { break };
                 let name = job.name.clone();
-                let _ = tx.send((name, write_frame(job, opts)));
+                let t0 = Instant::now();
+                let r = write_frame(job, &files);
+                let _ = tx.send((name, r, ms_since(t0)));
             });
         }
-        for frame in frames {
-            let name = frame.name.clone().unwrap_or_default();
-            let dir = out_dir.join(&name);
-            if opts.resume && dir.join("manifest.json").is_file() {
-                summary.skipped += 1;
-                progress();
-                continue;
+        let mut in_flight: Option<InFlight> = None;
+        let send = |job: std::result::Result<WriteJob, (String, Error)>, stages: &mut StageTimes| match job {
+            Ok(job) => {
+                let t0 = Instant::now();
+                if let Err(mpsc::SendError(job)) = job_tx.send(job) {
+                    let _ = result_tx.send((job.name, Err(Error::param("batch", "encode threads stopped")), 0.0));
+                }
+                stages.wait.push(ms_since(t0));
             }
-            remove_stale_temporaries(&dir);
-            match render_frame(gpu, frame, opts) {
-                Ok((outputs, manifest)) => {
+            Err((name, e)) => {
+                let _ = result_tx.send((name, Err(e), 0.0));
+            }
+        };
+        let mut handle = |(name, r, encode_ms): (String, Result<()>, f64), stages: &mut StageTimes| {
+            match r {
+                Ok(()) => {
                     summary.rendered += 1;
-                    let job = WriteJob {
-                        name: name.clone(),
-                        dir,
-                        outputs,
-                        manifest,
-                    };
-                    if opts.writer_threads == 0 {
-                        let _ = result_tx.send((name, write_frame(job, opts)));
-                    } else if let Err(mpsc::SendError(job)) = job_tx.send(job) {
-                        let _ = result_tx.send((job.name, Err(Error::param("batch writer", "writer threads stopped"))));
-                    }
+                    stages.encode.push(encode_ms);
                 }
                 Err(e) => summary.failed.push((name, e.to_string())),
             }
             progress();
+        };
+        loop {
+            while let Ok(done) = result_rx.try_recv() {
+                handle(done, &mut stages);
+            }
+            let t0 = Instant::now();
+            let Ok((i, src, decode_ms)) = decoded_rx.recv() else { break };
+            stages.wait.push(ms_since(t0));
+            let (_, name, dir, settings) = &todo[i];
+            let submitted = src.and_then(|src| {
+                stages.decode.push(decode_ms);
+                submit_frame(
+                    &mut refocuser,
+                    gpu,
+                    name.clone(),
+                    dir.clone(),
+                    &src,
+                    settings.clone(),
+                    opts,
+                    &mut stages,
+                )
+            });
+            // The GPU now works on this frame while the previous one is mapped and handed on.
+            if let Some(prev) = in_flight.take() {
+                let job = collect_frame(prev, &mut stages);
+                send(job, &mut stages);
+            }
+            match submitted {
+                Ok(f) => in_flight = Some(f),
+                Err(e) => {
+                    let _ = result_tx.send((name.clone(), Err(e), 0.0));
+                }
+            }
+        }
+        if let Some(prev) = in_flight.take() {
+            let job = collect_frame(prev, &mut stages);
+            send(job, &mut stages);
         }
         drop(job_tx);
-    });
-    drop(result_tx);
-    for (name, r) in result_rx {
-        if let Err(e) = r {
-            summary.rendered -= 1;
-            summary.failed.push((name, e.to_string()));
+        drop(result_tx);
+        // The last results arrive while the encoders finish; progress counts each frame once.
+        for done in result_rx.iter() {
+            handle(done, &mut stages);
         }
-    }
-    summary.wall_s = t0.elapsed().as_secs_f64();
+    });
+    summary.stages = stages;
+    summary.wall_s = t_start.elapsed().as_secs_f64();
     Ok(summary)
 }
 

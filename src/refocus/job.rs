@@ -41,6 +41,15 @@ impl Default for DepthFormats {
     }
 }
 
+/// What files a target produces and how they are encoded.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize)]
+pub struct FileFormats {
+    pub outputs: OutputSet,
+    pub rgb: RgbFormat,
+    pub depth: DepthFormats,
+    pub encoding: io::Encoding,
+}
+
 /// How target cameras are derived from the source.
 #[derive(Debug, Clone, PartialEq)]
 pub struct TargetSpec {
@@ -62,6 +71,19 @@ impl TargetSpec {
     pub fn targets(&self, source: &PinholeCamera) -> Result<Vec<PinholeCamera>> {
         if self.scales.is_empty() {
             return Err(Error::param("scales", "no focal scale given"));
+        }
+        // Each scale names its files: two that print alike would overwrite each other.
+        let mut tags = std::collections::HashMap::new();
+        for &s in &self.scales {
+            if let Some(prev) = tags.insert(scale_tag(s), s) {
+                return Err(Error::param(
+                    "focal scales",
+                    format!(
+                        "{prev} and {s} both name their files '{}' (6 decimals); give each scale once",
+                        scale_tag(s)
+                    ),
+                ));
+            }
         }
         let (w, h) = self.size.unwrap_or((source.width, source.height));
         let (cx, cy) = self.principal.unwrap_or((
@@ -126,7 +148,35 @@ pub struct Manifest {
     pub renderer: String,
     /// What the files hold: depth is view-space Z in metres with 0 = invalid; mask 255 = valid.
     pub notes: String,
+    /// The settings a batch frame was made with; resume redoes the frame when they differ.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub settings: Option<serde_json::Value>,
+    /// Every file written, with its size: resume checks they are all still there.
+    pub files: Vec<FileRecord>,
     pub outputs: Vec<ManifestEntry>,
+}
+
+/// A written file (name relative to the manifest's folder) and its size in bytes.
+#[derive(Debug, Clone, Serialize)]
+pub struct FileRecord {
+    pub name: String,
+    pub bytes: u64,
+}
+
+/// The files `entries` name, with their sizes on disk.
+pub fn file_records(dir: &Path, entries: &[ManifestEntry]) -> Result<Vec<FileRecord>> {
+    let mut out = Vec::new();
+    for e in entries {
+        for name in [&e.rgb, &e.depth_exr, &e.depth_npy, &e.mask].into_iter().flatten() {
+            let path = dir.join(name);
+            let bytes = std::fs::metadata(&path).map_err(|e| Error::io(&path, e))?.len();
+            out.push(FileRecord {
+                name: name.clone(),
+                bytes,
+            });
+        }
+    }
+    Ok(out)
 }
 
 fn scale_tag(scale: f64) -> String {
@@ -135,14 +185,8 @@ fn scale_tag(scale: f64) -> String {
 }
 
 /// Write the requested files of one output under `dir` (atomic: temporary name, then rename).
-pub fn write_output(
-    dir: &Path,
-    scale: f64,
-    out: &RefocusOutput,
-    outputs: &OutputSet,
-    rgb_format: RgbFormat,
-    depth_formats: DepthFormats,
-) -> Result<ManifestEntry> {
+pub fn write_output(dir: &Path, scale: f64, out: &RefocusOutput, files: &FileFormats) -> Result<ManifestEntry> {
+    let (outputs, rgb_format, depth_formats, enc) = (&files.outputs, files.rgb, files.depth, files.encoding);
     let t0 = std::time::Instant::now();
     let tag = scale_tag(scale);
     let name = |suffix: &str| -> (PathBuf, String) {
@@ -165,13 +209,13 @@ pub fn write_output(
     };
     if let (true, Some(rgb)) = (outputs.rgb, &out.rgb) {
         let (path, file) = name(&format!("rgb.{}", rgb_format.extension()));
-        io::save_rgb(&path, rgb)?;
+        io::save_rgb_with(&path, rgb, &enc)?;
         entry.rgb = Some(file);
     }
     if let (true, Some(depth)) = (outputs.depth, &out.depth) {
         if depth_formats.exr {
             let (path, file) = name("depth.exr");
-            io::save_depth_exr(&path, depth)?;
+            io::save_depth_exr_with(&path, depth, enc.exr)?;
             entry.depth_exr = Some(file);
         }
         if depth_formats.npy {
@@ -184,7 +228,7 @@ pub fn write_output(
     }
     if let (true, Some(mask)) = (outputs.mask, &out.mask) {
         let (path, file) = name("mask.png");
-        io::save_mask_png(&path, mask)?;
+        io::save_mask_png_with(&path, mask, enc.png)?;
         entry.mask = Some(file);
         let valid = mask.data.iter().filter(|m| **m != 0).count();
         entry.coverage = Some(valid as f64 / mask.data.len() as f64);
@@ -243,6 +287,13 @@ mod tests {
         };
         assert!(bad.targets(&src).unwrap_err().to_string().contains("focal scale"));
         assert_eq!(scale_tag(0.5), "s0.5");
+        let twins = TargetSpec {
+            scales: vec![0.5, 0.5000001],
+            size: None,
+            principal: None,
+        };
+        let e = twins.targets(&src).unwrap_err().to_string();
+        assert!(e.contains("0.5000001") && e.contains("s0.5"), "{e}");
         assert_eq!(scale_tag(1.0), "s1");
         assert_eq!(TargetSpec::scales_from_focal_list(&src.k, &[250.0]), vec![0.5]);
     }

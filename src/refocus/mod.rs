@@ -17,7 +17,7 @@ mod render;
 
 pub use grid::{axis_lookup, valid_depth, BreakRule, Grid};
 pub use mesh::{code_texture, TRI_TEX_WIDTH};
-pub use render::{RefocusOutput, Refocuser};
+pub use render::{PendingRefocus, RefocusOutput, Refocuser};
 
 use crate::camera::{Intrinsics, PinholeCamera, MAX_IMAGE_SIDE};
 use crate::error::{Error, Result};

@@ -218,6 +218,13 @@ struct FileOutputArgs {
     /// Depth file formats: exr, npy or both.
     #[arg(long, default_value = "exr")]
     depth_format: String,
+    /// PNG compression of colour and mask files: fast (datasets: several times less CPU,
+    /// larger files), default or best.
+    #[arg(long, default_value = "default")]
+    png_compression: String,
+    /// EXR compression of depth (and EXR colour): none, rle, zip (default) or piz; all lossless.
+    #[arg(long, default_value = "zip")]
+    exr_compression: String,
 }
 
 impl FileOutputArgs {
@@ -229,6 +236,24 @@ impl FileOutputArgs {
             RgbFormatArg::Exr => RgbFormat::Exr,
         };
         Ok((outputs, rgb, parse_depth_formats(&self.depth_format)?))
+    }
+
+    fn encoding(&self) -> Result<io::Encoding> {
+        Ok(io::Encoding {
+            png: self.png_compression.parse()?,
+            exr: self.exr_compression.parse()?,
+        })
+    }
+
+    /// Everything the refocus writers need.
+    fn file_formats(&self) -> Result<job::FileFormats> {
+        let (outputs, rgb, depth) = self.parse()?;
+        Ok(job::FileFormats {
+            outputs,
+            rgb,
+            depth,
+            encoding: self.encoding()?,
+        })
     }
 }
 

@@ -21,12 +21,17 @@ pub(crate) struct RefocusArgs {
     /// writer threads, and resume.
     #[arg(long, conflicts_with_all = ["rgb", "depth"])]
     batch: Option<PathBuf>,
-    /// With --batch: render frames that already have a manifest.json again.
+    /// With --batch: render every frame again, even those finished with the same settings.
+    #[arg(long, alias = "no-resume")]
+    force: bool,
+    /// With --batch: threads in each CPU pool (decoding inputs, encoding files) around the GL
+    /// thread; 0 runs every stage in turn on one thread. Default: the number of cores.
+    #[arg(long, alias = "writer-threads")]
+    jobs: Option<usize>,
+    /// With --batch: process only shard K of N (frames whose manifest index i has i % N == K,
+    /// K from 0), e.g. one Slurm array task or Kubernetes indexed Job per shard.
     #[arg(long)]
-    no_resume: bool,
-    /// With --batch: threads encoding files while the GPU renders (0 = none).
-    #[arg(long, default_value_t = 1)]
-    writer_threads: usize,
+    shard: Option<String>,
     /// Raw units per metre for integer depth (5000 for TUM, 1000 for NYU/SUN); divides float depth too when given.
     #[arg(long)]
     depth_scale: Option<f64>,
@@ -92,7 +97,8 @@ pub(crate) fn refocus(a: RefocusArgs) -> Result<()> {
         tau_abs: a.tau_abs,
     };
     rule.validate()?;
-    let (outputs, rgb_format, depth_formats) = a.files.parse()?;
+    let files = a.files.file_formats()?;
+    let outputs = files.outputs;
     let conv = a.conv.conventions();
     let method = match a.method {
         MethodArg::Mesh => Method::Mesh,
@@ -125,14 +131,7 @@ pub(crate) fn refocus(a: RefocusArgs) -> Result<()> {
     let mut entries = Vec::new();
     for (scale, target) in scales.iter().zip(&targets) {
         let out = refocuser.render(target)?;
-        entries.push(job::write_output(
-            &a.out_dir,
-            *scale,
-            &out,
-            &outputs,
-            rgb_format,
-            depth_formats,
-        )?);
+        entries.push(job::write_output(&a.out_dir, *scale, &out, &files)?);
         bar.inc(1);
     }
     bar.finish_and_clear();
@@ -144,6 +143,8 @@ pub(crate) fn refocus(a: RefocusArgs) -> Result<()> {
         conventions: conv,
         renderer: gpu.info().renderer.clone(),
         notes: job::MANIFEST_NOTES.to_string(),
+        settings: None,
+        files: job::file_records(&a.out_dir, &entries)?,
         outputs: entries,
     };
     let path = job::write_manifest(&a.out_dir, &manifest)?;
@@ -163,12 +164,20 @@ pub(crate) fn refocus(a: RefocusArgs) -> Result<()> {
 }
 
 pub(crate) fn refocus_batch(manifest: &Path, a: RefocusArgs) -> Result<()> {
-    use viewsynth::refocus::batch::{load_manifest, run_batch, BatchOptions};
+    use viewsynth::refocus::batch::{load_manifest, run_batch, BatchOptions, Shard, MAX_JOBS};
     if a.focal_list.is_some() {
         bail!("--focal-list is per frame; with --batch give --zoom-range scales");
     }
     let frames = load_manifest(manifest)?;
-    let (outputs, rgb_format, depth_formats) = a.files.parse()?;
+    let files = a.files.file_formats()?;
+    let jobs = match a.jobs {
+        Some(j) => j,
+        None => std::thread::available_parallelism().map_or(2, |n| n.get()),
+    };
+    if jobs > MAX_JOBS {
+        bail!("--jobs {jobs}: at most {MAX_JOBS}");
+    }
+    let shard: Option<Shard> = a.shard.as_deref().map(str::parse).transpose()?;
     let opts = BatchOptions {
         scales: a.zoom_range.clone(),
         size: a.width_out.zip(a.height_out),
@@ -181,12 +190,11 @@ pub(crate) fn refocus_batch(manifest: &Path, a: RefocusArgs) -> Result<()> {
             MethodArg::Mesh => Method::Mesh,
             MethodArg::Fullscreen => Method::Fullscreen,
         },
-        outputs,
         conv: a.conv.conventions(),
-        rgb_format,
-        depth_formats,
-        resume: !a.no_resume,
-        writer_threads: a.writer_threads,
+        files,
+        resume: !a.force,
+        jobs,
+        shard,
     };
     opts.rule.validate()?;
     prepare_out_dir(&a.out_dir)?;
@@ -194,8 +202,12 @@ pub(crate) fn refocus_batch(manifest: &Path, a: RefocusArgs) -> Result<()> {
     let bar = indicatif::ProgressBar::new(frames.len() as u64);
     let summary = run_batch(&gpu, &frames, &a.out_dir, &opts, || bar.inc(1))?;
     bar.finish_and_clear();
+    let shard_note = match opts.shard {
+        Some(s) => format!(" (shard {}/{}: {} frames belong to other shards)", s.index, s.count, summary.other_shards),
+        None => String::new(),
+    };
     println!(
-        "{} frames: {} rendered, {} already done (resume), {} failed; {:.1} s, {:.2} frames/s",
+        "{} frames{shard_note}: {} rendered, {} already done (resume), {} failed; {:.1} s, {:.2} frames/s",
         frames.len(),
         summary.rendered,
         summary.skipped,

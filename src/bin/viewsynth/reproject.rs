@@ -135,6 +135,7 @@ pub(crate) fn reproject(a: ReprojectArgs) -> Result<()> {
         ReprojectMethodArg::Gather3d => RMethod::Gather3d { steps: a.steps },
     };
     let (outputs, rgb_format, depth_formats) = a.files.parse()?;
+    let enc = a.files.encoding()?;
     // The mask is always rendered: the coverage printed below is measured on it.
     let params = ReprojectParams {
         method,
@@ -169,13 +170,13 @@ pub(crate) fn reproject(a: ReprojectArgs) -> Result<()> {
         if let Some(color) = &out.color {
             jobs.push((
                 a.out_dir.join(format!("{name}_rgb.{rgb_ext}")),
-                Box::new(move |p: &Path| io::save_rgb(p, color)),
+                Box::new(move |p: &Path| io::save_rgb_with(p, color, &enc)),
             ));
         }
         if let Some(depth) = out.depth.as_ref().filter(|_| depth_formats.exr) {
             jobs.push((
                 a.out_dir.join(format!("{name}_depth.exr")),
-                Box::new(move |p: &Path| io::save_depth_exr(p, depth)),
+                Box::new(move |p: &Path| io::save_depth_exr_with(p, depth, enc.exr)),
             ));
         }
         if let Some(depth) = out.depth.as_ref().filter(|_| depth_formats.npy) {
@@ -189,7 +190,7 @@ pub(crate) fn reproject(a: ReprojectArgs) -> Result<()> {
                 a.out_dir.join(format!("{name}_mask.png")),
                 Box::new(move |p: &Path| {
                     let bits = out.mask.iter().map(|m| (*m != 0) as u8).collect();
-                    io::save_mask_png(p, &io::Mask::new(width, height, bits)?)
+                    io::save_mask_png_with(p, &io::Mask::new(width, height, bits)?, enc.png)
                 }),
             ));
         }
