@@ -11,19 +11,35 @@ use crate::scene;
 use std::fmt::Write as _;
 use std::time::Instant;
 
-fn median(mut v: Vec<f64>) -> f64 {
-    v.sort_by(f64::total_cmp);
-    let n = v.len();
-    if n % 2 == 1 {
-        v[n / 2]
-    } else {
-        0.5 * (v[n / 2 - 1] + v[n / 2])
+use crate::bench_batch::median;
+
+/// One measured case, for `bench --json`.
+#[derive(Debug, Clone, serde::Serialize)]
+pub struct BenchCase {
+    pub capability: String,
+    pub case: String,
+    pub size: String,
+    pub setup_ms: Option<f64>,
+    /// Median ms per frame (refocus: 5 focal scales; cyclopean: one middle frame; stitch: one
+    /// stereo equirect).
+    pub median_ms: f64,
+}
+
+impl BenchCase {
+    pub fn new(capability: &str, case: &str, size: String, setup_ms: Option<f64>, median_ms: f64) -> Self {
+        BenchCase {
+            capability: capability.into(),
+            case: case.into(),
+            size,
+            setup_ms,
+            median_ms,
+        }
     }
 }
 
 const SCALES: [f64; 5] = [0.5, 0.75, 1.0, 1.5, 2.0];
 
-pub fn refocus_bench(gpu: &Gpu, sizes: &[(u32, u32)], repeats: usize) -> Result<String> {
+pub fn refocus_bench(gpu: &Gpu, sizes: &[(u32, u32)], repeats: usize, cases: &mut Vec<BenchCase>) -> Result<String> {
     let mut t = format!(
         "refocus benchmark on {} ({} repeats, medians)\n\n\
          | size | path | setup ms | ms / frame (5 scales) | ms / scale | job ms / frame incl. PNG+EXR+mask writes |\n\
@@ -70,6 +86,18 @@ pub fn refocus_bench(gpu: &Gpu, sizes: &[(u32, u32)], repeats: usize) -> Result<
                 Method::Mesh => format!("GPU mesh ({} triangles)", r.triangle_count().unwrap_or(0)),
                 Method::Fullscreen => "GPU full-screen".to_string(),
             };
+            let case = match method {
+                Method::Mesh => "gpu-mesh",
+                Method::Fullscreen => "gpu-fullscreen",
+            };
+            cases.push(BenchCase::new("refocus", case, format!("{w}x{h}"), Some(setup), m));
+            cases.push(BenchCase::new(
+                "refocus",
+                &format!("{case}-job-with-writes"),
+                format!("{w}x{h}"),
+                None,
+                median(with_io.clone()),
+            ));
             writeln!(
                 t,
                 "| {w}x{h} | {name} | {setup:.1} | {m:.2} | {:.2} | {:.1} |",
@@ -87,6 +115,7 @@ pub fn refocus_bench(gpu: &Gpu, sizes: &[(u32, u32)], repeats: usize) -> Result<
             cpu.push(t0.elapsed().as_secs_f64() * 1e3);
         }
         let m = median(cpu);
+        cases.push(BenchCase::new("refocus", "cpu-f64-reference", format!("{w}x{h}"), None, m));
         writeln!(
             t,
             "| {w}x{h} | CPU f64 reference (1 thread, baseline) | - | {m:.1} | {:.1} | - |",
@@ -99,7 +128,13 @@ pub fn refocus_bench(gpu: &Gpu, sizes: &[(u32, u32)], repeats: usize) -> Result<
 }
 
 /// Median ms per middle frame from two eyes of `width` x `height` for each cyclopean method.
-pub fn cyclopean_bench(gpu: &Gpu, width: u32, height: u32, repeats: usize) -> Result<String> {
+pub fn cyclopean_bench(
+    gpu: &Gpu,
+    width: u32,
+    height: u32,
+    repeats: usize,
+    cases: &mut Vec<BenchCase>,
+) -> Result<String> {
     use crate::cyclopean::render::CyclopeanRenderer;
     use crate::cyclopean::scene_frame::{scene_frame, StereoRig};
     use crate::cyclopean::DepthKind;
@@ -121,7 +156,9 @@ pub fn cyclopean_bench(gpu: &Gpu, width: u32, height: u32, repeats: usize) -> Re
             r.render(&mid)?;
             runs.push(t0.elapsed().as_secs_f64() * 1e3);
         }
-        writeln!(t, "| {name} | {setup:.1} | {:.1} |", median(runs)).expect("write to String");
+        let m = median(runs);
+        cases.push(BenchCase::new("cyclopean", name, format!("{width}x{height}"), Some(setup), m));
+        writeln!(t, "| {name} | {setup:.1} | {m:.1} |").expect("write to String");
     }
     let t0 = Instant::now();
     let mut warp = crate::cyclopean::forward::ForwardWarp::new(gpu, &frame, &crate::refocus::BreakRule::default())?;
@@ -133,12 +170,15 @@ pub fn cyclopean_bench(gpu: &Gpu, width: u32, height: u32, repeats: usize) -> Re
         warp.render(&mid)?;
         runs.push(t0.elapsed().as_secs_f64() * 1e3);
     }
-    writeln!(
-        t,
-        "| {} | {setup:.1} | {:.1} |",
+    let m = median(runs);
+    cases.push(BenchCase::new(
+        "cyclopean",
         crate::evaluation::FORWARD_NAME,
-        median(runs)
-    )
+        format!("{width}x{height}"),
+        Some(setup),
+        m,
+    ));
+    writeln!(t, "| {} | {setup:.1} | {m:.1} |", crate::evaluation::FORWARD_NAME)
     .expect("write to String");
     Ok(t)
 }

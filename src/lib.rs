@@ -9,6 +9,7 @@
 //! - [`metrics`]: error measures used by tests, reports and benchmarks.
 
 pub mod bench;
+pub mod bench_batch;
 pub mod camera;
 pub mod compare;
 pub mod convention;

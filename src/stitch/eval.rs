@@ -210,7 +210,7 @@ pub fn stitch_rows(gpu: &Gpu, repeats: usize) -> Result<(Vec<ReportRow>, Vec<Str
 
 /// Benchmark: ms per 4096 x 2048 stereo equirect (both eyes, readback included) from 6 faces
 /// of 1024 x 1024 per eye, overlap 10 deg, per method (median of 5 after a warm-up). Not asserted.
-pub fn stitch_bench(gpu: &Gpu) -> Result<String> {
+pub fn stitch_bench(gpu: &Gpu, cases: &mut Vec<crate::bench::BenchCase>) -> Result<String> {
     let rig = OdsRig::demo();
     let (n, overlap) = (1024, 10.0);
     let t0 = Instant::now();
@@ -238,7 +238,15 @@ pub fn stitch_bench(gpu: &Gpu) -> Result<String> {
         for _ in 0..5 {
             times.push(r.render(&params)?.1.wall_ms);
         }
-        let _ = writeln!(t, "| {} | {:.1} |", method.label(), median(times));
+        let m = median(times);
+        cases.push(crate::bench::BenchCase::new(
+            "stitch",
+            method.label(),
+            "4096x2048".into(),
+            Some(setup_ms),
+            m,
+        ));
+        let _ = writeln!(t, "| {} | {m:.1} |", method.label());
     }
     Ok(t)
 }

@@ -307,7 +307,7 @@ fn print_stitch_report_and_bench() {
     let g = gpu();
     let (_, notes) = viewsynth::stitch::stitch_rows(&g, 3).unwrap();
     println!("{}", notes.join("\n"));
-    println!("{}", viewsynth::stitch::stitch_bench(&g).unwrap());
+    println!("{}", viewsynth::stitch::stitch_bench(&g, &mut Vec::new()).unwrap());
 }
 
 #[test]

@@ -121,6 +121,20 @@ enum Command {
         /// Repetitions per measurement (the median is reported).
         #[arg(long, default_value_t = 7)]
         repeats: usize,
+        /// Benchmark the pipelined refocus batch instead: N frames of the built-in scene, or a
+        /// manifest FILE; runs the synchronous batch as the in-run baseline and prints frames/s,
+        /// per-stage medians and the stage that bounds the throughput.
+        #[arg(long, value_name = "N|FILE")]
+        batch: Option<String>,
+        /// With --batch: threads per CPU pool (default: the number of cores).
+        #[arg(long, requires = "batch")]
+        jobs: Option<usize>,
+        /// With --batch: PNG compression (fast, default, best).
+        #[arg(long, default_value = "default", requires = "batch")]
+        png_compression: String,
+        /// Print one JSON object instead of the tables.
+        #[arg(long)]
+        json: bool,
         #[command(flatten)]
         gpu: GpuArgs,
     },
@@ -279,7 +293,25 @@ fn main() {
             let conv = conv.conventions();
             render_scene(&scene, width, height, ipd, conv, &out_dir, &gpu)
         }
-        Command::Bench { sizes, repeats, gpu } => bench(&sizes, repeats, &gpu),
+        Command::Bench {
+            sizes,
+            repeats,
+            batch: Some(batch),
+            jobs,
+            png_compression,
+            json,
+            gpu,
+        } => {
+            let _ = (sizes, repeats);
+            bench_batch(&batch, jobs, &png_compression, json, &gpu)
+        }
+        Command::Bench {
+            sizes,
+            repeats,
+            json,
+            gpu,
+            ..
+        } => bench(&sizes, repeats, json, &gpu),
         Command::Stress { quick, only, json, gpu } => stress(quick, &only, json.as_deref(), &gpu),
         Command::Report {
             out_dir,
@@ -398,7 +430,36 @@ fn prepare_out_dir(dir: &Path) -> Result<()> {
     Ok(())
 }
 
-fn bench(sizes: &[String], repeats: usize, gpu: &GpuArgs) -> Result<()> {
+fn bench_batch(batch: &str, jobs: Option<usize>, png: &str, json: bool, gpu: &GpuArgs) -> Result<()> {
+    use viewsynth::bench_batch::{batch_bench, BatchInput};
+    let input = match batch.parse::<usize>() {
+        Ok(0) => bail!("--batch 0: give a number of frames >= 1 or a manifest file"),
+        Ok(n) if n > 100_000 => bail!("--batch {n}: at most 100000 frames of the built-in scene"),
+        Ok(n) => BatchInput::Scene { frames: n },
+        Err(_) => BatchInput::Manifest(PathBuf::from(batch)),
+    };
+    let jobs = jobs.unwrap_or_else(|| std::thread::available_parallelism().map_or(2, |n| n.get()));
+    if jobs > viewsynth::refocus::batch::MAX_JOBS {
+        bail!("--jobs {jobs}: at most {}", viewsynth::refocus::batch::MAX_JOBS);
+    }
+    let files = job::FileFormats {
+        encoding: io::Encoding {
+            png: png.parse()?,
+            ..Default::default()
+        },
+        ..Default::default()
+    };
+    let gpu = gpu.open()?;
+    let report = batch_bench(&gpu, &input, jobs, files)?;
+    if json {
+        println!("{}", serde_json::to_string_pretty(&report)?);
+    } else {
+        println!("{}", report.table());
+    }
+    Ok(())
+}
+
+fn bench(sizes: &[String], repeats: usize, json: bool, gpu: &GpuArgs) -> Result<()> {
     let mut parsed = Vec::new();
     for s in sizes {
         let (w, h) = s
@@ -407,13 +468,20 @@ fn bench(sizes: &[String], repeats: usize, gpu: &GpuArgs) -> Result<()> {
         parsed.push((w.parse::<u32>()?, h.parse::<u32>()?));
     }
     let gpu = gpu.open()?;
-    let table = viewsynth::bench::refocus_bench(&gpu, &parsed, repeats.max(1))?;
-    println!("{table}");
-    println!(
-        "{}",
-        viewsynth::bench::cyclopean_bench(&gpu, 1280, 720, repeats.max(1))?
-    );
-    println!("{}", viewsynth::stitch::stitch_bench(&gpu)?);
+    let mut cases = Vec::new();
+    let tables = [
+        viewsynth::bench::refocus_bench(&gpu, &parsed, repeats.max(1), &mut cases)?,
+        viewsynth::bench::cyclopean_bench(&gpu, 1280, 720, repeats.max(1), &mut cases)?,
+        viewsynth::stitch::stitch_bench(&gpu, &mut cases)?,
+    ];
+    if json {
+        let report = serde_json::json!({ "renderer": gpu.info().renderer, "cases": cases });
+        println!("{}", serde_json::to_string_pretty(&report)?);
+    } else {
+        for t in tables {
+            println!("{t}");
+        }
+    }
     Ok(())
 }
 

@@ -1,0 +1,257 @@
+//! `viewsynth bench --batch`: the pipelined refocus batch against the synchronous one (every
+//! stage in turn on one thread) in the same run, on the built-in scene or a manifest, with the
+//! per-stage medians and the stage that bounds the throughput. Nothing here asserts a time.
+
+use crate::error::{Error, Result};
+use crate::gpu::Gpu;
+use crate::refocus::batch::{load_manifest, run_batch, BatchFrame, BatchOptions, BatchSummary, StageTimes};
+use crate::refocus::job::FileFormats;
+use crate::refocus::{BreakRule, Method};
+use crate::{convention::Conventions, io, scene};
+use serde::Serialize;
+use std::fmt::Write as _;
+use std::path::{Path, PathBuf};
+
+/// Where the frames come from.
+#[derive(Debug, Clone)]
+pub enum BatchInput {
+    /// `frames` copies of a 640x480 frame of the built-in scene (PNG colour, EXR depth).
+    Scene { frames: usize },
+    /// A CSV/JSON manifest, as `refocus --batch` reads it.
+    Manifest(PathBuf),
+}
+
+/// Medians of the stages, ms per frame.
+#[derive(Debug, Clone, Copy, Default, Serialize)]
+pub struct StageMedians {
+    pub decode: f64,
+    pub upload: f64,
+    pub render: f64,
+    pub readback: f64,
+    pub encode: f64,
+    pub wait: f64,
+    /// GPU time of a frame's draws, where the driver's timer queries are meaningful.
+    pub gpu_render: Option<f64>,
+}
+
+/// One batch run.
+#[derive(Debug, Clone, Serialize)]
+pub struct BatchRun {
+    pub jobs: usize,
+    pub frames: usize,
+    pub failed: usize,
+    pub wall_s: f64,
+    pub frames_per_s: f64,
+    pub stages_ms: StageMedians,
+    /// Per-frame ms of each stage as the pipeline sees it: a pool's stage divided by its
+    /// threads, the GL thread's stages summed (they run in turn on one thread).
+    pub effective_ms: Vec<(String, f64)>,
+    /// The stage with the largest effective time: what bounds the throughput.
+    pub bound_by: String,
+    /// frames/s against 1 / (bounding stage's effective ms): 1.0 = the pipeline hides all else.
+    pub efficiency: f64,
+    pub frames_in_flight: usize,
+}
+
+/// The report: pipelined and synchronous on the same input.
+#[derive(Debug, Clone, Serialize)]
+pub struct BatchBench {
+    pub renderer: String,
+    pub input: String,
+    pub frame_size: (u32, u32),
+    pub scales: Vec<f64>,
+    /// Bytes one frame holds in memory (source + all outputs).
+    pub bytes_per_frame: usize,
+    pub png_compression: io::PngCompression,
+    /// Fields of the pipelined run, flat, for scripts.
+    pub frames_per_s: f64,
+    pub frames: usize,
+    pub stages_ms: StageMedians,
+    pub bound_by: String,
+    pub pipelined: BatchRun,
+    pub synchronous: BatchRun,
+    /// pipelined frames/s over synchronous frames/s.
+    pub speedup: f64,
+}
+
+pub(crate) fn median(mut v: Vec<f64>) -> f64 {
+    if v.is_empty() {
+        return 0.0;
+    }
+    v.sort_by(f64::total_cmp);
+    let n = v.len();
+    if n % 2 == 1 {
+        v[n / 2]
+    } else {
+        0.5 * (v[n / 2 - 1] + v[n / 2])
+    }
+}
+
+fn medians(s: &StageTimes) -> StageMedians {
+    StageMedians {
+        decode: median(s.decode.clone()),
+        upload: median(s.upload.clone()),
+        render: median(s.render.clone()),
+        readback: median(s.readback.clone()),
+        encode: median(s.encode.clone()),
+        wait: median(s.wait.clone()),
+        gpu_render: (!s.gpu_render.is_empty()).then(|| median(s.gpu_render.clone())),
+    }
+}
+
+fn summarise(jobs: usize, s: &BatchSummary) -> BatchRun {
+    let m = medians(&s.stages);
+    let fps = s.rendered as f64 / s.wall_s.max(1e-9);
+    let gl = m.upload + m.render + m.readback;
+    let effective = if jobs == 0 {
+        vec![("one thread (all stages)".to_string(), m.decode + gl + m.encode)]
+    } else {
+        let threads = jobs as f64;
+        vec![
+            ("decode".to_string(), m.decode / threads),
+            (
+                format!(
+                    "GL thread (upload {:.1} + render {:.1} + readback {:.1})",
+                    m.upload, m.render, m.readback
+                ),
+                gl,
+            ),
+            ("encode".to_string(), m.encode / threads),
+        ]
+    };
+    let (bound_by, bound_ms) = effective
+        .iter()
+        .max_by(|a, b| a.1.total_cmp(&b.1))
+        .cloned()
+        .unwrap_or_default();
+    BatchRun {
+        jobs,
+        frames: s.rendered,
+        failed: s.failed.len(),
+        wall_s: s.wall_s,
+        frames_per_s: fps,
+        stages_ms: m,
+        effective_ms: effective,
+        bound_by,
+        efficiency: fps * bound_ms / 1e3,
+        frames_in_flight: s.frames_in_flight,
+    }
+}
+
+/// Write the built-in scene's frame and a manifest of `n` copies of it under `dir`.
+fn scene_manifest(dir: &Path, n: usize) -> Result<PathBuf> {
+    let cam = scene::demo_camera(640, 480);
+    let (rgb, depth) = scene::render(&cam);
+    io::save_rgb(&dir.join("rgb.png"), &rgb)?;
+    io::save_depth_exr(&dir.join("depth.exr"), &depth)?;
+    let k = cam.k;
+    let mut csv = String::from("rgb,depth,fx,fy,cx,cy,name\n");
+    for i in 0..n {
+        let _ = writeln!(csv, "rgb.png,depth.exr,{},{},{},{},f{i:05}", k.fx, k.fy, k.cx, k.cy);
+    }
+    let path = dir.join("frames.csv");
+    std::fs::write(&path, csv).map_err(|e| Error::io(&path, e))?;
+    Ok(path)
+}
+
+/// Run the batch twice on the same input (synchronous, then pipelined with `jobs` threads per
+/// pool) into scratch folders that are removed afterwards.
+pub fn batch_bench(gpu: &Gpu, input: &BatchInput, jobs: usize, files: FileFormats) -> Result<BatchBench> {
+    let scratch = tempfile::Builder::new()
+        .prefix("viewsynth-bench-batch-")
+        .tempdir()
+        .map_err(|e| Error::io(Path::new("temporary folder"), e))?;
+    let (manifest, label) = match input {
+        BatchInput::Scene { frames } => (
+            scene_manifest(scratch.path(), (*frames).max(1))?,
+            format!("built-in scene 640x480 x {frames}"),
+        ),
+        BatchInput::Manifest(p) => (p.clone(), p.display().to_string()),
+    };
+    let frames: Vec<BatchFrame> = load_manifest(&manifest)?;
+    let first = &frames[0];
+    let (w, h) = io::load_rgb(&first.rgb).map(|i| (i.width, i.height))?;
+    let scales = vec![0.5, 0.75, 1.0, 1.5, 2.0];
+    let opts = |jobs: usize| BatchOptions {
+        scales: scales.clone(),
+        size: None,
+        principal: None,
+        rule: BreakRule::default(),
+        method: Method::Fullscreen,
+        conv: Conventions::default(),
+        files,
+        resume: false,
+        jobs,
+        shard: None,
+    };
+    let run = |jobs: usize, name: &str| -> Result<BatchRun> {
+        let out = scratch.path().join(name);
+        let s = run_batch(gpu, &frames, &out, &opts(jobs), || ())?;
+        let _ = std::fs::remove_dir_all(&out);
+        Ok(summarise(jobs, &s))
+    };
+    let synchronous = run(0, "sync")?;
+    let pipelined = run(jobs.max(1), "pipelined")?;
+    let px = w as usize * h as usize;
+    let out_px: usize = scales.len() * px;
+    let bytes_per_frame = px * (3 + 4) + out_px * (3 * files.outputs.rgb as usize + 4 * files.outputs.depth as usize + files.outputs.mask as usize);
+    Ok(BatchBench {
+        renderer: gpu.info().renderer.clone(),
+        input: label,
+        frame_size: (w, h),
+        scales,
+        bytes_per_frame,
+        png_compression: files.encoding.png,
+        frames_per_s: pipelined.frames_per_s,
+        frames: pipelined.frames,
+        stages_ms: pipelined.stages_ms,
+        bound_by: pipelined.bound_by.clone(),
+        speedup: pipelined.frames_per_s / synchronous.frames_per_s.max(1e-9),
+        pipelined,
+        synchronous,
+    })
+}
+
+impl BatchBench {
+    /// Markdown tables: throughput of both runs and the stage medians.
+    pub fn table(&self) -> String {
+        let mut t = format!(
+            "batch refocus benchmark on {} — {}, {} scales, PNG {:?}; {:.1} MB per frame in memory\n\n\
+             | run | jobs | frames | frames/s | decode | upload | render | readback | encode | wait | GPU render | bound by | efficiency |\n\
+             |---|---|---|---|---|---|---|---|---|---|---|---|---|\n",
+            self.renderer,
+            self.input,
+            self.scales.len(),
+            self.png_compression,
+            self.bytes_per_frame as f64 / 1e6
+        );
+        for (name, r) in [("synchronous", &self.synchronous), ("pipelined", &self.pipelined)] {
+            let m = &r.stages_ms;
+            let _ = writeln!(
+                t,
+                "| {name} | {} | {} | {:.2} | {:.1} | {:.1} | {:.1} | {:.1} | {:.1} | {:.1} | {} | {} | {:.2} |",
+                r.jobs,
+                r.frames,
+                r.frames_per_s,
+                m.decode,
+                m.upload,
+                m.render,
+                m.readback,
+                m.encode,
+                m.wait,
+                m.gpu_render.map_or("-".to_string(), |g| format!("{g:.2}")),
+                r.bound_by,
+                r.efficiency
+            );
+        }
+        let _ = writeln!(
+            t,
+            "\nstage columns: median ms per frame; pipelined / synchronous = {:.2}x; at most {} frames in memory \
+             (~{:.0} MB)",
+            self.speedup,
+            self.pipelined.frames_in_flight,
+            (self.pipelined.frames_in_flight * self.bytes_per_frame) as f64 / 1e6
+        );
+        t
+    }
+}
