@@ -77,7 +77,15 @@ pub fn refocus_bench(gpu: &Gpu, sizes: &[(u32, u32)], repeats: usize, cases: &mu
                 let t0 = Instant::now();
                 for (s, target) in SCALES.iter().zip(&targets) {
                     let out = r.render(target)?;
-                    job::write_output(&tmp, *s, &out, &FileFormats { outputs, ..Default::default() })?;
+                    job::write_output(
+                        &tmp,
+                        *s,
+                        &out,
+                        &FileFormats {
+                            outputs,
+                            ..Default::default()
+                        },
+                    )?;
                 }
                 with_io.push(t0.elapsed().as_secs_f64() * 1e3);
             }
@@ -115,7 +123,13 @@ pub fn refocus_bench(gpu: &Gpu, sizes: &[(u32, u32)], repeats: usize, cases: &mu
             cpu.push(t0.elapsed().as_secs_f64() * 1e3);
         }
         let m = median(cpu);
-        cases.push(BenchCase::new("refocus", "cpu-f64-reference", format!("{w}x{h}"), None, m));
+        cases.push(BenchCase::new(
+            "refocus",
+            "cpu-f64-reference",
+            format!("{w}x{h}"),
+            None,
+            m,
+        ));
         writeln!(
             t,
             "| {w}x{h} | CPU f64 reference (1 thread, baseline) | - | {m:.1} | {:.1} | - |",
@@ -157,7 +171,13 @@ pub fn cyclopean_bench(
             runs.push(t0.elapsed().as_secs_f64() * 1e3);
         }
         let m = median(runs);
-        cases.push(BenchCase::new("cyclopean", name, format!("{width}x{height}"), Some(setup), m));
+        cases.push(BenchCase::new(
+            "cyclopean",
+            name,
+            format!("{width}x{height}"),
+            Some(setup),
+            m,
+        ));
         writeln!(t, "| {name} | {setup:.1} | {m:.1} |").expect("write to String");
     }
     let t0 = Instant::now();
@@ -178,7 +198,6 @@ pub fn cyclopean_bench(
         Some(setup),
         m,
     ));
-    writeln!(t, "| {} | {setup:.1} | {m:.1} |", crate::evaluation::FORWARD_NAME)
-    .expect("write to String");
+    writeln!(t, "| {} | {setup:.1} | {m:.1} |", crate::evaluation::FORWARD_NAME).expect("write to String");
     Ok(t)
 }

@@ -194,7 +194,8 @@ pub fn batch_bench(gpu: &Gpu, input: &BatchInput, jobs: usize, files: FileFormat
     let pipelined = run(jobs.max(1), "pipelined")?;
     let px = w as usize * h as usize;
     let out_px: usize = scales.len() * px;
-    let bytes_per_frame = px * (3 + 4) + out_px * (3 * files.outputs.rgb as usize + 4 * files.outputs.depth as usize + files.outputs.mask as usize);
+    let bytes_per_frame = px * (3 + 4)
+        + out_px * (3 * files.outputs.rgb as usize + 4 * files.outputs.depth as usize + files.outputs.mask as usize);
     Ok(BatchBench {
         renderer: gpu.info().renderer.clone(),
         input: label,

@@ -45,7 +45,15 @@ pub fn run(gpu: &Gpu, out_dir: &Path) -> Result<PathBuf> {
         let mut r = Refocuser::new(gpu, &src, &rule, method, outputs, Conventions::default())?;
         for (scale, target) in DEMO_SCALES.iter().zip(&targets) {
             let out = r.render(target)?;
-            job::write_output(&dir, *scale, &out, &FileFormats { outputs, ..Default::default() })?;
+            job::write_output(
+                &dir,
+                *scale,
+                &out,
+                &FileFormats {
+                    outputs,
+                    ..Default::default()
+                },
+            )?;
             let (gt_rgb, gt_depth) = scene::render(target);
             let mask: Vec<bool> = out
                 .mask

@@ -1,9 +1,9 @@
 //! Framebuffers with multiple render targets (MRT) and an optional float depth buffer.
 
 use super::{Gpu, PendingRead, ReadFormat, Texture, TextureFormat};
-use std::cell::RefCell;
 use crate::error::{Error, Result};
 use glow::HasContext;
+use std::cell::RefCell;
 
 /// One colour attachment: its format and the value it is cleared to.
 #[derive(Debug, Clone, Copy)]
@@ -163,7 +163,13 @@ impl Framebuffer {
                         })
                     })
                     .collect();
-                *flipped = Some(Box::new(Framebuffer::new(&self.gpu, self.width, self.height, &attachments, false)?));
+                *flipped = Some(Box::new(Framebuffer::new(
+                    &self.gpu,
+                    self.width,
+                    self.height,
+                    &attachments,
+                    false,
+                )?));
             }
             let target = flipped.as_ref().expect("created above").raw;
             let mut draw = vec![glow::NONE; self.colors.len()];

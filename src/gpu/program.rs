@@ -66,7 +66,12 @@ impl Program {
                 let names: Vec<_> = stages.iter().map(|s| s.1).collect();
                 return Err(Error::Gl(format!("linking {}: {log}", names.join(" + "))));
             }
-            super::label(gl, glow::PROGRAM, program.0.get(), stages.first().map_or("program", |s| s.1));
+            super::label(
+                gl,
+                glow::PROGRAM,
+                program.0.get(),
+                stages.first().map_or("program", |s| s.1),
+            );
             Ok(Program {
                 gpu: gpu.clone(),
                 raw: program,
@@ -96,11 +101,11 @@ impl Program {
 
     fn location(&self, name: &str) -> Option<glow::UniformLocation> {
         if let Some(l) = self.locations.borrow().get(name) {
-            return l.clone();
+            return *l;
         }
         // SAFETY: valid program handle.
         let l = unsafe { self.gpu.gl().get_uniform_location(self.raw, name) };
-        self.locations.borrow_mut().insert(name.to_string(), l.clone());
+        self.locations.borrow_mut().insert(name.to_string(), l);
         l
     }
 

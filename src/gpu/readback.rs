@@ -23,6 +23,8 @@ const KEEP_PER_SIZE: usize = 16;
 pub(crate) struct ReadbackPool {
     free: HashMap<usize, Vec<glow::Buffer>>,
     queries: Vec<glow::Query>,
+    /// Pixel-pack buffers created so far (tests and reports check the steady state adds none).
+    created: usize,
 }
 
 impl ReadbackPool {
@@ -226,6 +228,7 @@ impl Gpu {
         if let Some(b) = self.0.readback.borrow_mut().free.get_mut(&len).and_then(Vec::pop) {
             return Ok(b);
         }
+        self.0.readback.borrow_mut().created += 1;
         let size = i32::try_from(len.max(1))
             .map_err(|_| Error::param("readback size", format!("{len} bytes exceed a GL buffer")))?;
         let gl = self.gl();
@@ -250,6 +253,11 @@ impl Gpu {
             // SAFETY: handle owned by the caller, not pooled.
             unsafe { self.gl().delete_buffer(b) }
         }
+    }
+
+    /// Pixel-pack buffers this context has created for readback so far.
+    pub fn readback_buffers_created(&self) -> usize {
+        self.0.readback.borrow().created
     }
 
     /// A pooled query object (for timer queries read after their frame's fence).

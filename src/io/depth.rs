@@ -267,7 +267,14 @@ mod tests {
         let dir = scratch_dir("depth-exr-ambiguous");
         let path = dir.join("d.exr");
         atomic_write(&path, |out| {
-            write_f32_channels(&path, out, 1, 1, vec![("alpha", vec![1.0]), ("beta", vec![2.0])], crate::io::ExrCompression::default())
+            write_f32_channels(
+                &path,
+                out,
+                1,
+                1,
+                vec![("alpha", vec![1.0]), ("beta", vec![2.0])],
+                crate::io::ExrCompression::default(),
+            )
         })
         .unwrap();
         let err = load_depth(&path, &DepthDecode::default()).unwrap_err().to_string();

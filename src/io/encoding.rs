@@ -41,7 +41,10 @@ impl std::str::FromStr for PngCompression {
             "fast" => Ok(PngCompression::Fast),
             "default" => Ok(PngCompression::Default),
             "best" => Ok(PngCompression::Best),
-            _ => Err(Error::param("png-compression", format!("'{s}': expected fast, default or best"))),
+            _ => Err(Error::param(
+                "png-compression",
+                format!("'{s}': expected fast, default or best"),
+            )),
         }
     }
 }
@@ -98,8 +101,19 @@ mod tests {
     fn names_parse_and_defaults_are_the_historical_settings() {
         assert_eq!("fast".parse::<PngCompression>().unwrap(), PngCompression::Fast);
         assert_eq!("piz".parse::<ExrCompression>().unwrap(), ExrCompression::Piz);
-        assert!("gzip".parse::<ExrCompression>().unwrap_err().to_string().contains("exr-compression"));
-        assert!("max".parse::<PngCompression>().unwrap_err().to_string().contains("png-compression"));
-        assert_eq!(ExrCompression::default().exr_encoding(), exr::prelude::Encoding::SMALL_LOSSLESS);
+        assert!("gzip"
+            .parse::<ExrCompression>()
+            .unwrap_err()
+            .to_string()
+            .contains("exr-compression"));
+        assert!("max"
+            .parse::<PngCompression>()
+            .unwrap_err()
+            .to_string()
+            .contains("png-compression"));
+        assert_eq!(
+            ExrCompression::default().exr_encoding(),
+            exr::prelude::Encoding::SMALL_LOSSLESS
+        );
     }
 }

@@ -5,8 +5,8 @@ use std::io::{BufWriter, Cursor};
 use std::path::Path;
 
 use exr::prelude::{
-    AnyChannel, AnyChannels, FlatSamples, Image, Layer, LayerAttributes, MetaData, ReadChannels, ReadLayers,
-    SmallVec, WritableImage,
+    AnyChannel, AnyChannels, FlatSamples, Image, Layer, LayerAttributes, MetaData, ReadChannels, ReadLayers, SmallVec,
+    WritableImage,
 };
 
 use super::depth::{RawDepth, RawSamples};

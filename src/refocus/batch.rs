@@ -169,7 +169,10 @@ impl std::str::FromStr for Shard {
     fn from_str(s: &str) -> Result<Self> {
         let bad = || Error::param("shard", format!("'{s}': expected K/N with 0 <= K < N, e.g. 0/4"));
         let (k, n) = s.split_once('/').ok_or_else(bad)?;
-        let (index, count): (usize, usize) = (k.trim().parse().map_err(|_| bad())?, n.trim().parse().map_err(|_| bad())?);
+        let (index, count): (usize, usize) = (
+            k.trim().parse().map_err(|_| bad())?,
+            n.trim().parse().map_err(|_| bad())?,
+        );
         if count == 0 || index >= count {
             return Err(bad());
         }
@@ -278,16 +281,24 @@ fn frame_finished(dir: &Path, settings: &serde_json::Value) -> bool {
     if std::fs::metadata(&path).map_or(true, |m| !m.is_file() || m.len() > 16 << 20) {
         return false;
     }
-    let Ok(text) = std::fs::read_to_string(&path) else { return false };
-    let Ok(m) = serde_json::from_str::<serde_json::Value>(&text) else { return false };
+    let Ok(text) = std::fs::read_to_string(&path) else {
+        return false;
+    };
+    let Ok(m) = serde_json::from_str::<serde_json::Value>(&text) else {
+        return false;
+    };
     if m.get("settings") != Some(settings) {
         return false;
     }
-    let Some(files) = m.get("files").and_then(|f| f.as_array()) else { return false };
+    let Some(files) = m.get("files").and_then(|f| f.as_array()) else {
+        return false;
+    };
     !files.is_empty()
         && files.iter().all(|f| {
-            let (Some(name), Some(bytes)) = (f.get("name").and_then(|v| v.as_str()), f.get("bytes").and_then(|v| v.as_u64()))
-            else {
+            let (Some(name), Some(bytes)) = (
+                f.get("name").and_then(|v| v.as_str()),
+                f.get("bytes").and_then(|v| v.as_u64()),
+            ) else {
                 return false;
             };
             // Names are ours (scale tags); refuse anything that would leave the folder.
@@ -303,7 +314,10 @@ fn check_frame_dir(dir: &Path) -> Result<()> {
     match std::fs::symlink_metadata(dir) {
         Ok(m) if m.file_type().is_symlink() => Err(Error::param(
             "frame folder",
-            format!("{} is a symbolic link; outputs are only written inside --out-dir", dir.display()),
+            format!(
+                "{} is a symbolic link; outputs are only written inside --out-dir",
+                dir.display()
+            ),
         )),
         Ok(m) if !m.is_dir() => Err(Error::param(
             "frame folder",
@@ -339,8 +353,12 @@ fn remove_stale_temporaries(dir: &Path) {
     let Ok(entries) = std::fs::read_dir(dir) else { return };
     for e in entries.flatten() {
         let name = e.file_name().to_string_lossy().into_owned();
-        let Some((_, tail)) = name.rsplit_once(".tmp-") else { continue };
-        let Some(pid) = tail.split('-').next().and_then(|p| p.parse::<u32>().ok()) else { continue };
+        let Some((_, tail)) = name.rsplit_once(".tmp-") else {
+            continue;
+        };
+        let Some(pid) = tail.split('-').next().and_then(|p| p.parse::<u32>().ok()) else {
+            continue;
+        };
         let alive = pid == std::process::id() || Path::new(&format!("/proc/{pid}")).exists();
         if name.starts_with('.') && !alive {
             let _ = std::fs::remove_file(e.path());
@@ -378,7 +396,6 @@ struct InFlight {
 /// Upload a decoded frame and queue all its targets.
 fn submit_frame(
     refocuser: &mut Refocuser,
-    gpu: &Gpu,
     name: String,
     dir: PathBuf,
     src: &RefocusSource,
@@ -396,7 +413,10 @@ fn submit_frame(
     refocuser.set_source(src)?;
     stages.upload.push(ms_since(t0));
     let t0 = Instant::now();
-    let pending = targets.iter().map(|t| refocuser.submit(t)).collect::<Result<Vec<_>>>()?;
+    let pending = targets
+        .iter()
+        .map(|t| refocuser.submit(t))
+        .collect::<Result<Vec<_>>>()?;
     stages.render.push(ms_since(t0));
     let manifest = Manifest {
         tool: format!("viewsynth {}", env!("CARGO_PKG_VERSION")),
@@ -404,7 +424,7 @@ fn submit_frame(
         method: opts.method,
         break_rule: opts.rule,
         conventions: opts.conv,
-        renderer: gpu.info().renderer.clone(),
+        renderer: refocuser.gpu().info().renderer.clone(),
         notes: job::MANIFEST_NOTES.to_string(),
         settings: Some(settings),
         files: Vec::new(),
@@ -459,7 +479,10 @@ pub fn run_batch(
         return Err(Error::param("scales", "no focal scale given"));
     }
     if opts.jobs > MAX_JOBS {
-        return Err(Error::param("jobs", format!("{} exceeds the limit of {MAX_JOBS}", opts.jobs)));
+        return Err(Error::param(
+            "jobs",
+            format!("{} exceeds the limit of {MAX_JOBS}", opts.jobs),
+        ));
     }
     opts.rule.validate()?;
     std::fs::create_dir_all(out_dir).map_err(|e| Error::io(out_dir, e))?;
@@ -493,9 +516,11 @@ pub fn run_batch(
             let t0 = Instant::now();
             let result = decode_frame(frame).and_then(|src| {
                 stages.decode.push(ms_since(t0));
-                submit_frame(&mut refocuser, gpu, name.clone(), dir, &src, settings, opts, &mut stages)
+                submit_frame(&mut refocuser, name.clone(), dir, &src, settings, opts, &mut stages)
             });
-            let result = result.map_err(|e| (name.clone(), e)).and_then(|f| collect_frame(f, &mut stages));
+            let result = result
+                .map_err(|e| (name.clone(), e))
+                .and_then(|f| collect_frame(f, &mut stages));
             match result.and_then(|job| {
                 let t0 = Instant::now();
                 let r = write_frame(job, &files).map_err(|e| (name.clone(), e));
@@ -574,14 +599,15 @@ pub fn run_batch(
                 handle(done, &mut stages);
             }
             let t0 = Instant::now();
-            let Ok((i, src, decode_ms)) = decoded_rx.recv() else { break };
+            let Ok((i, src, decode_ms)) = decoded_rx.recv() else {
+                break;
+            };
             stages.wait.push(ms_since(t0));
             let (_, name, dir, settings) = &todo[i];
             let submitted = src.and_then(|src| {
                 stages.decode.push(decode_ms);
                 submit_frame(
                     &mut refocuser,
-                    gpu,
                     name.clone(),
                     dir.clone(),
                     &src,

@@ -200,7 +200,10 @@ impl Refocuser {
         }
         let grid = Grid { width: w, height: h };
         let keep = grid.keep_mask(&src.depth.data, &self.rule);
-        let same_size = self.source.as_ref().is_some_and(|s| s.camera.width == w && s.camera.height == h);
+        let same_size = self
+            .source
+            .as_ref()
+            .is_some_and(|s| s.camera.width == w && s.camera.height == h);
         let previous = if same_size { self.source.take() } else { None };
         self.source = None; // free a differently sized source before allocating
         match &mut self.geometry {
@@ -253,6 +256,11 @@ impl Refocuser {
         Ok(())
     }
 
+    /// The context this refocuser renders on.
+    pub fn gpu(&self) -> &Gpu {
+        &self.gpu
+    }
+
     /// Number of kept triangles (mesh path) for reports.
     pub fn triangle_count(&self) -> Option<usize> {
         match &self.geometry {
@@ -290,7 +298,11 @@ impl Refocuser {
             let framebuffer = Framebuffer::new(&self.gpu, w, h, &attachments, with_depth)?;
             let cols = Texture::new(&self.gpu, w, 1, TextureFormat::Rgba32F, None)?;
             let rows = Texture::new(&self.gpu, h, 1, TextureFormat::Rgba32F, None)?;
-            self.slots.push(TargetSlot { framebuffer, cols, rows });
+            self.slots.push(TargetSlot {
+                framebuffer,
+                cols,
+                rows,
+            });
         }
         Ok(self.slots.last().expect("pushed above"))
     }

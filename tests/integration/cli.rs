@@ -244,13 +244,15 @@ fn batch_reports_a_corrupt_frame_completes_the_rest_and_resumes() {
     // Repair the frame and resume: only it is rendered; finished frames are left alone, and a
     // temporary left by an interrupted write in the unfinished frame is cleared.
     std::fs::create_dir_all(out.join("frame1")).unwrap();
-    std::fs::write(out.join("frame1").join(".s2_rgb.png.tmp-1-1"), b"partial").unwrap();
+    // (pid 999999999 cannot run: above Linux's pid_max, so the temporary is stale)
+    std::fs::write(out.join("frame1").join(".s2_rgb.png.tmp-999999999-1"), b"partial").unwrap();
     let (rgb, _) = inputs(&d.join("f1"), 32, 24);
     assert!(rgb.is_file());
     let o = run(&out, &[]);
     let text = String::from_utf8_lossy(&o.stdout);
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
     assert!(text.contains("1 rendered, 2 already done"), "{text}");
+    assert!(!out.join("frame1").join(".s2_rgb.png.tmp-999999999-1").exists());
     assert_eq!(
         std::fs::read(out.join("frame2").join("s0.5_depth.exr")).unwrap(),
         before
@@ -266,5 +268,46 @@ fn batch_reports_a_corrupt_frame_completes_the_rest_and_resumes() {
             std::fs::read(out.join("frame1").join(f)).unwrap(),
             "{f}"
         );
+    }
+}
+
+#[test]
+fn bench_batch_prints_throughput_and_stage_medians_as_json() {
+    let o = bin()
+        .args([
+            "bench",
+            "--batch",
+            "2",
+            "--jobs",
+            "1",
+            "--png-compression",
+            "fast",
+            "--json",
+        ])
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let v: serde_json::Value = serde_json::from_slice(&o.stdout).expect("one JSON object on stdout");
+    assert_eq!(v["frames"], 2);
+    assert!(v["frames_per_s"].as_f64().unwrap() > 0.0);
+    for stage in ["decode", "upload", "render", "readback", "encode", "wait"] {
+        assert!(v["stages_ms"][stage].as_f64().unwrap() >= 0.0, "stage {stage}: {v}");
+    }
+    assert!(v["renderer"].as_str().unwrap().contains("llvmpipe") || !v["renderer"].as_str().unwrap().is_empty());
+    assert_eq!(v["synchronous"]["frames"], 2);
+    assert!(!v["bound_by"].as_str().unwrap().is_empty());
+    // Bad values are usage errors that name the option, never a panic.
+    for (args, needle) in [
+        (vec!["bench", "--batch", "0"], "--batch 0"),
+        (vec!["bench", "--batch", "2", "--jobs", "30000"], "--jobs"),
+        (
+            vec!["bench", "--batch", "2", "--png-compression", "max"],
+            "png-compression",
+        ),
+    ] {
+        let o = bin().args(&args).output().unwrap();
+        let err = String::from_utf8_lossy(&o.stderr);
+        assert!(!o.status.success() && err.contains(needle), "{args:?}: {err}");
+        assert!(!err.contains("panicked"), "{err}");
     }
 }

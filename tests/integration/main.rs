@@ -1,12 +1,14 @@
 //! Integration tests: one binary. GPU tests need EGL with GL 4.5 (Mesa llvmpipe in CI); a
 //! missing EGL fails them with the library's error, never a skip.
 
+mod batch;
 mod cli;
 mod cli_reproject_stitch;
 mod common;
 mod compare;
 mod cyclopean;
 mod gpu_context;
+mod readback;
 mod refocus_accuracy;
 mod refocus_conventions;
 mod refocus_edge_cases;

@@ -203,7 +203,10 @@ pub(crate) fn refocus_batch(manifest: &Path, a: RefocusArgs) -> Result<()> {
     let summary = run_batch(&gpu, &frames, &a.out_dir, &opts, || bar.inc(1))?;
     bar.finish_and_clear();
     let shard_note = match opts.shard {
-        Some(s) => format!(" (shard {}/{}: {} frames belong to other shards)", s.index, s.count, summary.other_shards),
+        Some(s) => format!(
+            " (shard {}/{}: {} frames belong to other shards)",
+            s.index, s.count, summary.other_shards
+        ),
         None => String::new(),
     };
     println!(
