@@ -167,20 +167,21 @@ impl CyclopeanRenderer {
 }
 
 /// Read a middle-view framebuffer (RGBA8 colour, R32F depth, R8 source bits) back top-down;
-/// colour and depth only where the framebuffer has them.
+/// colour and depth only where the framebuffer has them. All reads are queued before the first
+/// is waited for; the GPU flips the rows (GL row order) and packs RGB, so the mapped bytes are
+/// the images' bytes.
 pub(crate) fn read_output(fb: &Framebuffer, rows: RowOrder) -> Result<CyclopeanOutput> {
+    use crate::gpu::ReadFormat;
     let (w, h) = (fb.width, fb.height);
-    let read = |i: usize, bpp: usize| -> Result<Option<Vec<u8>>> {
-        Ok(fb.read_color(i)?.map(|data| rows.convert_rows(data, w as usize * bpp)))
-    };
-    let sources = read(2, 1)?.ok_or_else(|| Error::Gl("middle framebuffer lacks the source bits".into()))?;
+    let flip = rows == RowOrder::BottomUp;
+    let sources = fb
+        .read_async(2, ReadFormat::R8, flip)?
+        .ok_or_else(|| Error::Gl("middle framebuffer lacks the source bits".into()))?;
+    let color = fb.read_async(0, ReadFormat::RGB8, flip)?;
+    let depth = fb.read_async(1, ReadFormat::R32F, flip)?;
     Ok(CyclopeanOutput {
-        color: read(0, 4)?
-            .map(|rgba| RgbImage::new(w, h, crate::gpu::pixels::rgba_to_rgb(&rgba)))
-            .transpose()?,
-        depth: read(1, 4)?
-            .map(|d| DepthMap::new(w, h, crate::gpu::pixels::bytes_to_f32(&d)))
-            .transpose()?,
-        sources,
+        sources: sources.finish()?,
+        color: color.map(|r| RgbImage::new(w, h, r.finish()?)).transpose()?,
+        depth: depth.map(|r| DepthMap::new(w, h, r.finish_f32()?)).transpose()?,
     })
 }
