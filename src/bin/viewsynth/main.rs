@@ -12,6 +12,7 @@ use viewsynth::refocus::{BreakRule, Method, OutputSet, RefocusSource, Refocuser}
 
 mod compare;
 mod cyclopean;
+mod intrinsics;
 mod refocus;
 mod reproject;
 mod scene;
@@ -19,6 +20,7 @@ mod stitch;
 
 use compare::{compare, CompareArgs};
 use cyclopean::{cyclopean, CyclopeanArgs};
+use intrinsics::IntrinsicsArgs;
 use refocus::{refocus, RefocusArgs};
 use reproject::{reproject, ReprojectArgs};
 use scene::render_scene;

@@ -33,14 +33,8 @@ pub(crate) struct RefocusArgs {
     /// SUN RGB-D PNG depth: rotate the 16-bit value right by 3 bits before scaling.
     #[arg(long)]
     sun_bit_rotate: bool,
-    #[arg(long, required_unless_present = "batch")]
-    fx: Option<f64>,
-    #[arg(long, required_unless_present = "batch")]
-    fy: Option<f64>,
-    #[arg(long, required_unless_present = "batch")]
-    cx: Option<f64>,
-    #[arg(long, required_unless_present = "batch")]
-    cy: Option<f64>,
+    #[command(flatten)]
+    intrinsics: IntrinsicsArgs,
     #[arg(long)]
     out_dir: PathBuf,
     /// Target focal lengths fx' in pixels (fy' keeps the source fy/fx).
@@ -80,13 +74,11 @@ pub(crate) fn refocus(a: RefocusArgs) -> Result<()> {
     }
     // Everything that can be checked before touching the GPU or the output directory is.
     // (clap requires these without --batch.)
-    let (Some(rgb_path), Some(depth_path), Some(fx), Some(fy), Some(cx), Some(cy)) =
-        (a.rgb.clone(), a.depth.clone(), a.fx, a.fy, a.cx, a.cy)
-    else {
-        bail!("--rgb, --depth, --fx, --fy, --cx and --cy are required without --batch");
+    let (Some(rgb_path), Some(depth_path)) = (a.rgb.clone(), a.depth.clone()) else {
+        bail!("--rgb and --depth are required without --batch");
     };
-    let k = Intrinsics { fx, fy, cx, cy };
-    k.validate("source intrinsics")?;
+    let source_k = a.intrinsics.resolve()?;
+    let k = source_k.k;
     let rule = BreakRule {
         tau_rel: a.tau_rel,
         tau_abs: a.tau_abs,
@@ -105,6 +97,7 @@ pub(crate) fn refocus(a: RefocusArgs) -> Result<()> {
         ..Default::default()
     };
     let depth = io::load_depth(&depth_path, &decode)?;
+    source_k.check_size(rgb.width, rgb.height)?;
     let src = RefocusSource::new(rgb, depth, k)
         .with_context(|| format!("{} and {}", rgb_path.display(), depth_path.display()))?;
     let scales = match &a.focal_list {
@@ -164,6 +157,9 @@ pub(crate) fn refocus(a: RefocusArgs) -> Result<()> {
 
 pub(crate) fn refocus_batch(manifest: &Path, a: RefocusArgs) -> Result<()> {
     use viewsynth::refocus::batch::{load_manifest, run_batch, BatchOptions};
+    if a.intrinsics.any_given() {
+        bail!("--intrinsics/--fx/--fy/--cx/--cy are per frame: with --batch they come from the manifest");
+    }
     if a.focal_list.is_some() {
         bail!("--focal-list is per frame; with --batch give --zoom-range scales");
     }

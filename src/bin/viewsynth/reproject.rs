@@ -61,19 +61,13 @@ pub(crate) struct ReprojectArgs {
     /// Far plane (metres; may be inf) the device depth was written with (--depth-kind device).
     #[arg(long)]
     far: Option<f64>,
-    /// Source intrinsics in pixels (with a rig).
-    #[arg(long, required_unless_present = "cameras")]
-    fx: Option<f64>,
-    #[arg(long, required_unless_present = "cameras")]
-    fy: Option<f64>,
-    #[arg(long, required_unless_present = "cameras")]
-    cx: Option<f64>,
-    #[arg(long, required_unless_present = "cameras")]
-    cy: Option<f64>,
+    /// Source intrinsics (with a rig).
+    #[command(flatten)]
+    intrinsics: IntrinsicsArgs,
     /// Full eye matrices instead of a rig: a cameras.json as `viewsynth scene` writes it (left
     /// and right GL view and projection, conventions, depth kind: those of the file apply).
     /// The source is --from's eye, the target the other eye; --method gather3d only.
-    #[arg(long, conflicts_with_all = ["fx", "fy", "cx", "cy", "baseline", "separation", "near", "far", "focal"])]
+    #[arg(long, conflicts_with_all = ["intrinsics", "fx", "fy", "cx", "cy", "baseline", "separation", "near", "far", "focal"])]
     cameras: Option<PathBuf>,
     /// Rectified rig: distance between the eyes in metres (x_right = x_left + doffs - f B / Z).
     /// Also the baseline of --depth-kind disparity.
@@ -245,11 +239,12 @@ fn rig_setup(a: &ReprojectArgs) -> Result<Setup> {
 
     // Everything that can be checked before reading files, touching the GPU or the output
     // directory is.
-    let (Some(fx), Some(fy), Some(cx), Some(cy)) = (a.fx, a.fy, a.cx, a.cy) else {
-        bail!("give the source intrinsics --fx --fy --cx --cy (or --cameras FILE)");
-    };
-    let k = Intrinsics { fx, fy, cx, cy };
-    k.validate("source intrinsics")?;
+    if !a.intrinsics.any_given() {
+        bail!("give the source intrinsics: --intrinsics FILE or --fx --fy --cx --cy (or full eye matrices: --cameras FILE)");
+    }
+    let source_k = a.intrinsics.resolve()?;
+    let k = source_k.k;
+    let fx = k.fx;
     let from = match a.from {
         FromArg::Left => Some(Eye::Left),
         FromArg::Centre => None,
@@ -300,6 +295,7 @@ fn rig_setup(a: &ReprojectArgs) -> Result<Setup> {
             .map_or_else(String::new, |v| v.get_name().to_string())
     );
     let src = load_source(a, depth_kind, conv, &what)?;
+    source_k.check_size(src.color.width, src.color.height)?;
     let camera = PinholeCamera {
         k,
         width: src.color.width,

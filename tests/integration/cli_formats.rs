@@ -1,0 +1,174 @@
+//! The input formats users already have, through the binary: `--intrinsics FILE` (each format,
+//! flags overriding), `.npz` depth (`--npz-key`), and the printed input summary.
+
+use crate::cli::{assert_clean_failure, bin, files_in, scratch};
+use std::path::{Path, PathBuf};
+use std::process::Output;
+use viewsynth::io::{self, DepthMap, RgbImage};
+
+fn s(p: &Path) -> &str {
+    p.to_str().unwrap()
+}
+
+/// A 32x24 colour + view-Z pair (1 to 1.31 m across).
+fn inputs(dir: &Path) -> (PathBuf, PathBuf) {
+    let (w, h) = (32u32, 24u32);
+    let rgb: Vec<u8> = (0..w * h * 3).map(|i| (i * 7 % 251) as u8).collect();
+    let depth: Vec<f32> = (0..w * h).map(|i| 1.0 + 0.01 * (i % w) as f32).collect();
+    let (rp, dp) = (dir.join("rgb.png"), dir.join("depth.npy"));
+    io::save_rgb(&rp, &RgbImage::new(w, h, rgb).unwrap()).unwrap();
+    io::save_depth_npy(&dp, &DepthMap::new(w, h, depth).unwrap()).unwrap();
+    (rp, dp)
+}
+
+fn refocus(rgb: &Path, depth: &Path, out: &Path, camera: &[&str]) -> Output {
+    bin()
+        .args([
+            "refocus",
+            "--zoom-range",
+            "1.5",
+            "--rgb",
+            s(rgb),
+            "--depth",
+            s(depth),
+            "--out-dir",
+            s(out),
+        ])
+        .args(camera)
+        .output()
+        .unwrap()
+}
+
+fn source_of(out: &Path) -> serde_json::Value {
+    let m: serde_json::Value = serde_json::from_slice(&std::fs::read(out.join("manifest.json")).unwrap()).unwrap();
+    m["source"].clone()
+}
+
+fn ok(o: &Output) -> String {
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    String::from_utf8_lossy(&o.stderr).into_owned()
+}
+
+#[test]
+fn refocus_intrinsics_file_in_every_format_matches_the_flags() {
+    let d = scratch("k-formats");
+    let (rgb, depth) = inputs(&d);
+    let flags = d.join("flags");
+    ok(&refocus(
+        &rgb,
+        &depth,
+        &flags,
+        &["--fx", "40", "--fy", "41", "--cx", "15.5", "--cy", "11.5"],
+    ));
+    let want_rgb = std::fs::read(flags.join("s1.5_rgb.png")).unwrap();
+    let files = [
+        ("K.json", "[[40, 0, 15.5], [0, 41, 11.5], [0, 0, 1]]".to_string()),
+        ("K.txt", "40 0 15.5\n0 41 11.5\n0 0 1\n".to_string()),
+        (
+            "open3d.json",
+            r#"{"width": 32, "height": 24, "intrinsic_matrix": [40, 0, 0, 0, 41, 0, 15.5, 11.5, 1]}"#.to_string(),
+        ),
+        // Middlebury cam0 has one f: fy comes from the flag below.
+        (
+            "calib.txt",
+            "cam0=[40 0 15.5; 0 40 11.5; 0 0 1]\nwidth=32\nheight=24\n".to_string(),
+        ),
+        ("cameras.txt", "# COLMAP\n1 PINHOLE 32 24 40 41 16 12\n".to_string()),
+    ];
+    for (name, text) in files {
+        let path = d.join(name);
+        std::fs::write(&path, text).unwrap();
+        let out = d.join(format!("out-{name}"));
+        let extra: &[&str] = if name == "calib.txt" { &["--fy", "41"] } else { &[] };
+        let mut args = vec!["--intrinsics", s(&path)];
+        args.extend_from_slice(extra);
+        ok(&refocus(&rgb, &depth, &out, &args));
+        assert_eq!(source_of(&out), source_of(&flags), "{name}");
+        assert_eq!(std::fs::read(out.join("s1.5_rgb.png")).unwrap(), want_rgb, "{name}");
+    }
+}
+
+#[test]
+fn refocus_flags_override_single_values_of_the_file() {
+    let d = scratch("k-override");
+    let (rgb, depth) = inputs(&d);
+    let k = d.join("K.txt");
+    std::fs::write(&k, "40 0 15.5\n0 40 11.5\n0 0 1\n").unwrap();
+    let out = d.join("out");
+    ok(&refocus(
+        &rgb,
+        &depth,
+        &out,
+        &["--intrinsics", s(&k), "--cx", "14", "--fx", "38"],
+    ));
+    let src = source_of(&out);
+    assert_eq!((src["fx"].as_f64(), src["fy"].as_f64()), (Some(38.0), Some(40.0)));
+    assert_eq!((src["cx"].as_f64(), src["cy"].as_f64()), (Some(14.0), Some(11.5)));
+}
+
+#[test]
+fn bad_intrinsics_files_fail_cleanly() {
+    let d = scratch("k-bad");
+    let (rgb, depth) = inputs(&d);
+    let out = d.join("out");
+    let cases = [
+        ("cameras.txt", "1 OPENCV 32 24 40 40 16 12 0.1 0 0 0", "OPENCV"),
+        (
+            "open3d.json",
+            r#"{"width": 64, "height": 48, "intrinsic_matrix": [40,0,0,0,40,0,15.5,11.5,1]}"#,
+            "64x48",
+        ),
+        ("K.json", "[[40, 0, 15.5], [0, 40, 11.5]]", "3x3"),
+    ];
+    for (name, text, needle) in cases {
+        let path = d.join(name);
+        std::fs::write(&path, text).unwrap();
+        let o = refocus(&rgb, &depth, &out, &["--intrinsics", s(&path)]);
+        assert_clean_failure(&o, needle, &out);
+        assert_clean_failure(&o, name, &out);
+    }
+    let o = refocus(&rgb, &depth, &out, &["--fx", "40", "--fy", "40", "--cx", "15.5"]);
+    assert_clean_failure(&o, "--cy is missing", &out);
+    assert!(files_in(&out).iter().all(|f| f.starts_with(".viewsynth-write-test")));
+}
+
+#[test]
+fn reproject_takes_an_intrinsics_file() {
+    let d = scratch("k-reproject");
+    let (rgb, depth) = inputs(&d);
+    let k = d.join("K.json");
+    std::fs::write(
+        &k,
+        r#"{"K": [40, 0, 15.5, 0, 40, 11.5, 0, 0, 1], "width": 32, "height": 24}"#,
+    )
+    .unwrap();
+    let run = |out: &Path, camera: &[&str]| {
+        bin()
+            .args([
+                "reproject",
+                "--color",
+                s(&rgb),
+                "--depth",
+                s(&depth),
+                "--baseline",
+                "0.05",
+                "--out-dir",
+                s(out),
+            ])
+            .args(camera)
+            .output()
+            .unwrap()
+    };
+    let (a, b) = (d.join("a"), d.join("b"));
+    ok(&run(&a, &["--fx", "40", "--fy", "40", "--cx", "15.5", "--cy", "11.5"]));
+    ok(&run(&b, &["--intrinsics", s(&k)]));
+    for f in ["right_rgb.png", "right_depth.exr", "right_mask.png"] {
+        assert_eq!(
+            std::fs::read(a.join(f)).unwrap(),
+            std::fs::read(b.join(f)).unwrap(),
+            "{f}"
+        );
+    }
+    let none = d.join("none");
+    assert_clean_failure(&run(&none, &[]), "--intrinsics FILE", &none);
+}
