@@ -13,6 +13,7 @@ mod image_types;
 mod mask;
 mod netpbm;
 mod npy;
+mod npz;
 mod pfm;
 mod pgm;
 mod rgb;
@@ -23,8 +24,9 @@ mod dataset_tests;
 mod test_util;
 
 pub use atomic::atomic_write;
-pub use depth::{load_depth, save_depth_exr, save_depth_npy, DepthDecode};
+pub use depth::{load_depth, load_depth_with_key, save_depth_exr, save_depth_npy, DepthDecode};
 pub use image_types::{DepthMap, Mask, RgbImage, MAX_DIMENSION};
 pub use mask::{load_mask_png, save_mask_png};
 pub use npy::{load_npy, save_npy_f32, NpyArray, NpyDtype};
+pub use npz::load_npz_array;
 pub use rgb::{load_rgb, save_rgb};

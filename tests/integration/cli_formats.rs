@@ -172,3 +172,74 @@ fn reproject_takes_an_intrinsics_file() {
     let none = d.join("none");
     assert_clean_failure(&run(&none, &[]), "--intrinsics FILE", &none);
 }
+
+#[test]
+fn reproject_motorcycle_from_npz_disparity_with_a_calib_txt() {
+    let d = scratch("npz-motorcycle");
+    let data = crate::common::data_dir().join("middlebury2014_motorcycle_skimage");
+    let (left, npz) = (data.join("motorcycle_left.png"), data.join("motorcycle_disp.npz"));
+    // The published calib.txt scaled to the 4x downsampled pair (the data README's values).
+    let calib = d.join("calib.txt");
+    std::fs::write(
+        &calib,
+        "cam0=[994.978 0 311.193; 0 994.978 254.877; 0 0 1]\n\
+         cam1=[994.978 0 342.279; 0 994.978 254.877; 0 0 1]\n\
+         doffs=31.086\nbaseline=193.001\nwidth=741\nheight=500\n",
+    )
+    .unwrap();
+    // The same disparity as .npy, to check the .npz path reads it identically.
+    let npy = d.join("disp.npy");
+    io::save_depth_npy(&npy, &io::load_depth(&npz, &io::DepthDecode::default()).unwrap()).unwrap();
+    let run = |depth: &Path, out: &Path, extra: &[&str]| {
+        bin()
+            .args([
+                "reproject",
+                "--color",
+                s(&left),
+                "--depth",
+                s(depth),
+                "--depth-kind",
+                "disparity",
+            ])
+            .args([
+                "--baseline",
+                "0.193001",
+                "--doffs",
+                "31.086",
+                "--outputs",
+                "rgb,mask",
+                "--out-dir",
+                s(out),
+            ])
+            .args(extra)
+            .output()
+            .unwrap()
+    };
+    let (a, b) = (d.join("npz"), d.join("npy"));
+    ok(&run(&npz, &a, &["--intrinsics", s(&calib), "--npz-key", "arr_0"]));
+    ok(&run(
+        &npy,
+        &b,
+        &[
+            "--fx", "994.978", "--fy", "994.978", "--cx", "311.193", "--cy", "254.877",
+        ],
+    ));
+    for f in ["right_rgb.png", "right_mask.png"] {
+        assert_eq!(
+            std::fs::read(a.join(f)).unwrap(),
+            std::fs::read(b.join(f)).unwrap(),
+            "{f}"
+        );
+    }
+    let bad = d.join("bad");
+    assert_clean_failure(
+        &run(&npz, &bad, &["--intrinsics", s(&calib), "--npz-key", "disp"]),
+        "no array 'disp' (arrays: arr_0)",
+        &bad,
+    );
+    assert_clean_failure(
+        &run(&npy, &bad, &["--intrinsics", s(&calib), "--npz-key", "arr_0"]),
+        "applies to .npz files only",
+        &bad,
+    );
+}

@@ -37,6 +37,10 @@ pub(crate) struct CompareArgs {
     a_rows: RowsArg,
     #[arg(long, value_enum, default_value = "top-down")]
     b_rows: RowsArg,
+    /// Array of an .npz depth file (both sides) to read (default: the only array, else the first
+    /// floating-point one).
+    #[arg(long, value_name = "NAME")]
+    npz_key: Option<String>,
     /// Near/far planes of the device depth (metres; far may be inf).
     #[arg(long, default_value_t = 0.1)]
     near: f64,
@@ -63,7 +67,9 @@ pub(crate) fn compare(a: CompareArgs) -> Result<()> {
     let side = |rgb: &Path, depth: Option<&Path>, kind: DepthKindArg, conv: Conventions| -> Result<Side> {
         Ok(Side {
             color: io::load_rgb(rgb)?,
-            depth: depth.map(|d| io::load_depth(d, &DepthDecode::default())).transpose()?,
+            depth: depth
+                .map(|d| io::load_depth_with_key(d, a.npz_key.as_deref(), &DepthDecode::default()))
+                .transpose()?,
             storage: if kind == DepthKindArg::Device {
                 DepthStorage::Device(planes)
             } else {

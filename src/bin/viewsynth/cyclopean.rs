@@ -26,6 +26,10 @@ pub(crate) struct CyclopeanArgs {
     /// Raw units per unit of depth for integer depth files.
     #[arg(long)]
     depth_scale: Option<f64>,
+    /// Array of an .npz depth file (both eyes) to read (default: the only array, else the first
+    /// floating-point one).
+    #[arg(long, value_name = "NAME")]
+    npz_key: Option<String>,
     /// 0 = the seed's single step; k >= 1 = k-step refinement with projection check.
     #[arg(long, default_value_t = 3)]
     refine_steps: u32,
@@ -88,7 +92,7 @@ pub(crate) fn cyclopean(a: CyclopeanArgs) -> Result<()> {
     let eye = |rgb: &Path, depth: &Path, cam: &viewsynth::cyclopean::camera_file::EyeCameras| -> Result<EyeInput> {
         Ok(EyeInput {
             color: io::load_rgb(rgb)?,
-            depth: io::load_depth(depth, &decode)?,
+            depth: io::load_depth_with_key(depth, a.npz_key.as_deref(), &decode)?,
             view: cam.view,
             proj: cam.proj,
         })

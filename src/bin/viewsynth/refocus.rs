@@ -13,7 +13,7 @@ pub(crate) struct RefocusArgs {
     /// Source colour (PNG, JPEG, PPM, EXR).
     #[arg(long, required_unless_present = "batch")]
     rgb: Option<PathBuf>,
-    /// Source metric depth, view-space Z (EXR, NPY f32/f64/u16, 16-bit PNG/PGM with --depth-scale, PFM).
+    /// Source metric depth, view-space Z (EXR, NPY/NPZ f32/f64/u16, 16-bit PNG/PGM with --depth-scale, PFM).
     #[arg(long, required_unless_present = "batch")]
     depth: Option<PathBuf>,
     /// Refocus every frame of a CSV/JSON manifest (columns rgb,depth,fx,fy,cx,cy[,depth_scale,name];
@@ -30,6 +30,10 @@ pub(crate) struct RefocusArgs {
     /// Raw units per metre for integer depth (5000 for TUM, 1000 for NYU/SUN); divides float depth too when given.
     #[arg(long)]
     depth_scale: Option<f64>,
+    /// Array of an .npz depth file to read (default: the only array, else the first
+    /// floating-point one).
+    #[arg(long, value_name = "NAME")]
+    npz_key: Option<String>,
     /// SUN RGB-D PNG depth: rotate the 16-bit value right by 3 bits before scaling.
     #[arg(long)]
     sun_bit_rotate: bool,
@@ -96,7 +100,7 @@ pub(crate) fn refocus(a: RefocusArgs) -> Result<()> {
         sun_rgbd_bit_rotate: a.sun_bit_rotate,
         ..Default::default()
     };
-    let depth = io::load_depth(&depth_path, &decode)?;
+    let depth = io::load_depth_with_key(&depth_path, a.npz_key.as_deref(), &decode)?;
     source_k.check_size(rgb.width, rgb.height)?;
     let src = RefocusSource::new(rgb, depth, k)
         .with_context(|| format!("{} and {}", rgb_path.display(), depth_path.display()))?;

@@ -46,7 +46,7 @@ pub(crate) struct ReprojectArgs {
     /// Source colour (PNG, JPEG, PPM, EXR), rows top-down.
     #[arg(long, visible_alias = "rgb")]
     color: PathBuf,
-    /// Source depth (EXR, NPY, 16-bit PNG/PGM with --depth-scale, PFM), holding --depth-kind.
+    /// Source depth (EXR, NPY, NPZ, 16-bit PNG/PGM with --depth-scale, PFM), holding --depth-kind.
     #[arg(long)]
     depth: PathBuf,
     #[arg(long, value_enum, default_value = "view-z")]
@@ -55,6 +55,10 @@ pub(crate) struct ReprojectArgs {
     /// disparity PGMs); divides float depth too when given.
     #[arg(long)]
     depth_scale: Option<f64>,
+    /// Array of an .npz depth file to read (default: the only array, else the first
+    /// floating-point one).
+    #[arg(long, value_name = "NAME")]
+    npz_key: Option<String>,
     /// Near plane (metres) the device depth was written with (--depth-kind device).
     #[arg(long)]
     near: Option<f64>,
@@ -219,7 +223,7 @@ fn load_source(
     };
     let src = viewsynth::reproject::ReprojectSource {
         color: io::load_rgb(&a.color)?,
-        depth: io::load_depth(&a.depth, &decode)?,
+        depth: io::load_depth_with_key(&a.depth, a.npz_key.as_deref(), &decode)?,
         depth_kind,
         conv,
     };
