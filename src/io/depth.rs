@@ -199,7 +199,7 @@ fn to_metres(path: &Path, raw: RawDepth, decode: &DepthDecode) -> Result<DepthMa
             v.into_iter().map(|d| int_to_metres(d.into(), s)).collect()
         }
         RawSamples::U16(v) => {
-            let s = need_scale("16-bit", "5000 for TUM, 1000 for NYU/SUN")?;
+            let s = need_scale("16-bit", "5000 for TUM, 1000 for SUN RGB-D or millimetres")?;
             v.into_iter()
                 .map(|d| {
                     let d = if decode.swap_bytes { d.swap_bytes() } else { d };
@@ -443,7 +443,10 @@ mod tests {
         }
 
         let err = load_depth(&dir.join("d.tiff"), &DepthDecode::default()).unwrap_err();
-        assert!(err.to_string().contains("expected .exr .npy .npz .png .pgm .pfm"), "{err}");
+        assert!(
+            err.to_string().contains("expected .exr .npy .npz .png .pgm .pfm"),
+            "{err}"
+        );
     }
 
     #[test]

@@ -8,6 +8,7 @@
 mod atomic;
 mod decode;
 mod depth;
+mod depth_summary;
 mod exr_io;
 mod image_types;
 mod mask;
@@ -25,6 +26,7 @@ mod test_util;
 
 pub use atomic::atomic_write;
 pub use depth::{load_depth, load_depth_with_key, save_depth_exr, save_depth_npy, DepthDecode};
+pub use depth_summary::{DepthSummary, DepthWarning, PLAUSIBLE_MEDIAN_M};
 pub use image_types::{DepthMap, Mask, RgbImage, MAX_DIMENSION};
 pub use mask::{load_mask_png, save_mask_png};
 pub use npy::{load_npy, save_npy_f32, NpyArray, NpyDtype};

@@ -216,7 +216,14 @@ fn reproject_motorcycle_from_npz_disparity_with_a_calib_txt() {
             .unwrap()
     };
     let (a, b) = (d.join("npz"), d.join("npy"));
-    ok(&run(&npz, &a, &["--intrinsics", s(&calib), "--npz-key", "arr_0"]));
+    let log = ok(&run(&npz, &a, &["--intrinsics", s(&calib), "--npz-key", "arr_0"]));
+    // 27,226 of 741 x 500 pixels are +inf and d runs 7.19..59.91 px (the data README), so
+    // Z = B f / (d + doffs) runs 2.110..5.017 m.
+    assert!(
+        log.contains("motorcycle_disp.npz: 741x500, 92.7 % valid depth, min 2.110 / median 2.750 / max 5.017 m"),
+        "{log}"
+    );
+    assert!(!log.contains("warning"), "{log}");
     ok(&run(
         &npy,
         &b,
@@ -241,5 +248,102 @@ fn reproject_motorcycle_from_npz_disparity_with_a_calib_txt() {
         &run(&npy, &bad, &["--intrinsics", s(&calib), "--npz-key", "arr_0"]),
         "applies to .npz files only",
         &bad,
+    );
+}
+
+/// stderr of a refocus run on a real RGB-D frame of ../shared/data.
+fn refocus_log(color: &str, depth: &str, extra: &[&str]) -> String {
+    let d = crate::common::data_dir().join("rgbd_open3d_testdata");
+    let out = scratch(&format!("summary-{depth}-{}", extra.join("")));
+    let (color, depth) = (d.join(color), d.join(depth));
+    let o = refocus(
+        &color,
+        &depth,
+        &out,
+        &[
+            &[
+                "--fx",
+                "525",
+                "--fy",
+                "525",
+                "--cx",
+                "319.5",
+                "--cy",
+                "239.5",
+                "--outputs",
+                "mask",
+            ][..],
+            extra,
+        ]
+        .concat(),
+    );
+    ok(&o)
+}
+
+#[test]
+fn refocus_prints_the_input_range_and_warns_on_implausible_scales() {
+    let tum = refocus_log("TUM_color.png", "TUM_depth.png", &["--depth-scale", "5000"]);
+    // The data README: 19 % holes, 1.46 to 9.33 m.
+    assert!(
+        tum.contains("TUM_depth.png: 640x480, 80.8 % valid depth, min 1.464 / median 2.415 / max 9.331 m"),
+        "{tum}"
+    );
+    assert!(!tum.contains("warning"), "{tum}");
+    let sun = refocus_log("SUN_color.jpg", "SUN_depth.png", &["--depth-scale", "1000"]);
+    assert!(
+        sun.contains("warning") && sun.contains("implausibly far") && sun.contains("--sun-bit-rotate"),
+        "{sun}"
+    );
+    let sun_ok = refocus_log(
+        "SUN_color.jpg",
+        "SUN_depth.png",
+        &["--depth-scale", "1000", "--sun-bit-rotate"],
+    );
+    assert!(
+        sun_ok.contains("max 9.870 m") && !sun_ok.contains("warning"),
+        "{sun_ok}"
+    );
+    // NYU's raw PGM holds Kinect disparity counts, little-endian: no scale makes it metres.
+    let nyu = refocus_log("NYU_color.ppm", "NYU_depth.pgm", &["--depth-scale", "1000"]);
+    assert!(
+        nyu.contains("median 54.275") && nyu.contains("implausibly far"),
+        "{nyu}"
+    );
+}
+
+#[test]
+fn cyclopean_warns_when_the_depth_kind_is_wrong() {
+    let d = scratch("summary-cyclopean");
+    let scene = d.join("scene");
+    ok(&bin()
+        .args(["scene", "--width", "64", "--height", "48", "--out-dir", s(&scene)])
+        .output()
+        .unwrap());
+    let run = |suffix: &str, out: &Path| {
+        let mut c = bin();
+        c.args([
+            "cyclopean",
+            "--cameras",
+            s(&scene.join("cameras.json")),
+            "--out-dir",
+            s(out),
+        ]);
+        for eye in ["left", "right"] {
+            c.arg(format!("--{eye}-rgb")).arg(scene.join(format!("{eye}_rgb.png")));
+            c.arg(format!("--{eye}-depth"))
+                .arg(scene.join(format!("{eye}_{suffix}.exr")));
+        }
+        c.output().unwrap()
+    };
+    let right = ok(&run("device_depth", &d.join("a")));
+    assert_eq!(right.matches("input depth").count(), 2, "{right}");
+    assert!(!right.contains("warning"), "{right}");
+    // View distance where the camera file says device depth: values > 1 are no window depth.
+    let wrong = run("view_z", &d.join("b"));
+    let log = String::from_utf8_lossy(&wrong.stderr);
+    assert!(log.contains("left_view_z.exr: 64x48, 0.0 % valid depth"), "{log}");
+    assert!(
+        log.contains("warning") && log.contains("no pixel holds valid depth") && log.contains("depth_kind"),
+        "{log}"
     );
 }

@@ -104,6 +104,17 @@ pub(crate) fn cyclopean(a: CyclopeanArgs) -> Result<()> {
         conv: cams.conventions,
     };
     frame.validate()?;
+    for (path, eye) in [(&a.left_depth, &frame.left), (&a.right_depth, &frame.right)] {
+        print_depth_summary(
+            path,
+            &view_z_in_metres(eye, frame.depth_kind, &frame.conv)?,
+            &format!(
+                "read as {:?} depth (check depth_kind and the projections in {}, and --depth-scale)",
+                frame.depth_kind,
+                a.cameras.display()
+            ),
+        );
+    }
     prepare_out_dir(&a.out_dir)?;
     let gpu = a.gpu.open()?;
     let wanted = CyclopeanOutputs {
@@ -148,4 +159,20 @@ pub(crate) fn cyclopean(a: CyclopeanArgs) -> Result<()> {
         a.out_dir.display()
     );
     Ok(())
+}
+
+/// An eye's depth as view Z in metres (0 where invalid), for the input summary.
+fn view_z_in_metres(
+    eye: &viewsynth::cyclopean::EyeInput,
+    kind: viewsynth::cyclopean::DepthKind,
+    conv: &Conventions,
+) -> Result<viewsynth::io::DepthMap> {
+    use viewsynth::reproject::DepthInput;
+    let input = match kind {
+        viewsynth::cyclopean::DepthKind::ViewZ => DepthInput::ViewZ,
+        viewsynth::cyclopean::DepthKind::Device => DepthInput::Device {
+            planes: viewsynth::convention::DepthPlanes::from_gl_projection(&eye.proj, conv)?,
+        },
+    };
+    Ok(input.view_z_map(conv, &eye.depth))
 }

@@ -17,6 +17,7 @@ mod refocus;
 mod reproject;
 mod scene;
 mod stitch;
+mod summary;
 
 use compare::{compare, CompareArgs};
 use cyclopean::{cyclopean, CyclopeanArgs};
@@ -25,6 +26,7 @@ use refocus::{refocus, RefocusArgs};
 use reproject::{reproject, ReprojectArgs};
 use scene::render_scene;
 use stitch::{stitch, StitchArgs};
+use summary::print_depth_summary;
 
 #[derive(Parser)]
 #[command(

@@ -27,7 +27,9 @@ pub(crate) struct RefocusArgs {
     /// With --batch: threads encoding files while the GPU renders (0 = none).
     #[arg(long, default_value_t = 1)]
     writer_threads: usize,
-    /// Raw units per metre for integer depth (5000 for TUM, 1000 for NYU/SUN); divides float depth too when given.
+    /// Raw units per metre for integer depth: 5000 for TUM, 1000 for SUN RGB-D (with
+    /// --sun-bit-rotate) and millimetre PNGs. Divides float depth too when given. (NYU v2 raw PGM
+    /// holds Kinect disparity, not depth: no scale fits; convert it first.)
     #[arg(long)]
     depth_scale: Option<f64>,
     /// Array of an .npz depth file to read (default: the only array, else the first
@@ -102,6 +104,12 @@ pub(crate) fn refocus(a: RefocusArgs) -> Result<()> {
     };
     let depth = io::load_depth_with_key(&depth_path, a.npz_key.as_deref(), &decode)?;
     source_k.check_size(rgb.width, rgb.height)?;
+    print_depth_summary(
+        &depth_path,
+        &depth,
+        "check --depth-scale (raw units per metre: 5000 TUM, 1000 SUN RGB-D with --sun-bit-rotate) \
+         and that the file holds metric depth, not disparity",
+    );
     let src = RefocusSource::new(rgb, depth, k)
         .with_context(|| format!("{} and {}", rgb_path.display(), depth_path.display()))?;
     let scales = match &a.focal_list {

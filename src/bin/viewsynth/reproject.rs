@@ -229,6 +229,11 @@ fn load_source(
     };
     src.validate()
         .with_context(|| format!("{} and {}", a.color.display(), a.depth.display()))?;
+    print_depth_summary(
+        &a.depth,
+        &src.depth_kind.view_z_map(&src.conv, &src.depth),
+        &format!("read as {what}"),
+    );
     if src.inverse_depth_range().is_none() {
         bail!("{}: no pixel holds valid depth as {what}", a.depth.display());
     }
