@@ -2,6 +2,7 @@
 //! missing EGL fails them with the library's error, never a skip.
 
 mod cli;
+mod cli_compare;
 mod cli_formats;
 mod cli_reproject_stitch;
 mod common;

@@ -46,17 +46,48 @@ pub(crate) struct CompareArgs {
     near: f64,
     #[arg(long, default_value_t = 1000.0)]
     far: f64,
-    /// Write |A - B| x 8 here.
+    /// Write the colour difference here: |A - B| per channel, scaled so that the largest
+    /// difference is white (x 255 / max; the factor is printed and in the JSON).
     #[arg(long)]
     diff: Option<PathBuf>,
-    /// Print JSON instead of text.
-    #[arg(long)]
-    json: bool,
+    /// Compare only where this image (rows top-down, the images' size) is nonzero.
+    #[arg(long, value_name = "FILE")]
+    mask: Option<PathBuf>,
+    /// Fail (exit 1) when the colour RMSE exceeds X (8-bit levels).
+    #[arg(long, visible_alias = "max-color-rmse", value_name = "X")]
+    max_colour_rmse: Option<f64>,
+    /// Fail (exit 1) when the colour PSNR is below X dB.
+    #[arg(long, value_name = "X")]
+    min_psnr: Option<f64>,
+    /// Fail (exit 1) when the largest relative depth error (pixels valid in both) exceeds X.
+    #[arg(long, value_name = "X", requires = "a_depth")]
+    max_depth_rel: Option<f64>,
+    /// Write the summary as JSON to FILE (without FILE, or "-": print it instead of text).
+    /// An infinite PSNR is written as the string "inf".
+    #[arg(long, value_name = "FILE", num_args = 0..=1, default_missing_value = "-")]
+    json: Option<PathBuf>,
+}
+
+/// What `--json` writes.
+#[derive(serde::Serialize)]
+struct Summary<'a> {
+    #[serde(flatten)]
+    comparison: &'a viewsynth::compare::Comparison,
+    thresholds: viewsynth::compare::Thresholds,
+    broken: &'a [String],
+    passed: bool,
 }
 
 pub(crate) fn compare(a: CompareArgs) -> Result<()> {
-    use viewsynth::compare::{compare as run_compare, DepthStorage, Side};
+    use std::io::Write;
+    use viewsynth::compare::{compare_masked, DepthStorage, Side, Thresholds};
     use viewsynth::convention::DepthPlanes;
+    let thresholds = Thresholds {
+        max_color_rmse: a.max_colour_rmse,
+        min_psnr_db: a.min_psnr,
+        max_depth_rel: a.max_depth_rel,
+    };
+    thresholds.validate()?;
     if !(a.near.is_finite() && a.near > 0.0 && a.far > a.near) {
         bail!("invalid --near {} / --far {}: need 0 < near < far", a.near, a.far);
     }
@@ -90,23 +121,63 @@ pub(crate) fn compare(a: CompareArgs) -> Result<()> {
         a.b_depth_kind,
         conventions(a.b_ndc, a.b_reversed_z, a.b_rows),
     )?;
-    let (cmp, diff) = run_compare(&sa, &sb)?;
+    let mask = a.mask.as_deref().map(io::load_mask_png).transpose()?;
+    let (cmp, diff) = compare_masked(&sa, &sb, mask.as_ref()).with_context(|| match &a.mask {
+        Some(m) => format!("comparing A and B over {}", m.display()),
+        None => "comparing A and B".to_string(),
+    })?;
+    let broken = thresholds.broken(&cmp);
+    let summary = Summary {
+        comparison: &cmp,
+        thresholds,
+        broken: &broken,
+        passed: broken.is_empty(),
+    };
+    let json = serde_json::to_string_pretty(&summary)?;
+    let mut jobs: Vec<WriteJob> = Vec::new();
     if let Some(p) = &a.diff {
-        io::save_rgb(p, &diff)?;
+        jobs.push((p.clone(), Box::new(|p: &Path| io::save_rgb(p, &diff))));
     }
-    if a.json {
-        println!("{}", serde_json::to_string_pretty(&cmp)?);
+    match a.json.as_deref() {
+        Some(p) if p != Path::new("-") => jobs.push((
+            p.to_path_buf(),
+            Box::new(|p: &Path| {
+                io::atomic_write(p, |w| {
+                    w.write_all(json.as_bytes()).map_err(|e| viewsynth::Error::io(p, e))
+                })
+            }),
+        )),
+        _ => {}
+    }
+    write_all_or_none(jobs)?;
+    if a.json.as_deref() == Some(Path::new("-")) {
+        println!("{json}");
     } else {
+        let over = if a.mask.is_some() { " (in the mask)" } else { "" };
         println!(
-            "colour: PSNR {:.2} dB, max difference {} levels over {} pixels",
-            cmp.psnr_db, cmp.max_color_diff, cmp.pixels
+            "colour: PSNR {:.2} dB, RMSE {:.4} levels, max difference {} levels over {} pixels{over}",
+            cmp.psnr_db, cmp.color_rmse, cmp.max_color_diff, cmp.pixels
         );
+        if let Some(p) = &a.diff {
+            println!(
+                "diff: {} = |A - B| x {:.3} (the largest difference is white)",
+                p.display(),
+                cmp.diff_scale
+            );
+        }
         if let (Some(abs), Some(rel), Some(d)) = (cmp.depth_max_abs, cmp.depth_max_rel, cmp.mask_disagreement) {
             println!("depth: max abs {abs:.3e} m, max rel {rel:.3e}; valid in only one: {d} pixels");
         }
         if let Some(s) = &cmp.suspicion {
             println!("suspicion: {s}");
         }
+    }
+    if !broken.is_empty() {
+        for b in &broken {
+            eprintln!("threshold broken: {b}");
+        }
+        // Exit 1 means "A and B differ beyond the limits" for CI, whatever other errors map to.
+        std::process::exit(1);
     }
     Ok(())
 }
