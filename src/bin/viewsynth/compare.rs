@@ -12,12 +12,16 @@ pub(crate) enum DepthKindArg {
 
 #[derive(Args)]
 pub(crate) struct CompareArgs {
+    /// A's colour (e.g. ours).
     #[arg(long)]
     a_rgb: PathBuf,
+    /// B's colour (e.g. the other renderer's), the same size.
     #[arg(long)]
     b_rgb: PathBuf,
+    /// A's depth (EXR, NPY, NPZ, PFM), as --a-depth-kind says.
     #[arg(long, requires = "b_depth")]
     a_depth: Option<PathBuf>,
+    /// B's depth, as --b-depth-kind says.
     #[arg(long, requires = "a_depth")]
     b_depth: Option<PathBuf>,
     #[arg(long, value_enum, default_value = "view-z")]
@@ -28,8 +32,10 @@ pub(crate) struct CompareArgs {
     a_ndc: NdcArg,
     #[arg(long, value_enum, default_value = "gl")]
     b_ndc: NdcArg,
+    /// A's device depth was written with reversed-Z (near at the top of the range).
     #[arg(long)]
     a_reversed_z: bool,
+    /// B's device depth was written with reversed-Z.
     #[arg(long)]
     b_reversed_z: bool,
     /// Row order each file is stored in (image files are normally top-down).

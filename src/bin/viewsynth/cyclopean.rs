@@ -10,17 +10,21 @@ pub(crate) enum BlendArg {
 
 #[derive(Args)]
 pub(crate) struct CyclopeanArgs {
+    /// Left eye colour (PNG, JPEG, PPM, EXR), rows top-down.
     #[arg(long)]
     left_rgb: PathBuf,
     /// Left depth: device (window) depth or view distance, as `depth_kind` in the camera file.
     #[arg(long)]
     left_depth: PathBuf,
+    /// Right eye colour.
     #[arg(long)]
     right_rgb: PathBuf,
+    /// Right depth, as --left-depth.
     #[arg(long)]
     right_depth: PathBuf,
-    /// Camera JSON: per-eye view/projection, middle projection and size, gaze or fixation,
-    /// conventions, depth kind (see src/cyclopean/camera_file.rs).
+    /// Camera JSON: per-eye GL view and projection (row-major 4x4), middle projection and size,
+    /// gaze rays or fixation distance, conventions, depth kind (device or view-z); `viewsynth
+    /// scene` writes one.
     #[arg(long)]
     cameras: PathBuf,
     /// Raw units per unit of depth for integer depth files.
@@ -30,13 +34,17 @@ pub(crate) struct CyclopeanArgs {
     /// floating-point one).
     #[arg(long, value_name = "NAME")]
     npz_key: Option<String>,
-    /// 0 = the seed's single step; k >= 1 = k-step refinement with projection check.
+    /// 0 = one gather step from the fixation depth (the basic middle-view method); k >= 1 =
+    /// k-step refinement to the surface with a projection check.
     #[arg(long, default_value_t = 3)]
     refine_steps: u32,
+    /// How the two eyes' samples combine: hard (depth disagreement above --z-threshold takes
+    /// the nearer eye, else the mean) or soft (fades from the nearer eye to the mean as the
+    /// disagreement shrinks).
     #[arg(long, value_enum, default_value = "hard")]
     blend: BlendArg,
-    /// Middle-space depth disagreement (metres) treated as different surfaces (default: the
-    /// seed's clamp(0.02 * fixation, 0.02, 0.25)).
+    /// Middle-space depth disagreement (metres) treated as different surfaces (default:
+    /// clamp(0.02 * fixation, 0.02, 0.25)).
     #[arg(long)]
     z_threshold: Option<f64>,
     /// Dominant eye and its blend weight, e.g. `left:0.7`.
@@ -46,7 +54,8 @@ pub(crate) struct CyclopeanArgs {
     /// neither rendered into an attachment nor read back.
     #[arg(long, default_value = "rgb,depth,mask")]
     outputs: String,
-    /// Writes middle_rgb.png, middle_depth.exr, middle_mask.png (those in --outputs).
+    /// Output folder (created if missing): middle_rgb.png, middle_depth.exr, middle_mask.png
+    /// (those in --outputs).
     #[arg(long)]
     out_dir: PathBuf,
     #[command(flatten)]

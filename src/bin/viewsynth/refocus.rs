@@ -16,9 +16,10 @@ pub(crate) struct RefocusArgs {
     /// Source metric depth, view-space Z (EXR, NPY/NPZ f32/f64/u16, 16-bit PNG/PGM with --depth-scale, PFM).
     #[arg(long, required_unless_present = "batch")]
     depth: Option<PathBuf>,
-    /// Refocus every frame of a CSV/JSON manifest (columns rgb,depth,fx,fy,cx,cy[,depth_scale,name];
-    /// see src/refocus/batch.rs) into <out-dir>/<name>/, with one GL context, files encoded on
-    /// writer threads, and resume.
+    /// Refocus every frame of a manifest into <out-dir>/<name>/, with one GL context, files
+    /// encoded on writer threads, and resume. CSV with a header row rgb,depth,fx,fy,cx,cy and
+    /// optional depth_scale,name columns, or a JSON array of objects with those keys (and
+    /// sun_bit_rotate); relative paths are relative to the manifest.
     #[arg(long, conflicts_with_all = ["rgb", "depth"])]
     batch: Option<PathBuf>,
     /// With --batch: render frames that already have a manifest.json again.
@@ -41,6 +42,8 @@ pub(crate) struct RefocusArgs {
     sun_bit_rotate: bool,
     #[command(flatten)]
     intrinsics: IntrinsicsArgs,
+    /// Output folder (created if missing): per focal scale s, s{s}_rgb.png, s{s}_depth.exr,
+    /// s{s}_mask.png (those in --outputs), and manifest.json.
     #[arg(long)]
     out_dir: PathBuf,
     /// Target focal lengths fx' in pixels (fy' keeps the source fy/fx).
@@ -55,13 +58,17 @@ pub(crate) struct RefocusArgs {
     /// Break an edge when |za - zb| > tau_abs (metres; "inf" disables).
     #[arg(long, default_value_t = BreakRule::default().tau_abs)]
     tau_abs: f64,
+    /// Output width in pixels (default: the source's; with --height-out).
     #[arg(long, requires = "height_out")]
     width_out: Option<u32>,
+    /// Output height in pixels (default: the source's; with --width-out).
     #[arg(long, requires = "width_out")]
     height_out: Option<u32>,
-    /// Output principal point (default: the source's offset from the image centre).
+    /// Output principal point x in pixels (default: the source's offset from the image centre:
+    /// cx' = cx + (W' - W) / 2; with --cy-out).
     #[arg(long, requires = "cy_out")]
     cx_out: Option<f64>,
+    /// Output principal point y in pixels (default: cy' = cy + (H' - H) / 2; with --cx-out).
     #[arg(long, requires = "cx_out")]
     cy_out: Option<f64>,
     #[command(flatten)]

@@ -83,7 +83,7 @@ pub(crate) struct ReprojectArgs {
     /// cx_right - cx_left in pixels (Middlebury's doffs) of the rectified rig and of disparity.
     #[arg(long, default_value_t = 0.0)]
     doffs: f64,
-    /// Seed 004's rig instead of --baseline: separation = interaxial / screen width (texture
+    /// A game-engine stereo rig instead of --baseline: separation = interaxial / screen width (texture
     /// units; the eyes move +-S/2 (1 - c/Z) in texture x), with --convergence.
     #[arg(long, requires = "convergence")]
     separation: Option<f64>,
@@ -106,7 +106,8 @@ pub(crate) struct ReprojectArgs {
     tau_rel: f64,
     #[command(flatten)]
     files: FileOutputArgs,
-    /// Writes <target>_rgb.png, <target>_depth.exr, <target>_mask.png (target = left, right).
+    /// Output folder (created if missing): <target>_rgb.png, <target>_depth.exr,
+    /// <target>_mask.png (target = left, right; those in --outputs).
     #[arg(long)]
     out_dir: PathBuf,
     #[command(flatten)]
@@ -240,7 +241,7 @@ fn load_source(
     Ok(src)
 }
 
-/// The source and its targets on a parallel rig (rectified or seed 004) from intrinsics.
+/// The source and its targets on a parallel rig (rectified, or separation/convergence) from intrinsics.
 fn rig_setup(a: &ReprojectArgs) -> Result<Setup> {
     use viewsynth::camera::stereo::{Eye, StereoParams};
     use viewsynth::camera::PinholeCamera;
@@ -294,7 +295,7 @@ fn rig_setup(a: &ReprojectArgs) -> Result<Setup> {
         _ => None,
     };
     if seed.is_none() && a.baseline.is_none() {
-        bail!("give the rig: --baseline B (rectified, metres) or --separation S --convergence C (seed 004)");
+        bail!("give the rig: --baseline B (rectified, metres) or --separation S --convergence C (game-engine stereo)");
     }
     let conv = a.conv.conventions();
     let what = format!(
