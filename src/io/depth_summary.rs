@@ -180,7 +180,7 @@ mod tests {
         assert_eq!(
             near.warnings(),
             [DepthWarning::MedianTooNear {
-                median: 0.002 as f32 as f64
+                median: f64::from(0.002_f32)
             }]
         );
         let ok = DepthSummary::of(&map(vec![0.06, 19.0, 19.5]));
