@@ -114,6 +114,14 @@ impl Conventions {
 }
 
 impl RowOrder {
+    /// The name the CLI and the JSON files use: `bottom-up` or `top-down`.
+    pub fn name(self) -> &'static str {
+        match self {
+            RowOrder::BottomUp => "bottom-up",
+            RowOrder::TopDown => "top-down",
+        }
+    }
+
     /// Convert between top-down image rows and this order's memory rows (the same operation
     /// both ways: a row flip for bottom-up, nothing for top-down). `row_bytes` is one row.
     pub fn convert_rows(self, mut data: Vec<u8>, row_bytes: usize) -> Vec<u8> {

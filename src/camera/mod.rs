@@ -1,6 +1,7 @@
 //! Camera models: pinhole intrinsics and the projections built from them.
 
 mod intrinsics;
+pub mod intrinsics_file;
 pub mod mat4;
 pub mod pose;
 mod projection;
@@ -8,5 +9,6 @@ pub mod stereo;
 pub mod vergence;
 
 pub use intrinsics::{Intrinsics, PinholeCamera, MAX_IMAGE_SIDE};
+pub use intrinsics_file::{IntrinsicsFile, IntrinsicsFormat};
 pub use pose::{gl_projection, Pose};
 pub use projection::clip_from_view_opencv;

@@ -9,6 +9,7 @@ use super::decode::{decode_image, Samples};
 use super::exr_io::{read_depth_channel, write_f32_channels};
 use super::image_types::{decode_dims, encode_dims, DepthMap};
 use super::npy::{load_npy, save_npy_f32, NpyArray, NpyDtype};
+use super::npz::load_npz_array;
 use super::rgb::lowercase_extension;
 use super::{pfm, pgm};
 use crate::error::{Error, Result};
@@ -62,21 +63,41 @@ pub(crate) struct RawDepth {
 
 /// Loads a depth (or disparity) map by extension, case-insensitive: `.exr` (one channel,
 /// see below), `.npy` (shape (H, W) or (H, W, 1); `<f4 >f4 <f8 >f8 <u2 >u2`, either
-/// order), `.png` (single-channel 16-bit, or 8-bit when `scale` is given), `.pgm` (P5/P2,
+/// order), `.npz` (the only array, else the first floating-point one, as `.npy`), `.png` (single-channel 16-bit, or 8-bit when `scale` is given), `.pgm` (P5/P2,
 /// big-endian per Netpbm unless `swap_bytes`), `.pfm` (grayscale `Pf`).
 ///
 /// The EXR channel is "Z", else "depth" (any case), else "Y", else "R", else the only one.
 pub fn load_depth(path: &Path, decode: &DepthDecode) -> Result<DepthMap> {
-    let raw = match lowercase_extension(path).as_str() {
+    load_depth_with_key(path, None, decode)
+}
+
+/// [`load_depth`], reading array `npz_key` of an `.npz` (`None`: the only array, else the
+/// first floating-point one). A key given for another format is refused.
+pub fn load_depth_with_key(path: &Path, npz_key: Option<&str>, decode: &DepthDecode) -> Result<DepthMap> {
+    let ext = lowercase_extension(path);
+    if npz_key.is_some() && ext != "npz" {
+        return Err(Error::param(
+            "npz-key",
+            format!("{}: applies to .npz files only", path.display()),
+        ));
+    }
+    let raw = match ext.as_str() {
         "exr" => read_depth_channel(path)?,
         "npy" => from_npy(path, load_npy(path)?)?,
+        "npz" => {
+            let (key, array) = load_npz_array(path, npz_key)?;
+            from_npy(path, array).map_err(|e| match e {
+                Error::Decode { path, message } => Error::decode(path, format!("array '{key}': {message}")),
+                other => other,
+            })?
+        }
         "png" => read_png(path)?,
         "pgm" => pgm::read_pgm(path)?,
         "pfm" => pfm::read_pfm(path)?,
         _ => {
             return Err(Error::decode(
                 path,
-                "unknown depth format: expected .exr .npy .png .pgm .pfm",
+                "unknown depth format: expected .exr .npy .npz .png .pgm .pfm",
             ))
         }
     };
@@ -183,7 +204,7 @@ fn to_metres(path: &Path, raw: RawDepth, decode: &DepthDecode) -> Result<DepthMa
             v.into_iter().map(|d| int_to_metres(d.into(), s)).collect()
         }
         RawSamples::U16(v) => {
-            let s = need_scale("16-bit", "5000 for TUM, 1000 for NYU/SUN")?;
+            let s = need_scale("16-bit", "5000 for TUM, 1000 for SUN RGB-D or millimetres")?;
             v.into_iter()
                 .map(|d| {
                     let d = if decode.swap_bytes { d.swap_bytes() } else { d };
@@ -434,7 +455,10 @@ mod tests {
         }
 
         let err = load_depth(&dir.join("d.tiff"), &DepthDecode::default()).unwrap_err();
-        assert!(err.to_string().contains("expected .exr .npy .png .pgm .pfm"), "{err}");
+        assert!(
+            err.to_string().contains("expected .exr .npy .npz .png .pgm .pfm"),
+            "{err}"
+        );
     }
 
     #[test]

@@ -8,12 +8,14 @@
 mod atomic;
 mod decode;
 mod depth;
+mod depth_summary;
 mod encoding;
 mod exr_io;
 mod image_types;
 mod mask;
 mod netpbm;
 mod npy;
+mod npz;
 mod pfm;
 mod pgm;
 mod rgb;
@@ -24,9 +26,11 @@ mod dataset_tests;
 mod test_util;
 
 pub use atomic::atomic_write;
-pub use depth::{load_depth, save_depth_exr, save_depth_exr_with, save_depth_npy, DepthDecode};
+pub use depth::{load_depth, load_depth_with_key, save_depth_exr, save_depth_exr_with, save_depth_npy, DepthDecode};
+pub use depth_summary::{DepthSummary, DepthWarning, PLAUSIBLE_MEDIAN_M};
 pub use encoding::{Encoding, ExrCompression, PngCompression};
 pub use image_types::{DepthMap, Mask, RgbImage, MAX_DIMENSION};
 pub use mask::{load_mask_png, save_mask_png, save_mask_png_with};
 pub use npy::{load_npy, save_npy_f32, NpyArray, NpyDtype};
+pub use npz::load_npz_array;
 pub use rgb::{load_rgb, save_rgb, save_rgb_with};

@@ -34,8 +34,13 @@ pub struct NpyArray {
 /// `descr`, `fortran_order` and `shape`; the payload must be exactly as long as it says.
 pub fn load_npy(path: &Path) -> Result<NpyArray> {
     let bytes = std::fs::read(path).map_err(|e| Error::io(path, e))?;
-    let bad = |msg: String| Error::decode(path, format!("invalid NPY: {msg}"));
-    let (header, payload) = split_header(&bytes).map_err(bad)?;
+    decode_npy(&bytes).map_err(|m| Error::decode(path, m))
+}
+
+/// The `.npy` bytes of a file or an `.npz` member; the error says what is wrong.
+pub(crate) fn decode_npy(bytes: &[u8]) -> std::result::Result<NpyArray, String> {
+    let bad = |msg: String| format!("invalid NPY: {msg}");
+    let (header, payload) = split_header(bytes).map_err(bad)?;
     let h = parse_header(header).map_err(bad)?;
     let count = h
         .shape

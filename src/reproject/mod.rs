@@ -32,7 +32,6 @@
 //! identity map. A point behind the camera cannot be stored (Z > 0 is required). All outputs
 //! are finite: 0 colour and depth where the mask is 0.
 
-pub mod npz;
 pub mod reference;
 pub mod render;
 pub mod rows;

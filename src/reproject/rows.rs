@@ -117,7 +117,8 @@ pub fn motorcycle_case(data_dir: &Path, conv: Conventions) -> Result<Case> {
     let dir = data_dir.join("middlebury2014_motorcycle_skimage");
     let left = io::load_rgb(&dir.join("motorcycle_left.png"))?;
     let truth = io::load_rgb(&dir.join("motorcycle_right.png"))?;
-    let disparity = super::npz::load_npz_map(&dir.join("motorcycle_disp.npz"), "arr_0")?;
+    // +inf (invalid) stays as stored: float depth is not rescaled without a scale.
+    let disparity = io::load_depth(&dir.join("motorcycle_disp.npz"), &DepthDecode::default())?;
     let (f, baseline, doffs) = (994.978, 0.193001, 31.086);
     let camera = PinholeCamera {
         k: Intrinsics {

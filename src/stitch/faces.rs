@@ -14,7 +14,7 @@ pub const FACE_TAGS: [&str; 6] = ["pz", "nz", "up", "down", "px", "nx"];
 /// Colour file extensions tried in a face folder, in this order.
 pub const FACE_COLOR_EXTS: [&str; 5] = ["png", "jpg", "jpeg", "ppm", "exr"];
 /// Depth (view-space Z) file extensions tried in a face folder, in this order.
-pub const FACE_DEPTH_EXTS: [&str; 4] = ["exr", "npy", "pfm", "png"];
+pub const FACE_DEPTH_EXTS: [&str; 5] = ["exr", "npy", "npz", "pfm", "png"];
 use crate::scene;
 
 /// The six faces of `side`, N x N, FOV `fov_deg`, from the f64 ray tracer: colour rounded to
@@ -104,7 +104,7 @@ fn find_face_file(dir: &Path, stem: &str, exts: &[&str], what: &str) -> Result<P
 }
 
 /// The six faces of `side` from a face folder: colour `{left,right}_{tag}.{png,jpg,jpeg,ppm,exr}`
-/// and view-space Z `{left,right}_{tag}_depth.{exr,npy,pfm,png}` ([`FACE_TAGS`]; integer depth
+/// and view-space Z `{left,right}_{tag}_depth.{exr,npy,npz,pfm,png}` ([`FACE_TAGS`]; integer depth
 /// decoded with `decode`; device depth converted with [`view_z_of`]), rendered with the poses
 /// [`CubeFace::pose`] gives for `rig`.
 pub fn load_face_dir(

@@ -93,3 +93,97 @@ fn flipped_rows_ndc_stored_as_window_depth_and_reversed_z_mismatch_are_named() {
     };
     assert!(compare(&a, &small).is_err());
 }
+
+/// A 4x1 top-down side: grey 100, pixel 3 at `last`, view Z 2 m with pixel 2 at `z2`.
+fn strip(last: u8, z2: f32) -> Side {
+    let mut color = vec![100u8; 12];
+    color[9..12].fill(last);
+    Side {
+        color: RgbImage::new(4, 1, color).unwrap(),
+        depth: Some(DepthMap::new(4, 1, vec![2.0, 2.0, z2, 2.0]).unwrap()),
+        storage: DepthStorage::ViewZ,
+        conv: Conventions {
+            row_order: RowOrder::TopDown,
+            ..Conventions::default()
+        },
+    }
+}
+
+#[test]
+fn a_mask_restricts_every_measure_and_the_diff_image() {
+    use viewsynth::compare::compare_masked;
+    use viewsynth::io::Mask;
+    let (a, b) = (strip(100, 2.0), strip(110, 2.2));
+    // Whole image: 3 of 12 samples differ by 10 -> MSE 25, RMSE 5.
+    let (c, diff) = compare(&a, &b).unwrap();
+    assert_eq!((c.pixels, c.max_color_diff, c.color_rmse), (4, 10, 5.0));
+    assert!((c.psnr_db - 10.0 * (255.0f64 * 255.0 / 25.0).log10()).abs() < 1e-12);
+    assert!((c.depth_max_rel.unwrap() - 0.1).abs() < 1e-6, "{c:?}");
+    // The largest difference is white, not 10 x 8 = 80 (or saturated at 255 for differences >= 32).
+    assert_eq!(c.diff_scale, 25.5);
+    assert_eq!(diff.data, [0, 0, 0, 0, 0, 0, 0, 0, 0, 255, 255, 255]);
+    // Pixels 0 and 1 only: identical colour and depth.
+    let mask = Mask::new(4, 1, vec![1, 1, 0, 0]).unwrap();
+    let (m, diff) = compare_masked(&a, &b, Some(&mask)).unwrap();
+    assert_eq!(
+        (m.pixels, m.max_color_diff, m.color_rmse, m.depth_max_rel),
+        (2, 0, 0.0, Some(0.0))
+    );
+    assert_eq!(m.psnr_db, f64::INFINITY);
+    assert!(diff.data.iter().all(|v| *v == 0));
+    let json = serde_json::to_value(&m).unwrap();
+    assert_eq!(json["psnr_db"], "inf");
+    // A mask of another size, or one selecting nothing, is refused.
+    assert!(compare_masked(&a, &b, Some(&Mask::new(2, 2, vec![1; 4]).unwrap())).is_err());
+    let none = compare_masked(&a, &b, Some(&Mask::new(4, 1, vec![0; 4]).unwrap())).unwrap_err();
+    assert!(none.to_string().contains("mask"), "{none}");
+}
+
+#[test]
+fn thresholds_name_each_limit_broken() {
+    use viewsynth::compare::Thresholds;
+    let (c, _) = compare(&strip(100, 2.0), &strip(110, 2.2)).unwrap();
+    let all = Thresholds {
+        max_color_rmse: Some(4.0),
+        min_psnr_db: Some(40.0),
+        max_depth_rel: Some(0.05),
+    };
+    let broken = all.broken(&c);
+    assert_eq!(broken.len(), 3, "{broken:?}");
+    assert!(
+        broken[0].contains("colour RMSE 5.0000 > 4") && broken[1].contains("< 40 dB"),
+        "{broken:?}"
+    );
+    let loose = Thresholds {
+        max_color_rmse: Some(5.0),
+        min_psnr_db: Some(30.0),
+        max_depth_rel: Some(0.11),
+    };
+    assert!(loose.broken(&c).is_empty(), "{:?}", loose.broken(&c));
+    let mut no_depth = strip(100, 2.0);
+    no_depth.depth = None;
+    let (c, _) = compare(&no_depth, &no_depth).unwrap();
+    assert!(loose.broken(&c)[0].contains("no depth was compared"));
+    assert!(Thresholds {
+        max_color_rmse: Some(-1.0),
+        ..Default::default()
+    }
+    .validate()
+    .is_err());
+}
+
+#[test]
+fn suspicion_names_row_orders_as_the_cli_spells_them() {
+    let a = stored(Conventions::default());
+    let mut b = stored(Conventions {
+        row_order: RowOrder::TopDown,
+        ..Conventions::default()
+    });
+    b.conv.row_order = RowOrder::BottomUp;
+    let (c, _) = compare(&a, &b).unwrap();
+    let s = c.suspicion.unwrap();
+    assert!(
+        s.contains("read as top-down") && s.contains("declared bottom-up"),
+        "{s}"
+    );
+}

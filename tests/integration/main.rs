@@ -3,6 +3,8 @@
 
 mod batch;
 mod cli;
+mod cli_compare;
+mod cli_formats;
 mod cli_reproject_stitch;
 mod common;
 mod compare;

@@ -218,9 +218,9 @@ fn middlebury_motorcycle_and_teddy_left_to_right() {
 
 #[test]
 fn motorcycle_disparity_loads_from_the_npz() {
-    let d = viewsynth::reproject::npz::load_npz_map(
+    let d = viewsynth::io::load_depth(
         &data_dir().join("middlebury2014_motorcycle_skimage/motorcycle_disp.npz"),
-        "arr_0",
+        &viewsynth::io::DepthDecode::default(),
     )
     .unwrap();
     assert_eq!((d.width, d.height), (741, 500));

@@ -10,29 +10,41 @@ pub(crate) enum BlendArg {
 
 #[derive(Args)]
 pub(crate) struct CyclopeanArgs {
+    /// Left eye colour (PNG, JPEG, PPM, EXR), rows top-down.
     #[arg(long)]
     left_rgb: PathBuf,
     /// Left depth: device (window) depth or view distance, as `depth_kind` in the camera file.
     #[arg(long)]
     left_depth: PathBuf,
+    /// Right eye colour.
     #[arg(long)]
     right_rgb: PathBuf,
+    /// Right depth, as --left-depth.
     #[arg(long)]
     right_depth: PathBuf,
-    /// Camera JSON: per-eye view/projection, middle projection and size, gaze or fixation,
-    /// conventions, depth kind (see src/cyclopean/camera_file.rs).
+    /// Camera JSON: per-eye GL view and projection (row-major 4x4), middle projection and size,
+    /// gaze rays or fixation distance, conventions, depth kind (device or view-z); `viewsynth
+    /// scene` writes one.
     #[arg(long)]
     cameras: PathBuf,
     /// Raw units per unit of depth for integer depth files.
     #[arg(long)]
     depth_scale: Option<f64>,
-    /// 0 = the seed's single step; k >= 1 = k-step refinement with projection check.
+    /// Array of an .npz depth file (both eyes) to read (default: the only array, else the first
+    /// floating-point one).
+    #[arg(long, value_name = "NAME")]
+    npz_key: Option<String>,
+    /// 0 = one gather step from the fixation depth (the basic middle-view method); k >= 1 =
+    /// k-step refinement to the surface with a projection check.
     #[arg(long, default_value_t = 3)]
     refine_steps: u32,
+    /// How the two eyes' samples combine: hard (depth disagreement above --z-threshold takes
+    /// the nearer eye, else the mean) or soft (fades from the nearer eye to the mean as the
+    /// disagreement shrinks).
     #[arg(long, value_enum, default_value = "hard")]
     blend: BlendArg,
-    /// Middle-space depth disagreement (metres) treated as different surfaces (default: the
-    /// seed's clamp(0.02 * fixation, 0.02, 0.25)).
+    /// Middle-space depth disagreement (metres) treated as different surfaces (default:
+    /// clamp(0.02 * fixation, 0.02, 0.25)).
     #[arg(long)]
     z_threshold: Option<f64>,
     /// Dominant eye and its blend weight, e.g. `left:0.7`.
@@ -42,7 +54,8 @@ pub(crate) struct CyclopeanArgs {
     /// neither rendered into an attachment nor read back.
     #[arg(long, default_value = "rgb,depth,mask")]
     outputs: String,
-    /// Writes middle_rgb.png, middle_depth.exr, middle_mask.png (those in --outputs).
+    /// Output folder (created if missing): middle_rgb.png, middle_depth.exr, middle_mask.png
+    /// (those in --outputs).
     #[arg(long)]
     out_dir: PathBuf,
     #[command(flatten)]
@@ -88,7 +101,7 @@ pub(crate) fn cyclopean(a: CyclopeanArgs) -> Result<()> {
     let eye = |rgb: &Path, depth: &Path, cam: &viewsynth::cyclopean::camera_file::EyeCameras| -> Result<EyeInput> {
         Ok(EyeInput {
             color: io::load_rgb(rgb)?,
-            depth: io::load_depth(depth, &decode)?,
+            depth: io::load_depth_with_key(depth, a.npz_key.as_deref(), &decode)?,
             view: cam.view,
             proj: cam.proj,
         })
@@ -100,6 +113,17 @@ pub(crate) fn cyclopean(a: CyclopeanArgs) -> Result<()> {
         conv: cams.conventions,
     };
     frame.validate()?;
+    for (path, eye) in [(&a.left_depth, &frame.left), (&a.right_depth, &frame.right)] {
+        print_depth_summary(
+            path,
+            &view_z_in_metres(eye, frame.depth_kind, &frame.conv)?,
+            &format!(
+                "read as {:?} depth (check depth_kind and the projections in {}, and --depth-scale)",
+                frame.depth_kind,
+                a.cameras.display()
+            ),
+        );
+    }
     prepare_out_dir(&a.out_dir)?;
     let gpu = a.gpu.open()?;
     let wanted = CyclopeanOutputs {
@@ -144,4 +168,20 @@ pub(crate) fn cyclopean(a: CyclopeanArgs) -> Result<()> {
         a.out_dir.display()
     );
     Ok(())
+}
+
+/// An eye's depth as view Z in metres (0 where invalid), for the input summary.
+fn view_z_in_metres(
+    eye: &viewsynth::cyclopean::EyeInput,
+    kind: viewsynth::cyclopean::DepthKind,
+    conv: &Conventions,
+) -> Result<viewsynth::io::DepthMap> {
+    use viewsynth::reproject::DepthInput;
+    let input = match kind {
+        viewsynth::cyclopean::DepthKind::ViewZ => DepthInput::ViewZ,
+        viewsynth::cyclopean::DepthKind::Device => DepthInput::Device {
+            planes: viewsynth::convention::DepthPlanes::from_gl_projection(&eye.proj, conv)?,
+        },
+    };
+    Ok(input.view_z_map(conv, &eye.depth))
 }

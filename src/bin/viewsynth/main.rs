@@ -12,17 +12,21 @@ use viewsynth::refocus::{BreakRule, Method, OutputSet, RefocusSource, Refocuser}
 
 mod compare;
 mod cyclopean;
+mod intrinsics;
 mod refocus;
 mod reproject;
 mod scene;
 mod stitch;
+mod summary;
 
 use compare::{compare, CompareArgs};
 use cyclopean::{cyclopean, CyclopeanArgs};
+use intrinsics::IntrinsicsArgs;
 use refocus::{refocus, RefocusArgs};
 use reproject::{reproject, ReprojectArgs};
 use scene::render_scene;
 use stitch::{stitch, StitchArgs};
+use summary::print_depth_summary;
 
 #[derive(Parser)]
 #[command(
@@ -64,7 +68,7 @@ enum Command {
     /// and middle colour, view distance and device depth, and a cameras.json that
     /// `viewsynth cyclopean` reads.
     Scene {
-        /// `demo`, `boxes`, or a scene JSON file (src/scene/shapes.rs).
+        /// `demo`, `boxes`, or a scene JSON file of planes, spheres and boxes.
         #[arg(long, default_value = "demo")]
         scene: String,
         #[arg(long, default_value_t = 640)]
@@ -76,6 +80,7 @@ enum Command {
         ipd: f64,
         #[command(flatten)]
         conv: ConventionArgs,
+        /// Output folder (created if missing).
         #[arg(long, default_value = "out/scene")]
         out_dir: PathBuf,
         #[command(flatten)]
@@ -88,6 +93,7 @@ enum Command {
     /// Render the built-in scene, refocus it at 5 scales, synthesise the cyclopean middle view of
     /// a stereo pair with each method, and write every output plus the error/run-time report.
     Demo {
+        /// Output folder (created if missing).
         #[arg(long, default_value = "out/demo")]
         out_dir: PathBuf,
         #[command(flatten)]
@@ -96,6 +102,7 @@ enum Command {
     /// Measure every method's error against ground truth (built-in scene, and real data when
     /// --data-dir holds ../shared/data's sets) next to its run time: report.{md,csv,svg}.
     Report {
+        /// Output folder (created if missing): report.md, report.csv, report.svg.
         #[arg(long, default_value = "out/report")]
         out_dir: PathBuf,
         /// Folder with middlebury2003_cones/ and middlebury2003_teddy/ (skipped when absent).
@@ -186,10 +193,14 @@ impl GpuArgs {
 /// The convention switches of a rendering command.
 #[derive(Args, Clone, Copy)]
 struct ConventionArgs {
+    /// NDC depth range of the GPU passes (and of device depth read or written).
     #[arg(long, value_enum, default_value = "gl")]
     ndc: NdcArg,
+    /// Reversed-Z: near maps to the top of the depth range and far to 0 (float depth buffer,
+    /// cleared to 0, GREATER test); device depth read or written follows it.
     #[arg(long)]
     reversed_z: bool,
+    /// Row order of the GPU framebuffers (image files are always written top-down).
     #[arg(long, value_enum, default_value = "bottom-up")]
     rows: RowsArg,
 }
@@ -210,7 +221,9 @@ enum NdcArg {
 
 #[derive(Clone, Copy, ValueEnum)]
 enum RowsArg {
+    /// OpenGL: row 0 is the bottom of the picture.
     BottomUp,
+    /// Vulkan/D3D and image files: row 0 is the top.
     TopDown,
 }
 

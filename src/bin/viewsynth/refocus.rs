@@ -13,12 +13,13 @@ pub(crate) struct RefocusArgs {
     /// Source colour (PNG, JPEG, PPM, EXR).
     #[arg(long, required_unless_present = "batch")]
     rgb: Option<PathBuf>,
-    /// Source metric depth, view-space Z (EXR, NPY f32/f64/u16, 16-bit PNG/PGM with --depth-scale, PFM).
+    /// Source metric depth, view-space Z (EXR, NPY/NPZ f32/f64/u16, 16-bit PNG/PGM with --depth-scale, PFM).
     #[arg(long, required_unless_present = "batch")]
     depth: Option<PathBuf>,
-    /// Refocus every frame of a CSV/JSON manifest (columns rgb,depth,fx,fy,cx,cy[,depth_scale,name];
-    /// see src/refocus/batch.rs) into <out-dir>/<name>/, with one GL context, files encoded on
-    /// writer threads, and resume.
+    /// Refocus every frame of a manifest into <out-dir>/<name>/, with one GL context, files
+    /// encoded on writer threads, and resume. CSV with a header row rgb,depth,fx,fy,cx,cy and
+    /// optional depth_scale,name columns, or a JSON array of objects with those keys (and
+    /// sun_bit_rotate); relative paths are relative to the manifest.
     #[arg(long, conflicts_with_all = ["rgb", "depth"])]
     batch: Option<PathBuf>,
     /// With --batch: render every frame again, even those finished with the same settings.
@@ -32,20 +33,22 @@ pub(crate) struct RefocusArgs {
     /// K from 0), e.g. one Slurm array task or Kubernetes indexed Job per shard.
     #[arg(long)]
     shard: Option<String>,
-    /// Raw units per metre for integer depth (5000 for TUM, 1000 for NYU/SUN); divides float depth too when given.
+    /// Raw units per metre for integer depth: 5000 for TUM, 1000 for SUN RGB-D (with
+    /// --sun-bit-rotate) and millimetre PNGs. Divides float depth too when given. (NYU v2 raw PGM
+    /// holds Kinect disparity, not depth: no scale fits; convert it first.)
     #[arg(long)]
     depth_scale: Option<f64>,
+    /// Array of an .npz depth file to read (default: the only array, else the first
+    /// floating-point one).
+    #[arg(long, value_name = "NAME")]
+    npz_key: Option<String>,
     /// SUN RGB-D PNG depth: rotate the 16-bit value right by 3 bits before scaling.
     #[arg(long)]
     sun_bit_rotate: bool,
-    #[arg(long, required_unless_present = "batch")]
-    fx: Option<f64>,
-    #[arg(long, required_unless_present = "batch")]
-    fy: Option<f64>,
-    #[arg(long, required_unless_present = "batch")]
-    cx: Option<f64>,
-    #[arg(long, required_unless_present = "batch")]
-    cy: Option<f64>,
+    #[command(flatten)]
+    intrinsics: IntrinsicsArgs,
+    /// Output folder (created if missing): per focal scale s, s{s}_rgb.png, s{s}_depth.exr,
+    /// s{s}_mask.png (those in --outputs), and manifest.json.
     #[arg(long)]
     out_dir: PathBuf,
     /// Target focal lengths fx' in pixels (fy' keeps the source fy/fx).
@@ -60,13 +63,17 @@ pub(crate) struct RefocusArgs {
     /// Break an edge when |za - zb| > tau_abs (metres; "inf" disables).
     #[arg(long, default_value_t = BreakRule::default().tau_abs)]
     tau_abs: f64,
+    /// Output width in pixels (default: the source's; with --height-out).
     #[arg(long, requires = "height_out")]
     width_out: Option<u32>,
+    /// Output height in pixels (default: the source's; with --width-out).
     #[arg(long, requires = "width_out")]
     height_out: Option<u32>,
-    /// Output principal point (default: the source's offset from the image centre).
+    /// Output principal point x in pixels (default: the source's offset from the image centre:
+    /// cx' = cx + (W' - W) / 2; with --cy-out).
     #[arg(long, requires = "cy_out")]
     cx_out: Option<f64>,
+    /// Output principal point y in pixels (default: cy' = cy + (H' - H) / 2; with --cx-out).
     #[arg(long, requires = "cx_out")]
     cy_out: Option<f64>,
     #[command(flatten)]
@@ -85,13 +92,11 @@ pub(crate) fn refocus(a: RefocusArgs) -> Result<()> {
     }
     // Everything that can be checked before touching the GPU or the output directory is.
     // (clap requires these without --batch.)
-    let (Some(rgb_path), Some(depth_path), Some(fx), Some(fy), Some(cx), Some(cy)) =
-        (a.rgb.clone(), a.depth.clone(), a.fx, a.fy, a.cx, a.cy)
-    else {
-        bail!("--rgb, --depth, --fx, --fy, --cx and --cy are required without --batch");
+    let (Some(rgb_path), Some(depth_path)) = (a.rgb.clone(), a.depth.clone()) else {
+        bail!("--rgb and --depth are required without --batch");
     };
-    let k = Intrinsics { fx, fy, cx, cy };
-    k.validate("source intrinsics")?;
+    let source_k = a.intrinsics.resolve()?;
+    let k = source_k.k;
     let rule = BreakRule {
         tau_rel: a.tau_rel,
         tau_abs: a.tau_abs,
@@ -110,7 +115,14 @@ pub(crate) fn refocus(a: RefocusArgs) -> Result<()> {
         sun_rgbd_bit_rotate: a.sun_bit_rotate,
         ..Default::default()
     };
-    let depth = io::load_depth(&depth_path, &decode)?;
+    let depth = io::load_depth_with_key(&depth_path, a.npz_key.as_deref(), &decode)?;
+    source_k.check_size(rgb.width, rgb.height)?;
+    print_depth_summary(
+        &depth_path,
+        &depth,
+        "check --depth-scale (raw units per metre: 5000 TUM, 1000 SUN RGB-D with --sun-bit-rotate) \
+         and that the file holds metric depth, not disparity",
+    );
     let src = RefocusSource::new(rgb, depth, k)
         .with_context(|| format!("{} and {}", rgb_path.display(), depth_path.display()))?;
     let scales = match &a.focal_list {
@@ -165,6 +177,9 @@ pub(crate) fn refocus(a: RefocusArgs) -> Result<()> {
 
 pub(crate) fn refocus_batch(manifest: &Path, a: RefocusArgs) -> Result<()> {
     use viewsynth::refocus::batch::{load_manifest, run_batch, BatchOptions, Shard, MAX_JOBS};
+    if a.intrinsics.any_given() {
+        bail!("--intrinsics/--fx/--fy/--cx/--cy are per frame: with --batch they come from the manifest");
+    }
     if a.focal_list.is_some() {
         bail!("--focal-list is per frame; with --batch give --zoom-range scales");
     }

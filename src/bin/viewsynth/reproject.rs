@@ -46,7 +46,7 @@ pub(crate) struct ReprojectArgs {
     /// Source colour (PNG, JPEG, PPM, EXR), rows top-down.
     #[arg(long, visible_alias = "rgb")]
     color: PathBuf,
-    /// Source depth (EXR, NPY, 16-bit PNG/PGM with --depth-scale, PFM), holding --depth-kind.
+    /// Source depth (EXR, NPY, NPZ, 16-bit PNG/PGM with --depth-scale, PFM), holding --depth-kind.
     #[arg(long)]
     depth: PathBuf,
     #[arg(long, value_enum, default_value = "view-z")]
@@ -55,25 +55,23 @@ pub(crate) struct ReprojectArgs {
     /// disparity PGMs); divides float depth too when given.
     #[arg(long)]
     depth_scale: Option<f64>,
+    /// Array of an .npz depth file to read (default: the only array, else the first
+    /// floating-point one).
+    #[arg(long, value_name = "NAME")]
+    npz_key: Option<String>,
     /// Near plane (metres) the device depth was written with (--depth-kind device).
     #[arg(long)]
     near: Option<f64>,
     /// Far plane (metres; may be inf) the device depth was written with (--depth-kind device).
     #[arg(long)]
     far: Option<f64>,
-    /// Source intrinsics in pixels (with a rig).
-    #[arg(long, required_unless_present = "cameras")]
-    fx: Option<f64>,
-    #[arg(long, required_unless_present = "cameras")]
-    fy: Option<f64>,
-    #[arg(long, required_unless_present = "cameras")]
-    cx: Option<f64>,
-    #[arg(long, required_unless_present = "cameras")]
-    cy: Option<f64>,
+    /// Source intrinsics (with a rig).
+    #[command(flatten)]
+    intrinsics: IntrinsicsArgs,
     /// Full eye matrices instead of a rig: a cameras.json as `viewsynth scene` writes it (left
     /// and right GL view and projection, conventions, depth kind: those of the file apply).
     /// The source is --from's eye, the target the other eye; --method gather3d only.
-    #[arg(long, conflicts_with_all = ["fx", "fy", "cx", "cy", "baseline", "separation", "near", "far", "focal"])]
+    #[arg(long, conflicts_with_all = ["intrinsics", "fx", "fy", "cx", "cy", "baseline", "separation", "near", "far", "focal"])]
     cameras: Option<PathBuf>,
     /// Rectified rig: distance between the eyes in metres (x_right = x_left + doffs - f B / Z).
     /// Also the baseline of --depth-kind disparity.
@@ -85,7 +83,7 @@ pub(crate) struct ReprojectArgs {
     /// cx_right - cx_left in pixels (Middlebury's doffs) of the rectified rig and of disparity.
     #[arg(long, default_value_t = 0.0)]
     doffs: f64,
-    /// Seed 004's rig instead of --baseline: separation = interaxial / screen width (texture
+    /// A game-engine stereo rig instead of --baseline: separation = interaxial / screen width (texture
     /// units; the eyes move +-S/2 (1 - c/Z) in texture x), with --convergence.
     #[arg(long, requires = "convergence")]
     separation: Option<f64>,
@@ -108,7 +106,8 @@ pub(crate) struct ReprojectArgs {
     tau_rel: f64,
     #[command(flatten)]
     files: FileOutputArgs,
-    /// Writes <target>_rgb.png, <target>_depth.exr, <target>_mask.png (target = left, right).
+    /// Output folder (created if missing): <target>_rgb.png, <target>_depth.exr,
+    /// <target>_mask.png (target = left, right; those in --outputs).
     #[arg(long)]
     out_dir: PathBuf,
     #[command(flatten)]
@@ -226,19 +225,24 @@ fn load_source(
     };
     let src = viewsynth::reproject::ReprojectSource {
         color: io::load_rgb(&a.color)?,
-        depth: io::load_depth(&a.depth, &decode)?,
+        depth: io::load_depth_with_key(&a.depth, a.npz_key.as_deref(), &decode)?,
         depth_kind,
         conv,
     };
     src.validate()
         .with_context(|| format!("{} and {}", a.color.display(), a.depth.display()))?;
+    print_depth_summary(
+        &a.depth,
+        &src.depth_kind.view_z_map(&src.conv, &src.depth),
+        &format!("read as {what}"),
+    );
     if src.inverse_depth_range().is_none() {
         bail!("{}: no pixel holds valid depth as {what}", a.depth.display());
     }
     Ok(src)
 }
 
-/// The source and its targets on a parallel rig (rectified or seed 004) from intrinsics.
+/// The source and its targets on a parallel rig (rectified, or separation/convergence) from intrinsics.
 fn rig_setup(a: &ReprojectArgs) -> Result<Setup> {
     use viewsynth::camera::stereo::{Eye, StereoParams};
     use viewsynth::camera::PinholeCamera;
@@ -246,11 +250,12 @@ fn rig_setup(a: &ReprojectArgs) -> Result<Setup> {
 
     // Everything that can be checked before reading files, touching the GPU or the output
     // directory is.
-    let (Some(fx), Some(fy), Some(cx), Some(cy)) = (a.fx, a.fy, a.cx, a.cy) else {
-        bail!("give the source intrinsics --fx --fy --cx --cy (or --cameras FILE)");
-    };
-    let k = Intrinsics { fx, fy, cx, cy };
-    k.validate("source intrinsics")?;
+    if !a.intrinsics.any_given() {
+        bail!("give the source intrinsics: --intrinsics FILE or --fx --fy --cx --cy (or full eye matrices: --cameras FILE)");
+    }
+    let source_k = a.intrinsics.resolve()?;
+    let k = source_k.k;
+    let fx = k.fx;
     let from = match a.from {
         FromArg::Left => Some(Eye::Left),
         FromArg::Centre => None,
@@ -291,7 +296,7 @@ fn rig_setup(a: &ReprojectArgs) -> Result<Setup> {
         _ => None,
     };
     if seed.is_none() && a.baseline.is_none() {
-        bail!("give the rig: --baseline B (rectified, metres) or --separation S --convergence C (seed 004)");
+        bail!("give the rig: --baseline B (rectified, metres) or --separation S --convergence C (game-engine stereo)");
     }
     let conv = a.conv.conventions();
     let what = format!(
@@ -301,6 +306,7 @@ fn rig_setup(a: &ReprojectArgs) -> Result<Setup> {
             .map_or_else(String::new, |v| v.get_name().to_string())
     );
     let src = load_source(a, depth_kind, conv, &what)?;
+    source_k.check_size(src.color.width, src.color.height)?;
     let camera = PinholeCamera {
         k,
         width: src.color.width,

@@ -6,7 +6,8 @@ use super::*;
 pub(crate) enum StitchMethodArg {
     /// Linear feather over the overlap.
     Blend,
-    /// Seed 001's stitch with border weight.
+    /// Stitch with border weight: in the overlap, each face's sample is displaced along its
+    /// depth towards the other face's eye by a fixed angular weight.
     BorderWeight,
     /// Depth-aware reprojection along the ODS ray.
     Reproject,
@@ -78,7 +79,8 @@ pub(crate) struct StitchArgs {
     /// whole image.
     #[arg(long)]
     truth: bool,
-    /// Writes ods_top_bottom.png (left eye on top).
+    /// Output folder (created if missing): ods_top_bottom.png (left eye on top), with
+    /// --per-eye also ods_left.png and ods_right.png.
     #[arg(long)]
     out_dir: PathBuf,
     #[command(flatten)]

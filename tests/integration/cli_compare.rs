@@ -1,0 +1,172 @@
+//! `viewsynth compare` for CI: thresholds with exit 1, a mask, the JSON summary ("inf" PSNR), a
+//! diff image that does not saturate, and row orders named as the CLI spells them.
+
+use crate::cli::{bin, scratch};
+use std::path::{Path, PathBuf};
+use std::process::Output;
+use viewsynth::io::{self, DepthMap, Mask, RgbImage};
+
+fn s(p: &Path) -> &str {
+    p.to_str().unwrap()
+}
+
+/// 8x2 colour, grey 100 with the last column at `last`; view Z 2 m with (0, 0) at `z0`.
+fn side(dir: &Path, name: &str, last: u8, z0: f32) -> (PathBuf, PathBuf) {
+    let mut color = vec![100u8; 8 * 2 * 3];
+    for y in 0..2 {
+        color[(y * 8 + 7) * 3..(y * 8 + 8) * 3].fill(last);
+    }
+    let mut z = vec![2.0f32; 16];
+    z[0] = z0;
+    let (c, d) = (dir.join(format!("{name}.png")), dir.join(format!("{name}_z.exr")));
+    io::save_rgb(&c, &RgbImage::new(8, 2, color).unwrap()).unwrap();
+    io::save_depth_exr(&d, &DepthMap::new(8, 2, z).unwrap()).unwrap();
+    (c, d)
+}
+
+fn compare(a: &(PathBuf, PathBuf), b: &(PathBuf, PathBuf), extra: &[&str]) -> Output {
+    bin()
+        .args(["compare", "--a-rgb", s(&a.0), "--b-rgb", s(&b.0)])
+        .args(["--a-depth", s(&a.1), "--b-depth", s(&b.1)])
+        .args(extra)
+        .output()
+        .unwrap()
+}
+
+fn json(p: &Path) -> serde_json::Value {
+    serde_json::from_slice(&std::fs::read(p).unwrap()).unwrap()
+}
+
+#[test]
+fn identical_inputs_pass_and_write_inf_psnr() {
+    let d = scratch("cmp-same");
+    let a = side(&d, "a", 100, 2.0);
+    let summary = d.join("summary.json");
+    let o = compare(
+        &a,
+        &a,
+        &[
+            "--min-psnr",
+            "60",
+            "--max-colour-rmse",
+            "0",
+            "--max-depth-rel",
+            "0",
+            "--json",
+            s(&summary),
+        ],
+    );
+    assert_eq!(o.status.code(), Some(0), "{}", String::from_utf8_lossy(&o.stderr));
+    let j = json(&summary);
+    assert_eq!(
+        (j["psnr_db"].as_str(), j["passed"].as_bool()),
+        (Some("inf"), Some(true)),
+        "{j}"
+    );
+    assert_eq!(j["thresholds"]["min_psnr_db"], 60.0);
+    // Without FILE, the JSON goes to stdout.
+    let o = compare(&a, &a, &["--json"]);
+    let printed: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+    assert_eq!(printed["psnr_db"], "inf");
+}
+
+#[test]
+fn each_broken_threshold_exits_1_and_a_mask_can_exclude_the_difference() {
+    let d = scratch("cmp-diff");
+    // The last column differs by 40 levels: MSE 40^2 / 8 = 200, RMSE 14.14, PSNR
+    // 10 log10(255^2 / 200) = 25.12 dB; depth by 5 % at (0, 0).
+    let (a, b) = (side(&d, "a", 100, 2.0), side(&d, "b", 140, 2.1));
+    let summary = d.join("summary.json");
+    for (flags, needle) in [
+        (["--max-colour-rmse", "14"], "colour RMSE 14.1421 > 14"),
+        (["--max-color-rmse", "10"], "colour RMSE"),
+        (["--min-psnr", "30"], "PSNR 25.12 dB < 30 dB"),
+        (["--max-depth-rel", "0.04"], "max relative depth error 5.000e-2 > 4e-2"),
+    ] {
+        let _ = std::fs::remove_file(&summary);
+        let o = compare(&a, &b, &[&flags[..], &["--json", s(&summary)]].concat());
+        let err = String::from_utf8_lossy(&o.stderr);
+        assert_eq!(o.status.code(), Some(1), "{flags:?}: {err}");
+        assert!(
+            err.contains("threshold broken") && err.contains(needle),
+            "{flags:?}: {err}"
+        );
+        // The summary is still written, for the CI log.
+        let j = json(&summary);
+        assert_eq!(
+            (j["passed"].as_bool(), j["broken"].as_array().map(Vec::len)),
+            (Some(false), Some(1))
+        );
+    }
+    let loose = [
+        "--max-colour-rmse",
+        "14.2",
+        "--min-psnr",
+        "25",
+        "--max-depth-rel",
+        "0.05",
+    ];
+    assert_eq!(compare(&a, &b, &loose).status.code(), Some(0));
+    // Masking out the last column and (0, 0) leaves identical pixels.
+    let mask = d.join("mask.png");
+    let mut bits = vec![1u8; 16];
+    for i in [0, 7, 15] {
+        bits[i] = 0;
+    }
+    io::save_mask_png(&mask, &Mask::new(8, 2, bits).unwrap()).unwrap();
+    let o = compare(
+        &a,
+        &b,
+        &[
+            "--mask",
+            s(&mask),
+            "--min-psnr",
+            "100",
+            "--max-depth-rel",
+            "0",
+            "--json",
+            s(&summary),
+        ],
+    );
+    assert_eq!(o.status.code(), Some(0), "{}", String::from_utf8_lossy(&o.stderr));
+    assert_eq!(
+        (json(&summary)["pixels"].as_u64(), json(&summary)["psnr_db"].as_str()),
+        (Some(13), Some("inf"))
+    );
+}
+
+#[test]
+fn the_diff_image_is_scaled_to_its_largest_difference() {
+    let d = scratch("cmp-image");
+    // Differences of 40 and 20 levels: x 255/40 gives 255 and 128, where x 8 would give 255
+    // (saturated: 320) and 160.
+    let a = side(&d, "a", 100, 2.0);
+    let b = side(&d, "b", 140, 2.0);
+    let mut c = io::load_rgb(&b.0).unwrap();
+    c.data[6 * 3] = 120;
+    io::save_rgb(&b.0, &c).unwrap();
+    let diff = d.join("diff.png");
+    let o = compare(&a, &b, &["--diff", s(&diff)]);
+    let out = String::from_utf8_lossy(&o.stdout);
+    assert!(o.status.success() && out.contains("x 6.375"), "{out}");
+    let img = io::load_rgb(&diff).unwrap();
+    assert_eq!(&img.data[6 * 3..8 * 3], [128, 0, 0, 255, 255, 255]);
+    assert!(img.data[..6 * 3].iter().all(|v| *v == 0));
+}
+
+#[test]
+fn bad_thresholds_and_masks_fail_cleanly() {
+    let d = scratch("cmp-bad");
+    let a = side(&d, "a", 100, 2.0);
+    let o = compare(&a, &a, &["--max-colour-rmse=-1"]);
+    assert!(String::from_utf8_lossy(&o.stderr).contains("max-colour-rmse"));
+    assert_ne!(o.status.code(), Some(0));
+    let small = d.join("small.png");
+    io::save_mask_png(&small, &Mask::new(2, 2, vec![1; 4]).unwrap()).unwrap();
+    let o = compare(&a, &a, &["--mask", s(&small)]);
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(
+        o.status.code() == Some(1) && err.contains("small.png") && err.contains("2x2"),
+        "{err}"
+    );
+}
