@@ -208,8 +208,8 @@ impl ForwardWarp {
         }
         gpu.clip_control(glow::LOWER_LEFT, glow::NEGATIVE_ONE_TO_ONE);
         gpu.check("forward warp")?;
-        let timing = timer.stop();
         let out = super::render::read_output(&fb, self.conv.row_order)?;
+        let timing = timer.stop();
         fb.unbind();
         Ok((out, timing))
     }

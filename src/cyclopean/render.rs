@@ -159,8 +159,8 @@ impl CyclopeanRenderer {
         p.set_i32("u_steps", self.params.steps() as i32);
         self.vao.draw_fullscreen();
         self.gpu.check("cyclopean draw")?;
-        let timing = timer.stop();
         let out = read_output(fb, self.rows)?;
+        let timing = timer.stop();
         fb.unbind();
         Ok((out, timing))
     }

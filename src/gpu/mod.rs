@@ -81,12 +81,6 @@ impl Gpu {
         let i = self.info();
         i.max_texture_size.min(i.max_viewport[0]).min(i.max_viewport[1]).max(0) as u32
     }
-
-    /// Wait for all submitted GL work (used for wall-clock timing where timer queries lie).
-    pub fn finish(&self) {
-        // SAFETY: no arguments.
-        unsafe { self.gl().finish() }
-    }
 }
 
 /// Name a GL object for debuggers (RenderDoc, apitrace); KHR_debug is core since GL 4.3.

@@ -212,13 +212,13 @@ impl Reprojector {
                 p.set_i32("u_steps", steps as i32);
                 s.vao.draw_fullscreen();
                 self.gpu.check("reproject shift draw")?;
-                let timing = timer.stop();
                 let read = |i: usize, bpp: usize| -> Result<Option<Vec<u8>>> {
                     Ok(fb
                         .read_color(i)?
                         .map(|data| memory_rows(&data, w as usize * bpp, self.flip)))
                 };
                 let (rgba, depth) = (read(0, 4)?, read(1, 4)?);
+                let timing = timer.stop();
                 let mask = read(2, 1)?.ok_or_else(|| Error::Gl("reproject: mask attachment missing".into()))?;
                 fb.unbind();
                 Ok((

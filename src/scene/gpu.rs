@@ -267,12 +267,12 @@ impl SceneRenderer {
         self.vao.bind();
         self.vao.draw_fullscreen();
         gpu.check("scene ray trace")?;
-        let timing = timer.stop();
         let rows = |data: Vec<u8>, bpp: usize| cam.conv.row_order.convert_rows(data, w as usize * bpp);
         let floats = |b: Vec<u8>| crate::gpu::pixels::bytes_to_f32(&b);
         let rgba = rows(fb.read_color(0)?.expect("colour"), 4);
         let view_z = rows(fb.read_color(1)?.expect("view z"), 4);
         let device = rows(fb.read_color(2)?.expect("device depth"), 4);
+        let timing = timer.stop();
         fb.unbind();
         Ok((
             SceneImage {

@@ -192,10 +192,12 @@ impl StitchRenderer {
             }
         }
         self.gpu.check("stitch draw")?;
-        let rgba = fb.read_color(0)?.expect("colour attachment");
+        // Rows flipped (GL row order) and RGB packed on the GPU: the mapped bytes are the image.
+        let flip = self.conv.row_order == crate::convention::RowOrder::BottomUp;
+        let read = fb.read_async(0, crate::gpu::ReadFormat::RGB8, flip)?;
+        let rgb = read.expect("colour attachment").finish()?;
         fb.unbind();
         let timing = timer.stop();
-        let rgb = crate::gpu::pixels::rgba_to_rgb(&self.conv.row_order.convert_rows(rgba, w as usize * 4));
         Ok((RgbImage::new(w, 2 * h, rgb)?, timing))
     }
 }
