@@ -29,6 +29,19 @@ pub enum Error {
     /// libEGL is missing, no display could be opened, or no GL 4.5 core context is available.
     #[error("EGL/OpenGL unavailable: {0}")]
     Egl(String),
+    /// Hardware rendering was required (`--require-gpu`, `VIEWSYNTH_REQUIRE_GPU=1`) but the
+    /// context renders in software.
+    #[error(
+        "a hardware GPU is required (--require-gpu or VIEWSYNTH_REQUIRE_GPU=1) but the renderer is \
+         software: '{renderer}' on {location}; {seen}"
+    )]
+    SoftwareRenderer {
+        renderer: String,
+        /// The EGL device or platform the context was created on.
+        location: String,
+        /// The hardware seen (and why it was not used), or that none is visible.
+        seen: String,
+    },
     /// A GL call or object failed (shader compile/link, incomplete framebuffer, GL error).
     #[error("OpenGL error: {0}")]
     Gl(String),

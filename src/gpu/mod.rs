@@ -2,16 +2,20 @@
 //! folder touches a raw GL handle.
 
 mod buffer;
+pub mod devices;
 mod egl;
 mod framebuffer;
 pub mod pixels;
+mod policy;
 mod program;
 mod texture;
 mod timer;
 mod vertex_array;
 
 pub use buffer::IndexBuffer;
+pub use devices::EglDevice;
 pub use egl::{DeviceChoice, EglContext, GpuInfo};
+pub use policy::GpuPolicy;
 pub use framebuffer::{Attachment, Framebuffer};
 pub use program::Program;
 pub use texture::{Texture, TextureFormat};
@@ -27,8 +31,18 @@ use std::rc::Rc;
 pub struct Gpu(Rc<EglContext>);
 
 impl Gpu {
+    /// A context on `choice` under the default policy (which still honours
+    /// `VIEWSYNTH_REQUIRE_GPU`).
     pub fn new(choice: DeviceChoice) -> Result<Self> {
+        Self::open(choice, GpuPolicy::default())
+    }
+
+    /// A context on `choice`, refused with [`Error::SoftwareRenderer`] when the policy (or
+    /// `VIEWSYNTH_REQUIRE_GPU=1`) requires hardware and the renderer is software.
+    pub fn open(choice: DeviceChoice, policy: GpuPolicy) -> Result<Self> {
+        let policy = policy.with_env()?;
         let ctx = EglContext::new(choice)?;
+        policy.check(&ctx.info)?;
         Ok(Gpu(Rc::new(ctx)))
     }
 
