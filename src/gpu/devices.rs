@@ -186,6 +186,13 @@ fn nvidia_vendor_files(dir: &Path) -> Vec<PathBuf> {
     files
 }
 
+/// Hardware EGL devices and NVIDIA driver signs, one line each.
+pub fn visible_hardware(devices: &[EglDevice], host_evidence: &[String]) -> Vec<String> {
+    let mut seen: Vec<String> = devices.iter().filter(|d| !d.software).map(EglDevice::label).collect();
+    seen.extend(host_evidence.iter().map(|e| format!("NVIDIA driver sign {e}")));
+    seen
+}
+
 /// The warning to print when rendering runs on software although hardware is visible: `None`
 /// when the renderer is hardware, or when nothing suggests a GPU. Names the software renderer
 /// and every hardware device or NVIDIA sign seen, plus why hardware devices were not used.
@@ -200,8 +207,7 @@ pub fn software_warning(
     if !software {
         return None;
     }
-    let mut seen: Vec<String> = devices.iter().filter(|d| !d.software).map(EglDevice::label).collect();
-    seen.extend(host_evidence.iter().map(|e| format!("NVIDIA driver sign {e}")));
+    let seen = visible_hardware(devices, host_evidence);
     if seen.is_empty() {
         return None;
     }

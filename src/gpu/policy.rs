@@ -1,5 +1,6 @@
 //! What a caller demands of the renderer: `--require-gpu` and `VIEWSYNTH_REQUIRE_GPU`.
 
+use super::devices::{visible_hardware, HostProbe};
 use super::egl::GpuInfo;
 use crate::error::{Error, Result};
 
@@ -26,17 +27,25 @@ impl GpuPolicy {
         if !self.require_hardware || !info.software {
             return Ok(());
         }
+        self.check_with(info, &HostProbe::default().nvidia_evidence())
+    }
+
+    /// [`Self::check`] with the host's NVIDIA signs given (tests pass synthetic ones).
+    pub fn check_with(&self, info: &GpuInfo, host_evidence: &[String]) -> Result<()> {
+        if !self.require_hardware || !info.software {
+            return Ok(());
+        }
         let location = match info.device_index.and_then(|i| info.devices.get(i)) {
             Some(d) => d.label(),
             None => format!("the {} platform", info.platform),
         };
-        let hardware: Vec<String> = info.devices.iter().filter(|d| !d.software).map(|d| d.label()).collect();
-        let seen = match (&info.software_warning, hardware.is_empty()) {
-            (Some(w), _) => w.clone(),
-            (None, false) => format!("hardware devices listed: {}", hardware.join("; ")),
-            (None, true) => "no hardware EGL device or NVIDIA driver is visible (in Docker: --gpus all \
-                             -e NVIDIA_DRIVER_CAPABILITIES=graphics,utility)"
-                .into(),
+        let hardware = visible_hardware(&info.devices, host_evidence);
+        let seen = if hardware.is_empty() {
+            "no hardware EGL device or NVIDIA driver is visible (in Docker: --gpus all \
+             -e NVIDIA_DRIVER_CAPABILITIES=graphics,utility)"
+                .to_string()
+        } else {
+            format!("hardware visible but not used: {}", hardware.join("; "))
         };
         Err(Error::SoftwareRenderer {
             renderer: info.renderer.clone(),
@@ -106,13 +115,18 @@ mod tests {
         use crate::gpu::EglDevice;
         let sw = vec![EglDevice::new(0, "EGL_MESA_device_software")];
         let required = GpuPolicy { require_hardware: true };
-        let e = required.check(&info("llvmpipe (LLVM 15)", true, sw.clone())).unwrap_err();
+        let e = required.check_with(&info("llvmpipe (LLVM 15)", true, sw.clone()), &[]).unwrap_err();
         assert!(matches!(e, Error::SoftwareRenderer { .. }));
         let text = e.to_string();
         assert!(text.contains("'llvmpipe (LLVM 15)'") && text.contains("EGL device 0 (software"), "{text}");
         assert!(text.contains("no hardware EGL device"), "{text}");
-        GpuPolicy::default().check(&info("llvmpipe", true, sw)).unwrap();
+        let text = required
+            .check_with(&info("llvmpipe", true, sw.clone()), &["/dev/nvidia0".into()])
+            .unwrap_err()
+            .to_string();
+        assert!(text.contains("hardware visible but not used: NVIDIA driver sign /dev/nvidia0"), "{text}");
+        GpuPolicy::default().check_with(&info("llvmpipe", true, sw), &[]).unwrap();
         let hw = vec![EglDevice::new(0, "EGL_NV_device_cuda")];
-        required.check(&info("NVIDIA H100", false, hw)).unwrap();
+        required.check_with(&info("NVIDIA H100", false, hw), &[]).unwrap();
     }
 }
