@@ -23,6 +23,14 @@ pub enum Error {
     /// A parameter is out of its domain (non-finite, non-positive, too large, mismatched).
     #[error("invalid {name}: {message}")]
     InvalidParameter { name: String, message: String },
+    /// An image side exceeds what the GPU context renders (`gpu::check_image_size`).
+    #[error("invalid {name}: {width}x{height} exceeds this GPU's limit of {limit} px per side")]
+    ImageTooLarge {
+        name: String,
+        width: u64,
+        height: u64,
+        limit: u32,
+    },
     /// Two inputs that must agree in size do not.
     #[error("size mismatch: {message}")]
     SizeMismatch { message: String },

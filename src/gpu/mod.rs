@@ -5,6 +5,7 @@ mod buffer;
 pub mod devices;
 mod egl;
 mod framebuffer;
+mod limits;
 pub mod pixels;
 mod policy;
 mod program;
@@ -17,6 +18,7 @@ pub use devices::EglDevice;
 pub use egl::{DeviceChoice, EglContext, GpuInfo};
 pub use policy::GpuPolicy;
 pub use framebuffer::{Attachment, Framebuffer};
+pub use limits::check_image_size;
 pub use program::Program;
 pub use texture::{Texture, TextureFormat};
 pub use timer::{GpuTimer, Timing};
@@ -75,6 +77,11 @@ impl Gpu {
     pub fn max_image_side(&self) -> u32 {
         let i = self.info();
         i.max_texture_size.min(i.max_viewport[0]).min(i.max_viewport[1]).max(0) as u32
+    }
+
+    /// [`check_image_size`] against this context's [`Self::max_image_side`].
+    pub fn check_image_size(&self, name: &str, width: u32, height: u32) -> Result<()> {
+        check_image_size(name, width.into(), height.into(), self.max_image_side())
     }
 
     /// Wait for all submitted GL work (used for wall-clock timing where timer queries lie).

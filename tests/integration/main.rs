@@ -8,6 +8,7 @@ mod compare;
 mod cyclopean;
 mod device_choice;
 mod gpu_context;
+mod limits;
 mod refocus_accuracy;
 mod refocus_conventions;
 mod refocus_edge_cases;
