@@ -129,8 +129,11 @@ pub fn renderer_is_software(renderer: &str) -> bool {
 pub struct HostProbe {
     pub device_nodes: Vec<PathBuf>,
     pub driver_version_file: PathBuf,
-    /// glvnd EGL vendor folders; a JSON there naming NVIDIA's library means its EGL is installed.
+    /// glvnd EGL vendor folders; a JSON there naming NVIDIA's library counts when that library
+    /// is present (an image may ship the JSON for the NVIDIA toolkit to fill in).
     pub egl_vendor_dirs: Vec<PathBuf>,
+    /// Where a vendor JSON's bare library name is looked for.
+    pub library_dirs: Vec<PathBuf>,
 }
 
 impl Default for HostProbe {
@@ -141,10 +144,26 @@ impl Default for HostProbe {
             None => Vec::new(),
         };
         egl_vendor_dirs.extend(["/etc/glvnd/egl_vendor.d", "/usr/share/glvnd/egl_vendor.d"].map(PathBuf::from));
+        let mut library_dirs: Vec<PathBuf> = match std::env::var_os("LD_LIBRARY_PATH") {
+            Some(v) => std::env::split_paths(&v).collect(),
+            None => Vec::new(),
+        };
+        library_dirs.extend(
+            [
+                "/usr/lib/x86_64-linux-gnu",
+                "/usr/lib/aarch64-linux-gnu",
+                "/usr/lib64",
+                "/usr/lib",
+                "/usr/local/nvidia/lib64",
+                "/usr/local/nvidia/lib",
+            ]
+            .map(PathBuf::from),
+        );
         HostProbe {
             device_nodes: vec![PathBuf::from("/dev/nvidia0")],
             driver_version_file: PathBuf::from("/proc/driver/nvidia/version"),
             egl_vendor_dirs,
+            library_dirs,
         }
     }
 }
@@ -163,27 +182,41 @@ impl HostProbe {
             found.push(format!("{} ({first})", self.driver_version_file.display()));
         }
         for dir in &self.egl_vendor_dirs {
-            found.extend(nvidia_vendor_files(dir).iter().map(|p| p.display().to_string()));
+            for (json, lib) in self.nvidia_vendor_files(dir) {
+                found.push(format!("{} -> {}", json.display(), lib.display()));
+            }
         }
         found
     }
-}
 
-fn nvidia_vendor_files(dir: &Path) -> Vec<PathBuf> {
-    let Ok(entries) = std::fs::read_dir(dir) else {
-        return Vec::new();
-    };
-    let mut files: Vec<PathBuf> = entries
-        .filter_map(|e| e.ok().map(|e| e.path()))
-        .filter(|p| p.extension().is_some_and(|x| x == "json"))
-        .filter(|p| {
-            std::fs::read_to_string(p)
-                .map(|t| t.to_ascii_lowercase().contains("nvidia"))
-                .unwrap_or(false)
-        })
-        .collect();
-    files.sort();
-    files
+    /// NVIDIA vendor JSONs in `dir` whose library exists, with that library's path.
+    fn nvidia_vendor_files(&self, dir: &Path) -> Vec<(PathBuf, PathBuf)> {
+        let Ok(entries) = std::fs::read_dir(dir) else {
+            return Vec::new();
+        };
+        let mut jsons: Vec<PathBuf> = entries
+            .filter_map(|e| e.ok().map(|e| e.path()))
+            .filter(|p| p.extension().is_some_and(|x| x == "json"))
+            .collect();
+        jsons.sort();
+        jsons
+            .into_iter()
+            .filter_map(|json| {
+                let text = std::fs::read_to_string(&json).ok()?;
+                let value: serde_json::Value = serde_json::from_str(&text).ok()?;
+                let lib = value["ICD"]["library_path"].as_str()?;
+                if !lib.to_ascii_lowercase().contains("nvidia") {
+                    return None;
+                }
+                let found = if lib.contains('/') {
+                    Some(PathBuf::from(lib)).filter(|p| p.exists())
+                } else {
+                    self.library_dirs.iter().map(|d| d.join(lib)).find(|p| p.exists())
+                };
+                found.map(|lib| (json, lib))
+            })
+            .collect()
+    }
 }
 
 /// Hardware EGL devices and NVIDIA driver signs, one line each.
@@ -323,13 +356,20 @@ mod tests {
         let vendor = dir.join("egl_vendor.d");
         std::fs::create_dir_all(&vendor).unwrap();
         std::fs::write(vendor.join("50_mesa.json"), r#"{"ICD":{"library_path":"libEGL_mesa.so.0"}}"#).unwrap();
+        let libs = dir.join("lib");
+        std::fs::create_dir_all(&libs).unwrap();
         let probe = HostProbe {
             device_nodes: vec![dir.join("nvidia0")],
             driver_version_file: dir.join("version"),
             egl_vendor_dirs: vec![vendor.clone(), dir.join("absent")],
+            library_dirs: vec![libs.clone()],
         };
         assert!(probe.nvidia_evidence().is_empty());
+        // A vendor JSON whose library is absent (an image shipping the JSON, run without
+        // --gpus) is no sign of a driver.
         std::fs::write(vendor.join("10_nvidia.json"), r#"{"ICD":{"library_path":"libEGL_nvidia.so.0"}}"#).unwrap();
+        assert!(probe.nvidia_evidence().is_empty());
+        std::fs::write(libs.join("libEGL_nvidia.so.0"), "").unwrap();
         std::fs::write(dir.join("version"), "NVRM version: NVIDIA UNIX x86_64 Kernel Module  550.54\nGCC\n").unwrap();
         std::fs::write(dir.join("nvidia0"), "").unwrap();
         let ev = probe.nvidia_evidence();
@@ -337,6 +377,6 @@ mod tests {
         assert_eq!(ev.len(), 3, "{ev:?}");
         assert!(ev[0].ends_with("nvidia0"));
         assert!(ev[1].contains("Kernel Module  550.54"), "{ev:?}");
-        assert!(ev[2].ends_with("10_nvidia.json"));
+        assert!(ev[2].contains("10_nvidia.json -> ") && ev[2].ends_with("libEGL_nvidia.so.0"), "{ev:?}");
     }
 }

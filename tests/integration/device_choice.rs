@@ -135,7 +135,8 @@ fn software_rendering_with_an_nvidia_vendor_file_visible_warns_loudly() {
         return; // a hardware renderer: no warning to provoke
     }
     // glvnd reads vendor files from __EGL_VENDOR_LIBRARY_DIRS instead of the system folders:
-    // Mesa's plus an NVIDIA one whose library is absent, as in a container without the driver.
+    // Mesa's plus an NVIDIA one whose library exists but does not load (as when the toolkit
+    // mounts the driver without the graphics capability), so glvnd falls back to Mesa.
     let d = scratch("nvidia-vendor");
     let mesa = ["/usr/share/glvnd/egl_vendor.d", "/etc/glvnd/egl_vendor.d"]
         .iter()
@@ -146,9 +147,14 @@ fn software_rendering_with_an_nvidia_vendor_file_visible_warns_loudly() {
         return; // EGL not through glvnd: the variable has no effect
     };
     std::fs::copy(&mesa, d.join("50_mesa.json")).unwrap();
+    let lib = d.join("libEGL_nvidia.so.0");
+    std::fs::write(&lib, b"not an ELF file").unwrap();
     std::fs::write(
         d.join("10_nvidia.json"),
-        r#"{"file_format_version":"1.0.0","ICD":{"library_path":"libEGL_nvidia.so.0"}}"#,
+        format!(
+            r#"{{"file_format_version":"1.0.0","ICD":{{"library_path":"{}"}}}}"#,
+            lib.display()
+        ),
     )
     .unwrap();
     let o = bin()
