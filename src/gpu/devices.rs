@@ -317,7 +317,9 @@ mod tests {
         assert!(renderer_is_software("llvmpipe (LLVM 15.0.6, 256 bits)"));
         assert!(renderer_is_software("softpipe"));
         assert!(!renderer_is_software("NVIDIA H100 80GB HBM3/PCIe/SSE2"));
-        assert!(!renderer_is_software("AMD Radeon RX 7900 XTX (radeonsi, navi31, LLVM 15.0.7)"));
+        assert!(!renderer_is_software(
+            "AMD Radeon RX 7900 XTX (radeonsi, navi31, LLVM 15.0.7)"
+        ));
     }
 
     #[test]
@@ -327,7 +329,10 @@ mod tests {
         let w = software_warning("llvmpipe (LLVM 15)", Some(&devices[0]), &devices, &[], &attempts)
             .expect("hardware device visible");
         assert!(w.contains("llvmpipe (LLVM 15)"), "{w}");
-        assert!(w.contains("EGL device 1 (hardware, nvidia, /dev/dri/card0, CUDA 0)"), "{w}");
+        assert!(
+            w.contains("EGL device 1 (hardware, nvidia, /dev/dri/card0, CUDA 0)"),
+            "{w}"
+        );
         assert!(w.contains("BadAlloc"), "{w}");
 
         let evidence = ["/dev/nvidia0".to_string()];
@@ -345,7 +350,10 @@ mod tests {
             None
         );
         let only_sw = [mesa_software(0)];
-        assert_eq!(software_warning("llvmpipe", Some(&only_sw[0]), &only_sw, &[], &[]), None);
+        assert_eq!(
+            software_warning("llvmpipe", Some(&only_sw[0]), &only_sw, &[], &[]),
+            None
+        );
         // Surfaceless (no device) with a software GL_RENDERER still warns when a GPU is seen.
         assert!(software_warning("llvmpipe", None, &[], &ev, &[]).is_some());
     }
@@ -355,7 +363,11 @@ mod tests {
         let dir = std::env::temp_dir().join(format!("viewsynth-host-probe-{}", std::process::id()));
         let vendor = dir.join("egl_vendor.d");
         std::fs::create_dir_all(&vendor).unwrap();
-        std::fs::write(vendor.join("50_mesa.json"), r#"{"ICD":{"library_path":"libEGL_mesa.so.0"}}"#).unwrap();
+        std::fs::write(
+            vendor.join("50_mesa.json"),
+            r#"{"ICD":{"library_path":"libEGL_mesa.so.0"}}"#,
+        )
+        .unwrap();
         let libs = dir.join("lib");
         std::fs::create_dir_all(&libs).unwrap();
         let probe = HostProbe {
@@ -367,16 +379,27 @@ mod tests {
         assert!(probe.nvidia_evidence().is_empty());
         // A vendor JSON whose library is absent (an image shipping the JSON, run without
         // --gpus) is no sign of a driver.
-        std::fs::write(vendor.join("10_nvidia.json"), r#"{"ICD":{"library_path":"libEGL_nvidia.so.0"}}"#).unwrap();
+        std::fs::write(
+            vendor.join("10_nvidia.json"),
+            r#"{"ICD":{"library_path":"libEGL_nvidia.so.0"}}"#,
+        )
+        .unwrap();
         assert!(probe.nvidia_evidence().is_empty());
         std::fs::write(libs.join("libEGL_nvidia.so.0"), "").unwrap();
-        std::fs::write(dir.join("version"), "NVRM version: NVIDIA UNIX x86_64 Kernel Module  550.54\nGCC\n").unwrap();
+        std::fs::write(
+            dir.join("version"),
+            "NVRM version: NVIDIA UNIX x86_64 Kernel Module  550.54\nGCC\n",
+        )
+        .unwrap();
         std::fs::write(dir.join("nvidia0"), "").unwrap();
         let ev = probe.nvidia_evidence();
         let _ = std::fs::remove_dir_all(&dir);
         assert_eq!(ev.len(), 3, "{ev:?}");
         assert!(ev[0].ends_with("nvidia0"));
         assert!(ev[1].contains("Kernel Module  550.54"), "{ev:?}");
-        assert!(ev[2].contains("10_nvidia.json -> ") && ev[2].ends_with("libEGL_nvidia.so.0"), "{ev:?}");
+        assert!(
+            ev[2].contains("10_nvidia.json -> ") && ev[2].ends_with("libEGL_nvidia.so.0"),
+            "{ev:?}"
+        );
     }
 }

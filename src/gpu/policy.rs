@@ -115,17 +115,27 @@ mod tests {
         use crate::gpu::EglDevice;
         let sw = vec![EglDevice::new(0, "EGL_MESA_device_software")];
         let required = GpuPolicy { require_hardware: true };
-        let e = required.check_with(&info("llvmpipe (LLVM 15)", true, sw.clone()), &[]).unwrap_err();
+        let e = required
+            .check_with(&info("llvmpipe (LLVM 15)", true, sw.clone()), &[])
+            .unwrap_err();
         assert!(matches!(e, Error::SoftwareRenderer { .. }));
         let text = e.to_string();
-        assert!(text.contains("'llvmpipe (LLVM 15)'") && text.contains("EGL device 0 (software"), "{text}");
+        assert!(
+            text.contains("'llvmpipe (LLVM 15)'") && text.contains("EGL device 0 (software"),
+            "{text}"
+        );
         assert!(text.contains("no hardware EGL device"), "{text}");
         let text = required
             .check_with(&info("llvmpipe", true, sw.clone()), &["/dev/nvidia0".into()])
             .unwrap_err()
             .to_string();
-        assert!(text.contains("hardware visible but not used: NVIDIA driver sign /dev/nvidia0"), "{text}");
-        GpuPolicy::default().check_with(&info("llvmpipe", true, sw), &[]).unwrap();
+        assert!(
+            text.contains("hardware visible but not used: NVIDIA driver sign /dev/nvidia0"),
+            "{text}"
+        );
+        GpuPolicy::default()
+            .check_with(&info("llvmpipe", true, sw), &[])
+            .unwrap();
         let hw = vec![EglDevice::new(0, "EGL_NV_device_cuda")];
         required.check_with(&info("NVIDIA H100", false, hw), &[]).unwrap();
     }

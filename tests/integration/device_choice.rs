@@ -8,7 +8,11 @@ use std::process::Output;
 
 /// `info --json` of this machine (what the other tests compare against).
 fn info_json() -> serde_json::Value {
-    let o = bin().args(["info", "--json"]).env_remove("VIEWSYNTH_REQUIRE_GPU").output().unwrap();
+    let o = bin()
+        .args(["info", "--json"])
+        .env_remove("VIEWSYNTH_REQUIRE_GPU")
+        .output()
+        .unwrap();
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
     serde_json::from_slice(&o.stdout).expect("info --json prints one JSON object")
 }
@@ -30,7 +34,11 @@ fn assert_refused_naming(o: &Output, renderer: &str) {
 
 #[test]
 fn require_gpu_flag_refuses_a_software_renderer() {
-    let o = bin().args(["info", "--require-gpu"]).env_remove("VIEWSYNTH_REQUIRE_GPU").output().unwrap();
+    let o = bin()
+        .args(["info", "--require-gpu"])
+        .env_remove("VIEWSYNTH_REQUIRE_GPU")
+        .output()
+        .unwrap();
     match software_renderer() {
         Some(r) => {
             assert!(r.contains("llvmpipe") || r.contains("softpipe"), "{r}");
@@ -66,12 +74,20 @@ fn require_gpu_env_refuses_every_command_before_any_output() {
         .output()
         .unwrap();
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
-    assert!(files_in(&out).iter().any(|f| f == "cameras.json"), "{:?}", files_in(&out));
+    assert!(
+        files_in(&out).iter().any(|f| f == "cameras.json"),
+        "{:?}",
+        files_in(&out)
+    );
 }
 
 #[test]
 fn a_mistyped_require_gpu_env_is_an_error_naming_it() {
-    let o = bin().arg("info").env("VIEWSYNTH_REQUIRE_GPU", "maybe").output().unwrap();
+    let o = bin()
+        .arg("info")
+        .env("VIEWSYNTH_REQUIRE_GPU", "maybe")
+        .output()
+        .unwrap();
     let err = String::from_utf8_lossy(&o.stderr);
     assert_eq!(o.status.code(), Some(1), "{err}");
     assert!(err.contains("VIEWSYNTH_REQUIRE_GPU") && err.contains("maybe"), "{err}");
@@ -103,7 +119,11 @@ fn info_lists_every_device_and_the_auto_pick() {
     let expected_pick = match i["auto_device"].as_u64() {
         Some(a) => format!(
             "auto picks device {a} ({})",
-            if devices[a as usize]["software"] == true { "software" } else { "hardware" }
+            if devices[a as usize]["software"] == true {
+                "software"
+            } else {
+                "hardware"
+            }
         ),
         None => "auto picks Mesa surfaceless".into(),
     };
@@ -114,7 +134,15 @@ fn info_lists_every_device_and_the_auto_pick() {
         assert!(text.contains(&format!("  [{n}] {kind}")), "{text}");
     }
     // The fields info printed before the device list are kept.
-    for field in ["vendor:", "renderer:", "GL version:", "EGL:", "device:", "device ext:", "limits:"] {
+    for field in [
+        "vendor:",
+        "renderer:",
+        "GL version:",
+        "EGL:",
+        "device:",
+        "device ext:",
+        "limits:",
+    ] {
         assert!(text.contains(field), "{field} missing: {text}");
     }
 }

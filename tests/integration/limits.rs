@@ -29,7 +29,8 @@ fn assert_refused(r: Result<(), Error>, w: u32, h: u32, limit: u32) -> String {
     let rest = e.strip_prefix("invalid ").unwrap_or_else(|| panic!("{e}"));
     let (name, rest) = rest.split_once(": ").unwrap_or_else(|| panic!("{e}"));
     assert_eq!(
-        rest.strip_prefix(&format!("{w}x{h} exceeds this GPU's limit of {limit}")).map(|_| ()),
+        rest.strip_prefix(&format!("{w}x{h} exceeds this GPU's limit of {limit}"))
+            .map(|_| ()),
         Some(()),
         "{e}"
     );
@@ -64,8 +65,15 @@ fn refocus_output_one_past_the_limit_is_refused() {
         Conventions::default(),
     )
     .unwrap();
-    let target = |w| PinholeCamera { k: k(w, 1), width: w, height: 1 };
-    assert_eq!(assert_refused(r.render(&target(max + 1)).map(|_| ()), max + 1, 1, max), "output size");
+    let target = |w| PinholeCamera {
+        k: k(w, 1),
+        width: w,
+        height: 1,
+    };
+    assert_eq!(
+        assert_refused(r.render(&target(max + 1)).map(|_| ()), max + 1, 1, max),
+        "output size"
+    );
     // The limit itself renders.
     r.render(&target(max)).expect("a side equal to the limit renders");
 }
@@ -105,9 +113,15 @@ fn cyclopean_middle_view_one_past_the_limit_is_refused_by_both_renderers() {
     let (frame, mut mid, _) = scene_frame(&rig, Conventions::default(), DepthKind::ViewZ);
     (mid.width, mid.height) = (max + 1, 1);
     let mut gather = CyclopeanRenderer::new(&g, &frame, CyclopeanParams::seed(3.0)).unwrap();
-    assert_eq!(assert_refused(gather.render(&mid).map(|_| ()), max + 1, 1, max), "middle size");
+    assert_eq!(
+        assert_refused(gather.render(&mid).map(|_| ()), max + 1, 1, max),
+        "middle size"
+    );
     let mut forward = ForwardWarp::new(&g, &frame, &BreakRule::default()).unwrap();
-    assert_eq!(assert_refused(forward.render(&mid).map(|_| ()), max + 1, 1, max), "middle size");
+    assert_eq!(
+        assert_refused(forward.render(&mid).map(|_| ()), max + 1, 1, max),
+        "middle size"
+    );
 }
 
 #[test]
@@ -122,7 +136,11 @@ fn reproject_source_one_past_the_limit_is_refused() {
         conv: Conventions::default(),
     };
     let geometry = Geometry::Rig {
-        camera: PinholeCamera { k: k(w, 1), width: w, height: 1 },
+        camera: PinholeCamera {
+            k: k(w, 1),
+            width: w,
+            height: 1,
+        },
         shift: ShiftModel::rectified(10.0, 0.0, 0.0, Some(Eye::Left), Some(Eye::Right)).unwrap(),
     };
     let r = Reprojector::new(&g, &src, &geometry, ReprojectParams::new(Method::ShiftScan)).map(|_| ());
@@ -149,7 +167,10 @@ fn stitch_equirect_one_past_the_limit_is_refused() {
     assert_eq!(assert_refused(refused, max + 1, 2, max), "equirect size");
     // The top-bottom image has 2 h rows: h = max / 2 + 1 is one past it.
     let h = max / 2 + 1;
-    assert_eq!(assert_refused(s.render(&params(1, h)).map(|_| ()), 1, 2 * h, max), "equirect size");
+    assert_eq!(
+        assert_refused(s.render(&params(1, h)).map(|_| ()), 1, 2 * h, max),
+        "equirect size"
+    );
 }
 
 #[test]
@@ -157,7 +178,11 @@ fn scene_camera_one_past_the_limit_is_refused() {
     let g = gpu();
     let max = g.max_image_side();
     let mut r = SceneRenderer::new(&g, &builtin("demo").unwrap()).unwrap();
-    let cam = PinholeCamera { k: k(max + 1, 1), width: max + 1, height: 1 };
+    let cam = PinholeCamera {
+        k: k(max + 1, 1),
+        width: max + 1,
+        height: 1,
+    };
     let conv = Conventions::default();
     let glc = GlCamera {
         view: Pose::yawed(0.0, [0.0, 0.0, 0.0]).gl_view(),
@@ -166,5 +191,8 @@ fn scene_camera_one_past_the_limit_is_refused() {
         height: 1,
         conv,
     };
-    assert_eq!(assert_refused(r.render(&glc).map(|_| ()), max + 1, 1, max), "camera size");
+    assert_eq!(
+        assert_refused(r.render(&glc).map(|_| ()), max + 1, 1, max),
+        "camera size"
+    );
 }

@@ -321,10 +321,7 @@ fn info(gpu: &GpuArgs, json: bool) -> Result<()> {
             "no (wall clock with glFinish)"
         }
     );
-    println!(
-        "rendering:   {}",
-        if i.software { "software" } else { "hardware" }
-    );
+    println!("rendering:   {}", if i.software { "software" } else { "hardware" });
     print!("{}", device_table(i));
     Ok(())
 }
@@ -342,7 +339,11 @@ fn device_table(i: &viewsynth::gpu::GpuInfo) -> String {
             "  [{}] {}{}  driver {}  vendor {}  file {}  CUDA {}  ext {}\n",
             d.index,
             d.kind(),
-            if i.device_index == Some(d.index) { " (in use)" } else { "" },
+            if i.device_index == Some(d.index) {
+                " (in use)"
+            } else {
+                ""
+            },
             or_dash(&d.driver),
             or_dash(&d.vendor),
             or_dash(&d.drm_file.clone().or(d.render_node.clone())),
