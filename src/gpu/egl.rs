@@ -314,7 +314,7 @@ fn device_string(query: QueryDeviceString, device: *mut c_void, name: egl::Int) 
 }
 
 /// What each device says about itself. Strings an extension does not promise are not asked
-/// for, so no EGL error is left pending.
+/// for.
 fn describe_devices(
     egl: &egl::DynamicInstance<egl::EGL1_4>,
     handles: &[*mut c_void],
@@ -340,7 +340,9 @@ fn describe_devices(
                 d.vendor = string(EGL_VENDOR_DEVICE);
                 d.renderer = string(EGL_RENDERER_EXT);
             }
-            if let (true, Some(attrib)) = (d.has_extension("EGL_NV_device_cuda"), attrib) {
+            // Asked of every device, as before the descriptions existed: a device without
+            // EGL_NV_device_cuda just answers false (and EGL's last error is per call).
+            if let Some(attrib) = attrib {
                 let mut value: isize = -1;
                 // SAFETY: valid device handle and out-pointer.
                 if unsafe { attrib(handle, EGL_CUDA_DEVICE_NV, &mut value) } != 0 {
