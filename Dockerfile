@@ -1,29 +1,52 @@
-# Multi-stage build: compile with the Rust image, run on a slim Debian with glvnd's libEGL.
-# Rendering picks NVIDIA's EGL when the NVIDIA container toolkit mounts it
-#   docker run --gpus all -e NVIDIA_DRIVER_CAPABILITIES=graphics,compute,utility viewsynth info
-# and falls back to Mesa llvmpipe (software) otherwise:
-#   docker run viewsynth info
+# viewsynth for GPU servers: a build stage with the Rust toolchain, and a slim Debian runtime with
+# glvnd's libEGL, Mesa (software fallback) and the glvnd vendor file for NVIDIA's EGL.
+#
+#   docker build -t viewsynth .
+#   docker run --rm --gpus all -e NVIDIA_DRIVER_CAPABILITIES=graphics,utility viewsynth
+#       NVIDIA: the toolkit mounts libEGL_nvidia.so.0 only with the `graphics` capability;
+#       prints `info` (every EGL device, which one `auto` picks), then runs the demo.
+#   docker run --rm --gpus all -e NVIDIA_DRIVER_CAPABILITIES=graphics,utility \
+#       -e VIEWSYNTH_REQUIRE_GPU=1 -v "$PWD:/work" viewsynth refocus ...
+#       fails (exit 1) instead of rendering on llvmpipe when the GPU is not reachable.
+#   docker run --rm viewsynth info
+#       no GPU: Mesa llvmpipe (software), said as much by `info`.
+# Outputs go under /work (the working directory, owned by the non-root user `viewsynth`, uid
+# 1000): mount a host folder there, e.g. -v "$PWD:/work" --user "$(id -u):$(id -g)".
+
 FROM rust:1-bookworm AS build
 WORKDIR /src
-COPY Cargo.toml Cargo.lock rustfmt.toml ./
+# Dependencies first, in their own layer: a placeholder crate with the real manifest and lock
+# file builds every dependency, so editing src/ or shaders/ rebuilds only viewsynth itself.
+COPY Cargo.toml Cargo.lock ./
+RUN mkdir -p src/bin/viewsynth \
+ && echo '' > src/lib.rs \
+ && echo 'fn main() {}' > src/bin/viewsynth/main.rs \
+ && cargo build --release --locked --bin viewsynth \
+ && rm -rf src target/release/.fingerprint/viewsynth-* target/release/deps/viewsynth-* \
+      target/release/deps/libviewsynth-* target/release/viewsynth
 COPY src src
 COPY shaders shaders
 RUN cargo build --release --locked --bin viewsynth
 
 FROM debian:bookworm-slim
-COPY ci/install-deps.sh /tmp/install-deps.sh
-# install-deps.sh would fetch Rust if cargo were missing; the runtime only needs the EGL packages.
 RUN apt-get update -qq \
  && DEBIAN_FRONTEND=noninteractive apt-get install -y -qq --no-install-recommends \
       libegl1 libegl-mesa0 libgl1-mesa-dri libgles2 ca-certificates \
- && rm -rf /var/lib/apt/lists/* /tmp/install-deps.sh
-# glvnd picks EGL vendors from these JSON files, lowest number first. The NVIDIA toolkit mounts
-# libEGL_nvidia.so.0 but not always this file; without it only Mesa would be found.
+ && rm -rf /var/lib/apt/lists/*
+# glvnd finds EGL vendors through these JSON files. The NVIDIA toolkit mounts libEGL_nvidia.so.0
+# (with NVIDIA_DRIVER_CAPABILITIES including graphics) but not always this file; without it only
+# Mesa's software renderer would be found. Where the library is absent glvnd skips the vendor,
+# and viewsynth does not count the file as a sign of a driver.
 RUN mkdir -p /usr/share/glvnd/egl_vendor.d \
  && printf '{"file_format_version":"1.0.0","ICD":{"library_path":"libEGL_nvidia.so.0"}}\n' \
       > /usr/share/glvnd/egl_vendor.d/10_nvidia.json
-ENV NVIDIA_DRIVER_CAPABILITIES=graphics,compute,utility
+ENV NVIDIA_VISIBLE_DEVICES=all \
+    NVIDIA_DRIVER_CAPABILITIES=graphics,utility
 COPY --from=build /src/target/release/viewsynth /usr/local/bin/viewsynth
+COPY docker/entrypoint.sh /usr/local/bin/viewsynth-entrypoint
+RUN useradd --create-home --uid 1000 --user-group viewsynth \
+ && mkdir -p /work && chown viewsynth:viewsynth /work
+USER viewsynth
 WORKDIR /work
-ENTRYPOINT ["viewsynth"]
-CMD ["info"]
+ENTRYPOINT ["viewsynth-entrypoint"]
+CMD []

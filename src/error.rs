@@ -23,12 +23,33 @@ pub enum Error {
     /// A parameter is out of its domain (non-finite, non-positive, too large, mismatched).
     #[error("invalid {name}: {message}")]
     InvalidParameter { name: String, message: String },
+    /// An image side exceeds what the GPU context renders (`gpu::check_image_size`).
+    #[error("invalid {name}: {width}x{height} exceeds this GPU's limit of {limit} px per side")]
+    ImageTooLarge {
+        name: String,
+        width: u64,
+        height: u64,
+        limit: u32,
+    },
     /// Two inputs that must agree in size do not.
     #[error("size mismatch: {message}")]
     SizeMismatch { message: String },
     /// libEGL is missing, no display could be opened, or no GL 4.5 core context is available.
     #[error("EGL/OpenGL unavailable: {0}")]
     Egl(String),
+    /// Hardware rendering was required (`--require-gpu`, `VIEWSYNTH_REQUIRE_GPU=1`) but the
+    /// context renders in software.
+    #[error(
+        "a hardware GPU is required (--require-gpu or VIEWSYNTH_REQUIRE_GPU=1) but the renderer is \
+         software: '{renderer}' on {location}; {seen}"
+    )]
+    SoftwareRenderer {
+        renderer: String,
+        /// The EGL device or platform the context was created on.
+        location: String,
+        /// The hardware seen (and why it was not used), or that none is visible.
+        seen: String,
+    },
     /// A GL call or object failed (shader compile/link, incomplete framebuffer, GL error).
     #[error("OpenGL error: {0}")]
     Gl(String),

@@ -8,7 +8,7 @@ mod projection;
 pub mod stereo;
 pub mod vergence;
 
-pub use intrinsics::{Intrinsics, PinholeCamera, MAX_IMAGE_SIDE};
+pub use intrinsics::{Intrinsics, PinholeCamera};
 pub use intrinsics_file::{IntrinsicsFile, IntrinsicsFormat};
 pub use pose::{gl_projection, Pose};
 pub use projection::clip_from_view_opencv;

@@ -119,9 +119,7 @@ impl ForwardWarp {
 
     pub fn render(&mut self, mid: &MiddleCamera) -> Result<(CyclopeanOutput, Timing)> {
         let (w, h) = (mid.width, mid.height);
-        if w == 0 || h == 0 || w > self.gpu.max_image_side() || h > self.gpu.max_image_side() {
-            return Err(Error::param("middle size", format!("{w}x{h}")));
-        }
+        self.gpu.check_image_size("middle size", w, h)?;
         let slot = |format| {
             Some(Attachment {
                 format,

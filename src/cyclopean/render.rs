@@ -95,9 +95,7 @@ impl CyclopeanRenderer {
 
     pub fn render(&mut self, mid: &MiddleCamera) -> Result<(CyclopeanOutput, Timing)> {
         let (w, h) = (mid.width, mid.height);
-        if w == 0 || h == 0 || w > self.gpu.max_image_side() || h > self.gpu.max_image_side() {
-            return Err(Error::param("middle size", format!("{w}x{h}")));
-        }
+        self.gpu.check_image_size("middle size", w, h)?;
         let inv = |m: &Mat4, what: &str| mat4::inverse(m).ok_or_else(|| Error::param(what.to_string(), "singular"));
         if !matches!(&self.framebuffer, Some(f) if f.width == w && f.height == h) {
             self.framebuffer = None;

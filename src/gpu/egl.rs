@@ -1,6 +1,7 @@
 //! Headless OpenGL 4.5+ core context through EGL: the device platform first, Mesa surfaceless
 //! as fallback. libEGL is loaded at run time, so a machine without it gets an ordinary error.
 
+use super::devices::{self, EglDevice, HostProbe};
 use crate::error::{Error, Result};
 use khronos_egl as egl;
 use std::ffi::{c_void, CStr};
@@ -8,8 +9,12 @@ use std::ffi::{c_void, CStr};
 const EGL_PLATFORM_DEVICE_EXT: egl::Enum = 0x313F;
 const EGL_PLATFORM_SURFACELESS_MESA: egl::Enum = 0x31DD;
 const EGL_EXTENSIONS_DEVICE: egl::Int = 0x3055; // EGL_EXTENSIONS, queried on a device
+const EGL_VENDOR_DEVICE: egl::Int = 0x3053; // EGL_VENDOR, queried on a device
 const EGL_DRM_DEVICE_FILE_EXT: egl::Int = 0x3233;
 const EGL_CUDA_DEVICE_NV: egl::Int = 0x323A;
+const EGL_DRIVER_NAME_EXT: egl::Int = 0x335E;
+const EGL_RENDERER_EXT: egl::Int = 0x335F;
+const EGL_DRM_RENDER_NODE_FILE_EXT: egl::Int = 0x3377;
 const EGL_CONTEXT_OPENGL_CORE_PROFILE_BIT: egl::Int = 0x1;
 
 type QueryDevices = unsafe extern "system" fn(egl::Int, *mut *mut c_void, *mut egl::Int) -> u32;
@@ -20,8 +25,9 @@ type GetPlatformDisplay = unsafe extern "system" fn(egl::Enum, *mut c_void, *con
 /// Which EGL device to render on.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
 pub enum DeviceChoice {
-    /// The CUDA_VISIBLE_DEVICES GPU when that is set and an NVIDIA device matches, else device 0,
-    /// else Mesa surfaceless.
+    /// The CUDA_VISIBLE_DEVICES GPU when that is set and an NVIDIA device matches, else the
+    /// first hardware device, else the first software one (EGL_MESA_device_software), else
+    /// Mesa surfaceless. See [`devices::auto_order`].
     #[default]
     Auto,
     /// The n-th EGL device from `eglQueryDevicesEXT`.
@@ -50,6 +56,16 @@ pub struct GpuInfo {
     pub max_viewport: [i32; 2],
     /// Whether GL_TIME_ELAPSED timer queries give real values (false on llvmpipe).
     pub gpu_timers_meaningful: bool,
+    /// Every EGL device `eglQueryDevicesEXT` lists, in its order.
+    pub devices: Vec<EglDevice>,
+    /// The device `--device auto` tries first (None: no device, Mesa surfaceless).
+    pub auto_device: Option<usize>,
+    /// The renderer is a software rasteriser (llvmpipe, softpipe, or a device with
+    /// EGL_MESA_device_software).
+    pub software: bool,
+    /// Set when rendering runs on software although a hardware device or an NVIDIA driver is
+    /// visible: callers print it (the CLI does, on stderr).
+    pub software_warning: Option<String>,
 }
 
 /// An EGL display and a current GL context on this thread. Dropping it releases the context.
@@ -94,33 +110,38 @@ impl EglContext {
 
         let mut attempts = Vec::new();
         let mut chosen = None;
-        let (devices, query_string) = enumerate_devices(&egl, &client_ext);
-        let device_count = devices.len();
+        let (handles, query_string) = enumerate_devices(&egl, &client_ext);
+        let devices = describe_devices(&egl, &handles, query_string);
+        let cuda_visible = std::env::var("CUDA_VISIBLE_DEVICES").ok();
+        let auto = devices::auto_order(&devices, cuda_visible.as_deref());
         if choice != DeviceChoice::Surfaceless && client_ext.contains("EGL_EXT_platform_device") {
-            let order = device_order(&egl, &devices, choice)?;
+            let order = match choice {
+                DeviceChoice::Index(i) if i >= devices.len() => {
+                    return Err(Error::param(
+                        "device",
+                        format!("index {i} out of range: {} EGL device(s)", devices.len()),
+                    ))
+                }
+                DeviceChoice::Index(i) => vec![i],
+                _ => auto.clone(),
+            };
             for index in order {
                 // SAFETY: device handle came from eglQueryDevicesEXT; attrib list is EGL_NONE.
                 let ptr =
-                    unsafe { get_platform_display(EGL_PLATFORM_DEVICE_EXT, devices[index], [egl::NONE].as_ptr()) };
+                    unsafe { get_platform_display(EGL_PLATFORM_DEVICE_EXT, handles[index], [egl::NONE].as_ptr()) };
+                let label = devices[index].label();
                 if ptr.is_null() {
-                    attempts.push(format!("device {index}: no display"));
+                    attempts.push(format!("{label}: no display"));
                     continue;
                 }
                 // SAFETY: non-null EGLDisplay returned by EGL.
                 let display = unsafe { egl::Display::from_ptr(ptr) };
                 match create_context(&egl, display) {
                     Ok(ctx) => {
-                        let file = query_string.and_then(|q| device_string(q, devices[index], EGL_DRM_DEVICE_FILE_EXT));
-                        let ext = query_string
-                            .and_then(|q| device_string(q, devices[index], EGL_EXTENSIONS_DEVICE))
-                            .unwrap_or_default();
-                        chosen = Some((display, ctx, "device", Some(index), file, ext));
+                        chosen = Some((display, ctx, "device", Some(index)));
                         break;
                     }
-                    Err(e) => attempts.push(format!("device {index}: {e}")),
-                }
-                if matches!(choice, DeviceChoice::Index(_)) {
-                    break;
+                    Err(e) => attempts.push(format!("{label}: {e}")),
                 }
             }
             if chosen.is_none() && matches!(choice, DeviceChoice::Index(_)) {
@@ -150,7 +171,7 @@ impl EglContext {
                     // SAFETY: non-null EGLDisplay returned by EGL.
                     let display = unsafe { egl::Display::from_ptr(ptr) };
                     match create_context(&egl, display) {
-                        Ok(ctx) => chosen = Some((display, ctx, "surfaceless", None, None, String::new())),
+                        Ok(ctx) => chosen = Some((display, ctx, "surfaceless", None)),
                         Err(e) => attempts.push(format!("surfaceless: {e}")),
                     }
                 }
@@ -158,12 +179,13 @@ impl EglContext {
                 attempts.push("no EGL_MESA_platform_surfaceless".into());
             }
         }
-        let Some((display, context, platform, device_index, device_file, device_extensions)) = chosen else {
+        let Some((display, context, platform, device_index)) = chosen else {
             return Err(Error::Egl(format!(
                 "no EGL display gave a GL 4.5 core context ({})",
                 attempts.join("; ")
             )));
         };
+        let chosen_device = device_index.map(|i| &devices[i]);
 
         // SAFETY: the context is current on this thread; EGL returns GL entry points for it.
         let gl = unsafe {
@@ -178,15 +200,20 @@ impl EglContext {
             .query_string(Some(display), egl::VERSION)
             .map(|s| s.to_string_lossy().into_owned())
             .unwrap_or_default();
-        let info = gl_info(
-            &gl,
-            egl_version,
-            platform,
-            device_index,
-            device_count,
-            device_file,
-            device_extensions,
-        );
+        let mut info = gl_info(&gl, egl_version, platform, device_index, chosen_device);
+        info.software = devices::renderer_is_software(&info.renderer) || chosen_device.is_some_and(|d| d.software);
+        if info.software {
+            info.software_warning = devices::software_warning(
+                &info.renderer,
+                chosen_device,
+                &devices,
+                &HostProbe::default().nvidia_evidence(),
+                &attempts,
+            );
+        }
+        info.device_count = devices.len();
+        info.auto_device = auto.first().copied();
+        info.devices = devices;
         if (info.gl_major, info.gl_minor) < (4, 5) {
             return Err(Error::Egl(format!(
                 "GL {}.{} < 4.5: {}",
@@ -286,39 +313,45 @@ fn device_string(query: QueryDeviceString, device: *mut c_void, name: egl::Int) 
     (!p.is_null()).then(|| unsafe { CStr::from_ptr(p) }.to_string_lossy().into_owned())
 }
 
-/// Order to try devices in: the requested index, or the CUDA_VISIBLE_DEVICES match then the rest.
-fn device_order(
+/// What each device says about itself. Strings an extension does not promise are not asked
+/// for.
+fn describe_devices(
     egl: &egl::DynamicInstance<egl::EGL1_4>,
-    devices: &[*mut c_void],
-    choice: DeviceChoice,
-) -> Result<Vec<usize>> {
-    if let DeviceChoice::Index(i) = choice {
-        if i >= devices.len() {
-            return Err(Error::param(
-                "device",
-                format!("index {i} out of range: {} EGL device(s)", devices.len()),
-            ));
-        }
-        return Ok(vec![i]);
-    }
-    let mut order: Vec<usize> = (0..devices.len()).collect();
-    let cuda_first = std::env::var("CUDA_VISIBLE_DEVICES")
-        .ok()
-        .and_then(|v| v.split(',').next().and_then(|s| s.trim().parse::<isize>().ok()));
+    handles: &[*mut c_void],
+    query_string: Option<QueryDeviceString>,
+) -> Vec<EglDevice> {
     let attrib: Option<QueryDeviceAttrib> = load_fn(egl, "eglQueryDeviceAttribEXT");
-    if let (Some(cuda), Some(attrib)) = (cuda_first, attrib) {
-        // With CUDA_VISIBLE_DEVICES=3 the process sees that GPU as CUDA device 0; EGL reports
-        // physical CUDA ordinals, so match the physical number.
-        if let Some(pos) = devices.iter().position(|&d| {
-            let mut value: isize = -1;
-            // SAFETY: valid device handle and out-pointer.
-            unsafe { attrib(d, EGL_CUDA_DEVICE_NV, &mut value) != 0 && value == cuda }
-        }) {
-            order.remove(pos);
-            order.insert(0, pos);
-        }
-    }
-    Ok(order)
+    handles
+        .iter()
+        .enumerate()
+        .map(|(index, &handle)| {
+            let string = |name| query_string.and_then(|q| device_string(q, handle, name));
+            let mut d = EglDevice::new(index, string(EGL_EXTENSIONS_DEVICE).unwrap_or_default());
+            if d.has_extension("EGL_EXT_device_drm") {
+                d.drm_file = string(EGL_DRM_DEVICE_FILE_EXT);
+            }
+            if d.has_extension("EGL_EXT_device_drm_render_node") {
+                d.render_node = string(EGL_DRM_RENDER_NODE_FILE_EXT);
+            }
+            if d.has_extension("EGL_EXT_device_persistent_id") {
+                d.driver = string(EGL_DRIVER_NAME_EXT);
+            }
+            if d.has_extension("EGL_EXT_device_query_name") {
+                d.vendor = string(EGL_VENDOR_DEVICE);
+                d.renderer = string(EGL_RENDERER_EXT);
+            }
+            // Asked of every device, as before the descriptions existed: a device without
+            // EGL_NV_device_cuda just answers false (and EGL's last error is per call).
+            if let Some(attrib) = attrib {
+                let mut value: isize = -1;
+                // SAFETY: valid device handle and out-pointer.
+                if unsafe { attrib(handle, EGL_CUDA_DEVICE_NV, &mut value) } != 0 {
+                    d.cuda_device = Some(value as i64);
+                }
+            }
+            d
+        })
+        .collect()
 }
 
 fn gl_info(
@@ -326,9 +359,7 @@ fn gl_info(
     egl_version: String,
     platform: &str,
     device_index: Option<usize>,
-    device_count: usize,
-    device_file: Option<String>,
-    device_extensions: String,
+    device: Option<&EglDevice>,
 ) -> GpuInfo {
     use glow::HasContext;
     // SAFETY: plain state queries on the current context.
@@ -345,13 +376,17 @@ fn gl_info(
             egl_version,
             platform: platform.to_string(),
             device_index,
-            device_count,
-            device_file,
-            device_extensions,
+            device_count: 0,
+            device_file: device.and_then(|d| d.drm_file.clone()),
+            device_extensions: device.map(|d| d.extensions.clone()).unwrap_or_default(),
             gl_major: gl.get_parameter_i32(glow::MAJOR_VERSION),
             gl_minor: gl.get_parameter_i32(glow::MINOR_VERSION),
             max_texture_size: gl.get_parameter_i32(glow::MAX_TEXTURE_SIZE),
             max_viewport: vp,
+            devices: Vec::new(),
+            auto_device: None,
+            software: false,
+            software_warning: None,
         }
     }
 }

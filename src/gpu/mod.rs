@@ -2,9 +2,12 @@
 //! folder touches a raw GL handle.
 
 mod buffer;
+pub mod devices;
 mod egl;
 mod framebuffer;
+mod limits;
 pub mod pixels;
+mod policy;
 mod program;
 mod readback;
 mod texture;
@@ -12,8 +15,11 @@ mod timer;
 mod vertex_array;
 
 pub use buffer::IndexBuffer;
+pub use devices::EglDevice;
 pub use egl::{DeviceChoice, EglContext, GpuInfo};
 pub use framebuffer::{Attachment, Framebuffer};
+pub use limits::check_image_size;
+pub use policy::GpuPolicy;
 pub use program::Program;
 pub use readback::{PendingRead, ReadFormat};
 pub use texture::{Texture, TextureFormat};
@@ -43,8 +49,18 @@ impl Drop for GpuInner {
 }
 
 impl Gpu {
+    /// A context on `choice` under the default policy (which still honours
+    /// `VIEWSYNTH_REQUIRE_GPU`).
     pub fn new(choice: DeviceChoice) -> Result<Self> {
+        Self::open(choice, GpuPolicy::default())
+    }
+
+    /// A context on `choice`, refused with [`Error::SoftwareRenderer`] when the policy (or
+    /// `VIEWSYNTH_REQUIRE_GPU=1`) requires hardware and the renderer is software.
+    pub fn open(choice: DeviceChoice, policy: GpuPolicy) -> Result<Self> {
+        let policy = policy.with_env()?;
         let ctx = EglContext::new(choice)?;
+        policy.check(&ctx.info)?;
         Ok(Gpu(Rc::new(GpuInner {
             ctx,
             readback: RefCell::default(),
@@ -80,6 +96,11 @@ impl Gpu {
     pub fn max_image_side(&self) -> u32 {
         let i = self.info();
         i.max_texture_size.min(i.max_viewport[0]).min(i.max_viewport[1]).max(0) as u32
+    }
+
+    /// [`check_image_size`] against this context's [`Self::max_image_side`].
+    pub fn check_image_size(&self, name: &str, width: u32, height: u32) -> Result<()> {
+        check_image_size(name, width.into(), height.into(), self.max_image_side())
     }
 }
 

@@ -55,13 +55,7 @@ impl Texture {
     /// Sampling is nearest with clamp-to-edge: passes that filter do it themselves in f32 with
     /// `texelFetch`, because fixed-function bilinear weights have only ~8 bits.
     pub fn new(gpu: &Gpu, width: u32, height: u32, format: TextureFormat, data: Option<&[u8]>) -> Result<Self> {
-        let max = gpu.max_image_side();
-        if width == 0 || height == 0 || width > max || height > max {
-            return Err(Error::param(
-                "texture size",
-                format!("{width}x{height} outside 1..={max} on this GPU"),
-            ));
-        }
+        gpu.check_image_size("texture size", width, height)?;
         let gl = gpu.gl();
         let (fmt, ty, bpp) = format.transfer();
         if let Some(d) = data {

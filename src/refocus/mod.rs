@@ -19,7 +19,7 @@ pub use grid::{axis_lookup, valid_depth, BreakRule, Grid};
 pub use mesh::{code_texture, TRI_TEX_WIDTH};
 pub use render::{PendingRefocus, RefocusOutput, Refocuser};
 
-use crate::camera::{Intrinsics, PinholeCamera, MAX_IMAGE_SIDE};
+use crate::camera::{Intrinsics, PinholeCamera};
 use crate::error::{Error, Result};
 use crate::io::{DepthMap, RgbImage};
 use serde::{Deserialize, Serialize};
@@ -42,10 +42,11 @@ impl RefocusSource {
                 ),
             });
         }
-        if rgb.width == 0 || rgb.height == 0 || rgb.width > MAX_IMAGE_SIDE || rgb.height > MAX_IMAGE_SIDE {
+        // The upper bound is the GPU context's (Refocuser::new checks it).
+        if rgb.width == 0 || rgb.height == 0 {
             return Err(Error::param(
                 "source size",
-                format!("{}x{} outside 1..={MAX_IMAGE_SIDE}", rgb.width, rgb.height),
+                format!("{}x{} has a zero side", rgb.width, rgb.height),
             ));
         }
         Ok(RefocusSource { rgb, depth, k })
@@ -74,6 +75,12 @@ impl RefocusSource {
 
 /// Source pixel coordinate seen by target pixel (x, y) under the same pose:
 /// u = cx + (x - cx') fx / fx' (and likewise v).
+/// Largest source side refocus takes on `gpu`: the grid has a cell per pixel plus a border
+/// ring, and its (w + 1) x (h + 1) cells are texels of one texture.
+pub fn max_source_side(gpu: &crate::gpu::Gpu) -> u32 {
+    gpu.max_image_side().saturating_sub(1)
+}
+
 pub fn source_point(src: &Intrinsics, dst: &Intrinsics, x: f64, y: f64) -> [f64; 2] {
     [
         src.cx + (x - dst.cx) * (src.fx / dst.fx),

@@ -183,21 +183,9 @@ impl Refocuser {
     pub fn set_source(&mut self, src: &RefocusSource) -> Result<()> {
         let gpu = self.gpu.clone();
         let (w, h) = (src.rgb.width, src.rgb.height);
-        let max = gpu.max_image_side();
         // The grid's cells include a half-pixel border ring: (w + 1) x (h + 1) of them, each a
         // texel of the coverage texture, so the source side is one less than the GPU's limit.
-        if w >= max || h >= max {
-            return Err(Error::param(
-                "source size",
-                format!(
-                    "{w}x{h}: its grid needs {}x{} cells (one per pixel plus the border ring) but this GPU's \
-                     texture limit is {max}; sources up to {} px per side",
-                    w + 1,
-                    h + 1,
-                    max - 1
-                ),
-            ));
-        }
+        crate::gpu::check_image_size("source size", w.into(), h.into(), super::max_source_side(&gpu))?;
         let grid = Grid { width: w, height: h };
         let keep = grid.keep_mask(&src.depth.data, &self.rule);
         let same_size = self
@@ -316,13 +304,7 @@ impl Refocuser {
     pub fn submit(&mut self, target: &PinholeCamera) -> Result<PendingRefocus> {
         let t0 = Instant::now();
         target.validate("target camera")?;
-        let max = self.gpu.max_image_side();
-        if target.width > max || target.height > max {
-            return Err(Error::param(
-                "output size",
-                format!("{}x{} exceeds this GPU's limit of {max}", target.width, target.height),
-            ));
-        }
+        self.gpu.check_image_size("output size", target.width, target.height)?;
         let Some(source) = &self.source else {
             return Err(Error::param("refocus source", "no source uploaded (set_source)"));
         };

@@ -52,6 +52,7 @@ pub struct Reprojector {
 
 impl Reprojector {
     pub fn new(gpu: &Gpu, src: &ReprojectSource, geometry: &Geometry, params: ReprojectParams) -> Result<Self> {
+        gpu.check_image_size("source size", src.color.width, src.color.height)?;
         let model = check(src, geometry, &params)?;
         let flip = src.conv.row_order == RowOrder::BottomUp;
         let (w, h) = (src.color.width, src.color.height);

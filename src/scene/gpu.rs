@@ -201,10 +201,7 @@ impl SceneRenderer {
         };
         let (vp, inv_vp, eye) = cam.matrices()?;
         let (w, h) = (cam.width, cam.height);
-        let max = self.gpu.max_image_side();
-        if w == 0 || h == 0 || w > max || h > max {
-            return Err(Error::param("camera size", format!("{w}x{h} outside 1..={max}")));
-        }
+        self.gpu.check_image_size("camera size", w, h)?;
         let gpu = self.gpu.clone();
         let slot = |format| {
             Some(Attachment {

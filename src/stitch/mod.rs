@@ -361,10 +361,12 @@ impl StitchParams {
                 ),
             ));
         }
-        if !(1..=crate::io::MAX_DIMENSION).contains(&self.width)
-            || !(1..=crate::io::MAX_DIMENSION).contains(&self.height)
-        {
-            return Err(Error::param("equirect size", format!("{}x{}", self.width, self.height)));
+        // The upper bound is the GPU context's (StitchRenderer::render checks it).
+        if self.width == 0 || self.height == 0 {
+            return Err(Error::param(
+                "equirect size",
+                format!("{}x{} has a zero side", self.width, self.height),
+            ));
         }
         Ok(())
     }

@@ -77,16 +77,8 @@ impl StitchRenderer {
         if left.rig != right.rig || left.fov_deg != right.fov_deg || left.size() != right.size() {
             return Err(Error::param("face sets", "left and right differ in rig, FOV or size"));
         }
-        if 6 * left.size() > gpu.max_image_side() {
-            return Err(Error::param(
-                "face size",
-                format!(
-                    "6 x {} exceeds the GPU's {} texture side",
-                    left.size(),
-                    gpu.max_image_side()
-                ),
-            ));
-        }
+        // The six faces of an eye sit side by side in one texture.
+        gpu.check_image_size("face atlas (6 x face size)", 6 * left.size(), left.size())?;
         let mut programs = Vec::new();
         for m in Method::ALL {
             let defines = format!(
@@ -113,12 +105,8 @@ impl StitchRenderer {
     pub fn render(&mut self, params: &StitchParams) -> Result<(RgbImage, Timing)> {
         params.validate(&self.template)?;
         let (w, h) = (params.width, params.height);
-        if w > self.gpu.max_image_side() || 2 * h > self.gpu.max_image_side() {
-            return Err(Error::param(
-                "equirect size",
-                format!("{w}x{} too large for this GPU", 2 * h),
-            ));
-        }
+        // Top-bottom: both eyes in one image of 2 h rows.
+        self.gpu.check_image_size("equirect size", w, 2 * h)?;
         if !matches!(&self.framebuffer, Some(f) if f.width == w && f.height == 2 * h) {
             self.framebuffer = None;
             self.framebuffer = Some(Framebuffer::new(

@@ -20,7 +20,7 @@
 
 use super::refocus::refused;
 use super::{test_texture, GpuPixels, RefPixels, StressOptions, StressRow, Tally, Tolerance, EPS32};
-use crate::camera::{Pose, MAX_IMAGE_SIDE};
+use crate::camera::Pose;
 use crate::convention::{Conventions, DepthPlanes};
 use crate::cyclopean::reference::cyclopean_reference;
 use crate::cyclopean::render::CyclopeanRenderer;
@@ -261,7 +261,7 @@ pub fn rows(gpu: &Gpu, opts: StressOptions) -> Result<Vec<StressRow>> {
     )?);
 
     // Output size extremes: 1x1 and the largest side (x 2 rows), then one past it.
-    let max = gpu.max_image_side().min(MAX_IMAGE_SIDE);
+    let max = gpu.max_image_side();
     let rig = StereoRig::demo(64, 48);
     let mut cases = Vec::new();
     for (mw, mh) in [(1, 1), (max, 2)] {
@@ -287,6 +287,6 @@ pub fn rows(gpu: &Gpu, opts: StressOptions) -> Result<Vec<StressRow>> {
     mid.height = 1;
     let r = CyclopeanRenderer::new(gpu, &frame, CyclopeanParams::seed(FIXATION))
         .and_then(|mut r| r.render(&mid).map(|_| ()));
-    rows.push(refused("cyclopean", max + 1, r));
+    rows.push(refused("cyclopean", max + 1, max, r));
     Ok(rows)
 }

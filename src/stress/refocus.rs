@@ -12,7 +12,7 @@
 //!   ties that the tie window does not cover: 0.1 %.
 
 use super::{test_texture, GpuPixels, RefPixels, StressOptions, StressRow, Tally, Tolerance, EPS32};
-use crate::camera::{Intrinsics, PinholeCamera, MAX_IMAGE_SIDE};
+use crate::camera::{Intrinsics, PinholeCamera};
 use crate::convention::Conventions;
 use crate::error::Result;
 use crate::gpu::Gpu;
@@ -180,8 +180,8 @@ pub fn rows(gpu: &Gpu, opts: StressOptions) -> Result<Vec<StressRow>> {
     let src = source(1, 1, |_, _| 2.5)?;
     rows.push(sweep(gpu, "1x1 image", &src, &[0.5, 1.0, 2.0], "")?);
 
-    // The grid has a cell per pixel plus a border ring: (w + 1) cells must fit a texture.
-    let max = (gpu.max_image_side() - 1).min(MAX_IMAGE_SIDE);
+    // The context's limit, less one: the grid's border ring (refocus::max_source_side).
+    let max = crate::refocus::max_source_side(gpu);
     let src = source(max, 2, |x, _| 1.0 + 1e-4 * x as f32)?;
     rows.push(sweep(
         gpu,
@@ -202,18 +202,42 @@ pub fn rows(gpu: &Gpu, opts: StressOptions) -> Result<Vec<StressRow>> {
         )
         .map(|_| ())
     });
-    rows.push(refused("refocus", max + 1, too_big));
+    rows.push(refused("refocus", max + 1, max, too_big));
+
+    // The output side: the context's limit itself is allowed, one past it refused.
+    let limit = gpu.max_image_side();
+    let too_big = source(4, 3, |_, _| 1.0).and_then(|src| {
+        let mut target = src.camera();
+        (target.width, target.height) = (limit + 1, 1);
+        Refocuser::new(
+            gpu,
+            &src,
+            &BreakRule::default(),
+            Method::Fullscreen,
+            OutputSet::default(),
+            Conventions::default(),
+        )?
+        .render(&target)
+        .map(|_| ())
+    });
+    rows.push(refused("refocus", limit + 1, limit, too_big));
     Ok(rows)
 }
 
-/// The rule for an image one past the largest side: refused with a message naming the size.
-pub(crate) fn refused(capability: &'static str, side: u32, r: Result<()>) -> StressRow {
-    let case = format!("{side} px side (one past the largest)");
+/// The rule for an image one past the context's largest side `limit`: refused with a message
+/// naming the size and the limit.
+pub(crate) fn refused(capability: &'static str, side: u32, limit: u32, r: Result<()>) -> StressRow {
+    let case = format!("{side} px side (one past the largest, {limit})");
     match r {
-        Err(e) if e.to_string().contains(&side.to_string()) => {
+        Err(e) if e.to_string().contains(&side.to_string()) && e.to_string().contains(&limit.to_string()) => {
             StressRow::rule(capability, case, true, format!("refused: {e}"))
         }
-        Err(e) => StressRow::rule(capability, case, false, format!("refused without naming the size: {e}")),
+        Err(e) => StressRow::rule(
+            capability,
+            case,
+            false,
+            format!("refused without naming the size and the limit: {e}"),
+        ),
         Ok(()) => StressRow::rule(capability, case, false, "accepted: should be refused (or tiled)"),
     }
 }

@@ -16,7 +16,7 @@
 use super::refocus::refused;
 use super::{test_texture, GpuPixels, RefPixels, StressOptions, StressRow, Tally, Tolerance, EPS32};
 use crate::camera::stereo::{Eye, StereoParams};
-use crate::camera::{Intrinsics, PinholeCamera, MAX_IMAGE_SIDE};
+use crate::camera::{Intrinsics, PinholeCamera};
 use crate::convention::{Conventions, DepthPlanes};
 use crate::cyclopean::scene_frame::{scene_frame, StereoRig};
 use crate::cyclopean::DepthKind;
@@ -338,7 +338,7 @@ pub fn rows(gpu: &Gpu, opts: StressOptions) -> Result<Vec<StressRow>> {
         "invalid source depth is never drawn: a hole in the mask",
     )?);
 
-    let max = gpu.max_image_side().min(MAX_IMAGE_SIDE);
+    let max = gpu.max_image_side();
     let mut cases = Vec::new();
     for (sw, sh) in [(2, 1), (max, 2)] {
         cases.push(Case {
@@ -364,6 +364,6 @@ pub fn rows(gpu: &Gpu, opts: StressOptions) -> Result<Vec<StressRow>> {
         };
         Reprojector::new(gpu, &src, &geometry, methods()[0]).map(|_| ())
     });
-    rows.push(refused("reproject", max + 1, r));
+    rows.push(refused("reproject", max + 1, max, r));
     Ok(rows)
 }

@@ -145,7 +145,7 @@ pub fn rows(gpu: &Gpu, opts: StressOptions) -> Result<Vec<StressRow>> {
         "",
     )?);
 
-    let max = crate::io::MAX_DIMENSION.min(gpu.max_image_side());
+    let max = gpu.max_image_side();
     let c = case("big", &rig, 10.0, 2, 2)?;
     let r = StitchRenderer::new(gpu, &c.left, &c.right).and_then(|mut r| {
         r.render(&StitchParams {
@@ -156,6 +156,6 @@ pub fn rows(gpu: &Gpu, opts: StressOptions) -> Result<Vec<StressRow>> {
         })
         .map(|_| ())
     });
-    rows.push(super::refocus::refused("stitch", max + 1, r));
+    rows.push(super::refocus::refused("stitch", max + 1, max, r));
     Ok(rows)
 }

@@ -130,7 +130,7 @@ fn bad_input_fails_cleanly() {
 
     assert_clean_failure(
         &refocus(&rgb, &depth, &out, &["--width-out", "16385", "--height-out", "10"]),
-        "width",
+        "output size: 16385x10 exceeds this GPU's limit",
         &out,
     );
     assert_clean_failure(

@@ -23,12 +23,18 @@ fn quick_sweep_of_every_capability_passes_with_no_nan_or_inf() {
     assert!(lossy
         .iter()
         .all(|r| !r.case.contains("reversed-Z") && !r.case.contains("vk-rev")));
-    // One past the largest image side is refused, naming the size, by every GPU capability.
+    // One past the context's largest image side is refused, naming the size and the limit, by
+    // every GPU capability (refocus: its source and its output).
+    let limit = g.max_image_side();
     let refused: Vec<_> = rows
         .iter()
         .filter(|r| r.case.contains("one past the largest"))
         .collect();
-    assert_eq!(refused.len(), 4);
+    assert_eq!(refused.len(), 5);
+    assert!(
+        refused.iter().all(|r| r.note.contains(&limit.to_string())),
+        "{refused:?}"
+    );
     assert!(
         refused.iter().all(|r| r.pass && r.note.starts_with("refused:")),
         "{refused:?}"

@@ -5,7 +5,7 @@ use clap::{Args, Parser, Subcommand, ValueEnum};
 use std::path::{Path, PathBuf};
 use viewsynth::camera::Intrinsics;
 use viewsynth::convention::{Conventions, NdcDepthRange, RowOrder};
-use viewsynth::gpu::{DeviceChoice, Gpu};
+use viewsynth::gpu::{DeviceChoice, Gpu, GpuPolicy};
 use viewsynth::io::{self, DepthDecode};
 use viewsynth::refocus::job::{self, DepthFormats, Manifest, RgbFormat, TargetSpec};
 use viewsynth::refocus::{BreakRule, Method, OutputSet, RefocusSource, Refocuser};
@@ -170,10 +170,14 @@ enum Command {
 
 #[derive(Args, Clone)]
 struct GpuArgs {
-    /// EGL device: auto (CUDA_VISIBLE_DEVICES match, else first device, else Mesa
-    /// surfaceless), an index from `viewsynth info`, or `surfaceless`.
+    /// EGL device: auto (CUDA_VISIBLE_DEVICES match, else the first hardware device, else the
+    /// software one, else Mesa surfaceless), an index from `viewsynth info`, or `surfaceless`.
     #[arg(long, default_value = "auto")]
     device: String,
+    /// Fail (exit 1) when the renderer is software (llvmpipe, softpipe) instead of warning.
+    /// VIEWSYNTH_REQUIRE_GPU=1 does the same.
+    #[arg(long)]
+    require_gpu: bool,
 }
 
 impl GpuArgs {
@@ -186,7 +190,14 @@ impl GpuArgs {
                     .with_context(|| format!("--device '{n}': expected auto, surfaceless or an index"))?,
             ),
         };
-        Ok(Gpu::new(choice)?)
+        let policy = GpuPolicy {
+            require_hardware: self.require_gpu,
+        };
+        let gpu = Gpu::open(choice, policy)?;
+        if let Some(w) = &gpu.info().software_warning {
+            eprintln!("\n*** WARNING: {w} ***\n");
+        }
+        Ok(gpu)
     }
 }
 
@@ -380,7 +391,37 @@ fn info(gpu: &GpuArgs, json: bool) -> Result<()> {
             "no (wall clock with glFinish)"
         }
     );
+    println!("rendering:   {}", if i.software { "software" } else { "hardware" });
+    print!("{}", device_table(i));
     Ok(())
+}
+
+/// Every EGL device, one line each, and the one `--device auto` picks.
+fn device_table(i: &viewsynth::gpu::GpuInfo) -> String {
+    let auto = match i.auto_device {
+        Some(d) => format!("device {d} ({})", i.devices[d].kind()),
+        None => "Mesa surfaceless (no EGL device)".into(),
+    };
+    let mut s = format!("EGL devices: {} (auto picks {auto})\n", i.devices.len());
+    for d in &i.devices {
+        let or_dash = |v: &Option<String>| v.clone().unwrap_or_else(|| "-".into());
+        s += &format!(
+            "  [{}] {}{}  driver {}  vendor {}  file {}  CUDA {}  ext {}\n",
+            d.index,
+            d.kind(),
+            if i.device_index == Some(d.index) {
+                " (in use)"
+            } else {
+                ""
+            },
+            or_dash(&d.driver),
+            or_dash(&d.vendor),
+            or_dash(&d.drm_file.clone().or(d.render_node.clone())),
+            d.cuda_device.map_or("-".into(), |c| c.to_string()),
+            d.notable_extensions()
+        );
+    }
+    s
 }
 
 fn demo(out_dir: &Path, gpu: &GpuArgs) -> Result<()> {

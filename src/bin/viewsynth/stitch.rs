@@ -148,12 +148,15 @@ pub(crate) fn stitch(a: StitchArgs) -> Result<()> {
         faces: Vec::new(),
     };
     params.validate(&template).context("--overlap/--fov/--width/--height")?;
-    if 2 * a.height as u64 > viewsynth::io::MAX_DIMENSION as u64 {
+    // The GPU's limit is checked when rendering; the image files' bound is known now.
+    let max = viewsynth::io::MAX_DIMENSION;
+    if a.width > max || 2 * a.height as u64 > max as u64 {
         bail!(
-            "--height {}: the top-bottom image ({} rows) exceeds {}",
+            "--width/--height {}x{}: the top-bottom image ({}x{}) exceeds the image files' limit of {max} px per side",
+            a.width,
             a.height,
-            2 * a.height,
-            viewsynth::io::MAX_DIMENSION
+            a.width,
+            2 * a.height as u64,
         );
     }
 
