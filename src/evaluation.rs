@@ -2,7 +2,7 @@
 //! capability, on the built-in scene (exact ray-traced truth) and on real data.
 
 use crate::convention::{Conventions, NdcDepthRange, RowOrder};
-use crate::cyclopean::disparity_frame::disparity_frame;
+use crate::cyclopean::disparity_frame::{disparity_frame, DisparityRig};
 use crate::cyclopean::forward::ForwardWarp;
 use crate::cyclopean::render::CyclopeanRenderer;
 use crate::cyclopean::scene_frame::{scene_frame, StereoRig};
@@ -256,7 +256,7 @@ pub fn cyclopean_real_rows(gpu: &Gpu, data_dir: &Path, repeats: usize) -> Result
     let cones = data_dir.join("middlebury2003_cones");
     let (l, r) = middlebury(&cones)?;
     let truth = io::load_rgb(&cones.join("im4.png"))?;
-    let (frame, mid) = disparity_frame(l, r, MIDDLEBURY_FOCAL_PX, MIDDLEBURY_BASELINE_M, Conventions::default())?;
+    let (frame, mid) = disparity_frame(l, r, &DisparityRig::middle(MIDDLEBURY_FOCAL_PX, MIDDLEBURY_BASELINE_M), Conventions::default())?;
     let mut runs = Vec::new();
     for (name, params) in cyclopean_methods(1.5) {
         runs.push((name, render_cyclopean(gpu, &frame, &mid, params, repeats)?));
@@ -276,7 +276,7 @@ pub fn cyclopean_real_rows(gpu: &Gpu, data_dir: &Path, repeats: usize) -> Result
         rows.push(row);
     }
     let (l, r) = middlebury(&data_dir.join("middlebury2003_teddy"))?;
-    let (frame, mid) = disparity_frame(l, r, MIDDLEBURY_FOCAL_PX, MIDDLEBURY_BASELINE_M, Conventions::default())?;
+    let (frame, mid) = disparity_frame(l, r, &DisparityRig::middle(MIDDLEBURY_FOCAL_PX, MIDDLEBURY_BASELINE_M), Conventions::default())?;
     for (name, params) in cyclopean_methods(1.5) {
         let (both, t) = render_cyclopean(gpu, &frame, &mid, params, repeats)?;
         // One eye at a time: the other eye's depth emptied.
