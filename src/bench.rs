@@ -140,5 +140,6 @@ pub fn cyclopean_bench(gpu: &Gpu, width: u32, height: u32, repeats: usize) -> Re
         median(runs)
     )
     .expect("write to String");
+    t.push_str(&crate::evaluation::splat_gather_bench_row(gpu, &frame, &mid, repeats)?);
     Ok(t)
 }

@@ -60,39 +60,48 @@ bool to_eye(mat4 view_proj, mat4 view, ivec2 size, vec3 ray_m, float z, out vec2
     return true;
 }
 
-// The bilinear taps of e on the surface of the nearest texel (which must be on z_eye's surface):
-// interpolated distance (inverse depth), colour, kept weight.
-bool surface_at(sampler2D dist, sampler2D color, vec2 e, float z_eye, out float z_surface, out vec3 c,
-                out float total) {
+// The nearest texel to e, which must be on z_eye's surface: its distance, or -1.
+float nearest_on_surface(sampler2D dist, vec2 e, float z_eye) {
     ivec2 size = textureSize(dist, 0);
     vec2 n = floor(e + 0.5);
     if (any(lessThan(n, vec2(0.0))) || any(greaterThanEqual(n, vec2(size)))) {
-        return false;
+        return -1.0;
     }
     float zn = texelFetch(dist, ivec2(n), 0).r;
-    if (!(zn > 0.0 && z_eye > 0.0 && same_surface(zn, z_eye))) {
-        return false;
-    }
-    vec2 f0 = floor(e);
-    vec2 fr = e - f0;
-    ivec2 i0 = ivec2(f0);
-    float inv = 0.0;
-    c = vec3(0.0);
-    total = 0.0;
-    for (int k = 0; k < 4; ++k) {
-        ivec2 o = ivec2(k & 1, k >> 1);
-        ivec2 tx = clamp(i0 + o, ivec2(0), size - 1);
-        float w = (o.x == 1 ? fr.x : 1.0 - fr.x) * (o.y == 1 ? fr.y : 1.0 - fr.y);
-        float z = texelFetch(dist, tx, 0).r;
-        if (z > 0.0 && same_surface(z, zn)) {
-            inv += w / z;
-            c += w * texelFetch(color, tx, 0).rgb * 255.0;
-            total += w;
-        }
-    }
+    return (zn > 0.0 && z_eye > 0.0 && same_surface(zn, z_eye)) ? zn : -1.0;
+}
+
+// The bilinear taps of e on the surface of distance zn: interpolated distance (inverse depth),
+// colour (WITH_COLOR), kept weight. Two variants so that llvmpipe, which runs both sides of a
+// branch, does not pay for colour fetches in the first step.
+#define TAPS(WITH_COLOR)                                                                   \
+    ivec2 size = textureSize(dist, 0);                                                    \
+    vec2 f0 = floor(e);                                                                   \
+    vec2 fr = e - f0;                                                                     \
+    ivec2 i0 = ivec2(f0);                                                                 \
+    float inv = 0.0;                                                                      \
+    total = 0.0;                                                                          \
+    for (int k = 0; k < 4; ++k) {                                                         \
+        ivec2 o = ivec2(k & 1, k >> 1);                                                   \
+        ivec2 tx = clamp(i0 + o, ivec2(0), size - 1);                                     \
+        float w = (o.x == 1 ? fr.x : 1.0 - fr.x) * (o.y == 1 ? fr.y : 1.0 - fr.y);        \
+        float z = texelFetch(dist, tx, 0).r;                                              \
+        float keep = (z > 0.0 && same_surface(z, zn)) ? w : 0.0;                          \
+        inv += keep / max(z, 1e-30);                                                      \
+        total += keep;                                                                    \
+        WITH_COLOR                                                                        \
+    }                                                                                     \
     z_surface = total / inv;
+
+void surface_depth(sampler2D dist, vec2 e, float zn, out float z_surface, out float total) {
+    TAPS()
+}
+
+void surface_color(sampler2D dist, sampler2D color, vec2 e, float zn, out float z_surface, out vec3 c,
+                   out float total) {
+    c = vec3(0.0);
+    TAPS(c += keep * texelFetch(color, tx, 0).rgb * 255.0;)
     c /= total;
-    return true;
 }
 
 Sample eye_sample(sampler2D color, sampler2D dist, mat4 view_proj, mat4 view, mat4 inv_view, mat4 inv_proj,
@@ -104,11 +113,12 @@ Sample eye_sample(sampler2D color, sampler2D dist, mat4 view_proj, mat4 view, ma
     if (!to_eye(view_proj, view, size, ray_m, z0, e0, z_eye0)) {
         return none;
     }
-    float z_surface, total;
-    vec3 c;
-    if (!surface_at(dist, color, e0, z_eye0, z_surface, c, total)) {
+    float zn = nearest_on_surface(dist, e0, z_eye0);
+    if (zn < 0.0) {
         return none;
     }
+    float z_surface, total;
+    surface_depth(dist, e0, zn, z_surface, total);
     vec2 ndc = (e0 + 0.5) / vec2(size) * 2.0 - 1.0;
     vec3 on_surface = transform_point(inv_view, view_ray(inv_proj, ndc) * z_surface);
     float z1 = -transform_point(u_view_m, on_surface).z;
@@ -120,9 +130,12 @@ Sample eye_sample(sampler2D color, sampler2D dist, mat4 view_proj, mat4 view, ma
     if (!to_eye(view_proj, view, size, ray_m, z1, e1, z_eye1)) {
         return none;
     }
-    if (!surface_at(dist, color, e1, z_eye1, z_surface, c, total)) {
+    zn = nearest_on_surface(dist, e1, z_eye1);
+    if (zn < 0.0) {
         return none;
     }
+    vec3 c;
+    surface_color(dist, color, e1, zn, z_surface, c, total);
     return Sample(true, c, z1, total);
 }
 
@@ -158,11 +171,15 @@ Sample eye(sampler2D color, sampler2D dist, usampler2D splat, mat4 view_proj, ma
            mat4 inv_proj, vec3 ray_m, ivec2 p) {
     vec2 cand = candidates(splat, p);
     Sample s = Sample(false, vec3(0.0), 0.0, 0.0);
-    if (!absent(cand.x)) {
-        s = eye_sample(color, dist, view_proj, view, inv_view, inv_proj, ray_m, cand.x);
-    }
-    if (!s.valid && !absent(cand.y)) {
-        s = eye_sample(color, dist, view_proj, view, inv_view, inv_proj, ray_m, cand.y);
+    // A loop, not two branches: llvmpipe leaves it as soon as every lane has its answer.
+    for (int k = 0; k < 2; ++k) {
+        float z0 = k == 0 ? cand.x : cand.y;
+        if (!absent(z0)) {
+            s = eye_sample(color, dist, view_proj, view, inv_view, inv_proj, ray_m, z0);
+            if (s.valid) {
+                break;
+            }
+        }
     }
     return s;
 }

@@ -68,7 +68,15 @@ pub fn forward_splat(
     let data = sum
         .iter()
         .zip(&count)
-        .flat_map(|(s, &n)| s.map(|v| if n > 0 { crate::metrics::quantize_u8(v / n as f64) } else { 0 }))
+        .flat_map(|(s, &n)| {
+            s.map(|v| {
+                if n > 0 {
+                    crate::metrics::quantize_u8(v / n as f64)
+                } else {
+                    0
+                }
+            })
+        })
         .collect();
     Ok(BaselineView {
         color: RgbImage::new(w as u32, h as u32, data)?,

@@ -38,10 +38,7 @@ impl DisparityRig {
         if !(self.focal_px.is_finite() && self.focal_px > 0.0 && self.baseline.is_finite() && self.baseline > 0.0) {
             return Err(Error::param(
                 "focal/baseline",
-                format!(
-                    "{} px, {} m: both must be finite and > 0",
-                    self.focal_px, self.baseline
-                ),
+                format!("{} px, {} m: both must be finite and > 0", self.focal_px, self.baseline),
             ));
         }
         if !self.doffs.is_finite() {

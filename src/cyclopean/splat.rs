@@ -13,7 +13,7 @@
 //!    the taps' weight (low at edges, where real pixels mix colours); else the nearer; a
 //!    disocclusion from the one eye that sees it.
 //!
-//! "Same surface" is one pixel of full-baseline disparity (`SplatParams::surface_tolerance_px`),
+//! "Same surface" is about one pixel of full-baseline disparity (`SplatParams::surface_tolerance_px`),
 //! a unit that means the same on every rig. The f64 twin is [`splat_reference`](super::splat_reference).
 
 use super::{CyclopeanOutput, CyclopeanOutputs, MiddleCamera, StereoFrame};
@@ -29,14 +29,16 @@ const GATHER_FRAG: &str = include_str!("../../shaders/cyclopean/splat_gather.fra
 pub struct SplatParams {
     /// Two depths are one surface when their full-baseline disparities differ by at most this
     /// many pixels (neighbouring texels of a slanted surface differ by its disparity gradient,
-    /// well under 1 on real scenes; object edges by several pixels).
+    /// well under 1 on real scenes; object edges by several pixels). Default 1.1, not 1:
+    /// disparities quantised to 1/2^k px (Middlebury: 1/4) differ by exactly 1 px often, and
+    /// a threshold on a quantisation step would be decided by f32 rounding.
     pub surface_tolerance_px: f64,
 }
 
 impl Default for SplatParams {
     fn default() -> Self {
         SplatParams {
-            surface_tolerance_px: 1.0,
+            surface_tolerance_px: 1.1,
         }
     }
 }
@@ -77,7 +79,11 @@ fn dist3(a: [f64; 3], b: [f64; 3]) -> f64 {
 impl SplatGeometry {
     pub fn new(frame: &StereoFrame, mid: &MiddleCamera) -> Result<Self> {
         frame.validate()?;
-        let (cl, cr, cm) = (centre(&frame.left.view)?, centre(&frame.right.view)?, centre(&mid.view)?);
+        let (cl, cr, cm) = (
+            centre(&frame.left.view)?,
+            centre(&frame.right.view)?,
+            centre(&mid.view)?,
+        );
         let baseline = dist3(cl, cr);
         // GL projection: x_ndc = P00 x / -z, so the focal length in pixels is P00 w / 2.
         let focal = frame.left.proj[0][0].abs() * frame.left.color.width as f64 / 2.0;
@@ -257,7 +263,8 @@ impl SplatRenderer {
         unsafe {
             use glow::HasContext;
             gpu.gl().memory_barrier(glow::TEXTURE_FETCH_BARRIER_BIT);
-            gpu.gl().bind_image_texture(0, None, 0, false, 0, glow::READ_WRITE, glow::R32UI);
+            gpu.gl()
+                .bind_image_texture(0, None, 0, false, 0, glow::READ_WRITE, glow::R32UI);
         }
         gpu.check("cyclopean splat")?;
         // Pass 2: gather and merge.

@@ -199,11 +199,7 @@ impl Ctx<'_> {
 }
 
 /// The splat-gather middle view in f64 (rows top-down; colour 0 where no eye answers).
-pub fn splat_reference(
-    frame: &StereoFrame,
-    mid: &MiddleCamera,
-    params: &SplatParams,
-) -> Result<CyclopeanReference> {
+pub fn splat_reference(frame: &StereoFrame, mid: &MiddleCamera, params: &SplatParams) -> Result<CyclopeanReference> {
     params.validate()?;
     let geo = SplatGeometry::new(frame, mid)?;
     let flip = frame.conv.row_order == RowOrder::BottomUp;

@@ -6,6 +6,7 @@ mod cli_reproject_stitch;
 mod common;
 mod compare;
 mod cyclopean;
+mod cyclopean_real;
 mod gpu_context;
 mod refocus_accuracy;
 mod refocus_conventions;

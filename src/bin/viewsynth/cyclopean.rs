@@ -254,10 +254,7 @@ pub(crate) fn cyclopean(a: CyclopeanArgs) -> Result<()> {
         bail!("--outputs depth needs --focal and --baseline (the depth is metric)");
     }
     let Setup {
-        frame,
-        mid,
-        fixation,
-        ..
+        frame, mid, fixation, ..
     } = setup;
     frame.validate()?;
     let params = match method {
@@ -274,7 +271,9 @@ pub(crate) fn cyclopean(a: CyclopeanArgs) -> Result<()> {
         (MethodArg::Seed | MethodArg::Refine, Some(p)) => {
             CyclopeanRenderer::with_outputs(&gpu, &frame, p, wanted)?.render(&mid)?
         }
-        (MethodArg::Forward, _) => ForwardWarp::new(&gpu, &frame, &viewsynth::refocus::BreakRule::default())?.render(&mid)?,
+        (MethodArg::Forward, _) => {
+            ForwardWarp::new(&gpu, &frame, &viewsynth::refocus::BreakRule::default())?.render(&mid)?
+        }
         _ => SplatRenderer::new(&gpu, &frame, SplatParams::default(), wanted)?.render(&mid)?,
     };
     let mask = io::Mask::new(
