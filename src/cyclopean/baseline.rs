@@ -57,8 +57,9 @@ pub fn forward_splat(
                 let Some(tx) = target(x, d, shift) else { continue };
                 let o = y * w + tx;
                 if d >= best[o] - 1.0 {
-                    for c in 0..3 {
-                        sum[o][c] += rgb.data[(y * w + x) * 3 + c] as f64;
+                    let src = &rgb.data[(y * w + x) * 3..(y * w + x) * 3 + 3];
+                    for (acc, v) in sum[o].iter_mut().zip(src) {
+                        *acc += *v as f64;
                     }
                     count[o] += 1;
                 }
@@ -104,4 +105,52 @@ pub fn no_warp(left: &RgbImage, right: &RgbImage, position: f64) -> Result<Basel
         color: RgbImage::new(left.width, left.height, data)?,
         covered: vec![true; left.data.len() / 3],
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn row(colors: &[u8], disparity: &[f32]) -> (RgbImage, DepthMap) {
+        let w = disparity.len() as u32;
+        let rgb = colors.iter().flat_map(|c| [*c; 3]).collect();
+        (
+            RgbImage::new(w, 1, rgb).unwrap(),
+            DepthMap::new(w, 1, disparity.to_vec()).unwrap(),
+        )
+    }
+
+    #[test]
+    fn splat_moves_by_t_d_nearest_wins_and_agreeing_eyes_average() {
+        // Left: a far wall (d = 2) with one near pixel (d = 6) at x = 4; right: the same scene.
+        let l = row(
+            &[10, 10, 10, 10, 200, 10, 10, 10],
+            &[2.0, 2.0, 2.0, 2.0, 6.0, 2.0, 2.0, 2.0],
+        );
+        let r = row(&[30, 30, 30, 30, 30, 30, 30, 30], &[2.0; 8]);
+        let v = forward_splat((&l.0, &l.1), (&r.0, &r.1), 0.5).unwrap();
+        let px = |x: usize| v.color.data[x * 3];
+        // x = 4 - 3 = 1: the near pixel wins over both eyes' wall.
+        assert_eq!(px(1), 200);
+        // x = 3: only the right wall (x = 2, moved +1) lands here; the left pixel that would (x = 4)
+        // is the near one and went to x = 1.
+        assert_eq!(px(3), 30);
+        // x = 5: left wall x = 6 (-1) and right wall x = 4 (+1) agree: their mean.
+        assert_eq!(px(5), 20);
+        // Position 0: the left image itself wherever the left disparity is known.
+        let v0 = forward_splat((&l.0, &l.1), (&r.0, &r.1), 0.0).unwrap();
+        assert_eq!(v0.color.data[4 * 3], 200);
+        // Unknown disparity splats nowhere.
+        let none = row(&[50; 8], &[0.0; 8]);
+        let v = forward_splat((&none.0, &none.1), (&none.0, &none.1), 0.5).unwrap();
+        assert!(v.covered.iter().all(|c| !c));
+    }
+
+    #[test]
+    fn no_warp_is_the_weighted_mean() {
+        let l = row(&[0, 100], &[1.0, 1.0]);
+        let r = row(&[100, 200], &[1.0, 1.0]);
+        let v = no_warp(&l.0, &r.0, 0.25).unwrap();
+        assert_eq!((v.color.data[0], v.color.data[3]), (25, 125));
+    }
 }
