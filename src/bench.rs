@@ -199,5 +199,15 @@ pub fn cyclopean_bench(
         m,
     ));
     writeln!(t, "| {} | {setup:.1} | {m:.1} |", crate::evaluation::FORWARD_NAME).expect("write to String");
+    let (setup, m) = crate::evaluation::splat_gather_bench(gpu, &frame, &mid, repeats)?;
+    let name = crate::evaluation::SPLAT_NAME;
+    cases.push(BenchCase::new(
+        "cyclopean",
+        name,
+        format!("{width}x{height}"),
+        Some(setup),
+        m,
+    ));
+    writeln!(t, "| {name} | {setup:.1} | {m:.1} |").expect("write to String");
     Ok(t)
 }

@@ -1,6 +1,10 @@
-//! A stereo frame from a rectified pair with disparity maps (Middlebury style), with a nominal
-//! focal length and baseline: depth Z = f B / d, eyes at -B/2 and +B/2 on a parallel rig, and the
-//! middle camera halfway. Disparity 0 (unknown) and non-finite values become invalid depth.
+//! A stereo frame from a rectified pair with disparity maps (Middlebury style): depth
+//! Z = f B / (d + doffs), eyes at -B/2 and +B/2 on a parallel rig, and the in-between camera at
+//! x = (t - 1/2) B. Disparity 0 (unknown) and non-finite values become invalid depth.
+//!
+//! With `doffs` (the right principal point minus the left one, Middlebury 2014) the right eye's
+//! principal point is `cx + doffs` and the in-between camera's `cx + t doffs`: then every image
+//! shift is exactly `t d`, whatever f, B and doffs, and only the metric depth depends on them.
 
 use super::scene_frame::StereoRig;
 use super::{DepthKind, EyeInput, MiddleCamera, StereoFrame};
@@ -9,70 +13,110 @@ use crate::convention::{Conventions, DepthPlanes};
 use crate::error::{Error, Result};
 use crate::io::{DepthMap, RgbImage};
 
+/// The rectified rig: focal length (px), baseline (m), principal-point offset (px) and the
+/// position of the synthesised view (0 = left eye, 1 = right eye).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct DisparityRig {
+    pub focal_px: f64,
+    pub baseline: f64,
+    pub doffs: f64,
+    pub position: f64,
+}
+
+impl DisparityRig {
+    /// The middle view of a rig with no principal-point offset.
+    pub fn middle(focal_px: f64, baseline: f64) -> Self {
+        DisparityRig {
+            focal_px,
+            baseline,
+            doffs: 0.0,
+            position: 0.5,
+        }
+    }
+
+    pub fn validate(&self) -> Result<()> {
+        if !(self.focal_px.is_finite() && self.focal_px > 0.0 && self.baseline.is_finite() && self.baseline > 0.0) {
+            return Err(Error::param(
+                "focal/baseline",
+                format!("{} px, {} m: both must be finite and > 0", self.focal_px, self.baseline),
+            ));
+        }
+        if !self.doffs.is_finite() {
+            return Err(Error::param("doffs", format!("{} must be finite", self.doffs)));
+        }
+        if !(0.0..=1.0).contains(&self.position) {
+            return Err(Error::param(
+                "position",
+                format!("{} outside [0, 1] (0 = left eye, 1 = right eye)", self.position),
+            ));
+        }
+        Ok(())
+    }
+}
+
 /// Left/right colour and their disparities (pixels, left: x_right = x_left - d; right:
-/// x_left = x_right + d), with the nominal focal length (px) and baseline (m).
+/// x_left = x_right + d) on `rig`.
 pub fn disparity_frame(
     left: (RgbImage, DepthMap),
     right: (RgbImage, DepthMap),
-    focal_px: f64,
-    baseline: f64,
+    rig: &DisparityRig,
     conv: Conventions,
 ) -> Result<(StereoFrame, MiddleCamera)> {
-    if !(focal_px.is_finite() && focal_px > 0.0 && baseline.is_finite() && baseline > 0.0) {
-        return Err(Error::param(
-            "focal/baseline",
-            format!("{focal_px} px, {baseline} m: both must be finite and > 0"),
-        ));
-    }
+    rig.validate()?;
     let (w, h) = (left.0.width, left.0.height);
     for (name, (c, d)) in [("left", &left), ("right", &right)] {
         if (c.width, c.height) != (w, h) || (d.width, d.height) != (w, h) {
             return Err(Error::SizeMismatch {
-                message: format!("{name} colour/disparity differ from the left colour's {w}x{h}"),
+                message: format!(
+                    "{name} colour {}x{} / disparity {}x{} differ from the left colour's {w}x{h}",
+                    c.width, c.height, d.width, d.height
+                ),
             });
         }
     }
-    let camera = PinholeCamera {
+    let camera_at = |shift: f64| PinholeCamera {
         k: Intrinsics {
-            fx: focal_px,
-            fy: focal_px,
-            cx: (w as f64 - 1.0) / 2.0,
+            fx: rig.focal_px,
+            fy: rig.focal_px,
+            cx: (w as f64 - 1.0) / 2.0 + shift,
             cy: (h as f64 - 1.0) / 2.0,
         },
         width: w,
         height: h,
     };
-    let rig = StereoRig {
-        camera,
-        ipd: baseline,
+    let stereo = StereoRig {
+        camera: camera_at(0.0),
+        ipd: rig.baseline,
         head: Pose::IDENTITY,
         planes: DepthPlanes { near: 0.01, far: 1e4 },
     };
+    let fb = rig.focal_px * rig.baseline;
     let to_depth = |d: &DepthMap| {
         let z = d.data.iter().map(|&v| {
-            if v.is_finite() && v > 0.0 {
-                (focal_px * baseline / v as f64) as f32
+            let v = v as f64;
+            if v.is_finite() && v > 0.0 && v + rig.doffs > 0.0 {
+                (fb / (v + rig.doffs)) as f32
             } else {
                 0.0
             }
         });
         DepthMap::new(w, h, z.collect()).expect("same size")
     };
-    let eye = |(color, disparity): (RgbImage, DepthMap), side: f64| EyeInput {
+    let eye = |(color, disparity): (RgbImage, DepthMap), side: f64, shift: f64| EyeInput {
         depth: to_depth(&disparity),
         color,
-        view: rig.eye_pose(side).gl_view(),
-        proj: gl_projection(&camera, &rig.planes, &conv),
+        view: stereo.eye_pose(side).gl_view(),
+        proj: gl_projection(&camera_at(shift), &stereo.planes, &conv),
     };
     let frame = StereoFrame {
-        left: eye(left, -1.0),
-        right: eye(right, 1.0),
+        left: eye(left, -1.0, 0.0),
+        right: eye(right, 1.0, rig.doffs),
         depth_kind: DepthKind::ViewZ,
         conv,
     };
     let mid = MiddleCamera {
-        view: rig.head.gl_view(),
-        proj: gl_projection(&camera, &rig.planes, &conv),
+        view: stereo.eye_pose(2.0 * rig.position - 1.0).gl_view(),
+        proj: gl_projection(&camera_at(rig.position * rig.doffs), &stereo.planes, &conv),
         width: w,
         height: h,
     };

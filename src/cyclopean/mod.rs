@@ -13,12 +13,15 @@
 //! - [`scene_frame`]: a stereo frame of the built-in scene under any conventions, for tests,
 //!   the demo and the report.
 
+pub mod baseline;
 pub mod camera_file;
 pub mod disparity_frame;
 pub mod forward;
 pub mod reference;
 pub mod render;
 pub mod scene_frame;
+pub mod splat;
+pub mod splat_reference;
 pub mod temporal;
 
 use crate::camera::mat4::{self, Mat4};

@@ -9,6 +9,7 @@ mod cli_reproject_stitch;
 mod common;
 mod compare;
 mod cyclopean;
+mod cyclopean_real;
 mod device_choice;
 mod gpu_context;
 mod limits;

@@ -1,6 +1,9 @@
-//! `viewsynth cyclopean`: arguments and the call into viewsynth::cyclopean.
+//! `viewsynth cyclopean`: arguments and the call into viewsynth::cyclopean. Two set-ups:
+//! a rectified pair with disparities (`--left-disparity/--right-disparity`), or any pair with
+//! depth and a camera file (`--left-depth/--right-depth --cameras`).
 
 use super::*;
+use viewsynth::cyclopean::{CyclopeanOutput, CyclopeanOutputs, MiddleCamera, StereoFrame};
 
 #[derive(Clone, Copy, ValueEnum)]
 pub(crate) enum BlendArg {
@@ -8,74 +11,209 @@ pub(crate) enum BlendArg {
     Soft,
 }
 
+#[derive(Clone, Copy, PartialEq, Eq, ValueEnum)]
+pub(crate) enum MethodArg {
+    /// Splat each eye's surfaces into the view (nearest first), then refine each pixel sub-pixel
+    /// on the surface it sees and merge the eyes (the best on real stereo).
+    SplatGather,
+    /// Seed 000 as written: one reconstruction step from the fixation depth.
+    Seed,
+    /// --refine-steps reconstruction steps and a projection check.
+    Refine,
+    /// Each eye's depth mesh rendered into the view, the nearest surface wins.
+    Forward,
+}
+
 #[derive(Args)]
 pub(crate) struct CyclopeanArgs {
     /// Left eye colour (PNG, JPEG, PPM, EXR), rows top-down.
     #[arg(long)]
     left_rgb: PathBuf,
-    /// Left depth: device (window) depth or view distance, as `depth_kind` in the camera file.
-    #[arg(long)]
-    left_depth: PathBuf,
     /// Right eye colour.
     #[arg(long)]
     right_rgb: PathBuf,
-    /// Right depth, as --left-depth.
+    /// Left disparity of a rectified pair, pixels (x_right = x_left - d); 0 or non-finite =
+    /// unknown. PGM/PNG (8/16-bit), PFM, NPY or EXR.
+    #[arg(long, conflicts_with_all = ["left_depth", "cameras"])]
+    left_disparity: Option<PathBuf>,
+    /// Right disparity, pixels (x_left = x_right + d).
+    #[arg(long, conflicts_with_all = ["right_depth", "cameras"])]
+    right_disparity: Option<PathBuf>,
+    /// Raw disparity units per pixel (4 for Middlebury 2003 PGMs; default 1).
     #[arg(long)]
-    right_depth: PathBuf,
+    disparity_scale: Option<f64>,
+    /// Right principal point minus left, pixels (Middlebury 2014 `doffs`): depth = f B / (d + doffs).
+    #[arg(long, default_value_t = 0.0)]
+    doffs: f64,
+    /// Focal length, pixels; with --baseline the view's metric depth is written.
+    #[arg(long, requires = "baseline")]
+    focal: Option<f64>,
+    /// Baseline, metres.
+    #[arg(long, requires = "focal")]
+    baseline: Option<f64>,
+    /// Where the view sits between the eyes: 0 = left, 0.5 = middle, 1 = right.
+    #[arg(long)]
+    position: Option<f64>,
+    /// Left depth: device (window) depth or view distance, as `depth_kind` in the camera file.
+    #[arg(long, requires = "cameras")]
+    left_depth: Option<PathBuf>,
+    /// Right depth, as --left-depth.
+    #[arg(long, requires = "cameras")]
+    right_depth: Option<PathBuf>,
     /// Camera JSON: per-eye GL view and projection (row-major 4x4), middle projection and size,
     /// gaze rays or fixation distance, conventions, depth kind (device or view-z); `viewsynth
     /// scene` writes one.
-    #[arg(long)]
-    cameras: PathBuf,
+    #[arg(long, requires_all = ["left_depth", "right_depth"])]
+    cameras: Option<PathBuf>,
     /// Raw units per unit of depth for integer depth files.
     #[arg(long)]
     depth_scale: Option<f64>,
-    /// Array of an .npz depth file (both eyes) to read (default: the only array, else the first
-    /// floating-point one).
+    /// Array of an .npz depth or disparity file (both eyes) to read (default: the only array,
+    /// else the first floating-point one).
     #[arg(long, value_name = "NAME")]
     npz_key: Option<String>,
-    /// 0 = one gather step from the fixation depth (the basic middle-view method); k >= 1 =
-    /// k-step refinement to the surface with a projection check.
-    #[arg(long, default_value_t = 3)]
-    refine_steps: u32,
-    /// How the two eyes' samples combine: hard (depth disagreement above --z-threshold takes
-    /// the nearer eye, else the mean) or soft (fades from the nearer eye to the mean as the
-    /// disagreement shrinks).
-    #[arg(long, value_enum, default_value = "hard")]
-    blend: BlendArg,
-    /// Middle-space depth disagreement (metres) treated as different surfaces (default:
-    /// clamp(0.02 * fixation, 0.02, 0.25)).
+    /// Method (default splat-gather; a lone --refine-steps selects seed (0) or refine as before).
+    #[arg(long, value_enum)]
+    method: Option<MethodArg>,
+    /// Reconstruction steps of the refine method (0 = the seed's single step).
+    #[arg(long)]
+    refine_steps: Option<u32>,
+    /// Seed/refine only.
+    #[arg(long, value_enum)]
+    blend: Option<BlendArg>,
+    /// Seed/refine only: middle-space depth disagreement (metres) treated as different surfaces
+    /// (default: the seed's clamp(0.02 * fixation, 0.02, 0.25)).
     #[arg(long)]
     z_threshold: Option<f64>,
-    /// Dominant eye and its blend weight, e.g. `left:0.7`.
+    /// Seed/refine only: dominant eye and its blend weight, e.g. `left:0.7`.
     #[arg(long)]
     dominant: Option<String>,
-    /// Outputs to write: any of rgb (or color), depth, mask. Colour and depth not listed are
-    /// neither rendered into an attachment nor read back.
-    #[arg(long, default_value = "rgb,depth,mask")]
-    outputs: String,
-    /// Output folder (created if missing): middle_rgb.png, middle_depth.exr, middle_mask.png
-    /// (those in --outputs).
+    /// Outputs to write: any of rgb (or color), depth, mask. Default all (disparity input: depth
+    /// only with --focal and --baseline). Colour and depth not listed are not read back.
+    #[arg(long)]
+    outputs: Option<String>,
+    /// Writes middle_rgb.png, middle_depth.exr, middle_mask.png (those in --outputs).
     #[arg(long)]
     out_dir: PathBuf,
     #[command(flatten)]
     gpu: GpuArgs,
 }
 
-pub(crate) fn cyclopean(a: CyclopeanArgs) -> Result<()> {
-    use viewsynth::cyclopean::camera_file::CameraFile;
-    use viewsynth::cyclopean::render::CyclopeanRenderer;
-    use viewsynth::cyclopean::{
-        Blend, CyclopeanOutputs, CyclopeanParams, Eye, EyeInput, Method as CMethod, StereoFrame,
+/// The frame, the view to render, the fixation the seed/refine methods start from, and whether
+/// depth is metric.
+struct Setup {
+    frame: StereoFrame,
+    mid: MiddleCamera,
+    fixation: f64,
+    metric_depth: bool,
+}
+
+fn stereo_setup(a: &CyclopeanArgs, left_disparity: &Path) -> Result<Setup> {
+    use viewsynth::cyclopean::disparity_frame::{disparity_frame, DisparityRig};
+    let Some(right_disparity) = &a.right_disparity else {
+        bail!("--left-disparity needs --right-disparity (a file of zeros if the right eye has none)")
     };
-    let outputs = OutputSet::parse(&a.outputs)?;
-    let cams = CameraFile::load(&a.cameras)?;
-    let (mid, fixation) = cams.middle_and_fixation()?;
-    let mut params = CyclopeanParams::seed(fixation);
-    if a.refine_steps > 0 {
-        params.method = CMethod::Refine { steps: a.refine_steps };
+    if a.depth_scale.is_some() {
+        bail!("--depth-scale is for --left-depth/--right-depth; use --disparity-scale with disparities");
     }
-    params.blend = match a.blend {
+    let decode = DepthDecode {
+        scale: Some(a.disparity_scale.unwrap_or(1.0)),
+        ..Default::default()
+    };
+    let eye = |rgb: &Path, disparity: &Path| -> Result<(io::RgbImage, io::DepthMap)> {
+        Ok((
+            io::load_rgb(rgb)?,
+            io::load_depth_with_key(disparity, a.npz_key.as_deref(), &decode)?,
+        ))
+    };
+    let left = eye(&a.left_rgb, left_disparity)?;
+    let right = eye(&a.right_rgb, right_disparity)?;
+    // Without a calibration only f B matters for the view; any nominal values do.
+    let rig = DisparityRig {
+        focal_px: a.focal.unwrap_or(left.0.width as f64),
+        baseline: a.baseline.unwrap_or(0.1),
+        doffs: a.doffs,
+        position: a.position.unwrap_or(0.5),
+    };
+    let (frame, mid) = disparity_frame(left, right, &rig, Conventions::default())?;
+    // The seed/refine methods start at a fixation depth: the median depth the left eye saw.
+    let mut z: Vec<f32> = frame.left.depth.data.iter().copied().filter(|z| *z > 0.0).collect();
+    if z.is_empty() {
+        bail!("{}: no known disparity (all 0 or non-finite)", left_disparity.display());
+    }
+    let half = z.len() / 2;
+    let fixation = *z.select_nth_unstable_by(half, f32::total_cmp).1 as f64;
+    Ok(Setup {
+        frame,
+        mid,
+        fixation,
+        metric_depth: a.focal.is_some(),
+    })
+}
+
+fn camera_file_setup(a: &CyclopeanArgs, cameras: &Path) -> Result<Setup> {
+    use viewsynth::cyclopean::camera_file::{CameraFile, EyeCameras};
+    use viewsynth::cyclopean::EyeInput;
+    for (flag, given) in [
+        ("--position", a.position.is_some()),
+        ("--focal", a.focal.is_some()),
+        ("--disparity-scale", a.disparity_scale.is_some()),
+        ("--doffs", a.doffs != 0.0),
+    ] {
+        if given {
+            bail!("{flag} is for --left-disparity/--right-disparity; the camera file places the view");
+        }
+    }
+    let (Some(left_depth), Some(right_depth)) = (&a.left_depth, &a.right_depth) else {
+        bail!("--cameras needs --left-depth and --right-depth")
+    };
+    let cams = CameraFile::load(cameras)?;
+    let (mid, fixation) = cams.middle_and_fixation()?;
+    let decode = DepthDecode {
+        scale: a.depth_scale,
+        ..Default::default()
+    };
+    let eye = |rgb: &Path, depth: &Path, cam: &EyeCameras| -> Result<EyeInput> {
+        Ok(EyeInput {
+            color: io::load_rgb(rgb)?,
+            depth: io::load_depth_with_key(depth, a.npz_key.as_deref(), &decode)?,
+            view: cam.view,
+            proj: cam.proj,
+        })
+    };
+    let frame = StereoFrame {
+        left: eye(&a.left_rgb, left_depth, &cams.left)?,
+        right: eye(&a.right_rgb, right_depth, &cams.right)?,
+        depth_kind: cams.depth_kind,
+        conv: cams.conventions,
+    };
+    for (path, eye) in [(left_depth, &frame.left), (right_depth, &frame.right)] {
+        print_depth_summary(
+            path,
+            &view_z_in_metres(eye, frame.depth_kind, &frame.conv)?,
+            &format!(
+                "read as {:?} depth (check depth_kind and the projections in {}, and --depth-scale)",
+                frame.depth_kind,
+                cameras.display()
+            ),
+        );
+    }
+    Ok(Setup {
+        frame,
+        mid,
+        fixation,
+        metric_depth: true,
+    })
+}
+
+fn gather_params(a: &CyclopeanArgs, method: MethodArg, fixation: f64) -> Result<viewsynth::cyclopean::CyclopeanParams> {
+    use viewsynth::cyclopean::{Blend, CyclopeanParams, Eye, Method as CMethod};
+    let mut params = CyclopeanParams::seed(fixation);
+    let steps = a.refine_steps.unwrap_or(3);
+    if method == MethodArg::Refine && steps > 0 {
+        params.method = CMethod::Refine { steps };
+    }
+    params.blend = match a.blend.unwrap_or(BlendArg::Hard) {
         BlendArg::Hard => Blend::Hard,
         BlendArg::Soft => Blend::Soft,
     };
@@ -94,56 +232,85 @@ pub(crate) fn cyclopean(a: CyclopeanArgs) -> Result<()> {
         params.dominant = Some((eye, w.parse().with_context(|| format!("--dominant '{d}': weight"))?));
     }
     params.validate()?;
-    let decode = DepthDecode {
-        scale: a.depth_scale,
-        ..Default::default()
+    Ok(params)
+}
+
+pub(crate) fn cyclopean(a: CyclopeanArgs) -> Result<()> {
+    use viewsynth::cyclopean::forward::ForwardWarp;
+    use viewsynth::cyclopean::render::CyclopeanRenderer;
+    use viewsynth::cyclopean::splat::{SplatParams, SplatRenderer};
+    let method = match (a.method, a.refine_steps) {
+        (Some(m), _) => m,
+        (None, Some(0)) => MethodArg::Seed,
+        (None, Some(_)) => MethodArg::Refine,
+        (None, None) => MethodArg::SplatGather,
     };
-    let eye = |rgb: &Path, depth: &Path, cam: &viewsynth::cyclopean::camera_file::EyeCameras| -> Result<EyeInput> {
-        Ok(EyeInput {
-            color: io::load_rgb(rgb)?,
-            depth: io::load_depth_with_key(depth, a.npz_key.as_deref(), &decode)?,
-            view: cam.view,
-            proj: cam.proj,
-        })
-    };
-    let frame = StereoFrame {
-        left: eye(&a.left_rgb, &a.left_depth, &cams.left)?,
-        right: eye(&a.right_rgb, &a.right_depth, &cams.right)?,
-        depth_kind: cams.depth_kind,
-        conv: cams.conventions,
-    };
-    frame.validate()?;
-    for (path, eye) in [(&a.left_depth, &frame.left), (&a.right_depth, &frame.right)] {
-        print_depth_summary(
-            path,
-            &view_z_in_metres(eye, frame.depth_kind, &frame.conv)?,
-            &format!(
-                "read as {:?} depth (check depth_kind and the projections in {}, and --depth-scale)",
-                frame.depth_kind,
-                a.cameras.display()
-            ),
-        );
+    if !matches!(method, MethodArg::Seed | MethodArg::Refine) {
+        for (flag, given) in [
+            ("--refine-steps", a.refine_steps.is_some()),
+            ("--blend", a.blend.is_some()),
+            ("--z-threshold", a.z_threshold.is_some()),
+            ("--dominant", a.dominant.is_some()),
+        ] {
+            if given {
+                bail!("{flag} applies to --method seed or refine only");
+            }
+        }
     }
+    let setup = match (&a.left_disparity, &a.cameras) {
+        (Some(disparity), _) => stereo_setup(&a, disparity)?,
+        (None, Some(cameras)) => camera_file_setup(&a, cameras)?,
+        (None, None) => bail!(
+            "give --left-disparity and --right-disparity (rectified pair), or --left-depth, --right-depth and --cameras"
+        ),
+    };
+    let outputs = match &a.outputs {
+        Some(list) => OutputSet::parse(list)?,
+        None => OutputSet {
+            rgb: true,
+            depth: setup.metric_depth,
+            mask: true,
+        },
+    };
+    if outputs.depth && !setup.metric_depth {
+        bail!("--outputs depth needs --focal and --baseline (the depth is metric)");
+    }
+    let Setup {
+        frame, mid, fixation, ..
+    } = setup;
+    frame.validate()?;
+    let params = match method {
+        MethodArg::Seed | MethodArg::Refine => Some(gather_params(&a, method, fixation)?),
+        _ => None,
+    };
     prepare_out_dir(&a.out_dir)?;
     let gpu = a.gpu.open()?;
     let wanted = CyclopeanOutputs {
         color: outputs.rgb,
         depth: outputs.depth,
     };
-    let (out, timing) = CyclopeanRenderer::with_outputs(&gpu, &frame, params, wanted)?.render(&mid)?;
+    let (out, timing): (CyclopeanOutput, _) = match (method, params) {
+        (MethodArg::Seed | MethodArg::Refine, Some(p)) => {
+            CyclopeanRenderer::with_outputs(&gpu, &frame, p, wanted)?.render(&mid)?
+        }
+        (MethodArg::Forward, _) => {
+            ForwardWarp::new(&gpu, &frame, &viewsynth::refocus::BreakRule::default())?.render(&mid)?
+        }
+        _ => SplatRenderer::new(&gpu, &frame, SplatParams::default(), wanted)?.render(&mid)?,
+    };
     let mask = io::Mask::new(
         mid.width,
         mid.height,
         out.sources.iter().map(|s| (*s != 0) as u8).collect(),
     )?;
     let mut jobs: Vec<WriteJob> = Vec::new();
-    if let Some(color) = &out.color {
+    if let Some(color) = out.color.as_ref().filter(|_| outputs.rgb) {
         jobs.push((
             a.out_dir.join("middle_rgb.png"),
             Box::new(move |p: &Path| io::save_rgb(p, color)),
         ));
     }
-    if let Some(depth) = &out.depth {
+    if let Some(depth) = out.depth.as_ref().filter(|_| outputs.depth) {
         jobs.push((
             a.out_dir.join("middle_depth.exr"),
             Box::new(move |p: &Path| io::save_depth_exr(p, depth)),
@@ -158,10 +325,9 @@ pub(crate) fn cyclopean(a: CyclopeanArgs) -> Result<()> {
     let written = write_all_or_none(jobs)?;
     let valid = out.sources.iter().filter(|s| **s != 0).count();
     println!(
-        "middle view {}x{}: fixation {:.3} m, {:.1} % valid, render {:.1} ms; wrote {} in {}",
+        "view {}x{}: {:.1} % valid, render {:.1} ms; wrote {} in {}",
         mid.width,
         mid.height,
-        fixation,
         valid as f64 / out.sources.len() as f64 * 100.0,
         timing.wall_ms,
         file_names(&written),

@@ -1,0 +1,47 @@
+// Splat pass of the splat-gather method (src/cyclopean/splat.rs; f64 twin: splat_reference.rs).
+// u_clear = 1: every middle pixel to "no surface" (0xFFFFFFFF). u_clear = 0: each valid eye
+// texel's surface point to the middle pixel its one-pixel footprint covers (the floor of its
+// window position), nearest first: positive floats order like their bit patterns, so an atomic
+// min on the bits keeps the nearest middle distance.
+
+layout(local_size_x = 8, local_size_y = 8) in;
+layout(r32ui, binding = 0) uniform uimage2D u_splat;
+uniform sampler2D u_dist;   // R32F eye view distance, memory order (0 = invalid)
+uniform int u_clear;
+uniform ivec2 u_grid;       // invocation grid: middle size (clear) or eye size (splat)
+uniform ivec2 u_size_m;
+uniform mat4 u_inv_view_e, u_inv_proj_e;
+uniform mat4 u_view_proj_m, u_view_m;
+
+const float RAY_NDC_Z = 0.5;
+
+void main() {
+    ivec2 t = ivec2(gl_GlobalInvocationID.xy);
+    if (any(greaterThanEqual(t, u_grid))) {
+        return;
+    }
+    if (u_clear == 1) {
+        imageStore(u_splat, t, uvec4(0xFFFFFFFFu));
+        return;
+    }
+    float z = texelFetch(u_dist, t, 0).r;
+    if (!(z > 0.0) || isinf(z)) {
+        return;
+    }
+    vec2 ndc = (vec2(t) + 0.5) / vec2(u_grid) * 2.0 - 1.0;
+    vec4 p = u_inv_proj_e * vec4(ndc, RAY_NDC_Z, 1.0);
+    vec3 ray = p.xyz / p.w;
+    ray /= -ray.z;
+    vec4 world = u_inv_view_e * vec4(ray * z, 1.0);
+    world /= world.w;
+    vec4 clip = u_view_proj_m * world;
+    if (!(clip.w > 0.0)) {
+        return;
+    }
+    vec2 px = floor((clip.xy / clip.w * 0.5 + 0.5) * vec2(u_size_m));
+    float zm = -(u_view_m * world).z;
+    if (any(lessThan(px, vec2(0.0))) || any(greaterThanEqual(px, vec2(u_size_m))) || !(zm > 0.0) || isinf(zm)) {
+        return;
+    }
+    imageAtomicMin(u_splat, ivec2(px), floatBitsToUint(zm));
+}

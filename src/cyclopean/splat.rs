@@ -1,0 +1,301 @@
+//! Splat-gather: the middle view for real stereo, where the gather walk's fixed point lands
+//! behind thin near objects. Two GPU passes:
+//!
+//! 1. splat (shaders/cyclopean/splat.comp): every valid eye texel's surface point goes to the
+//!    middle pixel its one-pixel footprint covers, nearest first (atomic min per eye). This says
+//!    *which* surface each middle pixel sees from each eye; a pole one texel wide stays one
+//!    pixel wide, so nothing behind it shows through.
+//! 2. gather (shaders/cyclopean/splat_gather.frag): per eye, from that candidate depth (or a
+//!    neighbour's, in the holes a splat leaves), one fixed-point step on the eye's surface
+//!    interpolated in inverse depth over the bilinear taps on that surface gives the sub-pixel
+//!    position, checked to land on the same surface, and the colour there (bilinear, the same
+//!    taps). The eyes merge per pixel: on one surface, weighted by nearness to each eye and by
+//!    the taps' weight (low at edges, where real pixels mix colours); else the nearer; a
+//!    disocclusion from the one eye that sees it.
+//!
+//! "Same surface" is about one pixel of full-baseline disparity (`SplatParams::surface_tolerance_px`),
+//! a unit that means the same on every rig. The f64 twin is [`splat_reference`](super::splat_reference).
+
+use super::{CyclopeanOutput, CyclopeanOutputs, MiddleCamera, StereoFrame};
+use crate::camera::mat4::{self, Mat4};
+use crate::convention::RowOrder;
+use crate::error::{Error, Result};
+use crate::gpu::{Attachment, Framebuffer, Gpu, GpuTimer, Program, Texture, TextureFormat, Timing, VertexArray};
+
+const SPLAT_COMP: &str = include_str!("../../shaders/cyclopean/splat.comp");
+const GATHER_FRAG: &str = include_str!("../../shaders/cyclopean/splat_gather.frag");
+
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct SplatParams {
+    /// Two depths are one surface when their full-baseline disparities differ by at most this
+    /// many pixels (neighbouring texels of a slanted surface differ by its disparity gradient,
+    /// well under 1 on real scenes; object edges by several pixels). Default 1.1, not 1:
+    /// disparities quantised to 1/2^k px (Middlebury: 1/4) differ by exactly 1 px often, and
+    /// a threshold on a quantisation step would be decided by f32 rounding.
+    pub surface_tolerance_px: f64,
+}
+
+impl Default for SplatParams {
+    fn default() -> Self {
+        SplatParams {
+            surface_tolerance_px: 1.1,
+        }
+    }
+}
+
+impl SplatParams {
+    pub fn validate(&self) -> Result<()> {
+        if !(self.surface_tolerance_px.is_finite() && self.surface_tolerance_px > 0.0) {
+            return Err(Error::param(
+                "surface tolerance",
+                format!("{} px must be finite and > 0", self.surface_tolerance_px),
+            ));
+        }
+        Ok(())
+    }
+}
+
+/// What both implementations derive from the frame and the middle camera.
+pub struct SplatGeometry {
+    /// Per eye view distance (0 = invalid), rows in memory order.
+    pub dist_mem: [Vec<f32>; 2],
+    /// focal (px) x baseline (m): full-baseline disparity = parallax_px / distance.
+    pub parallax_px: f64,
+    /// Weight of the left eye where both see one surface: the middle camera's nearness to it
+    /// (1 at the left eye, 0 at the right).
+    pub w_left: f64,
+    pub view_m: Mat4,
+}
+
+fn centre(view: &Mat4) -> Result<[f64; 3]> {
+    let inv = mat4::inverse(view).ok_or_else(|| Error::param("view matrix", "singular"))?;
+    Ok([inv[0][3], inv[1][3], inv[2][3]])
+}
+
+fn dist3(a: [f64; 3], b: [f64; 3]) -> f64 {
+    ((a[0] - b[0]).powi(2) + (a[1] - b[1]).powi(2) + (a[2] - b[2]).powi(2)).sqrt()
+}
+
+impl SplatGeometry {
+    pub fn new(frame: &StereoFrame, mid: &MiddleCamera) -> Result<Self> {
+        frame.validate()?;
+        let (cl, cr, cm) = (
+            centre(&frame.left.view)?,
+            centre(&frame.right.view)?,
+            centre(&mid.view)?,
+        );
+        let baseline = dist3(cl, cr);
+        // GL projection: x_ndc = P00 x / -z, so the focal length in pixels is P00 w / 2.
+        let focal = frame.left.proj[0][0].abs() * frame.left.color.width as f64 / 2.0;
+        let parallax_px = focal * baseline;
+        if !(parallax_px.is_finite() && parallax_px > 0.0) {
+            return Err(Error::param(
+                "eye cameras",
+                "the splat method needs two distinct eye positions (baseline > 0)",
+            ));
+        }
+        let (dl, dr) = (dist3(cm, cl), dist3(cm, cr));
+        let mem = |eye: &super::EyeInput| -> Result<Vec<f32>> {
+            let d = super::forward::eye_distances(eye, frame.depth_kind, &frame.conv)?;
+            let w = eye.depth.width as usize;
+            let bytes = frame
+                .conv
+                .row_order
+                .convert_rows(crate::gpu::pixels::f32_to_bytes(&d), w * 4);
+            Ok(crate::gpu::pixels::bytes_to_f32(&bytes))
+        };
+        Ok(SplatGeometry {
+            dist_mem: [mem(&frame.left)?, mem(&frame.right)?],
+            parallax_px,
+            w_left: if dl + dr > 0.0 { dr / (dl + dr) } else { 0.5 },
+            view_m: mid.view,
+        })
+    }
+}
+
+struct EyeGpu {
+    color: Texture,
+    dist: Texture,
+    view: Mat4,
+    proj: Mat4,
+}
+
+/// A stereo frame on the GPU, ready to render splat-gather views.
+pub struct SplatRenderer {
+    gpu: Gpu,
+    splat: Program,
+    gather: Program,
+    params: SplatParams,
+    outputs: CyclopeanOutputs,
+    rows: RowOrder,
+    frame_eyes: [(u32, u32); 2],
+    eyes: [EyeGpu; 2],
+    /// Kept to derive the geometry of each middle camera (its weights).
+    frame_views: [Mat4; 2],
+    parallax_px: f64,
+    vao: VertexArray,
+    targets: Option<(Framebuffer, [Texture; 2])>,
+}
+
+impl SplatRenderer {
+    pub fn new(gpu: &Gpu, frame: &StereoFrame, params: SplatParams, outputs: CyclopeanOutputs) -> Result<Self> {
+        params.validate()?;
+        // The middle camera does not change the eye data; any will do to derive it here.
+        let probe = MiddleCamera {
+            view: frame.left.view,
+            proj: frame.left.proj,
+            width: 1,
+            height: 1,
+        };
+        let geo = SplatGeometry::new(frame, &probe)?;
+        let upload = |eye: &super::EyeInput, dist: &[f32]| -> Result<EyeGpu> {
+            let (w, h) = (eye.color.width, eye.color.height);
+            let rgba = crate::gpu::pixels::rgb_to_rgba(&eye.color.data);
+            Ok(EyeGpu {
+                color: Texture::new(
+                    gpu,
+                    w,
+                    h,
+                    TextureFormat::Rgba8,
+                    Some(&frame.conv.row_order.convert_rows(rgba, w as usize * 4)),
+                )?,
+                dist: Texture::new(
+                    gpu,
+                    w,
+                    h,
+                    TextureFormat::R32F,
+                    Some(&crate::gpu::pixels::f32_to_bytes(dist)),
+                )?,
+                view: eye.view,
+                proj: eye.proj,
+            })
+        };
+        Ok(SplatRenderer {
+            gpu: gpu.clone(),
+            splat: Program::new(gpu, "", &[(glow::COMPUTE_SHADER, "cyclopean/splat.comp", SPLAT_COMP)])?,
+            gather: Program::fullscreen(gpu, "", "cyclopean/splat_gather.frag", GATHER_FRAG)?,
+            params,
+            outputs,
+            rows: frame.conv.row_order,
+            frame_eyes: [
+                (frame.left.color.width, frame.left.color.height),
+                (frame.right.color.width, frame.right.color.height),
+            ],
+            eyes: [
+                upload(&frame.left, &geo.dist_mem[0])?,
+                upload(&frame.right, &geo.dist_mem[1])?,
+            ],
+            frame_views: [frame.left.view, frame.right.view],
+            parallax_px: geo.parallax_px,
+            vao: VertexArray::new(gpu)?,
+            targets: None,
+        })
+    }
+
+    pub fn render(&mut self, mid: &MiddleCamera) -> Result<(CyclopeanOutput, Timing)> {
+        let (w, h) = (mid.width, mid.height);
+        self.gpu.check_image_size("middle size", w, h)?;
+        let inv = |m: &Mat4, what: &str| mat4::inverse(m).ok_or_else(|| Error::param(what.to_string(), "singular"));
+        let (cl, cr, cm) = (
+            centre(&self.frame_views[0])?,
+            centre(&self.frame_views[1])?,
+            centre(&mid.view)?,
+        );
+        let (dl, dr) = (dist3(cm, cl), dist3(cm, cr));
+        let w_left = if dl + dr > 0.0 { dr / (dl + dr) } else { 0.5 };
+        if !matches!(&self.targets, Some((f, _)) if f.width == w && f.height == h) {
+            self.targets = None;
+            let slot = |wanted: bool, format| {
+                wanted.then_some(Attachment {
+                    format,
+                    clear: [0.0; 4],
+                })
+            };
+            let fb = Framebuffer::new(
+                &self.gpu,
+                w,
+                h,
+                &[
+                    slot(self.outputs.color, TextureFormat::Rgba8),
+                    slot(self.outputs.depth, TextureFormat::R32F),
+                    slot(true, TextureFormat::R8),
+                ],
+                false,
+            )?;
+            let splats = [
+                Texture::new(&self.gpu, w, h, TextureFormat::R32Ui, None)?,
+                Texture::new(&self.gpu, w, h, TextureFormat::R32Ui, None)?,
+            ];
+            self.targets = Some((fb, splats));
+        }
+        let (fb, splats) = self.targets.as_ref().expect("allocated above");
+        let gpu = &self.gpu;
+        let timer = GpuTimer::start(gpu);
+        let view_proj_m = mat4::mul(&mid.proj, &mid.view);
+        // Pass 1: clear and splat each eye into its own image.
+        let s = &self.splat;
+        s.bind();
+        s.set_mat4_rows("u_view_proj_m", &view_proj_m);
+        s.set_mat4_rows("u_view_m", &mid.view);
+        s.set_ivec2("u_size_m", [w as i32, h as i32]);
+        s.set_i32("u_dist", 0);
+        for (eye, (size, target)) in self.eyes.iter().zip(self.frame_eyes.iter().zip(splats)) {
+            // SAFETY: the image is an R32UI texture of the bound size; barriers order the passes.
+            unsafe {
+                use glow::HasContext;
+                let gl = gpu.gl();
+                gl.bind_image_texture(0, Some(target.raw), 0, false, 0, glow::READ_WRITE, glow::R32UI);
+                s.set_i32("u_clear", 1);
+                s.set_ivec2("u_grid", [w as i32, h as i32]);
+                gl.dispatch_compute(w.div_ceil(8), h.div_ceil(8), 1);
+                gl.memory_barrier(glow::SHADER_IMAGE_ACCESS_BARRIER_BIT);
+                eye.dist.bind(0);
+                s.set_i32("u_clear", 0);
+                s.set_ivec2("u_grid", [size.0 as i32, size.1 as i32]);
+                s.set_mat4_rows("u_inv_view_e", &inv(&eye.view, "eye view")?);
+                s.set_mat4_rows("u_inv_proj_e", &inv(&eye.proj, "eye projection")?);
+                gl.dispatch_compute(size.0.div_ceil(8), size.1.div_ceil(8), 1);
+            }
+        }
+        // SAFETY: make the atomics visible to the gather's texel fetches.
+        unsafe {
+            use glow::HasContext;
+            gpu.gl().memory_barrier(glow::TEXTURE_FETCH_BARRIER_BIT);
+            gpu.gl()
+                .bind_image_texture(0, None, 0, false, 0, glow::READ_WRITE, glow::R32UI);
+        }
+        gpu.check("cyclopean splat")?;
+        // Pass 2: gather and merge.
+        fb.bind_and_clear(1.0);
+        let p = &self.gather;
+        p.bind();
+        self.vao.bind();
+        let names = ["l", "r"];
+        for (k, eye) in self.eyes.iter().enumerate() {
+            let sfx = names[k];
+            eye.color.bind(3 * k as u32);
+            eye.dist.bind(3 * k as u32 + 1);
+            splats[k].bind(3 * k as u32 + 2);
+            p.set_i32(&format!("u_color_{sfx}"), 3 * k as i32);
+            p.set_i32(&format!("u_dist_{sfx}"), 3 * k as i32 + 1);
+            p.set_i32(&format!("u_splat_{sfx}"), 3 * k as i32 + 2);
+            p.set_mat4_rows(&format!("u_view_proj_{sfx}"), &mat4::mul(&eye.proj, &eye.view));
+            p.set_mat4_rows(&format!("u_view_{sfx}"), &eye.view);
+            p.set_mat4_rows(&format!("u_inv_view_{sfx}"), &inv(&eye.view, "eye view")?);
+            p.set_mat4_rows(&format!("u_inv_proj_{sfx}"), &inv(&eye.proj, "eye projection")?);
+        }
+        p.set_mat4_rows("u_view_m", &mid.view);
+        p.set_mat4_rows("u_inv_view_m", &inv(&mid.view, "middle view")?);
+        p.set_mat4_rows("u_inv_proj_m", &inv(&mid.proj, "middle projection")?);
+        p.set_vec2("u_size_m", [w as f32, h as f32]);
+        p.set_f32("u_parallax_px", self.parallax_px as f32);
+        p.set_f32("u_tolerance_px", self.params.surface_tolerance_px as f32);
+        p.set_f32("u_w_left", w_left as f32);
+        self.vao.draw_fullscreen();
+        gpu.check("cyclopean splat gather")?;
+        let out = super::render::read_output(fb, self.rows)?;
+        let timing = timer.stop();
+        fb.unbind();
+        Ok((out, timing))
+    }
+}

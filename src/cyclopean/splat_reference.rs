@@ -1,0 +1,289 @@
+//! Float64 CPU twin of the splat-gather method (shaders/cyclopean/splat.comp and
+//! splat_gather.frag): the same passes, the same texel choices, in memory order (row 0 =
+//! framebuffer row 0) as the GPU sees its textures; converted to top-down rows at the end.
+
+use super::reference::CyclopeanReference;
+use super::splat::{SplatGeometry, SplatParams};
+use super::{MiddleCamera, StereoFrame};
+use crate::camera::mat4::{self, Mat4};
+use crate::convention::RowOrder;
+use crate::error::Result;
+
+/// One eye as the passes read it: distance (0 = invalid) and colour in memory order.
+struct Eye<'a> {
+    dist: &'a [f32],
+    color: &'a [u8],
+    flip: bool,
+    w: i64,
+    h: i64,
+    view: Mat4,
+    inv_view: Mat4,
+    inv_proj: Mat4,
+    view_proj: Mat4,
+}
+
+impl Eye<'_> {
+    fn dist(&self, x: i64, y: i64) -> f64 {
+        self.dist[(y * self.w + x) as usize] as f64
+    }
+    fn color(&self, x: i64, y: i64) -> [f64; 3] {
+        let row = if self.flip { self.h - 1 - y } else { y };
+        let i = ((row * self.w + x) * 3) as usize;
+        [0, 1, 2].map(|c| self.color[i + c] as f64)
+    }
+}
+
+/// View-space direction through NDC (x, y) with GL z = -1.
+fn view_ray(inv_proj: &Mat4, ndc: [f64; 2]) -> [f64; 3] {
+    let p = mat4::transform_point(inv_proj, [ndc[0], ndc[1], super::reference::RAY_NDC_Z]);
+    [p[0] / -p[2], p[1] / -p[2], -1.0]
+}
+
+fn scaled(r: [f64; 3], z: f64) -> [f64; 3] {
+    [r[0] * z, r[1] * z, r[2] * z]
+}
+
+/// The pass-1 splat of one eye: per middle pixel (memory order) the nearest middle distance of
+/// the eye texels whose centre projects into it (the pixel whose centre the texel's one-pixel
+/// footprint covers); +inf where none does.
+fn splat(eye: &Eye, view_proj_m: &Mat4, view_m: &Mat4, wm: i64, hm: i64) -> Vec<f64> {
+    let mut out = vec![f64::INFINITY; (wm * hm) as usize];
+    for y in 0..eye.h {
+        for x in 0..eye.w {
+            let z = eye.dist(x, y);
+            if z <= 0.0 {
+                continue;
+            }
+            let ndc = [
+                (x as f64 + 0.5) / eye.w as f64 * 2.0 - 1.0,
+                (y as f64 + 0.5) / eye.h as f64 * 2.0 - 1.0,
+            ];
+            let world = mat4::transform_point(&eye.inv_view, scaled(view_ray(&eye.inv_proj, ndc), z));
+            let clip = mat4::transform(view_proj_m, [world[0], world[1], world[2], 1.0]);
+            if clip[3].partial_cmp(&0.0) != Some(std::cmp::Ordering::Greater) {
+                continue;
+            }
+            let px = ((clip[0] / clip[3] * 0.5 + 0.5) * wm as f64).floor();
+            let py = ((clip[1] / clip[3] * 0.5 + 0.5) * hm as f64).floor();
+            let zm = -mat4::transform_point(view_m, world)[2];
+            if !(px >= 0.0 && py >= 0.0 && px < wm as f64 && py < hm as f64 && zm > 0.0 && zm.is_finite()) {
+                continue;
+            }
+            let o = (py as i64 * wm + px as i64) as usize;
+            out[o] = out[o].min(zm);
+        }
+    }
+    out
+}
+
+/// One eye's answer for a middle pixel.
+#[derive(Debug, Clone, Copy)]
+struct Sample {
+    color: [f64; 3],
+    z_middle: f64,
+    /// Bilinear weight of the texels on the surface found (0..1]: < 1 at the surface's edge,
+    /// where real images mix foreground and background colours.
+    confidence: f64,
+}
+
+struct Ctx<'a> {
+    geo: &'a SplatGeometry,
+    params: &'a SplatParams,
+    inv_view_m: Mat4,
+}
+
+impl Ctx<'_> {
+    fn same_surface(&self, z1: f64, z2: f64) -> bool {
+        (self.geo.parallax_px / z1 - self.geo.parallax_px / z2).abs() <= self.params.surface_tolerance_px
+    }
+
+    /// Eye texel coordinates (texel i's centre at i) of the middle ray point at middle distance z.
+    fn to_eye(&self, eye: &Eye, ray_m: [f64; 3], z: f64) -> Option<([f64; 2], f64)> {
+        let world = mat4::transform_point(&self.inv_view_m, scaled(ray_m, z));
+        let clip = mat4::transform(&eye.view_proj, [world[0], world[1], world[2], 1.0]);
+        if clip[3].partial_cmp(&0.0) != Some(std::cmp::Ordering::Greater) {
+            return None;
+        }
+        let e = [
+            (clip[0] / clip[3] * 0.5 + 0.5) * eye.w as f64 - 0.5,
+            (clip[1] / clip[3] * 0.5 + 0.5) * eye.h as f64 - 0.5,
+        ];
+        let z_eye = -mat4::transform_point(&eye.view, world)[2];
+        Some((e, z_eye))
+    }
+
+    /// The texel nearest `e` and the bilinear taps of `e` on its surface: (surface distance by
+    /// interpolated inverse depth, colour, kept weight); None when the nearest texel is invalid,
+    /// off the image, or on another surface than `z_eye`.
+    fn surface_at(&self, eye: &Eye, e: [f64; 2], z_eye: f64) -> Option<(f64, [f64; 3], f64)> {
+        let n = [(e[0] + 0.5).floor(), (e[1] + 0.5).floor()];
+        if !(n[0] >= 0.0 && n[1] >= 0.0 && n[0] < eye.w as f64 && n[1] < eye.h as f64) {
+            return None;
+        }
+        let zn = eye.dist(n[0] as i64, n[1] as i64);
+        if !(zn > 0.0 && z_eye > 0.0 && self.same_surface(zn, z_eye)) {
+            return None;
+        }
+        let (x0, y0) = (e[0].floor(), e[1].floor());
+        let (fx, fy) = (e[0] - x0, e[1] - y0);
+        let (mut inv, mut color, mut total) = (0.0, [0.0; 3], 0.0);
+        for (dx, dy, wt) in [
+            (0, 0, (1.0 - fx) * (1.0 - fy)),
+            (1, 0, fx * (1.0 - fy)),
+            (0, 1, (1.0 - fx) * fy),
+            (1, 1, fx * fy),
+        ] {
+            let x = (x0 as i64 + dx).clamp(0, eye.w - 1);
+            let y = (y0 as i64 + dy).clamp(0, eye.h - 1);
+            let z = eye.dist(x, y);
+            if z > 0.0 && self.same_surface(z, zn) {
+                let c = eye.color(x, y);
+                inv += wt / z;
+                for k in 0..3 {
+                    color[k] += wt * c[k];
+                }
+                total += wt;
+            }
+        }
+        // The nearest texel always qualifies and has weight >= 1/4.
+        Some((total / inv, color.map(|c| c / total), total))
+    }
+
+    /// Follow a candidate middle distance to the eye's surface: one fixed-point step on the
+    /// locally interpolated surface, then the colour there.
+    fn eye_sample(&self, eye: &Eye, ray_m: [f64; 3], z0: f64) -> Option<Sample> {
+        let (e0, z_eye0) = self.to_eye(eye, ray_m, z0)?;
+        let (z_surface, _, _) = self.surface_at(eye, e0, z_eye0)?;
+        let ndc = [
+            (e0[0] + 0.5) / eye.w as f64 * 2.0 - 1.0,
+            (e0[1] + 0.5) / eye.h as f64 * 2.0 - 1.0,
+        ];
+        let on_surface = mat4::transform_point(&eye.inv_view, scaled(view_ray(&eye.inv_proj, ndc), z_surface));
+        let z1 = -mat4::transform_point(&self.geo.view_m, on_surface)[2];
+        if !(z1.is_finite() && z1 > 0.0) {
+            return None;
+        }
+        let (e1, z_eye1) = self.to_eye(eye, ray_m, z1)?;
+        let (_, color, confidence) = self.surface_at(eye, e1, z_eye1)?;
+        Some(Sample {
+            color,
+            z_middle: z1,
+            confidence,
+        })
+    }
+
+    /// Candidates from the eye's splat: the nearest of the pixel and its 4 neighbours (a near
+    /// surface whose splat rounded next door), then the pixel's own (or, in a hole, the farthest
+    /// neighbour: the surface a disocclusion shows); the first that leads to a surface wins.
+    fn candidates(&self, splat: &[f64], x: i64, y: i64, wm: i64, hm: i64) -> [f64; 2] {
+        let own = splat[(y * wm + x) as usize];
+        let (mut near, mut far) = (own, if own.is_finite() { own } else { -1.0 });
+        for (dx, dy) in [(-1, 0), (1, 0), (0, -1), (0, 1)] {
+            let (nx, ny) = (x + dx, y + dy);
+            if nx < 0 || ny < 0 || nx >= wm || ny >= hm {
+                continue;
+            }
+            let z = splat[(ny * wm + nx) as usize];
+            near = near.min(z);
+            if !own.is_finite() && z.is_finite() {
+                far = far.max(z);
+            }
+        }
+        let second = if far > 0.0 && !self.same_surface(far, near) {
+            far
+        } else {
+            f64::INFINITY
+        };
+        [near, second]
+    }
+}
+
+/// The splat-gather middle view in f64 (rows top-down; colour 0 where no eye answers).
+pub fn splat_reference(frame: &StereoFrame, mid: &MiddleCamera, params: &SplatParams) -> Result<CyclopeanReference> {
+    params.validate()?;
+    let geo = SplatGeometry::new(frame, mid)?;
+    let flip = frame.conv.row_order == RowOrder::BottomUp;
+    let eyes: Vec<Eye> = [(&frame.left, &geo.dist_mem[0]), (&frame.right, &geo.dist_mem[1])]
+        .into_iter()
+        .map(|(input, dist)| -> Result<Eye> {
+            let inv = |m: &Mat4| mat4::inverse(m).ok_or_else(|| crate::Error::param("eye matrix", "singular"));
+            Ok(Eye {
+                dist,
+                color: &input.color.data,
+                flip,
+                w: input.color.width as i64,
+                h: input.color.height as i64,
+                view: input.view,
+                inv_view: inv(&input.view)?,
+                inv_proj: inv(&input.proj)?,
+                view_proj: mat4::mul(&input.proj, &input.view),
+            })
+        })
+        .collect::<Result<_>>()?;
+    let (wm, hm) = (mid.width as i64, mid.height as i64);
+    let view_proj_m = mat4::mul(&mid.proj, &mid.view);
+    let splats: Vec<Vec<f64>> = eyes.iter().map(|e| splat(e, &view_proj_m, &mid.view, wm, hm)).collect();
+    let ctx = Ctx {
+        geo: &geo,
+        params,
+        inv_view_m: mat4::inverse(&mid.view).ok_or_else(|| crate::Error::param("middle view", "singular"))?,
+    };
+    let inv_proj_m = mat4::inverse(&mid.proj).ok_or_else(|| crate::Error::param("middle projection", "singular"))?;
+    let n = (wm * hm) as usize;
+    let mut out = CyclopeanReference {
+        color: vec![[0.0; 3]; n],
+        depth: vec![0.0; n],
+        sources: vec![0; n],
+    };
+    for y in 0..hm {
+        let y_img = if flip { hm - 1 - y } else { y };
+        for x in 0..wm {
+            let ndc = [
+                (x as f64 + 0.5) / wm as f64 * 2.0 - 1.0,
+                (y as f64 + 0.5) / hm as f64 * 2.0 - 1.0,
+            ];
+            let ray = view_ray(&inv_proj_m, ndc);
+            let samples: Vec<Option<Sample>> = eyes
+                .iter()
+                .zip(&splats)
+                .map(|(eye, sp)| {
+                    ctx.candidates(sp, x, y, wm, hm)
+                        .into_iter()
+                        .filter(|z| z.is_finite())
+                        .find_map(|z| ctx.eye_sample(eye, ray, z))
+                })
+                .collect();
+            let o = (y_img * wm + x) as usize;
+            if let Some((c, z, bits)) = merge(&ctx, samples[0], samples[1]) {
+                out.color[o] = c;
+                out.depth[o] = z;
+                out.sources[o] = bits;
+            }
+        }
+    }
+    Ok(out)
+}
+
+/// Both eyes on one surface: their mean weighted by nearness to each eye and confidence; on
+/// different surfaces the nearer; one eye alone: that eye.
+fn merge(ctx: &Ctx, l: Option<Sample>, r: Option<Sample>) -> Option<([f64; 3], f64, u8)> {
+    match (l, r) {
+        (None, None) => None,
+        (Some(l), None) => Some((l.color, l.z_middle, 1)),
+        (None, Some(r)) => Some((r.color, r.z_middle, 2)),
+        (Some(l), Some(r)) => {
+            if ctx.same_surface(l.z_middle, r.z_middle) {
+                let wl = ctx.geo.w_left * l.confidence;
+                let wr = (1.0 - ctx.geo.w_left) * r.confidence;
+                // > 0: each confidence is >= 1/4 and the two position weights sum to 1.
+                let total = wl + wr;
+                let c = [0, 1, 2].map(|k| (wl * l.color[k] + wr * r.color[k]) / total);
+                Some((c, (wl * l.z_middle + wr * r.z_middle) / total, 3))
+            } else if l.z_middle <= r.z_middle {
+                Some((l.color, l.z_middle, 1))
+            } else {
+                Some((r.color, r.z_middle, 2))
+            }
+        }
+    }
+}
