@@ -1,0 +1,287 @@
+//! `viewsynth.Renderer`: one EGL context (shared per thread, see `context`) and the refocus call.
+
+use crate::arrays;
+use crate::context;
+use crate::errors::{self, Kind};
+use pyo3::prelude::*;
+use pyo3::types::{PyDict, PyList, PyString};
+use viewsynth::camera::PinholeCamera;
+use viewsynth::convention::Conventions;
+use viewsynth::gpu::Gpu;
+use viewsynth::refocus::job::TargetSpec;
+use viewsynth::refocus::{BreakRule, Method, OutputSet, RefocusOutput, RefocusSource, Refocuser};
+
+/// Moves a value into `Python::detach`, whose closure runs synchronously on the calling thread.
+/// The `Gpu` inside is an `Rc`: it is sound here because nothing else can reach it while the GIL
+/// is released (the Renderer is `unsendable`, so pyo3 refuses it to every other thread, and the
+/// call holds a reference to it until detach returns).
+struct SameThread<T>(T);
+// SAFETY: see above; the value never leaves the thread that made it.
+unsafe impl<T> Send for SameThread<T> {}
+
+/// A refocus call's inputs, validated while the GIL is held.
+struct RefocusJob {
+    source: RefocusSource,
+    rule: BreakRule,
+    method: Method,
+    outputs: OutputSet,
+    targets: Vec<PinholeCamera>,
+}
+
+/// The GPU work of one call: upload the source once, render every target.
+fn render_all(gpu: &Gpu, job: &RefocusJob) -> viewsynth::Result<(f64, Vec<RefocusOutput>)> {
+    let t0 = std::time::Instant::now();
+    let mut refocuser = Refocuser::new(
+        gpu,
+        &job.source,
+        &job.rule,
+        job.method,
+        job.outputs,
+        Conventions::default(),
+    )?;
+    let setup_ms = t0.elapsed().as_secs_f64() * 1e3;
+    let rendered = job
+        .targets
+        .iter()
+        .map(|t| refocuser.render(t))
+        .collect::<viewsynth::Result<Vec<_>>>()?;
+    Ok((setup_ms, rendered))
+}
+
+/// Fraction of output pixels that hold a value (as the CLI's manifest: the mask's, else depth's).
+fn coverage(out: &RefocusOutput) -> Option<f64> {
+    if let Some(m) = &out.mask {
+        return Some(m.data.iter().filter(|v| **v != 0).count() as f64 / m.data.len() as f64);
+    }
+    out.depth
+        .as_ref()
+        .map(|d| d.data.iter().filter(|z| **z > 0.0).count() as f64 / d.data.len() as f64)
+}
+
+fn output_set(obj: Option<&Bound<'_, PyAny>>) -> PyResult<OutputSet> {
+    let Some(obj) = obj else {
+        return Ok(OutputSet::default());
+    };
+    let list: Vec<String> = if let Ok(s) = obj.cast::<PyString>() {
+        vec![s.to_string()]
+    } else {
+        obj.extract()
+            .map_err(|_| errors::invalid("outputs", "expected a sequence of \"rgb\", \"depth\", \"mask\""))?
+    };
+    OutputSet::parse(&list.join(",")).map_err(errors::from_library)
+}
+
+/// Open EGL context for refocusing numpy images on the GPU.
+#[pyclass(unsendable, module = "viewsynth")]
+pub struct Renderer {
+    gpu: Option<Gpu>,
+    /// Process that opened the context: a forked child must not use (or free) it.
+    pid: u32,
+    device: String,
+}
+
+impl Renderer {
+    fn gpu(&self) -> PyResult<&Gpu> {
+        if self.pid != std::process::id() {
+            return Err(errors::raise(
+                Kind::Forked,
+                format!(
+                    "this Renderer was created in process {} and this is process {} (forked after it was \
+                     created): an EGL context does not survive fork; create the Renderer inside each \
+                     worker, after the fork (e.g. lazily on first use or in worker_init_fn)",
+                    self.pid,
+                    std::process::id()
+                ),
+                None,
+            ));
+        }
+        self.gpu
+            .as_ref()
+            .ok_or_else(|| errors::raise(Kind::Closed, "this Renderer is closed", None))
+    }
+
+    fn close_inner(&mut self) {
+        if let Some(gpu) = self.gpu.take() {
+            if self.pid == std::process::id() {
+                context::release(gpu);
+            } else {
+                std::mem::forget(gpu);
+            }
+        }
+    }
+}
+
+impl Drop for Renderer {
+    fn drop(&mut self) {
+        self.close_inner();
+    }
+}
+
+#[pymethods]
+impl Renderer {
+    #[new]
+    #[pyo3(signature = (device = "auto", require_gpu = false))]
+    fn new(device: &str, require_gpu: bool) -> PyResult<Self> {
+        let choice = context::parse_device(device)?;
+        let gpu = context::acquire(choice)?;
+        let renderer = Renderer {
+            gpu: Some(gpu),
+            pid: std::process::id(),
+            device: device.to_string(),
+        };
+        if require_gpu {
+            let info = renderer.gpu()?.info();
+            if crate::is_software(&info.renderer) {
+                return Err(errors::raise(
+                    Kind::GpuUnavailable,
+                    format!(
+                        "require_gpu=True but EGL device '{device}' gave the software renderer '{}' \
+                         (no GPU driver with EGL visible to this process)",
+                        info.renderer
+                    ),
+                    Some("require_gpu"),
+                ));
+            }
+        }
+        Ok(renderer)
+    }
+
+    /// What the context runs on (vendor, renderer, GL version, EGL platform and device, limits).
+    #[getter]
+    fn info<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
+        crate::info_dict(py, self.gpu()?.info())
+    }
+
+    /// True after close().
+    #[getter]
+    fn closed(&self) -> bool {
+        self.gpu.is_none()
+    }
+
+    /// Release the context now (it is also released when the Renderer is garbage-collected).
+    fn close(&mut self) {
+        self.close_inner();
+    }
+
+    fn __enter__(slf: Py<Self>) -> Py<Self> {
+        slf
+    }
+
+    #[pyo3(signature = (*_exc))]
+    fn __exit__(&mut self, _exc: &Bound<'_, pyo3::types::PyTuple>) -> bool {
+        self.close_inner();
+        false
+    }
+
+    fn __repr__(&self) -> String {
+        match (&self.gpu, self.pid == std::process::id()) {
+            (Some(gpu), true) => format!("Renderer(device={:?}, renderer={:?})", self.device, gpu.info().renderer),
+            (Some(_), false) => format!("Renderer(device={:?}, inherited through fork: unusable)", self.device),
+            (None, _) => format!("Renderer(device={:?}, closed)", self.device),
+        }
+    }
+
+    /// Re-render one RGB-D frame at other focal lengths, same pose. See viewsynth/_viewsynth.pyi.
+    #[allow(non_snake_case, clippy::too_many_arguments)]
+    #[pyo3(signature = (rgb, depth, K, *, scales = None, K_out = None, size = None, principal = None,
+                        outputs = None, tau_rel = 0.05, tau_abs = 0.2, method = "fullscreen"))]
+    fn refocus<'py>(
+        &mut self,
+        py: Python<'py>,
+        rgb: &Bound<'py, PyAny>,
+        depth: &Bound<'py, PyAny>,
+        K: &Bound<'py, PyAny>,
+        scales: Option<Vec<f64>>,
+        K_out: Option<&Bound<'py, PyAny>>,
+        size: Option<(u32, u32)>,
+        principal: Option<(f64, f64)>,
+        outputs: Option<&Bound<'py, PyAny>>,
+        tau_rel: f64,
+        tau_abs: f64,
+        method: &str,
+    ) -> PyResult<Bound<'py, PyList>> {
+        let gpu = self.gpu()?.clone();
+        let k = arrays::intrinsics(K, "K")?;
+        let source = RefocusSource::new(arrays::rgb_image(rgb)?, arrays::depth_map(depth)?, k)
+            .map_err(errors::from_library)?;
+        let rule = BreakRule { tau_rel, tau_abs };
+        rule.validate().map_err(errors::from_library)?;
+        let method: Method = method.parse().map_err(errors::from_library)?;
+        let outputs = output_set(outputs)?;
+        let camera = source.camera();
+        let targets = match (scales, K_out) {
+            (Some(scales), None) => TargetSpec {
+                scales,
+                size,
+                principal,
+            }
+            .targets(&camera)
+            .map_err(errors::from_library)?,
+            (None, Some(k_out)) => {
+                if principal.is_some() {
+                    return Err(errors::invalid("principal", "K_out already gives each target's cx, cy"));
+                }
+                let (width, height) = size.unwrap_or((camera.width, camera.height));
+                let mut targets = Vec::new();
+                for (i, item) in k_out
+                    .try_iter()
+                    .map_err(|_| errors::invalid("K_out", "expected a sequence of 3x3 matrices"))?
+                    .enumerate()
+                {
+                    let k = arrays::intrinsics(&item?, &format!("K_out[{i}]"))?;
+                    let cam = PinholeCamera { k, width, height };
+                    cam.validate(&format!("K_out[{i}] target")).map_err(errors::from_library)?;
+                    targets.push(cam);
+                }
+                if targets.is_empty() {
+                    return Err(errors::invalid("K_out", "no target matrix given"));
+                }
+                targets
+            }
+            (Some(_), Some(_)) => return Err(errors::invalid("scales", "give scales or K_out, not both")),
+            (None, None) => return Err(errors::invalid("scales", "give scales=[...] or K_out=[...]")),
+        };
+        let job = RefocusJob {
+            source,
+            rule,
+            method,
+            outputs,
+            targets,
+        };
+        // The inputs were copied out of numpy above, so other Python threads may run (and even
+        // modify those arrays) while the GPU works.
+        let work = SameThread((gpu, job));
+        let result = py.detach(move || {
+            // A whole-value move, so the closure captures `work` and not its (non-Send) fields.
+            let work = work;
+            let (gpu, job) = work.0;
+            SameThread(render_all(&gpu, &job))
+        });
+        let (setup_ms, rendered) = result.0.map_err(errors::from_library)?;
+
+        let list = PyList::empty(py);
+        for out in rendered {
+            let d = PyDict::new(py);
+            d.set_item("scale", out.camera.k.fx / k.fx)?;
+            d.set_item("K", arrays::k_matrix(py, &out.camera.k))?;
+            d.set_item("coverage", coverage(&out))?;
+            let timings = PyDict::new(py);
+            timings.set_item("setup_ms", setup_ms)?;
+            timings.set_item("render_ms", out.render.wall_ms)?;
+            timings.set_item("gpu_ms", out.render.gpu_ms)?;
+            timings.set_item("readback_ms", out.readback_ms)?;
+            d.set_item("timings", timings)?;
+            if let Some(img) = out.rgb {
+                d.set_item("rgb", arrays::rgb_array(py, img))?;
+            }
+            if let Some(z) = out.depth {
+                d.set_item("depth", arrays::depth_array(py, z))?;
+            }
+            if let Some(m) = out.mask {
+                d.set_item("mask", arrays::mask_array(py, m))?;
+            }
+            list.append(d)?;
+        }
+        Ok(list)
+    }
+}
