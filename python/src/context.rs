@@ -10,6 +10,7 @@
 use crate::errors::{self, Kind};
 use pyo3::PyResult;
 use std::cell::RefCell;
+use std::sync::atomic::{AtomicU32, Ordering};
 use viewsynth::gpu::{DeviceChoice, Gpu};
 
 struct Shared {
@@ -29,6 +30,11 @@ impl Drop for Slot {
     }
 }
 
+/// The process that first opened an EGL context. A child forked after that inherits the driver's
+/// state (display, screen, its worker threads gone): Mesa then hangs on the first draw, even after
+/// every context was closed, so a forked child refuses to open one at all.
+static EGL_PROCESS: AtomicU32 = AtomicU32::new(0);
+
 thread_local! {
     static OPEN: RefCell<Slot> = const { RefCell::new(Slot(None)) };
 }
@@ -46,6 +52,21 @@ pub fn parse_device(device: &str) -> PyResult<DeviceChoice> {
 
 /// This thread's context for `device`, opened on first use; each call counts one user.
 pub fn acquire(device: DeviceChoice) -> PyResult<Gpu> {
+    let opener = EGL_PROCESS.load(Ordering::SeqCst);
+    if opener != 0 && opener != std::process::id() {
+        return Err(errors::raise(
+            Kind::Forked,
+            format!(
+                "this process ({}) was forked from process {opener} after that one had opened an EGL \
+                 context; the GPU driver's state does not survive fork (rendering would hang). Start \
+                 workers with multiprocessing's \"spawn\" or \"forkserver\" method (torch: \
+                 DataLoader(multiprocessing_context=\"spawn\")), or open no Renderer (nor viewsynth.info()) \
+                 in the parent before forking",
+                std::process::id()
+            ),
+            None,
+        ));
+    }
     OPEN.with(|open| {
         let open = &mut open.borrow_mut().0;
         let pid = std::process::id();
@@ -71,6 +92,7 @@ pub fn acquire(device: DeviceChoice) -> PyResult<Gpu> {
             )),
             None => {
                 let gpu = Gpu::new(device).map_err(errors::from_library)?;
+                let _ = EGL_PROCESS.compare_exchange(0, pid, Ordering::SeqCst, Ordering::SeqCst);
                 *open = Some(Shared {
                     pid,
                     device,

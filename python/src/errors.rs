@@ -20,6 +20,8 @@ pub enum Kind {
     Forked,
     /// A Renderer used after `close()`.
     Closed,
+    /// A Renderer used on a thread other than its creator's.
+    WrongThread,
 }
 
 impl Kind {
@@ -31,6 +33,7 @@ impl Kind {
             Kind::File => "FileError",
             Kind::Forked => "RendererForkedError",
             Kind::Closed => "RendererClosedError",
+            Kind::WrongThread => "WrongThreadError",
         }
     }
 }

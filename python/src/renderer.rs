@@ -13,8 +13,8 @@ use viewsynth::refocus::{BreakRule, Method, OutputSet, RefocusOutput, RefocusSou
 
 /// Moves a value into `Python::detach`, whose closure runs synchronously on the calling thread.
 /// The `Gpu` inside is an `Rc`: it is sound here because nothing else can reach it while the GIL
-/// is released (the Renderer is `unsendable`, so pyo3 refuses it to every other thread, and the
-/// call holds a reference to it until detach returns).
+/// is released (the Renderer's handle is `ThreadBound`, refused to every other thread, and the
+/// call holds a mutable borrow of the Renderer until detach returns).
 struct SameThread<T>(T);
 // SAFETY: see above; the value never leaves the thread that made it.
 unsafe impl<T> Send for SameThread<T> {}
@@ -71,10 +71,69 @@ fn output_set(obj: Option<&Bound<'_, PyAny>>) -> PyResult<OutputSet> {
     OutputSet::parse(&list.join(",")).map_err(errors::from_library)
 }
 
+/// A value usable only on the thread that made it: every access checks the thread and fails
+/// with a catchable `WrongThreadError` elsewhere (pyo3's `unsendable` would raise a
+/// `PanicException`, which `except Exception` does not catch). Dropped on another thread, the
+/// value is leaked, never freed there.
+struct ThreadBound<T> {
+    owner: std::thread::ThreadId,
+    value: std::mem::ManuallyDrop<T>,
+}
+
+// SAFETY: the value is reached only through `get`/`take`, which refuse every thread but the
+// owner, and `Drop` frees it only on the owner: it never crosses threads.
+unsafe impl<T> Send for ThreadBound<T> {}
+// SAFETY: as above; a shared reference gives no access to the value off the owner thread.
+unsafe impl<T> Sync for ThreadBound<T> {}
+
+impl<T> ThreadBound<T> {
+    fn new(value: T) -> Self {
+        ThreadBound {
+            owner: std::thread::current().id(),
+            value: std::mem::ManuallyDrop::new(value),
+        }
+    }
+
+    fn on_owner(&self) -> bool {
+        std::thread::current().id() == self.owner
+    }
+
+    fn check(&self) -> PyResult<()> {
+        if self.on_owner() {
+            return Ok(());
+        }
+        Err(errors::raise(
+            Kind::WrongThread,
+            "this Renderer belongs to the thread that created it (its EGL context is current there \
+             only); create one Renderer per thread, e.g. in threading.local()",
+            None,
+        ))
+    }
+
+    fn get(&self) -> PyResult<&T> {
+        self.check()?;
+        Ok(&self.value)
+    }
+
+    fn get_mut(&mut self) -> PyResult<&mut T> {
+        self.check()?;
+        Ok(&mut self.value)
+    }
+}
+
+impl<T> Drop for ThreadBound<T> {
+    fn drop(&mut self) {
+        if self.on_owner() {
+            // SAFETY: dropped once, here, on the owner thread.
+            unsafe { std::mem::ManuallyDrop::drop(&mut self.value) }
+        }
+    }
+}
+
 /// Open EGL context for refocusing numpy images on the GPU.
-#[pyclass(unsendable, module = "viewsynth")]
+#[pyclass(module = "viewsynth")]
 pub struct Renderer {
-    gpu: Option<Gpu>,
+    gpu: ThreadBound<Option<Gpu>>,
     /// Process that opened the context: a forked child must not use (or free) it.
     pid: u32,
     device: String,
@@ -96,24 +155,29 @@ impl Renderer {
             ));
         }
         self.gpu
+            .get()?
             .as_ref()
             .ok_or_else(|| errors::raise(Kind::Closed, "this Renderer is closed", None))
     }
 
-    fn close_inner(&mut self) {
-        if let Some(gpu) = self.gpu.take() {
-            if self.pid == std::process::id() {
-                context::release(gpu);
-            } else {
+    fn close_inner(&mut self) -> PyResult<()> {
+        let forked = self.pid != std::process::id();
+        if let Some(gpu) = self.gpu.get_mut()?.take() {
+            if forked {
+                // The parent's context: never to be freed (or used) in the child.
                 std::mem::forget(gpu);
+            } else {
+                context::release(gpu);
             }
         }
+        Ok(())
     }
 }
 
 impl Drop for Renderer {
     fn drop(&mut self) {
-        self.close_inner();
+        // On another thread `close_inner` fails and ThreadBound leaks the handle instead.
+        let _ = self.close_inner();
     }
 }
 
@@ -125,7 +189,7 @@ impl Renderer {
         let choice = context::parse_device(device)?;
         let gpu = context::acquire(choice)?;
         let renderer = Renderer {
-            gpu: Some(gpu),
+            gpu: ThreadBound::new(Some(gpu)),
             pid: std::process::id(),
             device: device.to_string(),
         };
@@ -154,13 +218,13 @@ impl Renderer {
 
     /// True after close().
     #[getter]
-    fn closed(&self) -> bool {
-        self.gpu.is_none()
+    fn closed(&self) -> PyResult<bool> {
+        Ok(self.gpu.get()?.is_none())
     }
 
     /// Release the context now (it is also released when the Renderer is garbage-collected).
-    fn close(&mut self) {
-        self.close_inner();
+    fn close(&mut self) -> PyResult<()> {
+        self.close_inner()
     }
 
     fn __enter__(slf: Py<Self>) -> Py<Self> {
@@ -168,13 +232,16 @@ impl Renderer {
     }
 
     #[pyo3(signature = (*_exc))]
-    fn __exit__(&mut self, _exc: &Bound<'_, pyo3::types::PyTuple>) -> bool {
-        self.close_inner();
-        false
+    fn __exit__(&mut self, _exc: &Bound<'_, pyo3::types::PyTuple>) -> PyResult<bool> {
+        self.close_inner()?;
+        Ok(false)
     }
 
     fn __repr__(&self) -> String {
-        match (&self.gpu, self.pid == std::process::id()) {
+        if !self.gpu.on_owner() {
+            return format!("Renderer(device={:?}, owned by another thread)", self.device);
+        }
+        match (&*self.gpu.value, self.pid == std::process::id()) {
             (Some(gpu), true) => format!("Renderer(device={:?}, renderer={:?})", self.device, gpu.info().renderer),
             (Some(_), false) => format!("Renderer(device={:?}, inherited through fork: unusable)", self.device),
             (None, _) => format!("Renderer(device={:?}, closed)", self.device),

@@ -18,6 +18,7 @@ from .errors import (
     RendererClosedError,
     RendererForkedError,
     ViewsynthError,
+    WrongThreadError,
 )
 
 __all__ = [
@@ -31,4 +32,5 @@ __all__ = [
     "FileError",
     "RendererForkedError",
     "RendererClosedError",
+    "WrongThreadError",
 ]

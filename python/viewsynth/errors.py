@@ -30,11 +30,16 @@ class FileError(ViewsynthError, OSError):
 
 
 class RendererForkedError(ViewsynthError, RuntimeError):
-    """A Renderer was used in a process forked after it was created: create one per worker."""
+    """A Renderer (or any EGL context) crossed a fork: open Renderers in spawned workers, or only
+    in the forked workers and never in their parent."""
 
 
 class RendererClosedError(ViewsynthError, RuntimeError):
     """A Renderer was used after close()."""
+
+
+class WrongThreadError(ViewsynthError, RuntimeError):
+    """A Renderer was used on a thread other than the one that created it: one per thread."""
 
 
 __all__ = [
@@ -45,4 +50,5 @@ __all__ = [
     "FileError",
     "RendererForkedError",
     "RendererClosedError",
+    "WrongThreadError",
 ]
