@@ -11,6 +11,15 @@ use pyo3::prelude::*;
 use viewsynth::camera::Intrinsics;
 use viewsynth::io::{DepthMap, Mask, RgbImage};
 
+/// A shape as numpy prints it: (72, 96, 3), (5,).
+fn shape_text(shape: &[usize]) -> String {
+    let items: Vec<String> = shape.iter().map(|n| n.to_string()).collect();
+    match items.len() {
+        1 => format!("({},)", items[0]),
+        _ => format!("({})", items.join(", ")),
+    }
+}
+
 /// `obj` as a numpy array of element type `T`, C-contiguous and aligned, with `ndim` axes.
 fn checked<'py, T: numpy::Element>(
     obj: &Bound<'py, PyAny>,
@@ -33,7 +42,7 @@ fn checked<'py, T: numpy::Element>(
     if array.ndim() != ndim {
         return Err(errors::invalid(
             name,
-            format!("shape {:?} but expected {expected}", array.shape()),
+            format!("shape {} but expected {expected}", shape_text(array.shape())),
         ));
     }
     let aligned: bool = array.getattr("flags")?.getattr("aligned")?.extract()?;
@@ -41,9 +50,9 @@ fn checked<'py, T: numpy::Element>(
         return Err(errors::invalid(
             name,
             format!(
-                "array of shape {:?} is not C-contiguous and aligned (a slice, transpose or view); \
+                "array of shape {} is not C-contiguous and aligned (a slice, transpose or view); \
                  pass numpy.ascontiguousarray({name})",
-                array.shape()
+                shape_text(array.shape())
             ),
         ));
     }
@@ -63,7 +72,7 @@ pub fn rgb_image(obj: &Bound<'_, PyAny>) -> PyResult<RgbImage> {
     if shape[2] != 3 {
         return Err(errors::invalid(
             "rgb",
-            format!("shape {shape:?} but expected uint8[H, W, 3] (RGB, no alpha)"),
+            format!("shape {} but expected uint8[H, W, 3] (RGB, no alpha)", shape_text(&shape)),
         ));
     }
     let (w, h) = size(&shape, "rgb")?;
@@ -95,7 +104,7 @@ pub fn intrinsics(obj: &Bound<'_, PyAny>, name: &str) -> PyResult<Intrinsics> {
     if array.shape() != [3, 3] {
         return Err(errors::invalid(
             name,
-            format!("shape {:?} but expected a 3x3 matrix", array.shape()),
+            format!("shape {} but expected a 3x3 matrix", shape_text(array.shape())),
         ));
     }
     let m = array.readonly();
