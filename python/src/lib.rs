@@ -24,7 +24,9 @@ pub(crate) fn info_dict<'py>(py: Python<'py>, info: &GpuInfo) -> PyResult<Bound<
     Ok(dict)
 }
 
-/// Open (or reuse this thread's) EGL context and describe it.
+/// Describe the EGL/OpenGL context viewsynth renders with (opening one, or reusing this thread's):
+/// vendor, renderer, GL and EGL versions, platform, device index and count, limits, whether GPU
+/// timers are meaningful, "software" (True on llvmpipe) and "viewsynth_version".
 #[pyfunction]
 #[pyo3(signature = (device = "auto"))]
 fn info<'py>(py: Python<'py>, device: &str) -> PyResult<Bound<'py, PyAny>> {

@@ -130,7 +130,25 @@ impl<T> Drop for ThreadBound<T> {
     }
 }
 
-/// Open EGL context for refocusing numpy images on the GPU.
+/// An OpenGL 4.5 context over EGL (a GPU, or Mesa's llvmpipe on the CPU) for refocusing numpy
+/// RGB-D frames.
+///
+/// device: "auto" (the CUDA_VISIBLE_DEVICES GPU, else EGL device 0, else Mesa surfaceless),
+/// "surfaceless", or an EGL device index as a string ("0", "1", ...).
+/// require_gpu: raise GpuUnavailableError when EGL only offers a software renderer.
+///
+/// Threads: a Renderer belongs to the thread that created it; using it on another thread raises
+/// WrongThreadError. Open one per thread (threading.local()); Renderers opened on the same
+/// thread with the same device share one context. The GIL is released while the GPU renders.
+///
+/// Processes: an EGL context does not survive fork. With multiprocessing or a torch DataLoader,
+/// create the Renderer inside each worker, lazily on first use (or in worker_init_fn):
+/// - "spawn" / "forkserver" workers: always fine;
+/// - "fork" workers (Linux default): fine only if the parent never opened a Renderer (nor called
+///   viewsynth.info()); otherwise the child raises RendererForkedError instead of hanging.
+/// A Renderer does not pickle: pass frames to workers, not the Renderer.
+///
+/// Release the context with close() or a with-block; garbage collection also releases it.
 #[pyclass(module = "viewsynth")]
 pub struct Renderer {
     gpu: ThreadBound<Option<Gpu>>,
@@ -248,7 +266,29 @@ impl Renderer {
         }
     }
 
-    /// Re-render one RGB-D frame at other focal lengths, same pose. See viewsynth/_viewsynth.pyi.
+    /// Re-render one RGB-D frame at other focal lengths from the same pose (no hole filling:
+    /// what the source did not see stays invalid).
+    ///
+    /// rgb: uint8[H, W, 3], C-contiguous. depth: float32[H, W], C-contiguous, view-space Z in
+    /// metres (0, NaN, inf or negative = no depth). K: 3x3 pinhole [[fx, 0, cx], [0, fy, cy],
+    /// [0, 0, 1]] (any numeric dtype or nested lists; no skew), OpenCV pixel centres.
+    /// Targets, one of: scales=[s, ...] (fx' = s fx, fy' = s fy) or K_out=[K', ...] (3x3 each).
+    /// size: (width, height) of the outputs (default: the source's). principal: (cx', cy') with
+    /// scales (default: the source's offset from the image centre).
+    /// outputs: any of "rgb", "depth", "mask" (default all three); only those are rendered.
+    /// tau_rel, tau_abs: an edge between neighbouring depths za, zb breaks when
+    /// |za - zb| > tau_rel * min(za, zb) or > tau_abs metres (inf disables).
+    /// method: "fullscreen" (fast, default) or "mesh"; both give the same images.
+    ///
+    /// Returns one dict per target, in order: "scale" (fx'/fx), "K" (float64[3, 3]),
+    /// "coverage" (fraction of valid pixels; None with rgb alone), "timings" (setup_ms: upload
+    /// of this call's source, shared by its targets; render_ms; gpu_ms, None where GPU timers
+    /// are not meaningful; readback_ms), and the requested arrays: "rgb" uint8[H', W', 3]
+    /// (0 where invalid), "depth" float32[H', W'] (view-space Z, 0 where invalid), "mask"
+    /// bool[H', W']. The arrays are new and owned by the caller (no copy on the way out).
+    ///
+    /// Raises InvalidInputError (a ValueError) naming the argument for a wrong dtype, shape,
+    /// memory layout or value; GpuError if the GPU fails.
     #[allow(non_snake_case, clippy::too_many_arguments)]
     #[pyo3(signature = (rgb, depth, K, *, scales = None, K_out = None, size = None, principal = None,
                         outputs = None, tau_rel = 0.05, tau_abs = 0.2, method = "fullscreen"))]
