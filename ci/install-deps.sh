@@ -8,6 +8,8 @@ SUDO=""
 if [ "$(id -u)" -ne 0 ]; then SUDO="sudo"; fi
 
 PKGS=(libegl1 libegl-mesa0 libgl1-mesa-dri libgles2 ca-certificates curl pkg-config)
+# The Python package's build and tests (ci/python-tests.sh): an interpreter with venv + ensurepip.
+PKGS+=(python3 python3-venv)
 missing=()
 for p in "${PKGS[@]}"; do
   dpkg -s "$p" >/dev/null 2>&1 || missing+=("$p")

@@ -30,7 +30,10 @@ fn checked<'py, T: numpy::Element>(
     let py = obj.py();
     let Ok(array) = obj.cast::<PyUntypedArray>() else {
         let ty = obj.get_type().name().map(|n| n.to_string()).unwrap_or_default();
-        return Err(errors::invalid(name, format!("expected a numpy array {expected}, got {ty}")));
+        return Err(errors::invalid(
+            name,
+            format!("expected a numpy array {expected}, got {ty}"),
+        ));
     };
     let dt = array.dtype();
     if !dt.is_equiv_to(&dtype::<T>(py)) {
@@ -72,7 +75,10 @@ pub fn rgb_image(obj: &Bound<'_, PyAny>) -> PyResult<RgbImage> {
     if shape[2] != 3 {
         return Err(errors::invalid(
             "rgb",
-            format!("shape {} but expected uint8[H, W, 3] (RGB, no alpha)", shape_text(&shape)),
+            format!(
+                "shape {} but expected uint8[H, W, 3] (RGB, no alpha)",
+                shape_text(&shape)
+            ),
         ));
     }
     let (w, h) = size(&shape, "rgb")?;
@@ -116,7 +122,13 @@ pub fn intrinsics(obj: &Bound<'_, PyAny>, name: &str) -> PyResult<Intrinsics> {
         }
     }
     // The library's cameras are pinhole without skew: any other entry would be silently ignored.
-    let fixed = [((0, 1), 0.0), ((1, 0), 0.0), ((2, 0), 0.0), ((2, 1), 0.0), ((2, 2), 1.0)];
+    let fixed = [
+        ((0, 1), 0.0),
+        ((1, 0), 0.0),
+        ((2, 0), 0.0),
+        ((2, 1), 0.0),
+        ((2, 2), 1.0),
+    ];
     for ((r, c), want) in fixed {
         if at(r, c) != want {
             return Err(errors::invalid(

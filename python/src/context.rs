@@ -45,7 +45,10 @@ pub fn parse_device(device: &str) -> PyResult<DeviceChoice> {
         "auto" => Ok(DeviceChoice::Auto),
         "surfaceless" => Ok(DeviceChoice::Surfaceless),
         n => n.parse().map(DeviceChoice::Index).map_err(|_| {
-            errors::invalid("device", format!("'{n}': expected \"auto\", \"surfaceless\" or an index"))
+            errors::invalid(
+                "device",
+                format!("'{n}': expected \"auto\", \"surfaceless\" or an index"),
+            )
         }),
     }
 }

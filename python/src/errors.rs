@@ -61,7 +61,11 @@ pub fn raise(kind: Kind, message: impl Into<String>, parameter: Option<&str>) ->
 
 /// A bad-argument error naming the parameter.
 pub fn invalid(parameter: &str, message: impl std::fmt::Display) -> PyErr {
-    raise(Kind::InvalidInput, format!("invalid {parameter}: {message}"), Some(parameter))
+    raise(
+        Kind::InvalidInput,
+        format!("invalid {parameter}: {message}"),
+        Some(parameter),
+    )
 }
 
 /// The library's error as its Python class, with the library's own message.

@@ -309,8 +309,8 @@ impl Renderer {
     ) -> PyResult<Bound<'py, PyList>> {
         let gpu = self.gpu()?.clone();
         let k = arrays::intrinsics(K, "K")?;
-        let source = RefocusSource::new(arrays::rgb_image(rgb)?, arrays::depth_map(depth)?, k)
-            .map_err(errors::from_library)?;
+        let source =
+            RefocusSource::new(arrays::rgb_image(rgb)?, arrays::depth_map(depth)?, k).map_err(errors::from_library)?;
         let rule = BreakRule { tau_rel, tau_abs };
         rule.validate().map_err(errors::from_library)?;
         let method: Method = method.parse().map_err(errors::from_library)?;
@@ -337,7 +337,8 @@ impl Renderer {
                 {
                     let k = arrays::intrinsics(&item?, &format!("K_out[{i}]"))?;
                     let cam = PinholeCamera { k, width, height };
-                    cam.validate(&format!("K_out[{i}] target")).map_err(errors::from_library)?;
+                    cam.validate(&format!("K_out[{i}] target"))
+                        .map_err(errors::from_library)?;
                     targets.push(cam);
                 }
                 if targets.is_empty() {
