@@ -255,6 +255,14 @@ impl Renderer {
         Ok(false)
     }
 
+    /// A context cannot travel to another process: say what to do instead.
+    fn __reduce__(&self) -> PyResult<()> {
+        Err(pyo3::exceptions::PyTypeError::new_err(
+            "cannot pickle a viewsynth.Renderer (it holds a GPU context of this process): create one \
+             inside each worker instead, e.g. lazily on first use",
+        ))
+    }
+
     fn __repr__(&self) -> String {
         if !self.gpu.on_owner() {
             return format!("Renderer(device={:?}, owned by another thread)", self.device);

@@ -66,6 +66,13 @@ def test_renderers_on_one_thread_share_its_context(renderer, frame):
         vs.Renderer(device="surfaceless")
 
 
+def test_renderer_does_not_pickle_and_says_why(renderer):
+    import pickle
+
+    with pytest.raises(TypeError, match="create one inside each worker"):
+        pickle.dumps(renderer)
+
+
 def test_forked_child_refuses_instead_of_hanging(renderer):
     ctx = mp.get_context("fork")
     _workers.INHERITED = renderer
