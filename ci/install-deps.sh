@@ -21,6 +21,8 @@ die() {
 
 # --- system packages -------------------------------------------------------------------------
 PKGS=(libegl1 libegl-mesa0 libgl1-mesa-dri libgles2 ca-certificates curl pkg-config build-essential)
+# The Python package's build and tests (ci/python-tests.sh): an interpreter with venv + ensurepip.
+PKGS+=(python3 python3-venv)
 missing=()
 if command -v dpkg >/dev/null 2>&1; then
   for p in "${PKGS[@]}"; do

@@ -1,0 +1,28 @@
+#!/usr/bin/env bash
+# The Python package (python/): build and install it as the README says (pip install ./python)
+# into a venv under target/, lint its Rust, and run its pytest suite on EGL (llvmpipe without a
+# GPU). Run by .ci/run after the Rust tests; the comparison tests call target/release/viewsynth.
+set -euo pipefail
+cd "$(dirname "$0")/.."
+if [ -f "$HOME/.cargo/env" ]; then . "$HOME/.cargo/env"; fi
+
+VENV="${VIEWSYNTH_PY_VENV:-$PWD/target/python-venv}"
+python3 -m venv "$VENV"
+"$VENV/bin/python" -m pip install -q --disable-pip-version-check "maturin>=1.7,<2" numpy pytest pillow
+cargo build --release --locked --bin viewsynth
+"$VENV/bin/python" -m pip install -q --disable-pip-version-check --force-reinstall --no-deps ./python
+
+export PYO3_PYTHON="$VENV/bin/python"
+cargo fmt --manifest-path python/Cargo.toml --check
+cargo clippy --manifest-path python/Cargo.toml --release --locked --all-targets -- -D warnings
+
+# From the repository root, so `import viewsynth` is the installed package, not python/viewsynth.
+set +e
+VIEWSYNTH_CLI="$PWD/target/release/viewsynth" "$VENV/bin/python" -m pytest -q -p no:cacheprovider python/tests
+rc=$?
+set -e
+case $rc in
+  0) ;;
+  5) echo "python tests: pytest collected no tests (exit 5): failing" >&2; exit 1 ;;
+  *) echo "python tests: pytest failed (exit $rc)" >&2; exit "$rc" ;;
+esac

@@ -1,0 +1,47 @@
+//! Python bindings of the viewsynth library (not the CLI): numpy arrays in, numpy arrays out.
+//! The package `viewsynth` (python/viewsynth/) re-exports this module `viewsynth._viewsynth`.
+
+mod arrays;
+mod context;
+mod errors;
+mod renderer;
+
+use pyo3::prelude::*;
+use viewsynth::gpu::GpuInfo;
+
+/// Mesa's software rasterisers (no GPU behind them).
+pub(crate) fn is_software(renderer: &str) -> bool {
+    ["llvmpipe", "softpipe", "swrast", "lavapipe"]
+        .iter()
+        .any(|s| renderer.to_ascii_lowercase().contains(s))
+}
+
+/// GpuInfo as a plain dict (through its serde form, so new fields appear without a change here).
+pub(crate) fn info_dict<'py>(py: Python<'py>, info: &GpuInfo) -> PyResult<Bound<'py, PyAny>> {
+    let text = serde_json::to_string(info).map_err(|e| pyo3::exceptions::PyRuntimeError::new_err(e.to_string()))?;
+    let dict = py.import("json")?.call_method1("loads", (text,))?;
+    dict.set_item("software", is_software(&info.renderer))?;
+    Ok(dict)
+}
+
+/// Describe the EGL/OpenGL context viewsynth renders with (opening one, or reusing this thread's):
+/// vendor, renderer, GL and EGL versions, platform, device index and count, limits, whether GPU
+/// timers are meaningful, "software" (True on llvmpipe) and "viewsynth_version".
+#[pyfunction]
+#[pyo3(signature = (device = "auto"))]
+fn info<'py>(py: Python<'py>, device: &str) -> PyResult<Bound<'py, PyAny>> {
+    let gpu = context::acquire(context::parse_device(device)?)?;
+    let dict = info_dict(py, gpu.info());
+    context::release(gpu);
+    let dict = dict?;
+    dict.set_item("viewsynth_version", env!("CARGO_PKG_VERSION"))?;
+    Ok(dict)
+}
+
+#[pymodule]
+fn _viewsynth(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    m.add_class::<renderer::Renderer>()?;
+    m.add_function(wrap_pyfunction!(info, m)?)?;
+    m.add("__version__", env!("CARGO_PKG_VERSION"))?;
+    Ok(())
+}

@@ -1,0 +1,403 @@
+//! `viewsynth.Renderer`: one EGL context (shared per thread, see `context`) and the refocus call.
+
+use crate::arrays;
+use crate::context;
+use crate::errors::{self, Kind};
+use pyo3::prelude::*;
+use pyo3::types::{PyDict, PyList, PyString};
+use viewsynth::camera::PinholeCamera;
+use viewsynth::convention::Conventions;
+use viewsynth::gpu::Gpu;
+use viewsynth::refocus::job::TargetSpec;
+use viewsynth::refocus::{BreakRule, Method, OutputSet, RefocusOutput, RefocusSource, Refocuser};
+
+/// Moves a value into `Python::detach`, whose closure runs synchronously on the calling thread.
+/// The `Gpu` inside is an `Rc`: it is sound here because nothing else can reach it while the GIL
+/// is released (the Renderer's handle is `ThreadBound`, refused to every other thread, and the
+/// call holds a mutable borrow of the Renderer until detach returns).
+struct SameThread<T>(T);
+// SAFETY: see above; the value never leaves the thread that made it.
+unsafe impl<T> Send for SameThread<T> {}
+
+/// A refocus call's inputs, validated while the GIL is held.
+struct RefocusJob {
+    source: RefocusSource,
+    rule: BreakRule,
+    method: Method,
+    outputs: OutputSet,
+    targets: Vec<PinholeCamera>,
+}
+
+/// The GPU work of one call: upload the source once, render every target.
+fn render_all(gpu: &Gpu, job: &RefocusJob) -> viewsynth::Result<(f64, Vec<RefocusOutput>)> {
+    let t0 = std::time::Instant::now();
+    let mut refocuser = Refocuser::new(
+        gpu,
+        &job.source,
+        &job.rule,
+        job.method,
+        job.outputs,
+        Conventions::default(),
+    )?;
+    let setup_ms = t0.elapsed().as_secs_f64() * 1e3;
+    let rendered = job
+        .targets
+        .iter()
+        .map(|t| refocuser.render(t))
+        .collect::<viewsynth::Result<Vec<_>>>()?;
+    Ok((setup_ms, rendered))
+}
+
+/// Fraction of output pixels that hold a value (as the CLI's manifest: the mask's, else depth's).
+fn coverage(out: &RefocusOutput) -> Option<f64> {
+    if let Some(m) = &out.mask {
+        return Some(m.data.iter().filter(|v| **v != 0).count() as f64 / m.data.len() as f64);
+    }
+    out.depth
+        .as_ref()
+        .map(|d| d.data.iter().filter(|z| **z > 0.0).count() as f64 / d.data.len() as f64)
+}
+
+fn output_set(obj: Option<&Bound<'_, PyAny>>) -> PyResult<OutputSet> {
+    let Some(obj) = obj else {
+        return Ok(OutputSet::default());
+    };
+    let list: Vec<String> = if let Ok(s) = obj.cast::<PyString>() {
+        vec![s.to_string()]
+    } else {
+        obj.extract()
+            .map_err(|_| errors::invalid("outputs", "expected a sequence of \"rgb\", \"depth\", \"mask\""))?
+    };
+    OutputSet::parse(&list.join(",")).map_err(errors::from_library)
+}
+
+/// A value usable only on the thread that made it: every access checks the thread and fails
+/// with a catchable `WrongThreadError` elsewhere (pyo3's `unsendable` would raise a
+/// `PanicException`, which `except Exception` does not catch). Dropped on another thread, the
+/// value is leaked, never freed there.
+struct ThreadBound<T> {
+    owner: std::thread::ThreadId,
+    value: std::mem::ManuallyDrop<T>,
+}
+
+// SAFETY: the value is reached only through `get`/`take`, which refuse every thread but the
+// owner, and `Drop` frees it only on the owner: it never crosses threads.
+unsafe impl<T> Send for ThreadBound<T> {}
+// SAFETY: as above; a shared reference gives no access to the value off the owner thread.
+unsafe impl<T> Sync for ThreadBound<T> {}
+
+impl<T> ThreadBound<T> {
+    fn new(value: T) -> Self {
+        ThreadBound {
+            owner: std::thread::current().id(),
+            value: std::mem::ManuallyDrop::new(value),
+        }
+    }
+
+    fn on_owner(&self) -> bool {
+        std::thread::current().id() == self.owner
+    }
+
+    fn check(&self) -> PyResult<()> {
+        if self.on_owner() {
+            return Ok(());
+        }
+        Err(errors::raise(
+            Kind::WrongThread,
+            "this Renderer belongs to the thread that created it (its EGL context is current there \
+             only); create one Renderer per thread, e.g. in threading.local()",
+            None,
+        ))
+    }
+
+    fn get(&self) -> PyResult<&T> {
+        self.check()?;
+        Ok(&self.value)
+    }
+
+    fn get_mut(&mut self) -> PyResult<&mut T> {
+        self.check()?;
+        Ok(&mut self.value)
+    }
+}
+
+impl<T> Drop for ThreadBound<T> {
+    fn drop(&mut self) {
+        if self.on_owner() {
+            // SAFETY: dropped once, here, on the owner thread.
+            unsafe { std::mem::ManuallyDrop::drop(&mut self.value) }
+        }
+    }
+}
+
+/// An OpenGL 4.5 context over EGL (a GPU, or Mesa's llvmpipe on the CPU) for refocusing numpy
+/// RGB-D frames.
+///
+/// device: "auto" (the CUDA_VISIBLE_DEVICES GPU, else EGL device 0, else Mesa surfaceless),
+/// "surfaceless", or an EGL device index as a string ("0", "1", ...).
+/// require_gpu: raise GpuUnavailableError when EGL only offers a software renderer.
+///
+/// Threads: a Renderer belongs to the thread that created it; using it on another thread raises
+/// WrongThreadError. Open one per thread (threading.local()); Renderers opened on the same
+/// thread with the same device share one context. The GIL is released while the GPU renders.
+///
+/// Processes: an EGL context does not survive fork. With multiprocessing or a torch DataLoader,
+/// create the Renderer inside each worker, lazily on first use (or in worker_init_fn):
+/// - "spawn" / "forkserver" workers: always fine;
+/// - "fork" workers (Linux default): fine only if the parent never opened a Renderer (nor called
+///   viewsynth.info()); otherwise the child raises RendererForkedError instead of hanging.
+/// A Renderer does not pickle: pass frames to workers, not the Renderer.
+///
+/// Release the context with close() or a with-block; garbage collection also releases it.
+#[pyclass(module = "viewsynth")]
+pub struct Renderer {
+    gpu: ThreadBound<Option<Gpu>>,
+    /// Process that opened the context: a forked child must not use (or free) it.
+    pid: u32,
+    device: String,
+}
+
+impl Renderer {
+    fn gpu(&self) -> PyResult<&Gpu> {
+        if self.pid != std::process::id() {
+            return Err(errors::raise(
+                Kind::Forked,
+                format!(
+                    "this Renderer was created in process {} and this is process {} (forked after it was \
+                     created): an EGL context does not survive fork; create the Renderer inside each \
+                     worker, after the fork (e.g. lazily on first use or in worker_init_fn)",
+                    self.pid,
+                    std::process::id()
+                ),
+                None,
+            ));
+        }
+        self.gpu
+            .get()?
+            .as_ref()
+            .ok_or_else(|| errors::raise(Kind::Closed, "this Renderer is closed", None))
+    }
+
+    fn close_inner(&mut self) -> PyResult<()> {
+        let forked = self.pid != std::process::id();
+        if let Some(gpu) = self.gpu.get_mut()?.take() {
+            if forked {
+                // The parent's context: never to be freed (or used) in the child.
+                std::mem::forget(gpu);
+            } else {
+                context::release(gpu);
+            }
+        }
+        Ok(())
+    }
+}
+
+impl Drop for Renderer {
+    fn drop(&mut self) {
+        // On another thread `close_inner` fails and ThreadBound leaks the handle instead.
+        let _ = self.close_inner();
+    }
+}
+
+#[pymethods]
+impl Renderer {
+    #[new]
+    #[pyo3(signature = (device = "auto", require_gpu = false))]
+    fn new(device: &str, require_gpu: bool) -> PyResult<Self> {
+        let choice = context::parse_device(device)?;
+        let gpu = context::acquire(choice)?;
+        let renderer = Renderer {
+            gpu: ThreadBound::new(Some(gpu)),
+            pid: std::process::id(),
+            device: device.to_string(),
+        };
+        if require_gpu {
+            let info = renderer.gpu()?.info();
+            if crate::is_software(&info.renderer) {
+                return Err(errors::raise(
+                    Kind::GpuUnavailable,
+                    format!(
+                        "require_gpu=True but EGL device '{device}' gave the software renderer '{}' \
+                         (no GPU driver with EGL visible to this process)",
+                        info.renderer
+                    ),
+                    Some("require_gpu"),
+                ));
+            }
+        }
+        Ok(renderer)
+    }
+
+    /// What the context runs on (vendor, renderer, GL version, EGL platform and device, limits).
+    #[getter]
+    fn info<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
+        crate::info_dict(py, self.gpu()?.info())
+    }
+
+    /// True after close().
+    #[getter]
+    fn closed(&self) -> PyResult<bool> {
+        Ok(self.gpu.get()?.is_none())
+    }
+
+    /// Release the context now (it is also released when the Renderer is garbage-collected).
+    fn close(&mut self) -> PyResult<()> {
+        self.close_inner()
+    }
+
+    fn __enter__(slf: Py<Self>) -> Py<Self> {
+        slf
+    }
+
+    #[pyo3(signature = (*_exc))]
+    fn __exit__(&mut self, _exc: &Bound<'_, pyo3::types::PyTuple>) -> PyResult<bool> {
+        self.close_inner()?;
+        Ok(false)
+    }
+
+    /// A context cannot travel to another process: say what to do instead.
+    fn __reduce__(&self) -> PyResult<()> {
+        Err(pyo3::exceptions::PyTypeError::new_err(
+            "cannot pickle a viewsynth.Renderer (it holds a GPU context of this process): create one \
+             inside each worker instead, e.g. lazily on first use",
+        ))
+    }
+
+    fn __repr__(&self) -> String {
+        if !self.gpu.on_owner() {
+            return format!("Renderer(device={:?}, owned by another thread)", self.device);
+        }
+        match (&*self.gpu.value, self.pid == std::process::id()) {
+            (Some(gpu), true) => format!("Renderer(device={:?}, renderer={:?})", self.device, gpu.info().renderer),
+            (Some(_), false) => format!("Renderer(device={:?}, inherited through fork: unusable)", self.device),
+            (None, _) => format!("Renderer(device={:?}, closed)", self.device),
+        }
+    }
+
+    /// Re-render one RGB-D frame at other focal lengths from the same pose (no hole filling:
+    /// what the source did not see stays invalid).
+    ///
+    /// rgb: uint8[H, W, 3], C-contiguous. depth: float32[H, W], C-contiguous, view-space Z in
+    /// metres (0, NaN, inf or negative = no depth). K: 3x3 pinhole [[fx, 0, cx], [0, fy, cy],
+    /// [0, 0, 1]] (any numeric dtype or nested lists; no skew), OpenCV pixel centres.
+    /// Targets, one of: scales=[s, ...] (fx' = s fx, fy' = s fy) or K_out=[K', ...] (3x3 each).
+    /// size: (width, height) of the outputs (default: the source's). principal: (cx', cy') with
+    /// scales (default: the source's offset from the image centre).
+    /// outputs: any of "rgb", "depth", "mask" (default all three); only those are rendered.
+    /// tau_rel, tau_abs: an edge between neighbouring depths za, zb breaks when
+    /// |za - zb| > tau_rel * min(za, zb) or > tau_abs metres (inf disables).
+    /// method: "fullscreen" (fast, default) or "mesh"; both give the same images.
+    ///
+    /// Returns one dict per target, in order: "scale" (fx'/fx), "K" (float64[3, 3]),
+    /// "coverage" (fraction of valid pixels; None with rgb alone), "timings" (setup_ms: upload
+    /// of this call's source, shared by its targets; render_ms; gpu_ms, None where GPU timers
+    /// are not meaningful; readback_ms), and the requested arrays: "rgb" uint8[H', W', 3]
+    /// (0 where invalid), "depth" float32[H', W'] (view-space Z, 0 where invalid), "mask"
+    /// bool[H', W']. The arrays are new and owned by the caller (no copy on the way out).
+    ///
+    /// Raises InvalidInputError (a ValueError) naming the argument for a wrong dtype, shape,
+    /// memory layout or value; GpuError if the GPU fails.
+    #[allow(non_snake_case, clippy::too_many_arguments)]
+    #[pyo3(signature = (rgb, depth, K, *, scales = None, K_out = None, size = None, principal = None,
+                        outputs = None, tau_rel = 0.05, tau_abs = 0.2, method = "fullscreen"))]
+    fn refocus<'py>(
+        &mut self,
+        py: Python<'py>,
+        rgb: &Bound<'py, PyAny>,
+        depth: &Bound<'py, PyAny>,
+        K: &Bound<'py, PyAny>,
+        scales: Option<Vec<f64>>,
+        K_out: Option<&Bound<'py, PyAny>>,
+        size: Option<(u32, u32)>,
+        principal: Option<(f64, f64)>,
+        outputs: Option<&Bound<'py, PyAny>>,
+        tau_rel: f64,
+        tau_abs: f64,
+        method: &str,
+    ) -> PyResult<Bound<'py, PyList>> {
+        let gpu = self.gpu()?.clone();
+        let k = arrays::intrinsics(K, "K")?;
+        let source =
+            RefocusSource::new(arrays::rgb_image(rgb)?, arrays::depth_map(depth)?, k).map_err(errors::from_library)?;
+        let rule = BreakRule { tau_rel, tau_abs };
+        rule.validate().map_err(errors::from_library)?;
+        let method: Method = method.parse().map_err(errors::from_library)?;
+        let outputs = output_set(outputs)?;
+        let camera = source.camera();
+        let targets = match (scales, K_out) {
+            (Some(scales), None) => TargetSpec {
+                scales,
+                size,
+                principal,
+            }
+            .targets(&camera)
+            .map_err(errors::from_library)?,
+            (None, Some(k_out)) => {
+                if principal.is_some() {
+                    return Err(errors::invalid("principal", "K_out already gives each target's cx, cy"));
+                }
+                let (width, height) = size.unwrap_or((camera.width, camera.height));
+                let mut targets = Vec::new();
+                for (i, item) in k_out
+                    .try_iter()
+                    .map_err(|_| errors::invalid("K_out", "expected a sequence of 3x3 matrices"))?
+                    .enumerate()
+                {
+                    let k = arrays::intrinsics(&item?, &format!("K_out[{i}]"))?;
+                    let cam = PinholeCamera { k, width, height };
+                    cam.validate(&format!("K_out[{i}] target"))
+                        .map_err(errors::from_library)?;
+                    targets.push(cam);
+                }
+                if targets.is_empty() {
+                    return Err(errors::invalid("K_out", "no target matrix given"));
+                }
+                targets
+            }
+            (Some(_), Some(_)) => return Err(errors::invalid("scales", "give scales or K_out, not both")),
+            (None, None) => return Err(errors::invalid("scales", "give scales=[...] or K_out=[...]")),
+        };
+        let job = RefocusJob {
+            source,
+            rule,
+            method,
+            outputs,
+            targets,
+        };
+        // The inputs were copied out of numpy above, so other Python threads may run (and even
+        // modify those arrays) while the GPU works.
+        let work = SameThread((gpu, job));
+        let result = py.detach(move || {
+            // A whole-value move, so the closure captures `work` and not its (non-Send) fields.
+            let work = work;
+            let (gpu, job) = work.0;
+            SameThread(render_all(&gpu, &job))
+        });
+        let (setup_ms, rendered) = result.0.map_err(errors::from_library)?;
+
+        let list = PyList::empty(py);
+        for out in rendered {
+            let d = PyDict::new(py);
+            d.set_item("scale", out.camera.k.fx / k.fx)?;
+            d.set_item("K", arrays::k_matrix(py, &out.camera.k))?;
+            d.set_item("coverage", coverage(&out))?;
+            let timings = PyDict::new(py);
+            timings.set_item("setup_ms", setup_ms)?;
+            timings.set_item("render_ms", out.render.wall_ms)?;
+            timings.set_item("gpu_ms", out.render.gpu_ms)?;
+            timings.set_item("readback_ms", out.readback_ms)?;
+            d.set_item("timings", timings)?;
+            if let Some(img) = out.rgb {
+                d.set_item("rgb", arrays::rgb_array(py, img))?;
+            }
+            if let Some(z) = out.depth {
+                d.set_item("depth", arrays::depth_array(py, z))?;
+            }
+            if let Some(m) = out.mask {
+                d.set_item("mask", arrays::mask_array(py, m))?;
+            }
+            list.append(d)?;
+        }
+        Ok(list)
+    }
+}

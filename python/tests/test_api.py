@@ -1,0 +1,74 @@
+"""The public surface: info(), require_gpu, the .pyi stubs against the module, the example."""
+
+import ast
+import runpy
+import sys
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+import viewsynth as vs
+
+PACKAGE = Path(vs.__file__).parent
+EXAMPLES = Path(__file__).resolve().parents[1] / "examples"
+
+
+def test_info_describes_the_context(renderer):
+    i = vs.info()
+    assert i["gl_major"] * 10 + i["gl_minor"] >= 45
+    assert i["renderer"] == renderer.info["renderer"]
+    assert i["viewsynth_version"] == vs.__version__
+    assert isinstance(i["software"], bool)
+    assert i["software"] == ("llvmpipe" in i["renderer"].lower() or "softpipe" in i["renderer"].lower())
+
+
+def test_require_gpu_follows_the_renderer(renderer):
+    if renderer.info["software"]:
+        with pytest.raises(vs.GpuUnavailableError, match="software renderer"):
+            vs.Renderer(require_gpu=True)
+    else:
+        with vs.Renderer(require_gpu=True) as r:
+            assert not r.info["software"]
+
+
+def test_stubs_name_what_the_module_has():
+    tree = ast.parse((PACKAGE / "_viewsynth.pyi").read_text())
+    stub = {n.name for n in tree.body if isinstance(n, (ast.FunctionDef, ast.ClassDef))}
+    from viewsynth import _viewsynth
+
+    assert {"Renderer", "info"} <= stub
+    for name in stub - {"Timings", "RefocusView"}:
+        assert hasattr(_viewsynth, name), name
+    (renderer_stub,) = [n for n in tree.body if isinstance(n, ast.ClassDef) and n.name == "Renderer"]
+    methods = {n.name for n in renderer_stub.body if isinstance(n, ast.FunctionDef)}
+    for name in methods:
+        assert hasattr(vs.Renderer, name), name
+    assert (PACKAGE / "py.typed").exists()
+    assert "Thread" in vs.Renderer.__doc__ and "fork" in vs.Renderer.__doc__
+    assert "tau_rel" in vs.Renderer.refocus.__doc__
+
+
+def test_augment_example_draws_seeded_zooms():
+    sys.path.insert(0, str(EXAMPLES))
+    try:
+        from refocus_augment import RefocusAugment, synthetic_frame
+    finally:
+        sys.path.pop(0)
+    data = RefocusAugment([synthetic_frame()] * 3, zoom_min=0.6, zoom_max=1.8, seed=3)
+    items = [data[i] for i in range(len(data))]
+    scales = [it["scale"] for it in items]
+    assert len(set(scales)) == 3 and all(0.6 <= s <= 1.8 for s in scales)
+    assert [data[i]["scale"] for i in range(3)] == scales  # same epoch, same draws
+    data.set_epoch(1)
+    assert [data[i]["scale"] for i in range(3)] != scales
+    for it in items:
+        assert it["rgb"].shape == (120, 160, 3) and it["K"][0, 0] == pytest.approx(140.0 * it["scale"])
+        m = it["mask"]
+        # Zooming out leaves a border the source never saw; zooming in fills the frame's edges.
+        border = np.concatenate([m[0], m[-1], m[:, 0], m[:, -1]])
+        assert not border.any() if it["scale"] < 0.95 else border.all()
+        # The box's silhouette breaks the mesh: invalid pixels inside the frame either way.
+        assert not m[10:-10, 10:-10].all()
+    # The example's script entry point runs as documented.
+    runpy.run_path(str(EXAMPLES / "refocus_augment.py"), run_name="__main__")

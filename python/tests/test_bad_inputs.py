@@ -1,0 +1,98 @@
+"""Bad input raises InvalidInputError (a ValueError and a ViewsynthError) naming the argument,
+before any GPU work; the Renderer stays usable afterwards."""
+
+import math
+
+import numpy as np
+import pytest
+
+import viewsynth as vs
+
+
+def check(renderer, frame, parameter, words, **change):
+    rgb, depth, K = frame
+    args = dict(rgb=rgb, depth=depth, K=K, scales=[1.5])
+    args.update(change)
+    with pytest.raises(vs.InvalidInputError) as err:
+        renderer.refocus(args.pop("rgb"), args.pop("depth"), args.pop("K"), **args)
+    assert isinstance(err.value, ValueError) and isinstance(err.value, vs.ViewsynthError)
+    message = str(err.value)
+    assert parameter in message, message
+    for w in words:
+        assert w in message, message
+    return err.value
+
+
+def test_wrong_dtypes(renderer, frame):
+    rgb, depth, K = frame
+    check(renderer, frame, "rgb", ["float32", "uint8[H, W, 3]"], rgb=rgb.astype(np.float32))
+    e = check(renderer, frame, "depth", ["float64", "float32[H, W]"], depth=depth.astype(np.float64))
+    assert e.parameter == "depth"
+    check(renderer, frame, "depth", ["uint16"], depth=np.zeros(depth.shape, np.uint16))
+    check(renderer, frame, "rgb", ["expected a numpy array", "list"], rgb=rgb.tolist())
+    check(renderer, frame, "K", ["3x3 matrix of numbers"], K=[["a", 0, 1], [0, 1, 1], [0, 0, 1]])
+
+
+def test_non_contiguous(renderer, frame):
+    rgb, depth, K = frame
+    check(renderer, frame, "rgb", ["not C-contiguous", "ascontiguousarray"], rgb=rgb[:, ::2])
+    check(renderer, frame, "depth", ["not C-contiguous"], depth=np.asfortranarray(depth))
+    check(renderer, frame, "depth", ["not C-contiguous"], depth=depth.T.copy().T)
+
+
+def test_wrong_shapes(renderer, frame):
+    rgb, depth, K = frame
+    check(renderer, frame, "rgb", ["(72, 96, 4)", "no alpha"], rgb=np.zeros((72, 96, 4), np.uint8))
+    check(renderer, frame, "rgb", ["(72, 96)"], rgb=np.zeros((72, 96), np.uint8))
+    check(renderer, frame, "depth", ["(72, 96, 1)"], depth=depth[..., None])
+    check(renderer, frame, "size mismatch", ["96x72", "95x72"], depth=np.ascontiguousarray(depth[:, :95]))
+    check(renderer, frame, "source size", ["0x72"], rgb=np.zeros((72, 0, 3), np.uint8), depth=np.zeros((72, 0), np.float32))
+    check(renderer, frame, "K", ["(2, 3)", "3x3"], K=K[:2])
+
+
+def test_bad_intrinsics(renderer, frame):
+    rgb, depth, K = frame
+    nan_k = K.copy()
+    nan_k[0, 0] = math.nan
+    check(renderer, frame, "K", ["NaN is not finite"], K=nan_k)
+    inf_k = K.copy()
+    inf_k[1, 2] = math.inf
+    check(renderer, frame, "K", ["inf is not finite"], K=inf_k)
+    neg = K.copy()
+    neg[1, 1] = -5
+    check(renderer, frame, "K fy", ["must be > 0"], K=neg)
+    skew = K.copy()
+    skew[0, 1] = 0.5
+    check(renderer, frame, "K", ["K[0, 1] is 0.5", "no skew"], K=skew)
+    check(renderer, frame, "K_out[1]", ["not finite"], scales=None, K_out=[K, nan_k])
+
+
+def test_bad_targets_and_options(renderer, frame):
+    rgb, depth, K = frame
+    check(renderer, frame, "focal scale", ["must be finite and > 0"], scales=[1.0, -2.0])
+    check(renderer, frame, "focal scale", ["NaN"], scales=[math.nan])
+    check(renderer, frame, "scales", ["no focal scale"], scales=[])
+    check(renderer, frame, "scales", ["give scales=[...] or K_out=[...]"], scales=None)
+    check(renderer, frame, "scales", ["not both"], K_out=[K])
+    check(renderer, frame, "K_out", ["no target"], scales=None, K_out=[])
+    check(renderer, frame, "principal", ["K_out"], scales=None, K_out=[K], principal=(1.0, 2.0))
+    check(renderer, frame, "target camera width", ["outside 1..=16384"], size=(0, 10))
+    check(renderer, frame, "target camera height", ["16385 outside 1..=16384"], size=(10, 16385))
+    check(renderer, frame, "outputs", ["'normals'"], outputs=("rgb", "normals"))
+    check(renderer, frame, "outputs", ["at least one"], outputs=())
+    check(renderer, frame, "tau-rel", [">= 0"], tau_rel=-0.1)
+    check(renderer, frame, "tau-abs", [">= 0"], tau_abs=math.nan)
+    check(renderer, frame, "method", ["'raytrace'"], method="raytrace")
+    # After all that the renderer still renders.
+    (view,) = renderer.refocus(rgb, depth, K, scales=[1.5], outputs="rgb")
+    assert view["rgb"].shape == rgb.shape
+
+
+def test_bad_device_and_closed_renderer():
+    with pytest.raises(vs.InvalidInputError, match="device"):
+        vs.Renderer(device="gpu0")
+    with vs.Renderer() as r:
+        assert not r.closed
+    assert r.closed
+    with pytest.raises(vs.RendererClosedError, match="closed"):
+        r.refocus(np.zeros((2, 2, 3), np.uint8), np.ones((2, 2), np.float32), np.eye(3), scales=[1])

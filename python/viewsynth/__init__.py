@@ -1,0 +1,36 @@
+"""viewsynth: headless GPU view synthesis from RGB-D images, numpy in, numpy out.
+
+    import numpy as np, viewsynth as vs
+    r = vs.Renderer()                        # one EGL context (GPU, or Mesa llvmpipe)
+    views = r.refocus(rgb, depth, K, scales=[0.5, 2.0])
+    views[0]["rgb"], views[0]["depth"], views[0]["mask"], views[0]["K"]
+
+A Renderer belongs to the thread that created it, and to the process that created it:
+see the Renderer docstring for threads, fork and spawn.
+"""
+
+from ._viewsynth import Renderer, info, __version__
+from .errors import (
+    FileError,
+    GpuError,
+    GpuUnavailableError,
+    InvalidInputError,
+    RendererClosedError,
+    RendererForkedError,
+    ViewsynthError,
+    WrongThreadError,
+)
+
+__all__ = [
+    "Renderer",
+    "info",
+    "__version__",
+    "ViewsynthError",
+    "InvalidInputError",
+    "GpuUnavailableError",
+    "GpuError",
+    "FileError",
+    "RendererForkedError",
+    "RendererClosedError",
+    "WrongThreadError",
+]
