@@ -73,8 +73,9 @@ pub fn from_library(e: Error) -> PyErr {
     let message = e.to_string();
     match &e {
         Error::InvalidParameter { name, .. } => raise(Kind::InvalidInput, message, Some(name)),
+        Error::ImageTooLarge { name, .. } => raise(Kind::InvalidInput, message, Some(name)),
         Error::SizeMismatch { .. } => raise(Kind::InvalidInput, message, None),
-        Error::Egl(_) => raise(Kind::GpuUnavailable, message, None),
+        Error::Egl(_) | Error::SoftwareRenderer { .. } => raise(Kind::GpuUnavailable, message, None),
         Error::Gl(_) => raise(Kind::Gpu, message, None),
         Error::Io { .. } | Error::Decode { .. } | Error::Encode { .. } => raise(Kind::File, message, None),
     }
