@@ -9,6 +9,7 @@ mod atomic;
 mod decode;
 mod depth;
 mod exr_io;
+mod file_set;
 mod image_types;
 mod mask;
 mod netpbm;
@@ -22,7 +23,8 @@ mod dataset_tests;
 #[cfg(test)]
 mod test_util;
 
-pub use atomic::atomic_write;
+pub use atomic::{atomic_write, probe_writable, remove_orphan_temporaries, TEMP_PREFIX};
+pub use file_set::{FileSet, OutDir};
 pub use depth::{load_depth, save_depth_exr, save_depth_npy, DepthDecode};
 pub use image_types::{DepthMap, Mask, RgbImage, MAX_DIMENSION};
 pub use mask::{load_mask_png, save_mask_png};

@@ -100,7 +100,7 @@ pub(crate) fn cyclopean(a: CyclopeanArgs) -> Result<()> {
         conv: cams.conventions,
     };
     frame.validate()?;
-    prepare_out_dir(&a.out_dir)?;
+    let out_dir = prepare_out_dir(&a.out_dir)?;
     let gpu = a.gpu.open()?;
     let wanted = CyclopeanOutputs {
         color: outputs.rgb,
@@ -115,23 +115,23 @@ pub(crate) fn cyclopean(a: CyclopeanArgs) -> Result<()> {
     let mut jobs: Vec<WriteJob> = Vec::new();
     if let Some(color) = &out.color {
         jobs.push((
-            a.out_dir.join("middle_rgb.png"),
+            "middle_rgb.png".into(),
             Box::new(move |p: &Path| io::save_rgb(p, color)),
         ));
     }
     if let Some(depth) = &out.depth {
         jobs.push((
-            a.out_dir.join("middle_depth.exr"),
+            "middle_depth.exr".into(),
             Box::new(move |p: &Path| io::save_depth_exr(p, depth)),
         ));
     }
     if outputs.mask {
         jobs.push((
-            a.out_dir.join("middle_mask.png"),
+            "middle_mask.png".into(),
             Box::new(|p: &Path| io::save_mask_png(p, &mask)),
         ));
     }
-    let written = write_all_or_none(jobs)?;
+    let written = write_all_or_none(&out_dir, jobs)?;
     let valid = out.sources.iter().filter(|s| **s != 0).count();
     println!(
         "middle view {}x{}: fixation {:.3} m, {:.1} % valid, render {:.1} ms; wrote {} in {}",

@@ -364,13 +364,10 @@ fn parse_depth_formats(list: &str) -> Result<DepthFormats> {
     Ok(f)
 }
 
-fn prepare_out_dir(dir: &Path) -> Result<()> {
-    std::fs::create_dir_all(dir).with_context(|| format!("cannot create output directory {}", dir.display()))?;
-    // Probe writability now rather than after minutes of rendering.
-    let probe = dir.join(format!(".viewsynth-write-test-{}", std::process::id()));
-    std::fs::write(&probe, b"").with_context(|| format!("output directory {} is not writable", dir.display()))?;
-    let _ = std::fs::remove_file(probe);
-    Ok(())
+/// Creates --out-dir and probes that it accepts files now rather than after minutes of
+/// rendering (an exclusive temporary: no existing name is ever opened).
+fn prepare_out_dir(dir: &Path) -> Result<io::OutDir> {
+    Ok(io::OutDir::prepare(dir)?)
 }
 
 fn bench(sizes: &[String], repeats: usize, gpu: &GpuArgs) -> Result<()> {
@@ -415,23 +412,17 @@ fn stress(quick: bool, only: &[String], json: Option<&Path>, gpu: &GpuArgs) -> R
     Ok(())
 }
 
-/// An output file and the function writing it.
-type WriteJob<'a> = (PathBuf, Box<dyn FnOnce(&Path) -> viewsynth::Result<()> + 'a>);
+/// An output file's name in --out-dir and the function writing it (given a path).
+type WriteJob<'a> = (String, Box<dyn FnOnce(&Path) -> viewsynth::Result<()> + 'a>);
 
-/// Writes every file or none: on the first failure the files already written are removed
-/// (each write is atomic, so no partial file exists under a final name either).
-fn write_all_or_none(jobs: Vec<WriteJob<'_>>) -> Result<Vec<PathBuf>> {
-    let mut written = Vec::new();
-    for (path, write) in jobs {
-        if let Err(e) = write(&path) {
-            for p in &written {
-                let _ = std::fs::remove_file(p);
-            }
-            return Err(e.into());
-        }
-        written.push(path);
+/// Writes every file or none (an [`io::FileSet`]): on a failure nothing in `out` changes, the
+/// previous run's files included.
+fn write_all_or_none(out: &io::OutDir, jobs: Vec<WriteJob<'_>>) -> Result<Vec<PathBuf>> {
+    let set = out.file_set()?;
+    for (name, write) in jobs {
+        write(&set.staging().join(&name)).with_context(|| format!("writing {}", out.path().join(&name).display()))?;
     }
-    Ok(written)
+    Ok(set.commit()?)
 }
 
 /// Device depth written with `--near`/`--far` (`what` names the depth in the error).

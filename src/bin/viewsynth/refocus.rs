@@ -117,16 +117,18 @@ pub(crate) fn refocus(a: RefocusArgs) -> Result<()> {
         principal: a.cx_out.zip(a.cy_out),
     };
     let targets = spec.targets(&src.camera())?;
-    prepare_out_dir(&a.out_dir)?;
+    let out_dir = prepare_out_dir(&a.out_dir)?;
 
     let gpu = a.gpu.open()?;
     let mut refocuser = Refocuser::new(&gpu, &src, &rule, method, outputs, conv)?;
     let bar = indicatif::ProgressBar::new(targets.len() as u64);
     let mut entries = Vec::new();
+    // All targets and the manifest, or (on any failure) none: earlier runs' files stay.
+    let set = out_dir.file_set()?;
     for (scale, target) in scales.iter().zip(&targets) {
         let out = refocuser.render(target)?;
         entries.push(job::write_output(
-            &a.out_dir,
+            set.staging(),
             *scale,
             &out,
             &outputs,
@@ -146,7 +148,9 @@ pub(crate) fn refocus(a: RefocusArgs) -> Result<()> {
         notes: job::MANIFEST_NOTES.to_string(),
         outputs: entries,
     };
-    let path = job::write_manifest(&a.out_dir, &manifest)?;
+    job::write_manifest(set.staging(), &manifest)?;
+    set.commit()?;
+    let path = out_dir.path().join("manifest.json");
     for e in &manifest.outputs {
         println!(
             "s={:<6} fx'={:<9.3} {}x{} coverage {:>6.2}%  render {:>7.2} ms",

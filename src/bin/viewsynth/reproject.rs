@@ -152,7 +152,7 @@ pub(crate) fn reproject(a: ReprojectArgs) -> Result<()> {
         None => rig_setup(&a)?,
     };
     let (width, height) = (src.color.width, src.color.height);
-    prepare_out_dir(&a.out_dir)?;
+    let out_dir = prepare_out_dir(&a.out_dir)?;
 
     let gpu = a.gpu.open()?;
     let mut results = Vec::new();
@@ -168,25 +168,25 @@ pub(crate) fn reproject(a: ReprojectArgs) -> Result<()> {
         let name = eye_name(Some(*to));
         if let Some(color) = &out.color {
             jobs.push((
-                a.out_dir.join(format!("{name}_rgb.{rgb_ext}")),
+                format!("{name}_rgb.{rgb_ext}"),
                 Box::new(move |p: &Path| io::save_rgb(p, color)),
             ));
         }
         if let Some(depth) = out.depth.as_ref().filter(|_| depth_formats.exr) {
             jobs.push((
-                a.out_dir.join(format!("{name}_depth.exr")),
+                format!("{name}_depth.exr"),
                 Box::new(move |p: &Path| io::save_depth_exr(p, depth)),
             ));
         }
         if let Some(depth) = out.depth.as_ref().filter(|_| depth_formats.npy) {
             jobs.push((
-                a.out_dir.join(format!("{name}_depth.npy")),
+                format!("{name}_depth.npy"),
                 Box::new(move |p: &Path| io::save_depth_npy(p, depth)),
             ));
         }
         if outputs.mask {
             jobs.push((
-                a.out_dir.join(format!("{name}_mask.png")),
+                format!("{name}_mask.png"),
                 Box::new(move |p: &Path| {
                     let bits = out.mask.iter().map(|m| (*m != 0) as u8).collect();
                     io::save_mask_png(p, &io::Mask::new(width, height, bits)?)
@@ -194,7 +194,7 @@ pub(crate) fn reproject(a: ReprojectArgs) -> Result<()> {
             ));
         }
     }
-    let written = write_all_or_none(jobs)?;
+    let written = write_all_or_none(&out_dir, jobs)?;
     for (to, out, timing, setup_ms) in &results {
         println!(
             "{} -> {} ({}): {}x{}, coverage {:.2} %, render {} (setup + shader compile {setup_ms:.1} ms)",

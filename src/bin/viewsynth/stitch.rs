@@ -196,7 +196,7 @@ pub(crate) fn stitch(a: StitchArgs) -> Result<()> {
         (l, r, format!("ray-traced 12 faces of {n}x{n} (CPU)"))
     };
     let faces_ms = t0.elapsed().as_secs_f64() * 1e3;
-    prepare_out_dir(&a.out_dir)?;
+    let out_dir = prepare_out_dir(&a.out_dir)?;
 
     let gpu = a.gpu.open()?;
     let t0 = Instant::now();
@@ -213,20 +213,20 @@ pub(crate) fn stitch(a: StitchArgs) -> Result<()> {
         None
     };
     let mut jobs: Vec<WriteJob> = vec![(
-        a.out_dir.join("ods_top_bottom.png"),
+        "ods_top_bottom.png".into(),
         Box::new(|p: &Path| io::save_rgb(p, &img)),
     )];
     if let Some([l, r]) = &eyes {
         jobs.push((
-            a.out_dir.join("ods_left.png"),
+            "ods_left.png".into(),
             Box::new(move |p: &Path| io::save_rgb(p, l)),
         ));
         jobs.push((
-            a.out_dir.join("ods_right.png"),
+            "ods_right.png".into(),
             Box::new(move |p: &Path| io::save_rgb(p, r)),
         ));
     }
-    let written = write_all_or_none(jobs)?;
+    let written = write_all_or_none(&out_dir, jobs)?;
     println!("faces: {source}, FOV {fov} deg, in {faces_ms:.0} ms");
     println!("upload + shader compile {setup_ms:.1} ms");
     println!(
