@@ -11,6 +11,7 @@ mod depth;
 mod exr_io;
 mod file_set;
 mod image_types;
+mod input;
 mod mask;
 mod netpbm;
 mod npy;
@@ -25,7 +26,8 @@ mod test_util;
 
 pub use atomic::{atomic_write, probe_writable, remove_orphan_temporaries, TEMP_PREFIX};
 pub use file_set::{FileSet, OutDir};
-pub use depth::{load_depth, save_depth_exr, save_depth_npy, DepthDecode};
+pub use depth::{check_rgbd_sizes, depth_dimensions, rgb_dimensions, load_depth, save_depth_exr, save_depth_npy, DepthDecode};
+pub use input::{check_output_pixels, max_pixels, set_max_pixels, DEFAULT_MAX_PIXELS};
 pub use image_types::{DepthMap, Mask, RgbImage, MAX_DIMENSION};
 pub use mask::{load_mask_png, save_mask_png};
 pub use npy::{load_npy, save_npy_f32, NpyArray, NpyDtype};

@@ -86,6 +86,8 @@ pub(crate) fn cyclopean(a: CyclopeanArgs) -> Result<()> {
         ..Default::default()
     };
     let eye = |rgb: &Path, depth: &Path, cam: &viewsynth::cyclopean::camera_file::EyeCameras| -> Result<EyeInput> {
+        // Sizes and the pixel budget from the headers before either file is decoded.
+        io::check_rgbd_sizes(rgb, depth)?;
         Ok(EyeInput {
             color: io::load_rgb(rgb)?,
             depth: io::load_depth(depth, &decode)?,

@@ -33,6 +33,12 @@ use stitch::{stitch, StitchArgs};
 struct Cli {
     #[command(subcommand)]
     command: Command,
+    /// Largest image (width x height) any input may declare or any output may have; checked
+    /// from file headers before pixels are read (default 8192 x 8192, about 1.5 GB for the
+    /// heaviest command).
+    #[arg(long, global = true, default_value_t = io::DEFAULT_MAX_PIXELS,
+          value_parser = clap::value_parser!(u64).range(1..=(1u64 << 32)))]
+    max_pixels: u64,
 }
 
 #[derive(Subcommand)]
@@ -232,9 +238,40 @@ impl FileOutputArgs {
     }
 }
 
-fn main() {
+/// Exit status: 0 success, 1 a run error (this function), 2 a usage error (clap, before).
+fn main() -> std::process::ExitCode {
     let cli = Cli::parse();
-    let result = match cli.command {
+    let result = io::set_max_pixels(cli.max_pixels)
+        .map_err(anyhow::Error::from)
+        .and_then(|()| run(cli.command));
+    match result {
+        Ok(()) => std::process::ExitCode::SUCCESS,
+        Err(e) => {
+            eprintln!("error: {}", error_chain(&e));
+            std::process::ExitCode::FAILURE
+        }
+    }
+}
+
+/// The error and its causes joined by ": ", skipping a cause whose text the message already
+/// holds (the library's I/O errors print their source, which is also their cause).
+fn error_chain(e: &anyhow::Error) -> String {
+    let mut text = String::new();
+    for cause in e.chain() {
+        let part = cause.to_string();
+        if text.contains(&part) {
+            continue;
+        }
+        if !text.is_empty() {
+            text.push_str(": ");
+        }
+        text.push_str(&part);
+    }
+    text
+}
+
+fn run(command: Command) -> Result<()> {
+    match command {
         Command::Info { gpu, json } => info(&gpu, json),
         Command::Refocus(args) => refocus(*args),
         Command::Cyclopean(args) => cyclopean(*args),
@@ -263,10 +300,6 @@ fn main() {
             repeats,
             gpu,
         } => report(&out_dir, data_dir.as_deref(), &cases, repeats, &gpu),
-    };
-    if let Err(e) = result {
-        eprintln!("error: {e:#}");
-        std::process::exit(1);
     }
 }
 

@@ -98,6 +98,11 @@ pub(crate) fn refocus(a: RefocusArgs) -> Result<()> {
         MethodArg::Mesh => Method::Mesh,
         MethodArg::Fullscreen => Method::Fullscreen,
     };
+    if let (Some(w), Some(h)) = (a.width_out, a.height_out) {
+        io::check_output_pixels("--width-out/--height-out", w, h)?;
+    }
+    // Sizes and the pixel budget from the headers before either file is decoded.
+    io::check_rgbd_sizes(&rgb_path, &depth_path)?;
     let rgb = io::load_rgb(&rgb_path)?;
     let decode = DepthDecode {
         scale: a.depth_scale,

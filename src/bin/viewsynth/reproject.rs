@@ -223,6 +223,8 @@ fn load_source(
         scale: a.depth_scale,
         ..Default::default()
     };
+    // Sizes and the pixel budget from the headers before either file is decoded.
+    io::check_rgbd_sizes(&a.color, &a.depth)?;
     let src = viewsynth::reproject::ReprojectSource {
         color: io::load_rgb(&a.color)?,
         depth: io::load_depth(&a.depth, &decode)?,

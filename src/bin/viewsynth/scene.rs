@@ -23,6 +23,7 @@ pub(crate) fn render_scene(
     if !(ipd.is_finite() && ipd >= 0.0) {
         bail!("invalid ipd {ipd}: must be finite and >= 0");
     }
+    io::check_output_pixels("--width/--height", width, height)?;
     let mut rig = StereoRig::demo(width, height);
     rig.camera.validate("scene camera")?;
     rig.ipd = ipd;

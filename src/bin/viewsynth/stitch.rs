@@ -155,6 +155,7 @@ pub(crate) fn stitch(a: StitchArgs) -> Result<()> {
         );
     }
 
+    io::check_output_pixels("--width/--height (top-bottom)", a.width, a.height.saturating_mul(2))?;
     let conv = a.conv.conventions();
     let depth_kind = match (a.depth_kind, a.near, a.far) {
         (FaceDepthArg::ViewZ, None, None) => DepthInput::ViewZ,
