@@ -50,7 +50,8 @@ impl BatchFrame {
 
 /// Read a CSV or JSON manifest; every frame gets a unique, filesystem-safe name.
 pub fn load_manifest(path: &Path) -> Result<Vec<BatchFrame>> {
-    let text = std::fs::read_to_string(path).map_err(|e| Error::io(path, e))?;
+    // Spreadsheets save CSV with a UTF-8 byte-order mark: skipped.
+    let text = crate::io::read_text(path, crate::io::MAX_JSON_BYTES)?;
     let mut frames: Vec<BatchFrame> = if path.extension().is_some_and(|e| e.eq_ignore_ascii_case("json")) {
         serde_json::from_str(&text).map_err(|e| Error::decode(path, e.to_string()))?
     } else {

@@ -24,16 +24,16 @@ pub(crate) struct CyclopeanArgs {
     #[arg(long)]
     cameras: PathBuf,
     /// Raw units per unit of depth for integer depth files.
-    #[arg(long)]
+    #[arg(long, value_parser = finite_value)]
     depth_scale: Option<f64>,
     /// 0 = the seed's single step; k >= 1 = k-step refinement with projection check.
-    #[arg(long, default_value_t = 3)]
+    #[arg(long, default_value_t = 3, value_parser = clap::value_parser!(u32).range(0..=16))]
     refine_steps: u32,
     #[arg(long, value_enum, default_value = "hard")]
     blend: BlendArg,
     /// Middle-space depth disagreement (metres) treated as different surfaces (default: the
     /// seed's clamp(0.02 * fixation, 0.02, 0.25)).
-    #[arg(long)]
+    #[arg(long, value_parser = finite_value)]
     z_threshold: Option<f64>,
     /// Dominant eye and its blend weight, e.g. `left:0.7`.
     #[arg(long)]

@@ -73,12 +73,12 @@ enum Command {
         /// `demo`, `boxes`, or a scene JSON file (src/scene/shapes.rs).
         #[arg(long, default_value = "demo")]
         scene: String,
-        #[arg(long, default_value_t = 640)]
+        #[arg(long, default_value_t = 640, value_parser = clap::value_parser!(u32).range(1..=i64::from(io::MAX_DIMENSION)))]
         width: u32,
-        #[arg(long, default_value_t = 480)]
+        #[arg(long, default_value_t = 480, value_parser = clap::value_parser!(u32).range(1..=i64::from(io::MAX_DIMENSION)))]
         height: u32,
         /// Interocular distance in metres.
-        #[arg(long, default_value_t = 0.064)]
+        #[arg(long, default_value_t = 0.064, value_parser = finite_value)]
         ipd: f64,
         #[command(flatten)]
         conv: ConventionArgs,
@@ -113,7 +113,7 @@ enum Command {
         #[arg(long = "case")]
         cases: Vec<PathBuf>,
         /// Timed repetitions per row (the median is reported).
-        #[arg(long, default_value_t = 3)]
+        #[arg(long, default_value_t = 3, value_parser = clap::builder::RangedU64ValueParser::<usize>::new().range(0..=1000))]
         repeats: usize,
         #[command(flatten)]
         gpu: GpuArgs,
@@ -125,7 +125,7 @@ enum Command {
         #[arg(long, value_delimiter = ',', default_value = "640x480,1280x720")]
         sizes: Vec<String>,
         /// Repetitions per measurement (the median is reported).
-        #[arg(long, default_value_t = 7)]
+        #[arg(long, default_value_t = 7, value_parser = clap::builder::RangedU64ValueParser::<usize>::new().range(0..=1000))]
         repeats: usize,
         #[command(flatten)]
         gpu: GpuArgs,
@@ -359,6 +359,9 @@ fn report(out_dir: &Path, data_dir: Option<&Path>, cases: &[PathBuf], repeats: u
         if !d.is_dir() {
             bail!("--data-dir {}: not a directory", d.display());
         }
+        if std::fs::read_dir(d).map_or(true, |mut e| e.next().is_none()) {
+            eprintln!("note: --data-dir {} is empty: the real-data rows are skipped", d.display());
+        }
     }
     let gpu = gpu.open()?;
     let files = viewsynth::evaluation::run_report_with_cases(&gpu, out_dir, data_dir, cases, repeats)?;
@@ -456,6 +459,31 @@ fn write_all_or_none(out: &io::OutDir, jobs: Vec<WriteJob<'_>>) -> Result<Vec<Pa
         write(&set.staging().join(&name)).with_context(|| format!("writing {}", out.path().join(&name).display()))?;
     }
     Ok(set.commit()?)
+}
+
+/// Largest magnitude of a real-valued option (pixels, metres, degrees, scales): far beyond any
+/// camera, and small enough that f32 GPU maths keeps meaning.
+const MAX_OPTION_MAGNITUDE: f64 = 1e6;
+
+/// Most `--writer-threads` (each holds a frame's encoded files in memory).
+const MAX_WRITER_THREADS: u64 = 64;
+
+/// clap value parser: a finite number with magnitude <= [`MAX_OPTION_MAGNITUDE`].
+fn finite_value(s: &str) -> std::result::Result<f64, String> {
+    let v: f64 = s.trim().parse().map_err(|_| format!("'{s}' is not a number"))?;
+    if v.is_finite() && v.abs() <= MAX_OPTION_MAGNITUDE {
+        Ok(v)
+    } else {
+        Err(format!("{s} must be finite with magnitude <= {MAX_OPTION_MAGNITUDE:e}"))
+    }
+}
+
+/// clap value parser: as [`finite_value`], or `inf` where infinity has a meaning.
+fn finite_or_inf(s: &str) -> std::result::Result<f64, String> {
+    match s.trim().parse::<f64>() {
+        Ok(v) if v == f64::INFINITY => Ok(v),
+        _ => finite_value(s),
+    }
 }
 
 /// Device depth written with `--near`/`--far` (`what` names the depth in the error).

@@ -25,44 +25,44 @@ pub(crate) struct RefocusArgs {
     #[arg(long)]
     no_resume: bool,
     /// With --batch: threads encoding files while the GPU renders (0 = none).
-    #[arg(long, default_value_t = 1)]
+    #[arg(long, default_value_t = 1, value_parser = clap::builder::RangedU64ValueParser::<usize>::new().range(0..=MAX_WRITER_THREADS))]
     writer_threads: usize,
     /// Raw units per metre for integer depth (5000 for TUM, 1000 for NYU/SUN); divides float depth too when given.
-    #[arg(long)]
+    #[arg(long, value_parser = finite_value)]
     depth_scale: Option<f64>,
     /// SUN RGB-D PNG depth: rotate the 16-bit value right by 3 bits before scaling.
     #[arg(long)]
     sun_bit_rotate: bool,
-    #[arg(long, required_unless_present = "batch")]
+    #[arg(long, required_unless_present = "batch", value_parser = finite_value)]
     fx: Option<f64>,
-    #[arg(long, required_unless_present = "batch")]
+    #[arg(long, required_unless_present = "batch", value_parser = finite_value)]
     fy: Option<f64>,
-    #[arg(long, required_unless_present = "batch")]
+    #[arg(long, required_unless_present = "batch", value_parser = finite_value)]
     cx: Option<f64>,
-    #[arg(long, required_unless_present = "batch")]
+    #[arg(long, required_unless_present = "batch", value_parser = finite_value)]
     cy: Option<f64>,
     #[arg(long)]
     out_dir: PathBuf,
     /// Target focal lengths fx' in pixels (fy' keeps the source fy/fx).
-    #[arg(long, value_delimiter = ',', conflicts_with = "zoom_range")]
+    #[arg(long, value_delimiter = ',', conflicts_with = "zoom_range", value_parser = finite_value)]
     focal_list: Option<Vec<f64>>,
     /// Target focal scales s (fx' = s fx).
-    #[arg(long, value_delimiter = ',', default_value = "0.5,0.75,1,1.5,2")]
+    #[arg(long, value_delimiter = ',', default_value = "0.5,0.75,1,1.5,2", value_parser = finite_value)]
     zoom_range: Vec<f64>,
     /// Break an edge when |za - zb| > tau_rel * min(za, zb).
-    #[arg(long, default_value_t = BreakRule::default().tau_rel)]
+    #[arg(long, default_value_t = BreakRule::default().tau_rel, value_parser = finite_value)]
     tau_rel: f64,
     /// Break an edge when |za - zb| > tau_abs (metres; "inf" disables).
-    #[arg(long, default_value_t = BreakRule::default().tau_abs)]
+    #[arg(long, default_value_t = BreakRule::default().tau_abs, value_parser = finite_or_inf)]
     tau_abs: f64,
-    #[arg(long, requires = "height_out")]
+    #[arg(long, requires = "height_out", value_parser = clap::value_parser!(u32).range(1..=i64::from(io::MAX_DIMENSION)))]
     width_out: Option<u32>,
-    #[arg(long, requires = "width_out")]
+    #[arg(long, requires = "width_out", value_parser = clap::value_parser!(u32).range(1..=i64::from(io::MAX_DIMENSION)))]
     height_out: Option<u32>,
     /// Output principal point (default: the source's offset from the image centre).
-    #[arg(long, requires = "cy_out")]
+    #[arg(long, requires = "cy_out", value_parser = finite_value)]
     cx_out: Option<f64>,
-    #[arg(long, requires = "cx_out")]
+    #[arg(long, requires = "cx_out", value_parser = finite_value)]
     cy_out: Option<f64>,
     #[command(flatten)]
     files: FileOutputArgs,

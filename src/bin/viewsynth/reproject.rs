@@ -53,22 +53,22 @@ pub(crate) struct ReprojectArgs {
     depth_kind: ReprojectDepthArg,
     /// Raw units per unit of the depth file for integer files (1000 for mm, 4 for Middlebury 2003
     /// disparity PGMs); divides float depth too when given.
-    #[arg(long)]
+    #[arg(long, value_parser = finite_value)]
     depth_scale: Option<f64>,
     /// Near plane (metres) the device depth was written with (--depth-kind device).
-    #[arg(long)]
+    #[arg(long, value_parser = finite_value)]
     near: Option<f64>,
     /// Far plane (metres; may be inf) the device depth was written with (--depth-kind device).
-    #[arg(long)]
+    #[arg(long, value_parser = finite_or_inf)]
     far: Option<f64>,
     /// Source intrinsics in pixels (with a rig).
-    #[arg(long, required_unless_present = "cameras")]
+    #[arg(long, required_unless_present = "cameras", value_parser = finite_value)]
     fx: Option<f64>,
-    #[arg(long, required_unless_present = "cameras")]
+    #[arg(long, required_unless_present = "cameras", value_parser = finite_value)]
     fy: Option<f64>,
-    #[arg(long, required_unless_present = "cameras")]
+    #[arg(long, required_unless_present = "cameras", value_parser = finite_value)]
     cx: Option<f64>,
-    #[arg(long, required_unless_present = "cameras")]
+    #[arg(long, required_unless_present = "cameras", value_parser = finite_value)]
     cy: Option<f64>,
     /// Full eye matrices instead of a rig: a cameras.json as `viewsynth scene` writes it (left
     /// and right GL view and projection, conventions, depth kind: those of the file apply).
@@ -77,20 +77,20 @@ pub(crate) struct ReprojectArgs {
     cameras: Option<PathBuf>,
     /// Rectified rig: distance between the eyes in metres (x_right = x_left + doffs - f B / Z).
     /// Also the baseline of --depth-kind disparity.
-    #[arg(long)]
+    #[arg(long, value_parser = finite_value)]
     baseline: Option<f64>,
     /// Focal length (pixels) of the rectified rig and of disparity (default: --fx).
-    #[arg(long)]
+    #[arg(long, value_parser = finite_value)]
     focal: Option<f64>,
     /// cx_right - cx_left in pixels (Middlebury's doffs) of the rectified rig and of disparity.
-    #[arg(long, default_value_t = 0.0)]
+    #[arg(long, default_value_t = 0.0, value_parser = finite_value)]
     doffs: f64,
     /// Seed 004's rig instead of --baseline: separation = interaxial / screen width (texture
     /// units; the eyes move +-S/2 (1 - c/Z) in texture x), with --convergence.
-    #[arg(long, requires = "convergence")]
+    #[arg(long, requires = "convergence", value_parser = finite_value)]
     separation: Option<f64>,
     /// Zero-parallax distance c in metres (with --separation).
-    #[arg(long, requires = "separation")]
+    #[arg(long, requires = "separation", value_parser = finite_value)]
     convergence: Option<f64>,
     /// The source view.
     #[arg(long, value_enum, default_value = "left")]
@@ -101,10 +101,10 @@ pub(crate) struct ReprojectArgs {
     #[arg(long, value_enum, default_value = "shift-scan")]
     method: ReprojectMethodArg,
     /// Steps of the shift walk / 3-D gather (1..=16).
-    #[arg(long, default_value_t = 3)]
+    #[arg(long, default_value_t = 3, value_parser = clap::value_parser!(u32).range(1..=16))]
     steps: u32,
     /// A row segment breaks (an unseen surface) where |Z_a - Z_b| > tau_rel * min(Z_a, Z_b).
-    #[arg(long, default_value_t = 0.05)]
+    #[arg(long, default_value_t = 0.05, value_parser = finite_value)]
     tau_rel: f64,
     #[command(flatten)]
     files: FileOutputArgs,
