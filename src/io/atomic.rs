@@ -30,9 +30,12 @@ pub(crate) fn parent_dir(path: &Path) -> &Path {
 /// A new temporary file in `dir`, created exclusively (never through an existing name).
 /// Errors name `shown`.
 pub(crate) fn temp_file_in(dir: &Path, shown: &Path) -> Result<tempfile::NamedTempFile> {
+    use std::os::unix::fs::PermissionsExt;
     tempfile::Builder::new()
         .prefix(&own_prefix())
         .suffix(".tmp")
+        // What a plain create gives (the umask applies), not tempfile's private 0600.
+        .permissions(fs::Permissions::from_mode(0o666))
         .tempfile_in(dir)
         .map_err(|e| Error::io(shown, e))
 }
@@ -199,9 +202,15 @@ mod tests {
         let out = dir.join("sub");
         fs::create_dir(&out).unwrap();
         std::os::unix::fs::symlink(&victim, out.join("out.bin")).unwrap();
-        atomic_write(&out.join("out.bin"), |w| w.write_all(b"new").map_err(|e| Error::io("x", e))).unwrap();
+        atomic_write(&out.join("out.bin"), |w| {
+            w.write_all(b"new").map_err(|e| Error::io("x", e))
+        })
+        .unwrap();
         assert_eq!(fs::read(&victim).unwrap(), b"precious");
-        assert!(!fs::symlink_metadata(out.join("out.bin")).unwrap().file_type().is_symlink());
+        assert!(!fs::symlink_metadata(out.join("out.bin"))
+            .unwrap()
+            .file_type()
+            .is_symlink());
     }
 
     #[test]

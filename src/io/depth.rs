@@ -6,9 +6,10 @@ use image::ImageFormat;
 
 use super::atomic::atomic_write;
 use super::decode::{decode_image, image_dimensions, Samples};
-use super::netpbm::netpbm_dimensions;
 use super::exr_io::{exr_dimensions, read_depth_channel, write_f32_channels};
 use super::image_types::{decode_dims, encode_dims, DepthMap};
+use super::input::max_pixels;
+use super::netpbm::netpbm_dimensions;
 use super::npy::{open_npy, read_npy, save_npy_f32, NpyArray, NpyDtype};
 use super::rgb::lowercase_extension;
 use super::{pfm, pgm};
@@ -71,7 +72,7 @@ pub fn load_depth(path: &Path, decode: &DepthDecode) -> Result<DepthMap> {
     let raw = match lowercase_extension(path).as_str() {
         "exr" => read_depth_channel(path)?,
         "npy" => {
-            let file = open_npy(path)?;
+            let file = open_npy(path, max_pixels())?;
             npy_dims(path, file.shape())?;
             from_npy(path, read_npy(path, file)?)?
         }
@@ -93,7 +94,7 @@ pub fn load_depth(path: &Path, decode: &DepthDecode) -> Result<DepthMap> {
 pub fn depth_dimensions(path: &Path) -> Result<(u32, u32)> {
     match lowercase_extension(path).as_str() {
         "exr" => exr_dimensions(path),
-        "npy" => npy_dims(path, open_npy(path)?.shape()),
+        "npy" => npy_dims(path, open_npy(path, max_pixels())?.shape()),
         "png" => image_dimensions(path, Some(ImageFormat::Png)),
         "pgm" | "pfm" => netpbm_dimensions(path),
         _ => Err(Error::decode(

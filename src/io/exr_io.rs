@@ -53,7 +53,12 @@ pub(crate) fn read_depth_channel(path: &Path) -> Result<RawDepth> {
     // Uncompressed f32 (4 bytes a sample, 4/3 with mip levels) fits twice over: a longer file
     // is not this image, and is not read.
     let samples = u64::from(width) * u64::from(height) * header.channels.list.len() as u64;
-    check_file_len(path, len, samples.saturating_mul(8).saturating_add(1 << 20), "its header's image")?;
+    check_file_len(
+        path,
+        len,
+        samples.saturating_mul(8).saturating_add(1 << 20),
+        "its header's image",
+    )?;
     let channels_budget = max_pixels().saturating_mul(4);
     if samples > channels_budget {
         return Err(Error::decode(

@@ -83,7 +83,9 @@ impl OutDir {
         let real = self.real.join(name);
         match fs::symlink_metadata(&real) {
             Ok(m) if m.file_type().is_symlink() => {
-                let target = fs::read_link(&real).map(|t| t.display().to_string()).unwrap_or_default();
+                let target = fs::read_link(&real)
+                    .map(|t| t.display().to_string())
+                    .unwrap_or_default();
                 return Err(outside(&shown, &self.shown, &format!("is a symlink to {target}")));
             }
             Ok(m) if !m.is_dir() => {
@@ -103,7 +105,11 @@ impl OutDir {
         }
         let resolved = fs::canonicalize(&real).map_err(|e| Error::io(&shown, e))?;
         if resolved.parent() != Some(self.real.as_path()) || !resolved.is_dir() {
-            return Err(outside(&shown, &self.shown, &format!("resolves to {}", resolved.display())));
+            return Err(outside(
+                &shown,
+                &self.shown,
+                &format!("resolves to {}", resolved.display()),
+            ));
         }
         remove_orphan_temporaries(&resolved);
         Ok(OutDir { shown, real: resolved })
@@ -135,7 +141,10 @@ fn check_plain_name(name: &str, dir: &Path) -> Result<()> {
     if !plain || name.starts_with(TEMP_PREFIX) {
         return Err(Error::param(
             "output name",
-            format!("'{name}' in {}: must be a plain file name (no '/', '..' or '{TEMP_PREFIX}' prefix)", dir.display()),
+            format!(
+                "'{name}' in {}: must be a plain file name (no '/', '..' or '{TEMP_PREFIX}' prefix)",
+                dir.display()
+            ),
         ));
     }
     Ok(())
@@ -217,7 +226,10 @@ impl FileSet {
         for e in entries {
             let e = e.map_err(|e| Error::io(&self.shown, e))?;
             let name = e.file_name().to_str().map(str::to_string).ok_or_else(|| {
-                Error::param("output name", format!("non-UTF-8 name staged for {}", self.shown.display()))
+                Error::param(
+                    "output name",
+                    format!("non-UTF-8 name staged for {}", self.shown.display()),
+                )
             })?;
             let regular = e.file_type().map(|t| t.is_file()).unwrap_or(false);
             if !regular {
@@ -273,7 +285,11 @@ mod tests {
         set.write("b.txt", text("b")).unwrap();
         fs::write(set.staging().join("a.txt"), "a").unwrap();
         set.write("manifest.json", text("{}")).unwrap();
-        assert_eq!(list_dir(out.real_path()).len(), 1, "only the staging folder before commit");
+        assert_eq!(
+            list_dir(out.real_path()).len(),
+            1,
+            "only the staging folder before commit"
+        );
         let done = set.commit().unwrap();
         let names: Vec<_> = done.iter().map(|p| p.file_name().unwrap().to_str().unwrap()).collect();
         assert_eq!(names, ["a.txt", "b.txt", "manifest.json"]);
@@ -288,9 +304,7 @@ mod tests {
         fs::write(dir.join("b.txt"), "old b").unwrap();
         let mut set = FileSet::new(&dir).unwrap();
         set.write("a.txt", text("new a")).unwrap();
-        let err = set
-            .write("b.txt", |_| Err(Error::encode("b.txt", "boom")))
-            .unwrap_err();
+        let err = set.write("b.txt", |_| Err(Error::encode("b.txt", "boom"))).unwrap_err();
         assert!(err.to_string().contains("boom"));
         drop(set);
         assert_eq!(fs::read_to_string(dir.join("a.txt")).unwrap(), "old a");

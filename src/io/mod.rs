@@ -26,11 +26,13 @@ mod dataset_tests;
 mod test_util;
 
 pub use atomic::{atomic_write, probe_writable, remove_orphan_temporaries, TEMP_PREFIX};
+pub use depth::{
+    check_rgbd_sizes, depth_dimensions, load_depth, rgb_dimensions, save_depth_exr, save_depth_npy, DepthDecode,
+};
 pub use file_set::{FileSet, OutDir};
-pub use depth::{check_rgbd_sizes, depth_dimensions, rgb_dimensions, load_depth, save_depth_exr, save_depth_npy, DepthDecode};
-pub use json::{load_json, read_text, MAX_JSON_BYTES, MAX_JSON_MAGNITUDE};
-pub use input::{check_output_pixels, max_pixels, set_max_pixels, DEFAULT_MAX_PIXELS};
 pub use image_types::{DepthMap, Mask, RgbImage, MAX_DIMENSION};
+pub use input::{check_output_pixels, max_pixels, set_max_pixels, DEFAULT_MAX_PIXELS};
+pub use json::{load_json, read_text, MAX_JSON_BYTES, MAX_JSON_MAGNITUDE};
 pub use mask::{load_mask_png, save_mask_png};
 pub use npy::{load_npy, save_npy_f32, NpyArray, NpyDtype};
 pub use rgb::{load_rgb, save_rgb};

@@ -36,7 +36,7 @@ pub struct NpyArray {
 /// header is read and checked (element count against 4 x the pixel budget, the file's length
 /// against the shape) before the payload is read, and nothing past it is read.
 pub fn load_npy(path: &Path) -> Result<NpyArray> {
-    read_npy(path, open_npy(path)?)
+    read_npy(path, open_npy(path, max_pixels().saturating_mul(4))?)
 }
 
 /// Largest header accepted (NumPy writes well under 1 KiB; format 2.0 allows 4 GiB).
@@ -56,9 +56,9 @@ impl NpyFile {
     }
 }
 
-/// Reads and checks the header: element count against 4 x the pixel budget, the file's
-/// length against the shape.
-pub(crate) fn open_npy(path: &Path) -> Result<NpyFile> {
+/// Reads and checks the header: element count against `max_values` (from the pixel budget),
+/// then the file's length against the shape.
+pub(crate) fn open_npy(path: &Path, max_values: u64) -> Result<NpyFile> {
     let (mut file, len) = open_regular(path)?;
     let bad = |msg: String| Error::decode(path, format!("invalid NPY: {msg}"));
     // Magic (6), version (2), header length (2 or 4).
@@ -79,6 +79,16 @@ pub(crate) fn open_npy(path: &Path) -> Result<NpyFile> {
     let need = count
         .checked_mul(h.item_size)
         .ok_or_else(|| bad(format!("shape {:?} overflows", h.shape)))?;
+    if count as u64 > max_values {
+        return Err(Error::decode(
+            path,
+            format!(
+                "shape {:?} = {count} values exceeds the pixel budget ({} pixels; --max-pixels; refused before reading the values)",
+                h.shape,
+                max_pixels()
+            ),
+        ));
+    }
     let have = len.saturating_sub(data_offset as u64);
     if have != need as u64 {
         let what = if have < need as u64 {
@@ -90,16 +100,6 @@ pub(crate) fn open_npy(path: &Path) -> Result<NpyFile> {
             "{what}: header says shape {:?} of {} = {need} data bytes, file has {have}",
             h.shape, h.descr,
         )));
-    }
-    let budget = max_pixels().saturating_mul(4);
-    if count as u64 > budget {
-        return Err(Error::decode(
-            path,
-            format!(
-                "shape {:?} = {count} values exceeds 4 x the pixel budget ({budget}; --max-pixels)",
-                h.shape
-            ),
-        ));
     }
     Ok(NpyFile {
         file,

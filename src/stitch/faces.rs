@@ -103,14 +103,14 @@ fn find_face_file(dir: &Path, stem: &str, exts: &[&str], what: &str) -> Result<P
         ));
     }
     found.into_iter().next().ok_or_else(|| {
-            Error::io(
-                dir.join(format!("{stem}.{}", exts[0])),
-                std::io::Error::new(
-                    std::io::ErrorKind::NotFound,
-                    format!("missing {what} (also looked for .{})", exts[1..].join(", .")),
-                ),
-            )
-        })
+        Error::io(
+            dir.join(format!("{stem}.{}", exts[0])),
+            std::io::Error::new(
+                std::io::ErrorKind::NotFound,
+                format!("missing {what} (also looked for .{})", exts[1..].join(", .")),
+            ),
+        )
+    })
 }
 
 /// The six faces of `side` from a face folder: colour `{left,right}_{tag}.{png,jpg,jpeg,ppm,exr}`

@@ -94,7 +94,10 @@ fn refocus_writes_requested_files_and_a_manifest() {
 
 pub(crate) fn assert_clean_failure(o: &Output, needle: &str, out: &Path) {
     let err = String::from_utf8_lossy(&o.stderr);
-    assert_eq!(o.status.code(), Some(1), "stderr: {err}");
+    // A value outside an option's stated range is a usage error reported by the argument
+    // parser (exit 2); everything found while running is a run error (exit 1).
+    let usage = err.contains("invalid value '") && err.contains("try '--help'");
+    assert_eq!(o.status.code(), Some(if usage { 2 } else { 1 }), "stderr: {err}");
     assert!(
         err.contains("error:") && err.contains(needle),
         "expected '{needle}' in: {err}"

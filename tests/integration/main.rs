@@ -7,6 +7,7 @@ mod common;
 mod compare;
 mod cyclopean;
 mod gpu_context;
+mod hostile;
 mod refocus_accuracy;
 mod refocus_conventions;
 mod refocus_edge_cases;

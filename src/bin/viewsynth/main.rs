@@ -360,7 +360,10 @@ fn report(out_dir: &Path, data_dir: Option<&Path>, cases: &[PathBuf], repeats: u
             bail!("--data-dir {}: not a directory", d.display());
         }
         if std::fs::read_dir(d).map_or(true, |mut e| e.next().is_none()) {
-            eprintln!("note: --data-dir {} is empty: the real-data rows are skipped", d.display());
+            eprintln!(
+                "note: --data-dir {} is empty: the real-data rows are skipped",
+                d.display()
+            );
         }
     }
     let gpu = gpu.open()?;

@@ -213,19 +213,10 @@ pub(crate) fn stitch(a: StitchArgs) -> Result<()> {
     } else {
         None
     };
-    let mut jobs: Vec<WriteJob> = vec![(
-        "ods_top_bottom.png".into(),
-        Box::new(|p: &Path| io::save_rgb(p, &img)),
-    )];
+    let mut jobs: Vec<WriteJob> = vec![("ods_top_bottom.png".into(), Box::new(|p: &Path| io::save_rgb(p, &img)))];
     if let Some([l, r]) = &eyes {
-        jobs.push((
-            "ods_left.png".into(),
-            Box::new(move |p: &Path| io::save_rgb(p, l)),
-        ));
-        jobs.push((
-            "ods_right.png".into(),
-            Box::new(move |p: &Path| io::save_rgb(p, r)),
-        ));
+        jobs.push(("ods_left.png".into(), Box::new(move |p: &Path| io::save_rgb(p, l))));
+        jobs.push(("ods_right.png".into(), Box::new(move |p: &Path| io::save_rgb(p, r))));
     }
     let written = write_all_or_none(&out_dir, jobs)?;
     println!("faces: {source}, FOV {fov} deg, in {faces_ms:.0} ms");
