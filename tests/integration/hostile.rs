@@ -227,8 +227,11 @@ fn mkfifo(path: &Path) {
     assert!(ok, "mkfifo {}", path.display());
 }
 
-/// Hostile colour and depth files in `sb/in/`: (file, needle its error must contain).
-fn hostile_files(sb: &Sandbox) -> (Vec<(PathBuf, &'static str)>, Vec<(PathBuf, &'static str)>) {
+/// A hostile file and a text its error must contain.
+type Hostile = (PathBuf, &'static str);
+
+/// Hostile colour and depth files in `sb/in/`.
+fn hostile_files(sb: &Sandbox) -> (Vec<Hostile>, Vec<Hostile>) {
     let d = sb.path("in");
     std::fs::create_dir_all(&d).unwrap();
     let (rgb, depth) = write_inputs(&d, W, H, "ok_");
