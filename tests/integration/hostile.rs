@@ -1067,3 +1067,27 @@ fn csv_manifest_with_a_byte_order_mark_is_read() {
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
     assert_eq!(files_in(&sb.out).len(), 1, "{:?}", files_in(&sb.out));
 }
+
+#[test]
+fn a_symlinked_subfolder_of_the_out_dir_is_refused_before_rendering() {
+    let sb = Sandbox::new("demo-link");
+    std::fs::create_dir_all(&sb.out).unwrap();
+    symlink(sb.path("victim"), sb.out.join("stitch")).unwrap();
+    let before = snapshot(&sb.root, &sb.out);
+    let o = bin().arg("demo").arg("--out-dir").arg(&sb.out).output().unwrap();
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(1), "{err}");
+    assert!(
+        err.contains("stitch: is a symlink to") && err.contains("only written inside --out-dir"),
+        "{err}"
+    );
+    assert_eq!(
+        snapshot(&sb.root, &sb.out),
+        before,
+        "a file outside the out-dir changed"
+    );
+    // Nothing rendered: at most the (empty) subfolders made before the refusal.
+    for f in files_in(&sb.out).iter().filter(|f| f.as_str() != "stitch") {
+        assert!(files_in(&sb.out.join(f)).is_empty(), "{f} is not empty");
+    }
+}
