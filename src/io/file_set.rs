@@ -194,6 +194,30 @@ impl FileSet {
         self.shown.join(name)
     }
 
+    /// `e` with a path inside the staging folder replaced by the final path, for errors of
+    /// path-based savers that wrote into [`FileSet::staging`].
+    pub fn final_error(&self, e: Error) -> Error {
+        let fix = |p: PathBuf| match p.strip_prefix(self.staging.path()) {
+            Ok(rest) => self.shown.join(rest),
+            Err(_) => p,
+        };
+        match e {
+            Error::Io { path, source } => Error::Io {
+                path: fix(path),
+                source,
+            },
+            Error::Decode { path, message } => Error::Decode {
+                path: fix(path),
+                message,
+            },
+            Error::Encode { path, message } => Error::Encode {
+                path: fix(path),
+                message,
+            },
+            other => other,
+        }
+    }
+
     /// Stages `name` (one plain file name) with the bytes `write` produces. Errors name the
     /// final path. Returns the final path.
     pub fn write(&mut self, name: &str, write: impl FnOnce(&mut BufWriter<File>) -> Result<()>) -> Result<PathBuf> {
@@ -306,6 +330,11 @@ mod tests {
         set.write("a.txt", text("new a")).unwrap();
         let err = set.write("b.txt", |_| Err(Error::encode("b.txt", "boom"))).unwrap_err();
         assert!(err.to_string().contains("boom"));
+        let e = set.final_error(Error::encode(set.staging().join("c.png"), "x"));
+        assert_eq!(
+            e.to_string(),
+            format!("{}: cannot encode: x", dir.join("c.png").display())
+        );
         drop(set);
         assert_eq!(fs::read_to_string(dir.join("a.txt")).unwrap(), "old a");
         assert_eq!(list_dir(&dir), ["a.txt", "b.txt"]);

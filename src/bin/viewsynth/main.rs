@@ -459,7 +459,7 @@ type WriteJob<'a> = (String, Box<dyn FnOnce(&Path) -> viewsynth::Result<()> + 'a
 fn write_all_or_none(out: &io::OutDir, jobs: Vec<WriteJob<'_>>) -> Result<Vec<PathBuf>> {
     let set = out.file_set()?;
     for (name, write) in jobs {
-        write(&set.staging().join(&name)).with_context(|| format!("writing {}", out.path().join(&name).display()))?;
+        write(&set.staging().join(&name)).map_err(|e| set.final_error(e))?;
     }
     Ok(set.commit()?)
 }

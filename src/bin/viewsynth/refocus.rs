@@ -132,14 +132,10 @@ pub(crate) fn refocus(a: RefocusArgs) -> Result<()> {
     let set = out_dir.file_set()?;
     for (scale, target) in scales.iter().zip(&targets) {
         let out = refocuser.render(target)?;
-        entries.push(job::write_output(
-            set.staging(),
-            *scale,
-            &out,
-            &outputs,
-            rgb_format,
-            depth_formats,
-        )?);
+        entries.push(
+            job::write_output(set.staging(), *scale, &out, &outputs, rgb_format, depth_formats)
+                .map_err(|e| set.final_error(e))?,
+        );
         bar.inc(1);
     }
     bar.finish_and_clear();
@@ -153,7 +149,7 @@ pub(crate) fn refocus(a: RefocusArgs) -> Result<()> {
         notes: job::MANIFEST_NOTES.to_string(),
         outputs: entries,
     };
-    job::write_manifest(set.staging(), &manifest)?;
+    job::write_manifest(set.staging(), &manifest).map_err(|e| set.final_error(e))?;
     set.commit()?;
     let path = out_dir.path().join("manifest.json");
     for e in &manifest.outputs {

@@ -44,9 +44,10 @@ pub(crate) fn render_scene(
             height,
             conv,
         })?;
-        io::save_rgb(&staged.join(format!("{eye}_rgb.png")), &img.color)?;
-        io::save_depth_exr(&staged.join(format!("{eye}_view_z.exr")), &img.view_z)?;
-        io::save_depth_exr(&staged.join(format!("{eye}_device_depth.exr")), &img.device_depth)?;
+        let saved = io::save_rgb(&staged.join(format!("{eye}_rgb.png")), &img.color)
+            .and_then(|()| io::save_depth_exr(&staged.join(format!("{eye}_view_z.exr")), &img.view_z))
+            .and_then(|()| io::save_depth_exr(&staged.join(format!("{eye}_device_depth.exr")), &img.device_depth));
+        saved.map_err(|e| set.final_error(e))?;
         let entry = if eye == "middle" {
             serde_json::json!({ "view": view, "proj": proj, "width": width, "height": height })
         } else {
