@@ -16,7 +16,12 @@ pub const DEMO_SCALES: [f64; 5] = [0.5, 0.75, 1.0, 1.5, 2.0];
 
 /// Run the demo into `out_dir`; returns the path of the Markdown report.
 pub fn run(gpu: &Gpu, out_dir: &Path) -> Result<PathBuf> {
-    std::fs::create_dir_all(out_dir).map_err(|e| Error::io(out_dir, e))?;
+    // Subfolders through OutDir::subdir: a symlinked one is refused, never written through.
+    // All of them first, so a refused one fails the run before any rendering.
+    let out = io::OutDir::prepare(out_dir)?;
+    let sub = |name: &str| out.subdir(name).map(|d| d.path().to_path_buf());
+    let (cyclopean_dir, reproject_dir, stitch_dir) = (sub("cyclopean")?, sub("reproject")?, sub("stitch")?);
+    let method_dirs = [sub("fullscreen")?, sub("mesh")?];
     let cam = scene::demo_camera(640, 480);
     let (rgb, depth) = scene::render(&cam);
     io::save_rgb(&out_dir.join("source_rgb.png"), &rgb)?;
@@ -35,13 +40,11 @@ pub fn run(gpu: &Gpu, out_dir: &Path) -> Result<PathBuf> {
         "| method | scale | coverage % | PSNR vs scene (dB) | depth MAE vs scene (mm) | PSNR vs f64 ref (dB) | max depth err vs ref (m) | mask IoU vs ref | render ms (wall) |\n\
          |---|---|---|---|---|---|---|---|---|\n",
     );
-    for method in [Method::Fullscreen, Method::Mesh] {
+    for (method, dir) in [Method::Fullscreen, Method::Mesh].into_iter().zip(method_dirs) {
         let name = match method {
             Method::Mesh => "mesh",
             Method::Fullscreen => "fullscreen",
         };
-        let dir = out_dir.join(name);
-        std::fs::create_dir_all(&dir).map_err(|e| Error::io(&dir, e))?;
         let mut r = Refocuser::new(gpu, &src, &rule, method, outputs, Conventions::default())?;
         for (scale, target) in DEMO_SCALES.iter().zip(&targets) {
             let out = r.render(target)?;
@@ -109,9 +112,9 @@ pub fn run(gpu: &Gpu, out_dir: &Path) -> Result<PathBuf> {
         use std::io::Write;
         w.write_all(report.as_bytes()).map_err(|e| Error::io(&path, e))
     })?;
-    cyclopean_outputs(gpu, &out_dir.join("cyclopean"))?;
-    reproject_outputs(gpu, &out_dir.join("reproject"))?;
-    stitch_outputs(gpu, &out_dir.join("stitch"))?;
+    cyclopean_outputs(gpu, &cyclopean_dir)?;
+    reproject_outputs(gpu, &reproject_dir)?;
+    stitch_outputs(gpu, &stitch_dir)?;
     let files = crate::evaluation::run_report(gpu, out_dir, None, 3)?;
     Ok(files
         .into_iter()
@@ -125,7 +128,6 @@ fn cyclopean_outputs(gpu: &Gpu, dir: &Path) -> Result<()> {
     use crate::cyclopean::render::CyclopeanRenderer;
     use crate::cyclopean::scene_frame::{scene_frame, StereoRig};
     use crate::cyclopean::DepthKind;
-    std::fs::create_dir_all(dir).map_err(|e| Error::io(dir, e))?;
     let rig = StereoRig::demo(640, 480);
     let (frame, mid, truth) = scene_frame(&rig, Conventions::default(), DepthKind::Device);
     io::save_rgb(&dir.join("left_rgb.png"), &frame.left.color)?;
@@ -163,7 +165,6 @@ fn reproject_outputs(gpu: &Gpu, dir: &Path) -> Result<()> {
     use crate::reproject::render::Reprojector;
     use crate::reproject::rows::scene_cases;
     use crate::reproject::{Method, ReprojectParams};
-    std::fs::create_dir_all(dir).map_err(|e| Error::io(dir, e))?;
     let case = scene_cases(
         640,
         480,
@@ -203,7 +204,6 @@ fn stitch_outputs(gpu: &Gpu, dir: &Path) -> Result<()> {
     use crate::stitch::faces::scene_faces;
     use crate::stitch::render::StitchRenderer;
     use crate::stitch::{Method, OdsRig, Side, StitchParams};
-    std::fs::create_dir_all(dir).map_err(|e| Error::io(dir, e))?;
     let rig = OdsRig::demo();
     let overlap = 10.0;
     let (left, right) = (

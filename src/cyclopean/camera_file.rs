@@ -78,8 +78,7 @@ pub struct CameraFile {
 
 impl CameraFile {
     pub fn load(path: &Path) -> Result<Self> {
-        let text = std::fs::read_to_string(path).map_err(|e| Error::io(path, e))?;
-        serde_json::from_str(&text).map_err(|e| Error::decode(path, e.to_string()))
+        crate::io::load_json(path, crate::io::MAX_JSON_MAGNITUDE)
     }
 
     /// The middle camera and the fixation distance along its view axis.

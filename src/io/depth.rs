@@ -5,10 +5,12 @@ use std::path::Path;
 use image::ImageFormat;
 
 use super::atomic::atomic_write;
-use super::decode::{decode_image, Samples};
-use super::exr_io::{read_depth_channel, write_f32_channels};
+use super::decode::{decode_image, image_dimensions, Samples};
+use super::exr_io::{exr_dimensions, read_depth_channel, write_f32_channels};
 use super::image_types::{decode_dims, encode_dims, DepthMap};
-use super::npy::{load_npy, save_npy_f32, NpyArray, NpyDtype};
+use super::input::max_pixels;
+use super::netpbm::netpbm_dimensions;
+use super::npy::{open_npy, read_npy, save_npy_f32, NpyArray, NpyDtype};
 use super::npz::load_npz_array;
 use super::rgb::lowercase_extension;
 use super::{pfm, pgm};
@@ -83,9 +85,15 @@ pub fn load_depth_with_key(path: &Path, npz_key: Option<&str>, decode: &DepthDec
     }
     let raw = match ext.as_str() {
         "exr" => read_depth_channel(path)?,
-        "npy" => from_npy(path, load_npy(path)?)?,
+        "npy" => {
+            let file = open_npy(path, max_pixels())?;
+            npy_dims(path, file.shape())?;
+            from_npy(path, read_npy(path, file)?)?
+        }
         "npz" => {
+            // Bounded by the pixel budget inside the archive reader.
             let (key, array) = load_npz_array(path, npz_key)?;
+            npy_dims(path, &array.shape)?;
             from_npy(path, array).map_err(|e| match e {
                 Error::Decode { path, message } => Error::decode(path, format!("array '{key}': {message}")),
                 other => other,
@@ -102,6 +110,48 @@ pub fn load_depth_with_key(path: &Path, npz_key: Option<&str>, decode: &DepthDec
         }
     };
     to_metres(path, raw, decode)
+}
+
+/// Width and height of a depth file from its header alone (limits and pixel budget checked);
+/// nothing of the body is read.
+pub fn depth_dimensions(path: &Path) -> Result<(u32, u32)> {
+    match lowercase_extension(path).as_str() {
+        "exr" => exr_dimensions(path),
+        "npy" => npy_dims(path, open_npy(path, max_pixels())?.shape()),
+        "png" => image_dimensions(path, Some(ImageFormat::Png)),
+        "pgm" | "pfm" => netpbm_dimensions(path),
+        _ => Err(Error::decode(
+            path,
+            "unknown depth format: expected .exr .npy .png .pgm .pfm",
+        )),
+    }
+}
+
+/// Width and height of a colour file (PNG, JPEG, PPM, EXR) from its header alone.
+pub fn rgb_dimensions(path: &Path) -> Result<(u32, u32)> {
+    image_dimensions(path, None)
+}
+
+/// Checks from the headers alone (before either file is decoded) that a colour image and its
+/// depth map have the same size; returns it. The error names both files and sizes.
+pub fn check_rgbd_sizes(rgb: &Path, depth: &Path) -> Result<(u32, u32)> {
+    let (cw, ch) = rgb_dimensions(rgb)?;
+    if lowercase_extension(depth) == "npz" {
+        // An archive's array is only known once inflated (and its key chosen): the sizes are
+        // compared after decoding, still within the pixel budget.
+        return Ok((cw, ch));
+    }
+    let (dw, dh) = depth_dimensions(depth)?;
+    if (cw, ch) != (dw, dh) {
+        return Err(Error::SizeMismatch {
+            message: format!(
+                "colour {} is {cw}x{ch} but depth {} is {dw}x{dh} (from their headers; nothing decoded)",
+                rgb.display(),
+                depth.display()
+            ),
+        });
+    }
+    Ok((cw, ch))
 }
 
 /// Writes one f32 channel named "Z", ZIP compressed, rows top-down.
@@ -144,8 +194,9 @@ fn read_png(path: &Path) -> Result<RawDepth> {
     })
 }
 
-fn from_npy(path: &Path, arr: NpyArray) -> Result<RawDepth> {
-    let (h, w) = match arr.shape.as_slice() {
+/// Width and height of a depth NPY's shape, checked against the limits and the budget.
+fn npy_dims(path: &Path, shape: &[usize]) -> Result<(u32, u32)> {
+    let (h, w) = match shape {
         &[h, w] | &[h, w, 1] => (h, w),
         shape => {
             return Err(Error::decode(
@@ -154,7 +205,11 @@ fn from_npy(path: &Path, arr: NpyArray) -> Result<RawDepth> {
             ))
         }
     };
-    let (width, height) = decode_dims(path, w as u64, h as u64)?;
+    decode_dims(path, w as u64, h as u64)
+}
+
+fn from_npy(path: &Path, arr: NpyArray) -> Result<RawDepth> {
+    let (width, height) = npy_dims(path, &arr.shape)?;
     // Values were widened from the stored dtype, so narrowing back is exact.
     let samples = match arr.dtype {
         NpyDtype::U16 => RawSamples::U16(arr.data.iter().map(|&v| v as u16).collect()),
@@ -310,7 +365,7 @@ mod tests {
         let dir = scratch_dir("depth-npy");
         let path = dir.join("d.npy");
         save_depth_npy(&path, &sample_map()).unwrap();
-        assert_eq!(load_npy(&path).unwrap().shape, vec![2, 3]);
+        assert_eq!(crate::io::load_npy(&path).unwrap().shape, vec![2, 3]);
         let back = load_depth(&path, &DepthDecode::default()).unwrap();
         assert!(same(&back, &sample_map()), "{back:?}");
     }

@@ -1,7 +1,7 @@
 //! OpenEXR through the `exr` crate: one depth channel in, f32 channels out.
 
 use std::fs::File;
-use std::io::{BufWriter, Cursor};
+use std::io::{BufReader, BufWriter};
 use std::path::Path;
 
 use exr::prelude::{
@@ -11,14 +11,28 @@ use exr::prelude::{
 
 use super::depth::{RawDepth, RawSamples};
 use super::image_types::{decode_dims, sample_count};
+use super::input::{check_file_len, max_pixels, open_regular};
 use crate::error::{Error, Result};
+
+/// Width and height of a single-layer EXR from its header alone.
+pub(crate) fn exr_dimensions(path: &Path) -> Result<(u32, u32)> {
+    let (file, _) = open_regular(path)?;
+    let meta = MetaData::read_from_buffered(BufReader::new(file), false).map_err(|e| exr_error(path, e))?;
+    match meta.headers.as_slice() {
+        [h] => decode_dims(path, h.layer_size.width() as u64, h.layer_size.height() as u64),
+        hs => Err(Error::decode(
+            path,
+            format!("EXR has {} layers; expected exactly one", hs.len()),
+        )),
+    }
+}
 
 /// Reads the depth channel of a single-layer, flat EXR: "Z", else "depth" (any case), else
 /// "Y", else "R", else the only channel. f16 is widened to f32; u32 stays integer.
 pub(crate) fn read_depth_channel(path: &Path) -> Result<RawDepth> {
-    let bytes = std::fs::read(path).map_err(|e| Error::io(path, e))?;
-    // Headers first, so the size check happens before any pixel allocation.
-    let meta = MetaData::read_from_buffered(Cursor::new(&bytes), false).map_err(|e| exr_error(path, e))?;
+    // Headers first, so the size checks happen before the body is read or pixels allocated.
+    let (file, len) = open_regular(path)?;
+    let meta = MetaData::read_from_buffered(BufReader::new(file), false).map_err(|e| exr_error(path, e))?;
     let header = match meta.headers.as_slice() {
         [h] => h,
         hs => {
@@ -36,6 +50,26 @@ pub(crate) fn read_depth_channel(path: &Path) -> Result<RawDepth> {
         header.layer_size.width() as u64,
         header.layer_size.height() as u64,
     )?;
+    // Uncompressed f32 (4 bytes a sample, 4/3 with mip levels) fits twice over: a longer file
+    // is not this image, and is not read.
+    let samples = u64::from(width) * u64::from(height) * header.channels.list.len() as u64;
+    check_file_len(
+        path,
+        len,
+        samples.saturating_mul(8).saturating_add(1 << 20),
+        "its header's image",
+    )?;
+    let channels_budget = max_pixels().saturating_mul(4);
+    if samples > channels_budget {
+        return Err(Error::decode(
+            path,
+            format!(
+                "{width}x{height} with {} channels = {samples} samples exceeds 4 x the pixel budget ({channels_budget}; --max-pixels)",
+                header.channels.list.len()
+            ),
+        ));
+    }
+    let (file, _) = open_regular(path)?;
 
     let image = exr::prelude::read()
         .no_deep_data()
@@ -43,7 +77,7 @@ pub(crate) fn read_depth_channel(path: &Path) -> Result<RawDepth> {
         .all_channels()
         .all_layers()
         .all_attributes()
-        .from_buffered(Cursor::new(&bytes))
+        .from_buffered(BufReader::new(file))
         .map_err(|e| exr_error(path, e))?;
     let layer = match image.layer_data.into_iter().next() {
         Some(layer) => layer,

@@ -110,12 +110,16 @@ fn dims_problem(width: u64, height: u64) -> Option<String> {
     }
 }
 
-/// Dimension check for a file being read; returns the sizes as u32.
+/// Dimension and pixel-budget check for a file being read (from its header, before the
+/// pixels are read); returns the sizes as u32.
 pub(crate) fn decode_dims(path: &Path, width: u64, height: u64) -> Result<(u32, u32)> {
     match dims_problem(width, height) {
         Some(msg) => Err(Error::decode(path, msg)),
-        // Both are <= MAX_DIMENSION here, so the casts are lossless.
-        None => Ok((width as u32, height as u32)),
+        None => {
+            super::input::check_budget(path, width, height)?;
+            // Both are <= MAX_DIMENSION here, so the casts are lossless.
+            Ok((width as u32, height as u32))
+        }
     }
 }
 

@@ -11,7 +11,10 @@ mod depth;
 mod depth_summary;
 mod encoding;
 mod exr_io;
+mod file_set;
 mod image_types;
+mod input;
+mod json;
 mod mask;
 mod netpbm;
 mod npy;
@@ -25,11 +28,17 @@ mod dataset_tests;
 #[cfg(test)]
 mod test_util;
 
-pub use atomic::atomic_write;
-pub use depth::{load_depth, load_depth_with_key, save_depth_exr, save_depth_exr_with, save_depth_npy, DepthDecode};
+pub use atomic::{atomic_write, probe_writable, remove_orphan_temporaries, TEMP_PREFIX};
+pub use depth::{
+    check_rgbd_sizes, depth_dimensions, load_depth, load_depth_with_key, rgb_dimensions, save_depth_exr,
+    save_depth_exr_with, save_depth_npy, DepthDecode,
+};
 pub use depth_summary::{DepthSummary, DepthWarning, PLAUSIBLE_MEDIAN_M};
 pub use encoding::{Encoding, ExrCompression, PngCompression};
+pub use file_set::{FileSet, OutDir};
 pub use image_types::{DepthMap, Mask, RgbImage, MAX_DIMENSION};
+pub use input::{check_output_pixels, max_pixels, set_max_pixels, DEFAULT_MAX_PIXELS};
+pub use json::{load_json, read_text, MAX_JSON_BYTES, MAX_JSON_MAGNITUDE};
 pub use mask::{load_mask_png, save_mask_png, save_mask_png_with};
 pub use npy::{load_npy, save_npy_f32, NpyArray, NpyDtype};
 pub use npz::load_npz_array;

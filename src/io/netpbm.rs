@@ -2,6 +2,22 @@
 
 use std::str::FromStr;
 
+/// Width and height from a PGM/PFM header (magic, width, height), checked against the limits
+/// and the pixel budget; the rest is validated when the file is loaded.
+pub(crate) fn netpbm_dimensions(path: &std::path::Path) -> crate::Result<(u32, u32)> {
+    let (mut file, len) = super::input::open_regular(path)?;
+    let prefix = super::input::read_prefix(path, &mut file, len, NETPBM_HEADER_CAP)?;
+    let mut header = HeaderReader::new(&prefix);
+    let bad = |msg: String| crate::Error::decode(path, format!("invalid header: {msg}"));
+    header.token().ok_or_else(|| bad("empty file".into()))?;
+    let width: u64 = header.number("width").map_err(bad)?;
+    let height: u64 = header.number("height").map_err(bad)?;
+    super::image_types::decode_dims(path, width, height)
+}
+
+/// Bytes read for a Netpbm/PFM text header (comments included) before the raster.
+pub(crate) const NETPBM_HEADER_CAP: usize = 64 * 1024;
+
 pub(crate) struct HeaderReader<'a> {
     bytes: &'a [u8],
     pos: usize,
@@ -46,9 +62,15 @@ impl<'a> HeaderReader<'a> {
     }
 
     /// Consumes the single whitespace byte that ends the header and returns the raster.
-    pub(crate) fn raster(self) -> Result<&'a [u8], String> {
+    /// Offset of the next unread byte.
+    pub(crate) fn position(&self) -> usize {
+        self.pos
+    }
+
+    /// Offset of the raster: just past the single whitespace byte that ends the header.
+    pub(crate) fn raster_offset(&self) -> Result<usize, String> {
         match self.bytes.get(self.pos) {
-            Some(c) if c.is_ascii_whitespace() => Ok(self.bytes.get(self.pos + 1..).unwrap_or(&[])),
+            Some(c) if c.is_ascii_whitespace() => Ok(self.pos + 1),
             _ => Err("header is not followed by a single whitespace byte".into()),
         }
     }
@@ -65,7 +87,7 @@ mod tests {
         assert_eq!(r.number::<u32>("width"), Ok(3));
         assert_eq!(r.number::<u32>("height"), Ok(2));
         assert_eq!(r.number::<u32>("maxval"), Ok(65535));
-        assert_eq!(r.raster(), Ok(&b"\x01\x02"[..]));
+        assert_eq!(r.raster_offset(), Ok(b"P5\n# made by hand\n3 2 # size\n65535\n".len()));
 
         let mut r = HeaderReader::new(b"P5 -3");
         r.token();
@@ -75,6 +97,6 @@ mod tests {
         for _ in 0..4 {
             r.token();
         }
-        assert!(r.raster().is_err());
+        assert!(r.raster_offset().is_err());
     }
 }

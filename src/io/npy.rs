@@ -4,6 +4,7 @@ use std::io::Write;
 use std::path::Path;
 
 use super::atomic::atomic_write;
+use super::input::{max_pixels, open_regular, read_body, read_prefix};
 use crate::error::{Error, Result};
 
 const MAGIC: &[u8] = b"\x93NUMPY";
@@ -31,13 +32,102 @@ pub struct NpyArray {
 }
 
 /// Reads an `.npy` file. The header must be a well-formed dict with exactly the keys
-/// `descr`, `fortran_order` and `shape`; the payload must be exactly as long as it says.
+/// `descr`, `fortran_order` and `shape`; the payload must be exactly as long as it says. The
+/// header is read and checked (element count against 4 x the pixel budget, the file's length
+/// against the shape) before the payload is read, and nothing past it is read.
 pub fn load_npy(path: &Path) -> Result<NpyArray> {
-    let bytes = std::fs::read(path).map_err(|e| Error::io(path, e))?;
-    decode_npy(&bytes).map_err(|m| Error::decode(path, m))
+    read_npy(path, open_npy(path, max_pixels().saturating_mul(4))?)
 }
 
-/// The `.npy` bytes of a file or an `.npz` member; the error says what is wrong.
+/// Largest header accepted (NumPy writes well under 1 KiB; format 2.0 allows 4 GiB).
+const MAX_HEADER: usize = 1 << 20;
+
+/// An opened `.npy` whose header was read and whose length matches it; payload unread.
+pub(crate) struct NpyFile {
+    file: std::fs::File,
+    header: Header,
+    data_offset: usize,
+    need: usize,
+}
+
+impl NpyFile {
+    pub(crate) fn shape(&self) -> &[usize] {
+        &self.header.shape
+    }
+}
+
+/// Reads and checks the header: element count against `max_values` (from the pixel budget),
+/// then the file's length against the shape.
+pub(crate) fn open_npy(path: &Path, max_values: u64) -> Result<NpyFile> {
+    let (mut file, len) = open_regular(path)?;
+    let bad = |msg: String| Error::decode(path, format!("invalid NPY: {msg}"));
+    // Magic (6), version (2), header length (2 or 4).
+    let start = read_prefix(path, &mut file, len, 12)?;
+    let (prefix_len, header_len) = header_extent(&start).map_err(bad)?;
+    if header_len > MAX_HEADER {
+        return Err(bad(format!("header length {header_len} exceeds {MAX_HEADER} bytes")));
+    }
+    let data_offset = prefix_len + header_len;
+    let head = read_prefix(path, &mut file, len, data_offset)?;
+    let (header, _) = split_header(&head).map_err(bad)?;
+    let h = parse_header(header).map_err(bad)?;
+    let count = h
+        .shape
+        .iter()
+        .try_fold(1usize, |acc, &d| acc.checked_mul(d))
+        .ok_or_else(|| bad(format!("shape {:?} overflows", h.shape)))?;
+    let need = count
+        .checked_mul(h.item_size)
+        .ok_or_else(|| bad(format!("shape {:?} overflows", h.shape)))?;
+    if count as u64 > max_values {
+        return Err(Error::decode(
+            path,
+            format!(
+                "shape {:?} = {count} values exceeds the pixel budget ({} pixels; --max-pixels; refused before reading the values)",
+                h.shape,
+                max_pixels()
+            ),
+        ));
+    }
+    let have = len.saturating_sub(data_offset as u64);
+    if have != need as u64 {
+        let what = if have < need as u64 {
+            "truncated"
+        } else {
+            "trailing bytes"
+        };
+        return Err(bad(format!(
+            "{what}: header says shape {:?} of {} = {need} data bytes, file has {have}",
+            h.shape, h.descr,
+        )));
+    }
+    Ok(NpyFile {
+        file,
+        header: h,
+        data_offset,
+        need,
+    })
+}
+
+/// Reads exactly the payload the header declared.
+pub(crate) fn read_npy(path: &Path, mut f: NpyFile) -> Result<NpyArray> {
+    let payload = read_body(path, &mut f.file, f.data_offset as u64, f.need)?;
+    let h = f.header;
+    let data: Vec<f64> = payload.chunks_exact(h.item_size).map(h.decode).collect();
+    let data = if h.fortran_order {
+        fortran_to_c(&h.shape, &data)
+    } else {
+        data
+    };
+    Ok(NpyArray {
+        shape: h.shape,
+        dtype: h.dtype,
+        data,
+    })
+}
+
+/// The `.npy` bytes of an `.npz` member (already in memory, its size bounded by the archive
+/// reader); the element count is checked against 4 x the pixel budget like a file's.
 pub(crate) fn decode_npy(bytes: &[u8]) -> std::result::Result<NpyArray, String> {
     let bad = |msg: String| format!("invalid NPY: {msg}");
     let (header, payload) = split_header(bytes).map_err(bad)?;
@@ -47,6 +137,13 @@ pub(crate) fn decode_npy(bytes: &[u8]) -> std::result::Result<NpyArray, String> 
         .iter()
         .try_fold(1usize, |acc, &d| acc.checked_mul(d))
         .ok_or_else(|| bad(format!("shape {:?} overflows", h.shape)))?;
+    if count as u64 > max_pixels().saturating_mul(4) {
+        return Err(format!(
+            "shape {:?} = {count} values exceeds the pixel budget ({} pixels; --max-pixels)",
+            h.shape,
+            max_pixels()
+        ));
+    }
     let need = count
         .checked_mul(h.item_size)
         .ok_or_else(|| bad(format!("shape {:?} overflows", h.shape)))?;
@@ -74,6 +171,20 @@ pub(crate) fn decode_npy(bytes: &[u8]) -> std::result::Result<NpyArray, String> 
         dtype: h.dtype,
         data,
     })
+}
+
+/// (bytes before the header dict, its length) from the file's first bytes.
+fn header_extent(start: &[u8]) -> std::result::Result<(usize, usize), String> {
+    let rest = start.strip_prefix(MAGIC).ok_or("missing \\x93NUMPY magic")?;
+    let len_bytes = match rest.get(..2) {
+        Some([1, 0]) => 2,
+        Some([2, 0] | [3, 0]) => 4,
+        Some(v) => return Err(format!("unsupported format version {v:?}")),
+        None => return Err("file ends inside the header".into()),
+    };
+    let field = rest.get(2..2 + len_bytes).ok_or("file ends inside the header")?;
+    let len = field.iter().rev().fold(0usize, |acc, &b| (acc << 8) | usize::from(b));
+    Ok((MAGIC.len() + 2 + len_bytes, len))
 }
 
 /// Writes `data` as `<f4` in C order with the given shape, NPY format 1.0.
@@ -121,19 +232,8 @@ fn format_header(descr: &str, shape: &[usize]) -> Option<Vec<u8>> {
 
 /// Returns (header dict text, payload).
 fn split_header(bytes: &[u8]) -> std::result::Result<(&str, &[u8]), String> {
-    let rest = bytes.strip_prefix(MAGIC).ok_or("missing \\x93NUMPY magic")?;
-    let (version, rest) = rest.split_at_checked(2).ok_or("file ends inside the header")?;
-    let len_bytes = match version {
-        [1, 0] => 2,
-        [2, 0] | [3, 0] => 4,
-        _ => return Err(format!("unsupported format version {version:?}")),
-    };
-    let (len_field, rest) = rest.split_at_checked(len_bytes).ok_or("file ends inside the header")?;
-    let len = len_field
-        .iter()
-        .rev()
-        .fold(0usize, |acc, &b| (acc << 8) | usize::from(b));
-    let (header, payload) = rest
+    let (start, len) = header_extent(bytes)?;
+    let (header, payload) = bytes[start..]
         .split_at_checked(len)
         .ok_or_else(|| format!("header length {len} exceeds the file"))?;
     let header = std::str::from_utf8(header).map_err(|_| "header is not UTF-8")?;

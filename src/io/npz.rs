@@ -38,6 +38,15 @@ impl Member<'_> {
     }
 
     fn inflate(&self) -> std::result::Result<Vec<u8>, String> {
+        // The header's size is checked before anything is allocated from it.
+        if self.unpacked as u64 > npz_byte_limit() {
+            return Err(format!(
+                "{}: {} bytes unpacked exceed the pixel budget ({} pixels; --max-pixels)",
+                self.name,
+                self.unpacked,
+                super::input::max_pixels()
+            ));
+        }
         let out = match self.method {
             0 => self.data.to_vec(),
             8 => {
@@ -120,10 +129,27 @@ fn members(bytes: &[u8]) -> std::result::Result<Vec<Member<'_>>, String> {
     Ok(out)
 }
 
+/// Most bytes an archive or one member may hold: 4 values per budget pixel (as `.npy` files),
+/// 8 bytes each, plus room for headers.
+fn npz_byte_limit() -> u64 {
+    super::input::max_pixels().saturating_mul(32).saturating_add(1 << 20)
+}
+
 /// Array `key` (e.g. `arr_0`) of an `.npz` file, or with `None` the only array, else the
 /// first floating-point one. Returns the key read with the array.
 pub fn load_npz_array(path: &Path, key: Option<&str>) -> Result<(String, NpyArray)> {
-    let bytes = std::fs::read(path).map_err(|e| Error::io(path, e))?;
+    let (mut file, len) = super::input::open_regular(path)?;
+    if len > npz_byte_limit() {
+        return Err(Error::decode(
+            path,
+            format!(
+                "npz: {len} bytes exceed the pixel budget ({} pixels; --max-pixels); refused before reading",
+                super::input::max_pixels()
+            ),
+        ));
+    }
+    let mut bytes = Vec::with_capacity(len as usize);
+    std::io::Read::read_to_end(&mut (&mut file).take(len), &mut bytes).map_err(|e| Error::io(path, e))?;
     let bad = |m: String| Error::decode(path, format!("npz: {m}"));
     let members = members(&bytes).map_err(bad)?;
     let decode = |m: &Member| -> Result<NpyArray> {

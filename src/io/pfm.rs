@@ -7,11 +7,13 @@ use std::path::Path;
 
 use super::depth::{RawDepth, RawSamples};
 use super::image_types::{decode_dims, sample_count};
-use super::netpbm::HeaderReader;
+use super::input::{open_regular, read_body, read_prefix};
+use super::netpbm::{HeaderReader, NETPBM_HEADER_CAP};
 use crate::error::{Error, Result};
 
 pub(crate) fn read_pfm(path: &Path) -> Result<RawDepth> {
-    let bytes = std::fs::read(path).map_err(|e| Error::io(path, e))?;
+    let (mut file, len) = open_regular(path)?;
+    let bytes = read_prefix(path, &mut file, len, NETPBM_HEADER_CAP)?;
     let bad = |msg: String| Error::decode(path, format!("invalid PFM: {msg}"));
     let mut header = HeaderReader::new(&bytes);
     match header.token() {
@@ -27,14 +29,15 @@ pub(crate) fn read_pfm(path: &Path) -> Result<RawDepth> {
     }
     let little_endian = scale < 0.0;
     let (width, height) = decode_dims(path, width, height)?;
-    let raster = header.raster().map_err(bad)?;
+    let offset = header.raster_offset().map_err(bad)?;
     let need = sample_count(width, height, 4).ok_or_else(|| bad("size overflows".into()))?;
-    if raster.len() != need {
+    let have = len.saturating_sub(offset as u64);
+    if have != need as u64 {
         return Err(bad(format!(
-            "{width}x{height} needs {need} bytes of samples, file has {}",
-            raster.len()
+            "{width}x{height} needs {need} bytes of samples, file has {have}"
         )));
     }
+    let raster = read_body(path, &mut file, offset as u64, need)?;
     let row_bytes = width as usize * 4;
     let mut data = Vec::with_capacity(need / 4);
     for row in raster.chunks_exact(row_bytes).rev() {

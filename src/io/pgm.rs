@@ -8,13 +8,15 @@ use std::path::Path;
 
 use super::depth::{RawDepth, RawSamples};
 use super::image_types::{decode_dims, sample_count};
-use super::netpbm::HeaderReader;
+use super::input::{check_file_len, open_regular, read_body, read_prefix};
+use super::netpbm::{HeaderReader, NETPBM_HEADER_CAP};
 use crate::error::{Error, Result};
 
 pub(crate) fn read_pgm(path: &Path) -> Result<RawDepth> {
-    let bytes = std::fs::read(path).map_err(|e| Error::io(path, e))?;
+    let (mut file, len) = open_regular(path)?;
+    let prefix = read_prefix(path, &mut file, len, NETPBM_HEADER_CAP)?;
     let bad = |msg: String| Error::decode(path, format!("invalid PGM: {msg}"));
-    let mut header = HeaderReader::new(&bytes);
+    let mut header = HeaderReader::new(&prefix);
     let plain = match header.token() {
         Some(b"P5") => false,
         Some(b"P2") => true,
@@ -31,21 +33,32 @@ pub(crate) fn read_pgm(path: &Path) -> Result<RawDepth> {
     let wide = maxval > 255;
 
     let samples = if plain {
-        read_plain(header, count, wide).map_err(bad)?
+        // The samples are text right after the maxval. At most 6 bytes a sample ("65535 ")
+        // plus comments: refuse what cannot be a plain PGM of this size rather than read it.
+        let offset = header.position() as u64;
+        let body_len = len.saturating_sub(offset);
+        let most = (count as u64).saturating_mul(8).saturating_add(1 << 20);
+        check_file_len(path, body_len, most, &format!("a plain {width}x{height} PGM"))?;
+        let body = read_body(path, &mut file, offset, body_len as usize)?;
+        read_plain(HeaderReader::new(&body), count, wide).map_err(bad)?
     } else {
-        let raster = header.raster().map_err(bad)?;
+        let offset = header.raster_offset().map_err(bad)?;
+        let body_len = len.saturating_sub(offset as u64);
         let need = count.checked_mul(if wide { 2 } else { 1 });
-        // Trailing bytes are allowed: a PGM file may hold several images.
-        match need.and_then(|n| raster.get(..n)) {
-            Some(data) if wide => {
-                RawSamples::U16(data.chunks_exact(2).map(|b| u16::from_be_bytes([b[0], b[1]])).collect())
+        // Trailing bytes are allowed (a PGM file may hold several images) but never read.
+        match need.filter(|n| *n as u64 <= body_len) {
+            Some(n) => {
+                let data = read_body(path, &mut file, offset as u64, n)?;
+                if wide {
+                    RawSamples::U16(data.chunks_exact(2).map(|b| u16::from_be_bytes([b[0], b[1]])).collect())
+                } else {
+                    RawSamples::U8(data)
+                }
             }
-            Some(data) => RawSamples::U8(data.to_vec()),
             None => {
                 return Err(bad(format!(
-                    "truncated: {width}x{height} needs {} bytes of samples, file has {}",
+                    "truncated: {width}x{height} needs {} bytes of samples, file has {body_len}",
                     need.unwrap_or(usize::MAX),
-                    raster.len()
                 )))
             }
         }

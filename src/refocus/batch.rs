@@ -55,7 +55,8 @@ impl BatchFrame {
 
 /// Read a CSV or JSON manifest; every frame gets a unique, filesystem-safe name.
 pub fn load_manifest(path: &Path) -> Result<Vec<BatchFrame>> {
-    let text = std::fs::read_to_string(path).map_err(|e| Error::io(path, e))?;
+    // Spreadsheets save CSV with a UTF-8 byte-order mark: skipped.
+    let text = crate::io::read_text(path, crate::io::MAX_JSON_BYTES)?;
     let mut frames: Vec<BatchFrame> = if path.extension().is_some_and(|e| e.eq_ignore_ascii_case("json")) {
         serde_json::from_str(&text).map_err(|e| Error::decode(path, e.to_string()))?
     } else {
@@ -151,9 +152,9 @@ fn parse_csv(path: &Path, text: &str) -> Result<Vec<BatchFrame>> {
     Ok(frames)
 }
 
-/// Most threads either pool may have: beyond this a batch gains nothing and only risks
-/// exhausting the process's threads.
-pub const MAX_JOBS: usize = 256;
+/// Most threads either pool may have: each holds a frame in memory (VGA x 5 scales: 14 MB),
+/// and beyond the cores a pool only adds frames in flight.
+pub const MAX_JOBS: usize = 64;
 
 /// A deterministic share of a manifest: frames whose index i has i % count == index.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
@@ -236,7 +237,8 @@ pub struct BatchSummary {
 
 struct WriteJob {
     name: String,
-    dir: PathBuf,
+    /// The batch's --out-dir; the frame's folder is `name` inside it.
+    root: io::OutDir,
     outputs: Vec<(f64, RefocusOutput)>,
     manifest: Manifest,
 }
@@ -308,62 +310,27 @@ fn frame_finished(dir: &Path, settings: &serde_json::Value) -> bool {
         })
 }
 
-/// Refuse a frame folder that is not a plain folder inside the output folder (a symlink would
-/// send the outputs elsewhere).
-fn check_frame_dir(dir: &Path) -> Result<()> {
-    match std::fs::symlink_metadata(dir) {
-        Ok(m) if m.file_type().is_symlink() => Err(Error::param(
-            "frame folder",
-            format!(
-                "{} is a symbolic link; outputs are only written inside --out-dir",
-                dir.display()
-            ),
-        )),
-        Ok(m) if !m.is_dir() => Err(Error::param(
-            "frame folder",
-            format!("{} exists and is not a folder", dir.display()),
-        )),
-        _ => Ok(()),
-    }
-}
-
+/// Write a frame's files as one all-or-none set: staged, then renamed into the frame's folder
+/// (a plain folder inside --out-dir, never a symlink) with `manifest.json` last. A failure
+/// leaves the previous run's files of this frame untouched.
 fn write_frame(job: WriteJob, files: &FileFormats) -> Result<()> {
-    check_frame_dir(&job.dir)?;
-    std::fs::create_dir_all(&job.dir).map_err(|e| Error::io(&job.dir, e))?;
-    // The frame is unfinished from here until its new manifest is in place.
-    let manifest_path = job.dir.join("manifest.json");
-    match std::fs::remove_file(&manifest_path) {
-        Err(e) if e.kind() != std::io::ErrorKind::NotFound => return Err(Error::io(&manifest_path, e)),
-        _ => {}
-    }
+    let dir = job.root.subdir(&job.name)?;
+    let mut set = dir.file_set()?;
     let mut manifest = job.manifest;
     for (scale, out) in &job.outputs {
-        manifest.outputs.push(job::write_output(&job.dir, *scale, out, files)?);
+        let entry = job::write_output(set.staging(), *scale, out, files).map_err(|e| set.final_error(e))?;
+        manifest.outputs.push(entry);
     }
-    manifest.files = job::file_records(&job.dir, &manifest.outputs)?;
-    // Last: its presence marks the frame finished for resume.
-    job::write_manifest(&job.dir, &manifest)?;
+    manifest.files = job::file_records(set.staging(), &manifest.outputs)?;
+    let path = set.final_path("manifest.json");
+    let text = serde_json::to_string_pretty(&manifest).map_err(|e| Error::encode(&path, e.to_string()))?;
+    // Written last and renamed last: its presence marks the frame finished for resume.
+    set.write("manifest.json", |w| {
+        use std::io::Write;
+        w.write_all(text.as_bytes()).map_err(|e| Error::io(&path, e))
+    })?;
+    set.commit()?;
     Ok(())
-}
-
-/// An interrupted run (a signal cannot run cleanup) may leave `atomic_write` temporaries
-/// (`.{file}.tmp-{pid}-{n}`) in an unfinished frame's folder. Only those of processes that no
-/// longer run are removed: another batch writing into the same folder keeps its own.
-fn remove_stale_temporaries(dir: &Path) {
-    let Ok(entries) = std::fs::read_dir(dir) else { return };
-    for e in entries.flatten() {
-        let name = e.file_name().to_string_lossy().into_owned();
-        let Some((_, tail)) = name.rsplit_once(".tmp-") else {
-            continue;
-        };
-        let Some(pid) = tail.split('-').next().and_then(|p| p.parse::<u32>().ok()) else {
-            continue;
-        };
-        let alive = pid == std::process::id() || Path::new(&format!("/proc/{pid}")).exists();
-        if name.starts_with('.') && !alive {
-            let _ = std::fs::remove_file(e.path());
-        }
-    }
 }
 
 /// Read and validate one frame's inputs (errors name the frame's files).
@@ -387,7 +354,7 @@ fn ms_since(t: Instant) -> f64 {
 /// A frame on the GL thread: uploaded, its targets queued.
 struct InFlight {
     name: String,
-    dir: PathBuf,
+    root: io::OutDir,
     scales: Vec<f64>,
     pending: Vec<PendingRefocus>,
     manifest: Manifest,
@@ -397,7 +364,7 @@ struct InFlight {
 fn submit_frame(
     refocuser: &mut Refocuser,
     name: String,
-    dir: PathBuf,
+    root: io::OutDir,
     src: &RefocusSource,
     settings: serde_json::Value,
     opts: &BatchOptions,
@@ -432,7 +399,7 @@ fn submit_frame(
     };
     Ok(InFlight {
         name,
-        dir,
+        root,
         scales: opts.scales.clone(),
         pending,
         manifest,
@@ -461,7 +428,7 @@ fn collect_frame(f: InFlight, stages: &mut StageTimes) -> std::result::Result<Wr
     }
     Ok(WriteJob {
         name: f.name,
-        dir: f.dir,
+        root: f.root,
         outputs,
         manifest: f.manifest,
     })
@@ -485,7 +452,8 @@ pub fn run_batch(
         ));
     }
     opts.rule.validate()?;
-    std::fs::create_dir_all(out_dir).map_err(|e| Error::io(out_dir, e))?;
+    // Creates and checks --out-dir and clears temporaries that killed runs left in it.
+    let root = io::OutDir::prepare(out_dir)?;
     let t_start = Instant::now();
     let mut summary = BatchSummary::default();
     // The frames this run renders: its shard, less those finished with the same settings.
@@ -503,7 +471,6 @@ pub fn run_batch(
             progress();
             continue;
         }
-        remove_stale_temporaries(&dir);
         todo.push((frame, name, dir, settings));
     }
     let mut refocuser = Refocuser::with_settings(gpu, &opts.rule, opts.method, opts.files.outputs, opts.conv)?;
@@ -512,11 +479,19 @@ pub fn run_batch(
 
     if opts.jobs == 0 {
         // The synchronous baseline: each stage in turn on this thread.
-        for (frame, name, dir, settings) in todo {
+        for (frame, name, _, settings) in todo {
             let t0 = Instant::now();
             let result = decode_frame(frame).and_then(|src| {
                 stages.decode.push(ms_since(t0));
-                submit_frame(&mut refocuser, name.clone(), dir, &src, settings, opts, &mut stages)
+                submit_frame(
+                    &mut refocuser,
+                    name.clone(),
+                    root.clone(),
+                    &src,
+                    settings,
+                    opts,
+                    &mut stages,
+                )
             });
             let result = result
                 .map_err(|e| (name.clone(), e))
@@ -603,13 +578,13 @@ pub fn run_batch(
                 break;
             };
             stages.wait.push(ms_since(t0));
-            let (_, name, dir, settings) = &todo[i];
+            let (_, name, _, settings) = &todo[i];
             let submitted = src.and_then(|src| {
                 stages.decode.push(decode_ms);
                 submit_frame(
                     &mut refocuser,
                     name.clone(),
-                    dir.clone(),
+                    root.clone(),
                     &src,
                     settings.clone(),
                     opts,

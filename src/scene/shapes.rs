@@ -163,8 +163,7 @@ impl Scene {
 
     /// A scene from a JSON file (`{"name": .., "objects": [{"shape": {"type": "sphere", ..}, "pattern": 2}]}`).
     pub fn load(path: &std::path::Path) -> Result<Scene> {
-        let text = std::fs::read_to_string(path).map_err(|e| Error::io(path, e))?;
-        let scene: Scene = serde_json::from_str(&text).map_err(|e| Error::decode(path, e.to_string()))?;
+        let scene: Scene = crate::io::load_json(path, crate::io::MAX_JSON_MAGNITUDE)?;
         scene.validate().map_err(|e| Error::decode(path, e.to_string()))?;
         Ok(scene)
     }

@@ -86,21 +86,31 @@ pub fn view_z_of(depth: &DepthMap, kind: &DepthInput, conv: &Conventions) -> Res
     }
 }
 
-/// `dir/stem.ext` for the first extension of `exts` that exists; the error names the first
-/// candidate and what it should hold.
+/// `dir/stem.ext` for the one extension of `exts` that exists; the error names the first
+/// candidate and what it should hold, or every file found when more than one exists (which
+/// one is meant cannot be guessed).
 fn find_face_file(dir: &Path, stem: &str, exts: &[&str], what: &str) -> Result<PathBuf> {
-    exts.iter()
+    let found: Vec<PathBuf> = exts
+        .iter()
         .map(|e| dir.join(format!("{stem}.{e}")))
-        .find(|p| p.is_file())
-        .ok_or_else(|| {
-            Error::io(
-                dir.join(format!("{stem}.{}", exts[0])),
-                std::io::Error::new(
-                    std::io::ErrorKind::NotFound,
-                    format!("missing {what} (also looked for .{})", exts[1..].join(", .")),
-                ),
-            )
-        })
+        .filter(|p| p.is_file())
+        .collect();
+    if found.len() > 1 {
+        let names: Vec<String> = found.iter().map(|p| p.display().to_string()).collect();
+        return Err(Error::decode(
+            dir,
+            format!("{what}: {} files, keep one: {}", found.len(), names.join(" and ")),
+        ));
+    }
+    found.into_iter().next().ok_or_else(|| {
+        Error::io(
+            dir.join(format!("{stem}.{}", exts[0])),
+            std::io::Error::new(
+                std::io::ErrorKind::NotFound,
+                format!("missing {what} (also looked for .{})", exts[1..].join(", .")),
+            ),
+        )
+    })
 }
 
 /// The six faces of `side` from a face folder: colour `{left,right}_{tag}.{png,jpg,jpeg,ppm,exr}`

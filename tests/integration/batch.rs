@@ -166,7 +166,7 @@ fn resume_redoes_frames_whose_settings_or_files_changed() {
     assert_eq!(run_batch(&g, &frames, &out, &forced, || ()).unwrap().rendered, 3);
     // No temporaries left behind.
     for f in std::fs::read_dir(out.join("f1")).unwrap().flatten() {
-        assert!(!f.file_name().to_string_lossy().contains(".tmp-"));
+        assert!(!f.file_name().to_string_lossy().starts_with(io::TEMP_PREFIX));
     }
 }
 
@@ -185,7 +185,7 @@ fn a_frame_folder_that_is_a_symlink_is_refused_and_nothing_is_written_through_it
     assert_eq!(s.rendered, 1);
     assert_eq!(s.failed.len(), 1);
     assert!(
-        s.failed[0].0 == "f1" && s.failed[0].1.contains("symbolic link"),
+        s.failed[0].0 == "f1" && s.failed[0].1.contains("symlink"),
         "{:?}",
         s.failed
     );

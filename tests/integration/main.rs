@@ -12,6 +12,7 @@ mod cyclopean;
 mod cyclopean_real;
 mod device_choice;
 mod gpu_context;
+mod hostile;
 mod limits;
 mod readback;
 mod refocus_accuracy;

@@ -140,7 +140,9 @@ pub(crate) fn compare(a: CompareArgs) -> Result<()> {
         passed: broken.is_empty(),
     };
     let json = serde_json::to_string_pretty(&summary)?;
-    let mut jobs: Vec<WriteJob> = Vec::new();
+    // --diff and --json name files anywhere (no output folder): each is written atomically.
+    type Job<'a> = (PathBuf, Box<dyn FnOnce(&Path) -> viewsynth::Result<()> + 'a>);
+    let mut jobs: Vec<Job> = Vec::new();
     if let Some(p) = &a.diff {
         jobs.push((p.clone(), Box::new(|p: &Path| io::save_rgb(p, &diff))));
     }
@@ -155,7 +157,9 @@ pub(crate) fn compare(a: CompareArgs) -> Result<()> {
         )),
         _ => {}
     }
-    write_all_or_none(jobs)?;
+    for (path, write) in jobs {
+        write(&path).with_context(|| format!("writing {}", path.display()))?;
+    }
     if a.json.as_deref() == Some(Path::new("-")) {
         println!("{json}");
     } else {

@@ -66,7 +66,7 @@ pub(crate) struct CyclopeanArgs {
     #[arg(long, requires_all = ["left_depth", "right_depth"])]
     cameras: Option<PathBuf>,
     /// Raw units per unit of depth for integer depth files.
-    #[arg(long)]
+    #[arg(long, value_parser = finite_value)]
     depth_scale: Option<f64>,
     /// Array of an .npz depth or disparity file (both eyes) to read (default: the only array,
     /// else the first floating-point one).
@@ -76,14 +76,14 @@ pub(crate) struct CyclopeanArgs {
     #[arg(long, value_enum)]
     method: Option<MethodArg>,
     /// Reconstruction steps of the refine method (0 = the seed's single step).
-    #[arg(long)]
+    #[arg(long, value_parser = clap::value_parser!(u32).range(0..=16))]
     refine_steps: Option<u32>,
     /// Seed/refine only.
     #[arg(long, value_enum)]
     blend: Option<BlendArg>,
     /// Seed/refine only: middle-space depth disagreement (metres) treated as different surfaces
     /// (default: the seed's clamp(0.02 * fixation, 0.02, 0.25)).
-    #[arg(long)]
+    #[arg(long, value_parser = finite_value)]
     z_threshold: Option<f64>,
     /// Seed/refine only: dominant eye and its blend weight, e.g. `left:0.7`.
     #[arg(long)]
@@ -121,6 +121,7 @@ fn stereo_setup(a: &CyclopeanArgs, left_disparity: &Path) -> Result<Setup> {
         ..Default::default()
     };
     let eye = |rgb: &Path, disparity: &Path| -> Result<(io::RgbImage, io::DepthMap)> {
+        io::check_rgbd_sizes(rgb, disparity)?;
         Ok((
             io::load_rgb(rgb)?,
             io::load_depth_with_key(disparity, a.npz_key.as_deref(), &decode)?,
@@ -174,6 +175,8 @@ fn camera_file_setup(a: &CyclopeanArgs, cameras: &Path) -> Result<Setup> {
         ..Default::default()
     };
     let eye = |rgb: &Path, depth: &Path, cam: &EyeCameras| -> Result<EyeInput> {
+        // Sizes and the pixel budget from the headers before either file is decoded.
+        io::check_rgbd_sizes(rgb, depth)?;
         Ok(EyeInput {
             color: io::load_rgb(rgb)?,
             depth: io::load_depth_with_key(depth, a.npz_key.as_deref(), &decode)?,
@@ -283,7 +286,7 @@ pub(crate) fn cyclopean(a: CyclopeanArgs) -> Result<()> {
         MethodArg::Seed | MethodArg::Refine => Some(gather_params(&a, method, fixation)?),
         _ => None,
     };
-    prepare_out_dir(&a.out_dir)?;
+    let out_dir = prepare_out_dir(&a.out_dir)?;
     let gpu = a.gpu.open()?;
     let wanted = CyclopeanOutputs {
         color: outputs.rgb,
@@ -306,23 +309,23 @@ pub(crate) fn cyclopean(a: CyclopeanArgs) -> Result<()> {
     let mut jobs: Vec<WriteJob> = Vec::new();
     if let Some(color) = out.color.as_ref().filter(|_| outputs.rgb) {
         jobs.push((
-            a.out_dir.join("middle_rgb.png"),
+            "middle_rgb.png".into(),
             Box::new(move |p: &Path| io::save_rgb(p, color)),
         ));
     }
     if let Some(depth) = out.depth.as_ref().filter(|_| outputs.depth) {
         jobs.push((
-            a.out_dir.join("middle_depth.exr"),
+            "middle_depth.exr".into(),
             Box::new(move |p: &Path| io::save_depth_exr(p, depth)),
         ));
     }
     if outputs.mask {
         jobs.push((
-            a.out_dir.join("middle_mask.png"),
+            "middle_mask.png".into(),
             Box::new(|p: &Path| io::save_mask_png(p, &mask)),
         ));
     }
-    let written = write_all_or_none(jobs)?;
+    let written = write_all_or_none(&out_dir, jobs)?;
     let valid = out.sources.iter().filter(|s| **s != 0).count();
     println!(
         "view {}x{}: {:.1} % valid, render {:.1} ms; wrote {} in {}",

@@ -13,16 +13,16 @@ pub(crate) struct IntrinsicsArgs {
     #[arg(long, value_name = "FILE")]
     pub intrinsics: Option<PathBuf>,
     /// Source focal length along x, in pixels.
-    #[arg(long)]
+    #[arg(long, value_parser = super::finite_value)]
     pub fx: Option<f64>,
     /// Source focal length along y, in pixels.
-    #[arg(long)]
+    #[arg(long, value_parser = super::finite_value)]
     pub fy: Option<f64>,
     /// Source principal point x, in pixels (OpenCV: the first pixel's centre is at 0).
-    #[arg(long)]
+    #[arg(long, value_parser = super::finite_value)]
     pub cx: Option<f64>,
     /// Source principal point y, in pixels, rows downwards (OpenCV: the first pixel's centre is at 0).
-    #[arg(long)]
+    #[arg(long, value_parser = super::finite_value)]
     pub cy: Option<f64>,
 }
 

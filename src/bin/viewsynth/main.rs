@@ -37,6 +37,12 @@ use summary::print_depth_summary;
 struct Cli {
     #[command(subcommand)]
     command: Command,
+    /// Largest image (width x height) any input may declare or any output may have; checked
+    /// from file headers before pixels are read (default 8192 x 8192, about 1.5 GB for the
+    /// heaviest command).
+    #[arg(long, global = true, default_value_t = io::DEFAULT_MAX_PIXELS,
+          value_parser = clap::value_parser!(u64).range(1..=(1u64 << 32)))]
+    max_pixels: u64,
 }
 
 #[derive(Subcommand)]
@@ -71,12 +77,12 @@ enum Command {
         /// `demo`, `boxes`, or a scene JSON file of planes, spheres and boxes.
         #[arg(long, default_value = "demo")]
         scene: String,
-        #[arg(long, default_value_t = 640)]
+        #[arg(long, default_value_t = 640, value_parser = clap::value_parser!(u32).range(1..=i64::from(io::MAX_DIMENSION)))]
         width: u32,
-        #[arg(long, default_value_t = 480)]
+        #[arg(long, default_value_t = 480, value_parser = clap::value_parser!(u32).range(1..=i64::from(io::MAX_DIMENSION)))]
         height: u32,
         /// Interocular distance in metres.
-        #[arg(long, default_value_t = 0.064)]
+        #[arg(long, default_value_t = 0.064, value_parser = finite_value)]
         ipd: f64,
         #[command(flatten)]
         conv: ConventionArgs,
@@ -114,7 +120,7 @@ enum Command {
         #[arg(long = "case")]
         cases: Vec<PathBuf>,
         /// Timed repetitions per row (the median is reported).
-        #[arg(long, default_value_t = 3)]
+        #[arg(long, default_value_t = 3, value_parser = clap::builder::RangedU64ValueParser::<usize>::new().range(0..=1000))]
         repeats: usize,
         #[command(flatten)]
         gpu: GpuArgs,
@@ -126,7 +132,7 @@ enum Command {
         #[arg(long, value_delimiter = ',', default_value = "640x480,1280x720")]
         sizes: Vec<String>,
         /// Repetitions per measurement (the median is reported).
-        #[arg(long, default_value_t = 7)]
+        #[arg(long, default_value_t = 7, value_parser = clap::builder::RangedU64ValueParser::<usize>::new().range(0..=1000))]
         repeats: usize,
         /// Benchmark the pipelined refocus batch instead: N frames of the built-in scene, or a
         /// manifest FILE; runs the synchronous batch as the in-run baseline and prints frames/s,
@@ -295,9 +301,40 @@ impl FileOutputArgs {
     }
 }
 
-fn main() {
+/// Exit status: 0 success, 1 a run error (this function), 2 a usage error (clap, before).
+fn main() -> std::process::ExitCode {
     let cli = Cli::parse();
-    let result = match cli.command {
+    let result = io::set_max_pixels(cli.max_pixels)
+        .map_err(anyhow::Error::from)
+        .and_then(|()| run(cli.command));
+    match result {
+        Ok(()) => std::process::ExitCode::SUCCESS,
+        Err(e) => {
+            eprintln!("error: {}", error_chain(&e));
+            std::process::ExitCode::FAILURE
+        }
+    }
+}
+
+/// The error and its causes joined by ": ", skipping a cause whose text the message already
+/// holds (the library's I/O errors print their source, which is also their cause).
+fn error_chain(e: &anyhow::Error) -> String {
+    let mut text = String::new();
+    for cause in e.chain() {
+        let part = cause.to_string();
+        if text.contains(&part) {
+            continue;
+        }
+        if !text.is_empty() {
+            text.push_str(": ");
+        }
+        text.push_str(&part);
+    }
+    text
+}
+
+fn run(command: Command) -> Result<()> {
+    match command {
         Command::Info { gpu, json } => info(&gpu, json),
         Command::Refocus(args) => refocus(*args),
         Command::Cyclopean(args) => cyclopean(*args),
@@ -344,10 +381,6 @@ fn main() {
             repeats,
             gpu,
         } => report(&out_dir, data_dir.as_deref(), &cases, repeats, &gpu),
-    };
-    if let Err(e) = result {
-        eprintln!("error: {e:#}");
-        std::process::exit(1);
     }
 }
 
@@ -437,6 +470,12 @@ fn report(out_dir: &Path, data_dir: Option<&Path>, cases: &[PathBuf], repeats: u
         if !d.is_dir() {
             bail!("--data-dir {}: not a directory", d.display());
         }
+        if std::fs::read_dir(d).map_or(true, |mut e| e.next().is_none()) {
+            eprintln!(
+                "note: --data-dir {} is empty: the real-data rows are skipped",
+                d.display()
+            );
+        }
     }
     let gpu = gpu.open()?;
     let files = viewsynth::evaluation::run_report_with_cases(&gpu, out_dir, data_dir, cases, repeats)?;
@@ -475,13 +514,10 @@ fn parse_depth_formats(list: &str) -> Result<DepthFormats> {
     Ok(f)
 }
 
-fn prepare_out_dir(dir: &Path) -> Result<()> {
-    std::fs::create_dir_all(dir).with_context(|| format!("cannot create output directory {}", dir.display()))?;
-    // Probe writability now rather than after minutes of rendering.
-    let probe = dir.join(format!(".viewsynth-write-test-{}", std::process::id()));
-    std::fs::write(&probe, b"").with_context(|| format!("output directory {} is not writable", dir.display()))?;
-    let _ = std::fs::remove_file(probe);
-    Ok(())
+/// Creates --out-dir and probes that it accepts files now rather than after minutes of
+/// rendering (an exclusive temporary: no existing name is ever opened).
+fn prepare_out_dir(dir: &Path) -> Result<io::OutDir> {
+    Ok(io::OutDir::prepare(dir)?)
 }
 
 fn bench_batch(batch: &str, jobs: Option<usize>, png: &str, json: bool, gpu: &GpuArgs) -> Result<()> {
@@ -562,23 +598,39 @@ fn stress(quick: bool, only: &[String], json: Option<&Path>, gpu: &GpuArgs) -> R
     Ok(())
 }
 
-/// An output file and the function writing it.
-type WriteJob<'a> = (PathBuf, Box<dyn FnOnce(&Path) -> viewsynth::Result<()> + 'a>);
+/// An output file's name in --out-dir and the function writing it (given a path).
+type WriteJob<'a> = (String, Box<dyn FnOnce(&Path) -> viewsynth::Result<()> + 'a>);
 
-/// Writes every file or none: on the first failure the files already written are removed
-/// (each write is atomic, so no partial file exists under a final name either).
-fn write_all_or_none(jobs: Vec<WriteJob<'_>>) -> Result<Vec<PathBuf>> {
-    let mut written = Vec::new();
-    for (path, write) in jobs {
-        if let Err(e) = write(&path) {
-            for p in &written {
-                let _ = std::fs::remove_file(p);
-            }
-            return Err(e.into());
-        }
-        written.push(path);
+/// Writes every file or none (an [`io::FileSet`]): on a failure nothing in `out` changes, the
+/// previous run's files included.
+fn write_all_or_none(out: &io::OutDir, jobs: Vec<WriteJob<'_>>) -> Result<Vec<PathBuf>> {
+    let set = out.file_set()?;
+    for (name, write) in jobs {
+        write(&set.staging().join(&name)).map_err(|e| set.final_error(e))?;
     }
-    Ok(written)
+    Ok(set.commit()?)
+}
+
+/// Largest magnitude of a real-valued option (pixels, metres, degrees, scales): far beyond any
+/// camera, and small enough that f32 GPU maths keeps meaning.
+const MAX_OPTION_MAGNITUDE: f64 = 1e6;
+
+/// clap value parser: a finite number with magnitude <= [`MAX_OPTION_MAGNITUDE`].
+fn finite_value(s: &str) -> std::result::Result<f64, String> {
+    let v: f64 = s.trim().parse().map_err(|_| format!("'{s}' is not a number"))?;
+    if v.is_finite() && v.abs() <= MAX_OPTION_MAGNITUDE {
+        Ok(v)
+    } else {
+        Err(format!("{s} must be finite with magnitude <= {MAX_OPTION_MAGNITUDE:e}"))
+    }
+}
+
+/// clap value parser: as [`finite_value`], or `inf` where infinity has a meaning.
+fn finite_or_inf(s: &str) -> std::result::Result<f64, String> {
+    match s.trim().parse::<f64>() {
+        Ok(v) if v == f64::INFINITY => Ok(v),
+        _ => finite_value(s),
+    }
 }
 
 /// Device depth written with `--near`/`--far` (`what` names the depth in the error).

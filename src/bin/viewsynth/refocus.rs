@@ -27,7 +27,7 @@ pub(crate) struct RefocusArgs {
     force: bool,
     /// With --batch: threads in each CPU pool (decoding inputs, encoding files) around the GL
     /// thread; 0 runs every stage in turn on one thread. Default: the number of cores.
-    #[arg(long, alias = "writer-threads")]
+    #[arg(long, alias = "writer-threads", value_parser = clap::builder::RangedU64ValueParser::<usize>::new().range(0..=viewsynth::refocus::batch::MAX_JOBS as u64))]
     jobs: Option<usize>,
     /// With --batch: process only shard K of N (frames whose manifest index i has i % N == K,
     /// K from 0), e.g. one Slurm array task or Kubernetes indexed Job per shard.
@@ -36,7 +36,7 @@ pub(crate) struct RefocusArgs {
     /// Raw units per metre for integer depth: 5000 for TUM, 1000 for SUN RGB-D (with
     /// --sun-bit-rotate) and millimetre PNGs. Divides float depth too when given. (NYU v2 raw PGM
     /// holds Kinect disparity, not depth: no scale fits; convert it first.)
-    #[arg(long)]
+    #[arg(long, value_parser = finite_value)]
     depth_scale: Option<f64>,
     /// Array of an .npz depth file to read (default: the only array, else the first
     /// floating-point one).
@@ -52,29 +52,29 @@ pub(crate) struct RefocusArgs {
     #[arg(long)]
     out_dir: PathBuf,
     /// Target focal lengths fx' in pixels (fy' keeps the source fy/fx).
-    #[arg(long, value_delimiter = ',', conflicts_with = "zoom_range")]
+    #[arg(long, value_delimiter = ',', conflicts_with = "zoom_range", value_parser = finite_value)]
     focal_list: Option<Vec<f64>>,
     /// Target focal scales s (fx' = s fx).
-    #[arg(long, value_delimiter = ',', default_value = "0.5,0.75,1,1.5,2")]
+    #[arg(long, value_delimiter = ',', default_value = "0.5,0.75,1,1.5,2", value_parser = finite_value)]
     zoom_range: Vec<f64>,
     /// Break an edge when |za - zb| > tau_rel * min(za, zb).
-    #[arg(long, default_value_t = BreakRule::default().tau_rel)]
+    #[arg(long, default_value_t = BreakRule::default().tau_rel, value_parser = finite_value)]
     tau_rel: f64,
     /// Break an edge when |za - zb| > tau_abs (metres; "inf" disables).
-    #[arg(long, default_value_t = BreakRule::default().tau_abs)]
+    #[arg(long, default_value_t = BreakRule::default().tau_abs, value_parser = finite_or_inf)]
     tau_abs: f64,
     /// Output width in pixels (default: the source's; with --height-out).
-    #[arg(long, requires = "height_out")]
+    #[arg(long, requires = "height_out", value_parser = clap::value_parser!(u32).range(1..=i64::from(io::MAX_DIMENSION)))]
     width_out: Option<u32>,
     /// Output height in pixels (default: the source's; with --width-out).
-    #[arg(long, requires = "width_out")]
+    #[arg(long, requires = "width_out", value_parser = clap::value_parser!(u32).range(1..=i64::from(io::MAX_DIMENSION)))]
     height_out: Option<u32>,
     /// Output principal point x in pixels (default: the source's offset from the image centre:
     /// cx' = cx + (W' - W) / 2; with --cy-out).
-    #[arg(long, requires = "cy_out")]
+    #[arg(long, requires = "cy_out", value_parser = finite_value)]
     cx_out: Option<f64>,
     /// Output principal point y in pixels (default: cy' = cy + (H' - H) / 2; with --cx-out).
-    #[arg(long, requires = "cx_out")]
+    #[arg(long, requires = "cx_out", value_parser = finite_value)]
     cy_out: Option<f64>,
     #[command(flatten)]
     files: FileOutputArgs,
@@ -109,6 +109,11 @@ pub(crate) fn refocus(a: RefocusArgs) -> Result<()> {
         MethodArg::Mesh => Method::Mesh,
         MethodArg::Fullscreen => Method::Fullscreen,
     };
+    if let (Some(w), Some(h)) = (a.width_out, a.height_out) {
+        io::check_output_pixels("--width-out/--height-out", w, h)?;
+    }
+    // Sizes and the pixel budget from the headers before either file is decoded.
+    io::check_rgbd_sizes(&rgb_path, &depth_path)?;
     let rgb = io::load_rgb(&rgb_path)?;
     let decode = DepthDecode {
         scale: a.depth_scale,
@@ -135,15 +140,17 @@ pub(crate) fn refocus(a: RefocusArgs) -> Result<()> {
         principal: a.cx_out.zip(a.cy_out),
     };
     let targets = spec.targets(&src.camera())?;
-    prepare_out_dir(&a.out_dir)?;
+    let out_dir = prepare_out_dir(&a.out_dir)?;
 
     let gpu = a.gpu.open()?;
     let mut refocuser = Refocuser::new(&gpu, &src, &rule, method, outputs, conv)?;
     let bar = indicatif::ProgressBar::new(targets.len() as u64);
     let mut entries = Vec::new();
+    // All targets and the manifest, or (on any failure) none: earlier runs' files stay.
+    let set = out_dir.file_set()?;
     for (scale, target) in scales.iter().zip(&targets) {
         let out = refocuser.render(target)?;
-        entries.push(job::write_output(&a.out_dir, *scale, &out, &files)?);
+        entries.push(job::write_output(set.staging(), *scale, &out, &files).map_err(|e| set.final_error(e))?);
         bar.inc(1);
     }
     bar.finish_and_clear();
@@ -156,10 +163,12 @@ pub(crate) fn refocus(a: RefocusArgs) -> Result<()> {
         renderer: gpu.info().renderer.clone(),
         notes: job::MANIFEST_NOTES.to_string(),
         settings: None,
-        files: job::file_records(&a.out_dir, &entries)?,
+        files: job::file_records(set.staging(), &entries).map_err(|e| set.final_error(e))?,
         outputs: entries,
     };
-    let path = job::write_manifest(&a.out_dir, &manifest)?;
+    job::write_manifest(set.staging(), &manifest).map_err(|e| set.final_error(e))?;
+    set.commit()?;
+    let path = out_dir.path().join("manifest.json");
     for e in &manifest.outputs {
         println!(
             "s={:<6} fx'={:<9.3} {}x{} coverage {:>6.2}%  render {:>7.2} ms",

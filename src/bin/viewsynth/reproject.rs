@@ -53,17 +53,17 @@ pub(crate) struct ReprojectArgs {
     depth_kind: ReprojectDepthArg,
     /// Raw units per unit of the depth file for integer files (1000 for mm, 4 for Middlebury 2003
     /// disparity PGMs); divides float depth too when given.
-    #[arg(long)]
+    #[arg(long, value_parser = finite_value)]
     depth_scale: Option<f64>,
     /// Array of an .npz depth file to read (default: the only array, else the first
     /// floating-point one).
     #[arg(long, value_name = "NAME")]
     npz_key: Option<String>,
     /// Near plane (metres) the device depth was written with (--depth-kind device).
-    #[arg(long)]
+    #[arg(long, value_parser = finite_value)]
     near: Option<f64>,
     /// Far plane (metres; may be inf) the device depth was written with (--depth-kind device).
-    #[arg(long)]
+    #[arg(long, value_parser = finite_or_inf)]
     far: Option<f64>,
     /// Source intrinsics (with a rig).
     #[command(flatten)]
@@ -75,20 +75,20 @@ pub(crate) struct ReprojectArgs {
     cameras: Option<PathBuf>,
     /// Rectified rig: distance between the eyes in metres (x_right = x_left + doffs - f B / Z).
     /// Also the baseline of --depth-kind disparity.
-    #[arg(long)]
+    #[arg(long, value_parser = finite_value)]
     baseline: Option<f64>,
     /// Focal length (pixels) of the rectified rig and of disparity (default: --fx).
-    #[arg(long)]
+    #[arg(long, value_parser = finite_value)]
     focal: Option<f64>,
     /// cx_right - cx_left in pixels (Middlebury's doffs) of the rectified rig and of disparity.
-    #[arg(long, default_value_t = 0.0)]
+    #[arg(long, default_value_t = 0.0, value_parser = finite_value)]
     doffs: f64,
     /// A game-engine stereo rig instead of --baseline: separation = interaxial / screen width (texture
     /// units; the eyes move +-S/2 (1 - c/Z) in texture x), with --convergence.
-    #[arg(long, requires = "convergence")]
+    #[arg(long, requires = "convergence", value_parser = finite_value)]
     separation: Option<f64>,
     /// Zero-parallax distance c in metres (with --separation).
-    #[arg(long, requires = "separation")]
+    #[arg(long, requires = "separation", value_parser = finite_value)]
     convergence: Option<f64>,
     /// The source view.
     #[arg(long, value_enum, default_value = "left")]
@@ -99,10 +99,10 @@ pub(crate) struct ReprojectArgs {
     #[arg(long, value_enum, default_value = "shift-scan")]
     method: ReprojectMethodArg,
     /// Steps of the shift walk / 3-D gather (1..=16).
-    #[arg(long, default_value_t = 3)]
+    #[arg(long, default_value_t = 3, value_parser = clap::value_parser!(u32).range(1..=16))]
     steps: u32,
     /// A row segment breaks (an unseen surface) where |Z_a - Z_b| > tau_rel * min(Z_a, Z_b).
-    #[arg(long, default_value_t = 0.05)]
+    #[arg(long, default_value_t = 0.05, value_parser = finite_value)]
     tau_rel: f64,
     #[command(flatten)]
     files: FileOutputArgs,
@@ -152,7 +152,7 @@ pub(crate) fn reproject(a: ReprojectArgs) -> Result<()> {
         None => rig_setup(&a)?,
     };
     let (width, height) = (src.color.width, src.color.height);
-    prepare_out_dir(&a.out_dir)?;
+    let out_dir = prepare_out_dir(&a.out_dir)?;
 
     let gpu = a.gpu.open()?;
     let mut results = Vec::new();
@@ -168,25 +168,25 @@ pub(crate) fn reproject(a: ReprojectArgs) -> Result<()> {
         let name = eye_name(Some(*to));
         if let Some(color) = &out.color {
             jobs.push((
-                a.out_dir.join(format!("{name}_rgb.{rgb_ext}")),
+                format!("{name}_rgb.{rgb_ext}"),
                 Box::new(move |p: &Path| io::save_rgb_with(p, color, &enc)),
             ));
         }
         if let Some(depth) = out.depth.as_ref().filter(|_| depth_formats.exr) {
             jobs.push((
-                a.out_dir.join(format!("{name}_depth.exr")),
+                format!("{name}_depth.exr"),
                 Box::new(move |p: &Path| io::save_depth_exr_with(p, depth, enc.exr)),
             ));
         }
         if let Some(depth) = out.depth.as_ref().filter(|_| depth_formats.npy) {
             jobs.push((
-                a.out_dir.join(format!("{name}_depth.npy")),
+                format!("{name}_depth.npy"),
                 Box::new(move |p: &Path| io::save_depth_npy(p, depth)),
             ));
         }
         if outputs.mask {
             jobs.push((
-                a.out_dir.join(format!("{name}_mask.png")),
+                format!("{name}_mask.png"),
                 Box::new(move |p: &Path| {
                     let bits = out.mask.iter().map(|m| (*m != 0) as u8).collect();
                     io::save_mask_png_with(p, &io::Mask::new(width, height, bits)?, enc.png)
@@ -194,7 +194,7 @@ pub(crate) fn reproject(a: ReprojectArgs) -> Result<()> {
             ));
         }
     }
-    let written = write_all_or_none(jobs)?;
+    let written = write_all_or_none(&out_dir, jobs)?;
     for (to, out, timing, setup_ms) in &results {
         println!(
             "{} -> {} ({}): {}x{}, coverage {:.2} %, render {} (setup + shader compile {setup_ms:.1} ms)",
@@ -223,6 +223,8 @@ fn load_source(
         scale: a.depth_scale,
         ..Default::default()
     };
+    // Sizes and the pixel budget from the headers before either file is decoded.
+    io::check_rgbd_sizes(&a.color, &a.depth)?;
     let src = viewsynth::reproject::ReprojectSource {
         color: io::load_rgb(&a.color)?,
         depth: io::load_depth_with_key(&a.depth, a.npz_key.as_deref(), &decode)?,

@@ -23,10 +23,14 @@ pub(crate) fn render_scene(
     if !(ipd.is_finite() && ipd >= 0.0) {
         bail!("invalid ipd {ipd}: must be finite and >= 0");
     }
+    io::check_output_pixels("--width/--height", width, height)?;
     let mut rig = StereoRig::demo(width, height);
     rig.camera.validate("scene camera")?;
     rig.ipd = ipd;
-    prepare_out_dir(out_dir)?;
+    let out = prepare_out_dir(out_dir)?;
+    // Every file or none: a failing rerun leaves the previous scene intact.
+    let mut set = out.file_set()?;
+    let staged = set.staging().to_path_buf();
     let gpu = gpu.open()?;
     let mut renderer = SceneRenderer::new(&gpu, &scene)?;
     let proj = gl_projection(&rig.camera, &rig.planes, &conv);
@@ -40,9 +44,10 @@ pub(crate) fn render_scene(
             height,
             conv,
         })?;
-        io::save_rgb(&out_dir.join(format!("{eye}_rgb.png")), &img.color)?;
-        io::save_depth_exr(&out_dir.join(format!("{eye}_view_z.exr")), &img.view_z)?;
-        io::save_depth_exr(&out_dir.join(format!("{eye}_device_depth.exr")), &img.device_depth)?;
+        let saved = io::save_rgb(&staged.join(format!("{eye}_rgb.png")), &img.color)
+            .and_then(|()| io::save_depth_exr(&staged.join(format!("{eye}_view_z.exr")), &img.view_z))
+            .and_then(|()| io::save_depth_exr(&staged.join(format!("{eye}_device_depth.exr")), &img.device_depth));
+        saved.map_err(|e| set.final_error(e))?;
         let entry = if eye == "middle" {
             serde_json::json!({ "view": view, "proj": proj, "width": width, "height": height })
         } else {
@@ -54,12 +59,13 @@ pub(crate) fn render_scene(
     cams.insert("conventions".into(), serde_json::to_value(conv)?);
     cams.insert("depth_kind".into(), "device".into());
     cams.insert("fixation_distance".into(), 3.0.into());
-    let path = out_dir.join("cameras.json");
     let text = serde_json::to_string_pretty(&cams)?;
-    io::atomic_write(&path, |w| {
+    set.write("cameras.json", |w| {
         use std::io::Write;
-        w.write_all(text.as_bytes()).map_err(|e| viewsynth::Error::io(&path, e))
+        w.write_all(text.as_bytes())
+            .map_err(|e| viewsynth::Error::io(out_dir.join("cameras.json"), e))
     })?;
+    set.commit()?;
     println!(
         "scene '{}' written to {} (cameras.json feeds `viewsynth cyclopean`)",
         scene.name,

@@ -33,41 +33,41 @@ pub(crate) struct StitchArgs {
     #[arg(long)]
     faces: Option<PathBuf>,
     /// Face field of view in degrees, in (90, 178) (default 90 + 2 x overlap).
-    #[arg(long)]
+    #[arg(long, value_parser = finite_value)]
     fov: Option<f64>,
     /// Seam band half-width in degrees, in (0, (fov - 90) / 2] (default (fov - 90) / 2 with
     /// --fov, else 10).
-    #[arg(long)]
+    #[arg(long, value_parser = finite_value)]
     overlap: Option<f64>,
     #[arg(long, value_enum, default_value = "reproject")]
     method: StitchMethodArg,
     /// Equirect width per eye.
-    #[arg(long, default_value_t = 2048)]
+    #[arg(long, default_value_t = 2048, value_parser = clap::value_parser!(u32).range(1..=i64::from(io::MAX_DIMENSION)))]
     width: u32,
     /// Equirect height per eye (the top-bottom image is twice as high).
-    #[arg(long, default_value_t = 1024)]
+    #[arg(long, default_value_t = 1024, value_parser = clap::value_parser!(u32).range(1..=i64::from(io::MAX_DIMENSION)))]
     height: u32,
     /// Face side in pixels with --scene.
-    #[arg(long, default_value_t = 512)]
+    #[arg(long, default_value_t = 512, value_parser = clap::value_parser!(u32).range(1..=i64::from(io::MAX_DIMENSION)))]
     face_size: u32,
     /// Interpupillary distance (metres, the faces' units).
-    #[arg(long, default_value_t = 0.064)]
+    #[arg(long, default_value_t = 0.064, value_parser = finite_value)]
     ipd: f64,
     /// Latitude (deg) above which the eye radius fades to 0 at the poles.
-    #[arg(long, default_value_t = 45.0)]
+    #[arg(long, default_value_t = 45.0, value_parser = finite_value)]
     pole_fade: f64,
     /// Raw units per metre for integer face depth files.
-    #[arg(long)]
+    #[arg(long, value_parser = finite_value)]
     depth_scale: Option<f64>,
     /// What the face depth files hold (with --faces): view-z, or device depth written with
     /// --near/--far under --ndc and --reversed-z (converted to view Z before stitching).
     #[arg(long, value_enum, default_value = "view-z")]
     depth_kind: FaceDepthArg,
     /// Near plane of device-depth faces (metres).
-    #[arg(long)]
+    #[arg(long, value_parser = finite_value)]
     near: Option<f64>,
     /// Far plane of device-depth faces (metres; may be inf).
-    #[arg(long)]
+    #[arg(long, value_parser = finite_or_inf)]
     far: Option<f64>,
     /// Conventions of device-depth faces; the row order also sets the GPU pass's memory order.
     #[command(flatten)]
@@ -160,6 +160,7 @@ pub(crate) fn stitch(a: StitchArgs) -> Result<()> {
         );
     }
 
+    io::check_output_pixels("--width/--height (top-bottom)", a.width, a.height.saturating_mul(2))?;
     let conv = a.conv.conventions();
     let depth_kind = match (a.depth_kind, a.near, a.far) {
         (FaceDepthArg::ViewZ, None, None) => DepthInput::ViewZ,
@@ -201,7 +202,7 @@ pub(crate) fn stitch(a: StitchArgs) -> Result<()> {
         (l, r, format!("ray-traced 12 faces of {n}x{n} (CPU)"))
     };
     let faces_ms = t0.elapsed().as_secs_f64() * 1e3;
-    prepare_out_dir(&a.out_dir)?;
+    let out_dir = prepare_out_dir(&a.out_dir)?;
 
     let gpu = a.gpu.open()?;
     let t0 = Instant::now();
@@ -217,21 +218,12 @@ pub(crate) fn stitch(a: StitchArgs) -> Result<()> {
     } else {
         None
     };
-    let mut jobs: Vec<WriteJob> = vec![(
-        a.out_dir.join("ods_top_bottom.png"),
-        Box::new(|p: &Path| io::save_rgb(p, &img)),
-    )];
+    let mut jobs: Vec<WriteJob> = vec![("ods_top_bottom.png".into(), Box::new(|p: &Path| io::save_rgb(p, &img)))];
     if let Some([l, r]) = &eyes {
-        jobs.push((
-            a.out_dir.join("ods_left.png"),
-            Box::new(move |p: &Path| io::save_rgb(p, l)),
-        ));
-        jobs.push((
-            a.out_dir.join("ods_right.png"),
-            Box::new(move |p: &Path| io::save_rgb(p, r)),
-        ));
+        jobs.push(("ods_left.png".into(), Box::new(move |p: &Path| io::save_rgb(p, l))));
+        jobs.push(("ods_right.png".into(), Box::new(move |p: &Path| io::save_rgb(p, r))));
     }
-    let written = write_all_or_none(jobs)?;
+    let written = write_all_or_none(&out_dir, jobs)?;
     println!("faces: {source}, FOV {fov} deg, in {faces_ms:.0} ms");
     println!("upload + shader compile {setup_ms:.1} ms");
     println!(

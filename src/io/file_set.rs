@@ -1,0 +1,393 @@
+//! The output folder of a run and all-or-none sets of output files in it.
+//!
+//! [`OutDir`] is `--out-dir` made ready (created, resolved, probed) and the only way to reach
+//! folders under it: [`OutDir::subdir`] refuses a subfolder that is a symlink or resolves
+//! elsewhere, so outputs never land outside the real out-dir.
+//!
+//! [`FileSet`] stages every file of a set in a private folder `.viewsynth-<pid>-<random>/`
+//! inside the destination and renames them all into place in [`FileSet::commit`], only once
+//! every file was written. Until then the previous run's files stay untouched; on an error or
+//! a drop without commit only the set's own staging folder is removed.
+//!
+//! ```no_run
+//! # fn main() -> viewsynth::Result<()> {
+//! use std::io::Write;
+//! let out = viewsynth::io::OutDir::prepare("out".as_ref())?;
+//! let mut set = out.file_set()?;
+//! set.write("a.txt", |w| w.write_all(b"a").map_err(|e| viewsynth::Error::io("a.txt", e)))?;
+//! set.write("b.txt", |w| w.write_all(b"b").map_err(|e| viewsynth::Error::io("b.txt", e)))?;
+//! let written = set.commit()?; // both appear, or (on an error above) neither changes
+//! # Ok(()) }
+//! ```
+
+use std::fs::{self, File};
+use std::io::{self, BufWriter, Write};
+use std::path::{Component, Path, PathBuf};
+
+use super::atomic::{own_prefix, probe_writable, remove_orphan_temporaries, TEMP_PREFIX};
+use crate::error::{Error, Result};
+
+/// An output folder that exists, accepts files, and bounds where outputs may go.
+#[derive(Debug, Clone)]
+pub struct OutDir {
+    /// As the user gave it (for messages and the paths printed).
+    shown: PathBuf,
+    /// Resolved (symlinks followed once, at the root only).
+    real: PathBuf,
+}
+
+impl OutDir {
+    /// Creates `dir` (and its parents) if missing, resolves it, checks that it accepts new
+    /// files (without opening any existing name) and removes temporaries that killed runs left
+    /// in it (never those of a live process). The folder itself may be a symlink: where it
+    /// points is the out-dir.
+    pub fn prepare(dir: &Path) -> Result<Self> {
+        fs::create_dir_all(dir).map_err(|e| Error::io(dir, e))?;
+        let real = fs::canonicalize(dir).map_err(|e| Error::io(dir, e))?;
+        if !real.is_dir() {
+            return Err(Error::io(
+                dir,
+                io::Error::new(io::ErrorKind::NotADirectory, "not a directory"),
+            ));
+        }
+        probe_writable(&real).map_err(|e| match e {
+            Error::Io { source, .. } => Error::Io {
+                path: dir.to_path_buf(),
+                source: io::Error::new(source.kind(), format!("output directory is not writable ({source})")),
+            },
+            other => other,
+        })?;
+        remove_orphan_temporaries(&real);
+        Ok(Self {
+            shown: dir.to_path_buf(),
+            real,
+        })
+    }
+
+    /// The folder as given (join output names onto this for messages).
+    pub fn path(&self) -> &Path {
+        &self.shown
+    }
+
+    /// The folder with symlinks resolved.
+    pub fn real_path(&self) -> &Path {
+        &self.real
+    }
+
+    /// The folder `name` (one plain path component) directly inside, created if missing.
+    /// Refused, with the path named, when it exists as a symlink or as anything but a folder,
+    /// or when it resolves outside this out-dir.
+    pub fn subdir(&self, name: &str) -> Result<OutDir> {
+        check_plain_name(name, &self.shown)?;
+        let shown = self.shown.join(name);
+        let real = self.real.join(name);
+        match fs::symlink_metadata(&real) {
+            Ok(m) if m.file_type().is_symlink() => {
+                let target = fs::read_link(&real)
+                    .map(|t| t.display().to_string())
+                    .unwrap_or_default();
+                return Err(outside(&shown, &self.shown, &format!("is a symlink to {target}")));
+            }
+            Ok(m) if !m.is_dir() => {
+                return Err(Error::io(
+                    &shown,
+                    io::Error::new(io::ErrorKind::NotADirectory, "exists and is not a directory"),
+                ))
+            }
+            Ok(_) => {}
+            Err(e) if e.kind() == io::ErrorKind::NotFound => match fs::create_dir(&real) {
+                Ok(()) => {}
+                // Another process made it meanwhile: checked below like any existing folder.
+                Err(e) if e.kind() == io::ErrorKind::AlreadyExists => {}
+                Err(e) => return Err(Error::io(&shown, e)),
+            },
+            Err(e) => return Err(Error::io(&shown, e)),
+        }
+        let resolved = fs::canonicalize(&real).map_err(|e| Error::io(&shown, e))?;
+        if resolved.parent() != Some(self.real.as_path()) || !resolved.is_dir() {
+            return Err(outside(
+                &shown,
+                &self.shown,
+                &format!("resolves to {}", resolved.display()),
+            ));
+        }
+        remove_orphan_temporaries(&resolved);
+        Ok(OutDir { shown, real: resolved })
+    }
+
+    /// A new, empty set of files to be written into this folder.
+    pub fn file_set(&self) -> Result<FileSet> {
+        FileSet::new(&self.real).map(|s| s.shown_as(&self.shown))
+    }
+}
+
+fn outside(path: &Path, root: &Path, what: &str) -> Error {
+    Error::io(
+        path,
+        io::Error::new(
+            io::ErrorKind::InvalidInput,
+            format!(
+                "{what}: outputs are only written inside --out-dir {}; remove or rename it",
+                root.display()
+            ),
+        ),
+    )
+}
+
+/// `name` must be one normal path component and not look like one of our temporaries.
+fn check_plain_name(name: &str, dir: &Path) -> Result<()> {
+    let mut parts = Path::new(name).components();
+    let plain = matches!((parts.next(), parts.next()), (Some(Component::Normal(_)), None));
+    if !plain || name.starts_with(TEMP_PREFIX) {
+        return Err(Error::param(
+            "output name",
+            format!(
+                "'{name}' in {}: must be a plain file name (no '/', '..' or '{TEMP_PREFIX}' prefix)",
+                dir.display()
+            ),
+        ));
+    }
+    Ok(())
+}
+
+/// Files written all-or-none: staged privately, renamed into place by [`FileSet::commit`].
+#[derive(Debug)]
+pub struct FileSet {
+    /// Destination folder (real path) and how to name it in messages.
+    dir: PathBuf,
+    shown: PathBuf,
+    staging: tempfile::TempDir,
+    /// Names written through [`FileSet::write`], in order.
+    written: Vec<String>,
+}
+
+impl FileSet {
+    /// A set whose files go into `dir` (an existing folder) on commit. The staging folder is
+    /// created inside `dir` (same file system, so the renames are atomic).
+    pub fn new(dir: &Path) -> Result<Self> {
+        let staging = tempfile::Builder::new()
+            .prefix(&own_prefix())
+            .tempdir_in(dir)
+            .map_err(|e| Error::io(dir, e))?;
+        Ok(Self {
+            dir: dir.to_path_buf(),
+            shown: dir.to_path_buf(),
+            staging,
+            written: Vec::new(),
+        })
+    }
+
+    fn shown_as(mut self, shown: &Path) -> Self {
+        self.shown = shown.to_path_buf();
+        self
+    }
+
+    /// The private folder the set's files are staged in, for writers that take a path (e.g.
+    /// `io::save_rgb(&set.staging().join("a.png"), ..)`): every regular file found there at
+    /// commit is part of the set.
+    pub fn staging(&self) -> &Path {
+        self.staging.path()
+    }
+
+    /// Where `name` will be once committed (as the out-dir was given).
+    pub fn final_path(&self, name: &str) -> PathBuf {
+        self.shown.join(name)
+    }
+
+    /// `e` with a path inside the staging folder replaced by the final path, for errors of
+    /// path-based savers that wrote into [`FileSet::staging`].
+    pub fn final_error(&self, e: Error) -> Error {
+        let fix = |p: PathBuf| match p.strip_prefix(self.staging.path()) {
+            Ok(rest) => self.shown.join(rest),
+            Err(_) => p,
+        };
+        match e {
+            Error::Io { path, source } => Error::Io {
+                path: fix(path),
+                source,
+            },
+            Error::Decode { path, message } => Error::Decode {
+                path: fix(path),
+                message,
+            },
+            Error::Encode { path, message } => Error::Encode {
+                path: fix(path),
+                message,
+            },
+            other => other,
+        }
+    }
+
+    /// Stages `name` (one plain file name) with the bytes `write` produces. Errors name the
+    /// final path. Returns the final path.
+    pub fn write(&mut self, name: &str, write: impl FnOnce(&mut BufWriter<File>) -> Result<()>) -> Result<PathBuf> {
+        check_plain_name(name, &self.shown)?;
+        let shown = self.final_path(name);
+        if self.written.iter().any(|n| n == name) {
+            return Err(Error::param(
+                "output name",
+                format!("{} is written twice in one set", shown.display()),
+            ));
+        }
+        let file = File::create_new(self.staging.path().join(name)).map_err(|e| Error::io(&shown, e))?;
+        let mut writer = BufWriter::new(file);
+        write(&mut writer)?;
+        writer.flush().map_err(|e| Error::io(&shown, e))?;
+        let file = writer.into_inner().map_err(|e| Error::io(&shown, e.into_error()))?;
+        file.sync_all().map_err(|e| Error::io(&shown, e))?;
+        self.written.push(name.to_string());
+        Ok(shown)
+    }
+
+    /// Renames every staged file into the destination and returns the final paths: files put
+    /// into [`FileSet::staging`] directly first (by name), then those of [`FileSet::write`] in
+    /// the order written (so a completion marker written last lands last). Before the first
+    /// rename, every destination is checked not to be a folder. Nothing is renamed if the
+    /// staging folder holds anything but regular files.
+    pub fn commit(self) -> Result<Vec<PathBuf>> {
+        let mut direct = Vec::new();
+        let entries = fs::read_dir(self.staging.path()).map_err(|e| Error::io(&self.shown, e))?;
+        for e in entries {
+            let e = e.map_err(|e| Error::io(&self.shown, e))?;
+            let name = e.file_name().to_str().map(str::to_string).ok_or_else(|| {
+                Error::param(
+                    "output name",
+                    format!("non-UTF-8 name staged for {}", self.shown.display()),
+                )
+            })?;
+            let regular = e.file_type().map(|t| t.is_file()).unwrap_or(false);
+            if !regular {
+                return Err(Error::io(
+                    self.final_path(&name),
+                    io::Error::new(io::ErrorKind::InvalidInput, "staged output is not a regular file"),
+                ));
+            }
+            if !self.written.contains(&name) {
+                check_plain_name(&name, &self.shown)?;
+                direct.push(name);
+            }
+        }
+        direct.sort();
+        let order: Vec<String> = direct.into_iter().chain(self.written.iter().cloned()).collect();
+        for name in &order {
+            if fs::symlink_metadata(self.dir.join(name)).is_ok_and(|m| m.is_dir()) {
+                return Err(Error::io(
+                    self.final_path(name),
+                    io::Error::new(io::ErrorKind::IsADirectory, "a folder is in the way of this output"),
+                ));
+            }
+        }
+        let mut done = Vec::with_capacity(order.len());
+        for name in &order {
+            fs::rename(self.staging.path().join(name), self.dir.join(name))
+                .map_err(|e| Error::io(self.final_path(name), e))?;
+            done.push(self.final_path(name));
+        }
+        // Make the renames durable; failure to sync the folder is not worth failing the run.
+        if let Ok(d) = File::open(&self.dir) {
+            let _ = d.sync_all();
+        }
+        self.staging.close().map_err(|e| Error::io(&self.shown, e))?;
+        Ok(done)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::io::test_util::{list_dir, scratch_dir};
+
+    fn text(s: &'static str) -> impl FnOnce(&mut BufWriter<File>) -> Result<()> {
+        move |w| w.write_all(s.as_bytes()).map_err(|e| Error::io("x", e))
+    }
+
+    #[test]
+    fn all_files_appear_on_commit_only() {
+        let root = scratch_dir("set-ok");
+        let out = OutDir::prepare(&root.join("out")).unwrap();
+        let mut set = out.file_set().unwrap();
+        set.write("b.txt", text("b")).unwrap();
+        fs::write(set.staging().join("a.txt"), "a").unwrap();
+        set.write("manifest.json", text("{}")).unwrap();
+        assert_eq!(
+            list_dir(out.real_path()).len(),
+            1,
+            "only the staging folder before commit"
+        );
+        let done = set.commit().unwrap();
+        let names: Vec<_> = done.iter().map(|p| p.file_name().unwrap().to_str().unwrap()).collect();
+        assert_eq!(names, ["a.txt", "b.txt", "manifest.json"]);
+        assert_eq!(list_dir(out.real_path()), ["a.txt", "b.txt", "manifest.json"]);
+        assert!(done[0].starts_with(root.join("out")));
+    }
+
+    #[test]
+    fn failed_or_dropped_set_keeps_previous_files() {
+        let dir = scratch_dir("set-fail");
+        fs::write(dir.join("a.txt"), "old a").unwrap();
+        fs::write(dir.join("b.txt"), "old b").unwrap();
+        let mut set = FileSet::new(&dir).unwrap();
+        set.write("a.txt", text("new a")).unwrap();
+        let err = set.write("b.txt", |_| Err(Error::encode("b.txt", "boom"))).unwrap_err();
+        assert!(err.to_string().contains("boom"));
+        let e = set.final_error(Error::encode(set.staging().join("c.png"), "x"));
+        assert_eq!(
+            e.to_string(),
+            format!("{}: cannot encode: x", dir.join("c.png").display())
+        );
+        drop(set);
+        assert_eq!(fs::read_to_string(dir.join("a.txt")).unwrap(), "old a");
+        assert_eq!(list_dir(&dir), ["a.txt", "b.txt"]);
+    }
+
+    #[test]
+    fn commit_refuses_a_folder_in_the_way_before_renaming_anything() {
+        let dir = scratch_dir("set-dir");
+        fs::create_dir(dir.join("b.txt")).unwrap();
+        let mut set = FileSet::new(&dir).unwrap();
+        set.write("a.txt", text("a")).unwrap();
+        set.write("b.txt", text("b")).unwrap();
+        let err = set.commit().unwrap_err().to_string();
+        assert!(err.contains("b.txt") && err.contains("folder"), "{err}");
+        assert_eq!(list_dir(&dir), ["b.txt"]);
+    }
+
+    #[test]
+    fn names_must_be_plain() {
+        let dir = scratch_dir("set-names");
+        let mut set = FileSet::new(&dir).unwrap();
+        for bad in ["../x", "a/b", "", ".", "..", "/abs", ".viewsynth-1-x"] {
+            assert!(set.write(bad, text("x")).is_err(), "{bad}");
+        }
+        set.write("a", text("1")).unwrap();
+        assert!(set.write("a", text("2")).unwrap_err().to_string().contains("twice"));
+    }
+
+    #[test]
+    fn subdir_refuses_symlinks_and_files() {
+        let root = scratch_dir("set-subdir");
+        let elsewhere = root.join("elsewhere");
+        fs::create_dir(&elsewhere).unwrap();
+        let out = OutDir::prepare(&root.join("out")).unwrap();
+        std::os::unix::fs::symlink(&elsewhere, out.real_path().join("frame")).unwrap();
+        let err = out.subdir("frame").unwrap_err().to_string();
+        assert!(err.contains("frame") && err.contains("symlink"), "{err}");
+        fs::write(out.real_path().join("file"), "").unwrap();
+        assert!(out.subdir("file").is_err());
+        assert!(out.subdir("../elsewhere").is_err());
+        let sub = out.subdir("ok").unwrap();
+        sub.file_set().unwrap().commit().unwrap();
+        assert!(list_dir(&elsewhere).is_empty());
+        assert_eq!(list_dir(sub.real_path()), Vec::<String>::new());
+    }
+
+    #[test]
+    fn prepare_follows_a_symlinked_root() {
+        let root = scratch_dir("set-root-link");
+        fs::create_dir(root.join("real")).unwrap();
+        std::os::unix::fs::symlink(root.join("real"), root.join("link")).unwrap();
+        let out = OutDir::prepare(&root.join("link")).unwrap();
+        assert_eq!(out.path(), root.join("link"));
+        assert_eq!(out.real_path(), fs::canonicalize(root.join("real")).unwrap());
+    }
+}
