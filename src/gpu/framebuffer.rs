@@ -5,6 +5,9 @@ use crate::error::{Error, Result};
 use glow::HasContext;
 use std::cell::RefCell;
 
+/// GL_PACK_INVERT_MESA (GL_MESA_pack_invert): glReadPixels returns rows top row first.
+const PACK_INVERT_MESA: u32 = 0x8758;
+
 /// One colour attachment: its format and the value it is cleared to.
 #[derive(Debug, Clone, Copy)]
 pub struct Attachment {
@@ -150,7 +153,10 @@ impl Framebuffer {
         let gl = self.gpu.gl();
         let at = glow::COLOR_ATTACHMENT0 + index as u32;
         let (w, h) = (self.width as i32, self.height as i32);
-        let source = if flip_rows {
+        // Mesa packs rows in reverse while copying (GL_MESA_pack_invert): no extra pass, which
+        // on a software rasteriser costs as much as the draw. Elsewhere a GPU blit flips.
+        let pack_invert = flip_rows && self.gpu.has_pack_invert();
+        let source = if flip_rows && !pack_invert {
             let mut flipped = self.flipped.borrow_mut();
             if flipped.is_none() {
                 let attachments: Vec<Option<Attachment>> = self
@@ -194,9 +200,18 @@ impl Framebuffer {
             gl.bind_framebuffer(glow::READ_FRAMEBUFFER, Some(source));
             gl.read_buffer(at);
         }
+        if pack_invert {
+            // SAFETY: a pixel-store flag of GL_MESA_pack_invert, reset right after the read.
+            unsafe { gl.pixel_store_i32(PACK_INVERT_MESA, 1) };
+        }
         let read = PendingRead::queue(&self.gpu, self.width, self.height, layout);
-        // SAFETY: unbinding is always valid.
-        unsafe { gl.bind_framebuffer(glow::READ_FRAMEBUFFER, None) };
+        // SAFETY: resetting pixel-store state and unbinding are always valid.
+        unsafe {
+            if pack_invert {
+                gl.pixel_store_i32(PACK_INVERT_MESA, 0);
+            }
+            gl.bind_framebuffer(glow::READ_FRAMEBUFFER, None);
+        }
         Ok(Some(read?))
     }
 

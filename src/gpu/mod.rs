@@ -39,6 +39,9 @@ pub struct Gpu(Rc<GpuInner>);
 pub(crate) struct GpuInner {
     ctx: EglContext,
     readback: RefCell<readback::ReadbackPool>,
+    /// GL_MESA_pack_invert is supported and in use: glReadPixels reverses rows while packing.
+    pack_invert: std::cell::Cell<bool>,
+    pack_invert_supported: bool,
 }
 
 impl Drop for GpuInner {
@@ -61,9 +64,12 @@ impl Gpu {
         let policy = policy.with_env()?;
         let ctx = EglContext::new(choice)?;
         policy.check(&ctx.info)?;
+        let pack_invert = ctx.gl.supported_extensions().contains("GL_MESA_pack_invert");
         Ok(Gpu(Rc::new(GpuInner {
             ctx,
             readback: RefCell::default(),
+            pack_invert: std::cell::Cell::new(pack_invert),
+            pack_invert_supported: pack_invert,
         })))
     }
 
@@ -79,6 +85,17 @@ impl Gpu {
     pub fn clip_control(&self, origin: u32, depth: u32) {
         // SAFETY: GL 4.5 entry point with two enum arguments; the context is current.
         unsafe { (self.0.ctx.clip_control)(origin, depth) }
+    }
+
+    /// Whether reads can flip rows while packing (GL_MESA_pack_invert); otherwise a blit does.
+    pub fn has_pack_invert(&self) -> bool {
+        self.0.pack_invert.get()
+    }
+
+    /// Use GL_MESA_pack_invert where supported (the default) or the blit: tests and benchmarks
+    /// compare the two flip paths on one context.
+    pub fn use_pack_invert(&self, on: bool) {
+        self.0.pack_invert.set(on && self.0.pack_invert_supported);
     }
 
     /// Fail on any pending GL error, naming what was being done.

@@ -45,7 +45,9 @@ fn layouts_and_row_flip_match_the_uploaded_bytes() {
     fb.colors[2].as_ref().unwrap().upload(&bytes).unwrap();
     let rgb: Vec<u8> = rgba.chunks(4).flat_map(|p| [p[0], p[1], p[2]]).collect();
     let flip = |v: &[u8], row: usize| -> Vec<u8> { v.chunks(row).rev().flatten().copied().collect() };
-    for flipped in [false, true] {
+    // Both flip paths: the GPU blit (what NVIDIA uses) and GL_MESA_pack_invert where Mesa has it.
+    for (flipped, pack_invert) in [(false, false), (true, false), (true, true)] {
+        g.use_pack_invert(pack_invert);
         // All three queued before any is waited for: several reads in flight.
         let a = fb.read_async(0, ReadFormat::RGB8, flipped).unwrap().unwrap();
         let b = fb.read_async(1, ReadFormat::R32F, flipped).unwrap().unwrap();
@@ -65,6 +67,7 @@ fn layouts_and_row_flip_match_the_uploaded_bytes() {
         }
         assert_eq!(got_z, want_z, "f32 readback must be bit-exact (flipped {flipped})");
     }
+    g.use_pack_invert(true);
     // The synchronous helper goes through the same path.
     assert_eq!(fb.read_color(0).unwrap().unwrap(), rgba);
 }
