@@ -190,24 +190,19 @@ pub fn cyclopean_bench(
         warp.render(&mid)?;
         runs.push(t0.elapsed().as_secs_f64() * 1e3);
     }
-    let m = median(runs);
-    cases.push(BenchCase::new(
-        "cyclopean",
-        crate::evaluation::FORWARD_NAME,
-        format!("{width}x{height}"),
-        Some(setup),
-        m,
-    ));
-    writeln!(t, "| {} | {setup:.1} | {m:.1} |", crate::evaluation::FORWARD_NAME).expect("write to String");
-    let (setup, m) = crate::evaluation::splat_gather_bench(gpu, &frame, &mid, repeats)?;
-    let name = crate::evaluation::SPLAT_NAME;
-    cases.push(BenchCase::new(
-        "cyclopean",
-        name,
-        format!("{width}x{height}"),
-        Some(setup),
-        m,
-    ));
-    writeln!(t, "| {name} | {setup:.1} | {m:.1} |").expect("write to String");
+    let splat = crate::evaluation::splat_gather_bench(gpu, &frame, &mid, repeats)?;
+    for (name, (setup, m)) in [
+        (crate::evaluation::FORWARD_NAME, (setup, median(runs))),
+        (crate::evaluation::SPLAT_NAME, splat),
+    ] {
+        cases.push(BenchCase::new(
+            "cyclopean",
+            name,
+            format!("{width}x{height}"),
+            Some(setup),
+            m,
+        ));
+        writeln!(t, "| {name} | {setup:.1} | {m:.1} |").expect("write to String");
+    }
     Ok(t)
 }

@@ -112,18 +112,22 @@ pub(crate) fn open_npy(path: &Path, max_values: u64) -> Result<NpyFile> {
 /// Reads exactly the payload the header declared.
 pub(crate) fn read_npy(path: &Path, mut f: NpyFile) -> Result<NpyArray> {
     let payload = read_body(path, &mut f.file, f.data_offset as u64, f.need)?;
-    let h = f.header;
+    Ok(decode_payload(f.header, &payload))
+}
+
+/// Values of a payload whose length matches the header, in C order.
+fn decode_payload(h: Header, payload: &[u8]) -> NpyArray {
     let data: Vec<f64> = payload.chunks_exact(h.item_size).map(h.decode).collect();
     let data = if h.fortran_order {
         fortran_to_c(&h.shape, &data)
     } else {
         data
     };
-    Ok(NpyArray {
+    NpyArray {
         shape: h.shape,
         dtype: h.dtype,
         data,
-    })
+    }
 }
 
 /// The `.npy` bytes of an `.npz` member (already in memory, its size bounded by the archive
@@ -160,17 +164,7 @@ pub(crate) fn decode_npy(bytes: &[u8]) -> std::result::Result<NpyArray, String> 
             payload.len()
         )));
     }
-    let data: Vec<f64> = payload.chunks_exact(h.item_size).map(h.decode).collect();
-    let data = if h.fortran_order {
-        fortran_to_c(&h.shape, &data)
-    } else {
-        data
-    };
-    Ok(NpyArray {
-        shape: h.shape,
-        dtype: h.dtype,
-        data,
-    })
+    Ok(decode_payload(h, payload))
 }
 
 /// (bytes before the header dict, its length) from the file's first bytes.
