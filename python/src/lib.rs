@@ -3,6 +3,7 @@
 
 mod arrays;
 mod context;
+mod cyclopean;
 mod errors;
 mod renderer;
 
