@@ -6,6 +6,7 @@ mod context;
 mod cyclopean;
 mod errors;
 mod renderer;
+mod reproject;
 
 use pyo3::prelude::*;
 use viewsynth::gpu::GpuInfo;

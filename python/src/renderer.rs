@@ -1,5 +1,5 @@
 //! `viewsynth.Renderer`: one EGL context (shared per thread, see `context`), the refocus call and
-//! the cyclopean call (its work in `cyclopean`).
+//! the cyclopean and reproject calls (their work in `cyclopean`, `reproject`).
 
 use crate::arrays;
 use crate::context;
@@ -132,7 +132,8 @@ impl<T> Drop for ThreadBound<T> {
 }
 
 /// An OpenGL 4.5 context over EGL (a GPU, or Mesa's llvmpipe on the CPU) for refocusing numpy
-/// RGB-D frames (refocus) and synthesising in-between views of stereo pairs (cyclopean).
+/// RGB-D frames (refocus), synthesising in-between views of stereo pairs (cyclopean) and
+/// reprojecting a view of a stereo rig to the other eye (reproject).
 ///
 /// device: "auto" (the CUDA_VISIBLE_DEVICES GPU, else EGL device 0, else Mesa surfaceless),
 /// "surfaceless", or an EGL device index as a string ("0", "1", ...).
@@ -455,6 +456,80 @@ impl Renderer {
                 focal,
                 baseline,
                 doffs,
+                outputs,
+            },
+        )
+    }
+
+    /// Reproject one view of a parallel stereo rig (left eye, centre view or right eye) to the
+    /// other eye(s) from colour + depth: the library calls of `viewsynth reproject` with a rig
+    /// (--baseline or --separation/--convergence). Disocclusions stay invalid (no hole filling).
+    ///
+    /// rgb: uint8[H, W, 3]; depth: float32[H, W] holding depth_kind: "view-z" (metres; 0, NaN,
+    /// inf or negative = none), "device" (window depth in [0, 1] written with near and far,
+    /// OpenGL conventions; the far value is background) or "disparity" (pixels; Z = baseline *
+    /// focal / (d + doffs), d <= 0 unknown). K: 3x3 pinhole of the source, as for refocus.
+    /// The rig: baseline (metres; x_right = x_left + doffs - f B / Z) with focal (pixels,
+    /// default K's fx) and doffs (cx_right - cx_left), or a game-engine separation and
+    /// convergence (metres).
+    /// source: "left", "centre" or "right"; target: "left", "right" or "both" (from the centre).
+    /// method: "shift-scan" (exact, default), "shift" or "gather3d" (both with steps, 1..=16).
+    /// tau_rel: a row segment breaks where |Za - Zb| > tau_rel * min(Za, Zb).
+    /// outputs: any of "rgb", "depth", "mask" (default all three).
+    ///
+    /// Returns {"left": view, "right": view} for the targets rendered, each view a dict:
+    /// "coverage", "timings" (setup_ms, render_ms, gpu_ms) and the requested arrays "rgb"
+    /// uint8[H, W, 3], "depth" float32[H, W] (the target's Z in metres, 0 where invalid),
+    /// "mask" bool[H, W].
+    ///
+    /// Raises InvalidInputError (a ValueError) naming the argument for a wrong dtype, shape,
+    /// layout or value; GpuError if the GPU fails.
+    #[allow(non_snake_case, clippy::too_many_arguments)]
+    #[pyo3(signature = (rgb, depth, K, *, depth_kind = "view-z", baseline = None, focal = None, doffs = 0.0,
+                        separation = None, convergence = None, near = None, far = None, source = "left",
+                        target = "right", method = "shift-scan", steps = 3, tau_rel = 0.05, outputs = None))]
+    fn reproject<'py>(
+        &mut self,
+        py: Python<'py>,
+        rgb: &Bound<'py, PyAny>,
+        depth: &Bound<'py, PyAny>,
+        K: &Bound<'py, PyAny>,
+        depth_kind: &str,
+        baseline: Option<f64>,
+        focal: Option<f64>,
+        doffs: f64,
+        separation: Option<f64>,
+        convergence: Option<f64>,
+        near: Option<f64>,
+        far: Option<f64>,
+        source: &str,
+        target: &str,
+        method: &str,
+        steps: u32,
+        tau_rel: f64,
+        outputs: Option<&Bound<'py, PyAny>>,
+    ) -> PyResult<Bound<'py, PyDict>> {
+        let gpu = self.gpu()?.clone();
+        crate::reproject::reproject(
+            py,
+            gpu,
+            crate::reproject::ReprojectArgs {
+                rgb,
+                depth,
+                k: K,
+                depth_kind,
+                baseline,
+                focal,
+                doffs,
+                separation,
+                convergence,
+                near,
+                far,
+                source,
+                target,
+                method,
+                steps,
+                tau_rel,
                 outputs,
             },
         )

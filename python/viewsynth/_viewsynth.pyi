@@ -42,9 +42,18 @@ class CyclopeanView(TypedDict, total=False):
     depth: npt.NDArray[np.float32]
     mask: npt.NDArray[np.bool_]
 
+class ReprojectedView(TypedDict, total=False):
+    """One target eye of Renderer.reproject. "rgb", "depth", "mask" are present when requested."""
+
+    coverage: float
+    timings: CyclopeanTimings
+    rgb: npt.NDArray[np.uint8]
+    depth: npt.NDArray[np.float32]
+    mask: npt.NDArray[np.bool_]
+
 class Renderer:
-    """An OpenGL 4.5 context over EGL for refocusing numpy RGB-D frames and synthesising
-    in-between views of rectified stereo pairs.
+    """An OpenGL 4.5 context over EGL for refocusing numpy RGB-D frames, synthesising
+    in-between views of rectified stereo pairs and reprojecting a view to the other eye.
 
     Thread-affine (WrongThreadError on another thread; open one per thread) and process-affine
     (create it inside each worker; with "fork" workers only if the parent never opened one,
@@ -101,6 +110,31 @@ class Renderer:
         each eye's rgb uint8[H, W, 3] and disparity float32[H, W] (pixels, 0 = unknown), as
         `viewsynth cyclopean --left-disparity ...`. Depth (metres) needs focal and baseline.
         See help(viewsynth.Renderer.cyclopean)."""
+        ...
+    def reproject(
+        self,
+        rgb: npt.NDArray[np.uint8],
+        depth: npt.NDArray[np.float32],
+        K: ArrayLike3x3,
+        *,
+        depth_kind: Literal["view-z", "device", "disparity"] = "view-z",
+        baseline: Optional[float] = None,
+        focal: Optional[float] = None,
+        doffs: float = 0.0,
+        separation: Optional[float] = None,
+        convergence: Optional[float] = None,
+        near: Optional[float] = None,
+        far: Optional[float] = None,
+        source: Literal["left", "centre", "center", "right"] = "left",
+        target: Literal["left", "right", "both"] = "right",
+        method: Literal["shift-scan", "shift", "gather3d"] = "shift-scan",
+        steps: int = 3,
+        tau_rel: float = 0.05,
+        outputs: Optional[Union[OutputName, Sequence[OutputName]]] = None,
+    ) -> Dict[str, ReprojectedView]:
+        """Reproject a view of a parallel stereo rig (baseline=..., or separation= and
+        convergence=) to the other eye(s), as `viewsynth reproject` with a rig: returns
+        {"left": ..., "right": ...} for the targets. See help(viewsynth.Renderer.reproject)."""
         ...
 
 def info(device: str = "auto") -> Dict[str, Any]:
