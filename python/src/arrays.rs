@@ -68,28 +68,29 @@ fn size(shape: &[usize], name: &str) -> PyResult<(u32, u32)> {
     Ok((w, h))
 }
 
-/// uint8[H, W, 3] -> RgbImage (one copy).
-pub fn rgb_image(obj: &Bound<'_, PyAny>) -> PyResult<RgbImage> {
-    let array = checked::<u8>(obj, "rgb", 3, "uint8[H, W, 3]")?;
+/// uint8[H, W, 3] -> RgbImage (one copy); `name` is the argument named in errors.
+pub fn rgb_image(obj: &Bound<'_, PyAny>, name: &str) -> PyResult<RgbImage> {
+    let array = checked::<u8>(obj, name, 3, "uint8[H, W, 3]")?;
     let shape = array.shape().to_vec();
     if shape[2] != 3 {
         return Err(errors::invalid(
-            "rgb",
+            name,
             format!(
                 "shape {} but expected uint8[H, W, 3] (RGB, no alpha)",
                 shape_text(&shape)
             ),
         ));
     }
-    let (w, h) = size(&shape, "rgb")?;
+    let (w, h) = size(&shape, name)?;
     let data = array.readonly().as_slice()?.to_vec();
     RgbImage::new(w, h, data).map_err(errors::from_library)
 }
 
-/// float32[H, W] metric depth (view-space Z in metres; 0, NaN, inf or negative = no depth).
-pub fn depth_map(obj: &Bound<'_, PyAny>) -> PyResult<DepthMap> {
-    let array = checked::<f32>(obj, "depth", 2, "float32[H, W]")?;
-    let (w, h) = size(array.shape(), "depth")?;
+/// float32[H, W] -> DepthMap (one copy): metric depth (view-space Z in metres; 0, NaN, inf or
+/// negative = no depth) or disparity (pixels), as `name` says.
+pub fn float_map(obj: &Bound<'_, PyAny>, name: &str) -> PyResult<DepthMap> {
+    let array = checked::<f32>(obj, name, 2, "float32[H, W]")?;
+    let (w, h) = size(array.shape(), name)?;
     let data = array.readonly().as_slice()?.to_vec();
     DepthMap::new(w, h, data).map_err(errors::from_library)
 }

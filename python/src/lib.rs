@@ -3,8 +3,10 @@
 
 mod arrays;
 mod context;
+mod cyclopean;
 mod errors;
 mod renderer;
+mod reproject;
 
 use pyo3::prelude::*;
 use viewsynth::gpu::GpuInfo;

@@ -1,4 +1,5 @@
-//! `viewsynth.Renderer`: one EGL context (shared per thread, see `context`) and the refocus call.
+//! `viewsynth.Renderer`: one EGL context (shared per thread, see `context`), the refocus call and
+//! the cyclopean and reproject calls (their work in `cyclopean`, `reproject`).
 
 use crate::arrays;
 use crate::context;
@@ -15,7 +16,7 @@ use viewsynth::refocus::{BreakRule, Method, OutputSet, RefocusOutput, RefocusSou
 /// The `Gpu` inside is an `Rc`: it is sound here because nothing else can reach it while the GIL
 /// is released (the Renderer's handle is `ThreadBound`, refused to every other thread, and the
 /// call holds a mutable borrow of the Renderer until detach returns).
-struct SameThread<T>(T);
+pub(crate) struct SameThread<T>(pub(crate) T);
 // SAFETY: see above; the value never leaves the thread that made it.
 unsafe impl<T> Send for SameThread<T> {}
 
@@ -58,7 +59,7 @@ fn coverage(out: &RefocusOutput) -> Option<f64> {
         .map(|d| d.data.iter().filter(|z| **z > 0.0).count() as f64 / d.data.len() as f64)
 }
 
-fn output_set(obj: Option<&Bound<'_, PyAny>>) -> PyResult<OutputSet> {
+pub(crate) fn output_set(obj: Option<&Bound<'_, PyAny>>) -> PyResult<OutputSet> {
     let Some(obj) = obj else {
         return Ok(OutputSet::default());
     };
@@ -131,7 +132,8 @@ impl<T> Drop for ThreadBound<T> {
 }
 
 /// An OpenGL 4.5 context over EGL (a GPU, or Mesa's llvmpipe on the CPU) for refocusing numpy
-/// RGB-D frames.
+/// RGB-D frames (refocus), synthesising in-between views of stereo pairs (cyclopean) and
+/// reprojecting a view of a stereo rig to the other eye (reproject).
 ///
 /// device: "auto" (the CUDA_VISIBLE_DEVICES GPU, else EGL device 0, else Mesa surfaceless),
 /// "surfaceless", or an EGL device index as a string ("0", "1", ...).
@@ -317,8 +319,8 @@ impl Renderer {
     ) -> PyResult<Bound<'py, PyList>> {
         let gpu = self.gpu()?.clone();
         let k = arrays::intrinsics(K, "K")?;
-        let source =
-            RefocusSource::new(arrays::rgb_image(rgb)?, arrays::depth_map(depth)?, k).map_err(errors::from_library)?;
+        let source = RefocusSource::new(arrays::rgb_image(rgb, "rgb")?, arrays::float_map(depth, "depth")?, k)
+            .map_err(errors::from_library)?;
         let rule = BreakRule { tau_rel, tau_abs };
         rule.validate().map_err(errors::from_library)?;
         let method: Method = method.parse().map_err(errors::from_library)?;
@@ -399,5 +401,137 @@ impl Renderer {
             list.append(d)?;
         }
         Ok(list)
+    }
+
+    /// Synthesise an in-between view of a rectified stereo pair from each eye's colour and
+    /// disparity (the library calls of `viewsynth cyclopean --left-disparity ...`).
+    ///
+    /// left_rgb, right_rgb: uint8[H, W, 3], C-contiguous. left_disparity: float32[H, W], pixels,
+    /// x_right = x_left - d; right_disparity: float32[H, W], x_left = x_right + d (an array of
+    /// zeros if the right eye has none). 0, negative or non-finite = unknown. Scale integer
+    /// disparities to pixels first (Middlebury 2003 PGMs: / 4).
+    /// position: where the view sits, 0 = left eye, 0.5 = middle, 1 = right eye.
+    /// method: "splat-gather" (default, the best on real stereo), "seed", "refine" (3 steps) or
+    /// "forward", as the CLI's --method with its defaults.
+    /// focal (pixels) and baseline (metres): both or neither; with them the view's metric
+    /// depth can be asked for (without them only f B matters, and nominal values are used).
+    /// doffs: right principal point minus left, pixels (Middlebury 2014): depth = f B / (d + doffs).
+    /// outputs: any of "rgb", "depth", "mask" (default rgb and mask, plus depth with focal).
+    ///
+    /// Returns a dict: "coverage" (fraction of pixels some eye saw), "timings" (setup_ms:
+    /// uploads and set-up; render_ms; gpu_ms, None where GPU timers are not meaningful), and the
+    /// requested arrays: "rgb" uint8[H, W, 3], "depth" float32[H, W] (the view's Z in metres, 0
+    /// where invalid), "mask" bool[H, W] (True where some eye saw the surface).
+    ///
+    /// Raises InvalidInputError (a ValueError) naming the argument for a wrong dtype, shape,
+    /// layout or value; GpuError if the GPU fails.
+    #[allow(clippy::too_many_arguments)]
+    #[pyo3(signature = (left_rgb, right_rgb, left_disparity, right_disparity, position = 0.5, *,
+                        method = "splat-gather", focal = None, baseline = None, doffs = 0.0, outputs = None))]
+    fn cyclopean<'py>(
+        &mut self,
+        py: Python<'py>,
+        left_rgb: &Bound<'py, PyAny>,
+        right_rgb: &Bound<'py, PyAny>,
+        left_disparity: &Bound<'py, PyAny>,
+        right_disparity: &Bound<'py, PyAny>,
+        position: f64,
+        method: &str,
+        focal: Option<f64>,
+        baseline: Option<f64>,
+        doffs: f64,
+        outputs: Option<&Bound<'py, PyAny>>,
+    ) -> PyResult<Bound<'py, PyDict>> {
+        let gpu = self.gpu()?.clone();
+        crate::cyclopean::cyclopean(
+            py,
+            gpu,
+            crate::cyclopean::CyclopeanArgs {
+                left_rgb,
+                right_rgb,
+                left_disparity,
+                right_disparity,
+                position,
+                method,
+                focal,
+                baseline,
+                doffs,
+                outputs,
+            },
+        )
+    }
+
+    /// Reproject one view of a parallel stereo rig (left eye, centre view or right eye) to the
+    /// other eye(s) from colour + depth: the library calls of `viewsynth reproject` with a rig
+    /// (--baseline or --separation/--convergence). Disocclusions stay invalid (no hole filling).
+    ///
+    /// rgb: uint8[H, W, 3]; depth: float32[H, W] holding depth_kind: "view-z" (metres; 0, NaN,
+    /// inf or negative = none), "device" (window depth in [0, 1] written with near and far,
+    /// OpenGL conventions; the far value is background) or "disparity" (pixels; Z = baseline *
+    /// focal / (d + doffs), d <= 0 unknown). K: 3x3 pinhole of the source, as for refocus.
+    /// The rig: baseline (metres; x_right = x_left + doffs - f B / Z) with focal (pixels,
+    /// default K's fx) and doffs (cx_right - cx_left), or a game-engine separation and
+    /// convergence (metres).
+    /// source: "left", "centre" or "right"; target: "left", "right" or "both" (from the centre).
+    /// method: "shift-scan" (exact, default), "shift" or "gather3d" (both with steps, 1..=16).
+    /// tau_rel: a row segment breaks where |Za - Zb| > tau_rel * min(Za, Zb).
+    /// outputs: any of "rgb", "depth", "mask" (default all three).
+    ///
+    /// Returns {"left": view, "right": view} for the targets rendered, each view a dict:
+    /// "coverage", "timings" (setup_ms, render_ms, gpu_ms) and the requested arrays "rgb"
+    /// uint8[H, W, 3], "depth" float32[H, W] (the target's Z in metres, 0 where invalid),
+    /// "mask" bool[H, W].
+    ///
+    /// Raises InvalidInputError (a ValueError) naming the argument for a wrong dtype, shape,
+    /// layout or value; GpuError if the GPU fails.
+    #[allow(non_snake_case, clippy::too_many_arguments)]
+    #[pyo3(signature = (rgb, depth, K, *, depth_kind = "view-z", baseline = None, focal = None, doffs = 0.0,
+                        separation = None, convergence = None, near = None, far = None, source = "left",
+                        target = "right", method = "shift-scan", steps = 3, tau_rel = 0.05, outputs = None))]
+    fn reproject<'py>(
+        &mut self,
+        py: Python<'py>,
+        rgb: &Bound<'py, PyAny>,
+        depth: &Bound<'py, PyAny>,
+        K: &Bound<'py, PyAny>,
+        depth_kind: &str,
+        baseline: Option<f64>,
+        focal: Option<f64>,
+        doffs: f64,
+        separation: Option<f64>,
+        convergence: Option<f64>,
+        near: Option<f64>,
+        far: Option<f64>,
+        source: &str,
+        target: &str,
+        method: &str,
+        steps: u32,
+        tau_rel: f64,
+        outputs: Option<&Bound<'py, PyAny>>,
+    ) -> PyResult<Bound<'py, PyDict>> {
+        let gpu = self.gpu()?.clone();
+        crate::reproject::reproject(
+            py,
+            gpu,
+            crate::reproject::ReprojectArgs {
+                rgb,
+                depth,
+                k: K,
+                depth_kind,
+                baseline,
+                focal,
+                doffs,
+                separation,
+                convergence,
+                near,
+                far,
+                source,
+                target,
+                method,
+                steps,
+                tau_rel,
+                outputs,
+            },
+        )
     }
 }

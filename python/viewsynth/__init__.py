@@ -4,6 +4,8 @@
     r = vs.Renderer()                        # one EGL context (GPU, or Mesa llvmpipe)
     views = r.refocus(rgb, depth, K, scales=[0.5, 2.0])
     views[0]["rgb"], views[0]["depth"], views[0]["mask"], views[0]["K"]
+    mid = r.cyclopean(left_rgb, right_rgb, left_disparity, right_disparity, position=0.5)
+    right = r.reproject(rgb, depth, K, baseline=0.1)["right"]
 
 A Renderer belongs to the thread that created it, and to the process that created it:
 see the Renderer docstring for threads, fork and spawn.

@@ -28,8 +28,32 @@ class RefocusView(TypedDict, total=False):
     depth: npt.NDArray[np.float32]
     mask: npt.NDArray[np.bool_]
 
+class CyclopeanTimings(TypedDict):
+    setup_ms: float
+    render_ms: float
+    gpu_ms: Optional[float]
+
+class CyclopeanView(TypedDict, total=False):
+    """Renderer.cyclopean's result. "rgb", "depth", "mask" are present when requested."""
+
+    coverage: float
+    timings: CyclopeanTimings
+    rgb: npt.NDArray[np.uint8]
+    depth: npt.NDArray[np.float32]
+    mask: npt.NDArray[np.bool_]
+
+class ReprojectedView(TypedDict, total=False):
+    """One target eye of Renderer.reproject. "rgb", "depth", "mask" are present when requested."""
+
+    coverage: float
+    timings: CyclopeanTimings
+    rgb: npt.NDArray[np.uint8]
+    depth: npt.NDArray[np.float32]
+    mask: npt.NDArray[np.bool_]
+
 class Renderer:
-    """An OpenGL 4.5 context over EGL for refocusing numpy RGB-D frames.
+    """An OpenGL 4.5 context over EGL for refocusing numpy RGB-D frames, synthesising
+    in-between views of rectified stereo pairs and reprojecting a view to the other eye.
 
     Thread-affine (WrongThreadError on another thread; open one per thread) and process-affine
     (create it inside each worker; with "fork" workers only if the parent never opened one,
@@ -67,6 +91,50 @@ class Renderer:
         """Re-render rgb uint8[H, W, 3] + depth float32[H, W] (metres) with intrinsics K at
         other focal lengths (scales=[...] or K_out=[...]), same pose. size is (width, height).
         See help(viewsynth.Renderer.refocus)."""
+        ...
+    def cyclopean(
+        self,
+        left_rgb: npt.NDArray[np.uint8],
+        right_rgb: npt.NDArray[np.uint8],
+        left_disparity: npt.NDArray[np.float32],
+        right_disparity: npt.NDArray[np.float32],
+        position: float = 0.5,
+        *,
+        method: Literal["splat-gather", "seed", "refine", "forward"] = "splat-gather",
+        focal: Optional[float] = None,
+        baseline: Optional[float] = None,
+        doffs: float = 0.0,
+        outputs: Optional[Union[OutputName, Sequence[OutputName]]] = None,
+    ) -> CyclopeanView:
+        """Synthesise the view at position t (0 = left eye, 1 = right) of a rectified pair from
+        each eye's rgb uint8[H, W, 3] and disparity float32[H, W] (pixels, 0 = unknown), as
+        `viewsynth cyclopean --left-disparity ...`. Depth (metres) needs focal and baseline.
+        See help(viewsynth.Renderer.cyclopean)."""
+        ...
+    def reproject(
+        self,
+        rgb: npt.NDArray[np.uint8],
+        depth: npt.NDArray[np.float32],
+        K: ArrayLike3x3,
+        *,
+        depth_kind: Literal["view-z", "device", "disparity"] = "view-z",
+        baseline: Optional[float] = None,
+        focal: Optional[float] = None,
+        doffs: float = 0.0,
+        separation: Optional[float] = None,
+        convergence: Optional[float] = None,
+        near: Optional[float] = None,
+        far: Optional[float] = None,
+        source: Literal["left", "centre", "center", "right"] = "left",
+        target: Literal["left", "right", "both"] = "right",
+        method: Literal["shift-scan", "shift", "gather3d"] = "shift-scan",
+        steps: int = 3,
+        tau_rel: float = 0.05,
+        outputs: Optional[Union[OutputName, Sequence[OutputName]]] = None,
+    ) -> Dict[str, ReprojectedView]:
+        """Reproject a view of a parallel stereo rig (baseline=..., or separation= and
+        convergence=) to the other eye(s), as `viewsynth reproject` with a rig: returns
+        {"left": ..., "right": ...} for the targets. See help(viewsynth.Renderer.reproject)."""
         ...
 
 def info(device: str = "auto") -> Dict[str, Any]:

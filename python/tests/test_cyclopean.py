@@ -1,0 +1,175 @@
+"""Renderer.cyclopean equals `viewsynth cyclopean --left-disparity ...` on the same inputs (a crop
+of Middlebury 2003 Cones, disparities written as float32 .npy): decoded PNG pixels and the mask,
+for every method, positions, a metric rig with doffs; and bad inputs raise InvalidInputError
+naming the argument."""
+
+import os
+import re
+import subprocess
+from pathlib import Path
+
+import numpy as np
+import pytest
+from PIL import Image
+
+import viewsynth as vs
+
+from conftest import REPO
+
+def data_dir():
+    """../shared/data beside the repository, or VIEWSYNTH_DATA_DIR (as the Rust tests)."""
+    path = Path(os.environ.get("VIEWSYNTH_DATA_DIR", REPO.parent / "shared" / "data"))
+    assert path.is_dir(), f"test data missing: {path} (set VIEWSYNTH_DATA_DIR)"
+    return path
+
+
+def cones_crop():
+    """Left/right colour and disparity (pixels; the 2003 PGMs store 4 x d) of a 128x96 crop with
+    cones, background and the occlusions between them."""
+    cones = data_dir() / "middlebury2003_cones"
+    box = (slice(140, 236), slice(150, 278))
+    load = lambda name: np.asarray(Image.open(cones / name))[box]
+    left_rgb = np.ascontiguousarray(load("im2.png"))
+    right_rgb = np.ascontiguousarray(load("im6.png"))
+    left_d = np.ascontiguousarray(load("disp2.pgm").astype(np.float32) / 4)
+    right_d = np.ascontiguousarray(load("disp6.pgm").astype(np.float32) / 4)
+    return left_rgb, right_rgb, left_d, right_d
+
+
+@pytest.fixture(scope="module")
+def pair():
+    return cones_crop()
+
+
+def run_cli(cli, tmp_path, pair, flags):
+    names = ("left_rgb.png", "right_rgb.png", "left_disparity.npy", "right_disparity.npy")
+    paths = [tmp_path / n for n in names]
+    Image.fromarray(pair[0]).save(paths[0])
+    Image.fromarray(pair[1]).save(paths[1])
+    np.save(paths[2], pair[2])
+    np.save(paths[3], pair[3])
+    out = tmp_path / "out"
+    cmd = [
+        str(cli), "cyclopean", "--left-rgb", str(paths[0]), "--right-rgb", str(paths[1]),
+        "--left-disparity", str(paths[2]), "--right-disparity", str(paths[3]),
+        "--out-dir", str(out), "--device", "auto",
+    ] + flags
+    done = subprocess.run(cmd, capture_output=True, text=True)
+    assert done.returncode == 0, done.stderr
+    return out
+
+
+CASES = {
+    "splat_gather": (dict(), []),
+    "splat_gather_metric": (
+        dict(position=0.3, focal=700.0, baseline=0.16, doffs=2.5, outputs=("rgb", "depth", "mask")),
+        ["--position", "0.3", "--focal", "700", "--baseline", "0.16", "--doffs", "2.5"],
+    ),
+    "forward": (dict(method="forward", position=0.75), ["--method", "forward", "--position", "0.75"]),
+    "seed": (dict(method="seed"), ["--method", "seed"]),
+    "refine": (dict(method="refine", position=0.6), ["--method", "refine", "--position", "0.6"]),
+}
+
+
+@pytest.mark.parametrize("case", sorted(CASES))
+def test_cyclopean_equals_cli_files(renderer, cli, pair, tmp_path, case):
+    kwargs, flags = CASES[case]
+    view = renderer.cyclopean(*pair, **kwargs)
+    out = run_cli(cli, tmp_path, pair, flags)
+    h, w = pair[2].shape
+    cli_rgb = np.asarray(Image.open(out / "middle_rgb.png").convert("RGB"))
+    assert view["rgb"].dtype == np.uint8 and view["rgb"].shape == cli_rgb.shape == (h, w, 3)
+    assert np.array_equal(view["rgb"], cli_rgb)
+    cli_mask = np.asarray(Image.open(out / "middle_mask.png"))
+    assert view["mask"].dtype == np.bool_ and view["mask"].shape == (h, w)
+    assert np.array_equal(view["mask"], cli_mask == 255)
+    assert view["coverage"] == pytest.approx(view["mask"].mean(), abs=1e-12)
+    # The crop has occlusions and unknown disparity at its borders: invalid pixels were compared.
+    assert 0.5 < view["coverage"] < 1.0
+    assert set(view["timings"]) == {"setup_ms", "render_ms", "gpu_ms"}
+    metric = "focal" in kwargs
+    assert ("depth" in view) == metric
+    assert (out / "middle_depth.exr").is_file() == metric
+    if metric:
+        assert view["depth"].dtype == np.float32 and view["depth"].shape == (h, w)
+        assert depth_difference(cli, out / "middle_depth.exr", view["depth"], tmp_path) == (0.0, 0)
+
+
+def depth_difference(cli, exr, depth, tmp_path):
+    """Max |a - b| (metres) and the count of pixels valid in only one, by `viewsynth compare`
+    (no EXR reader is needed in Python: the CLI decodes its own file)."""
+    ours = tmp_path / "python_depth.npy"
+    np.save(ours, depth)
+    rgb = tmp_path / "out" / "middle_rgb.png"
+    cmd = [str(cli), "compare", "--a-rgb", str(rgb), "--b-rgb", str(rgb), "--a-depth", str(exr), "--b-depth", str(ours)]
+    done = subprocess.run(cmd, capture_output=True, text=True)
+    assert done.returncode == 0, done.stderr
+    found = re.search(r"depth: max abs (\S+) m, .*valid in only one: (\d+) pixels", done.stdout)
+    assert found, done.stdout
+    return float(found.group(1)), int(found.group(2))
+
+
+def test_metric_depth(renderer, pair):
+    """At the left eye (position 0) the view's depth is f B / (d + doffs) of the left eye where the
+    splat-gather view shows the left eye's own surface (no resampling needed there)."""
+    f, b, doffs = 700.0, 0.16, 2.5
+    view = renderer.cyclopean(*pair, position=0.0, focal=f, baseline=b, doffs=doffs)
+    left_d = pair[2]
+    expected = f * b / (left_d + doffs)
+    known = view["mask"] & (left_d > 0)
+    assert known.mean() > 0.8
+    z = view["depth"]
+    assert z.dtype == np.float32 and np.all(z[~view["mask"]] == 0)
+    close = np.isclose(z[known], expected[known], rtol=1e-3)
+    # Sub-pixel refinement may pick a neighbour's surface at edges; nearly all pixels agree.
+    assert close.mean() > 0.95, close.mean()
+
+
+def test_outputs_subset_and_positions(renderer, pair):
+    view = renderer.cyclopean(*pair, outputs="mask")
+    assert set(view) == {"coverage", "timings", "mask"}
+    middle = renderer.cyclopean(*pair)
+    left = renderer.cyclopean(*pair, position=0.0)
+    assert not np.array_equal(middle["rgb"], left["rgb"])
+    # The outputs are new arrays owned by the caller.
+    assert middle["rgb"].flags.owndata or middle["rgb"].base is not None
+    middle["rgb"][:] = 0
+    assert renderer.cyclopean(*pair)["rgb"].any()
+
+
+def check(renderer, pair, parameter, words, **change):
+    args = dict(zip(("left_rgb", "right_rgb", "left_disparity", "right_disparity"), pair))
+    args.update(change)
+    with pytest.raises(vs.InvalidInputError) as err:
+        renderer.cyclopean(**args)
+    assert isinstance(err.value, ValueError)
+    message = str(err.value)
+    assert parameter in message, message
+    for w in words:
+        assert w in message, message
+    return err.value
+
+
+def test_bad_inputs(renderer, pair):
+    left_rgb, right_rgb, left_d, right_d = pair
+    e = check(renderer, pair, "right_rgb", ["float32", "uint8[H, W, 3]"], right_rgb=right_rgb.astype(np.float32))
+    assert e.parameter == "right_rgb"
+    e = check(renderer, pair, "left_disparity", ["float64", "float32[H, W]"], left_disparity=left_d.astype(np.float64))
+    assert e.parameter == "left_disparity"
+    check(renderer, pair, "right_disparity", ["not C-contiguous"], right_disparity=np.asfortranarray(right_d))
+    check(renderer, pair, "left_rgb", ["no alpha"], left_rgb=np.zeros(left_rgb.shape[:2] + (4,), np.uint8))
+    e = check(renderer, pair, "right_disparity", ["differs from left_rgb"], right_disparity=np.ascontiguousarray(right_d[:, 1:]))
+    assert e.parameter == "right_disparity"
+    check(renderer, pair, "right_rgb", ["differs from left_rgb"], right_rgb=np.ascontiguousarray(right_rgb[1:]))
+    check(renderer, pair, "left_disparity", ["no known disparity"], left_disparity=np.zeros_like(left_d))
+    check(renderer, pair, "position", ["outside [0, 1]"], position=1.5)
+    check(renderer, pair, "position", ["outside [0, 1]"], position=float("nan"))
+    check(renderer, pair, "method", ["'mesh'", "splat-gather"], method="mesh")
+    check(renderer, pair, "baseline", ["focal needs baseline"], focal=700.0)
+    check(renderer, pair, "focal", ["baseline needs focal"], baseline=0.1)
+    check(renderer, pair, "focal/baseline", ["finite and > 0"], focal=-1.0, baseline=0.1)
+    check(renderer, pair, "doffs", ["finite"], doffs=float("inf"))
+    check(renderer, pair, "outputs", ["needs focal and baseline"], outputs=("rgb", "depth"))
+    check(renderer, pair, "outputs", [], outputs=("rgb", "normals"))
+    # Nothing was left broken: a good call still works.
+    assert renderer.cyclopean(*pair)["coverage"] > 0.5
