@@ -13,6 +13,7 @@ use viewsynth::refocus::{BreakRule, Method, OutputSet, RefocusSource, Refocuser}
 mod compare;
 mod cyclopean;
 mod intrinsics;
+mod progress;
 mod refocus;
 mod reproject;
 mod scene;

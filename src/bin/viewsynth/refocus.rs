@@ -144,16 +144,16 @@ pub(crate) fn refocus(a: RefocusArgs) -> Result<()> {
 
     let gpu = a.gpu.open()?;
     let mut refocuser = Refocuser::new(&gpu, &src, &rule, method, outputs, conv)?;
-    let bar = indicatif::ProgressBar::new(targets.len() as u64);
+    let bar = super::progress::Progress::new("refocus targets", targets.len() as u64);
     let mut entries = Vec::new();
     // All targets and the manifest, or (on any failure) none: earlier runs' files stay.
     let set = out_dir.file_set()?;
     for (scale, target) in scales.iter().zip(&targets) {
         let out = refocuser.render(target)?;
         entries.push(job::write_output(set.staging(), *scale, &out, &files).map_err(|e| set.final_error(e))?);
-        bar.inc(1);
+        bar.inc();
     }
-    bar.finish_and_clear();
+    bar.finish();
     let manifest = Manifest {
         tool: format!("viewsynth {}", env!("CARGO_PKG_VERSION")),
         source: src.camera(),
@@ -223,9 +223,9 @@ pub(crate) fn refocus_batch(manifest: &Path, a: RefocusArgs) -> Result<()> {
     opts.rule.validate()?;
     prepare_out_dir(&a.out_dir)?;
     let gpu = a.gpu.open()?;
-    let bar = indicatif::ProgressBar::new(frames.len() as u64);
-    let summary = run_batch(&gpu, &frames, &a.out_dir, &opts, || bar.inc(1))?;
-    bar.finish_and_clear();
+    let bar = super::progress::Progress::new("batch frames", frames.len() as u64);
+    let summary = run_batch(&gpu, &frames, &a.out_dir, &opts, || bar.inc())?;
+    bar.finish();
     let shard_note = match opts.shard {
         Some(s) => format!(
             " (shard {}/{}: {} frames belong to other shards)",

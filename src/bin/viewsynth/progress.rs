@@ -1,0 +1,91 @@
+//! Progress of long commands: a bar with rate and ETA on a terminal (indicatif), a log line
+//! every few seconds otherwise (Docker, Slurm and CI logs have no terminal), so no long run is
+//! silent.
+
+use std::cell::Cell;
+use std::io::IsTerminal;
+use std::time::{Duration, Instant};
+
+/// How often the log line is written when stderr is not a terminal.
+const LOG_EVERY: Duration = Duration::from_secs(10);
+
+pub(crate) struct Progress {
+    what: &'static str,
+    total: u64,
+    bar: Option<indicatif::ProgressBar>,
+    done: Cell<u64>,
+    start: Instant,
+    last_log: Cell<Instant>,
+}
+
+impl Progress {
+    pub(crate) fn new(what: &'static str, total: u64) -> Self {
+        let bar = std::io::stderr().is_terminal().then(|| {
+            let bar = indicatif::ProgressBar::new(total);
+            let style = indicatif::ProgressStyle::with_template("{msg} [{bar:30}] {pos}/{len} {per_sec} ETA {eta}")
+                .unwrap_or_else(|_| indicatif::ProgressStyle::default_bar());
+            bar.set_style(style.progress_chars("=> "));
+            bar.set_message(what);
+            bar
+        });
+        let now = Instant::now();
+        Progress {
+            what,
+            total,
+            bar,
+            done: Cell::new(0),
+            start: now,
+            last_log: Cell::new(now),
+        }
+    }
+
+    /// One more item finished.
+    pub(crate) fn inc(&self) {
+        let done = self.done.get() + 1;
+        self.done.set(done);
+        if let Some(bar) = &self.bar {
+            bar.inc(1);
+            return;
+        }
+        if self.last_log.get().elapsed() >= LOG_EVERY || done == self.total {
+            self.last_log.set(Instant::now());
+            eprintln!("{}", log_line(self.what, done, self.total, self.start.elapsed()));
+        }
+    }
+
+    pub(crate) fn finish(&self) {
+        if let Some(bar) = &self.bar {
+            bar.finish_and_clear();
+        }
+    }
+}
+
+/// "batch: 120/800 frames (15.0 %), 4.02 /s, ETA 2m49s".
+fn log_line(what: &str, done: u64, total: u64, elapsed: Duration) -> String {
+    let secs = elapsed.as_secs_f64().max(1e-9);
+    let rate = done as f64 / secs;
+    let eta = if done > 0 && total >= done {
+        let left = ((total - done) as f64 / rate).round() as u64;
+        format!("{}m{:02}s", left / 60, left % 60)
+    } else {
+        "?".to_string()
+    };
+    let pct = if total > 0 {
+        100.0 * done as f64 / total as f64
+    } else {
+        100.0
+    };
+    format!("{what}: {done}/{total} ({pct:.1} %), {rate:.2} /s, ETA {eta}")
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn log_line_gives_rate_and_eta() {
+        let l = log_line("batch frames", 30, 120, Duration::from_secs(10));
+        assert_eq!(l, "batch frames: 30/120 (25.0 %), 3.00 /s, ETA 0m30s");
+        assert!(log_line("x", 0, 5, Duration::from_secs(1)).ends_with("ETA ?"));
+    }
+}
