@@ -5,12 +5,14 @@
 use crate::error::{Error, Result};
 use serde::Serialize;
 
-/// PNG deflate effort. `Fast` suits dataset work: larger files, several times less CPU.
+/// PNG deflate effort. `Fast` is the default and what every earlier release wrote (the image
+/// crate's default); `Default` is deflate's own default level (smaller files, several times the
+/// CPU); `Best` the smallest files.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize)]
 #[serde(rename_all = "lowercase")]
 pub enum PngCompression {
-    Fast,
     #[default]
+    Fast,
     Default,
     Best,
 }

@@ -151,7 +151,7 @@ fn resume_redoes_frames_whose_settings_or_files_changed() {
     let before = io::load_rgb(&out.join("f1/s2_rgb.png")).unwrap();
     let mut fast = other.clone();
     fast.files.encoding = Encoding {
-        png: PngCompression::Fast,
+        png: PngCompression::Best,
         ..Default::default()
     };
     let s = run_batch(&g, &frames, &out, &fast, || ()).unwrap();

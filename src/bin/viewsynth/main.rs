@@ -144,7 +144,7 @@ enum Command {
         #[arg(long, requires = "batch")]
         jobs: Option<usize>,
         /// With --batch: PNG compression (fast, default, best).
-        #[arg(long, default_value = "default", requires = "batch")]
+        #[arg(long, default_value = "fast", requires = "batch")]
         png_compression: String,
         /// Print one JSON object instead of the tables.
         #[arg(long)]
@@ -263,9 +263,9 @@ struct FileOutputArgs {
     /// Depth file formats: exr, npy or both.
     #[arg(long, default_value = "exr")]
     depth_format: String,
-    /// PNG compression of colour and mask files: fast (datasets: several times less CPU,
-    /// larger files), default or best.
-    #[arg(long, default_value = "default")]
+    /// PNG compression of colour and mask files: fast (the default, as earlier releases wrote),
+    /// default (deflate's default level: smaller files, several times the CPU) or best.
+    #[arg(long, default_value = "fast")]
     png_compression: String,
     /// EXR compression of depth (and EXR colour): none, rle, zip (default) or piz; all lossless.
     #[arg(long, default_value = "zip")]
