@@ -8,6 +8,7 @@
 mod atomic;
 mod decode;
 mod depth;
+mod depth_png16;
 mod depth_summary;
 mod encoding;
 mod exr_io;
@@ -33,6 +34,7 @@ pub use depth::{
     check_rgbd_sizes, depth_dimensions, load_depth, load_depth_with_key, rgb_dimensions, save_depth_exr,
     save_depth_exr_with, save_depth_npy, DepthDecode,
 };
+pub use depth_png16::{save_depth_png16, PNG16_UNITS_PER_METRE};
 pub use depth_summary::{DepthSummary, DepthWarning, PLAUSIBLE_MEDIAN_M};
 pub use encoding::{Encoding, ExrCompression, PngCompression};
 pub use file_set::{FileSet, OutDir};

@@ -28,16 +28,24 @@ impl RgbFormat {
     }
 }
 
-/// File formats of the metric depth output (either or both).
+/// File formats of the metric depth output (any combination).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
 pub struct DepthFormats {
     pub exr: bool,
     pub npy: bool,
+    /// uint16 millimetres in a 16-bit gray PNG (0 = invalid). Left out of the settings JSON
+    /// when off, so batches made before it resume.
+    #[serde(skip_serializing_if = "std::ops::Not::not")]
+    pub png16: bool,
 }
 
 impl Default for DepthFormats {
     fn default() -> Self {
-        DepthFormats { exr: true, npy: false }
+        DepthFormats {
+            exr: true,
+            npy: false,
+            png16: false,
+        }
     }
 }
 
@@ -123,6 +131,11 @@ pub struct ManifestEntry {
     pub rgb: Option<String>,
     pub depth_exr: Option<String>,
     pub depth_npy: Option<String>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub depth_png16: Option<String>,
+    /// Valid pixels written as 0 in the PNG because they lie beyond 65.535 m.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub depth_png16_clipped: Option<u64>,
     pub mask: Option<String>,
     /// Fraction of output pixels with mask = 1 (when a mask or depth was produced).
     pub coverage: Option<f64>,
@@ -167,7 +180,10 @@ pub struct FileRecord {
 pub fn file_records(dir: &Path, entries: &[ManifestEntry]) -> Result<Vec<FileRecord>> {
     let mut out = Vec::new();
     for e in entries {
-        for name in [&e.rgb, &e.depth_exr, &e.depth_npy, &e.mask].into_iter().flatten() {
+        for name in [&e.rgb, &e.depth_exr, &e.depth_npy, &e.depth_png16, &e.mask]
+            .into_iter()
+            .flatten()
+        {
             let path = dir.join(name);
             let bytes = std::fs::metadata(&path).map_err(|e| Error::io(&path, e))?.len();
             out.push(FileRecord {
@@ -201,6 +217,8 @@ pub fn write_output(dir: &Path, scale: f64, out: &RefocusOutput, files: &FileFor
         rgb: None,
         depth_exr: None,
         depth_npy: None,
+        depth_png16: None,
+        depth_png16_clipped: None,
         mask: None,
         coverage: None,
         render_ms: out.render.wall_ms,
@@ -222,6 +240,11 @@ pub fn write_output(dir: &Path, scale: f64, out: &RefocusOutput, files: &FileFor
             let (path, file) = name("depth.npy");
             io::save_depth_npy(&path, depth)?;
             entry.depth_npy = Some(file);
+        }
+        if depth_formats.png16 {
+            let (path, file) = name("depth.png");
+            entry.depth_png16_clipped = Some(io::save_depth_png16(&path, depth, enc.png)?);
+            entry.depth_png16 = Some(file);
         }
         let valid = depth.data.iter().filter(|z| **z > 0.0).count();
         entry.coverage = Some(valid as f64 / depth.data.len() as f64);
@@ -296,5 +319,71 @@ mod tests {
         assert!(e.contains("0.5000001") && e.contains("s0.5"), "{e}");
         assert_eq!(scale_tag(1.0), "s1");
         assert_eq!(TargetSpec::scales_from_focal_list(&src.k, &[250.0]), vec![0.5]);
+    }
+
+    /// A 4x1 target whose depth holds `z`, rgb and mask all valid.
+    fn synthetic_output(z: Vec<f32>) -> RefocusOutput {
+        let (w, h) = (z.len() as u32, 1);
+        RefocusOutput {
+            camera: PinholeCamera {
+                k: Intrinsics {
+                    fx: 10.0,
+                    fy: 10.0,
+                    cx: 1.5,
+                    cy: 0.0,
+                },
+                width: w,
+                height: h,
+            },
+            rgb: Some(io::RgbImage::new(w, h, vec![128; (w * h * 3) as usize]).unwrap()),
+            depth: Some(io::DepthMap::new(w, h, z).unwrap()),
+            mask: Some(io::Mask::new(w, h, vec![1; (w * h) as usize]).unwrap()),
+            render: Default::default(),
+            readback_ms: 0.0,
+        }
+    }
+
+    fn scratch(tag: &str) -> tempfile::TempDir {
+        tempfile::Builder::new().prefix(tag).tempdir().unwrap()
+    }
+
+    #[test]
+    fn png16_depth_counts_what_lies_beyond_its_range() {
+        let dir = scratch("viewsynth-job-png16-");
+        let out = synthetic_output(vec![1.5, 0.0, 70.0, 65.6]);
+        let files = FileFormats {
+            depth: DepthFormats {
+                exr: false,
+                npy: false,
+                png16: true,
+            },
+            ..Default::default()
+        };
+        let e = write_output(dir.path(), 1.0, &out, &files).unwrap();
+        assert_eq!(e.depth_png16.as_deref(), Some("s1_depth.png"));
+        assert_eq!((e.depth_exr.as_deref(), e.depth_png16_clipped), (None, Some(2)));
+        let back = io::load_depth(
+            &dir.path().join("s1_depth.png"),
+            &io::DepthDecode {
+                scale: Some(1000.0),
+                ..Default::default()
+            },
+        )
+        .unwrap();
+        assert_eq!(back.data, vec![1.5, 0.0, 0.0, 0.0]);
+        let names: Vec<String> = file_records(dir.path(), &[e.clone()])
+            .unwrap()
+            .into_iter()
+            .map(|r| r.name)
+            .collect();
+        assert!(names.contains(&"s1_depth.png".to_string()), "{names:?}");
+        let json = serde_json::to_value(&e).unwrap();
+        assert_eq!(json["depth_png16_clipped"], 2);
+        // Off by default: neither the file nor the keys appear (older manifests stay as they were).
+        let plain = write_output(dir.path(), 2.0, &out, &FileFormats::default()).unwrap();
+        let json = serde_json::to_value(&plain).unwrap();
+        assert!(json.get("depth_png16").is_none() && json.get("depth_png16_clipped").is_none());
+        let settings = serde_json::to_value(FileFormats::default()).unwrap();
+        assert!(settings["depth"].get("png16").is_none(), "{settings}");
     }
 }

@@ -42,7 +42,11 @@ fn options(jobs: usize) -> BatchOptions {
         conv: Conventions::default(),
         files: FileFormats {
             outputs: OutputSet::default(),
-            depth: viewsynth::refocus::job::DepthFormats { exr: true, npy: true },
+            depth: viewsynth::refocus::job::DepthFormats {
+                exr: true,
+                npy: true,
+                png16: true,
+            },
             ..Default::default()
         },
         resume: true,

@@ -259,7 +259,8 @@ struct FileOutputArgs {
     outputs: String,
     #[arg(long, value_enum, default_value = "png")]
     rgb_format: RgbFormatArg,
-    /// Depth file formats: exr, npy or both.
+    /// Depth file formats, any of: exr (float32 metres), npy (float32 metres), png16 (uint16
+    /// millimetres, 0 = invalid; beyond 65.535 m written as 0 and counted in the manifest).
     #[arg(long, default_value = "exr")]
     depth_format: String,
     /// PNG compression of colour and mask files: fast (datasets: several times less CPU,
@@ -503,12 +504,17 @@ fn conventions(ndc: NdcArg, reversed_z: bool, rows: RowsArg) -> Conventions {
 }
 
 fn parse_depth_formats(list: &str) -> Result<DepthFormats> {
-    let mut f = DepthFormats { exr: false, npy: false };
+    let mut f = DepthFormats {
+        exr: false,
+        npy: false,
+        png16: false,
+    };
     for item in list.split(',').map(str::trim) {
         match item {
             "exr" => f.exr = true,
             "npy" => f.npy = true,
-            _ => bail!("invalid depth-format '{item}': expected exr, npy or exr,npy"),
+            "png16" => f.png16 = true,
+            _ => bail!("invalid depth-format '{item}': expected exr, npy, png16 or a list such as exr,png16"),
         }
     }
     Ok(f)
