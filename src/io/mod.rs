@@ -9,6 +9,7 @@ mod atomic;
 mod decode;
 mod depth;
 mod depth_png16;
+mod depth_preview;
 mod depth_summary;
 mod encoding;
 mod exr_io;
@@ -35,6 +36,7 @@ pub use depth::{
     save_depth_exr_with, save_depth_npy, DepthDecode,
 };
 pub use depth_png16::{save_depth_png16, PNG16_UNITS_PER_METRE};
+pub use depth_preview::{depth_preview, depth_preview_range, save_depth_preview, PreviewRange, PREVIEW_PERCENTILES};
 pub use depth_summary::{DepthSummary, DepthWarning, PLAUSIBLE_MEDIAN_M};
 pub use encoding::{Encoding, ExrCompression, PngCompression};
 pub use file_set::{FileSet, OutDir};

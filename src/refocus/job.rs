@@ -56,6 +56,10 @@ pub struct FileFormats {
     pub rgb: RgbFormat,
     pub depth: DepthFormats,
     pub encoding: io::Encoding,
+    /// A colour-mapped PNG of the depth output beside it (left out of the settings JSON when
+    /// off, so batches made before it resume).
+    #[serde(skip_serializing_if = "std::ops::Not::not")]
+    pub depth_preview: bool,
 }
 
 /// How target cameras are derived from the source.
@@ -136,6 +140,12 @@ pub struct ManifestEntry {
     /// Valid pixels written as 0 in the PNG because they lie beyond 65.535 m.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub depth_png16_clipped: Option<u64>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub depth_preview: Option<String>,
+    /// Depth in metres at the preview's near (red) and far (blue) colours: the 2nd and 98th
+    /// percentile of the valid depth; absent when no pixel is valid (the preview is black).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub depth_preview_range_m: Option<io::PreviewRange>,
     pub mask: Option<String>,
     /// Fraction of output pixels with mask = 1 (when a mask or depth was produced).
     pub coverage: Option<f64>,
@@ -180,9 +190,16 @@ pub struct FileRecord {
 pub fn file_records(dir: &Path, entries: &[ManifestEntry]) -> Result<Vec<FileRecord>> {
     let mut out = Vec::new();
     for e in entries {
-        for name in [&e.rgb, &e.depth_exr, &e.depth_npy, &e.depth_png16, &e.mask]
-            .into_iter()
-            .flatten()
+        for name in [
+            &e.rgb,
+            &e.depth_exr,
+            &e.depth_npy,
+            &e.depth_png16,
+            &e.depth_preview,
+            &e.mask,
+        ]
+        .into_iter()
+        .flatten()
         {
             let path = dir.join(name);
             let bytes = std::fs::metadata(&path).map_err(|e| Error::io(&path, e))?.len();
@@ -219,6 +236,8 @@ pub fn write_output(dir: &Path, scale: f64, out: &RefocusOutput, files: &FileFor
         depth_npy: None,
         depth_png16: None,
         depth_png16_clipped: None,
+        depth_preview: None,
+        depth_preview_range_m: None,
         mask: None,
         coverage: None,
         render_ms: out.render.wall_ms,
@@ -245,6 +264,11 @@ pub fn write_output(dir: &Path, scale: f64, out: &RefocusOutput, files: &FileFor
             let (path, file) = name("depth.png");
             entry.depth_png16_clipped = Some(io::save_depth_png16(&path, depth, enc.png)?);
             entry.depth_png16 = Some(file);
+        }
+        if files.depth_preview {
+            let (path, file) = name("depth_preview.png");
+            entry.depth_preview_range_m = io::save_depth_preview(&path, depth, &enc)?;
+            entry.depth_preview = Some(file);
         }
         let valid = depth.data.iter().filter(|z| **z > 0.0).count();
         entry.coverage = Some(valid as f64 / depth.data.len() as f64);
@@ -385,5 +409,31 @@ mod tests {
         assert!(json.get("depth_png16").is_none() && json.get("depth_png16_clipped").is_none());
         let settings = serde_json::to_value(FileFormats::default()).unwrap();
         assert!(settings["depth"].get("png16").is_none(), "{settings}");
+        assert!(settings.get("depth_preview").is_none(), "{settings}");
+    }
+
+    #[test]
+    fn the_depth_preview_and_its_range_are_in_the_entry() {
+        let dir = scratch("viewsynth-job-preview-");
+        let out = synthetic_output(vec![1.0, 0.0, 2.0, 3.0]);
+        let files = FileFormats {
+            depth_preview: true,
+            ..Default::default()
+        };
+        let e = write_output(dir.path(), 0.5, &out, &files).unwrap();
+        assert_eq!(e.depth_preview.as_deref(), Some("s0.5_depth_preview.png"));
+        let r = e.depth_preview_range_m.unwrap();
+        assert_eq!((r.min_m, r.max_m), (1.0, 3.0));
+        let json = serde_json::to_value(&e).unwrap();
+        assert_eq!(json["depth_preview_range_m"]["max_m"], 3.0);
+        let img = io::load_rgb(&dir.path().join("s0.5_depth_preview.png")).unwrap();
+        assert_eq!(img.data[3..6], [0, 0, 0]);
+        assert_ne!(img.data[..3], img.data[9..]);
+        let names: Vec<String> = file_records(dir.path(), &[e])
+            .unwrap()
+            .into_iter()
+            .map(|r| r.name)
+            .collect();
+        assert!(names.contains(&"s0.5_depth_preview.png".to_string()), "{names:?}");
     }
 }

@@ -80,3 +80,50 @@ fn png16_depth_matches_the_exr_to_half_a_millimetre() {
     let o = refocus(&rgb, &depth, &d.join("bad"), &["--depth-format", "exr,png8"]);
     super::cli::assert_clean_failure(&o, "png16", &d.join("bad"));
 }
+
+#[test]
+fn depth_preview_is_written_with_its_range() {
+    let d = scratch("depthout-preview");
+    let (rgb, depth) = inputs(&d, 32, 24);
+    let out = d.join("out");
+    let o = refocus(
+        &rgb,
+        &depth,
+        &out,
+        &["--zoom-range", "0.5", "--depth-preview", "--outputs", "depth"],
+    );
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    assert_eq!(
+        files_in(&out),
+        ["manifest.json", "s0.5_depth.exr", "s0.5_depth_preview.png"]
+    );
+    let m = manifest(&out);
+    let range = &m["outputs"][0]["depth_preview_range_m"];
+    let (lo, hi) = (range["min_m"].as_f64().unwrap(), range["max_m"].as_f64().unwrap());
+    // The ramp runs 1.0-4.1 m (its steep near end breaks into holes); the 2nd-98th
+    // percentile of what is rendered lies inside and is not flat.
+    assert!(1.0 <= lo && lo + 1.0 < hi && hi <= 4.11, "{lo} {hi}");
+    // At half the focal length the source covers the middle only: a border of holes.
+    let z = io::load_depth(&out.join("s0.5_depth.exr"), &DepthDecode::default()).unwrap();
+    let img = io::load_rgb(&out.join("s0.5_depth_preview.png")).unwrap();
+    let px = |i: usize| &img.data[3 * i..3 * i + 3];
+    let (mut near, mut far, mut holes) = (None, None, 0);
+    for (i, &zi) in z.data.iter().enumerate() {
+        if zi <= 0.0 {
+            assert_eq!(px(i), [0, 0, 0], "invalid pixel {i}");
+            holes += 1;
+        } else if zi < lo as f32 + 0.05 {
+            near = Some(i);
+        } else if zi > hi as f32 - 0.05 {
+            far = Some(i);
+        }
+    }
+    let (near, far) = (near.expect("a near pixel"), far.expect("a far pixel"));
+    assert_ne!(px(near), px(far));
+    assert_ne!(px(near), [0, 0, 0]);
+    assert!(holes > 0 && holes < z.data.len(), "{holes}");
+
+    let bad = d.join("bad");
+    let o = refocus(&rgb, &depth, &bad, &["--depth-preview", "--outputs", "rgb"]);
+    super::cli::assert_clean_failure(&o, "--depth-preview", &bad);
+}

@@ -263,6 +263,10 @@ struct FileOutputArgs {
     /// millimetres, 0 = invalid; beyond 65.535 m written as 0 and counted in the manifest).
     #[arg(long, default_value = "exr")]
     depth_format: String,
+    /// Also write s{tag}_depth_preview.png: the depth output colour-mapped (turbo: near red, far
+    /// blue, invalid black) over its 2nd-98th percentile, the range recorded in the manifest.
+    #[arg(long)]
+    depth_preview: bool,
     /// PNG compression of colour and mask files: fast (datasets: several times less CPU,
     /// larger files), default or best.
     #[arg(long, default_value = "default")]
@@ -293,11 +297,15 @@ impl FileOutputArgs {
     /// Everything the refocus writers need.
     fn file_formats(&self) -> Result<job::FileFormats> {
         let (outputs, rgb, depth) = self.parse()?;
+        if self.depth_preview && !outputs.depth {
+            bail!("--depth-preview colours the depth output: add depth to --outputs");
+        }
         Ok(job::FileFormats {
             outputs,
             rgb,
             depth,
             encoding: self.encoding()?,
+            depth_preview: self.depth_preview,
         })
     }
 }
