@@ -105,7 +105,10 @@ mod tests {
         // Near is the warm end of turbo, far the cool end.
         assert!(near[0] > near[2] && far[2] > far[0], "{near:?} {far:?}");
         // Every valid pixel is clearly brighter than a hole.
-        assert!((0..100).all(|i| px(i).iter().max().unwrap() >= &100), "{near:?} {far:?}");
+        assert!(
+            (0..100).all(|i| px(i).iter().max().unwrap() >= &100),
+            "{near:?} {far:?}"
+        );
         // Beyond the percentiles the end colours hold.
         assert_eq!(px(0), px(1));
     }

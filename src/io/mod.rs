@@ -11,6 +11,7 @@ mod depth;
 mod depth_png16;
 mod depth_preview;
 mod depth_summary;
+mod depth_trunc;
 mod encoding;
 mod exr_io;
 mod file_set;
@@ -38,6 +39,7 @@ pub use depth::{
 pub use depth_png16::{save_depth_png16, PNG16_UNITS_PER_METRE};
 pub use depth_preview::{depth_preview, depth_preview_range, save_depth_preview, PreviewRange, PREVIEW_PERCENTILES};
 pub use depth_summary::{DepthSummary, DepthWarning, PLAUSIBLE_MEDIAN_M};
+pub use depth_trunc::{check_depth_trunc, truncate_depth};
 pub use encoding::{Encoding, ExrCompression, PngCompression};
 pub use file_set::{FileSet, OutDir};
 pub use image_types::{DepthMap, Mask, RgbImage, MAX_DIMENSION};

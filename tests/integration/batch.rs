@@ -49,6 +49,7 @@ fn options(jobs: usize) -> BatchOptions {
             },
             ..Default::default()
         },
+        depth_trunc: None,
         resume: true,
         jobs,
         shard: None,

@@ -127,3 +127,79 @@ fn depth_preview_is_written_with_its_range() {
     let o = refocus(&rgb, &depth, &bad, &["--depth-preview", "--outputs", "rgb"]);
     super::cli::assert_clean_failure(&o, "--depth-preview", &bad);
 }
+
+/// Columns of the 32x24 ramp whose depth 1 + 0.1 x lies beyond 2.5 m start at x = 16.
+fn assert_far_columns_are_holes(mask_png: &Path) {
+    let mask = io::load_mask_png(mask_png).unwrap();
+    let at = |x: u32, y: u32| mask.data[(y * mask.width + x) as usize];
+    for y in 0..mask.height {
+        for x in 17..mask.width {
+            assert_eq!(at(x, y), 0, "{}: ({x}, {y}) lies beyond 2.5 m", mask_png.display());
+        }
+    }
+    let kept = (0..mask.height)
+        .flat_map(|y| (0..15).map(move |x| (x, y)))
+        .filter(|&(x, y)| at(x, y) == 1);
+    assert!(kept.count() > 0, "{}: nearer pixels stay", mask_png.display());
+}
+
+#[test]
+fn depth_trunc_makes_far_input_holes_single_frame_and_batch() {
+    let d = scratch("depthout-trunc");
+    let (rgb, depth) = inputs(&d, 32, 24);
+    let out = d.join("out");
+    let plain = d.join("plain");
+    let o = refocus(&rgb, &depth, &plain, &["--zoom-range", "1", "--outputs", "mask"]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let m = io::load_mask_png(&plain.join("s1_mask.png")).unwrap();
+    assert!(
+        m.data[(10 * 32 + 20) as usize] == 1,
+        "without the option the far side renders"
+    );
+
+    let o = refocus(
+        &rgb,
+        &depth,
+        &out,
+        &["--zoom-range", "1", "--outputs", "mask,depth", "--depth-trunc", "2.5"],
+    );
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    assert_far_columns_are_holes(&out.join("s1_mask.png"));
+    let z = io::load_depth(&out.join("s1_depth.exr"), &DepthDecode::default()).unwrap();
+    assert!(
+        z.data.iter().all(|&v| v <= 2.5),
+        "no output depth beyond the truncation"
+    );
+
+    let csv = d.join("frames.csv");
+    std::fs::write(
+        &csv,
+        "rgb,depth,fx,fy,cx,cy,name\nrgb.png,depth.npy,40,40,15.5,11.5,a\n",
+    )
+    .unwrap();
+    let batch_out = d.join("batch");
+    let o = bin()
+        .args([
+            "refocus",
+            "--zoom-range",
+            "1",
+            "--outputs",
+            "mask",
+            "--depth-trunc",
+            "2.5",
+            "--batch",
+        ])
+        .arg(&csv)
+        .arg("--out-dir")
+        .arg(&batch_out)
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    assert_far_columns_are_holes(&batch_out.join("a/s1_mask.png"));
+    assert_eq!(manifest(&batch_out.join("a"))["settings"]["depth_trunc"], 2.5);
+
+    for bad in ["0", "-1", "inf"] {
+        let o = refocus(&rgb, &depth, &d.join("bad"), &["--depth-trunc", bad]);
+        super::cli::assert_clean_failure(&o, "depth-trunc", &d.join("bad"));
+    }
+}

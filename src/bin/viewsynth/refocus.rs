@@ -42,6 +42,10 @@ pub(crate) struct RefocusArgs {
     /// floating-point one).
     #[arg(long, value_name = "NAME")]
     npz_key: Option<String>,
+    /// Treat input depth beyond M metres as invalid (as Open3D's depth_trunc), after
+    /// --depth-scale.
+    #[arg(long, value_name = "M", value_parser = finite_value)]
+    depth_trunc: Option<f64>,
     /// SUN RGB-D PNG depth: rotate the 16-bit value right by 3 bits before scaling.
     #[arg(long)]
     sun_bit_rotate: bool,
@@ -120,7 +124,7 @@ pub(crate) fn refocus(a: RefocusArgs) -> Result<()> {
         sun_rgbd_bit_rotate: a.sun_bit_rotate,
         ..Default::default()
     };
-    let depth = io::load_depth_with_key(&depth_path, a.npz_key.as_deref(), &decode)?;
+    let mut depth = io::load_depth_with_key(&depth_path, a.npz_key.as_deref(), &decode)?;
     source_k.check_size(rgb.width, rgb.height)?;
     print_depth_summary(
         &depth_path,
@@ -128,6 +132,10 @@ pub(crate) fn refocus(a: RefocusArgs) -> Result<()> {
         "check --depth-scale (raw units per metre: 5000 TUM, 1000 SUN RGB-D with --sun-bit-rotate) \
          and that the file holds metric depth, not disparity",
     );
+    if let Some(m) = a.depth_trunc {
+        let n = io::truncate_depth(&mut depth, m)?;
+        eprintln!("--depth-trunc {m}: {n} pixels beyond {m} m set invalid");
+    }
     let src = RefocusSource::new(rgb, depth, k)
         .with_context(|| format!("{} and {}", rgb_path.display(), depth_path.display()))?;
     let scales = match &a.focal_list {
@@ -216,6 +224,7 @@ pub(crate) fn refocus_batch(manifest: &Path, a: RefocusArgs) -> Result<()> {
         },
         conv: a.conv.conventions(),
         files,
+        depth_trunc: a.depth_trunc,
         resume: !a.force,
         jobs,
         shard,
