@@ -80,6 +80,24 @@ impl TargetSpec {
         fx_list.iter().map(|f| f / source.fx).collect()
     }
 
+    /// File-name tags of a focal list, one per fx' as given (`f571.4`); two fx' that print
+    /// alike would overwrite each other's files, so they are refused.
+    pub fn focal_tags(fx_list: &[f64]) -> Result<Vec<String>> {
+        let mut seen = std::collections::HashMap::new();
+        for &f in fx_list {
+            if let Some(prev) = seen.insert(focal_tag(f), f) {
+                return Err(Error::param(
+                    "focal-list",
+                    format!(
+                        "{prev} and {f} both name their files '{}' (6 decimals); give each focal length once",
+                        focal_tag(f)
+                    ),
+                ));
+            }
+        }
+        Ok(fx_list.iter().map(|&f| focal_tag(f)).collect())
+    }
+
     pub fn targets(&self, source: &PinholeCamera) -> Result<Vec<PinholeCamera>> {
         if self.scales.is_empty() {
             return Err(Error::param("scales", "no focal scale given"));
@@ -212,16 +230,40 @@ pub fn file_records(dir: &Path, entries: &[ManifestEntry]) -> Result<Vec<FileRec
     Ok(out)
 }
 
-fn scale_tag(scale: f64) -> String {
-    // 0.5 -> "s0.5", 1 -> "s1", 1.25 -> "s1.25": short, sortable enough, unambiguous.
-    format!("s{}", format!("{scale:.6}").trim_end_matches('0').trim_end_matches('.'))
+/// The file-name prefix of a zoom scale: 0.5 -> "s0.5", 1 -> "s1", 1.25 -> "s1.25" (short,
+/// sortable enough, unambiguous).
+pub fn scale_tag(scale: f64) -> String {
+    format!("s{}", trim_decimals(scale))
 }
 
-/// Write the requested files of one output under `dir` (atomic: temporary name, then rename).
+/// The file-name prefix of a target focal length fx' in pixels: 571.4 -> "f571.4".
+pub fn focal_tag(fx: f64) -> String {
+    format!("f{}", trim_decimals(fx))
+}
+
+fn trim_decimals(v: f64) -> String {
+    format!("{v:.6}")
+        .trim_end_matches('0')
+        .trim_end_matches('.')
+        .to_string()
+}
+
+/// Write the requested files of one output under `dir` (atomic: temporary name, then rename),
+/// named by the scale's tag.
 pub fn write_output(dir: &Path, scale: f64, out: &RefocusOutput, files: &FileFormats) -> Result<ManifestEntry> {
+    write_output_named(dir, &scale_tag(scale), scale, out, files)
+}
+
+/// [`write_output`] with the files named `{tag}_rgb.png` etc. (e.g. a [`focal_tag`]).
+pub fn write_output_named(
+    dir: &Path,
+    tag: &str,
+    scale: f64,
+    out: &RefocusOutput,
+    files: &FileFormats,
+) -> Result<ManifestEntry> {
     let (outputs, rgb_format, depth_formats, enc) = (&files.outputs, files.rgb, files.depth, files.encoding);
     let t0 = std::time::Instant::now();
-    let tag = scale_tag(scale);
     let name = |suffix: &str| -> (PathBuf, String) {
         let file = format!("{tag}_{suffix}");
         (dir.join(&file), file)
@@ -343,6 +385,27 @@ mod tests {
         assert!(e.contains("0.5000001") && e.contains("s0.5"), "{e}");
         assert_eq!(scale_tag(1.0), "s1");
         assert_eq!(TargetSpec::scales_from_focal_list(&src.k, &[250.0]), vec![0.5]);
+    }
+
+    #[test]
+    fn focal_lists_name_files_by_the_focal_given() {
+        assert_eq!(focal_tag(571.4), "f571.4");
+        assert_eq!(focal_tag(500.0), "f500");
+        assert_eq!(TargetSpec::focal_tags(&[571.4, 1000.0]).unwrap(), ["f571.4", "f1000"]);
+        let e = TargetSpec::focal_tags(&[600.0, 571.4, 571.4000001])
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.contains("focal-list") && e.contains("571.4000001") && e.contains("'f571.4'"),
+            "{e}"
+        );
+        let dir = scratch("viewsynth-job-focal-");
+        let out = synthetic_output(vec![1.0, 2.0]);
+        let e = write_output_named(dir.path(), "f571.4", 57.14, &out, &FileFormats::default()).unwrap();
+        assert_eq!(e.rgb.as_deref(), Some("f571.4_rgb.png"));
+        assert_eq!(e.depth_exr.as_deref(), Some("f571.4_depth.exr"));
+        assert_eq!(e.scale, 57.14);
+        assert!(dir.path().join("f571.4_mask.png").is_file());
     }
 
     /// A 4x1 target whose depth holds `z`, rgb and mask all valid.

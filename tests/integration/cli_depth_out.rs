@@ -203,3 +203,34 @@ fn depth_trunc_makes_far_input_holes_single_frame_and_batch() {
         super::cli::assert_clean_failure(&o, "depth-trunc", &d.join("bad"));
     }
 }
+
+#[test]
+fn focal_list_names_files_by_the_focal_given() {
+    let d = scratch("depthout-focal");
+    let (rgb, depth) = inputs(&d, 32, 24);
+    let out = d.join("out");
+    let o = refocus(
+        &rgb,
+        &depth,
+        &out,
+        &["--focal-list", "20,57.5", "--outputs", "rgb,mask"],
+    );
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    assert_eq!(
+        files_in(&out),
+        [
+            "f20_mask.png",
+            "f20_rgb.png",
+            "f57.5_mask.png",
+            "f57.5_rgb.png",
+            "manifest.json"
+        ]
+    );
+    let m = manifest(&out);
+    assert_eq!(m["outputs"][1]["rgb"], "f57.5_rgb.png");
+    assert_eq!(m["outputs"][1]["intrinsics"]["fx"], 57.5);
+
+    let bad = d.join("bad");
+    let o = refocus(&rgb, &depth, &bad, &["--focal-list", "30,57.5,57.50000001"]);
+    super::cli::assert_clean_failure(&o, "f57.5", &bad);
+}

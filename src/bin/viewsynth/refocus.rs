@@ -51,11 +51,13 @@ pub(crate) struct RefocusArgs {
     sun_bit_rotate: bool,
     #[command(flatten)]
     intrinsics: IntrinsicsArgs,
-    /// Output folder (created if missing): per focal scale s, s{s}_rgb.png, s{s}_depth.exr,
-    /// s{s}_mask.png (those in --outputs), and manifest.json.
+    /// Output folder (created if missing): per zoom scale s, s{s}_rgb.png, s{s}_depth.exr,
+    /// s{s}_mask.png (those in --outputs; f{fx'}_rgb.png etc. with --focal-list), and
+    /// manifest.json.
     #[arg(long)]
     out_dir: PathBuf,
-    /// Target focal lengths fx' in pixels (fy' keeps the source fy/fx).
+    /// Target focal lengths fx' in pixels (fy' keeps the source fy/fx); files are named by
+    /// them, e.g. f571.4_rgb.png.
     #[arg(long, value_delimiter = ',', conflicts_with = "zoom_range", value_parser = finite_value)]
     focal_list: Option<Vec<f64>>,
     /// Target focal scales s (fx' = s fx).
@@ -147,6 +149,11 @@ pub(crate) fn refocus(a: RefocusArgs) -> Result<()> {
         size: a.width_out.zip(a.height_out),
         principal: a.cx_out.zip(a.cy_out),
     };
+    // Files are named by the focal given with --focal-list, else by the zoom scale.
+    let tags = match &a.focal_list {
+        Some(list) => TargetSpec::focal_tags(list)?,
+        None => scales.iter().map(|&s| job::scale_tag(s)).collect(),
+    };
     let targets = spec.targets(&src.camera())?;
     let out_dir = prepare_out_dir(&a.out_dir)?;
 
@@ -156,9 +163,10 @@ pub(crate) fn refocus(a: RefocusArgs) -> Result<()> {
     let mut entries = Vec::new();
     // All targets and the manifest, or (on any failure) none: earlier runs' files stay.
     let set = out_dir.file_set()?;
-    for (scale, target) in scales.iter().zip(&targets) {
+    for ((scale, target), tag) in scales.iter().zip(&targets).zip(&tags) {
         let out = refocuser.render(target)?;
-        entries.push(job::write_output(set.staging(), *scale, &out, &files).map_err(|e| set.final_error(e))?);
+        let entry = job::write_output_named(set.staging(), tag, *scale, &out, &files);
+        entries.push(entry.map_err(|e| set.final_error(e))?);
         bar.inc(1);
     }
     bar.finish_and_clear();
