@@ -458,7 +458,7 @@ mod tests {
         )
         .unwrap();
         assert_eq!(back.data, vec![1.5, 0.0, 0.0, 0.0]);
-        let names: Vec<String> = file_records(dir.path(), &[e.clone()])
+        let names: Vec<String> = file_records(dir.path(), std::slice::from_ref(&e))
             .unwrap()
             .into_iter()
             .map(|r| r.name)
