@@ -180,6 +180,7 @@ pub fn batch_bench(gpu: &Gpu, input: &BatchInput, jobs: usize, files: FileFormat
         method: Method::Fullscreen,
         conv: Conventions::default(),
         files,
+        depth_trunc: None,
         resume: false,
         jobs,
         shard: None,

@@ -191,6 +191,8 @@ pub struct BatchOptions {
     pub method: Method,
     pub conv: Conventions,
     pub files: FileFormats,
+    /// Input depth beyond this many metres is treated as invalid (Open3D's depth_trunc).
+    pub depth_trunc: Option<f64>,
     /// Skip frames already finished with the same settings.
     pub resume: bool,
     /// Threads in each CPU pool (decode, encode); 0 runs every stage in turn on the GL thread
@@ -259,7 +261,7 @@ fn frame_settings(frame: &BatchFrame, opts: &BatchOptions) -> serde_json::Value 
             Err(_) => serde_json::json!({ "path": p.to_string_lossy() }),
         }
     };
-    serde_json::json!({
+    let mut settings = serde_json::json!({
         "rgb": stamp(&frame.rgb),
         "depth": stamp(&frame.depth),
         "intrinsics": [frame.fx, frame.fy, frame.cx, frame.cy],
@@ -272,7 +274,12 @@ fn frame_settings(frame: &BatchFrame, opts: &BatchOptions) -> serde_json::Value 
         "method": opts.method,
         "conventions": opts.conv,
         "files": opts.files,
-    })
+    });
+    // Only when given, so batches made before the option resume.
+    if let Some(m) = opts.depth_trunc {
+        settings["depth_trunc"] = m.into();
+    }
+    settings
 }
 
 /// A frame is finished when its manifest was written with the same settings and every file it
@@ -334,17 +341,17 @@ fn write_frame(job: WriteJob, files: &FileFormats) -> Result<()> {
 }
 
 /// Read and validate one frame's inputs (errors name the frame's files).
-fn decode_frame(frame: &BatchFrame) -> Result<RefocusSource> {
+fn decode_frame(frame: &BatchFrame, depth_trunc: Option<f64>) -> Result<RefocusSource> {
     let decode = DepthDecode {
         scale: frame.depth_scale,
         sun_rgbd_bit_rotate: frame.sun_bit_rotate,
         ..Default::default()
     };
-    RefocusSource::new(
-        io::load_rgb(&frame.rgb)?,
-        io::load_depth(&frame.depth, &decode)?,
-        frame.intrinsics(),
-    )
+    let mut depth = io::load_depth(&frame.depth, &decode)?;
+    if let Some(m) = depth_trunc {
+        io::truncate_depth(&mut depth, m)?;
+    }
+    RefocusSource::new(io::load_rgb(&frame.rgb)?, depth, frame.intrinsics())
 }
 
 fn ms_since(t: Instant) -> f64 {
@@ -445,6 +452,9 @@ pub fn run_batch(
     if opts.scales.is_empty() {
         return Err(Error::param("scales", "no focal scale given"));
     }
+    if let Some(m) = opts.depth_trunc {
+        io::check_depth_trunc(m)?;
+    }
     if opts.jobs > MAX_JOBS {
         return Err(Error::param(
             "jobs",
@@ -481,7 +491,7 @@ pub fn run_batch(
         // The synchronous baseline: each stage in turn on this thread.
         for (frame, name, _, settings) in todo {
             let t0 = Instant::now();
-            let result = decode_frame(frame).and_then(|src| {
+            let result = decode_frame(frame, opts.depth_trunc).and_then(|src| {
                 stages.decode.push(ms_since(t0));
                 submit_frame(
                     &mut refocuser,
@@ -517,6 +527,7 @@ pub fn run_batch(
     // Decoded frames waiting for the GL thread, and frames waiting for an encoder: `jobs` each.
     summary.frames_in_flight = jobs + 2 + 2 * jobs;
     let next = AtomicUsize::new(0);
+    let depth_trunc = opts.depth_trunc;
     let (result_tx, result_rx) = mpsc::channel::<(String, Result<()>, f64)>();
     std::thread::scope(|scope| {
         let (decoded_tx, decoded_rx) = mpsc::sync_channel::<(usize, Result<RefocusSource>, f64)>(jobs);
@@ -526,7 +537,7 @@ pub fn run_batch(
                 let i = next.fetch_add(1, Ordering::Relaxed);
                 let Some((frame, ..)) = todo.get(i) else { break };
                 let t0 = Instant::now();
-                let src = decode_frame(frame);
+                let src = decode_frame(frame, depth_trunc);
                 if tx.send((i, src, ms_since(t0))).is_err() {
                     break;
                 }

@@ -28,16 +28,24 @@ impl RgbFormat {
     }
 }
 
-/// File formats of the metric depth output (either or both).
+/// File formats of the metric depth output (any combination).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
 pub struct DepthFormats {
     pub exr: bool,
     pub npy: bool,
+    /// uint16 millimetres in a 16-bit gray PNG (0 = invalid). Left out of the settings JSON
+    /// when off, so batches made before it resume.
+    #[serde(skip_serializing_if = "std::ops::Not::not")]
+    pub png16: bool,
 }
 
 impl Default for DepthFormats {
     fn default() -> Self {
-        DepthFormats { exr: true, npy: false }
+        DepthFormats {
+            exr: true,
+            npy: false,
+            png16: false,
+        }
     }
 }
 
@@ -48,6 +56,10 @@ pub struct FileFormats {
     pub rgb: RgbFormat,
     pub depth: DepthFormats,
     pub encoding: io::Encoding,
+    /// A colour-mapped PNG of the depth output beside it (left out of the settings JSON when
+    /// off, so batches made before it resume).
+    #[serde(skip_serializing_if = "std::ops::Not::not")]
+    pub depth_preview: bool,
 }
 
 /// How target cameras are derived from the source.
@@ -66,6 +78,24 @@ impl TargetSpec {
     /// Scales from absolute target focal lengths fx' (fy' follows with the source aspect).
     pub fn scales_from_focal_list(source: &Intrinsics, fx_list: &[f64]) -> Vec<f64> {
         fx_list.iter().map(|f| f / source.fx).collect()
+    }
+
+    /// File-name tags of a focal list, one per fx' as given (`f571.4`); two fx' that print
+    /// alike would overwrite each other's files, so they are refused.
+    pub fn focal_tags(fx_list: &[f64]) -> Result<Vec<String>> {
+        let mut seen = std::collections::HashMap::new();
+        for &f in fx_list {
+            if let Some(prev) = seen.insert(focal_tag(f), f) {
+                return Err(Error::param(
+                    "focal-list",
+                    format!(
+                        "{prev} and {f} both name their files '{}' (6 decimals); give each focal length once",
+                        focal_tag(f)
+                    ),
+                ));
+            }
+        }
+        Ok(fx_list.iter().map(|&f| focal_tag(f)).collect())
     }
 
     pub fn targets(&self, source: &PinholeCamera) -> Result<Vec<PinholeCamera>> {
@@ -123,6 +153,17 @@ pub struct ManifestEntry {
     pub rgb: Option<String>,
     pub depth_exr: Option<String>,
     pub depth_npy: Option<String>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub depth_png16: Option<String>,
+    /// Valid pixels written as 0 in the PNG because they lie beyond 65.535 m.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub depth_png16_clipped: Option<u64>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub depth_preview: Option<String>,
+    /// Depth in metres at the preview's near (red) and far (blue) colours: the 2nd and 98th
+    /// percentile of the valid depth; absent when no pixel is valid (the preview is black).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub depth_preview_range_m: Option<io::PreviewRange>,
     pub mask: Option<String>,
     /// Fraction of output pixels with mask = 1 (when a mask or depth was produced).
     pub coverage: Option<f64>,
@@ -167,7 +208,17 @@ pub struct FileRecord {
 pub fn file_records(dir: &Path, entries: &[ManifestEntry]) -> Result<Vec<FileRecord>> {
     let mut out = Vec::new();
     for e in entries {
-        for name in [&e.rgb, &e.depth_exr, &e.depth_npy, &e.mask].into_iter().flatten() {
+        for name in [
+            &e.rgb,
+            &e.depth_exr,
+            &e.depth_npy,
+            &e.depth_png16,
+            &e.depth_preview,
+            &e.mask,
+        ]
+        .into_iter()
+        .flatten()
+        {
             let path = dir.join(name);
             let bytes = std::fs::metadata(&path).map_err(|e| Error::io(&path, e))?.len();
             out.push(FileRecord {
@@ -179,16 +230,40 @@ pub fn file_records(dir: &Path, entries: &[ManifestEntry]) -> Result<Vec<FileRec
     Ok(out)
 }
 
-fn scale_tag(scale: f64) -> String {
-    // 0.5 -> "s0.5", 1 -> "s1", 1.25 -> "s1.25": short, sortable enough, unambiguous.
-    format!("s{}", format!("{scale:.6}").trim_end_matches('0').trim_end_matches('.'))
+/// The file-name prefix of a zoom scale: 0.5 -> "s0.5", 1 -> "s1", 1.25 -> "s1.25" (short,
+/// sortable enough, unambiguous).
+pub fn scale_tag(scale: f64) -> String {
+    format!("s{}", trim_decimals(scale))
 }
 
-/// Write the requested files of one output under `dir` (atomic: temporary name, then rename).
+/// The file-name prefix of a target focal length fx' in pixels: 571.4 -> "f571.4".
+pub fn focal_tag(fx: f64) -> String {
+    format!("f{}", trim_decimals(fx))
+}
+
+fn trim_decimals(v: f64) -> String {
+    format!("{v:.6}")
+        .trim_end_matches('0')
+        .trim_end_matches('.')
+        .to_string()
+}
+
+/// Write the requested files of one output under `dir` (atomic: temporary name, then rename),
+/// named by the scale's tag.
 pub fn write_output(dir: &Path, scale: f64, out: &RefocusOutput, files: &FileFormats) -> Result<ManifestEntry> {
+    write_output_named(dir, &scale_tag(scale), scale, out, files)
+}
+
+/// [`write_output`] with the files named `{tag}_rgb.png` etc. (e.g. a [`focal_tag`]).
+pub fn write_output_named(
+    dir: &Path,
+    tag: &str,
+    scale: f64,
+    out: &RefocusOutput,
+    files: &FileFormats,
+) -> Result<ManifestEntry> {
     let (outputs, rgb_format, depth_formats, enc) = (&files.outputs, files.rgb, files.depth, files.encoding);
     let t0 = std::time::Instant::now();
-    let tag = scale_tag(scale);
     let name = |suffix: &str| -> (PathBuf, String) {
         let file = format!("{tag}_{suffix}");
         (dir.join(&file), file)
@@ -201,6 +276,10 @@ pub fn write_output(dir: &Path, scale: f64, out: &RefocusOutput, files: &FileFor
         rgb: None,
         depth_exr: None,
         depth_npy: None,
+        depth_png16: None,
+        depth_png16_clipped: None,
+        depth_preview: None,
+        depth_preview_range_m: None,
         mask: None,
         coverage: None,
         render_ms: out.render.wall_ms,
@@ -222,6 +301,16 @@ pub fn write_output(dir: &Path, scale: f64, out: &RefocusOutput, files: &FileFor
             let (path, file) = name("depth.npy");
             io::save_depth_npy(&path, depth)?;
             entry.depth_npy = Some(file);
+        }
+        if depth_formats.png16 {
+            let (path, file) = name("depth.png");
+            entry.depth_png16_clipped = Some(io::save_depth_png16(&path, depth, enc.png)?);
+            entry.depth_png16 = Some(file);
+        }
+        if files.depth_preview {
+            let (path, file) = name("depth_preview.png");
+            entry.depth_preview_range_m = io::save_depth_preview(&path, depth, &enc)?;
+            entry.depth_preview = Some(file);
         }
         let valid = depth.data.iter().filter(|z| **z > 0.0).count();
         entry.coverage = Some(valid as f64 / depth.data.len() as f64);
@@ -296,5 +385,118 @@ mod tests {
         assert!(e.contains("0.5000001") && e.contains("s0.5"), "{e}");
         assert_eq!(scale_tag(1.0), "s1");
         assert_eq!(TargetSpec::scales_from_focal_list(&src.k, &[250.0]), vec![0.5]);
+    }
+
+    #[test]
+    fn focal_lists_name_files_by_the_focal_given() {
+        assert_eq!(focal_tag(571.4), "f571.4");
+        assert_eq!(focal_tag(500.0), "f500");
+        assert_eq!(TargetSpec::focal_tags(&[571.4, 1000.0]).unwrap(), ["f571.4", "f1000"]);
+        let e = TargetSpec::focal_tags(&[600.0, 571.4, 571.4000001])
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.contains("focal-list") && e.contains("571.4000001") && e.contains("'f571.4'"),
+            "{e}"
+        );
+        let dir = scratch("viewsynth-job-focal-");
+        let out = synthetic_output(vec![1.0, 2.0]);
+        let e = write_output_named(dir.path(), "f571.4", 57.14, &out, &FileFormats::default()).unwrap();
+        assert_eq!(e.rgb.as_deref(), Some("f571.4_rgb.png"));
+        assert_eq!(e.depth_exr.as_deref(), Some("f571.4_depth.exr"));
+        assert_eq!(e.scale, 57.14);
+        assert!(dir.path().join("f571.4_mask.png").is_file());
+    }
+
+    /// A 4x1 target whose depth holds `z`, rgb and mask all valid.
+    fn synthetic_output(z: Vec<f32>) -> RefocusOutput {
+        let (w, h) = (z.len() as u32, 1);
+        RefocusOutput {
+            camera: PinholeCamera {
+                k: Intrinsics {
+                    fx: 10.0,
+                    fy: 10.0,
+                    cx: 1.5,
+                    cy: 0.0,
+                },
+                width: w,
+                height: h,
+            },
+            rgb: Some(io::RgbImage::new(w, h, vec![128; (w * h * 3) as usize]).unwrap()),
+            depth: Some(io::DepthMap::new(w, h, z).unwrap()),
+            mask: Some(io::Mask::new(w, h, vec![1; (w * h) as usize]).unwrap()),
+            render: Default::default(),
+            readback_ms: 0.0,
+        }
+    }
+
+    fn scratch(tag: &str) -> tempfile::TempDir {
+        tempfile::Builder::new().prefix(tag).tempdir().unwrap()
+    }
+
+    #[test]
+    fn png16_depth_counts_what_lies_beyond_its_range() {
+        let dir = scratch("viewsynth-job-png16-");
+        let out = synthetic_output(vec![1.5, 0.0, 70.0, 65.6]);
+        let files = FileFormats {
+            depth: DepthFormats {
+                exr: false,
+                npy: false,
+                png16: true,
+            },
+            ..Default::default()
+        };
+        let e = write_output(dir.path(), 1.0, &out, &files).unwrap();
+        assert_eq!(e.depth_png16.as_deref(), Some("s1_depth.png"));
+        assert_eq!((e.depth_exr.as_deref(), e.depth_png16_clipped), (None, Some(2)));
+        let back = io::load_depth(
+            &dir.path().join("s1_depth.png"),
+            &io::DepthDecode {
+                scale: Some(1000.0),
+                ..Default::default()
+            },
+        )
+        .unwrap();
+        assert_eq!(back.data, vec![1.5, 0.0, 0.0, 0.0]);
+        let names: Vec<String> = file_records(dir.path(), std::slice::from_ref(&e))
+            .unwrap()
+            .into_iter()
+            .map(|r| r.name)
+            .collect();
+        assert!(names.contains(&"s1_depth.png".to_string()), "{names:?}");
+        let json = serde_json::to_value(&e).unwrap();
+        assert_eq!(json["depth_png16_clipped"], 2);
+        // Off by default: neither the file nor the keys appear (older manifests stay as they were).
+        let plain = write_output(dir.path(), 2.0, &out, &FileFormats::default()).unwrap();
+        let json = serde_json::to_value(&plain).unwrap();
+        assert!(json.get("depth_png16").is_none() && json.get("depth_png16_clipped").is_none());
+        let settings = serde_json::to_value(FileFormats::default()).unwrap();
+        assert!(settings["depth"].get("png16").is_none(), "{settings}");
+        assert!(settings.get("depth_preview").is_none(), "{settings}");
+    }
+
+    #[test]
+    fn the_depth_preview_and_its_range_are_in_the_entry() {
+        let dir = scratch("viewsynth-job-preview-");
+        let out = synthetic_output(vec![1.0, 0.0, 2.0, 3.0]);
+        let files = FileFormats {
+            depth_preview: true,
+            ..Default::default()
+        };
+        let e = write_output(dir.path(), 0.5, &out, &files).unwrap();
+        assert_eq!(e.depth_preview.as_deref(), Some("s0.5_depth_preview.png"));
+        let r = e.depth_preview_range_m.unwrap();
+        assert_eq!((r.min_m, r.max_m), (1.0, 3.0));
+        let json = serde_json::to_value(&e).unwrap();
+        assert_eq!(json["depth_preview_range_m"]["max_m"], 3.0);
+        let img = io::load_rgb(&dir.path().join("s0.5_depth_preview.png")).unwrap();
+        assert_eq!(img.data[3..6], [0, 0, 0]);
+        assert_ne!(img.data[..3], img.data[9..]);
+        let names: Vec<String> = file_records(dir.path(), &[e])
+            .unwrap()
+            .into_iter()
+            .map(|r| r.name)
+            .collect();
+        assert!(names.contains(&"s0.5_depth_preview.png".to_string()), "{names:?}");
     }
 }

@@ -42,9 +42,14 @@ fn options(jobs: usize) -> BatchOptions {
         conv: Conventions::default(),
         files: FileFormats {
             outputs: OutputSet::default(),
-            depth: viewsynth::refocus::job::DepthFormats { exr: true, npy: true },
+            depth: viewsynth::refocus::job::DepthFormats {
+                exr: true,
+                npy: true,
+                png16: true,
+            },
             ..Default::default()
         },
+        depth_trunc: None,
         resume: true,
         jobs,
         shard: None,
@@ -81,7 +86,7 @@ fn pipelined_outputs_are_byte_identical_to_the_synchronous_path() {
         piped.failed
     );
     let (a, b) = (files(&dir.path().join("sync")), files(&dir.path().join("piped")));
-    assert_eq!(a.len(), 5 * 3 * 4, "rgb, mask, exr and npy per scale");
+    assert_eq!(a.len(), 5 * 3 * 5, "rgb, mask, exr, npy and png16 per scale");
     assert_eq!(a.keys().collect::<Vec<_>>(), b.keys().collect::<Vec<_>>());
     for (k, v) in &a {
         assert!(

@@ -4,6 +4,7 @@
 mod batch;
 mod cli;
 mod cli_compare;
+mod cli_depth_out;
 mod cli_formats;
 mod cli_reproject_stitch;
 mod common;

@@ -260,9 +260,14 @@ struct FileOutputArgs {
     outputs: String,
     #[arg(long, value_enum, default_value = "png")]
     rgb_format: RgbFormatArg,
-    /// Depth file formats: exr, npy or both.
+    /// Depth file formats, any of: exr (float32 metres), npy (float32 metres), png16 (uint16
+    /// millimetres, 0 = invalid; beyond 65.535 m written as 0 and counted in the manifest).
     #[arg(long, default_value = "exr")]
     depth_format: String,
+    /// Also write s{tag}_depth_preview.png: the depth output colour-mapped (turbo: near red, far
+    /// blue, invalid black) over its 2nd-98th percentile, the range recorded in the manifest.
+    #[arg(long)]
+    depth_preview: bool,
     /// PNG compression of colour and mask files: fast (the default, as earlier releases wrote),
     /// default (deflate's default level: smaller files, several times the CPU) or best.
     #[arg(long, default_value = "fast")]
@@ -293,11 +298,15 @@ impl FileOutputArgs {
     /// Everything the refocus writers need.
     fn file_formats(&self) -> Result<job::FileFormats> {
         let (outputs, rgb, depth) = self.parse()?;
+        if self.depth_preview && !outputs.depth {
+            bail!("--depth-preview colours the depth output: add depth to --outputs");
+        }
         Ok(job::FileFormats {
             outputs,
             rgb,
             depth,
             encoding: self.encoding()?,
+            depth_preview: self.depth_preview,
         })
     }
 }
@@ -504,12 +513,17 @@ fn conventions(ndc: NdcArg, reversed_z: bool, rows: RowsArg) -> Conventions {
 }
 
 fn parse_depth_formats(list: &str) -> Result<DepthFormats> {
-    let mut f = DepthFormats { exr: false, npy: false };
+    let mut f = DepthFormats {
+        exr: false,
+        npy: false,
+        png16: false,
+    };
     for item in list.split(',').map(str::trim) {
         match item {
             "exr" => f.exr = true,
             "npy" => f.npy = true,
-            _ => bail!("invalid depth-format '{item}': expected exr, npy or exr,npy"),
+            "png16" => f.png16 = true,
+            _ => bail!("invalid depth-format '{item}': expected exr, npy, png16 or a list such as exr,png16"),
         }
     }
     Ok(f)

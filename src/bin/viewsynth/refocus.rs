@@ -42,16 +42,22 @@ pub(crate) struct RefocusArgs {
     /// floating-point one).
     #[arg(long, value_name = "NAME")]
     npz_key: Option<String>,
+    /// Treat input depth beyond M metres as invalid (as Open3D's depth_trunc), after
+    /// --depth-scale.
+    #[arg(long, value_name = "M", value_parser = finite_value)]
+    depth_trunc: Option<f64>,
     /// SUN RGB-D PNG depth: rotate the 16-bit value right by 3 bits before scaling.
     #[arg(long)]
     sun_bit_rotate: bool,
     #[command(flatten)]
     intrinsics: IntrinsicsArgs,
-    /// Output folder (created if missing): per focal scale s, s{s}_rgb.png, s{s}_depth.exr,
-    /// s{s}_mask.png (those in --outputs), and manifest.json.
+    /// Output folder (created if missing): per zoom scale s, s{s}_rgb.png, s{s}_depth.exr,
+    /// s{s}_mask.png (those in --outputs; f{fx'}_rgb.png etc. with --focal-list), and
+    /// manifest.json.
     #[arg(long)]
     out_dir: PathBuf,
-    /// Target focal lengths fx' in pixels (fy' keeps the source fy/fx).
+    /// Target focal lengths fx' in pixels (fy' keeps the source fy/fx); files are named by
+    /// them, e.g. f571.4_rgb.png.
     #[arg(long, value_delimiter = ',', conflicts_with = "zoom_range", value_parser = finite_value)]
     focal_list: Option<Vec<f64>>,
     /// Target focal scales s (fx' = s fx).
@@ -120,7 +126,7 @@ pub(crate) fn refocus(a: RefocusArgs) -> Result<()> {
         sun_rgbd_bit_rotate: a.sun_bit_rotate,
         ..Default::default()
     };
-    let depth = io::load_depth_with_key(&depth_path, a.npz_key.as_deref(), &decode)?;
+    let mut depth = io::load_depth_with_key(&depth_path, a.npz_key.as_deref(), &decode)?;
     source_k.check_size(rgb.width, rgb.height)?;
     print_depth_summary(
         &depth_path,
@@ -128,6 +134,10 @@ pub(crate) fn refocus(a: RefocusArgs) -> Result<()> {
         "check --depth-scale (raw units per metre: 5000 TUM, 1000 SUN RGB-D with --sun-bit-rotate) \
          and that the file holds metric depth, not disparity",
     );
+    if let Some(m) = a.depth_trunc {
+        let n = io::truncate_depth(&mut depth, m)?;
+        eprintln!("--depth-trunc {m}: {n} pixels beyond {m} m set invalid");
+    }
     let src = RefocusSource::new(rgb, depth, k)
         .with_context(|| format!("{} and {}", rgb_path.display(), depth_path.display()))?;
     let scales = match &a.focal_list {
@@ -139,6 +149,11 @@ pub(crate) fn refocus(a: RefocusArgs) -> Result<()> {
         size: a.width_out.zip(a.height_out),
         principal: a.cx_out.zip(a.cy_out),
     };
+    // Files are named by the focal given with --focal-list, else by the zoom scale.
+    let tags = match &a.focal_list {
+        Some(list) => TargetSpec::focal_tags(list)?,
+        None => scales.iter().map(|&s| job::scale_tag(s)).collect(),
+    };
     let targets = spec.targets(&src.camera())?;
     let out_dir = prepare_out_dir(&a.out_dir)?;
 
@@ -148,9 +163,10 @@ pub(crate) fn refocus(a: RefocusArgs) -> Result<()> {
     let mut entries = Vec::new();
     // All targets and the manifest, or (on any failure) none: earlier runs' files stay.
     let set = out_dir.file_set()?;
-    for (scale, target) in scales.iter().zip(&targets) {
+    for ((scale, target), tag) in scales.iter().zip(&targets).zip(&tags) {
         let out = refocuser.render(target)?;
-        entries.push(job::write_output(set.staging(), *scale, &out, &files).map_err(|e| set.final_error(e))?);
+        let entry = job::write_output_named(set.staging(), tag, *scale, &out, &files);
+        entries.push(entry.map_err(|e| set.final_error(e))?);
         bar.inc();
     }
     bar.finish();
@@ -216,6 +232,7 @@ pub(crate) fn refocus_batch(manifest: &Path, a: RefocusArgs) -> Result<()> {
         },
         conv: a.conv.conventions(),
         files,
+        depth_trunc: a.depth_trunc,
         resume: !a.force,
         jobs,
         shard,
