@@ -127,3 +127,15 @@ pub fn disparity_frame(
     };
     Ok((frame, mid))
 }
+
+/// The fixation the seed and refine methods start from on a rectified pair: the median depth
+/// the left eye saw (a far or near fixation leaves more of the view to the refinement). None
+/// when the left eye has no known depth.
+pub fn median_fixation(frame: &StereoFrame) -> Option<f64> {
+    let mut z: Vec<f32> = frame.left.depth.data.iter().copied().filter(|z| *z > 0.0).collect();
+    if z.is_empty() {
+        return None;
+    }
+    let half = z.len() / 2;
+    Some(*z.select_nth_unstable_by(half, f32::total_cmp).1 as f64)
+}

@@ -114,11 +114,15 @@ impl MiddleCamera {
 pub enum Method {
     /// Seed 000 as written: one reconstruction step from the fixation depth.
     Seed,
-    /// `steps` reconstruction steps, then a check that the surface found projects onto this
+    /// The seed's step followed by `steps` refinement steps (each re-reads the eye's depth where
+    /// the last estimate projects), then a check that the surface found projects onto this
     /// middle pixel (within `REFINE_TOLERANCE_PX`); eyes failing it are dropped. Colour is
     /// filtered edge-aware: texels at another depth (beyond `z_threshold`) get no weight.
+    /// The seed is refine 0: its one step reads the texel where the fixation guess projects,
+    /// which lies on the surface only near the fixation, so the check needs at least one
+    /// refinement to pass elsewhere.
     Refine {
-        /// Reconstruction steps before the check, 1..=16.
+        /// Refinement steps after the seed's step, 1..=16.
         steps: u32,
     },
 }
@@ -198,10 +202,11 @@ impl CyclopeanParams {
         Ok(())
     }
 
+    /// Depth reads of the walk: the seed's step plus the refinements.
     pub(crate) fn steps(&self) -> u32 {
         match self.method {
             Method::Seed => 1,
-            Method::Refine { steps } => steps,
+            Method::Refine { steps } => steps + 1,
         }
     }
 }

@@ -24,7 +24,7 @@ pub enum CyclopeanMethod {
     SplatGather,
     /// Seed 000: one reconstruction step from the fixation depth.
     Seed,
-    /// `--refine-steps` reconstruction steps and a projection check.
+    /// The seed's step, `--refine-steps` refinement steps and a projection check.
     Refine,
     /// Each eye's depth mesh rendered into the view, the nearest surface wins.
     Forward,
@@ -398,12 +398,8 @@ impl CyclopeanJob {
             position: *position,
         };
         let (frame, mid) = disparity_frame(l, r, &rig, Conventions::default())?;
-        let mut z: Vec<f32> = frame.left.depth.data.iter().copied().filter(|z| *z > 0.0).collect();
-        if z.is_empty() {
-            return Err(crate::Error::decode(left, "no known disparity (all 0 or non-finite)").into());
-        }
-        let half = z.len() / 2;
-        let fixation = *z.select_nth_unstable_by(half, f32::total_cmp).1 as f64;
+        let fixation = crate::cyclopean::disparity_frame::median_fixation(&frame)
+            .ok_or_else(|| crate::Error::decode(left, "no known disparity (all 0 or non-finite)"))?;
         Ok((frame, mid, fixation))
     }
 

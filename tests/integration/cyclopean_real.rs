@@ -21,8 +21,8 @@ use std::path::{Path, PathBuf};
 use viewsynth::camera::{gl_projection, Intrinsics, PinholeCamera};
 use viewsynth::convention::Conventions;
 use viewsynth::convention::DepthPlanes;
-use viewsynth::cyclopean::baseline::{forward_splat, forward_splat_offset};
-use viewsynth::cyclopean::disparity_frame::{disparity_frame, DisparityRig};
+use viewsynth::cyclopean::baseline::{forward_splat, forward_splat_offset, forward_splat_rounded, Rounding};
+use viewsynth::cyclopean::disparity_frame::{disparity_frame, median_fixation, DisparityRig};
 use viewsynth::cyclopean::reference::CyclopeanReference;
 use viewsynth::cyclopean::render::CyclopeanRenderer;
 use viewsynth::cyclopean::scene_frame::{scene_frame, StereoRig};
@@ -157,6 +157,7 @@ fn count(mask: &[bool]) -> usize {
 #[test]
 fn default_beats_the_splat_baseline_on_cones_and_covers_more() {
     let (l, r, truth) = cones();
+    let (l0, r0) = (l.clone(), r.clone());
     let base = forward_splat((&l.0, &l.1), (&r.0, &r.1), 0.5).unwrap();
     let (frame, mid) = disparity_frame(l, r, &DisparityRig::middle(400.0, 0.1), Conventions::default()).unwrap();
     let out = splat_gpu(&frame, &mid);
@@ -181,6 +182,30 @@ fn default_beats_the_splat_baseline_on_cones_and_covers_more() {
     // baseline nothing (next test).
     assert!(ours >= theirs + 0.5, "{msg}");
     assert!(count(&covered) >= count(&base.covered), "{msg}");
+    // Issue 13's own baseline, the 40 lines of numpy whose `np.round` rounds halves to even
+    // (89.5 % coverage there and here): its target, >= 1 dB over it on the common pixels with
+    // >= 89.5 % coverage. Measured when written: 29.54 vs 28.13 dB (+1.42) on 150,613 pixels,
+    // 96.4 % vs 89.5 % covered; the bound keeps 0.1 dB for other GPUs' f32 decisions as above.
+    let issue = forward_splat_rounded((&l0.0, &l0.1), (&r0.0, &r0.1), 0.5, [0.0, 0.0], Rounding::HalfEven).unwrap();
+    let common: Vec<bool> = covered.iter().zip(&issue.covered).map(|(a, b)| *a && *b).collect();
+    let (ours, theirs) = (
+        psnr(out.color().unwrap(), &truth, &common),
+        psnr(&issue.color, &truth, &common),
+    );
+    let n = covered.len() as f64;
+    let msg = format!(
+        "splat-gather {ours:.3} dB vs issue 13's numpy splat {theirs:.3} dB on {} common pixels; coverage {:.4} vs {:.4}",
+        count(&common),
+        count(&covered) as f64 / n,
+        count(&issue.covered) as f64 / n
+    );
+    eprintln!("{msg}");
+    assert!(ours >= theirs + 1.3, "{msg}");
+    assert!(count(&covered) as f64 >= 0.895 * n, "{msg}");
+    assert!(
+        (count(&issue.covered) as f64 / n - 0.895).abs() < 0.001,
+        "the issue's coverage reproduced: {msg}"
+    );
     // No worse than that where it matters most: one eye reprojected to the other (im2 -> im6,
     // the right disparity left out), where a splat has no second eye to fill its holes.
     let (l, mut r, _) = cones();
@@ -362,16 +387,14 @@ fn thin_poles_keep_their_colour_and_width_and_no_wall_shows_through() {
     );
 }
 
-/// Refine with one step cannot work from a fixation plane far from the surface, by design:
-/// after one step the texel it read was found at the fixation guess, and the projection check
-/// (1 px, plus the rounding to that texel) accepts it only where the surface is within about
-/// 2 px of middle parallax (4 px of disparity at t = 1/2; measured: all pass at 2 px of
-/// disparity off, none at 5) of that guess. On a wall the check passes everywhere with the
-/// fixation on the wall and nowhere with it 6-8 px of disparity off; more steps converge from
-/// there. Cones spans 10-55 px of disparity, hence the 8-10 % coverage of refine 1 there (the
-/// issue's "broken"); refine 2 already covers 94 %.
+/// Refine 1 is the seed's step and one refinement: on a wall parallel to the eyes the seed's
+/// step already finds the wall's depth from any fixation (it reads the wall wherever the guess
+/// projects) and the refinement samples where that depth projects, so the check passes
+/// everywhere. It can fail: sampling at the seed's guess instead (refine 1 before this
+/// definition) passed only within about 2 px of middle parallax of the fixation (0 % at 8 px
+/// nearer or 6 px farther, 8-10 % of Cones).
 #[test]
-fn refine_one_step_covers_only_surfaces_near_the_fixation() {
+fn refine_one_covers_a_wall_from_any_fixation() {
     let (w, h) = (64u32, 16u32);
     let d_wall = 8.0f32;
     let texture: Vec<u8> = (0..w * h * 3).map(|i| (i * 37 % 251) as u8).collect();
@@ -405,8 +428,35 @@ fn refine_one_step_covers_only_surfaces_near_the_fixation() {
         coverage(d_wall as f64 + 8.0, 6),
     ];
     assert!(
-        c[0] > 0.99 && c[1] < 0.01 && c[2] < 0.01 && c[3] > 0.99,
-        "on the wall, 8 px nearer, 6 px farther, 8 px nearer with 6 steps: {c:?}"
+        c.iter().all(|c| *c > 0.99),
+        "refine 1 on the wall, 8 px nearer, 6 px farther; refine 6 8 px nearer: {c:?}"
+    );
+}
+
+/// Refine 1 on Cones from the CLI's fixation (the median disparity): most pixels covered and
+/// no worse than a few dB under the default. Measured when written (llvmpipe): 94.2 % covered,
+/// 26.24 dB on its covered pixels (refine 6: 95.9 %, 26.60 dB; the old refine 1: 10.3 %).
+/// Bounds: 2 points of coverage and 0.5 dB under those, for other GPUs' f32 decisions at
+/// Cones' quarter-pixel ties (1.3 % of the pixels, see the twin test).
+#[test]
+fn refine_one_covers_cones() {
+    let (l, r, truth) = cones();
+    let (frame, mid) = disparity_frame(l, r, &DisparityRig::middle(400.0, 0.1), Conventions::default()).unwrap();
+    let fixation = median_fixation(&frame).unwrap();
+    let params = CyclopeanParams {
+        method: Method::Refine { steps: 1 },
+        ..CyclopeanParams::seed(fixation)
+    };
+    let (out, _) = CyclopeanRenderer::new(&gpu(), &frame, params)
+        .unwrap()
+        .render(&mid)
+        .unwrap();
+    let covered: Vec<bool> = out.sources.iter().map(|s| *s != 0).collect();
+    let fraction = count(&covered) as f64 / covered.len() as f64;
+    let db = psnr(out.color().unwrap(), &truth, &covered);
+    assert!(
+        fraction >= 0.92 && db >= 25.7,
+        "refine 1 on Cones: {fraction:.4} covered, {db:.2} dB"
     );
 }
 

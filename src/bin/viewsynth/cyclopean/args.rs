@@ -22,7 +22,7 @@ pub(crate) enum MethodArg {
     SplatGather,
     /// Seed 000 as written: one reconstruction step from the fixation depth.
     Seed,
-    /// --refine-steps reconstruction steps and a projection check.
+    /// The seed's step, --refine-steps refinement steps and a projection check.
     Refine,
     /// Each eye's depth mesh rendered into the view, the nearest surface wins.
     Forward,
@@ -79,7 +79,7 @@ pub(crate) struct CyclopeanArgs {
     /// Method (default splat-gather; a lone --refine-steps selects seed (0) or refine as before).
     #[arg(long, value_enum)]
     method: Option<MethodArg>,
-    /// Reconstruction steps of the refine method (0 = the seed's single step).
+    /// Refinement steps of the refine method after the seed's step (0 = the seed alone).
     #[arg(long, value_parser = clap::value_parser!(u32).range(0..=16))]
     refine_steps: Option<u32>,
     /// Seed/refine only.
