@@ -135,13 +135,24 @@ float splat_at(usampler2D splat, ivec2 p) {
     return bits == 0xFFFFFFFFu ? NONE : uintBitsToFloat(bits);
 }
 
-// The nearest of the pixel's and its 4 neighbours' splats, then the pixel's own (in a hole: the
-// farthest neighbour's) when it is another surface; NONE where absent.
-vec2 candidates(usampler2D splat, ivec2 p) {
+// One eye's splats around pixel p, fetched once for all of the pixel's samples: the
+// candidates (the nearest of the pixel's and its 4 neighbours' splats, then the pixel's own (in
+// a hole: the farthest neighbour's) when it is another surface; NONE where absent), and whether
+// a depth edge may cross the pixel along x (the pixel or its left or right neighbour empty, or
+// two of them different surfaces).
+struct Neighbourhood {
+    vec2 cand;
+    bool edge;
+};
+
+Neighbourhood neighbourhood(usampler2D splat, ivec2 p) {
     ivec2 size = ivec2(u_size_m);
     float own = splat_at(splat, p);
     float near = own;
     float far = absent(own) ? -1.0 : own;
+    // Along x (a neighbour outside the image counts as the pixel itself).
+    float lo = own;
+    float hi = own;
     ivec2 offsets[4] = ivec2[4](ivec2(-1, 0), ivec2(1, 0), ivec2(0, -1), ivec2(0, 1));
     for (int k = 0; k < 4; ++k) {
         ivec2 q = p + offsets[k];
@@ -153,14 +164,17 @@ vec2 candidates(usampler2D splat, ivec2 p) {
         if (absent(own) && !absent(z)) {
             far = max(far, z);
         }
+        if (k < 2) {
+            lo = min(lo, z);
+            hi = max(hi, z);
+        }
     }
     float second = (far > 0.0 && !same_surface(far, near)) ? far : NONE;
-    return vec2(near, second);
+    return Neighbourhood(vec2(near, second), absent(hi) || !same_surface(lo, hi));
 }
 
-Sample eye(sampler2D color, sampler2D dist, usampler2D splat, mat4 view_proj, mat4 view, mat4 inv_view,
-           mat4 inv_proj, vec3 ray_m, ivec2 p) {
-    vec2 cand = candidates(splat, p);
+Sample eye(sampler2D color, sampler2D dist, mat4 view_proj, mat4 view, mat4 inv_view, mat4 inv_proj, vec3 ray_m,
+           vec2 cand) {
     Sample s = Sample(false, vec3(0.0), 0.0, 0.0);
     // A loop, not two branches: llvmpipe leaves it as soon as every lane has its answer.
     for (int k = 0; k < 2; ++k) {
@@ -182,14 +196,14 @@ struct Merged {
     int bits;
 };
 
-// Both eyes' answers for the middle ray through window position `frag`, from pixel p's splat
+// Both eyes' answers for the middle ray through window position `frag`, from the pixel's splat
 // candidates, merged: on one surface weighted by nearness to each eye and confidence; else the
 // nearer; one eye alone: that eye.
-Merged shade(vec2 frag, ivec2 p) {
+Merged shade(vec2 frag, vec2 cand_l, vec2 cand_r) {
     vec2 ndc = frag / u_size_m * 2.0 - 1.0;
     vec3 ray = view_ray(u_inv_proj_m, ndc);
-    Sample l = eye(u_color_l, u_dist_l, u_splat_l, u_view_proj_l, u_view_l, u_inv_view_l, u_inv_proj_l, ray, p);
-    Sample r = eye(u_color_r, u_dist_r, u_splat_r, u_view_proj_r, u_view_r, u_inv_view_r, u_inv_proj_r, ray, p);
+    Sample l = eye(u_color_l, u_dist_l, u_view_proj_l, u_view_l, u_inv_view_l, u_inv_proj_l, ray, cand_l);
+    Sample r = eye(u_color_r, u_dist_r, u_view_proj_r, u_view_r, u_inv_view_r, u_inv_proj_r, ray, cand_r);
     Merged m = Merged(false, vec3(0.0), 0.0, 0);
     if (l.valid && r.valid && same_surface(l.z_middle, r.z_middle)) {
         // > 0: each confidence is >= 1/4 and the two position weights sum to 1.
@@ -204,35 +218,23 @@ Merged shade(vec2 frag, ivec2 p) {
     return m;
 }
 
-// Whether a depth edge may cross the pixel along x: in either eye's splat the pixel or its left
-// or right neighbour is empty, or two of them are different surfaces.
-bool edge_nearby(usampler2D splat, ivec2 p) {
-    float lo = NONE;
-    float hi = 0.0;
-    for (int dx = -1; dx <= 1; ++dx) {
-        ivec2 q = clamp(p + ivec2(dx, 0), ivec2(0), ivec2(u_size_m) - 1);
-        float z = splat_at(splat, q);
-        lo = min(lo, z);
-        hi = max(hi, z);
-    }
-    return absent(hi) || !same_surface(lo, hi);
-}
-
 void main() {
     ivec2 p = ivec2(gl_FragCoord.xy);
-    Merged m = shade(gl_FragCoord.xy, p);
+    Neighbourhood nl = neighbourhood(u_splat_l, p);
+    Neighbourhood nr = neighbourhood(u_splat_r, p);
+    Merged m = shade(gl_FragCoord.xy, nl.cand, nr.cand);
     // A camera pixel integrates its footprint: where a depth edge crosses it, its colour mixes
     // both surfaces. Rectified views move edges only along x (their mixing along y is already in
     // the eyes' pixels), so at an edge the colour is the mean of the centre and two samples at
     // +-1/3 px along x (a 3-tap box over the pixel), over those an eye answers. Elsewhere, and
     // where the three see one surface, the centre alone: no blur on surfaces.
-    if (m.valid && (edge_nearby(u_splat_l, p) || edge_nearby(u_splat_r, p))) {
+    if (m.valid && (nl.edge || nr.edge)) {
         vec3 sum = m.color;
         float n = 1.0;
         float d_lo = u_parallax_px / m.z;
         float d_hi = d_lo;
         for (int k = 0; k < 2; ++k) {
-            Merged s = shade(gl_FragCoord.xy + vec2(k == 0 ? -SUBSAMPLE : SUBSAMPLE, 0.0), p);
+            Merged s = shade(gl_FragCoord.xy + vec2(k == 0 ? -SUBSAMPLE : SUBSAMPLE, 0.0), nl.cand, nr.cand);
             if (s.valid) {
                 sum += s.color;
                 n += 1.0;
