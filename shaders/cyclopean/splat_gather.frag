@@ -138,8 +138,8 @@ float splat_at(usampler2D splat, ivec2 p) {
 // One eye's splats around pixel p, fetched once for all of the pixel's samples: the
 // candidates (the nearest of the pixel's and its 4 neighbours' splats, then the pixel's own (in
 // a hole: the farthest neighbour's) when it is another surface; NONE where absent), and whether
-// a depth edge may cross the pixel along x (the pixel or its left or right neighbour empty, or
-// two of them different surfaces).
+// a depth edge may cross the pixel along x (two of it and its left and right neighbours hold
+// different surfaces; an empty one is a crack or the other eye's edge, not an edge here).
 struct Neighbourhood {
     vec2 cand;
     bool edge;
@@ -152,7 +152,7 @@ Neighbourhood neighbourhood(usampler2D splat, ivec2 p) {
     float far = absent(own) ? -1.0 : own;
     // Along x (a neighbour outside the image counts as the pixel itself).
     float lo = own;
-    float hi = own;
+    float hi = absent(own) ? 0.0 : own;
     ivec2 offsets[4] = ivec2[4](ivec2(-1, 0), ivec2(1, 0), ivec2(0, -1), ivec2(0, 1));
     for (int k = 0; k < 4; ++k) {
         ivec2 q = p + offsets[k];
@@ -164,13 +164,13 @@ Neighbourhood neighbourhood(usampler2D splat, ivec2 p) {
         if (absent(own) && !absent(z)) {
             far = max(far, z);
         }
-        if (k < 2) {
+        if (k < 2 && !absent(z)) {
             lo = min(lo, z);
             hi = max(hi, z);
         }
     }
     float second = (far > 0.0 && !same_surface(far, near)) ? far : NONE;
-    return Neighbourhood(vec2(near, second), absent(hi) || !same_surface(lo, hi));
+    return Neighbourhood(vec2(near, second), hi > 0.0 && !same_surface(lo, hi));
 }
 
 Sample eye(sampler2D color, sampler2D dist, mat4 view_proj, mat4 view, mat4 inv_view, mat4 inv_proj, vec3 ray_m,

@@ -173,17 +173,20 @@ impl Ctx<'_> {
         })
     }
 
-    /// Whether a depth edge may cross pixel (x, y) along x: the pixel or its left or right
-    /// neighbour (clamped to the image) is empty in this eye's splat, or two are different
-    /// surfaces.
+    /// Whether a depth edge may cross pixel (x, y) along x: two of the pixel and its left and
+    /// right neighbours (clamped to the image) hold different surfaces in this eye's splat.
+    /// An empty one is no edge: a crack in a stretched surface is none, and where one eye's
+    /// splat is empty because the surface was hidden from it, the other eye's shows the edge.
     fn edge_nearby(&self, splat: &[f64], x: i64, y: i64, wm: i64) -> bool {
         let (mut lo, mut hi) = (f64::INFINITY, 0.0f64);
         for dx in -1..=1 {
             let z = splat[(y * wm + (x + dx).clamp(0, wm - 1)) as usize];
-            lo = lo.min(z);
-            hi = hi.max(z);
+            if z.is_finite() {
+                lo = lo.min(z);
+                hi = hi.max(z);
+            }
         }
-        !hi.is_finite() || !self.same_surface(lo, hi)
+        hi > 0.0 && !self.same_surface(lo, hi)
     }
 
     /// Candidates from the eye's splat: the nearest of the pixel and its 4 neighbours (a near
