@@ -1,14 +1,13 @@
 // Splat pass of the splat-gather method (src/cyclopean/splat.rs; f64 twin: splat_reference.rs).
-// u_clear = 1: every middle pixel to "no surface" (0xFFFFFFFF). u_clear = 0: each valid eye
-// texel's surface point to the middle pixel its one-pixel footprint covers (the floor of its
+// Into an image the driver cleared to "no surface" (0xFFFFFFFF, Framebuffer::clear): each valid
+// eye texel's surface point to the middle pixel its one-pixel footprint covers (the floor of its
 // window position), nearest first: positive floats order like their bit patterns, so an atomic
 // min on the bits keeps the nearest middle distance.
 
 layout(local_size_x = 8, local_size_y = 8) in;
 layout(r32ui, binding = 0) uniform uimage2D u_splat;
 uniform sampler2D u_dist;   // R32F eye view distance, memory order (0 = invalid)
-uniform int u_clear;
-uniform ivec2 u_grid;       // invocation grid: middle size (clear) or eye size (splat)
+uniform ivec2 u_grid;       // invocation grid: the eye's size
 uniform ivec2 u_size_m;
 uniform mat4 u_inv_view_e, u_inv_proj_e;
 uniform mat4 u_view_proj_m, u_view_m;
@@ -16,10 +15,6 @@ uniform mat4 u_view_proj_m, u_view_m;
 void main() {
     ivec2 t = ivec2(gl_GlobalInvocationID.xy);
     if (any(greaterThanEqual(t, u_grid))) {
-        return;
-    }
-    if (u_clear == 1) {
-        imageStore(u_splat, t, uvec4(0xFFFFFFFFu));
         return;
     }
     float z = texelFetch(u_dist, t, 0).r;

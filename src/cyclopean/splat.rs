@@ -1,21 +1,29 @@
 //! Splat-gather: the middle view for real stereo, where the gather walk's fixed point lands
-//! behind thin near objects. Two GPU passes:
+//! behind thin near objects. Three GPU passes:
 //!
-//! 1. splat (shaders/cyclopean/splat.comp): every valid eye texel's surface point goes to the
+//! 1. splat (shaders/cyclopean/splat.comp, into images the driver clears): every valid eye texel's surface point goes to the
 //!    middle pixel its one-pixel footprint covers, nearest first (atomic min per eye). This says
 //!    *which* surface each middle pixel sees from each eye; a pole one texel wide stays one
 //!    pixel wide, so nothing behind it shows through.
-//! 2. gather (shaders/cyclopean/splat_gather.frag): per eye, from that candidate depth (or a
+//! 2. gather (shaders/cyclopean/splat_gather.frag over the functions of splat_gather.glsl): per
+//!    eye, from that candidate depth (or a
 //!    neighbour's, in the holes a splat leaves), one fixed-point step on the eye's surface
 //!    interpolated in inverse depth over the bilinear taps on that surface gives the sub-pixel
 //!    position, checked to land on the same surface, and the colour there (bilinear, the same
 //!    taps). The eyes merge per pixel: on one surface, weighted by nearness to each eye and by
 //!    the taps' weight (low at edges, where real pixels mix colours); else the nearer; a
-//!    disocclusion from the one eye that sees it. Where a depth edge crosses the pixel (the
-//!    centre and two samples at +-1/3 px along x see different surfaces) the colour is their
-//!    mean, as a camera pixel integrates both surfaces: measured +0.5 dB on Cones, +0.2 to
-//!    +0.4 dB on the one-eye Cones/Teddy reprojections, +0.0 to +0.1 dB with estimated
-//!    disparities (a 1 px box; 2 samples gave less, 4 or 8 the same on the reprojections).
+//!    disocclusion from the one eye that sees it. It lists the pixels a depth edge may cross
+//!    (two of it and its left and right neighbours different surfaces in an eye's splat).
+//! 3. edges (shaders/cyclopean/splat_edges.comp, one invocation per listed pixel, dispatched
+//!    indirectly by the count the gather kept): where the centre and two samples at +-1/3 px
+//!    along x see different surfaces the colour is their mean, as a camera pixel integrates
+//!    both surfaces: measured +0.5 dB on Cones, +0.2 to +0.4 dB on the one-eye Cones/Teddy
+//!    reprojections, +0.0 to +0.1 dB with estimated disparities (a 1 px box; 2 samples gave
+//!    less, 4 or 8 the same on the reprojections). A pass of its own, not a branch of the
+//!    gather: llvmpipe runs both sides of every branch for every pixel, so the branch cost 40 %
+//!    of the frame though 0.3 % of the built-in scene's pixels are at edges; on SIMT GPUs it
+//!    keeps no warp waiting on a few edge lanes. 720p on llvmpipe: 2.4x the seed method's time
+//!    as a branch, 1.6x as a pass (the built-in scene; 2.0x on Cones upsampled to 720p).
 //!
 //! Before both, once per frame, each eye's depth breaks are moved onto its colour edges where
 //! they sit one texel off (shaders/cyclopean/edge_snap.comp, [`edge_snap`](super::edge_snap)).
@@ -28,8 +36,8 @@ use crate::camera::mat4::{self, Mat4};
 use crate::convention::RowOrder;
 use crate::error::{Error, Result};
 use crate::gpu::{
-    Attachment, Barrier, DrawState, Framebuffer, Gpu, GpuTimer, Program, ProgramKind, ShaderProgram, Texture,
-    TextureFormat, Timing, VertexArray,
+    Attachment, Barrier, DrawState, Framebuffer, Gpu, GpuTimer, Program, ProgramKind, ShaderProgram, StorageBuffer,
+    Texture, TextureFormat, Timing, VertexArray,
 };
 
 /// Settings of the splat-gather method.
@@ -180,6 +188,8 @@ pub struct SplatRenderer {
     gpu: Gpu,
     splat: Program,
     gather: Program,
+    /// The edge pass over the pixels the gather listed (shaders/cyclopean/splat_edges.comp).
+    edges: Program,
     params: SplatParams,
     outputs: CyclopeanOutputs,
     rows: RowOrder,
@@ -189,7 +199,9 @@ pub struct SplatRenderer {
     frame_views: [Mat4; 2],
     parallax_px: f64,
     vao: VertexArray,
-    targets: Option<(Framebuffer, [Texture; 2])>,
+    /// Per view size: its framebuffer; as the two attachments of a second one (cleared to "no
+    /// surface" by the driver each frame), each eye's splat image; the edge-pixel list.
+    targets: Option<(Framebuffer, Framebuffer, StorageBuffer)>,
 }
 
 impl SplatRenderer {
@@ -242,6 +254,7 @@ impl SplatRenderer {
             gpu: gpu.clone(),
             splat: ShaderProgram::new(frame.conv, ProgramKind::CyclopeanSplat).build(gpu)?,
             gather: ShaderProgram::new(frame.conv, ProgramKind::CyclopeanSplatGather).build(gpu)?,
+            edges: ShaderProgram::new(frame.conv, ProgramKind::CyclopeanSplatEdges).build(gpu)?,
             params,
             outputs,
             rows: frame.conv.row_order,
@@ -269,7 +282,7 @@ impl SplatRenderer {
         );
         let (dl, dr) = (dist3(cm, cl), dist3(cm, cr));
         let w_left = if dl + dr > 0.0 { dr / (dl + dr) } else { 0.5 };
-        if !matches!(&self.targets, Some((f, _)) if f.width == w && f.height == h) {
+        if !matches!(&self.targets, Some((f, ..)) if f.width == w && f.height == h) {
             self.targets = None;
             let slot = |wanted: bool, format| {
                 wanted.then_some(Attachment {
@@ -289,17 +302,24 @@ impl SplatRenderer {
                 false,
             )?
             .with_label("splat-gather target");
-            let splats = [
-                Texture::new(&self.gpu, w, h, TextureFormat::R32Ui, None)?.with_label("splat left"),
-                Texture::new(&self.gpu, w, h, TextureFormat::R32Ui, None)?.with_label("splat right"),
-            ];
-            self.targets = Some((fb, splats));
+            // 0xFFFFFFFF, "no surface": the clear's f32 is converted with saturation
+            // (u32::MAX as f32 rounds up to 2^32, which saturates back to u32::MAX).
+            let none = Some(Attachment {
+                format: TextureFormat::R32Ui,
+                clear: [u32::MAX as f32; 4],
+            });
+            let splats = Framebuffer::new(&self.gpu, w, h, &[none, none], false)?.with_label("splat left, right");
+            // The counter and the edge pass's 3 dispatch words, then room for every pixel.
+            let edges = StorageBuffer::new(&self.gpu, 4 + w as usize * h as usize)?.with_label("edge pixels");
+            self.targets = Some((fb, splats, edges));
         }
-        let (fb, splats) = self.targets.as_ref().expect("allocated above");
+        let (fb, splats, edges) = self.targets.as_ref().expect("allocated above");
         let gpu = &self.gpu;
         let timer = GpuTimer::start(gpu);
         let view_proj_m = mat4::mul(&mid.proj, &mid.view);
         // Pass 1: clear and splat each eye into its own image.
+        splats.clear();
+        let splats: [&Texture; 2] = [0, 1].map(|k| splats.colors[k].as_ref().expect("two attachments"));
         let s = &self.splat;
         s.bind();
         s.set_mat4_rows("u_view_proj_m", &view_proj_m);
@@ -308,13 +328,7 @@ impl SplatRenderer {
         s.set_i32("u_dist", 0);
         for (eye, (size, target)) in self.eyes.iter().zip(self.frame_eyes.iter().zip(splats)) {
             let _image = target.bind_image(0)?;
-            s.set_i32("u_clear", 1);
-            s.set_ivec2("u_grid", [w as i32, h as i32]);
-            s.dispatch([w.div_ceil(8), h.div_ceil(8)]);
-            // The clear before the atomics.
-            gpu.memory_barrier(Barrier::ImageAccess);
             eye.dist.bind(0);
-            s.set_i32("u_clear", 0);
             s.set_ivec2("u_grid", [size.0 as i32, size.1 as i32]);
             s.set_mat4_rows("u_inv_view_e", &inv(&eye.view, "eye view")?);
             s.set_mat4_rows("u_inv_proj_e", &inv(&eye.proj, "eye projection")?);
@@ -325,30 +339,54 @@ impl SplatRenderer {
         gpu.check("cyclopean splat")?;
         // Pass 2: gather and merge.
         let pass = fb.begin_pass(DrawState::default(), 1.0);
-        let p = &self.gather;
-        p.bind();
         let names = ["l", "r"];
         for (k, eye) in self.eyes.iter().enumerate() {
-            let sfx = names[k];
             eye.color.bind(3 * k as u32);
             eye.dist.bind(3 * k as u32 + 1);
             splats[k].bind(3 * k as u32 + 2);
-            p.set_i32(&format!("u_color_{sfx}"), 3 * k as i32);
-            p.set_i32(&format!("u_dist_{sfx}"), 3 * k as i32 + 1);
-            p.set_i32(&format!("u_splat_{sfx}"), 3 * k as i32 + 2);
-            p.set_mat4_rows(&format!("u_view_proj_{sfx}"), &mat4::mul(&eye.proj, &eye.view));
-            p.set_mat4_rows(&format!("u_view_{sfx}"), &eye.view);
-            p.set_mat4_rows(&format!("u_inv_view_{sfx}"), &inv(&eye.view, "eye view")?);
-            p.set_mat4_rows(&format!("u_inv_proj_{sfx}"), &inv(&eye.proj, "eye projection")?);
         }
-        p.set_mat4_rows("u_view_m", &mid.view);
-        p.set_mat4_rows("u_inv_view_m", &inv(&mid.view, "middle view")?);
-        p.set_mat4_rows("u_inv_proj_m", &inv(&mid.proj, "middle projection")?);
-        p.set_vec2("u_size_m", [w as f32, h as f32]);
-        p.set_f32("u_parallax_px", self.parallax_px as f32);
-        p.set_f32("u_tolerance_px", self.params.surface_tolerance_px as f32);
-        p.set_f32("u_w_left", w_left as f32);
-        pass.draw_fullscreen(&self.vao);
+        // No edge pixel yet: count 0, no work group (x), 1 (y), 1 (z).
+        edges.write_head(&[0, 0, 1, 1]);
+        edges.bind_storage(0);
+        // The centre samples, then the listed edge pixels over them (same inputs, uniforms).
+        let programs = if self.outputs.color {
+            [Some(&self.gather), Some(&self.edges)]
+        } else {
+            // Edge mixing changes colour only.
+            [Some(&self.gather), None]
+        };
+        for (k, p) in programs.into_iter().flatten().enumerate() {
+            p.bind();
+            for (k, eye) in self.eyes.iter().enumerate() {
+                let sfx = names[k];
+                p.set_i32(&format!("u_color_{sfx}"), 3 * k as i32);
+                p.set_i32(&format!("u_dist_{sfx}"), 3 * k as i32 + 1);
+                p.set_i32(&format!("u_splat_{sfx}"), 3 * k as i32 + 2);
+                p.set_mat4_rows(&format!("u_view_proj_{sfx}"), &mat4::mul(&eye.proj, &eye.view));
+                p.set_mat4_rows(&format!("u_view_{sfx}"), &eye.view);
+                p.set_mat4_rows(&format!("u_inv_view_{sfx}"), &inv(&eye.view, "eye view")?);
+                p.set_mat4_rows(&format!("u_inv_proj_{sfx}"), &inv(&eye.proj, "eye projection")?);
+            }
+            p.set_mat4_rows("u_view_m", &mid.view);
+            p.set_mat4_rows("u_inv_view_m", &inv(&mid.view, "middle view")?);
+            p.set_mat4_rows("u_inv_proj_m", &inv(&mid.proj, "middle projection")?);
+            p.set_vec2("u_size_m", [w as f32, h as f32]);
+            p.set_f32("u_parallax_px", self.parallax_px as f32);
+            p.set_f32("u_tolerance_px", self.params.surface_tolerance_px as f32);
+            p.set_f32("u_w_left", w_left as f32);
+            if k == 0 {
+                pass.draw_fullscreen(&self.vao);
+                // The list and its counts before the edge pass reads them.
+                gpu.memory_barrier(Barrier::StorageAndCommand);
+            } else {
+                let color = fb.colors[0].as_ref().expect("colour requested");
+                let _image = color.bind_image(0)?;
+                p.set_i32("u_color_out", 0);
+                p.dispatch_indirect(edges, 1);
+                // The rewritten texels before the readback.
+                gpu.memory_barrier(Barrier::Framebuffer);
+            }
+        }
         drop(pass);
         gpu.check("cyclopean splat gather")?;
         let out = super::render::read_output(fb, self.rows)?;

@@ -1,4 +1,4 @@
-//! Element (index) buffers.
+//! Element (index) buffers, and storage buffers shaders append to and indirect dispatches read.
 
 use super::census::GlObject;
 use super::Gpu;
@@ -50,6 +50,96 @@ impl IndexBuffer {
 }
 
 impl Drop for IndexBuffer {
+    fn drop(&mut self) {
+        // SAFETY: handle owned by self.
+        unsafe { self.gpu.gl().delete_buffer(self.raw) }
+        self.gpu.deleted(GlObject::Buffer);
+    }
+}
+
+/// A GL buffer of u32 words that shaders read and write (`layout(std430, binding = b) buffer`)
+/// and that an indirect compute dispatch reads its work-group counts from. Allocated once;
+/// [`StorageBuffer::write_head`] rewrites its first words each frame without reallocating.
+pub struct StorageBuffer {
+    gpu: Gpu,
+    raw: glow::Buffer,
+    /// Size in u32 words.
+    words: usize,
+}
+
+impl StorageBuffer {
+    /// A buffer of `words` u32 words, contents undefined until written.
+    pub fn new(gpu: &Gpu, words: usize) -> Result<Self> {
+        let bytes = words
+            .checked_mul(4)
+            .and_then(|b| i32::try_from(b).ok())
+            .ok_or_else(|| Error::Gl(format!("storage buffer of {words} words exceeds 2 GiB")))?;
+        // SAFETY: a fresh buffer given its size; unbound afterwards.
+        unsafe {
+            let gl = gpu.gl();
+            let raw = gl.create_buffer().map_err(Error::Gl)?;
+            gpu.created(GlObject::Buffer);
+            let buffer = StorageBuffer {
+                gpu: gpu.clone(),
+                raw,
+                words,
+            };
+            gl.bind_buffer(glow::SHADER_STORAGE_BUFFER, Some(raw));
+            gl.buffer_data_size(glow::SHADER_STORAGE_BUFFER, bytes, glow::DYNAMIC_COPY);
+            gl.bind_buffer(glow::SHADER_STORAGE_BUFFER, None);
+            gpu.label(glow::BUFFER, raw.0.get(), "viewsynth storage buffer");
+            gpu.check("storage buffer allocation")?;
+            Ok(buffer)
+        }
+    }
+
+    /// Name this buffer for debuggers (RenderDoc, apitrace).
+    pub fn with_label(self, name: &str) -> Self {
+        self.gpu.label(glow::BUFFER, self.raw.0.get(), name);
+        self
+    }
+
+    /// Size in u32 words.
+    pub fn words(&self) -> usize {
+        self.words
+    }
+
+    /// Overwrite the first `head.len()` words (a counter and indirect arguments), in order
+    /// with the GL commands before and after.
+    pub fn write_head(&self, head: &[u32]) {
+        let n = head.len().min(self.words);
+        let bytes: Vec<u8> = head[..n].iter().flat_map(|w| w.to_ne_bytes()).collect();
+        // SAFETY: `bytes` fits inside the buffer (n <= words).
+        unsafe {
+            let gl = self.gpu.gl();
+            gl.bind_buffer(glow::SHADER_STORAGE_BUFFER, Some(self.raw));
+            gl.buffer_sub_data_u8_slice(glow::SHADER_STORAGE_BUFFER, 0, &bytes);
+            gl.bind_buffer(glow::SHADER_STORAGE_BUFFER, None);
+        }
+    }
+
+    /// Bind to shader storage binding point `index` (`layout(std430, binding = index)`).
+    pub fn bind_storage(&self, index: u32) {
+        // SAFETY: valid handle.
+        unsafe {
+            self.gpu
+                .gl()
+                .bind_buffer_base(glow::SHADER_STORAGE_BUFFER, index, Some(self.raw))
+        }
+    }
+
+    /// Bind as the source of indirect dispatch arguments.
+    pub(super) fn bind_dispatch_indirect(&self) {
+        // SAFETY: valid handle.
+        unsafe {
+            self.gpu
+                .gl()
+                .bind_buffer(glow::DISPATCH_INDIRECT_BUFFER, Some(self.raw))
+        }
+    }
+}
+
+impl Drop for StorageBuffer {
     fn drop(&mut self) {
         // SAFETY: handle owned by self.
         unsafe { self.gpu.gl().delete_buffer(self.raw) }

@@ -27,7 +27,7 @@ mod texture;
 mod timer;
 mod vertex_array;
 
-pub use buffer::IndexBuffer;
+pub use buffer::{IndexBuffer, StorageBuffer};
 pub use census::LiveObjects;
 pub use devices::EglDevice;
 pub use egl::{DeviceChoice, EglContext, GpuInfo};
@@ -164,6 +164,8 @@ impl Gpu {
         let bits = match barrier {
             Barrier::ImageAccess => glow::SHADER_IMAGE_ACCESS_BARRIER_BIT,
             Barrier::TextureFetch => glow::TEXTURE_FETCH_BARRIER_BIT,
+            Barrier::StorageAndCommand => glow::SHADER_STORAGE_BARRIER_BIT | glow::COMMAND_BARRIER_BIT,
+            Barrier::Framebuffer => glow::FRAMEBUFFER_BARRIER_BIT,
         };
         // SAFETY: plain synchronisation command.
         unsafe { self.gl().memory_barrier(bits) }
@@ -177,4 +179,10 @@ pub enum Barrier {
     ImageAccess,
     /// Later texel fetches (a draw sampling what a compute pass wrote).
     TextureFetch,
+    /// Later storage-buffer reads and indirect dispatch arguments (a compute pass over a list
+    /// an earlier draw appended to a [`StorageBuffer`], sized by the count it kept there).
+    StorageAndCommand,
+    /// Later reads of framebuffer attachments, readback included (a compute pass rewrote some
+    /// texels of a colour attachment through an image).
+    Framebuffer,
 }

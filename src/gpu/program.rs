@@ -4,7 +4,7 @@
 
 use super::census::GlObject;
 use super::shaders::{ShaderFile, ShaderProgram};
-use super::Gpu;
+use super::{Gpu, StorageBuffer};
 use crate::error::{Error, Result};
 use glow::HasContext;
 use std::cell::RefCell;
@@ -108,6 +108,21 @@ impl Program {
         self.bind();
         // SAFETY: a compute program is bound; its images and textures are bound by the caller.
         unsafe { self.gpu.gl().dispatch_compute(groups[0], groups[1], 1) }
+    }
+
+    /// Dispatch as many work groups as the 3 words at `offset_words` of `args` say (x, y, z),
+    /// which an earlier pass wrote; the writes must be made visible first
+    /// ([`crate::gpu::Barrier::StorageAndCommand`]).
+    pub fn dispatch_indirect(&self, args: &StorageBuffer, offset_words: usize) {
+        self.bind();
+        args.bind_dispatch_indirect();
+        // SAFETY: a compute program is bound; `args` holds 3 words at the offset (the caller
+        // sized it), 4-byte aligned.
+        unsafe {
+            let gl = self.gpu.gl();
+            gl.dispatch_compute_indirect(offset_words as i32 * 4);
+            gl.bind_buffer(glow::DISPATCH_INDIRECT_BUFFER, None);
+        }
     }
 
     /// Makes this the current program (glUseProgram).

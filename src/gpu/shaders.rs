@@ -55,6 +55,9 @@ mod files {
     pub const CYCLOPEAN_FORWARD_FRAG: ShaderFile = shader_file!("cyclopean/forward.frag");
     pub const CYCLOPEAN_SPLAT: ShaderFile = shader_file!("cyclopean/splat.comp");
     pub const CYCLOPEAN_SPLAT_GATHER: ShaderFile = shader_file!("cyclopean/splat_gather.frag");
+    pub const CYCLOPEAN_SPLAT_GATHER_LIB: ShaderFile = shader_file!("cyclopean/splat_gather.glsl");
+    pub const CYCLOPEAN_SPLAT_EDGES: ShaderFile = shader_file!("cyclopean/splat_edges.comp");
+    pub const CYCLOPEAN_EDGE_LIST: ShaderFile = shader_file!("cyclopean/edge_list.glsl");
     pub const CYCLOPEAN_EDGE_SNAP: ShaderFile = shader_file!("cyclopean/edge_snap.comp");
     pub const REPROJECT_SHIFT: ShaderFile = shader_file!("reproject/shift.frag");
     pub const SCENE_RAYTRACE: ShaderFile = shader_file!("scene/raytrace.frag");
@@ -139,8 +142,11 @@ pub enum ProgramKind {
     CyclopeanForward,
     /// cyclopean/splat.comp: nearest-first splat (compute).
     CyclopeanSplat,
-    /// cyclopean/splat_gather.frag: the gather after the splat.
+    /// cyclopean/splat_gather.frag: the gather after the splat; lists the edge pixels.
     CyclopeanSplatGather,
+    /// cyclopean/splat_edges.comp: the listed edge pixels' colour mixed over the pixel's width
+    /// (compute, after the gather).
+    CyclopeanSplatEdges,
     /// cyclopean/edge_snap.comp: depth breaks moved onto colour edges before the splat (compute).
     CyclopeanEdgeSnap,
     /// reproject/shift.frag: the row shift as a gather (walk, or the exact scan).
@@ -233,6 +239,7 @@ impl ProgramKind {
             ProgramKind::CyclopeanForward => "cyclopean/forward",
             ProgramKind::CyclopeanSplat => "cyclopean/splat",
             ProgramKind::CyclopeanSplatGather => "cyclopean/splat_gather",
+            ProgramKind::CyclopeanSplatEdges => "cyclopean/splat_edges",
             ProgramKind::CyclopeanEdgeSnap => "cyclopean/edge_snap",
             ProgramKind::ReprojectShift { .. } => "reproject/shift",
             ProgramKind::SceneRaytrace => "scene/raytrace",
@@ -260,6 +267,7 @@ impl ProgramKind {
             ProgramKind::CyclopeanForward => vec![int("TRI_TEX_WIDTH", TRI_TEX_WIDTH.into())],
             ProgramKind::CyclopeanSplat
             | ProgramKind::CyclopeanSplatGather
+            | ProgramKind::CyclopeanSplatEdges
             | ProgramKind::CyclopeanEdgeSnap
             | ProgramKind::SceneRaytrace => vec![],
             ProgramKind::ReprojectShift {
@@ -318,7 +326,23 @@ impl ProgramKind {
             ],
             ProgramKind::CyclopeanSplat => vec![(Compute, vec![CAMERA, CYCLOPEAN_SPLAT])],
             ProgramKind::CyclopeanEdgeSnap => vec![(Compute, vec![CYCLOPEAN_EDGE_SNAP])],
-            ProgramKind::CyclopeanSplatGather => fullscreen(vec![CAMERA, BILINEAR, CYCLOPEAN_SPLAT_GATHER]),
+            ProgramKind::CyclopeanSplatGather => fullscreen(vec![
+                CAMERA,
+                BILINEAR,
+                CYCLOPEAN_EDGE_LIST,
+                CYCLOPEAN_SPLAT_GATHER_LIB,
+                CYCLOPEAN_SPLAT_GATHER,
+            ]),
+            ProgramKind::CyclopeanSplatEdges => vec![(
+                Compute,
+                vec![
+                    CAMERA,
+                    BILINEAR,
+                    CYCLOPEAN_EDGE_LIST,
+                    CYCLOPEAN_SPLAT_GATHER_LIB,
+                    CYCLOPEAN_SPLAT_EDGES,
+                ],
+            )],
             ProgramKind::ReprojectShift { .. } => fullscreen(vec![DEPTH, REPROJECT_SHIFT]),
             ProgramKind::SceneRaytrace => fullscreen(vec![CAMERA, DEPTH, ODS, SCENE_RAYTRACE]),
             ProgramKind::Stitch { .. } => fullscreen(vec![BILINEAR, ODS, STITCH]),
@@ -351,6 +375,7 @@ impl ShaderProgram {
             ProgramKind::CyclopeanForward,
             ProgramKind::CyclopeanSplat,
             ProgramKind::CyclopeanSplatGather,
+            ProgramKind::CyclopeanSplatEdges,
             ProgramKind::CyclopeanEdgeSnap,
             ProgramKind::SceneRaytrace,
         ]);

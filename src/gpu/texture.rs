@@ -165,10 +165,11 @@ impl Texture {
         let format = match self.format {
             TextureFormat::R32Ui => glow::R32UI,
             TextureFormat::R32F => glow::R32F,
+            TextureFormat::Rgba8 => glow::RGBA8,
             other => return Err(Error::Gl(format!("image binding of a {other:?} texture"))),
         };
-        // SAFETY: valid single-channel 32-bit texture, level 0, read-write as an image of its
-        // own format.
+        // SAFETY: valid 32-bit-per-texel texture, level 0, read-write as an image of its own
+        // format.
         unsafe {
             self.gpu
                 .gl()

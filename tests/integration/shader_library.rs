@@ -20,9 +20,9 @@ fn every_program_compiles_and_links_under_every_convention() {
             built += 1;
         }
     }
-    // 8 conventions x (refocus 3 x 2 + gather 8 + forward, splat, splat gather, edge snap,
-    // scene 5 + shift 3 x 2 + stitch 3).
-    assert_eq!(built, 8 * (6 + 8 + 5 + 6 + 3));
+    // 8 conventions x (refocus 3 x 2 + gather 8 + forward, splat, splat gather, splat edges,
+    // edge snap, scene 6 + shift 3 x 2 + stitch 3).
+    assert_eq!(built, 8 * (6 + 8 + 6 + 6 + 3));
 }
 
 #[test]
