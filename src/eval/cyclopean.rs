@@ -1,5 +1,6 @@
 //! Cyclopean report rows: every method on the built-in scene under the depth conventions (exact
-//! ray-traced middle view), on Middlebury 2003 (real data) and on user cases, with run times.
+//! ray-traced middle view), on Middlebury 2003 (real data, ground-truth disparities), on real
+//! pairs with disparities estimated by [`super::block_match`] and on user cases, with run times.
 
 use super::{score, timed};
 use crate::convention::{Conventions, NdcDepthRange, RowOrder};
@@ -259,7 +260,8 @@ fn real_rows(scene: &str, setting: &str, runs: &[RealRun], truth: &RgbImage) -> 
 
 /// Cones (im2 + im6 -> im4, the real middle view as truth) and Teddy (no middle view: im2 alone
 /// reprojected to the right eye against im6, right disparity emptied), every method beside the
-/// forward-splat and no-warp baselines.
+/// forward-splat and no-warp baselines; then the same on estimated disparities
+/// ([`cyclopean_estimated_rows`]).
 pub fn cyclopean_real_rows(gpu: &Gpu, data_dir: &Path, repeats: usize) -> Result<(Vec<ReportRow>, Vec<String>)> {
     let mut rows = Vec::new();
     let mut notes = Vec::new();
@@ -417,10 +419,13 @@ pub fn estimated_cases(data_dir: &Path) -> Result<(Vec<EstimatedCase>, Vec<Strin
     Ok((cases, notes))
 }
 
+/// One eye of a rectified pair: its image and its disparity (pixels, 0 = unknown).
+pub type Eye = (RgbImage, DepthMap);
+
 /// A case's eyes with estimated disparities (the right one emptied for `left_eye_only`) and its
 /// rig, on the nominal Middlebury focal length and baseline: disparities are estimated between
 /// these very images, so there is no principal-point offset (doffs 0) and only t d matters.
-pub fn estimated_eyes(case: &EstimatedCase) -> Result<((RgbImage, DepthMap), (RgbImage, DepthMap), DisparityRig)> {
+pub fn estimated_eyes(case: &EstimatedCase) -> Result<(Eye, Eye, DisparityRig)> {
     let (dl, mut dr) = super::block_match::estimate_disparities(&case.left, &case.right, case.max_disparity)?;
     if case.left_eye_only {
         dr.data.iter_mut().for_each(|d| *d = 0.0);
