@@ -113,6 +113,21 @@ fn seed_case(rig: &StereoRig, conv: Conventions) -> Result<Case> {
     })
 }
 
+/// Calibration of the Middlebury 2014 Motorcycle copy (4x down), from the data README:
+/// focal length and principal point (px), baseline (m), doffs (px).
+pub struct MotorcycleCalibration;
+
+impl MotorcycleCalibration {
+    /// Focal length, px.
+    pub const FOCAL_PX: f64 = 994.978;
+    /// Baseline, m.
+    pub const BASELINE_M: f64 = 0.193001;
+    /// Right principal point x minus the left one, px.
+    pub const DOFFS_PX: f64 = 31.086;
+    /// Principal point, px.
+    pub const PRINCIPAL_POINT: [f64; 2] = [311.193, 254.877];
+}
+
 /// Middlebury 2014 Motorcycle (scikit-image copy, 4x down): left + left disparity -> right,
 /// with the calibration of the data README (f, cx, cy, doffs in px; baseline in m).
 pub fn motorcycle_case(data_dir: &Path, conv: Conventions) -> Result<Case> {
@@ -121,13 +136,14 @@ pub fn motorcycle_case(data_dir: &Path, conv: Conventions) -> Result<Case> {
     let truth = io::load_rgb(&dir.join("motorcycle_right.png"))?;
     // +inf (invalid) stays as stored: float depth is not rescaled without a scale.
     let disparity = io::load_depth(&dir.join("motorcycle_disp.npz"), &DepthDecode::default())?;
-    let (f, baseline, doffs) = (994.978, 0.193001, 31.086);
+    type C = MotorcycleCalibration;
+    let (f, baseline, doffs) = (C::FOCAL_PX, C::BASELINE_M, C::DOFFS_PX);
     let camera = PinholeCamera {
         k: Intrinsics {
             fx: f,
             fy: f,
-            cx: 311.193,
-            cy: 254.877,
+            cx: C::PRINCIPAL_POINT[0],
+            cy: C::PRINCIPAL_POINT[1],
         },
         width: left.width,
         height: left.height,

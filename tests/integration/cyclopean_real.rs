@@ -185,8 +185,9 @@ fn default_beats_the_splat_baseline_on_cones_and_covers_more() {
     assert!(count(&covered) >= count(&base.covered), "{msg}");
     // Issue 13's own baseline, the 40 lines of numpy whose `np.round` rounds halves to even
     // (89.5 % coverage there and here): its target, >= 1 dB over it on the common pixels with
-    // >= 89.5 % coverage. Measured when written: 29.54 vs 28.13 dB (+1.42) on 150,613 pixels,
-    // 96.4 % vs 89.5 % covered; the bound keeps 0.1 dB for other GPUs' f32 decisions as above.
+    // >= 89.5 % coverage. Measured when written: 29.54 vs 28.17 dB (+1.37) on 150,554 pixels,
+    // 96.3 % vs 89.5 % covered; the bound keeps about 0.1 dB for other GPUs' f32 decisions as
+    // above.
     let issue = forward_splat_rounded((&l0.0, &l0.1), (&r0.0, &r0.1), 0.5, [0.0, 0.0], Rounding::HalfEven).unwrap();
     let common: Vec<bool> = covered.iter().zip(&issue.covered).map(|(a, b)| *a && *b).collect();
     let (ours, theirs) = (
@@ -201,7 +202,7 @@ fn default_beats_the_splat_baseline_on_cones_and_covers_more() {
         count(&issue.covered) as f64 / n
     );
     eprintln!("{msg}");
-    assert!(ours >= theirs + 1.3, "{msg}");
+    assert!(ours >= theirs + 1.25, "{msg}");
     assert!(count(&covered) as f64 >= 0.895 * n, "{msg}");
     assert!(
         (count(&issue.covered) as f64 / n - 0.895).abs() < 0.001,
