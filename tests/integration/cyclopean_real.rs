@@ -41,6 +41,10 @@ fn splat_gpu(frame: &StereoFrame, mid: &viewsynth::cyclopean::MiddleCamera) -> C
         .0
 }
 
+fn gather_gpu(frame: &StereoFrame, mid: &viewsynth::cyclopean::MiddleCamera, params: CyclopeanParams) -> CyclopeanOutput {
+    CyclopeanRenderer::new(&gpu(), frame, params).unwrap().render(mid).unwrap().0
+}
+
 fn out_dir(name: &str) -> PathBuf {
     let dir = std::env::temp_dir().join(format!("viewsynth-{name}-{}", std::process::id()));
     let _ = std::fs::remove_dir_all(&dir);
@@ -377,10 +381,7 @@ fn thin_poles_keep_their_colour_and_width_and_no_wall_shows_through() {
         method: Method::Refine { steps: 6 },
         ..CyclopeanParams::seed(fixation)
     };
-    let (walk, _) = CyclopeanRenderer::new(&gpu(), &frame, params)
-        .unwrap()
-        .render(&mid)
-        .unwrap();
+    let walk = gather_gpu(&frame, &mid, params);
     let walked = pole_columns(&walk);
     assert!(
         walked.iter().any(|cols| cols != &expected),
@@ -413,10 +414,7 @@ fn refine_one_covers_a_wall_from_any_fixation() {
             method: Method::Refine { steps },
             ..CyclopeanParams::seed(f * b / disparity)
         };
-        let (out, _) = CyclopeanRenderer::new(&gpu(), &frame, params)
-            .unwrap()
-            .render(&mid)
-            .unwrap();
+        let out = gather_gpu(&frame, &mid, params);
         // Columns the eyes cannot both see (the border) aside: the middle 40 columns.
         let inner: Vec<u8> = (0..h as usize)
             .flat_map(|y| out.sources[y * w as usize + 12..y * w as usize + 52].to_vec())
@@ -449,10 +447,7 @@ fn refine_one_covers_cones() {
         method: Method::Refine { steps: 1 },
         ..CyclopeanParams::seed(fixation)
     };
-    let (out, _) = CyclopeanRenderer::new(&gpu(), &frame, params)
-        .unwrap()
-        .render(&mid)
-        .unwrap();
+    let out = gather_gpu(&frame, &mid, params);
     let covered: Vec<bool> = out.sources.iter().map(|s| *s != 0).collect();
     let fraction = count(&covered) as f64 / covered.len() as f64;
     let db = psnr(out.color().unwrap(), &truth, &covered);
