@@ -99,7 +99,7 @@ impl CyclopeanRenderer {
         let (w, h) = (mid.width, mid.height);
         self.gpu.check_image_size("middle size", w, h)?;
         let inv = |m: &Mat4, what: &str| mat4::inverse(m).ok_or_else(|| Error::param(what.to_string(), "singular"));
-        if !matches!(&self.framebuffer, Some(f) if f.width == w && f.height == h) {
+        if !matches!(&self.framebuffer, Some(f) if f.width() == w && f.height() == h) {
             self.framebuffer = None;
             let slot = |wanted: bool, format| {
                 wanted.then_some(Attachment {
@@ -174,7 +174,7 @@ impl CyclopeanRenderer {
 /// the images' bytes.
 pub(crate) fn read_output(fb: &Framebuffer, rows: RowOrder) -> Result<CyclopeanOutput> {
     use crate::gpu::ReadFormat;
-    let (w, h) = (fb.width, fb.height);
+    let (w, h) = (fb.width(), fb.height());
     let flip = rows == RowOrder::BottomUp;
     let sources = fb
         .read_async(2, ReadFormat::R8, flip)?

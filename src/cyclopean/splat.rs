@@ -163,7 +163,7 @@ fn snap_edges(
     params: &SplatParams,
     margin: u32,
 ) -> Result<Texture> {
-    let (w, h) = (eye.dist.width, eye.dist.height);
+    let (w, h) = (eye.dist.width(), eye.dist.height());
     let out = Texture::new(gpu, w, h, TextureFormat::R32F, None)?.with_label("edge-snapped distances");
     snap.bind();
     eye.dist.bind(0);
@@ -282,7 +282,7 @@ impl SplatRenderer {
         );
         let (dl, dr) = (dist3(cm, cl), dist3(cm, cr));
         let w_left = if dl + dr > 0.0 { dr / (dl + dr) } else { 0.5 };
-        if !matches!(&self.targets, Some((f, ..)) if f.width == w && f.height == h) {
+        if !matches!(&self.targets, Some((f, ..)) if f.width() == w && f.height() == h) {
             self.targets = None;
             let slot = |wanted: bool, format| {
                 wanted.then_some(Attachment {
@@ -319,7 +319,7 @@ impl SplatRenderer {
         let view_proj_m = mat4::mul(&mid.proj, &mid.view);
         // Pass 1: clear and splat each eye into its own image.
         splats.clear();
-        let splats: [&Texture; 2] = [0, 1].map(|k| splats.colors[k].as_ref().expect("two attachments"));
+        let splats: [&Texture; 2] = [0, 1].map(|k| splats.color(k).expect("two attachments"));
         let s = &self.splat;
         s.bind();
         s.set_mat4_rows("u_view_proj_m", &view_proj_m);
@@ -379,7 +379,7 @@ impl SplatRenderer {
                 // The list and its counts before the edge pass reads them.
                 gpu.memory_barrier(Barrier::StorageAndCommand);
             } else {
-                let color = fb.colors[0].as_ref().expect("colour requested");
+                let color = fb.color(0).expect("colour requested");
                 let _image = color.bind_image(0)?;
                 p.set_i32("u_color_out", 0);
                 p.dispatch_indirect(edges, 1);

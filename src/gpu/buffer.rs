@@ -9,8 +9,7 @@ use glow::HasContext;
 pub struct IndexBuffer {
     gpu: Gpu,
     raw: glow::Buffer,
-    /// Number of indices.
-    pub count: usize,
+    pub(super) count: usize,
 }
 
 impl IndexBuffer {
@@ -40,6 +39,11 @@ impl IndexBuffer {
     pub fn with_label(self, name: &str) -> Self {
         self.gpu.label(glow::BUFFER, self.raw.0.get(), name);
         self
+    }
+
+    /// Number of indices.
+    pub fn count(&self) -> usize {
+        self.count
     }
 
     /// Bind as the element buffer of the currently bound vertex array.

@@ -25,20 +25,39 @@ pub struct Framebuffer {
     gpu: Gpu,
     raw: glow::Framebuffer,
     /// Colour attachments by output location; None where the slot has no texture.
-    pub colors: Vec<Option<Texture>>,
+    colors: Vec<Option<Texture>>,
     clears: Vec<[f32; 4]>,
     /// The float depth buffer, when asked for.
-    pub depth: Option<Texture>,
-    /// Width in pixels.
-    pub width: u32,
-    /// Height in pixels.
-    pub height: u32,
+    depth: Option<Texture>,
+    width: u32,
+    height: u32,
     /// Companion of the same attachments that reads with flipped rows are blitted into;
     /// created on the first such read and kept.
     flipped: RefCell<Option<Box<Framebuffer>>>,
 }
 
 impl Framebuffer {
+    /// Width in pixels.
+    pub fn width(&self) -> u32 {
+        self.width
+    }
+
+    /// Height in pixels.
+    pub fn height(&self) -> u32 {
+        self.height
+    }
+
+    /// The colour attachment of output location `index`; None for an empty slot (or past the
+    /// last).
+    pub fn color(&self, index: usize) -> Option<&Texture> {
+        self.colors.get(index).and_then(|t| t.as_ref())
+    }
+
+    /// The float depth attachment, when the framebuffer has one.
+    pub fn depth(&self) -> Option<&Texture> {
+        self.depth.as_ref()
+    }
+
     /// A `width` x `height` FBO with one texture per `Some` attachment and, if `with_depth`, a [`TextureFormat::Depth32F`] depth buffer; fails if GL reports it incomplete.
     pub fn new(
         gpu: &Gpu,

@@ -54,15 +54,27 @@ impl TextureFormat {
 pub struct Texture {
     gpu: Gpu,
     pub(super) raw: glow::Texture,
-    /// Width in texels.
-    pub width: u32,
-    /// Height in texels.
-    pub height: u32,
-    /// Texel format.
-    pub format: TextureFormat,
+    pub(super) width: u32,
+    pub(super) height: u32,
+    pub(super) format: TextureFormat,
 }
 
 impl Texture {
+    /// Width in texels.
+    pub fn width(&self) -> u32 {
+        self.width
+    }
+
+    /// Height in texels.
+    pub fn height(&self) -> u32 {
+        self.height
+    }
+
+    /// Texel format.
+    pub fn format(&self) -> TextureFormat {
+        self.format
+    }
+
     /// Allocate a texture; `data` (tightly packed rows, row 0 first) is uploaded when given.
     /// Sampling is nearest with clamp-to-edge: passes that filter do it themselves in f32 with
     /// `texelFetch`, because fixed-function bilinear weights have only ~8 bits.

@@ -192,7 +192,7 @@ impl Refocuser {
                 let flags = grid.coverage_flags(&keep);
                 let (cx, cy) = (grid.cells_x() as u32, grid.cells_y() as u32);
                 match keep_tex {
-                    Some(t) if (t.width, t.height) == (cx, cy) => t.upload(&flags)?,
+                    Some(t) if (t.width(), t.height()) == (cx, cy) => t.upload(&flags)?,
                     _ => {
                         *keep_tex = None;
                         *keep_tex = Some(
@@ -260,7 +260,7 @@ impl Refocuser {
         if let Some(i) = self
             .slots
             .iter()
-            .position(|s| (s.framebuffer.width, s.framebuffer.height) == (w, h))
+            .position(|s| (s.framebuffer.width(), s.framebuffer.height()) == (w, h))
         {
             let s = self.slots.remove(i);
             self.slots.push(s);

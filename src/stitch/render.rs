@@ -111,7 +111,7 @@ impl StitchRenderer {
         let (w, h) = (params.width, params.height);
         // Top-bottom: both eyes in one image of 2 h rows.
         self.gpu.check_image_size("equirect size", w, 2 * h)?;
-        if !matches!(&self.framebuffer, Some(f) if f.width == w && f.height == 2 * h) {
+        if !matches!(&self.framebuffer, Some(f) if f.width() == w && f.height() == 2 * h) {
             self.framebuffer = None;
             self.framebuffer = Some(
                 Framebuffer::new(
@@ -130,7 +130,7 @@ impl StitchRenderer {
         let fb = self.framebuffer.as_ref().expect("allocated above");
         let p = &self.programs[params.method.index() as usize];
         let set = &self.template;
-        let n = self.left.color.height;
+        let n = self.left.color.height();
         let cam = face_camera(n, set.fov_deg);
         let timer = GpuTimer::start(&self.gpu);
         let pass = fb.begin_pass(DrawState::default(), 1.0);

@@ -41,8 +41,16 @@ fn splat_gpu(frame: &StereoFrame, mid: &viewsynth::cyclopean::MiddleCamera) -> C
         .0
 }
 
-fn gather_gpu(frame: &StereoFrame, mid: &viewsynth::cyclopean::MiddleCamera, params: CyclopeanParams) -> CyclopeanOutput {
-    CyclopeanRenderer::new(&gpu(), frame, params).unwrap().render(mid).unwrap().0
+fn gather_gpu(
+    frame: &StereoFrame,
+    mid: &viewsynth::cyclopean::MiddleCamera,
+    params: CyclopeanParams,
+) -> CyclopeanOutput {
+    CyclopeanRenderer::new(&gpu(), frame, params)
+        .unwrap()
+        .render(mid)
+        .unwrap()
+        .0
 }
 
 fn out_dir(name: &str) -> PathBuf {

@@ -36,13 +36,9 @@ fn layouts_and_row_flip_match_the_uploaded_bytes() {
     let rgba: Vec<u8> = (0..n * 4).map(|i| (i * 7 % 251) as u8).collect();
     let depth: Vec<f32> = (0..n).map(|i| i as f32 * 0.37 - 3.0).collect();
     let bytes: Vec<u8> = (0..n).map(|i| (i * 13 % 256) as u8).collect();
-    fb.colors[0].as_ref().unwrap().upload(&rgba).unwrap();
-    fb.colors[1]
-        .as_ref()
-        .unwrap()
-        .upload(bytemuck::cast_slice(&depth))
-        .unwrap();
-    fb.colors[2].as_ref().unwrap().upload(&bytes).unwrap();
+    fb.color(0).unwrap().upload(&rgba).unwrap();
+    fb.color(1).unwrap().upload(bytemuck::cast_slice(&depth)).unwrap();
+    fb.color(2).unwrap().upload(&bytes).unwrap();
     let rgb: Vec<u8> = rgba.chunks(4).flat_map(|p| [p[0], p[1], p[2]]).collect();
     let flip = |v: &[u8], row: usize| -> Vec<u8> { v.chunks(row).rev().flatten().copied().collect() };
     // Both flip paths: the GPU blit (what NVIDIA uses) and GL_MESA_pack_invert where Mesa has it.
