@@ -9,13 +9,8 @@
 layout(local_size_x = EDGE_GROUP_SIZE_INT) in;
 layout(rgba8, binding = 0) writeonly uniform image2D u_color_out;
 
-void main() {
-    uint i = gl_GlobalInvocationID.x;
-    if (i >= edge_count) {
-        return;
-    }
-    uint xy = edge_pixel[i];
-    ivec2 p = ivec2(int(xy & 0xFFFFu), int(xy >> 16));
+// The mixed colour of listed pixel p, written where its samples see more than one surface.
+void mix_edge(ivec2 p) {
     vec2 centre = vec2(p) + 0.5;
     Neighbourhood nl = neighbourhood(u_splat_l, p);
     Neighbourhood nr = neighbourhood(u_splat_r, p);
@@ -36,5 +31,14 @@ void main() {
     }
     if (d_hi - d_lo > u_tolerance_px) {
         imageStore(u_color_out, p, vec4(sum / n / 255.0, 1.0));
+    }
+}
+
+void main() {
+    // Over the whole list whatever the number of work groups (capped at EDGE_MAX_GROUPS).
+    uint stride = gl_NumWorkGroups.x * EDGE_GROUP_SIZE;
+    for (uint i = gl_GlobalInvocationID.x; i < edge_count; i += stride) {
+        uint xy = edge_pixel[i];
+        mix_edge(ivec2(int(xy & 0xFFFFu), int(xy >> 16)));
     }
 }

@@ -16,7 +16,7 @@ void main() {
     Merged m = shade(gl_FragCoord.xy, nl.cand, nr.cand);
     if (m.valid && (nl.edge || nr.edge)) {
         uint i = atomicAdd(edge_count, 1u);
-        if (i % EDGE_GROUP_SIZE == 0u) {
+        if (i % EDGE_GROUP_SIZE == 0u && i / EDGE_GROUP_SIZE < EDGE_MAX_GROUPS) {
             atomicAdd(edge_groups, 1u);
         }
         edge_pixel[i] = uint(p.y) << 16 | uint(p.x);
