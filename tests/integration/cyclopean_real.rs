@@ -689,3 +689,27 @@ fn estimated_cases_skip_absent_sets_and_search_the_documented_range() {
         ]
     );
 }
+
+/// More edge pixels than GL guarantees work groups for (65,535 groups of 64 = 4,194,240): every
+/// pixel of a 2,100 x 2,100 view of one-texel stripes at two depths sits at a depth edge, so the
+/// edge pass runs its capped work groups over the list more than once (the grid-stride loop in
+/// splat_edges.comp). The stripes' half disparities (2.4, 6.4 px) put an edge 0.1 px from many
+/// pixel centres, where the colour is mixed (6.3 % of the pixels change with mixing off).
+/// Were the list cut at the cap, the pixels beyond it (in append order, anywhere) would keep
+/// their unmixed colour: 13,385 (0.3 %) differ from the twin with the loop disabled, none with
+/// it. Bound: 0.1 %, as on the built-in scene (off the quarter-pixel grid, f32 and f64 decide
+/// alike but for a handful of pixels).
+#[test]
+fn edge_pass_mixes_more_edge_pixels_than_the_work_group_limit() {
+    let (w, h) = (2100u32, 2100u32);
+    let texture: Vec<u8> = (0..w * h * 3).map(|i| (i * 37 % 251) as u8).collect();
+    let disparity: Vec<f32> = (0..w * h).map(|i| if i % w % 2 == 0 { 4.8 } else { 12.8 }).collect();
+    let eye = || {
+        (
+            RgbImage::new(w, h, texture.clone()).unwrap(),
+            DepthMap::new(w, h, disparity.clone()).unwrap(),
+        )
+    };
+    let (frame, mid) = disparity_frame(eye(), eye(), &DisparityRig::middle(1000.0, 0.1), Conventions::default()).unwrap();
+    check_twin("edge-list-beyond-the-group-limit", &frame, &mid, 0.001);
+}
