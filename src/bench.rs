@@ -159,9 +159,9 @@ pub fn cyclopean_bench(
 ) -> Result<String> {
     use crate::cyclopean::render::CyclopeanRenderer;
     use crate::cyclopean::scene_frame::{scene_frame, StereoRig};
-    use crate::cyclopean::DepthKind;
+    use crate::cyclopean::FrameDepth;
     let rig = StereoRig::demo(width, height);
-    let (frame, mid, _) = scene_frame(&rig, Conventions::default(), DepthKind::Device);
+    let (frame, mid, _) = scene_frame(&rig, Conventions::default(), FrameDepth::Device);
     let mut t = format!(
         "cyclopean benchmark on {}: 2 eyes {width}x{height} -> middle {width}x{height} ({repeats} repeats, medians)\n\n\
          | method | setup ms | ms / middle frame (draw + readback) |\n|---|---|---|\n",

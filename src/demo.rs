@@ -139,9 +139,9 @@ pub fn run_with_progress(gpu: &Gpu, out_dir: &Path, progress: &dyn crate::progre
 fn cyclopean_outputs(gpu: &Gpu, dir: &Path) -> Result<()> {
     use crate::cyclopean::render::CyclopeanRenderer;
     use crate::cyclopean::scene_frame::{scene_frame, StereoRig};
-    use crate::cyclopean::DepthKind;
+    use crate::cyclopean::FrameDepth;
     let rig = StereoRig::demo(640, 480);
-    let (frame, mid, truth) = scene_frame(&rig, Conventions::default(), DepthKind::Device);
+    let (frame, mid, truth) = scene_frame(&rig, Conventions::default(), FrameDepth::Device);
     io::save_rgb(&dir.join("left_rgb.png"), &frame.left.color)?;
     io::save_rgb(&dir.join("right_rgb.png"), &frame.right.color)?;
     io::save_depth_exr(&dir.join("left_device_depth.exr"), &frame.left.depth)?;
@@ -182,7 +182,7 @@ fn reproject_outputs(gpu: &Gpu, dir: &Path) -> Result<()> {
         480,
         0.064,
         Conventions::default(),
-        crate::cyclopean::DepthKind::Device,
+        crate::cyclopean::FrameDepth::Device,
     )?
     .into_iter()
     .next()

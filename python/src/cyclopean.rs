@@ -17,8 +17,7 @@ use viewsynth::cyclopean::forward::ForwardWarp;
 use viewsynth::cyclopean::render::CyclopeanRenderer;
 use viewsynth::cyclopean::splat::{SplatParams, SplatRenderer};
 use viewsynth::cyclopean::{
-    CyclopeanOutput, CyclopeanOutputs, CyclopeanParams, DepthKind, EyeInput, Method as GatherMethod, MiddleCamera,
-    StereoFrame,
+    CyclopeanOutput, CyclopeanOutputs, CyclopeanParams, EyeInput, Method as GatherMethod, MiddleCamera, StereoFrame,
 };
 use viewsynth::gpu::{Gpu, Timing};
 use viewsynth::io::{DepthMap, RgbImage};
@@ -260,14 +259,7 @@ fn camera_file(obj: &Bound<'_, PyAny>) -> PyResult<CameraFile> {
     }
     let value = camera_json(obj, "cameras")?;
     // The file's parser: field errors name the field (left.R, middle.K, ...).
-    let file: CameraFile = serde_json::from_value(value).map_err(camera_error)?;
-    if !matches!(file.depth_kind, DepthKind::Device | DepthKind::ViewZ) {
-        return Err(camera_error(format!(
-            "invalid depth_kind: \"{}\": expected \"device\" or \"view-z\"",
-            file.depth_kind.name()
-        )));
-    }
-    Ok(file)
+    serde_json::from_value(value).map_err(camera_error)
 }
 
 /// The size the camera gives its eye must be the image's (the CLI's check, argument named).

@@ -22,12 +22,13 @@
 //! middle view axis.
 
 use super::camera_spec::CameraSpec;
-use super::{DepthKind, MiddleCamera};
+use super::{FrameDepth, MiddleCamera};
 use crate::camera::mat4::{self, Mat4};
 use crate::camera::vergence::{resolve_fixation, DepthRange, GazeRay};
 use crate::convention::Conventions;
+use crate::depth::DepthKind;
 use crate::error::{Error, Result};
-use serde::Deserialize;
+use serde::{Deserialize, Deserializer};
 use std::path::Path;
 
 /// An eye's GL matrices, from either form of the file.
@@ -93,7 +94,8 @@ pub struct Gaze {
 struct CameraFileSpec {
     #[serde(default)]
     conventions: Conventions,
-    depth_kind: DepthKind,
+    #[serde(deserialize_with = "frame_depth")]
+    depth_kind: FrameDepth,
     left: CameraSpec,
     right: CameraSpec,
     middle: CameraSpec,
@@ -107,6 +109,18 @@ struct CameraFileSpec {
     fixation_range: Option<[f64; 2]>,
 }
 
+/// `depth_kind`: any depth kind's name parses (an unknown one lists them all, as for every
+/// depth kind in a file), but the eyes' planes are their projections, so only device depth or
+/// view Z is accepted; the error names the field and the two accepted values.
+fn frame_depth<'de, D: Deserializer<'de>>(d: D) -> std::result::Result<FrameDepth, D::Error> {
+    FrameDepth::try_from(DepthKind::deserialize(d)?).map_err(|kind| {
+        serde::de::Error::custom(format!(
+            "depth_kind \"{}\": expected \"device\" or \"view-z\"",
+            kind.name()
+        ))
+    })
+}
+
 /// A parsed cameras.json, every camera resolved to GL matrices.
 #[derive(Debug, Clone, Deserialize)]
 #[serde(try_from = "CameraFileSpec")]
@@ -114,7 +128,7 @@ pub struct CameraFile {
     /// NDC depth range, reversed-Z and row order of the projections and of the depth files (default: GL's).
     pub conventions: Conventions,
     /// What the eye depth maps hold.
-    pub depth_kind: DepthKind,
+    pub depth_kind: FrameDepth,
     /// The left eye's cameras.
     pub left: EyeCameras,
     /// The right eye's cameras.
@@ -173,18 +187,7 @@ impl TryFrom<CameraFileSpec> for CameraFile {
 impl CameraFile {
     /// Read and resolve a camera file; errors name the file and the field.
     pub fn load(path: &Path) -> Result<Self> {
-        let file: CameraFile = crate::io::load_json(path, crate::io::MAX_JSON_MAGNITUDE)?;
-        // The eyes' planes are their projections: device depth or view Z, nothing else.
-        if !matches!(file.depth_kind, DepthKind::Device | DepthKind::ViewZ) {
-            return Err(Error::decode(
-                path,
-                format!(
-                    "depth_kind \"{}\": expected \"device\" or \"view-z\"",
-                    file.depth_kind.name()
-                ),
-            ));
-        }
-        Ok(file)
+        crate::io::load_json(path, crate::io::MAX_JSON_MAGNITUDE)
     }
 
     /// The middle camera and the fixation distance along its view axis.
@@ -269,6 +272,33 @@ mod tests {
         let (mid, fix) = f.middle_and_fixation().unwrap();
         assert!((fix - 2.0).abs() < 1e-9, "{fix}");
         assert_eq!(mid.width, 8);
+    }
+
+    #[test]
+    fn depth_kind_names_round_trip_and_other_kinds_are_refused_naming_the_field() {
+        for (kind, name) in [(FrameDepth::Device, "device"), (FrameDepth::ViewZ, "view-z")] {
+            assert_eq!(serde_json::to_string(&kind).unwrap(), format!("\"{name}\""));
+            assert_eq!(
+                serde_json::from_str::<FrameDepth>(&format!("\"{name}\"")).unwrap(),
+                kind
+            );
+            assert_eq!(kind.name(), name);
+            let f: CameraFile = serde_json::from_str(&file("").replace("view-z", name)).unwrap();
+            assert_eq!(f.depth_kind, kind);
+        }
+        let dir = tempfile::tempdir().unwrap();
+        for refused in ["view-distance", "disparity"] {
+            let path = dir.path().join(format!("{refused}.json"));
+            std::fs::write(&path, file("").replace("view-z", refused)).unwrap();
+            let e = CameraFile::load(&path).unwrap_err().to_string();
+            // The message `viewsynth cyclopean --cameras` has always given.
+            let expected = format!("depth_kind \"{refused}\": expected \"device\" or \"view-z\"");
+            assert_eq!(e, Error::decode(&path, expected).to_string());
+            assert!(e.contains(&path.display().to_string()), "{e}");
+        }
+        // A name no depth kind has is still refused, listing the kinds.
+        let e = serde_json::from_str::<CameraFile>(&file("").replace("view-z", "z-buffer")).unwrap_err();
+        assert!(e.to_string().contains("unknown variant `z-buffer`"), "{e}");
     }
 
     #[test]

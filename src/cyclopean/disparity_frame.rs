@@ -7,7 +7,7 @@
 //! shift is exactly `t d`, whatever f, B and doffs, and only the metric depth depends on them.
 
 use super::scene_frame::StereoRig;
-use super::{DepthKind, EyeInput, MiddleCamera, StereoFrame};
+use super::{EyeInput, FrameDepth, MiddleCamera, StereoFrame};
 use crate::camera::{gl_projection, Intrinsics, PinholeCamera, Pose};
 use crate::convention::{Conventions, DepthPlanes};
 use crate::error::{Error, Result};
@@ -116,7 +116,7 @@ pub fn disparity_frame(
     let frame = StereoFrame {
         left: eye(left, -1.0, 0.0),
         right: eye(right, 1.0, rig.doffs),
-        depth_kind: DepthKind::ViewZ,
+        depth_kind: FrameDepth::ViewZ,
         conv,
     };
     let mid = MiddleCamera {

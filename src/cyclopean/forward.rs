@@ -4,7 +4,7 @@
 //! guess to get wrong and fills every pixel a kept triangle covers; its oracle is the
 //! ray-traced middle view (tests/integration/cyclopean.rs).
 
-use super::{CyclopeanOutput, DepthKind, EyeInput, MiddleCamera, StereoFrame};
+use super::{CyclopeanOutput, EyeInput, FrameDepth, MiddleCamera, StereoFrame};
 use crate::camera::mat4::{self, Mat4};
 use crate::convention::RowOrder;
 use crate::error::{Error, Result};
@@ -21,7 +21,7 @@ use crate::refocus::{BreakRule, Grid};
 pub const RIGHT_EYE_DEPTH_BIAS: f32 = 1e-4;
 
 /// View distance per eye pixel (rows top-down), 0 where the depth is background or invalid.
-pub fn eye_distances(eye: &EyeInput, kind: DepthKind, conv: &crate::convention::Conventions) -> Result<Vec<f32>> {
+pub fn eye_distances(eye: &EyeInput, kind: FrameDepth, conv: &crate::convention::Conventions) -> Result<Vec<f32>> {
     let inv_proj = mat4::inverse(&eye.proj).ok_or_else(|| Error::param("eye projection", "singular"))?;
     let (w, h) = (eye.depth.width as usize, eye.depth.height as usize);
     let mut out = vec![0f32; w * h];

@@ -21,6 +21,7 @@ pub mod camera_spec;
 pub mod disparity_frame;
 pub mod edge_snap;
 pub mod forward;
+pub mod frame_depth;
 pub mod pass;
 pub mod reference;
 pub mod render;
@@ -35,9 +36,7 @@ use crate::error::{Error, Result};
 use crate::io::{DepthMap, RgbImage};
 use serde::{Deserialize, Serialize};
 
-/// What the eye depth maps hold: device depth (its planes are the eyes' projections) or view Z;
-/// the other kinds are refused by [`StereoFrame::validate`].
-pub use crate::depth::DepthKind;
+pub use frame_depth::FrameDepth;
 pub use pass::{CyclopeanInput, CyclopeanPass};
 
 /// One eye: colour, depth (rows top-down) and the GL matrices it was rendered with.
@@ -61,7 +60,7 @@ pub struct StereoFrame {
     /// The right eye.
     pub right: EyeInput,
     /// What both eyes' depth maps hold.
-    pub depth_kind: DepthKind,
+    pub depth_kind: FrameDepth,
     /// NDC depth range, reversed-Z and row order the eyes were rendered under.
     pub conv: Conventions,
 }
@@ -261,17 +260,8 @@ impl CyclopeanOutput {
 }
 
 impl StereoFrame {
-    /// Refuses depth kinds other than device depth and view Z, colour and depth of different sizes, and non-finite or singular eye matrices.
+    /// Refuses colour and depth of different sizes, and non-finite or singular eye matrices.
     pub fn validate(&self) -> Result<()> {
-        if !matches!(self.depth_kind, DepthKind::Device | DepthKind::ViewZ) {
-            return Err(Error::param(
-                "depth kind",
-                format!(
-                    "{} depth is not accepted here: give device or view-z",
-                    self.depth_kind.name()
-                ),
-            ));
-        }
         for (name, eye) in [("left", &self.left), ("right", &self.right)] {
             if (eye.color.width, eye.color.height) != (eye.depth.width, eye.depth.height) {
                 return Err(Error::SizeMismatch {

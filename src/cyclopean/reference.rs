@@ -2,7 +2,7 @@
 //! texel choices. Images are handled in memory order (row 0 = framebuffer row 0 under the
 //! frame's row order) exactly as the GPU sees its textures, and converted at the end.
 
-use super::{Blend, CyclopeanOutput, CyclopeanParams, DepthKind, Eye, EyeInput, MiddleCamera, StereoFrame};
+use super::{Blend, CyclopeanOutput, CyclopeanParams, Eye, EyeInput, FrameDepth, MiddleCamera, StereoFrame};
 use crate::camera::mat4::{self, Mat4};
 use crate::convention::{Conventions, RowOrder};
 use crate::depth::{is_background, ndc_z_of_window_depth};
@@ -44,7 +44,7 @@ impl Eye64<'_> {
     /// With `edge_aware = Some((z, tolerance))`, texels whose view distance differs from z by
     /// more than the tolerance get no weight (no colour bleeding across depth edges); the
     /// texel holding uv always qualifies, so the weights never all vanish.
-    fn bilinear(&self, uv: [f64; 2], edge_aware: Option<(f64, f64, DepthKind, &Conventions)>) -> [f64; 3] {
+    fn bilinear(&self, uv: [f64; 2], edge_aware: Option<(f64, f64, FrameDepth, &Conventions)>) -> [f64; 3] {
         let (w, h) = self.size();
         let t = [uv[0] * w as f64 - 0.5, uv[1] * h as f64 - 0.5];
         let (x0, y0) = (t[0].floor(), t[1].floor());
@@ -82,7 +82,7 @@ impl Eye64<'_> {
     }
 
     /// View-space distance stored at texel (x, y) (memory order), None for background.
-    fn view_distance(&self, x: i64, y: i64, kind: DepthKind, conv: &Conventions) -> Option<f64> {
+    fn view_distance(&self, x: i64, y: i64, kind: FrameDepth, conv: &Conventions) -> Option<f64> {
         let (w, h) = self.size();
         let ndc = [
             (x as f64 + 0.5) / w as f64 * 2.0 - 1.0,
@@ -94,12 +94,11 @@ impl Eye64<'_> {
 
 /// The eye view-space point a stored depth `d` describes at NDC (x, y): device depth unprojected
 /// through the eye's inverse projection, or a view distance along the pixel's ray. None for
-/// background (device depth by [`crate::depth::is_background`], distance <= 0), non-finite values
-/// and the kinds a stereo frame refuses (view distance, disparity).
+/// background (device depth by [`crate::depth::is_background`], distance <= 0) and non-finite values.
 pub(crate) fn stored_view_point(
     d: f64,
     ndc: [f64; 2],
-    kind: DepthKind,
+    kind: FrameDepth,
     conv: &Conventions,
     inv_proj: &Mat4,
 ) -> Option<[f64; 3]> {
@@ -107,21 +106,20 @@ pub(crate) fn stored_view_point(
         return None;
     }
     match kind {
-        DepthKind::Device => {
+        FrameDepth::Device => {
             if is_background(d, conv) {
                 return None;
             }
             let ndc_z = ndc_z_of_window_depth(d, conv);
             Some(mat4::transform_point(inv_proj, [ndc[0], ndc[1], ndc_z]))
         }
-        DepthKind::ViewZ => {
+        FrameDepth::ViewZ => {
             if d <= 0.0 {
                 return None;
             }
             let r = view_ray(inv_proj, ndc);
             Some([r[0] * d, r[1] * d, r[2] * d])
         }
-        DepthKind::ViewDistance | DepthKind::Disparity => None,
     }
 }
 

@@ -2,7 +2,7 @@
 //! middle depth and source bits, read back top-down.
 
 use super::{
-    Blend, CyclopeanOutput, CyclopeanOutputs, CyclopeanParams, DepthKind, Eye, EyeInput, Method, MiddleCamera,
+    Blend, CyclopeanOutput, CyclopeanOutputs, CyclopeanParams, Eye, EyeInput, FrameDepth, Method, MiddleCamera,
     StereoFrame,
 };
 use crate::camera::mat4::{self, Mat4};
@@ -76,7 +76,7 @@ impl CyclopeanRenderer {
         frame.validate()?;
         params.validate()?;
         let kind = ProgramKind::CyclopeanGather {
-            depth_is_device: frame.depth_kind == DepthKind::Device,
+            depth_is_device: frame.depth_kind == FrameDepth::Device,
             refine: matches!(params.method, Method::Refine { .. }),
             blend_soft: params.blend == Blend::Soft,
         };

@@ -1,7 +1,7 @@
 //! A stereo frame of the built-in scene, rendered exactly (f64 ray tracing) under any
 //! conventions, with the ray-traced middle view as ground truth.
 
-use super::{DepthKind, EyeInput, MiddleCamera, StereoFrame};
+use super::{EyeInput, FrameDepth, MiddleCamera, StereoFrame};
 use crate::camera::{gl_projection, PinholeCamera, Pose};
 use crate::convention::{Conventions, DepthPlanes};
 use crate::depth::DepthEncoding;
@@ -52,11 +52,11 @@ pub struct MiddleTruth {
     pub depth: DepthMap,
 }
 
-fn eye_input(rig: &StereoRig, pose: &Pose, conv: &Conventions, kind: DepthKind) -> EyeInput {
+fn eye_input(rig: &StereoRig, pose: &Pose, conv: &Conventions, kind: FrameDepth) -> EyeInput {
     let (color, z) = scene::render_posed(&rig.camera, pose);
     let depth = match kind {
-        DepthKind::ViewZ => z,
-        DepthKind::Device => {
+        FrameDepth::ViewZ => z,
+        FrameDepth::Device => {
             let far = conv.clear_depth() as f32;
             let encoding = DepthEncoding::Device { planes: rig.planes };
             let data = z
@@ -72,10 +72,6 @@ fn eye_input(rig: &StereoRig, pose: &Pose, conv: &Conventions, kind: DepthKind) 
                 .collect();
             DepthMap::new(z.width, z.height, data).expect("same size")
         }
-        other => panic!(
-            "scene_frame: a stereo frame holds device depth or view Z, not {}",
-            other.name()
-        ),
     };
     EyeInput {
         color,
@@ -86,9 +82,7 @@ fn eye_input(rig: &StereoRig, pose: &Pose, conv: &Conventions, kind: DepthKind) 
 }
 
 /// Left/right eyes, the middle camera (same intrinsics as the eyes) and its ground truth.
-///
-/// Panics for a `kind` other than device depth or view Z (what a stereo frame accepts).
-pub fn scene_frame(rig: &StereoRig, conv: Conventions, kind: DepthKind) -> (StereoFrame, MiddleCamera, MiddleTruth) {
+pub fn scene_frame(rig: &StereoRig, conv: Conventions, kind: FrameDepth) -> (StereoFrame, MiddleCamera, MiddleTruth) {
     let frame = StereoFrame {
         left: eye_input(rig, &rig.eye_pose(-1.0), &conv, kind),
         right: eye_input(rig, &rig.eye_pose(1.0), &conv, kind),

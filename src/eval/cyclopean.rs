@@ -11,7 +11,7 @@ use crate::cyclopean::render::CyclopeanRenderer;
 use crate::cyclopean::scene_frame::{scene_frame, StereoRig};
 use crate::cyclopean::splat::{SplatParams, SplatRenderer};
 use crate::cyclopean::{
-    Blend, CyclopeanOutput, CyclopeanOutputs, CyclopeanParams, DepthKind, Method as CyclopeanMethod, MiddleCamera,
+    Blend, CyclopeanOutput, CyclopeanOutputs, CyclopeanParams, FrameDepth, Method as CyclopeanMethod, MiddleCamera,
     StereoFrame,
 };
 use crate::error::Result;
@@ -80,7 +80,7 @@ pub fn cyclopean_scene_rows(gpu: &Gpu, repeats: usize) -> Result<Vec<ReportRow>>
         let mut rig = StereoRig::demo(640, 480);
         rig.ipd = ipd;
         for conv in depth_conventions() {
-            let (frame, mid, truth) = scene_frame(&rig, conv, DepthKind::Device);
+            let (frame, mid, truth) = scene_frame(&rig, conv, FrameDepth::Device);
             let mut runs = Vec::new();
             for (name, params) in cyclopean_methods(3.0) {
                 runs.push((name, render_cyclopean(gpu, &frame, &mid, params, repeats)?));
@@ -533,10 +533,8 @@ pub fn cyclopean_case_rows(gpu: &Gpu, dir: &Path, repeats: usize) -> Result<Vec<
     let cams = CameraFile::load(&dir.join("cameras.json"))?;
     let (mid, fixation) = cams.middle_and_fixation()?;
     let suffix = match cams.depth_kind {
-        DepthKind::Device => "device_depth",
-        DepthKind::ViewZ => "view_z",
-        // CameraFile::load accepts these two only.
-        other => unreachable!("camera file with {} depth", other.name()),
+        FrameDepth::Device => "device_depth",
+        FrameDepth::ViewZ => "view_z",
     };
     let eye = |name: &str, cam: &crate::cyclopean::camera_file::EyeCameras| -> Result<EyeInput> {
         Ok(EyeInput {

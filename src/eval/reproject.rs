@@ -5,7 +5,8 @@ use crate::camera::stereo::Eye;
 use crate::camera::{Intrinsics, PinholeCamera};
 use crate::convention::Conventions;
 use crate::cyclopean::scene_frame::{scene_frame, StereoRig};
-use crate::depth::{DepthEncoding, DepthKind};
+use crate::cyclopean::FrameDepth;
+use crate::depth::DepthEncoding;
 use crate::error::Result;
 use crate::gpu::{Gpu, Timing};
 use crate::io::{self, DepthDecode, DepthMap, RgbImage};
@@ -43,12 +44,12 @@ pub struct Case {
 
 /// Built-in scene on a parallel rig (`ipd` apart): left eye -> right eye with the given depth
 /// kind, the ray-traced centre view (view Z) -> right eye, and the seed's converged form.
-pub fn scene_cases(width: u32, height: u32, ipd: f64, conv: Conventions, kind: DepthKind) -> Result<Vec<Case>> {
+pub fn scene_cases(width: u32, height: u32, ipd: f64, conv: Conventions, kind: FrameDepth) -> Result<Vec<Case>> {
     let mut rig = StereoRig::demo(width, height);
     rig.ipd = ipd;
     let (frame, _, mid_truth) = scene_frame(&rig, conv, kind);
     let right = crate::scene::render_posed(&rig.camera, &rig.eye_pose(1.0));
-    let depth_kind = DepthEncoding::with_planes(kind, rig.planes)?;
+    let depth_kind = DepthEncoding::with_planes(kind.into(), rig.planes)?;
     let fx = rig.camera.k.fx;
     Ok(vec![
         Case {
@@ -348,7 +349,7 @@ pub fn reproject_rows(gpu: &Gpu, data_dir: Option<&Path>, repeats: usize) -> Res
     ];
     let conv = Conventions::default();
     for ipd in [0.064, 0.2] {
-        for case in scene_cases(640, 480, ipd, conv, DepthKind::Device)? {
+        for case in scene_cases(640, 480, ipd, conv, FrameDepth::Device)? {
             for params in methods() {
                 let (out, t) = run_timed(gpu, &case, params, repeats)?;
                 let (mut r, _) = row(&case, "builtin:demo 640x480", params, &out, t)?;

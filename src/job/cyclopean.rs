@@ -10,7 +10,9 @@ use crate::cyclopean::disparity_frame::{disparity_frame, DisparityRig};
 use crate::cyclopean::forward::ForwardWarp;
 use crate::cyclopean::render::CyclopeanRenderer;
 use crate::cyclopean::splat::{SplatParams, SplatRenderer};
-use crate::cyclopean::{Blend, CyclopeanOutputs, CyclopeanParams, DepthKind, Eye, EyeInput, MiddleCamera, StereoFrame};
+use crate::cyclopean::{
+    Blend, CyclopeanOutputs, CyclopeanParams, Eye, EyeInput, FrameDepth, MiddleCamera, StereoFrame,
+};
 use crate::depth::DepthEncoding;
 use crate::io::{self, DepthDecode, DepthMap, DepthSummary, RgbImage};
 use crate::refocus::{BreakRule, OutputSet};
@@ -455,18 +457,12 @@ impl CyclopeanJob {
 }
 
 /// An eye's depth as view Z in metres (0 where invalid), for the input summary.
-fn view_z_in_metres(eye: &EyeInput, kind: DepthKind, conv: &Conventions) -> crate::Result<DepthMap> {
+fn view_z_in_metres(eye: &EyeInput, kind: FrameDepth, conv: &Conventions) -> crate::Result<DepthMap> {
     let input = match kind {
-        DepthKind::ViewZ => DepthEncoding::ViewZ,
-        DepthKind::Device => DepthEncoding::Device {
+        FrameDepth::ViewZ => DepthEncoding::ViewZ,
+        FrameDepth::Device => DepthEncoding::Device {
             planes: DepthPlanes::from_gl_projection(&eye.proj, conv)?,
         },
-        other => {
-            return Err(crate::Error::param(
-                "depth kind",
-                format!("{} depth: a stereo frame holds device depth or view Z", other.name()),
-            ))
-        }
     };
     Ok(input.view_z_map(conv, &eye.depth))
 }

@@ -9,7 +9,7 @@ use crate::camera::stereo::{Eye, StereoParams};
 use crate::camera::PinholeCamera;
 use crate::convention::{Conventions, DepthPlanes};
 use crate::cyclopean::camera_file::CameraFile;
-use crate::cyclopean::{DepthKind, MiddleCamera};
+use crate::cyclopean::{FrameDepth, MiddleCamera};
 use crate::depth::DepthEncoding;
 use crate::gpu::Timing;
 use crate::io::{self, DepthDecode, DepthSummary};
@@ -407,21 +407,11 @@ impl ReprojectJob {
         };
         let conv = file.conventions;
         let depth_kind = match file.depth_kind {
-            DepthKind::ViewZ => DepthEncoding::ViewZ,
-            DepthKind::Device => DepthEncoding::Device {
+            FrameDepth::ViewZ => DepthEncoding::ViewZ,
+            FrameDepth::Device => DepthEncoding::Device {
                 planes: DepthPlanes::from_gl_projection(&source.proj, &conv)
                     .within(|| format!("{}: {} projection", path.display(), view_name(Some(from))))?,
             },
-            other => {
-                return Err(JobError::Lib(crate::Error::param(
-                    "depth kind",
-                    format!(
-                        "{}: {} depth: the camera file holds device depth or view Z",
-                        path.display(),
-                        other.name()
-                    ),
-                )))
-            }
         };
         let what = format!(
             "{:?} depth under {} (from {})",

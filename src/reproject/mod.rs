@@ -45,7 +45,7 @@ use crate::camera::mat4::{self, Mat4};
 use crate::camera::stereo::{Eye, StereoParams};
 use crate::camera::{gl_projection, PinholeCamera, Pose};
 use crate::convention::{Conventions, DepthPlanes};
-use crate::cyclopean::{EyeInput, MiddleCamera, StereoFrame};
+use crate::cyclopean::{EyeInput, FrameDepth, MiddleCamera, StereoFrame};
 use crate::depth::{DepthEncoding, DepthKind};
 use crate::error::{Error, Result};
 use crate::io::{DepthMap, RgbImage};
@@ -296,10 +296,10 @@ impl ReprojectOutput {
 
 /// Source depth as cyclopean input: device depth stays device depth (same conventions), the
 /// rest becomes view Z (0 = invalid).
-fn cyclopean_depth(src: &ReprojectSource) -> (DepthMap, DepthKind) {
+fn cyclopean_depth(src: &ReprojectSource) -> (DepthMap, FrameDepth) {
     match src.depth_kind {
-        DepthEncoding::Device { .. } => (src.depth.clone(), DepthKind::Device),
-        _ => (src.depth_kind.view_z_map(&src.conv, &src.depth), DepthKind::ViewZ),
+        DepthEncoding::Device { .. } => (src.depth.clone(), FrameDepth::Device),
+        _ => (src.depth_kind.view_z_map(&src.conv, &src.depth), FrameDepth::ViewZ),
     }
 }
 
@@ -359,9 +359,8 @@ pub fn one_eye_frame(src: &ReprojectSource, geometry: &Geometry) -> Result<(Ster
         }
     };
     let far = match kind {
-        DepthKind::Device => src.conv.clear_depth() as f32,
-        // cyclopean_depth gives device depth or view Z only.
-        _ => 0.0,
+        FrameDepth::Device => src.conv.clear_depth() as f32,
+        FrameDepth::ViewZ => 0.0,
     };
     let eye = EyeInput {
         color: src.color.clone(),

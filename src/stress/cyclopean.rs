@@ -25,7 +25,7 @@ use crate::convention::{Conventions, DepthPlanes};
 use crate::cyclopean::reference::cyclopean_reference;
 use crate::cyclopean::render::CyclopeanRenderer;
 use crate::cyclopean::scene_frame::{scene_frame, StereoRig};
-use crate::cyclopean::{CyclopeanParams, DepthKind, Method, MiddleCamera, StereoFrame};
+use crate::cyclopean::{CyclopeanParams, FrameDepth, Method, MiddleCamera, StereoFrame};
 use crate::error::Result;
 use crate::gpu::Gpu;
 use crate::io::RgbImage;
@@ -48,14 +48,11 @@ fn methods(fixation: f64) -> [(&'static str, CyclopeanParams); 2] {
     ]
 }
 
-fn bound(conv_precise: bool, kind: DepthKind, z_max: f64, near: f64) -> f64 {
+fn bound(conv_precise: bool, kind: FrameDepth, z_max: f64, near: f64) -> f64 {
     match (kind, conv_precise) {
-        (DepthKind::ViewZ, _) => 8.0 * EPS32,
-        (DepthKind::Device, true) => 16.0 * EPS32,
-        (DepthKind::Device, false) => 8.0 * EPS32 * (1.0 + z_max / near) + 8.0 * EPS32,
-        (DepthKind::ViewDistance | DepthKind::Disparity, _) => {
-            unreachable!("cyclopean frames hold device depth or view Z")
-        }
+        (FrameDepth::ViewZ, _) => 8.0 * EPS32,
+        (FrameDepth::Device, true) => 16.0 * EPS32,
+        (FrameDepth::Device, false) => 8.0 * EPS32 * (1.0 + z_max / near) + 8.0 * EPS32,
     }
 }
 
@@ -93,7 +90,7 @@ fn sweep(gpu: &Gpu, case: &str, cases: &[Case], fixation: f64, tol: Tolerance, n
     Ok(StressRow::from_tally("cyclopean", case, tally, tol, note))
 }
 
-fn scene_cases(rig: &StereoRig, convs: &[Conventions], kind: DepthKind) -> Vec<Case> {
+fn scene_cases(rig: &StereoRig, convs: &[Conventions], kind: FrameDepth) -> Vec<Case> {
     convs
         .iter()
         .map(|&conv| {
@@ -127,7 +124,7 @@ pub fn rows(gpu: &Gpu, opts: StressOptions) -> Result<Vec<StressRow>> {
             (&lossy, "standard Z or GL range", false),
             (&fine, "reversed-Z [0,1]", true),
         ] {
-            let b = bound(is_fine, DepthKind::Device, SCENE_Z_MAX, near);
+            let b = bound(is_fine, FrameDepth::Device, SCENE_Z_MAX, near);
             let by_design = !is_fine && b > 1e-4;
             let tol = if by_design {
                 Tolerance::lost_by_design(b)
@@ -146,7 +143,7 @@ pub fn rows(gpu: &Gpu, opts: StressOptions) -> Result<Vec<StressRow>> {
             rows.push(sweep(
                 gpu,
                 &format!("device depth, near/far {ratio:.0e}, {label}"),
-                &scene_cases(&rig, convs, DepthKind::Device),
+                &scene_cases(&rig, convs, FrameDepth::Device),
                 FIXATION,
                 tol,
                 &note,
@@ -155,13 +152,13 @@ pub fn rows(gpu: &Gpu, opts: StressOptions) -> Result<Vec<StressRow>> {
     }
 
     let two = [Conventions::default(), all[7]];
-    let view_z_tol = Tolerance::new(bound(true, DepthKind::ViewZ, 0.0, 1.0), 1e-3, 1e-3);
+    let view_z_tol = Tolerance::new(bound(true, FrameDepth::ViewZ, 0.0, 1.0), 1e-3, 1e-3);
     let mut rig = StereoRig::demo(w, h);
     rig.ipd = 0.0;
     rows.push(sweep(
         gpu,
         "zero IPD",
-        &scene_cases(&rig, &two, DepthKind::ViewZ),
+        &scene_cases(&rig, &two, FrameDepth::ViewZ),
         FIXATION,
         view_z_tol,
         "both eyes at the middle: the middle view is either eye",
@@ -176,7 +173,7 @@ pub fn rows(gpu: &Gpu, opts: StressOptions) -> Result<Vec<StressRow>> {
         rows.push(sweep(
             gpu,
             label,
-            &scene_cases(&rig, &two, DepthKind::ViewZ),
+            &scene_cases(&rig, &two, FrameDepth::ViewZ),
             fixation,
             view_z_tol,
             "the walk starts at the fixation depth; the projection check drops what does not converge",
@@ -185,7 +182,7 @@ pub fn rows(gpu: &Gpu, opts: StressOptions) -> Result<Vec<StressRow>> {
 
     // NaN / Inf / negative / zero patches in both eyes' view Z.
     let bad = [f32::NAN, f32::INFINITY, f32::NEG_INFINITY, -1.0, 0.0];
-    let mut cases = scene_cases(&rig, &two, DepthKind::ViewZ);
+    let mut cases = scene_cases(&rig, &two, FrameDepth::ViewZ);
     for c in &mut cases {
         for eye in [&mut c.frame.left, &mut c.frame.right] {
             let wd = eye.depth.width as usize;
@@ -209,7 +206,7 @@ pub fn rows(gpu: &Gpu, opts: StressOptions) -> Result<Vec<StressRow>> {
     // The middle camera ~1.5 m ahead of the eyes: much of what they saw is behind it. Not at a
     // round offset: at (0, 0, 0.5) with fixation 3 m the first guesses project exactly onto texel
     // rows (a scale of 3 / 3.5), and f32 and f64 break those ties apart on ~2 % of pixels.
-    let mut cases = scene_cases(&rig, &two, DepthKind::ViewZ);
+    let mut cases = scene_cases(&rig, &two, FrameDepth::ViewZ);
     for c in &mut cases {
         c.mid.view = Pose {
             position: [0.0123, -0.0071, 1.4629],
@@ -232,7 +229,7 @@ pub fn rows(gpu: &Gpu, opts: StressOptions) -> Result<Vec<StressRow>> {
     rig.planes = DepthPlanes { near: 1e-4, far: 1e6 };
     let mut cases = Vec::new();
     for conv in two {
-        let (mut frame, mid, _) = scene_frame(&rig, conv, DepthKind::ViewZ);
+        let (mut frame, mid, _) = scene_frame(&rig, conv, FrameDepth::ViewZ);
         for eye in [&mut frame.left, &mut frame.right] {
             let wd = eye.depth.width as usize;
             for (i, z) in eye.depth.data.iter_mut().enumerate() {
@@ -269,7 +266,7 @@ pub fn rows(gpu: &Gpu, opts: StressOptions) -> Result<Vec<StressRow>> {
     let rig = StereoRig::demo(64, 48);
     let mut cases = Vec::new();
     for (mw, mh) in [(1, 1), (max, 2)] {
-        let (frame, mut mid, _) = scene_frame(&rig, all[7], DepthKind::ViewZ);
+        let (frame, mut mid, _) = scene_frame(&rig, all[7], FrameDepth::ViewZ);
         mid.width = mw;
         mid.height = mh;
         cases.push(Case {
@@ -286,7 +283,7 @@ pub fn rows(gpu: &Gpu, opts: StressOptions) -> Result<Vec<StressRow>> {
         view_z_tol,
         "",
     )?);
-    let (frame, mut mid, _) = scene_frame(&rig, all[7], DepthKind::ViewZ);
+    let (frame, mut mid, _) = scene_frame(&rig, all[7], FrameDepth::ViewZ);
     mid.width = max + 1;
     mid.height = 1;
     let r = CyclopeanRenderer::new(gpu, &frame, CyclopeanParams::seed(FIXATION))

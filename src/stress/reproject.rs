@@ -19,7 +19,8 @@ use crate::camera::stereo::{Eye, StereoParams};
 use crate::camera::{Intrinsics, PinholeCamera};
 use crate::convention::{Conventions, DepthPlanes};
 use crate::cyclopean::scene_frame::{scene_frame, StereoRig};
-use crate::depth::{DepthEncoding, DepthKind};
+use crate::cyclopean::FrameDepth;
+use crate::depth::DepthEncoding;
 use crate::error::Result;
 use crate::eval::reproject::methods;
 use crate::gpu::Gpu;
@@ -94,7 +95,7 @@ fn shift_ties(src: &ReprojectSource, geometry: &Geometry) -> Option<Vec<bool>> {
 }
 
 /// Left -> right on the built-in scene with the given planes (device depth) or view Z.
-fn scene_case(w: u32, h: u32, ipd: f64, planes: DepthPlanes, conv: Conventions, kind: DepthKind) -> Result<Case> {
+fn scene_case(w: u32, h: u32, ipd: f64, planes: DepthPlanes, conv: Conventions, kind: FrameDepth) -> Result<Case> {
     let mut rig = StereoRig::demo(w, h);
     rig.ipd = ipd;
     rig.planes = planes;
@@ -104,7 +105,7 @@ fn scene_case(w: u32, h: u32, ipd: f64, planes: DepthPlanes, conv: Conventions, 
         source: ReprojectSource {
             color: frame.left.color,
             depth: frame.left.depth,
-            depth_kind: DepthEncoding::with_planes(kind, planes)?,
+            depth_kind: DepthEncoding::with_planes(kind.into(), planes)?,
             conv,
         },
         geometry: Geometry::Rig {
@@ -186,7 +187,7 @@ pub fn rows(gpu: &Gpu, opts: StressOptions) -> Result<Vec<StressRow>> {
             };
             let cases = convs
                 .iter()
-                .map(|&c| scene_case(w, h, 0.2011, planes, c, DepthKind::Device))
+                .map(|&c| scene_case(w, h, 0.2011, planes, c, FrameDepth::Device))
                 .collect::<Result<Vec<_>>>()?;
             let note = if by_design {
                 format!(

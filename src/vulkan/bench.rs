@@ -74,11 +74,11 @@ pub fn refocus_bench(vk: &Vk, sizes: &[(u32, u32)], repeats: usize, cases: &mut 
 /// `cases` as `vulkan-<method>`.
 pub fn cyclopean_bench(vk: &Vk, width: u32, height: u32, repeats: usize, cases: &mut Vec<BenchCase>) -> Result<String> {
     use crate::cyclopean::scene_frame::{scene_frame, StereoRig};
-    use crate::cyclopean::DepthKind;
+    use crate::cyclopean::FrameDepth;
     let (frame, mid, _) = scene_frame(
         &StereoRig::demo(width, height),
         Conventions::default(),
-        DepthKind::Device,
+        FrameDepth::Device,
     );
     let mut t = format!(
         "cyclopean benchmark on Vulkan device '{}': 2 eyes {width}x{height} -> middle {width}x{height} \

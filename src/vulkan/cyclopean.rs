@@ -18,7 +18,7 @@ use super::targets::ColorTargets;
 use crate::camera::mat4::{self, Mat4};
 use crate::convention::RowOrder;
 use crate::cyclopean::{
-    Blend, CyclopeanOutput, CyclopeanOutputs, CyclopeanParams, DepthKind, Eye, EyeInput, Method, MiddleCamera,
+    Blend, CyclopeanOutput, CyclopeanOutputs, CyclopeanParams, Eye, EyeInput, FrameDepth, Method, MiddleCamera,
     StereoFrame,
 };
 use crate::error::{Error, Result};
@@ -46,7 +46,7 @@ pub fn preamble(frame: &StereoFrame, params: &CyclopeanParams) -> String {
 /// The program's switches, as render.rs picks them.
 fn kind(frame: &StereoFrame, params: &CyclopeanParams) -> ProgramKind {
     ProgramKind::CyclopeanGather {
-        depth_is_device: frame.depth_kind == DepthKind::Device,
+        depth_is_device: frame.depth_kind == FrameDepth::Device,
         refine: matches!(params.method, Method::Refine { .. }),
         blend_soft: params.blend == Blend::Soft,
     }

@@ -13,7 +13,7 @@ use crate::camera::PinholeCamera;
 use crate::convention::Conventions;
 use crate::cyclopean::render::CyclopeanRenderer;
 use crate::cyclopean::scene_frame::{scene_frame, StereoRig};
-use crate::cyclopean::{CyclopeanOutput, CyclopeanParams, DepthKind, Method as CyclopeanMethod};
+use crate::cyclopean::{CyclopeanOutput, CyclopeanParams, FrameDepth, Method as CyclopeanMethod};
 use crate::error::Result;
 use crate::gpu::{Gpu, GpuPolicy};
 use crate::refocus::{BreakRule, Method, OutputSet, RefocusOutput, RefocusSource, Refocuser};
@@ -143,7 +143,7 @@ fn cyclopean_table(gpu: &Gpu, vk: &Vk, s: &mut String) -> Result<()> {
     )
     .expect("write to String");
     for conv in Conventions::all() {
-        let (frame, mid, _) = scene_frame(&rig, conv, DepthKind::Device);
+        let (frame, mid, _) = scene_frame(&rig, conv, FrameDepth::Device);
         let (a, ta) = CyclopeanRenderer::new(gpu, &frame, params)?.render(&mid)?;
         let (b, tb) = VkCyclopean::new(vk, &frame, params)?.render(&mid)?;
         let d = cyclopean_diff(&a, &b);

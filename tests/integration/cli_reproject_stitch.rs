@@ -8,7 +8,7 @@ use std::path::{Path, PathBuf};
 use std::process::Output;
 use viewsynth::camera::stereo::{Eye, StereoParams};
 use viewsynth::convention::Conventions;
-use viewsynth::cyclopean::DepthKind;
+use viewsynth::cyclopean::FrameDepth;
 use viewsynth::eval::reproject::{scene_cases, Case};
 use viewsynth::io::{self, DepthMap};
 use viewsynth::reproject::render::Reprojector;
@@ -41,7 +41,7 @@ fn s(p: &Path) -> &str {
 
 /// The built-in scene's case `index` of [`scene_cases`] at W x H, its source written as PNG +
 /// EXR in `dir`.
-fn case_files(dir: &Path, kind: DepthKind, index: usize) -> (Case, PathBuf, PathBuf) {
+fn case_files(dir: &Path, kind: FrameDepth, index: usize) -> (Case, PathBuf, PathBuf) {
     let case = scene_cases(W, H, IPD, Conventions::default(), kind)
         .unwrap()
         .swap_remove(index);
@@ -102,7 +102,7 @@ fn coverage_in(text: &str) -> f64 {
 #[test]
 fn reproject_left_to_right_from_device_depth_matches_the_library() {
     let d = scratch("rp-device");
-    let (case, c, z) = case_files(&d, DepthKind::Device, 0);
+    let (case, c, z) = case_files(&d, FrameDepth::Device, 0);
     let out = d.join("out");
     let mut args = vec![
         "reproject".to_string(),
@@ -139,7 +139,7 @@ fn reproject_left_to_right_from_device_depth_matches_the_library() {
 fn reproject_centre_to_both_eyes_on_the_seed_rig() {
     let d = scratch("rp-seed");
     // Case 2: the centre view (view Z) -> right eye with seed 004's S and c = 3 m.
-    let (case, c, z) = case_files(&d, DepthKind::ViewZ, 2);
+    let (case, c, z) = case_files(&d, FrameDepth::ViewZ, 2);
     let Geometry::Rig { camera, shift } = case.geometry else {
         panic!("rig")
     };
@@ -203,7 +203,7 @@ fn reproject_centre_to_both_eyes_on_the_seed_rig() {
 #[test]
 fn reproject_from_disparity_agrees_with_view_z() {
     let d = scratch("rp-disp");
-    let (case, c, _) = case_files(&d, DepthKind::ViewZ, 0);
+    let (case, c, _) = case_files(&d, FrameDepth::ViewZ, 0);
     let Geometry::Rig { camera, .. } = case.geometry else {
         panic!("rig")
     };
@@ -269,7 +269,7 @@ fn reproject_from_disparity_agrees_with_view_z() {
 #[test]
 fn reproject_bad_input_fails_cleanly() {
     let d = scratch("rp-bad");
-    let (case, c, z) = case_files(&d, DepthKind::ViewZ, 0);
+    let (case, c, z) = case_files(&d, FrameDepth::ViewZ, 0);
     let k = intrinsics(&case);
     let out = d.join("out");
     let rp = |color: &Path, depth: &Path, extra: &[&str]| -> Output {

@@ -13,7 +13,7 @@ use viewsynth::cyclopean::reference::cyclopean_reference;
 use viewsynth::cyclopean::render::CyclopeanRenderer;
 use viewsynth::cyclopean::scene_frame::{scene_frame, MiddleTruth, StereoRig};
 use viewsynth::cyclopean::{
-    pass, Blend, CyclopeanInput, CyclopeanOutput, CyclopeanOutputs, CyclopeanParams, CyclopeanPass, DepthKind, Eye,
+    pass, Blend, CyclopeanInput, CyclopeanOutput, CyclopeanOutputs, CyclopeanParams, CyclopeanPass, Eye, FrameDepth,
     Method,
 };
 use viewsynth::eval::image_check;
@@ -77,7 +77,7 @@ fn gpu_matches_the_f64_reference_under_every_convention_and_depth_kind() {
     let mut rig = StereoRig::demo(160, 120);
     rig.ipd = 0.2;
     for conv in Conventions::all() {
-        for kind in [DepthKind::Device, DepthKind::ViewZ] {
+        for kind in [FrameDepth::Device, FrameDepth::ViewZ] {
             let (frame, mid, _) = scene_frame(&rig, conv, kind);
             for (name, params) in methods() {
                 let input = CyclopeanInput {
@@ -108,7 +108,7 @@ fn output_does_not_depend_on_the_convention() {
     let g = gpu();
     let mut rig = StereoRig::demo(160, 120);
     rig.ipd = 0.2;
-    for kind in [DepthKind::Device, DepthKind::ViewZ] {
+    for kind in [FrameDepth::Device, FrameDepth::ViewZ] {
         for (name, params) in methods() {
             let mut base: Option<CyclopeanOutput> = None;
             for conv in Conventions::all() {
@@ -175,7 +175,7 @@ fn refinement_beats_the_seed_where_parallax_is_large() {
     let g = gpu();
     let mut rig = StereoRig::demo(320, 240);
     rig.ipd = 0.2;
-    let (frame, mid, truth) = scene_frame(&rig, Conventions::default(), DepthKind::Device);
+    let (frame, mid, truth) = scene_frame(&rig, Conventions::default(), FrameDepth::Device);
     let mut results = Vec::new();
     for (name, params) in methods() {
         let (out, _) = CyclopeanRenderer::new(&g, &frame, params)
@@ -205,7 +205,7 @@ fn forward_warp_is_convention_independent_and_beats_the_seed() {
     rig.ipd = 0.2;
     let mut base: Option<CyclopeanOutput> = None;
     for conv in Conventions::all() {
-        let (frame, mid, truth) = scene_frame(&rig, conv, DepthKind::Device);
+        let (frame, mid, truth) = scene_frame(&rig, conv, FrameDepth::Device);
         let (out, _) = ForwardWarp::new(&g, &frame, &BreakRule::default())
             .unwrap()
             .render(&mid)
@@ -247,7 +247,7 @@ fn forward_warp_is_convention_independent_and_beats_the_seed() {
 #[test]
 fn bad_parameters_are_errors_not_panics() {
     let rig = StereoRig::demo(16, 12);
-    let (frame, mid, _) = scene_frame(&rig, Conventions::default(), DepthKind::Device);
+    let (frame, mid, _) = scene_frame(&rig, Conventions::default(), FrameDepth::Device);
     for params in [
         CyclopeanParams::seed(0.0),
         CyclopeanParams::seed(f64::NAN),
@@ -282,7 +282,7 @@ fn cli_renders_the_same_middle_view_as_the_library_from_files() {
     let g = gpu();
     let rig = StereoRig::demo(96, 72);
     let conv = Conventions::all()[5];
-    let (frame, mid, _) = scene_frame(&rig, conv, DepthKind::Device);
+    let (frame, mid, _) = scene_frame(&rig, conv, FrameDepth::Device);
     let dir = std::env::temp_dir().join(format!("viewsynth-cyclopean-cli-{}", std::process::id()));
     let _ = std::fs::remove_dir_all(&dir);
     std::fs::create_dir_all(&dir).unwrap();
@@ -390,7 +390,7 @@ fn temporal_accumulation_fills_disocclusions_from_the_previous_frame() {
         let mut rig = StereoRig::demo(320, 240);
         rig.ipd = 0.2;
         rig.head = viewsynth::camera::Pose::at([x, 0.0, 0.0]);
-        let (mut frame, mid, truth) = scene_frame(&rig, conv, DepthKind::Device);
+        let (mut frame, mid, truth) = scene_frame(&rig, conv, FrameDepth::Device);
         frame
             .right
             .depth
@@ -456,7 +456,7 @@ fn temporal_accumulation_fills_disocclusions_from_the_previous_frame() {
 fn unrequested_colour_and_depth_get_no_attachment_and_no_readback() {
     use viewsynth::cyclopean::CyclopeanOutputs;
     let g = gpu();
-    let (frame, mid, _) = scene_frame(&StereoRig::demo(64, 48), Conventions::all()[7], DepthKind::Device);
+    let (frame, mid, _) = scene_frame(&StereoRig::demo(64, 48), Conventions::all()[7], FrameDepth::Device);
     let params = CyclopeanParams {
         method: Method::Refine { steps: 3 },
         ..CyclopeanParams::seed(3.0)

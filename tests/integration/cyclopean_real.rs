@@ -28,7 +28,7 @@ use viewsynth::cyclopean::render::CyclopeanRenderer;
 use viewsynth::cyclopean::scene_frame::{scene_frame, StereoRig};
 use viewsynth::cyclopean::splat::{SplatParams, SplatRenderer};
 use viewsynth::cyclopean::splat_reference::splat_reference;
-use viewsynth::cyclopean::{CyclopeanOutput, CyclopeanOutputs, CyclopeanParams, DepthKind, Method, StereoFrame};
+use viewsynth::cyclopean::{CyclopeanOutput, CyclopeanOutputs, CyclopeanParams, FrameDepth, Method, StereoFrame};
 use viewsynth::eval::cyclopean::{estimated_cases, estimated_eyes};
 use viewsynth::io::{self, DepthDecode, DepthMap, RgbImage};
 use viewsynth::metrics;
@@ -120,7 +120,7 @@ fn splat_gather_gpu_matches_its_f64_twin() {
     let mut rig = StereoRig::demo(160, 120);
     rig.ipd = 0.2;
     for conv in Conventions::all() {
-        for kind in [DepthKind::Device, DepthKind::ViewZ] {
+        for kind in [FrameDepth::Device, FrameDepth::ViewZ] {
             let (frame, mid, _) = scene_frame(&rig, conv, kind);
             check_twin(&format!("scene-{}-{kind:?}", conv.label()), &frame, &mid, 0.001);
         }

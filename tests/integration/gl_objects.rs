@@ -7,7 +7,7 @@ use viewsynth::camera::PinholeCamera;
 use viewsynth::convention::Conventions;
 use viewsynth::cyclopean::scene_frame::{scene_frame, StereoRig};
 use viewsynth::cyclopean::splat::{SplatParams, SplatRenderer};
-use viewsynth::cyclopean::{CyclopeanOutputs, DepthKind};
+use viewsynth::cyclopean::{CyclopeanOutputs, FrameDepth};
 use viewsynth::gpu::{Attachment, Framebuffer, Gpu, IndexBuffer, LiveObjects, TextureFormat, VertexArray};
 use viewsynth::refocus::{BreakRule, Method, OutputSet, RefocusSource, Refocuser};
 
@@ -131,7 +131,7 @@ fn a_second_identical_refocus_frame_allocates_no_gl_objects() {
 #[test]
 fn a_second_identical_cyclopean_frame_allocates_no_gl_objects() {
     let g = gpu();
-    let (frame, mid, _) = scene_frame(&StereoRig::demo(40, 30), Conventions::default(), DepthKind::ViewZ);
+    let (frame, mid, _) = scene_frame(&StereoRig::demo(40, 30), Conventions::default(), FrameDepth::ViewZ);
     let call = || {
         let mut r = SplatRenderer::new(&g, &frame, SplatParams::default(), CyclopeanOutputs::default()).unwrap();
         r.render(&mid).unwrap().0.sources

@@ -10,7 +10,7 @@ use viewsynth::convention::{Conventions, DepthPlanes};
 use viewsynth::cyclopean::forward::ForwardWarp;
 use viewsynth::cyclopean::render::CyclopeanRenderer;
 use viewsynth::cyclopean::scene_frame::{scene_frame, StereoRig};
-use viewsynth::cyclopean::{CyclopeanParams, DepthKind};
+use viewsynth::cyclopean::{CyclopeanParams, FrameDepth};
 use viewsynth::depth::DepthEncoding;
 use viewsynth::io::{DepthMap, RgbImage};
 use viewsynth::refocus::{BreakRule, Method as RefocusMethod, OutputSet, RefocusSource, Refocuser};
@@ -111,7 +111,7 @@ fn cyclopean_middle_view_one_past_the_limit_is_refused_by_both_renderers() {
     let g = gpu();
     let max = g.max_image_side();
     let rig = StereoRig::demo(16, 12);
-    let (frame, mut mid, _) = scene_frame(&rig, Conventions::default(), DepthKind::ViewZ);
+    let (frame, mut mid, _) = scene_frame(&rig, Conventions::default(), FrameDepth::ViewZ);
     (mid.width, mid.height) = (max + 1, 1);
     let mut gather = CyclopeanRenderer::new(&g, &frame, CyclopeanParams::seed(3.0)).unwrap();
     assert_eq!(

@@ -10,7 +10,7 @@ use viewsynth::cyclopean::render::CyclopeanRenderer;
 use viewsynth::cyclopean::scene_frame::{scene_frame, StereoRig};
 use viewsynth::cyclopean::splat::{SplatParams, SplatRenderer};
 use viewsynth::cyclopean::splat_reference::splat_reference;
-use viewsynth::cyclopean::{self, CyclopeanInput, CyclopeanOutputs, CyclopeanParams, CyclopeanPass, DepthKind};
+use viewsynth::cyclopean::{self, CyclopeanInput, CyclopeanOutputs, CyclopeanParams, CyclopeanPass, FrameDepth};
 use viewsynth::eval::reproject::scene_cases;
 use viewsynth::refocus::reference::refocus_reference;
 use viewsynth::refocus::{self, BreakRule, Method, OutputSet, RefocusInput, Refocuser};
@@ -100,7 +100,7 @@ fn refocus_pass_and_twin_are_the_renderer_and_the_twin() {
 fn cyclopean_pass_and_twin_are_the_renderers_and_the_twins() {
     let g = gpu();
     let conv = other_conventions();
-    let (frame, mid, _) = scene_frame(&StereoRig::demo(96, 72), conv, DepthKind::Device);
+    let (frame, mid, _) = scene_frame(&StereoRig::demo(96, 72), conv, FrameDepth::Device);
     let (w, h) = (mid.width, mid.height);
     let outputs = CyclopeanOutputs::default();
     let gather = CyclopeanParams::seed(3.0);
@@ -162,7 +162,7 @@ fn cyclopean_pass_and_twin_are_the_renderers_and_the_twins() {
 #[test]
 fn reproject_pass_and_twin_are_the_renderer_and_the_twin() {
     let g = gpu();
-    let cases = scene_cases(96, 72, 0.2, other_conventions(), DepthKind::ViewZ).unwrap();
+    let cases = scene_cases(96, 72, 0.2, other_conventions(), FrameDepth::ViewZ).unwrap();
     for case in &cases {
         for params in viewsynth::eval::reproject::methods() {
             let input = ReprojectInput {

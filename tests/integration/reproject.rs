@@ -19,7 +19,7 @@ use crate::common::{data_dir, gpu};
 use viewsynth::camera::stereo::{Eye, StereoParams};
 use viewsynth::camera::{Intrinsics, PinholeCamera};
 use viewsynth::convention::Conventions;
-use viewsynth::cyclopean::{DepthKind, MiddleCamera};
+use viewsynth::cyclopean::{FrameDepth, MiddleCamera};
 use viewsynth::depth::DepthEncoding;
 use viewsynth::eval::image_check;
 use viewsynth::eval::reproject::{methods, motorcycle_case, run_timed, scene_cases, score, teddy_case, Case};
@@ -112,7 +112,7 @@ fn gpu_matches_the_f64_reference_under_every_convention_and_depth_kind() {
     let g = gpu();
     let mut base: Vec<Option<ViewOutput>> = vec![None; 3 * 3 * 2];
     for conv in Conventions::all() {
-        for (ki, kind) in [DepthKind::Device, DepthKind::ViewZ].into_iter().enumerate() {
+        for (ki, kind) in [FrameDepth::Device, FrameDepth::ViewZ].into_iter().enumerate() {
             for (ci, case) in scene_cases(160, 120, 0.2, conv, kind).unwrap().into_iter().enumerate() {
                 for (mi, params) in methods().into_iter().enumerate() {
                     let tag = format!("{} {}", conv.label(), case.name);
@@ -155,7 +155,7 @@ fn scene_left_and_centre_to_right_against_the_ray_traced_right_eye() {
     // at the nearest texel and checks to 1 px, so it lands slightly worse.
     let g = gpu();
     for ipd in [0.064, 0.2] {
-        for case in scene_cases(640, 480, ipd, Conventions::default(), DepthKind::Device).unwrap() {
+        for case in scene_cases(640, 480, ipd, Conventions::default(), FrameDepth::Device).unwrap() {
             let (mut scan_psnr, mut walk_psnr) = (None, None);
             for params in methods() {
                 let (out, t) = run_timed(&g, &case, params, 3).unwrap();
@@ -488,8 +488,8 @@ fn full_eye_matrices_drive_the_3d_gather_like_the_rig() {
     let conv = Conventions::default();
     let mut rig = viewsynth::cyclopean::scene_frame::StereoRig::demo(160, 120);
     rig.ipd = 0.2;
-    let (frame, _, _) = viewsynth::cyclopean::scene_frame::scene_frame(&rig, conv, DepthKind::Device);
-    let case = &scene_cases(160, 120, 0.2, conv, DepthKind::Device).unwrap()[0];
+    let (frame, _, _) = viewsynth::cyclopean::scene_frame::scene_frame(&rig, conv, FrameDepth::Device);
+    let case = &scene_cases(160, 120, 0.2, conv, FrameDepth::Device).unwrap()[0];
     let matrices = Geometry::Matrices {
         source_view: frame.left.view,
         source_proj: frame.left.proj,
@@ -532,7 +532,7 @@ fn mesh_warp_comparison_matches_the_ray_traced_right_eye_under_every_convention(
     let g = gpu();
     let mut first: Option<Vec<u8>> = None;
     for conv in Conventions::all() {
-        let case = scene_cases(320, 240, 0.2, conv, DepthKind::Device)
+        let case = scene_cases(320, 240, 0.2, conv, FrameDepth::Device)
             .unwrap()
             .into_iter()
             .next()
@@ -566,7 +566,7 @@ fn unrequested_colour_and_depth_get_no_attachment_and_no_readback() {
     // Pay only for what is asked: no attachment and no readback for colour or depth when not
     // requested; what is produced is identical to the full render.
     let g = gpu();
-    let case = scene_cases(64, 48, 0.064, Conventions::default(), DepthKind::ViewZ)
+    let case = scene_cases(64, 48, 0.064, Conventions::default(), FrameDepth::ViewZ)
         .unwrap()
         .remove(0);
     for full in methods() {

@@ -32,7 +32,7 @@ use crate::vulkan_refocus::vulkan;
 use viewsynth::convention::Conventions;
 use viewsynth::cyclopean::render::CyclopeanRenderer;
 use viewsynth::cyclopean::scene_frame::{scene_frame, StereoRig};
-use viewsynth::cyclopean::{CyclopeanOutput, CyclopeanParams, DepthKind, Method};
+use viewsynth::cyclopean::{CyclopeanOutput, CyclopeanParams, FrameDepth, Method};
 use viewsynth::vulkan::VkCyclopean;
 
 /// Derivation above.
@@ -91,7 +91,7 @@ fn gather_pass_gl_and_vulkan_agree_under_every_convention_depth_kind_and_method(
     for conv in Conventions::all() {
         let mut row = Diff::default();
         let (mut gl_ms, mut vk_ms) = (0.0, 0.0);
-        for kind in [DepthKind::Device, DepthKind::ViewZ] {
+        for kind in [FrameDepth::Device, FrameDepth::ViewZ] {
             let (frame, mid, _) = scene_frame(&rig, conv, kind);
             for (name, params) in methods() {
                 let (gl, tg) = CyclopeanRenderer::new(&g, &frame, params)
@@ -137,7 +137,7 @@ fn gather_pass_gl_and_vulkan_agree_under_every_convention_depth_kind_and_method(
 #[test]
 fn vulkan_reads_back_only_the_requested_outputs() {
     let v = vulkan();
-    let (frame, mid, _) = scene_frame(&StereoRig::demo(64, 48), Conventions::default(), DepthKind::ViewZ);
+    let (frame, mid, _) = scene_frame(&StereoRig::demo(64, 48), Conventions::default(), FrameDepth::ViewZ);
     let params = CyclopeanParams::seed(3.0);
     let (all, _) = VkCyclopean::new(&v, &frame, params).unwrap().render(&mid).unwrap();
     let outputs = viewsynth::cyclopean::CyclopeanOutputs {
@@ -161,7 +161,7 @@ fn cli_backend_vulkan_writes_the_gather_view_and_refuses_other_methods() {
     let v = vulkan();
     let rig = StereoRig::demo(96, 72);
     let conv = Conventions::all()[5];
-    let (frame, mid, _) = scene_frame(&rig, conv, DepthKind::Device);
+    let (frame, mid, _) = scene_frame(&rig, conv, FrameDepth::Device);
     let dir = scratch("vulkan-cyclopean-cli");
     for (name, eye) in [("left", &frame.left), ("right", &frame.right)] {
         viewsynth::io::save_rgb(&dir.join(format!("{name}.png")), &eye.color).unwrap();
