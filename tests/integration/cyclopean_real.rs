@@ -710,6 +710,7 @@ fn edge_pass_mixes_more_edge_pixels_than_the_work_group_limit() {
             DepthMap::new(w, h, disparity.clone()).unwrap(),
         )
     };
-    let (frame, mid) = disparity_frame(eye(), eye(), &DisparityRig::middle(1000.0, 0.1), Conventions::default()).unwrap();
+    let (frame, mid) =
+        disparity_frame(eye(), eye(), &DisparityRig::middle(1000.0, 0.1), Conventions::default()).unwrap();
     check_twin("edge-list-beyond-the-group-limit", &frame, &mid, 0.001);
 }
