@@ -109,16 +109,18 @@ fn dist3(a: [f64; 3], b: [f64; 3]) -> f64 {
     ((a[0] - b[0]).powi(2) + (a[1] - b[1]).powi(2) + (a[2] - b[2]).powi(2)).sqrt()
 }
 
+/// [`SplatGeometry::w_left`] of eyes and a middle camera given by their view matrices.
+fn left_weight(left_view: &Mat4, right_view: &Mat4, mid_view: &Mat4) -> Result<f64> {
+    let (cl, cr, cm) = (centre(left_view)?, centre(right_view)?, centre(mid_view)?);
+    let (dl, dr) = (dist3(cm, cl), dist3(cm, cr));
+    Ok(if dl + dr > 0.0 { dr / (dl + dr) } else { 0.5 })
+}
+
 impl SplatGeometry {
     /// Eye distances and rig weights of `frame` seen from `mid` (the frame is validated first).
     pub fn new(frame: &StereoFrame, mid: &MiddleCamera) -> Result<Self> {
         frame.validate()?;
-        let (cl, cr, cm) = (
-            centre(&frame.left.view)?,
-            centre(&frame.right.view)?,
-            centre(&mid.view)?,
-        );
-        let baseline = dist3(cl, cr);
+        let baseline = dist3(centre(&frame.left.view)?, centre(&frame.right.view)?);
         // GL projection: x_ndc = P00 x / -z, so the focal length in pixels is P00 w / 2.
         let focal = frame.left.proj[0][0].abs() * frame.left.color.width as f64 / 2.0;
         let parallax_px = focal * baseline;
@@ -128,7 +130,6 @@ impl SplatGeometry {
                 "the splat method needs two distinct eye positions (baseline > 0)",
             ));
         }
-        let (dl, dr) = (dist3(cm, cl), dist3(cm, cr));
         let mem = |eye: &super::EyeInput| -> Result<Vec<f32>> {
             let d = super::forward::eye_distances(eye, frame.depth_kind, &frame.conv)?;
             let w = eye.depth.width as usize;
@@ -141,7 +142,7 @@ impl SplatGeometry {
         Ok(SplatGeometry {
             dist_mem: [mem(&frame.left)?, mem(&frame.right)?],
             parallax_px,
-            w_left: if dl + dr > 0.0 { dr / (dl + dr) } else { 0.5 },
+            w_left: left_weight(&frame.left.view, &frame.right.view, &mid.view)?,
             view_m: mid.view,
         })
     }
@@ -275,13 +276,7 @@ impl SplatRenderer {
         let (w, h) = (mid.width, mid.height);
         self.gpu.check_image_size("middle size", w, h)?;
         let inv = |m: &Mat4, what: &str| mat4::inverse(m).ok_or_else(|| Error::param(what.to_string(), "singular"));
-        let (cl, cr, cm) = (
-            centre(&self.frame_views[0])?,
-            centre(&self.frame_views[1])?,
-            centre(&mid.view)?,
-        );
-        let (dl, dr) = (dist3(cm, cl), dist3(cm, cr));
-        let w_left = if dl + dr > 0.0 { dr / (dl + dr) } else { 0.5 };
+        let w_left = left_weight(&self.frame_views[0], &self.frame_views[1], &mid.view)?;
         if !matches!(&self.targets, Some((f, ..)) if f.width() == w && f.height() == h) {
             self.targets = None;
             let slot = |wanted: bool, format| {
@@ -339,7 +334,6 @@ impl SplatRenderer {
         gpu.check("cyclopean splat")?;
         // Pass 2: gather and merge.
         let pass = fb.begin_pass(DrawState::default(), 1.0);
-        let names = ["l", "r"];
         for (k, eye) in self.eyes.iter().enumerate() {
             eye.color.bind(3 * k as u32);
             eye.dist.bind(3 * k as u32 + 1);
@@ -349,48 +343,48 @@ impl SplatRenderer {
         edges.write_head(&[0, 0, 1, 1]);
         edges.bind_storage(0);
         // The centre samples, then the listed edge pixels over them (same inputs, uniforms).
-        let programs = if self.outputs.color {
-            [Some(&self.gather), Some(&self.edges)]
-        } else {
-            // Edge mixing changes colour only.
-            [Some(&self.gather), None]
-        };
-        for (k, p) in programs.into_iter().flatten().enumerate() {
-            p.bind();
-            for (k, eye) in self.eyes.iter().enumerate() {
-                let sfx = names[k];
-                p.set_i32(&format!("u_color_{sfx}"), 3 * k as i32);
-                p.set_i32(&format!("u_dist_{sfx}"), 3 * k as i32 + 1);
-                p.set_i32(&format!("u_splat_{sfx}"), 3 * k as i32 + 2);
-                p.set_mat4_rows(&format!("u_view_proj_{sfx}"), &mat4::mul(&eye.proj, &eye.view));
-                p.set_mat4_rows(&format!("u_view_{sfx}"), &eye.view);
-                p.set_mat4_rows(&format!("u_inv_view_{sfx}"), &inv(&eye.view, "eye view")?);
-                p.set_mat4_rows(&format!("u_inv_proj_{sfx}"), &inv(&eye.proj, "eye projection")?);
-            }
-            p.set_mat4_rows("u_view_m", &mid.view);
-            p.set_mat4_rows("u_inv_view_m", &inv(&mid.view, "middle view")?);
-            p.set_mat4_rows("u_inv_proj_m", &inv(&mid.proj, "middle projection")?);
-            p.set_vec2("u_size_m", [w as f32, h as f32]);
-            p.set_f32("u_parallax_px", self.parallax_px as f32);
-            p.set_f32("u_tolerance_px", self.params.surface_tolerance_px as f32);
-            p.set_f32("u_w_left", w_left as f32);
-            if k == 0 {
-                pass.draw_fullscreen(&self.vao);
-                // The list and its counts before the edge pass reads them.
-                gpu.memory_barrier(Barrier::StorageAndCommand);
-            } else {
-                let color = fb.color(0).expect("colour requested");
-                let _image = color.bind_image(0)?;
-                p.set_i32("u_color_out", 0);
-                p.dispatch_indirect(edges, 1);
-                // The rewritten texels before the readback.
-                gpu.memory_barrier(Barrier::Framebuffer);
-            }
+        self.bind_gather_inputs(&self.gather, mid, w_left)?;
+        pass.draw_fullscreen(&self.vao);
+        // Edge mixing changes colour only: without a colour attachment there is nothing to mix.
+        if let Some(color) = fb.color(0) {
+            // The list and its counts before the edge pass reads them.
+            gpu.memory_barrier(Barrier::StorageAndCommand);
+            self.bind_gather_inputs(&self.edges, mid, w_left)?;
+            let _image = color.bind_image(0)?;
+            self.edges.set_i32("u_color_out", 0);
+            self.edges.dispatch_indirect(edges, 1);
+            // The rewritten texels before the readback.
+            gpu.memory_barrier(Barrier::Framebuffer);
         }
         drop(pass);
         gpu.check("cyclopean splat gather")?;
         let out = super::render::read_output(fb, self.rows)?;
         let timing = timer.stop();
         Ok((out, timing))
+    }
+
+    /// Binds `p` (the gather draw or the edge pass: one set of inputs, splat_gather.glsl) and
+    /// sets its uniforms for view `mid`: each eye's texture units (colour 3k, distance 3k + 1,
+    /// splat 3k + 2, bound by the caller) and cameras, the middle camera, the rig's constants.
+    fn bind_gather_inputs(&self, p: &Program, mid: &MiddleCamera, w_left: f64) -> Result<()> {
+        let inv = |m: &Mat4, what: &str| mat4::inverse(m).ok_or_else(|| Error::param(what.to_string(), "singular"));
+        p.bind();
+        for (k, (eye, sfx)) in self.eyes.iter().zip(["l", "r"]).enumerate() {
+            p.set_i32(&format!("u_color_{sfx}"), 3 * k as i32);
+            p.set_i32(&format!("u_dist_{sfx}"), 3 * k as i32 + 1);
+            p.set_i32(&format!("u_splat_{sfx}"), 3 * k as i32 + 2);
+            p.set_mat4_rows(&format!("u_view_proj_{sfx}"), &mat4::mul(&eye.proj, &eye.view));
+            p.set_mat4_rows(&format!("u_view_{sfx}"), &eye.view);
+            p.set_mat4_rows(&format!("u_inv_view_{sfx}"), &inv(&eye.view, "eye view")?);
+            p.set_mat4_rows(&format!("u_inv_proj_{sfx}"), &inv(&eye.proj, "eye projection")?);
+        }
+        p.set_mat4_rows("u_view_m", &mid.view);
+        p.set_mat4_rows("u_inv_view_m", &inv(&mid.view, "middle view")?);
+        p.set_mat4_rows("u_inv_proj_m", &inv(&mid.proj, "middle projection")?);
+        p.set_vec2("u_size_m", [mid.width as f32, mid.height as f32]);
+        p.set_f32("u_parallax_px", self.parallax_px as f32);
+        p.set_f32("u_tolerance_px", self.params.surface_tolerance_px as f32);
+        p.set_f32("u_w_left", w_left as f32);
+        Ok(())
     }
 }

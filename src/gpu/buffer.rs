@@ -103,11 +103,6 @@ impl StorageBuffer {
         self
     }
 
-    /// Size in u32 words.
-    pub fn words(&self) -> usize {
-        self.words
-    }
-
     /// Overwrite the first `head.len()` words (a counter and indirect arguments), in order
     /// with the GL commands before and after.
     pub fn write_head(&self, head: &[u32]) {
