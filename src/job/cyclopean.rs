@@ -99,22 +99,30 @@ pub struct CyclopeanOptions {
 #[derive(Debug, Clone)]
 enum Input {
     /// A rectified pair with disparities; without a calibration only f B matters.
-    Disparity {
-        left: PathBuf,
-        right: PathBuf,
-        scale: f64,
-        focal: Option<f64>,
-        baseline: Option<f64>,
-        doffs: f64,
-        position: f64,
-    },
+    Disparity(DisparityInput),
     /// Depth per eye and the camera file with their matrices.
-    CameraFile {
-        cameras: PathBuf,
-        left: PathBuf,
-        right: PathBuf,
-        depth_scale: Option<f64>,
-    },
+    CameraFile(CameraFileInput),
+}
+
+/// [`Input::Disparity`]: the disparity files and the rig.
+#[derive(Debug, Clone)]
+struct DisparityInput {
+    left: PathBuf,
+    right: PathBuf,
+    scale: f64,
+    focal: Option<f64>,
+    baseline: Option<f64>,
+    doffs: f64,
+    position: f64,
+}
+
+/// [`Input::CameraFile`]: the camera file and each eye's depth file.
+#[derive(Debug, Clone)]
+struct CameraFileInput {
+    cameras: PathBuf,
+    left: PathBuf,
+    right: PathBuf,
+    depth_scale: Option<f64>,
 }
 
 /// The seed/refine settings, all but the fixation (known once the inputs are read).
@@ -222,7 +230,7 @@ impl CyclopeanJob {
                 if o.depth_scale.is_some() {
                     return Err(ArgError::DepthScaleWithDisparity);
                 }
-                let input = Input::Disparity {
+                let input = Input::Disparity(DisparityInput {
                     left: left.clone(),
                     right,
                     scale: o.disparity_scale.unwrap_or(1.0),
@@ -230,7 +238,7 @@ impl CyclopeanJob {
                     baseline: o.baseline,
                     doffs: o.doffs,
                     position: o.position.unwrap_or(0.5),
-                };
+                });
                 (input, o.focal.is_some())
             }
             (None, Some(cameras)) => {
@@ -247,12 +255,12 @@ impl CyclopeanJob {
                 let (Some(left), Some(right)) = (o.left_depth.clone(), o.right_depth.clone()) else {
                     return Err(ArgError::CameraFileWithoutDepth);
                 };
-                let input = Input::CameraFile {
+                let input = Input::CameraFile(CameraFileInput {
                     cameras: cameras.clone(),
                     left,
                     right,
                     depth_scale: o.depth_scale,
-                };
+                });
                 (input, true)
             }
             (None, None) => return Err(ArgError::NoStereoInput),
@@ -300,8 +308,8 @@ impl CyclopeanJob {
     /// Reads the pair, renders the view and writes the requested files all-or-none.
     pub fn run(&self, host: &dyn Host) -> Result<CyclopeanReport, JobError> {
         let (frame, mid, fixation) = match &self.input {
-            Input::Disparity { .. } => self.disparity_setup()?,
-            Input::CameraFile { .. } => self.camera_file_setup(host)?,
+            Input::Disparity(input) => self.disparity_setup(input)?,
+            Input::CameraFile(input) => self.camera_file_setup(input, host)?,
         };
         frame.validate()?;
         let params = self.gather.map(|g| g.params(fixation)).transpose()?;
@@ -366,8 +374,8 @@ impl CyclopeanJob {
 
     /// A rectified pair: the frame, the view, and the fixation the seed/refine methods start
     /// from (the median depth the left eye saw).
-    fn disparity_setup(&self) -> Result<(StereoFrame, MiddleCamera, f64), JobError> {
-        let Input::Disparity {
+    fn disparity_setup(&self, input: &DisparityInput) -> Result<(StereoFrame, MiddleCamera, f64), JobError> {
+        let DisparityInput {
             left,
             right,
             scale,
@@ -375,10 +383,7 @@ impl CyclopeanJob {
             baseline,
             doffs,
             position,
-        } = &self.input
-        else {
-            unreachable!("called for disparity input")
-        };
+        } = input;
         let decode = DepthDecode {
             scale: Some(*scale),
             ..Default::default()
@@ -406,16 +411,17 @@ impl CyclopeanJob {
     }
 
     /// Depth per eye placed by the camera file.
-    fn camera_file_setup(&self, host: &dyn Host) -> Result<(StereoFrame, MiddleCamera, f64), JobError> {
-        let Input::CameraFile {
+    fn camera_file_setup(
+        &self,
+        input: &CameraFileInput,
+        host: &dyn Host,
+    ) -> Result<(StereoFrame, MiddleCamera, f64), JobError> {
+        let CameraFileInput {
             cameras,
             left,
             right,
             depth_scale,
-        } = &self.input
-        else {
-            unreachable!("called for camera-file input")
-        };
+        } = input;
         let cams = CameraFile::load(cameras)?;
         let (mid, fixation) = cams.middle_and_fixation()?;
         let decode = DepthDecode {

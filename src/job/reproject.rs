@@ -127,19 +127,23 @@ pub struct ReprojectOptions {
 #[derive(Debug, Clone)]
 enum Views {
     /// A parallel rig from intrinsics.
-    Rig {
-        from: Option<Eye>,
-        intrinsics: SourceIntrinsics,
-        targets: Vec<Eye>,
-        depth_kind: DepthEncoding,
-        /// Game-engine stereo, or None for the rectified rig below.
-        seed: Option<StereoParams>,
-        /// The rectified rig's shift per target (when no `seed`).
-        rectified: Vec<ShiftModel>,
-        conventions: Conventions,
-    },
+    Rig(RigViews),
     /// Full eye matrices from a camera file: the source eye to the other.
     Cameras { path: PathBuf, from: Eye, to: Eye },
+}
+
+/// [`Views::Rig`]: the source eye, its intrinsics and depth, the target eyes and their shifts.
+#[derive(Debug, Clone)]
+struct RigViews {
+    from: Option<Eye>,
+    intrinsics: SourceIntrinsics,
+    targets: Vec<Eye>,
+    depth_kind: DepthEncoding,
+    /// Game-engine stereo, or None for the rectified rig below.
+    seed: Option<StereoParams>,
+    /// The rectified rig's shift per target (when no `seed`).
+    rectified: Vec<ShiftModel>,
+    conventions: Conventions,
 }
 
 /// A checked reprojection.
@@ -255,7 +259,7 @@ impl ReprojectJob {
     /// Reads the source, renders every target and writes the files all-or-none.
     pub fn run(&self, host: &dyn Host) -> Result<ReprojectReport, JobError> {
         let (src, from, targets) = match &self.views {
-            Views::Rig { .. } => self.rig_setup(host)?,
+            Views::Rig(rig) => self.rig_setup(host, rig)?,
             Views::Cameras { path, from, to } => self.camera_file_setup(host, path, *from, *to)?,
         };
         let (width, height) = (src.color.width, src.color.height);
@@ -353,8 +357,12 @@ impl ReprojectJob {
 
     /// The source and its targets on the parallel rig.
     #[allow(clippy::type_complexity)]
-    fn rig_setup(&self, host: &dyn Host) -> Result<(ReprojectSource, Option<Eye>, Vec<(Eye, Geometry)>), JobError> {
-        let Views::Rig {
+    fn rig_setup(
+        &self,
+        host: &dyn Host,
+        rig: &RigViews,
+    ) -> Result<(ReprojectSource, Option<Eye>, Vec<(Eye, Geometry)>), JobError> {
+        let RigViews {
             from,
             intrinsics,
             targets,
@@ -362,10 +370,7 @@ impl ReprojectJob {
             seed,
             rectified,
             conventions,
-        } = &self.views
-        else {
-            unreachable!("called for a rig")
-        };
+        } = rig;
         let what = format!(
             "--depth-kind {} (check --depth-kind, --depth-scale, --near/--far, conventions)",
             self.depth_option.option_value()
@@ -486,7 +491,7 @@ fn rig_views(o: &ReprojectOptions) -> Result<Views, ArgError> {
             .collect::<Result<_, _>>()?,
         (None, None) => return Err(ArgError::NoRig),
     };
-    Ok(Views::Rig {
+    Ok(Views::Rig(RigViews {
         from: o.from,
         intrinsics,
         targets,
@@ -494,7 +499,7 @@ fn rig_views(o: &ReprojectOptions) -> Result<Views, ArgError> {
         seed,
         rectified,
         conventions: o.conventions,
-    })
+    }))
 }
 
 /// The camera file's checks: an eye to the other, 3-D gather, the file's own conventions.
