@@ -95,22 +95,29 @@ pub fn float_map(obj: &Bound<'_, PyAny>, name: &str) -> PyResult<DepthMap> {
     DepthMap::new(w, h, data).map_err(errors::from_library)
 }
 
-/// The six cube faces of one eye, uint8[6, N, N, 3] (order pz, nz, up, down, px, nx) ->
-/// six RgbImages (one copy).
-pub fn rgb_faces(obj: &Bound<'_, PyAny>, name: &str) -> PyResult<Vec<RgbImage>> {
-    let expected = "uint8[6, N, N, 3] (faces pz, nz, up, down, px, nx)";
-    let array = checked::<u8>(obj, name, 4, expected)?;
-    let shape = array.shape().to_vec();
-    if shape[0] != 6 || shape[1] != shape[2] || shape[3] != 3 {
+/// The side N of six square cube faces of `shape` ([6, N, N, ...], at least 2x2); `rest_ok`
+/// says whether the dimensions after the faces' are the ones `expected` names.
+fn face_side(shape: &[usize], rest_ok: bool, name: &str, expected: &str) -> PyResult<u32> {
+    if shape[0] != 6 || shape[1] != shape[2] || !rest_ok {
         return Err(errors::invalid(
             name,
-            format!("shape {} but expected {expected}", shape_text(&shape)),
+            format!("shape {} but expected {expected}", shape_text(shape)),
         ));
     }
     let (n, _) = size(&shape[1..], name)?;
     if n < 2 {
         return Err(errors::invalid(name, format!("faces of {n}x{n}: at least 2x2 needed")));
     }
+    Ok(n)
+}
+
+/// The six cube faces of one eye, uint8[6, N, N, 3] (order pz, nz, up, down, px, nx) ->
+/// six RgbImages (one copy).
+pub fn rgb_faces(obj: &Bound<'_, PyAny>, name: &str) -> PyResult<Vec<RgbImage>> {
+    let expected = "uint8[6, N, N, 3] (faces pz, nz, up, down, px, nx)";
+    let array = checked::<u8>(obj, name, 4, expected)?;
+    let shape = array.shape().to_vec();
+    let n = face_side(&shape, shape[3] == 3, name, expected)?;
     let data = array.readonly();
     let data = data.as_slice()?;
     data.chunks_exact(data.len() / 6)
@@ -123,16 +130,7 @@ pub fn depth_faces(obj: &Bound<'_, PyAny>, name: &str) -> PyResult<Vec<DepthMap>
     let expected = "float32[6, N, N] (faces pz, nz, up, down, px, nx)";
     let array = checked::<f32>(obj, name, 3, expected)?;
     let shape = array.shape().to_vec();
-    if shape[0] != 6 || shape[1] != shape[2] {
-        return Err(errors::invalid(
-            name,
-            format!("shape {} but expected {expected}", shape_text(&shape)),
-        ));
-    }
-    let (n, _) = size(&shape[1..], name)?;
-    if n < 2 {
-        return Err(errors::invalid(name, format!("faces of {n}x{n}: at least 2x2 needed")));
-    }
+    let n = face_side(&shape, true, name, expected)?;
     let data = array.readonly();
     let data = data.as_slice()?;
     data.chunks_exact(data.len() / 6)
