@@ -138,3 +138,55 @@ pub fn compare_views(out: &ViewOutput, reference: &ViewOutput) -> Agreement {
 pub fn reference(src: &RefocusSource, target: &PinholeCamera) -> ReferenceImage {
     refocus_reference(src, &BreakRule::default(), target)
 }
+
+/// Writes `frame` for `viewsynth cyclopean` into `dir`: each eye's colour (`left.png`,
+/// `right.png`) and depth (`left.exr`, `right.exr`), and `cams.json` with the eyes' matrices,
+/// conventions and depth kind, the middle camera `mid` and a 3 m fixation. Returns that JSON
+/// (tests write variants of it).
+pub fn write_cyclopean_files(
+    dir: &std::path::Path,
+    frame: &viewsynth::cyclopean::StereoFrame,
+    mid: &viewsynth::cyclopean::MiddleCamera,
+) -> serde_json::Value {
+    for (name, eye) in [("left", &frame.left), ("right", &frame.right)] {
+        io::save_rgb(&dir.join(format!("{name}.png")), &eye.color).unwrap();
+        io::save_depth_exr(&dir.join(format!("{name}.exr")), &eye.depth).unwrap();
+    }
+    let cams = serde_json::json!({
+        "conventions": frame.conv,
+        "depth_kind": frame.depth_kind,
+        "left": { "view": frame.left.view, "proj": frame.left.proj },
+        "right": { "view": frame.right.view, "proj": frame.right.proj },
+        "middle": { "proj": mid.proj, "width": mid.width, "height": mid.height, "view": mid.view },
+        "fixation_distance": 3.0
+    });
+    std::fs::write(dir.join("cams.json"), serde_json::to_string(&cams).unwrap()).unwrap();
+    cams
+}
+
+/// `viewsynth cyclopean` on the files [`write_cyclopean_files`] wrote in `dir`, with the camera
+/// file `cameras` (in `dir`), the options `extra`, into `out`.
+pub fn cyclopean_cli(
+    dir: &std::path::Path,
+    cameras: &str,
+    extra: &[&str],
+    out: &std::path::Path,
+) -> std::process::Output {
+    std::process::Command::new(env!("CARGO_BIN_EXE_viewsynth"))
+        .arg("cyclopean")
+        .args(extra)
+        .arg("--left-rgb")
+        .arg(dir.join("left.png"))
+        .arg("--left-depth")
+        .arg(dir.join("left.exr"))
+        .arg("--right-rgb")
+        .arg(dir.join("right.png"))
+        .arg("--right-depth")
+        .arg(dir.join("right.exr"))
+        .arg("--cameras")
+        .arg(dir.join(cameras))
+        .arg("--out-dir")
+        .arg(out)
+        .output()
+        .unwrap()
+}

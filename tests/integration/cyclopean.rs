@@ -7,7 +7,7 @@
 //! Middle depth then agrees to the f32 error of reconstructing from device depth: with
 //! standard Z at 6 m and near 0.05 m that is ~5e-6 relative, so 2e-5 is the bound.
 
-use crate::common::gpu;
+use crate::common::{cyclopean_cli, gpu, write_cyclopean_files};
 use viewsynth::convention::Conventions;
 use viewsynth::cyclopean::reference::cyclopean_reference;
 use viewsynth::cyclopean::render::CyclopeanRenderer;
@@ -286,37 +286,9 @@ fn cli_renders_the_same_middle_view_as_the_library_from_files() {
     let dir = std::env::temp_dir().join(format!("viewsynth-cyclopean-cli-{}", std::process::id()));
     let _ = std::fs::remove_dir_all(&dir);
     std::fs::create_dir_all(&dir).unwrap();
-    for (name, eye) in [("left", &frame.left), ("right", &frame.right)] {
-        viewsynth::io::save_rgb(&dir.join(format!("{name}.png")), &eye.color).unwrap();
-        viewsynth::io::save_depth_exr(&dir.join(format!("{name}.exr")), &eye.depth).unwrap();
-    }
-    let cams = serde_json::json!({
-        "conventions": conv,
-        "depth_kind": "device",
-        "left": { "view": frame.left.view, "proj": frame.left.proj },
-        "right": { "view": frame.right.view, "proj": frame.right.proj },
-        "middle": { "proj": mid.proj, "width": mid.width, "height": mid.height, "view": mid.view },
-        "fixation_distance": 3.0
-    });
-    std::fs::write(dir.join("cams.json"), serde_json::to_string(&cams).unwrap()).unwrap();
+    let cams = write_cyclopean_files(&dir, &frame, &mid);
     // The binary on the files written above, with `cameras` and `--refine-steps 3`.
-    let run = |cameras: &str, out: &std::path::Path| {
-        std::process::Command::new(env!("CARGO_BIN_EXE_viewsynth"))
-            .args(["cyclopean", "--refine-steps", "3", "--left-rgb"])
-            .arg(dir.join("left.png"))
-            .arg("--left-depth")
-            .arg(dir.join("left.exr"))
-            .arg("--right-rgb")
-            .arg(dir.join("right.png"))
-            .arg("--right-depth")
-            .arg(dir.join("right.exr"))
-            .arg("--cameras")
-            .arg(dir.join(cameras))
-            .arg("--out-dir")
-            .arg(out)
-            .output()
-            .unwrap()
-    };
+    let run = |cameras: &str, out: &std::path::Path| cyclopean_cli(&dir, cameras, &["--refine-steps", "3"], out);
     let out = dir.join("out");
     let o = run("cams.json", &out);
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
@@ -337,21 +309,12 @@ fn cli_renders_the_same_middle_view_as_the_library_from_files() {
 
     // Only the mask asked for: only the mask written, the same as the full run's.
     let only_mask = dir.join("only-mask");
-    let o = std::process::Command::new(env!("CARGO_BIN_EXE_viewsynth"))
-        .args(["cyclopean", "--refine-steps", "3", "--outputs", "mask", "--left-rgb"])
-        .arg(dir.join("left.png"))
-        .arg("--left-depth")
-        .arg(dir.join("left.exr"))
-        .arg("--right-rgb")
-        .arg(dir.join("right.png"))
-        .arg("--right-depth")
-        .arg(dir.join("right.exr"))
-        .arg("--cameras")
-        .arg(dir.join("cams.json"))
-        .arg("--out-dir")
-        .arg(&only_mask)
-        .output()
-        .unwrap();
+    let o = cyclopean_cli(
+        &dir,
+        "cams.json",
+        &["--refine-steps", "3", "--outputs", "mask"],
+        &only_mask,
+    );
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
     let names: Vec<_> = std::fs::read_dir(&only_mask)
         .unwrap()

@@ -26,7 +26,7 @@
 //!   the GL-vs-Vulkan comparison asks.
 
 use crate::cli::scratch;
-use crate::common::gpu;
+use crate::common::{cyclopean_cli, gpu, write_cyclopean_files};
 use crate::cyclopean::methods;
 use crate::vulkan_refocus::vulkan;
 use viewsynth::convention::Conventions;
@@ -163,38 +163,8 @@ fn cli_backend_vulkan_writes_the_gather_view_and_refuses_other_methods() {
     let conv = Conventions::all()[5];
     let (frame, mid, _) = scene_frame(&rig, conv, FrameDepth::Device);
     let dir = scratch("vulkan-cyclopean-cli");
-    for (name, eye) in [("left", &frame.left), ("right", &frame.right)] {
-        viewsynth::io::save_rgb(&dir.join(format!("{name}.png")), &eye.color).unwrap();
-        viewsynth::io::save_depth_exr(&dir.join(format!("{name}.exr")), &eye.depth).unwrap();
-    }
-    let cams = serde_json::json!({
-        "conventions": conv,
-        "depth_kind": "device",
-        "left": { "view": frame.left.view, "proj": frame.left.proj },
-        "right": { "view": frame.right.view, "proj": frame.right.proj },
-        "middle": { "proj": mid.proj, "width": mid.width, "height": mid.height, "view": mid.view },
-        "fixation_distance": 3.0
-    });
-    std::fs::write(dir.join("cams.json"), serde_json::to_string(&cams).unwrap()).unwrap();
-    let run = |extra: &[&str], out: &std::path::Path| {
-        std::process::Command::new(env!("CARGO_BIN_EXE_viewsynth"))
-            .arg("cyclopean")
-            .args(extra)
-            .arg("--left-rgb")
-            .arg(dir.join("left.png"))
-            .arg("--left-depth")
-            .arg(dir.join("left.exr"))
-            .arg("--right-rgb")
-            .arg(dir.join("right.png"))
-            .arg("--right-depth")
-            .arg(dir.join("right.exr"))
-            .arg("--cameras")
-            .arg(dir.join("cams.json"))
-            .arg("--out-dir")
-            .arg(out)
-            .output()
-            .unwrap()
-    };
+    write_cyclopean_files(&dir, &frame, &mid);
+    let run = |extra: &[&str], out: &std::path::Path| cyclopean_cli(&dir, "cams.json", extra, out);
     let vk_out = dir.join("vulkan");
     let o = run(
         &["--backend", "vulkan", "--method", "refine", "--refine-steps", "3"],
