@@ -67,27 +67,8 @@ fn require_gpu_refuses_a_cpu_vulkan_device() {
     );
     // The same rule on a rendering command, before any output is written.
     let d = scratch("vk-require");
-    let frame = data_dir().join("rgbd_open3d_testdata");
-    let o = bin()
-        .args(["refocus", "--backend", "vulkan", "--device", &index, "--require-gpu"])
-        .args([
-            "--rgb",
-            s(&frame.join("TUM_color.png")),
-            "--depth",
-            s(&frame.join("TUM_depth.png")),
-        ])
-        .args([
-            "--depth-scale",
-            "5000",
-            "--fx",
-            "525",
-            "--fy",
-            "525",
-            "--cx",
-            "319.5",
-            "--cy",
-            "239.5",
-        ])
+    let o = tum_refocus()
+        .args(["--backend", "vulkan", "--device", &index, "--require-gpu"])
         .args(["--zoom-range", "1", "--out-dir", s(&d.join("out"))])
         .output()
         .unwrap();
@@ -95,11 +76,11 @@ fn require_gpu_refuses_a_cpu_vulkan_device() {
     assert!(!d.join("out").join("manifest.json").exists());
 }
 
-/// Refocus TUM at scale 1.5 under `backend` and the Vulkan conventions into `out`.
-fn refocus(backend: &str, method: &str, out: &Path) {
+/// `viewsynth refocus` on the TUM frame with its calibration; options and outputs to add.
+fn tum_refocus() -> std::process::Command {
     let frame = data_dir().join("rgbd_open3d_testdata");
-    let o = bin()
-        .args(["refocus", "--backend", backend, "--method", method])
+    let mut c = bin();
+    c.arg("refocus")
         .args([
             "--rgb",
             s(&frame.join("TUM_color.png")),
@@ -117,7 +98,14 @@ fn refocus(backend: &str, method: &str, out: &Path) {
             "319.5",
             "--cy",
             "239.5",
-        ])
+        ]);
+    c
+}
+
+/// Refocus TUM at scale 1.5 under `backend` and the Vulkan conventions into `out`.
+fn refocus(backend: &str, method: &str, out: &Path) {
+    let o = tum_refocus()
+        .args(["--backend", backend, "--method", method])
         .args([
             "--zoom-range",
             "1.5",
