@@ -13,7 +13,7 @@
 
 use super::context::{vk_err, Vk};
 use super::pipeline::{Pipeline, PipelineDesc};
-use super::resources::{sampled_image, sampler_and_set_layout, Buffer, Image};
+use super::resources::{pool_with_one_set, sampled_image, sampler_and_set_layout, Buffer, Image};
 use super::targets::ColorTargets;
 use crate::camera::mat4::{self, Mat4};
 use crate::convention::RowOrder;
@@ -173,19 +173,7 @@ impl VkCyclopean {
                     .ty(vk::DescriptorType::UNIFORM_BUFFER)
                     .descriptor_count(1),
             ];
-            me.descriptor_pool = d
-                .create_descriptor_pool(
-                    &vk::DescriptorPoolCreateInfo::default().max_sets(1).pool_sizes(&sizes),
-                    None,
-                )
-                .map_err(vk_err("vkCreateDescriptorPool"))?;
-            me.set = d
-                .allocate_descriptor_sets(
-                    &vk::DescriptorSetAllocateInfo::default()
-                        .descriptor_pool(me.descriptor_pool)
-                        .set_layouts(&layouts),
-                )
-                .map_err(vk_err("vkAllocateDescriptorSets"))?[0];
+            (me.descriptor_pool, me.set) = pool_with_one_set(vk, &sizes, set_layout)?;
             // The eyes and the uniform buffer never change: the set is written once.
             let images = [&me.left.color, &me.right.color, &me.left.depth, &me.right.depth];
             let infos: Vec<[vk::DescriptorImageInfo; 1]> = images

@@ -12,7 +12,7 @@
 
 use super::context::{vk_err, Vk};
 use super::pipeline::{Pipeline, PipelineDesc, DEPTH_FORMAT};
-use super::resources::{sampled_image, sampler_and_set_layout, Buffer, Image};
+use super::resources::{pool_with_one_set, sampled_image, sampler_and_set_layout, Buffer, Image};
 use super::targets::ColorTargets;
 use crate::camera::{clip_from_view_opencv, PinholeCamera};
 use crate::convention::{Conventions, DepthPlanes, NdcDepthRange};
@@ -185,19 +185,7 @@ impl VkRefocuser {
             let sizes = [vk::DescriptorPoolSize::default()
                 .ty(vk::DescriptorType::COMBINED_IMAGE_SAMPLER)
                 .descriptor_count(BINDINGS)];
-            me.descriptor_pool = d
-                .create_descriptor_pool(
-                    &vk::DescriptorPoolCreateInfo::default().max_sets(1).pool_sizes(&sizes),
-                    None,
-                )
-                .map_err(vk_err("vkCreateDescriptorPool"))?;
-            me.set = d
-                .allocate_descriptor_sets(
-                    &vk::DescriptorSetAllocateInfo::default()
-                        .descriptor_pool(me.descriptor_pool)
-                        .set_layouts(&layouts),
-                )
-                .map_err(vk_err("vkAllocateDescriptorSets"))?[0];
+            (me.descriptor_pool, me.set) = pool_with_one_set(vk, &sizes, set_layout)?;
         }
         let preamble = preamble(&conv, outputs.rgb);
         let depth_op = if conv.reversed_z {
