@@ -1,16 +1,18 @@
-//! Compiles the refocus and cyclopean gather GLSL passes to SPIR-V for the Vulkan backend (src/vulkan/), from the same
-//! files the OpenGL backend compiles at run time, with glslangValidator (Debian/Ubuntu package
-//! `glslang-tools`, installed by ci/install-deps.sh).
+//! Compiles every program the shader table (shaders/programs.rs) marks for Vulkan to SPIR-V
+//! for the Vulkan backend (src/vulkan/), from the same files the OpenGL backend compiles at run
+//! time, with glslangValidator (Debian/Ubuntu package `glslang-tools`, installed by
+//! ci/install-deps.sh).
 //!
 //! Each stage is assembled as src/gpu/shaders.rs + program.rs do it for GL: `#version`, the `#define`
-//! preamble, `#line 1`, the body; the Vulkan layer (shaders/common/vulkan.glsl and the pass's
-//! vulkan_interface.glsl: descriptor bindings and push constants instead of loose uniforms) sits
-//! between the preamble and `#line 1`, so compile errors keep the body's line numbers. The
-//! preamble is compiled for every convention combination and every value of the program's own
-//! switches (refocus: the colour output; cyclopean gather: depth kind, refine, soft blend);
-//! the Vulkan backend looks a variant up by the exact preamble text the GL backend would use, so
-//! a drift between this file and `ShaderProgram::preamble` fails loudly there (and in its
-//! unit test), never silently.
+//! preamble, `#line 1`, the body; the Vulkan layer (shaders/common/vulkan.glsl and any layer
+//! files the table names, e.g. refocus's push constants) sits between the preamble and
+//! `#line 1`, so compile errors keep the body's line numbers. Passes whose parameters are one
+//! std140 block (`*_params.glsl`) need no layer of their own: the same text binds under both
+//! APIs. The preamble is compiled for every convention combination and every combination of the
+//! program's switch values in the table; the Vulkan backend looks a variant up by the exact
+//! preamble text the GL backend would use, so a drift between the table and
+//! `ShaderProgram::preamble` fails loudly there (and in its unit test), never silently. Also
+//! writes OUT_DIR/shader_files.rs, every GLSL file embedded, for the GL loader.
 //!
 //! It also generates, with gl_generator from the Khronos XML registries, the few EGL extension
 //! and GL entry points that khronos-egl and glow do not carry (see [`write_khronos_bindings`]).
@@ -19,163 +21,20 @@ use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 use std::process::{Command, Stdio};
 
-/// Keep in step with src/refocus/mesh.rs TRI_TEX_WIDTH (a mismatch makes the run-time lookup fail).
-const TRI_TEX_WIDTH: u32 = 4096;
+// The shader library's one table (program, stages, files, switch values, Vulkan layer), shared
+// with src/gpu/shaders.rs.
+include!("shaders/programs.rs");
 
-struct Stage {
-    /// Program name (the lookup key with the stage).
-    program: &'static str,
-    /// glslang stage: vert or frag.
-    stage: &'static str,
-    /// Files concatenated (joined by newlines) into the body, as the GL backend does.
-    body: &'static [&'static str],
-    /// The program's own `#define` switches (after the conventions in the preamble).
-    switches: Switches,
-}
-
-/// The program-specific defines of `ProgramKind::defines` (src/gpu/shaders.rs).
-#[derive(Clone, Copy)]
-enum Switches {
-    /// WANT_RGB, TRI_TEX_WIDTH.
-    Refocus,
-    /// DEPTH_IS_DEVICE, REFINE, BLEND_SOFT.
-    CyclopeanGather,
-}
-
-impl Switches {
-    /// Number of switch bits (variants per convention: 2^bits).
-    fn bits(self) -> u32 {
-        match self {
-            Switches::Refocus => 1,
-            Switches::CyclopeanGather => 3,
-        }
-    }
-
-    /// The define lines for switch bits `b`.
-    fn defines(self, b: u32) -> String {
-        match self {
-            Switches::Refocus => format!("#define WANT_RGB {}\n#define TRI_TEX_WIDTH {TRI_TEX_WIDTH}\n", b & 1),
-            Switches::CyclopeanGather => format!(
-                "#define DEPTH_IS_DEVICE {}\n#define REFINE {}\n#define BLEND_SOFT {}\n",
-                b & 1,
-                (b >> 1) & 1,
-                (b >> 2) & 1
-            ),
-        }
-    }
-
-    /// The pass's Vulkan interface (after shaders/common/vulkan.glsl).
-    fn interface(self) -> &'static str {
-        match self {
-            Switches::Refocus => "shaders/refocus/vulkan_interface.glsl",
-            Switches::CyclopeanGather => "shaders/cyclopean/vulkan_interface.glsl",
-        }
-    }
-}
-
-// The file lists of src/gpu/shaders.rs (`ProgramKind::stages`) for the refocus programs; a drift
-// fails the SPIR-V lookup test in src/vulkan/pipeline.rs, never silently.
-const REFOCUS_FRAG_COMMON: [&str; 4] = [
-    "shaders/common/bilinear.glsl",
-    "shaders/common/grid_mesh.glsl",
-    "shaders/common/refocus_grid.glsl",
-    "shaders/common/refocus_sample.glsl",
-];
-
-const STAGES: &[Stage] = &[
-    Stage {
-        program: "refocus/fullscreen",
-        stage: "vert",
-        body: &["shaders/common/fullscreen.vert"],
-        switches: Switches::Refocus,
-    },
-    Stage {
-        program: "refocus/fullscreen",
-        stage: "frag",
-        body: &[
-            REFOCUS_FRAG_COMMON[0],
-            REFOCUS_FRAG_COMMON[1],
-            REFOCUS_FRAG_COMMON[2],
-            REFOCUS_FRAG_COMMON[3],
-            "shaders/refocus/fullscreen.frag",
-        ],
-        switches: Switches::Refocus,
-    },
-    Stage {
-        program: "refocus/mesh_interior",
-        stage: "vert",
-        body: &[
-            "shaders/common/grid_mesh.glsl",
-            "shaders/common/refocus_grid.glsl",
-            "shaders/refocus/mesh_interior.vert",
-        ],
-        switches: Switches::Refocus,
-    },
-    Stage {
-        program: "refocus/mesh_interior",
-        stage: "frag",
-        body: &[
-            REFOCUS_FRAG_COMMON[0],
-            REFOCUS_FRAG_COMMON[1],
-            REFOCUS_FRAG_COMMON[2],
-            REFOCUS_FRAG_COMMON[3],
-            "shaders/refocus/mesh_interior.frag",
-        ],
-        switches: Switches::Refocus,
-    },
-    Stage {
-        program: "refocus/mesh_boundary",
-        stage: "vert",
-        body: &[
-            "shaders/common/grid_mesh.glsl",
-            "shaders/common/mesh_pull.glsl",
-            "shaders/common/refocus_grid.glsl",
-            "shaders/refocus/mesh_boundary.vert",
-        ],
-        switches: Switches::Refocus,
-    },
-    Stage {
-        program: "refocus/mesh_boundary",
-        stage: "frag",
-        body: &[
-            REFOCUS_FRAG_COMMON[0],
-            REFOCUS_FRAG_COMMON[1],
-            REFOCUS_FRAG_COMMON[2],
-            REFOCUS_FRAG_COMMON[3],
-            "shaders/refocus/mesh_boundary.frag",
-        ],
-        switches: Switches::Refocus,
-    },
-    // ProgramKind::CyclopeanGather: the full-screen triangle, then camera, depth, bilinear and
-    // the gather itself.
-    Stage {
-        program: "cyclopean/gather",
-        stage: "vert",
-        body: &["shaders/common/fullscreen.vert"],
-        switches: Switches::CyclopeanGather,
-    },
-    Stage {
-        program: "cyclopean/gather",
-        stage: "frag",
-        body: &[
-            "shaders/common/camera.glsl",
-            "shaders/common/depth.glsl",
-            "shaders/common/bilinear.glsl",
-            "shaders/cyclopean/gather.frag",
-        ],
-        switches: Switches::CyclopeanGather,
-    },
-];
-
-/// The Vulkan layer every pass shares (before its own interface).
-const VULKAN_COMMON: &str = "shaders/common/vulkan.glsl";
+/// The Vulkan layer every pass shares (before its own layer files, if any).
+const VULKAN_COMMON: &str = "common/vulkan.glsl";
 
 /// `depth::FAR_EPS`, the device-depth background epsilon the GL preamble carries.
 const DEVICE_DEPTH_FAR_EPS: f64 = 1e-6;
 
-/// The GL backend's preamble for one convention combination and a program's switch bits:
-/// `ShaderProgram::preamble` (src/gpu/shaders.rs), define for define and in its order.
-fn defines(ndc_zero_to_one: bool, reversed_z: bool, rows_top_down: bool, switches: Switches, b: u32) -> String {
+/// The conventions part of the GL backend's preamble (`ShaderProgram::defines`, define for
+/// define and in its order), for convention bits `c` (NDC 0..1, reversed-Z, rows top-down).
+fn convention_defines(c: u32) -> String {
+    let (ndc_zero_to_one, reversed_z, rows_top_down) = (c & 1 != 0, c & 2 != 0, c & 4 != 0);
     let (lo, hi) = if ndc_zero_to_one {
         (0.0, 1.0)
     } else {
@@ -184,12 +43,21 @@ fn defines(ndc_zero_to_one: bool, reversed_z: bool, rows_top_down: bool, switche
     let (zn, zf): (f64, f64) = if reversed_z { (hi, lo) } else { (lo, hi) };
     format!(
         "#define NDC_ZERO_TO_ONE {}\n#define REVERSED_Z {}\n#define ROWS_TOP_DOWN {}\n\
-         #define NDC_Z_NEAR {zn:?}\n#define NDC_Z_FAR {zf:?}\n#define DEVICE_DEPTH_FAR_EPS {DEVICE_DEPTH_FAR_EPS:?}\n{}",
-        ndc_zero_to_one as u8,
-        reversed_z as u8,
-        rows_top_down as u8,
-        switches.defines(b)
+         #define NDC_Z_NEAR {zn:?}\n#define NDC_Z_FAR {zf:?}\n#define DEVICE_DEPTH_FAR_EPS {DEVICE_DEPTH_FAR_EPS:?}\n",
+        ndc_zero_to_one as u8, reversed_z as u8, rows_top_down as u8,
     )
+}
+
+/// Every combination of a program's switch values, as `#define` lines in table order.
+fn switch_defines(switches: &[(&str, &[i64])]) -> Vec<String> {
+    let mut out = vec![String::new()];
+    for (name, values) in switches {
+        out = out
+            .iter()
+            .flat_map(|prefix| values.iter().map(move |v| format!("{prefix}#define {name} {v}\n")))
+            .collect();
+    }
+    out
 }
 
 fn read(root: &Path, rel: &str) -> String {
@@ -216,9 +84,12 @@ fn main() {
     let root = PathBuf::from(std::env::var("CARGO_MANIFEST_DIR").expect("cargo sets CARGO_MANIFEST_DIR"));
     let out = PathBuf::from(std::env::var("OUT_DIR").expect("cargo sets OUT_DIR"));
     println!("cargo:rerun-if-changed=build.rs");
+    println!("cargo:rerun-if-changed=shaders/programs.rs");
     write_khronos_bindings(&out);
+    write_shader_files(&root, &out);
     let exe = glslang();
-    let common_layer = read(&root, VULKAN_COMMON) + "\n";
+    let shader = |rel: &str| read(&root, &format!("shaders/{rel}"));
+    let common_layer = shader(VULKAN_COMMON) + "\n";
     let dir = out.join("spirv");
     std::fs::create_dir_all(&dir).expect("creating OUT_DIR/spirv");
 
@@ -227,32 +98,79 @@ fn main() {
         "// Generated by build.rs: (program, stage, preamble, SPIR-V path) for every variant.\n\
          pub(crate) const SPIRV_VARIANTS: &[(&str, &str, &str, &[u8])] = &[\n",
     );
-    for s in STAGES {
-        let body: Vec<String> = s.body.iter().map(|f| read(&root, f)).collect();
-        let body = body.join("\n");
-        let layer = format!("{common_layer}{}\n", read(&root, s.switches.interface()));
-        for bits in 0..(8u32 << s.switches.bits()) {
-            let d = defines(bits & 1 != 0, bits & 2 != 0, bits & 4 != 0, s.switches, bits >> 3);
-            let source = format!("#version 450 core\n{d}{layer}#line 1\n{body}");
-            let stem = format!("{}_{}_{bits}", s.program.replace('/', "_"), s.stage);
-            let src_path = dir.join(format!("{stem}.{}", s.stage));
-            let spv_path = dir.join(format!("{stem}.spv"));
-            std::fs::write(&src_path, source).expect("writing shader source to OUT_DIR");
-            jobs.push((s.program, s.stage, src_path, spv_path.clone()));
-            writeln!(
-                table,
-                "    ({:?}, {:?}, {:?}, include_bytes!({:?})),",
-                s.program,
-                s.stage,
-                d,
-                spv_path.display().to_string()
-            )
-            .expect("writing to a String");
+    for p in PROGRAMS {
+        let Some(layer_files) = p.vulkan else { continue };
+        let mut layer = common_layer.clone();
+        for f in layer_files {
+            layer += &(shader(f) + "\n");
+        }
+        let variants = switch_defines(p.switches);
+        for (stage, files) in p.stages {
+            let body: Vec<String> = files.iter().map(|f| shader(f)).collect();
+            let body = body.join("\n");
+            for c in 0..8u32 {
+                for (v, own) in variants.iter().enumerate() {
+                    let d = convention_defines(c) + own;
+                    let source = format!("#version 450 core\n{d}{layer}#line 1\n{body}");
+                    let stem = format!("{}_{stage}_{c}_{v}", p.name.replace('/', "_"));
+                    let src_path = dir.join(format!("{stem}.{stage}"));
+                    let spv_path = dir.join(format!("{stem}.spv"));
+                    std::fs::write(&src_path, source).expect("writing shader source to OUT_DIR");
+                    jobs.push((p.name, *stage, src_path, spv_path.clone()));
+                    writeln!(
+                        table,
+                        "    ({:?}, {:?}, {:?}, include_bytes!({:?})),",
+                        p.name,
+                        stage,
+                        d,
+                        spv_path.display().to_string()
+                    )
+                    .expect("writing to a String");
+                }
+            }
         }
     }
     compile_all(&exe, &jobs);
     table.push_str("];\n");
     std::fs::write(out.join("spirv_variants.rs"), table).expect("writing spirv_variants.rs");
+}
+
+/// OUT_DIR/shader_files.rs: every GLSL file below shaders/ as a `ShaderFile` (path, embedded
+/// text), sorted by path, for the GL loader (src/gpu/shaders.rs), which finds the table's files
+/// in it.
+fn write_shader_files(root: &Path, out: &Path) {
+    let shaders = root.join("shaders");
+    println!("cargo:rerun-if-changed=shaders");
+    let mut paths = Vec::new();
+    for dir in std::fs::read_dir(&shaders).expect("reading shaders/") {
+        let dir = dir.expect("reading shaders/").path();
+        if !dir.is_dir() {
+            continue;
+        }
+        println!("cargo:rerun-if-changed={}", dir.display());
+        for f in std::fs::read_dir(&dir).expect("reading a shaders/ folder") {
+            let f = f.expect("reading a shaders/ folder").path();
+            let rel = f
+                .strip_prefix(&shaders)
+                .expect("below shaders/")
+                .to_string_lossy()
+                .replace('\\', "/");
+            paths.push((rel, f));
+        }
+    }
+    paths.sort();
+    let mut text = String::from("[\n");
+    for (rel, abs) in &paths {
+        println!("cargo:rerun-if-changed={}", abs.display());
+        writeln!(
+            text,
+            "    ShaderFile {{ path: {rel:?}, text: include_str!({:?}) }},",
+            abs.display().to_string()
+        )
+        .expect("writing to a String");
+    }
+    text.push(']');
+    std::fs::write(out.join("shader_files.rs"), text).expect("writing shader_files.rs");
 }
 
 /// EGL extension entry points src/gpu/egl.rs calls: device enumeration and query
@@ -275,8 +193,9 @@ const EGL_COMMANDS: &[&str] = &[
     "QueryDeviceStringEXT",
     "QueryDeviceAttribEXT",
 ];
-/// glClipControl (GL 4.5, ARB_clip_control): glow 0.16 has no wrapper for it.
-const GL_COMMANDS: &[&str] = &["ClipControl"];
+/// glClipControl (GL 4.5, ARB_clip_control) and glClearTexImage (GL 4.4): glow 0.16 has no
+/// wrapper for them.
+const GL_COMMANDS: &[&str] = &["ClipControl", "ClearTexImage"];
 
 /// Write OUT_DIR/egl_ext_bindings.rs and gl_ext_bindings.rs (struct loaders: `Egl::load_with`,
 /// `Gl::load_with`), included by src/gpu/khronos.rs. No alias fallbacks, so each entry point is

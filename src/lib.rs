@@ -57,6 +57,7 @@ pub mod gpu;
 pub mod io;
 pub mod job;
 pub mod metrics;
+pub mod pass;
 pub mod progress;
 pub mod refocus;
 pub mod report;

@@ -8,7 +8,7 @@
 const uint EDGE_GROUP_SIZE = uint(EDGE_GROUP_SIZE_INT);
 const uint EDGE_MAX_GROUPS = 65535u;
 
-layout(std430, binding = 0) buffer EdgeList {
+layout(std430, STORAGE_BUFFER(0)) buffer EdgeList {
     uint edge_count;
     uint edge_groups;
     uint edge_groups_y;

@@ -9,12 +9,15 @@
 // compared as integers so that the decision is exact on every GPU and in the twin.
 
 layout(local_size_x = 8, local_size_y = 8) in;
-layout(r32f, binding = 0) uniform writeonly image2D u_snapped;
-uniform sampler2D u_dist;   // R32F eye view distance, memory order (0 = invalid)
-uniform sampler2D u_color;  // RGBA8, memory order
-uniform float u_parallax_px;  // full-baseline disparity = this / distance
-uniform float u_tolerance_px;
-uniform int u_margin;
+// Parameters (`EdgeSnapParams` in src/cyclopean/splat.rs), one block for GL and Vulkan.
+layout(std140, binding = 0) uniform EdgeSnapParams {
+    float u_parallax_px;  // full-baseline disparity = this / distance
+    float u_tolerance_px;
+    int u_margin;
+};
+layout(binding = 1) uniform sampler2D u_dist;   // R32F eye view distance, memory order (0 = invalid)
+layout(binding = 2) uniform sampler2D u_color;  // RGBA8, memory order
+layout(r32f, STORAGE_IMAGE(0)) uniform writeonly image2D u_snapped;
 
 float disparity(ivec2 t) {
     float z = texelFetch(u_dist, t, 0).r;

@@ -3,20 +3,7 @@
 // Defines: DEPTH_IS_DEVICE, REFINE (k-step + projection check + edge-aware colour), BLEND_SOFT,
 // plus the conventions preamble (NDC_ZERO_TO_ONE, REVERSED_Z, ROWS_TOP_DOWN).
 
-#ifndef VULKAN  // Vulkan: shaders/cyclopean/vulkan_interface.glsl
-uniform sampler2D u_color_l;  // RGBA8, memory order
-uniform sampler2D u_color_r;
-uniform sampler2D u_depth_l;  // R32F: window depth or view distance (DEPTH_IS_DEVICE)
-uniform sampler2D u_depth_r;
-uniform mat4 u_view_proj_l, u_inv_view_l, u_inv_proj_l, u_view_l;
-uniform mat4 u_view_proj_r, u_inv_view_r, u_inv_proj_r, u_view_r;
-uniform mat4 u_view_m, u_inv_view_m, u_inv_proj_m, u_view_proj_m;
-uniform vec2 u_size_m;
-uniform float u_fixation;    // initial distance along the middle view axis
-uniform float u_z_threshold;
-uniform float u_w_left;      // weight of the left eye in blends (0.5 without a dominant eye)
-uniform int u_steps;
-#endif
+// Parameters and images: shaders/cyclopean/gather_params.glsl (one block, both backends).
 
 layout(location = 0) out vec4 o_color;
 layout(location = 1) out float o_depth;

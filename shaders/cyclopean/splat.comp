@@ -5,12 +5,17 @@
 // min on the bits keeps the nearest middle distance.
 
 layout(local_size_x = 8, local_size_y = 8) in;
-layout(r32ui, binding = 0) uniform uimage2D u_splat;
-uniform sampler2D u_dist;   // R32F eye view distance, memory order (0 = invalid)
-uniform ivec2 u_grid;       // invocation grid: the eye's size
-uniform ivec2 u_size_m;
-uniform mat4 u_inv_view_e, u_inv_proj_e;
-uniform mat4 u_view_proj_m, u_view_m;
+// Parameters (`SplatParams` in src/cyclopean/splat.rs), one block for GL and Vulkan.
+layout(std140, binding = 0) uniform SplatParams {
+    mat4 u_inv_view_e;
+    mat4 u_inv_proj_e;
+    mat4 u_view_proj_m;
+    mat4 u_view_m;
+    ivec2 u_grid;       // invocation grid: the eye's size
+    ivec2 u_size_m;
+};
+layout(binding = 1) uniform sampler2D u_dist;   // R32F eye view distance, memory order (0 = invalid)
+layout(r32ui, STORAGE_IMAGE(0)) uniform uimage2D u_splat;
 
 void main() {
     ivec2 t = ivec2(gl_GlobalInvocationID.xy);

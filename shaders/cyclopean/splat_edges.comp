@@ -7,7 +7,7 @@
 // left as written). Same inputs and functions as the gather draw, so the centre is the same.
 
 layout(local_size_x = EDGE_GROUP_SIZE_INT) in;
-layout(rgba8, binding = 0) writeonly uniform image2D u_color_out;
+layout(rgba8, STORAGE_IMAGE(0)) writeonly uniform image2D u_color_out;
 
 // The mixed colour of listed pixel p, written where its samples see more than one surface.
 void mix_edge(ivec2 p) {

@@ -2,19 +2,31 @@
 // the gather draw (splat_gather.frag) and the edge pass (splat_edges.comp). The f64 twin is
 // src/cyclopean/splat_reference.rs: keep them in step.
 
-uniform sampler2D u_color_l;  // RGBA8, memory order
-uniform sampler2D u_color_r;
-uniform sampler2D u_dist_l;   // R32F eye view distance, memory order (0 = invalid)
-uniform sampler2D u_dist_r;
-uniform usampler2D u_splat_l; // R32UI nearest splatted middle distance (bits), 0xFFFFFFFF = none
-uniform usampler2D u_splat_r;
-uniform mat4 u_view_proj_l, u_view_l, u_inv_view_l, u_inv_proj_l;
-uniform mat4 u_view_proj_r, u_view_r, u_inv_view_r, u_inv_proj_r;
-uniform mat4 u_view_m, u_inv_view_m, u_inv_proj_m;
-uniform vec2 u_size_m;
-uniform float u_parallax_px;  // focal (px) x baseline: full-baseline disparity = this / distance
-uniform float u_tolerance_px;
-uniform float u_w_left;
+// Parameters (`SplatGatherParams` in src/cyclopean/splat.rs), one block for GL and Vulkan,
+// shared by the gather draw and the edge pass.
+layout(std140, binding = 0) uniform SplatGatherParams {
+    mat4 u_view_proj_l;
+    mat4 u_view_l;
+    mat4 u_inv_view_l;
+    mat4 u_inv_proj_l;
+    mat4 u_view_proj_r;
+    mat4 u_view_r;
+    mat4 u_inv_view_r;
+    mat4 u_inv_proj_r;
+    mat4 u_view_m;
+    mat4 u_inv_view_m;
+    mat4 u_inv_proj_m;
+    vec2 u_size_m;
+    float u_parallax_px;  // focal (px) x baseline: full-baseline disparity = this / distance
+    float u_tolerance_px;
+    float u_w_left;
+};
+layout(binding = 1) uniform sampler2D u_color_l;  // RGBA8, memory order
+layout(binding = 2) uniform sampler2D u_dist_l;   // R32F eye view distance, memory order (0 = invalid)
+layout(binding = 3) uniform usampler2D u_splat_l; // R32UI nearest splatted middle distance (bits), 0xFFFFFFFF = none
+layout(binding = 4) uniform sampler2D u_color_r;
+layout(binding = 5) uniform sampler2D u_dist_r;
+layout(binding = 6) uniform usampler2D u_splat_r;
 
 // No splat (a sentinel beyond any finite distance the splat can store).
 const float NONE = 3.4e38;
@@ -82,7 +94,7 @@ float nearest_on_surface(sampler2D dist, vec2 e, float z_eye) {
     z_surface = total / inv;
 
 void surface_depth(sampler2D dist, vec2 e, float zn, out float z_surface, out float total) {
-    TAPS()
+    TAPS(;)  // no colour: an empty statement (glslang refuses an empty macro argument)
 }
 
 void surface_color(sampler2D dist, sampler2D color, vec2 e, float zn, out float z_surface, out vec3 c,

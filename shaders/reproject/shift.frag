@@ -4,13 +4,7 @@
 // Defines: DEPTH_MODE (0 view Z, 1 device depth, 2 disparity), SCAN (exact scan, else walk),
 // SCAN_MARGIN, plus the conventions preamble (REVERSED_Z, through common/depth.glsl).
 
-uniform sampler2D u_color;  // RGBA8, memory order
-uniform sampler2D u_depth;  // R32F, raw stored value
-uniform float u_a, u_b;     // shift model, pixels
-uniform float u_alpha, u_beta;  // q = alpha * stored + beta (DEPTH_MODE 1, 2)
-uniform float u_q_min, u_q_max; // inverse depth range of the frame
-uniform float u_tau_rel;
-uniform int u_steps;
+// Parameters and images: shaders/reproject/shift_params.glsl (one block, both backends).
 
 layout(location = 0) out vec4 o_color;
 layout(location = 1) out float o_depth;

@@ -3,26 +3,7 @@
 // Outputs colour, view distance (GL: -z_eye; 0 on a miss) and window depth under the
 // conventions (the far value on a miss).
 
-const int MAX_OBJECTS = 32;
-uniform int u_count;
-uniform ivec2 u_kind[MAX_OBJECTS];  // x: 0 plane, 1 sphere, 2 cuboid; y: pattern
-uniform vec4 u_a[MAX_OBJECTS];      // plane point | sphere centre, radius | cuboid min
-uniform vec4 u_b[MAX_OBJECTS];      // plane normal | - | cuboid max
-uniform vec4 u_c[MAX_OBJECTS];      // plane bounds min
-uniform vec4 u_d[MAX_OBJECTS];      // plane bounds max
-uniform mat4 u_inv_view_proj;
-uniform mat4 u_view_proj;
-uniform mat4 u_view;
-uniform vec3 u_eye;
-uniform vec2 u_size;
-// Omni-directional stereo equirect camera instead of the GL camera (rows top-down, longitude 0
-// = +z, +90 deg = +x, row 0 = up = -y): each pixel's ray starts on the circle of radius
-// u_ods_radius (signed: -left, +right) tangent to its direction, faded to 0 towards the poles
-// from latitude u_ods_fade_start (same rule as src/stitch OdsRig).
-uniform int u_ods;
-uniform vec3 u_ods_centre;
-uniform float u_ods_radius;
-uniform float u_ods_fade_start;
+// Parameters: shaders/scene/raytrace_params.glsl (one block, both backends).
 
 layout(location = 0) out vec4 o_color;
 layout(location = 1) out float o_view_z;

@@ -2,20 +2,7 @@
 // alternatives in src/stitch/mod.rs). The f64 twin is src/stitch/reference.rs: keep in step.
 // Defines: METHOD (0 blend, 1 border weight, 2 reproject), REPROJECT_STEPS.
 
-uniform sampler2D u_color;  // RGBA8 atlas: face k at columns [k n, (k + 1) n), rows in memory order
-uniform sampler2D u_depth;  // R32F atlas, view Z, <= 0 / NaN / Inf = background
-uniform mat4 u_rot[6];      // world from face rotation (upper 3x3)
-uniform vec4 u_eye[6];      // face eyes (xyz)
-uniform float u_f;
-uniform float u_c;
-uniform int u_n;
-uniform vec4 u_centre;      // ODS circle centre (xyz)
-uniform float u_half_ipd;
-uniform float u_fade_start; // radians
-uniform float u_side;       // -1 left, +1 right
-uniform float u_overlap;    // radians
-uniform ivec2 u_size;       // equirect size per eye
-uniform int u_row0;         // first framebuffer row of this eye
+// Parameters and atlases: shaders/stitch/stitch_params.glsl (one block, both backends).
 
 layout(location = 0) out vec4 o_color;
 

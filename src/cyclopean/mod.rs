@@ -163,6 +163,16 @@ pub struct CyclopeanParams {
 }
 
 impl CyclopeanParams {
+    /// The weight of the left eye where both are blended: the dominant eye's weight, else even
+    /// (one rule for the gather shader's block and the f64 twin).
+    pub fn left_eye_weight(&self) -> f64 {
+        match self.dominant {
+            Some((Eye::Left, w)) => w,
+            Some((Eye::Right, w)) => 1.0 - w,
+            None => 0.5,
+        }
+    }
+
     /// The seed's settings: one step, hard blend, threshold clamp(0.02 d, 0.02, 0.25) m at fixation distance `d`.
     pub fn seed(fixation_distance: f64) -> Self {
         CyclopeanParams {

@@ -2,7 +2,7 @@
 //! texel choices. Images are handled in memory order (row 0 = framebuffer row 0 under the
 //! frame's row order) exactly as the GPU sees its textures, and converted at the end.
 
-use super::{Blend, CyclopeanOutput, CyclopeanParams, Eye, EyeInput, FrameDepth, MiddleCamera, StereoFrame};
+use super::{Blend, CyclopeanOutput, CyclopeanParams, EyeInput, FrameDepth, MiddleCamera, StereoFrame};
 use crate::camera::mat4::{self, Mat4};
 use crate::convention::{Conventions, RowOrder};
 use crate::depth::{is_background, ndc_z_of_window_depth};
@@ -238,11 +238,7 @@ pub const REFINE_TOLERANCE_PX: f64 = 1.0;
 
 /// Resolve the two eyes' samples into colour, middle depth and source bits (shared rule).
 pub fn combine(l: &EyeSample, r: &EyeSample, params: &CyclopeanParams) -> Option<([f64; 3], f64, u8)> {
-    let w_left = match params.dominant {
-        Some((Eye::Left, w)) => w,
-        Some((Eye::Right, w)) => 1.0 - w,
-        None => 0.5,
-    };
+    let w_left = params.left_eye_weight();
     match (l.valid, r.valid) {
         (false, false) => None,
         (true, false) => Some((l.color, l.z_middle, 1)),

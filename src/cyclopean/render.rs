@@ -1,170 +1,186 @@
 //! GPU cyclopean pass: one full-screen draw (shaders/cyclopean/gather.frag) into colour,
-//! middle depth and source bits, read back top-down.
+//! middle depth and source bits, read back top-down; described once ([`crate::pass`]) and run
+//! by the GL or the Vulkan executor.
 
 use super::{
-    Blend, CyclopeanOutput, CyclopeanOutputs, CyclopeanParams, Eye, EyeInput, FrameDepth, Method, MiddleCamera,
-    StereoFrame,
+    Blend, CyclopeanOutput, CyclopeanOutputs, CyclopeanParams, EyeInput, FrameDepth, Method, MiddleCamera, StereoFrame,
 };
 use crate::camera::mat4::{self, Mat4};
 use crate::convention::RowOrder;
 use crate::error::{Error, Result};
-use crate::gpu::{
-    Attachment, DrawState, Framebuffer, Gpu, GpuTimer, Program, ProgramKind, ShaderProgram, Texture, TextureFormat,
-    Timing, VertexArray,
-};
+use crate::gpu::{Framebuffer, ProgramKind, ShaderProgram, Timing};
 use crate::io::{DepthMap, RgbImage};
+use crate::pass::{mat4_std140, Device, Draw, Format, Image, ImageData, Target, ToDevice};
+
+crate::param_block! {
+    /// The gather's parameters: shaders/cyclopean/gather_params.glsl, member for member.
+    pub struct GatherParams("GatherParams") {
+        u_view_proj_l: [[f32; 4]; 4],
+        u_inv_view_l: [[f32; 4]; 4],
+        u_inv_proj_l: [[f32; 4]; 4],
+        u_view_l: [[f32; 4]; 4],
+        u_view_proj_r: [[f32; 4]; 4],
+        u_inv_view_r: [[f32; 4]; 4],
+        u_inv_proj_r: [[f32; 4]; 4],
+        u_view_r: [[f32; 4]; 4],
+        u_view_m: [[f32; 4]; 4],
+        u_inv_view_m: [[f32; 4]; 4],
+        u_inv_proj_m: [[f32; 4]; 4],
+        u_view_proj_m: [[f32; 4]; 4],
+        u_size_m: [f32; 2],
+        u_fixation: f32,
+        u_z_threshold: f32,
+        u_w_left: f32,
+        u_steps: i32,
+    }
+}
 
 struct EyeGpu {
-    color: Texture,
-    depth: Texture,
+    color: Image,
+    depth: Image,
     view: Mat4,
     proj: Mat4,
 }
 
-fn upload_eye(gpu: &Gpu, eye: &EyeInput, rows: RowOrder) -> Result<EyeGpu> {
+fn upload_eye(device: &Device, eye: &EyeInput, rows: RowOrder) -> Result<EyeGpu> {
     let (w, h) = (eye.color.width, eye.color.height);
+    device.check_image_size("eye size", w, h)?;
     let rgba: Vec<u8> = crate::gpu::pixels::rgb_to_rgba(&eye.color.data);
     let depth: Vec<u8> = crate::gpu::pixels::f32_to_bytes(&eye.depth.data);
+    let image = |bytes: &[u8], format, label| {
+        device.upload(&ImageData {
+            width: w,
+            height: h,
+            format,
+            bytes,
+            label,
+        })
+    };
     Ok(EyeGpu {
-        color: Texture::new(
-            gpu,
-            w,
-            h,
-            TextureFormat::Rgba8,
-            Some(&rows.convert_rows(rgba, w as usize * 4)),
-        )?
-        .with_label("cyclopean eye colour"),
-        depth: Texture::new(
-            gpu,
-            w,
-            h,
-            TextureFormat::R32F,
-            Some(&rows.convert_rows(depth, w as usize * 4)),
-        )?
-        .with_label("cyclopean eye depth"),
+        color: image(
+            &rows.convert_rows(rgba, w as usize * 4),
+            Format::Rgba8,
+            "cyclopean eye colour",
+        )?,
+        depth: image(
+            &rows.convert_rows(depth, w as usize * 4),
+            Format::R32F,
+            "cyclopean eye depth",
+        )?,
         view: eye.view,
         proj: eye.proj,
     })
 }
 
-/// A stereo frame on the GPU, ready to render middle views.
+/// A stereo frame on the GPU (GL or Vulkan), ready to render middle views.
 pub struct CyclopeanRenderer {
-    gpu: Gpu,
-    program: Program,
+    device: Device,
+    program: ShaderProgram,
     params: CyclopeanParams,
     outputs: CyclopeanOutputs,
     rows: RowOrder,
     left: EyeGpu,
     right: EyeGpu,
-    vao: VertexArray,
-    framebuffer: Option<Framebuffer>,
 }
 
 impl CyclopeanRenderer {
     /// All outputs (colour, depth, source bits).
-    pub fn new(gpu: &Gpu, frame: &StereoFrame, params: CyclopeanParams) -> Result<Self> {
-        Self::with_outputs(gpu, frame, params, CyclopeanOutputs::default())
+    pub fn new(device: impl ToDevice, frame: &StereoFrame, params: CyclopeanParams) -> Result<Self> {
+        Self::with_outputs(device, frame, params, CyclopeanOutputs::default())
     }
 
     /// Only the requested colour/depth (the source bits always).
     pub fn with_outputs(
-        gpu: &Gpu,
+        device: impl ToDevice,
         frame: &StereoFrame,
         params: CyclopeanParams,
         outputs: CyclopeanOutputs,
     ) -> Result<Self> {
         frame.validate()?;
         params.validate()?;
+        let device = device.to_device()?;
         let kind = ProgramKind::CyclopeanGather {
             depth_is_device: frame.depth_kind == FrameDepth::Device,
             refine: matches!(params.method, Method::Refine { .. }),
             blend_soft: params.blend == Blend::Soft,
         };
-        let program = ShaderProgram::new(frame.conv, kind).build(gpu)?;
         Ok(CyclopeanRenderer {
-            gpu: gpu.clone(),
-            program,
+            program: ShaderProgram::new(frame.conv, kind),
             params,
             outputs,
             rows: frame.conv.row_order,
-            left: upload_eye(gpu, &frame.left, frame.conv.row_order)?,
-            right: upload_eye(gpu, &frame.right, frame.conv.row_order)?,
-            vao: VertexArray::new(gpu)?.with_label("cyclopean vertex array"),
-            framebuffer: None,
+            left: upload_eye(&device, &frame.left, frame.conv.row_order)?,
+            right: upload_eye(&device, &frame.right, frame.conv.row_order)?,
+            device,
+        })
+    }
+
+    /// The parameter block for middle camera `mid`: matrices and their inverses in f64, rounded
+    /// to f32 once.
+    fn block(&self, mid: &MiddleCamera) -> Result<GatherParams> {
+        let inv = |m: &Mat4, what: &str| {
+            mat4::inverse(m)
+                .map(|m| mat4_std140(&m))
+                .ok_or_else(|| Error::param(what.to_string(), "singular"))
+        };
+        let (l, r) = (&self.left, &self.right);
+        Ok(GatherParams {
+            u_view_proj_l: mat4_std140(&mat4::mul(&l.proj, &l.view)),
+            u_inv_view_l: inv(&l.view, "eye view")?,
+            u_inv_proj_l: inv(&l.proj, "eye projection")?,
+            u_view_l: mat4_std140(&l.view),
+            u_view_proj_r: mat4_std140(&mat4::mul(&r.proj, &r.view)),
+            u_inv_view_r: inv(&r.view, "eye view")?,
+            u_inv_proj_r: inv(&r.proj, "eye projection")?,
+            u_view_r: mat4_std140(&r.view),
+            u_view_m: mat4_std140(&mid.view),
+            u_inv_view_m: inv(&mid.view, "middle view")?,
+            u_inv_proj_m: inv(&mid.proj, "middle projection")?,
+            u_view_proj_m: mat4_std140(&mat4::mul(&mid.proj, &mid.view)),
+            u_size_m: [mid.width as f32, mid.height as f32],
+            u_fixation: self.params.fixation_distance as f32,
+            u_z_threshold: self.params.z_threshold as f32,
+            u_w_left: self.params.left_eye_weight() as f32,
+            u_steps: self.params.steps() as i32,
         })
     }
 
     /// Renders the middle view of camera `mid` (one full-screen gather pass), with its times.
     pub fn render(&mut self, mid: &MiddleCamera) -> Result<(CyclopeanOutput, Timing)> {
         let (w, h) = (mid.width, mid.height);
-        self.gpu.check_image_size("middle size", w, h)?;
-        let inv = |m: &Mat4, what: &str| mat4::inverse(m).ok_or_else(|| Error::param(what.to_string(), "singular"));
-        if !matches!(&self.framebuffer, Some(f) if f.width() == w && f.height() == h) {
-            self.framebuffer = None;
-            let slot = |wanted: bool, format| {
-                wanted.then_some(Attachment {
-                    format,
-                    clear: [0.0; 4],
-                })
-            };
-            self.framebuffer = Some(
-                Framebuffer::new(
-                    &self.gpu,
-                    w,
-                    h,
-                    &[
-                        slot(self.outputs.color, TextureFormat::Rgba8),
-                        slot(self.outputs.depth, TextureFormat::R32F),
-                        slot(true, TextureFormat::R8),
-                    ],
-                    false,
-                )?
-                .with_label("cyclopean target"),
-            );
-        }
-        let fb = self.framebuffer.as_ref().expect("allocated above");
-        let p = &self.program;
-        let timer = GpuTimer::start(&self.gpu);
-        let pass = fb.begin_pass(DrawState::default(), 1.0);
-        p.bind();
-        for (unit, t) in [&self.left.color, &self.right.color, &self.left.depth, &self.right.depth]
-            .into_iter()
-            .enumerate()
-        {
-            t.bind(unit as u32);
-        }
-        for (unit, name) in ["u_color_l", "u_color_r", "u_depth_l", "u_depth_r"]
-            .into_iter()
-            .enumerate()
-        {
-            p.set_i32(name, unit as i32);
-        }
-        for (suffix, eye) in [("l", &self.left), ("r", &self.right)] {
-            p.set_mat4_rows(&format!("u_view_proj_{suffix}"), &mat4::mul(&eye.proj, &eye.view));
-            p.set_mat4_rows(&format!("u_inv_view_{suffix}"), &inv(&eye.view, "eye view")?);
-            p.set_mat4_rows(&format!("u_inv_proj_{suffix}"), &inv(&eye.proj, "eye projection")?);
-            p.set_mat4_rows(&format!("u_view_{suffix}"), &eye.view);
-        }
-        p.set_mat4_rows("u_view_m", &mid.view);
-        p.set_mat4_rows("u_inv_view_m", &inv(&mid.view, "middle view")?);
-        p.set_mat4_rows("u_inv_proj_m", &inv(&mid.proj, "middle projection")?);
-        p.set_mat4_rows("u_view_proj_m", &mat4::mul(&mid.proj, &mid.view));
-        p.set_vec2("u_size_m", [w as f32, h as f32]);
-        p.set_f32("u_fixation", self.params.fixation_distance as f32);
-        p.set_f32("u_z_threshold", self.params.z_threshold as f32);
-        let w_left = match self.params.dominant {
-            Some((Eye::Left, wt)) => wt,
-            Some((Eye::Right, wt)) => 1.0 - wt,
-            None => 0.5,
+        self.device.check_image_size("middle size", w, h)?;
+        let block = self.block(mid)?;
+        let target = Target {
+            width: w,
+            height: h,
+            outputs: vec![
+                self.outputs.color.then_some(Format::Rgba8),
+                self.outputs.depth.then_some(Format::R32F),
+                Some(Format::R8),
+            ],
+            rows: self.rows,
         };
-        p.set_f32("u_w_left", w_left as f32);
-        p.set_i32("u_steps", self.params.steps() as i32);
-        pass.draw_fullscreen(&self.vao);
-        drop(pass);
-        self.gpu.check("cyclopean draw")?;
-        let out = read_output(fb, self.rows)?;
-        let timing = timer.stop();
-        Ok((out, timing))
+        let images = [
+            self.left.color.id(),
+            self.right.color.id(),
+            self.left.depth.id(),
+            self.right.depth.id(),
+        ];
+        let draw = Draw {
+            program: self.program,
+            params: bytemuck::bytes_of(&block),
+            images: &images,
+            buffers: &[],
+            viewport: [0, 0, w, h],
+        };
+        let mut out = self.device.render(&target, &[draw])?;
+        let color = out.outputs[0].take().map(|c| RgbImage::new(w, h, c)).transpose()?;
+        let depth = out.outputs[1]
+            .take()
+            .map(|d| DepthMap::new(w, h, bytemuck::pod_collect_to_vec(&d)))
+            .transpose()?;
+        let sources = out.take(2, "cyclopean gather")?;
+        Ok((CyclopeanOutput { color, depth, sources }, out.timing))
     }
 }
 

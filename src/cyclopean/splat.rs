@@ -35,10 +35,52 @@ use super::{CyclopeanOutput, CyclopeanOutputs, MiddleCamera, StereoFrame};
 use crate::camera::mat4::{self, Mat4};
 use crate::convention::RowOrder;
 use crate::error::{Error, Result};
-use crate::gpu::{
-    Attachment, Barrier, DrawState, Framebuffer, Gpu, GpuTimer, Program, ProgramKind, ShaderProgram, StorageBuffer,
-    Texture, TextureFormat, Timing, VertexArray,
+use crate::gpu::{ProgramKind, ShaderProgram, Timing};
+use crate::pass::{
+    mat4_std140, Buffer, Device, Dispatch, Draw, Format, Groups, Image, ImageData, Step, StorageImage, Target, ToDevice,
 };
+
+crate::param_block! {
+    /// The splat's parameters: shaders/cyclopean/splat.comp, member for member.
+    pub struct SplatBlock("SplatParams") {
+        u_inv_view_e: [[f32; 4]; 4],
+        u_inv_proj_e: [[f32; 4]; 4],
+        u_view_proj_m: [[f32; 4]; 4],
+        u_view_m: [[f32; 4]; 4],
+        u_grid: [i32; 2],
+        u_size_m: [i32; 2],
+    }
+}
+
+crate::param_block! {
+    /// The edge snap's parameters: shaders/cyclopean/edge_snap.comp, member for member.
+    pub struct EdgeSnapBlock("EdgeSnapParams") {
+        u_parallax_px: f32,
+        u_tolerance_px: f32,
+        u_margin: i32,
+    }
+}
+
+crate::param_block! {
+    /// The gather draw's and the edge pass's parameters: shaders/cyclopean/splat_gather.glsl.
+    pub struct SplatGatherBlock("SplatGatherParams") {
+        u_view_proj_l: [[f32; 4]; 4],
+        u_view_l: [[f32; 4]; 4],
+        u_inv_view_l: [[f32; 4]; 4],
+        u_inv_proj_l: [[f32; 4]; 4],
+        u_view_proj_r: [[f32; 4]; 4],
+        u_view_r: [[f32; 4]; 4],
+        u_inv_view_r: [[f32; 4]; 4],
+        u_inv_proj_r: [[f32; 4]; 4],
+        u_view_m: [[f32; 4]; 4],
+        u_inv_view_m: [[f32; 4]; 4],
+        u_inv_proj_m: [[f32; 4]; 4],
+        u_size_m: [f32; 2],
+        u_parallax_px: f32,
+        u_tolerance_px: f32,
+        u_w_left: f32,
+    }
+}
 
 /// Settings of the splat-gather method.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -149,66 +191,73 @@ impl SplatGeometry {
 }
 
 struct EyeGpu {
-    color: Texture,
-    dist: Texture,
+    color: Image,
+    dist: Image,
+    size: (u32, u32),
     view: Mat4,
     proj: Mat4,
 }
 
+fn inverse(m: &Mat4, what: &str) -> Result<[[f32; 4]; 4]> {
+    mat4::inverse(m)
+        .map(|m| mat4_std140(&m))
+        .ok_or_else(|| Error::param(what.to_string(), "singular"))
+}
+
 /// One eye's distances with its depth breaks snapped to its colour edges (edge_snap.comp).
-fn snap_edges(
-    gpu: &Gpu,
-    snap: &Program,
-    eye: &EyeGpu,
-    parallax_px: f64,
-    params: &SplatParams,
-    margin: u32,
-) -> Result<Texture> {
-    let (w, h) = (eye.dist.width(), eye.dist.height());
-    let out = Texture::new(gpu, w, h, TextureFormat::R32F, None)?.with_label("edge-snapped distances");
-    snap.bind();
-    eye.dist.bind(0);
-    eye.color.bind(1);
-    snap.set_i32("u_dist", 0);
-    snap.set_i32("u_color", 1);
-    snap.set_f32("u_parallax_px", parallax_px as f32);
-    snap.set_f32("u_tolerance_px", params.surface_tolerance_px as f32);
-    snap.set_i32("u_margin", margin as i32);
-    {
-        let _image = out.bind_image(0)?;
-        snap.dispatch([w.div_ceil(8), h.div_ceil(8)]);
-    }
-    // The snapped distances before the later passes' texel fetches.
-    gpu.memory_barrier(Barrier::TextureFetch);
-    gpu.check("cyclopean edge snap")?;
+fn snap_edges(device: &Device, program: ShaderProgram, eye: &EyeGpu, block: &EdgeSnapBlock) -> Result<Image> {
+    let (w, h) = eye.size;
+    let out = device.create_image(w, h, Format::R32F, "edge-snapped distances")?;
+    let images = [eye.dist.id(), eye.color.id()];
+    let storage = [StorageImage::Image(out.id())];
+    device.run(
+        None,
+        &[Step::Dispatch(Dispatch {
+            program,
+            params: bytemuck::bytes_of(block),
+            images: &images,
+            storage_images: &storage,
+            buffers: &[],
+            groups: Groups::Fixed([w.div_ceil(8), h.div_ceil(8)]),
+        })],
+    )?;
     Ok(out)
 }
 
-/// A stereo frame on the GPU, ready to render splat-gather views.
+/// Per middle-view size: each eye's splat image and the edge-pixel list.
+struct SizedTargets {
+    size: (u32, u32),
+    splats: [Image; 2],
+    edges: Buffer,
+}
+
+/// A stereo frame on the GPU (GL or Vulkan), ready to render splat-gather views.
 pub struct SplatRenderer {
-    gpu: Gpu,
-    splat: Program,
-    gather: Program,
+    device: Device,
+    splat: ShaderProgram,
+    gather: ShaderProgram,
     /// The edge pass over the pixels the gather listed (shaders/cyclopean/splat_edges.comp).
-    edges: Program,
+    edges: ShaderProgram,
     params: SplatParams,
     outputs: CyclopeanOutputs,
     rows: RowOrder,
-    frame_eyes: [(u32, u32); 2],
     eyes: [EyeGpu; 2],
     /// Kept to derive the geometry of each middle camera (its weights).
     frame_views: [Mat4; 2],
     parallax_px: f64,
-    vao: VertexArray,
-    /// Per view size: its framebuffer; as the two attachments of a second one (cleared to "no
-    /// surface" by the driver each frame), each eye's splat image; the edge-pixel list.
-    targets: Option<(Framebuffer, Framebuffer, StorageBuffer)>,
+    targets: Option<SizedTargets>,
 }
 
 impl SplatRenderer {
-    /// Uploads `frame`'s eyes (edge-snapped when the params say so) and builds both programs.
-    pub fn new(gpu: &Gpu, frame: &StereoFrame, params: SplatParams, outputs: CyclopeanOutputs) -> Result<Self> {
+    /// Uploads `frame`'s eyes (edge-snapped when the params say so).
+    pub fn new(
+        device: impl ToDevice,
+        frame: &StereoFrame,
+        params: SplatParams,
+        outputs: CyclopeanOutputs,
+    ) -> Result<Self> {
         params.validate()?;
+        let device = device.to_device()?;
         // The middle camera does not change the eye data; any will do to derive it here.
         let probe = MiddleCamera {
             view: frame.left.view,
@@ -219,24 +268,24 @@ impl SplatRenderer {
         let geo = SplatGeometry::new(frame, &probe)?;
         let upload = |eye: &super::EyeInput, dist: &[f32]| -> Result<EyeGpu> {
             let (w, h) = (eye.color.width, eye.color.height);
+            device.check_image_size("eye size", w, h)?;
             let rgba = crate::gpu::pixels::rgb_to_rgba(&eye.color.data);
             Ok(EyeGpu {
-                color: Texture::new(
-                    gpu,
-                    w,
-                    h,
-                    TextureFormat::Rgba8,
-                    Some(&frame.conv.row_order.convert_rows(rgba, w as usize * 4)),
-                )?
-                .with_label("splat eye colour"),
-                dist: Texture::new(
-                    gpu,
-                    w,
-                    h,
-                    TextureFormat::R32F,
-                    Some(&crate::gpu::pixels::f32_to_bytes(dist)),
-                )?
-                .with_label("splat eye distance"),
+                color: device.upload(&ImageData {
+                    width: w,
+                    height: h,
+                    format: Format::Rgba8,
+                    bytes: &frame.conv.row_order.convert_rows(rgba, w as usize * 4),
+                    label: "splat eye colour",
+                })?,
+                dist: device.upload(&ImageData {
+                    width: w,
+                    height: h,
+                    format: Format::R32F,
+                    bytes: bytemuck::cast_slice(dist),
+                    label: "splat eye distance",
+                })?,
+                size: (w, h),
                 view: eye.view,
                 proj: eye.proj,
             })
@@ -246,27 +295,27 @@ impl SplatRenderer {
             upload(&frame.right, &geo.dist_mem[1])?,
         ];
         if let Some(margin) = params.edge_snap_margin {
-            let snap = ShaderProgram::new(frame.conv, ProgramKind::CyclopeanEdgeSnap).build(gpu)?;
+            let snap = ShaderProgram::new(frame.conv, ProgramKind::CyclopeanEdgeSnap);
+            let block = EdgeSnapBlock {
+                u_parallax_px: geo.parallax_px as f32,
+                u_tolerance_px: params.surface_tolerance_px as f32,
+                u_margin: margin as i32,
+            };
             for eye in &mut eyes {
-                eye.dist = snap_edges(gpu, &snap, eye, geo.parallax_px, &params, margin)?;
+                eye.dist = snap_edges(&device, snap, eye, &block)?;
             }
         }
         Ok(SplatRenderer {
-            gpu: gpu.clone(),
-            splat: ShaderProgram::new(frame.conv, ProgramKind::CyclopeanSplat).build(gpu)?,
-            gather: ShaderProgram::new(frame.conv, ProgramKind::CyclopeanSplatGather).build(gpu)?,
-            edges: ShaderProgram::new(frame.conv, ProgramKind::CyclopeanSplatEdges).build(gpu)?,
+            splat: ShaderProgram::new(frame.conv, ProgramKind::CyclopeanSplat),
+            gather: ShaderProgram::new(frame.conv, ProgramKind::CyclopeanSplatGather),
+            edges: ShaderProgram::new(frame.conv, ProgramKind::CyclopeanSplatEdges),
+            device,
             params,
             outputs,
             rows: frame.conv.row_order,
-            frame_eyes: [
-                (frame.left.color.width, frame.left.color.height),
-                (frame.right.color.width, frame.right.color.height),
-            ],
             eyes,
             frame_views: [frame.left.view, frame.right.view],
             parallax_px: geo.parallax_px,
-            vao: VertexArray::new(gpu)?.with_label("splat-gather vertex array"),
             targets: None,
         })
     }
@@ -274,117 +323,136 @@ impl SplatRenderer {
     /// Renders the middle view of camera `mid`, with its times.
     pub fn render(&mut self, mid: &MiddleCamera) -> Result<(CyclopeanOutput, Timing)> {
         let (w, h) = (mid.width, mid.height);
-        self.gpu.check_image_size("middle size", w, h)?;
-        let inv = |m: &Mat4, what: &str| mat4::inverse(m).ok_or_else(|| Error::param(what.to_string(), "singular"));
+        self.device.check_image_size("middle size", w, h)?;
         let w_left = left_weight(&self.frame_views[0], &self.frame_views[1], &mid.view)?;
-        if !matches!(&self.targets, Some((f, ..)) if f.width() == w && f.height() == h) {
+        if self.targets.as_ref().is_none_or(|t| t.size != (w, h)) {
             self.targets = None;
-            let slot = |wanted: bool, format| {
-                wanted.then_some(Attachment {
-                    format,
-                    clear: [0.0; 4],
-                })
-            };
-            let fb = Framebuffer::new(
-                &self.gpu,
-                w,
-                h,
-                &[
-                    slot(self.outputs.color, TextureFormat::Rgba8),
-                    slot(self.outputs.depth, TextureFormat::R32F),
-                    slot(true, TextureFormat::R8),
-                ],
-                false,
-            )?
-            .with_label("splat-gather target");
-            // 0xFFFFFFFF, "no surface": the clear's f32 is converted with saturation
-            // (u32::MAX as f32 rounds up to 2^32, which saturates back to u32::MAX).
-            let none = Some(Attachment {
-                format: TextureFormat::R32Ui,
-                clear: [u32::MAX as f32; 4],
-            });
-            let splats = Framebuffer::new(&self.gpu, w, h, &[none, none], false)?.with_label("splat left, right");
+            let splat = |label| self.device.create_image(w, h, Format::R32Ui, label);
             // The counter and the edge pass's 3 dispatch words, then room for every pixel.
-            let edges = StorageBuffer::new(&self.gpu, 4 + w as usize * h as usize)?.with_label("edge pixels");
-            self.targets = Some((fb, splats, edges));
+            self.targets = Some(SizedTargets {
+                size: (w, h),
+                splats: [splat("splat left")?, splat("splat right")?],
+                edges: self.device.create_buffer(4 + w as usize * h as usize, "edge pixels")?,
+            });
         }
-        let (fb, splats, edges) = self.targets.as_ref().expect("allocated above");
-        let gpu = &self.gpu;
-        let timer = GpuTimer::start(gpu);
-        let view_proj_m = mat4::mul(&mid.proj, &mid.view);
-        // Pass 1: clear and splat each eye into its own image.
-        splats.clear();
-        let splats: [&Texture; 2] = [0, 1].map(|k| splats.color(k).expect("two attachments"));
-        let s = &self.splat;
-        s.bind();
-        s.set_mat4_rows("u_view_proj_m", &view_proj_m);
-        s.set_mat4_rows("u_view_m", &mid.view);
-        s.set_ivec2("u_size_m", [w as i32, h as i32]);
-        s.set_i32("u_dist", 0);
-        for (eye, (size, target)) in self.eyes.iter().zip(self.frame_eyes.iter().zip(splats)) {
-            let _image = target.bind_image(0)?;
-            eye.dist.bind(0);
-            s.set_ivec2("u_grid", [size.0 as i32, size.1 as i32]);
-            s.set_mat4_rows("u_inv_view_e", &inv(&eye.view, "eye view")?);
-            s.set_mat4_rows("u_inv_proj_e", &inv(&eye.proj, "eye projection")?);
-            s.dispatch([size.0.div_ceil(8), size.1.div_ceil(8)]);
-        }
-        // The atomics before the gather's texel fetches.
-        gpu.memory_barrier(Barrier::TextureFetch);
-        gpu.check("cyclopean splat")?;
-        // Pass 2: gather and merge.
-        let pass = fb.begin_pass(DrawState::default(), 1.0);
+        let t = self.targets.as_ref().expect("allocated above");
+        let view_proj_m = mat4_std140(&mat4::mul(&mid.proj, &mid.view));
+        let splat_blocks = self
+            .eyes
+            .iter()
+            .map(|eye| {
+                Ok(SplatBlock {
+                    u_inv_view_e: inverse(&eye.view, "eye view")?,
+                    u_inv_proj_e: inverse(&eye.proj, "eye projection")?,
+                    u_view_proj_m: view_proj_m,
+                    u_view_m: mat4_std140(&mid.view),
+                    u_grid: [eye.size.0 as i32, eye.size.1 as i32],
+                    u_size_m: [w as i32, h as i32],
+                })
+            })
+            .collect::<Result<Vec<_>>>()?;
+        let [l, r] = &self.eyes;
+        let gather = SplatGatherBlock {
+            u_view_proj_l: mat4_std140(&mat4::mul(&l.proj, &l.view)),
+            u_view_l: mat4_std140(&l.view),
+            u_inv_view_l: inverse(&l.view, "eye view")?,
+            u_inv_proj_l: inverse(&l.proj, "eye projection")?,
+            u_view_proj_r: mat4_std140(&mat4::mul(&r.proj, &r.view)),
+            u_view_r: mat4_std140(&r.view),
+            u_inv_view_r: inverse(&r.view, "eye view")?,
+            u_inv_proj_r: inverse(&r.proj, "eye projection")?,
+            u_view_m: mat4_std140(&mid.view),
+            u_inv_view_m: inverse(&mid.view, "middle view")?,
+            u_inv_proj_m: inverse(&mid.proj, "middle projection")?,
+            u_size_m: [w as f32, h as f32],
+            u_parallax_px: self.parallax_px as f32,
+            u_tolerance_px: self.params.surface_tolerance_px as f32,
+            u_w_left: w_left as f32,
+        };
+        let splat_images = [[l.dist.id()], [r.dist.id()]];
+        let splat_targets = [
+            [StorageImage::Image(t.splats[0].id())],
+            [StorageImage::Image(t.splats[1].id())],
+        ];
+        let gather_images = [
+            l.color.id(),
+            l.dist.id(),
+            t.splats[0].id(),
+            r.color.id(),
+            r.dist.id(),
+            t.splats[1].id(),
+        ];
+        let edges = [t.edges.id()];
+        let color_out = [StorageImage::Output(0)];
+        let mut steps = vec![
+            // "No surface" in both splat images (the driver fills them).
+            Step::Clear {
+                image: t.splats[0].id(),
+                bits: u32::MAX,
+            },
+            Step::Clear {
+                image: t.splats[1].id(),
+                bits: u32::MAX,
+            },
+        ];
+        // Pass 1: each eye splatted into its own image.
         for (k, eye) in self.eyes.iter().enumerate() {
-            eye.color.bind(3 * k as u32);
-            eye.dist.bind(3 * k as u32 + 1);
-            splats[k].bind(3 * k as u32 + 2);
+            steps.push(Step::Dispatch(Dispatch {
+                program: self.splat,
+                params: bytemuck::bytes_of(&splat_blocks[k]),
+                images: &splat_images[k],
+                storage_images: &splat_targets[k],
+                buffers: &[],
+                groups: Groups::Fixed([eye.size.0.div_ceil(8), eye.size.1.div_ceil(8)]),
+            }));
         }
         // No edge pixel yet: count 0, no work group (x), 1 (y), 1 (z).
-        edges.write_head(&[0, 0, 1, 1]);
-        edges.bind_storage(0);
-        // The centre samples, then the listed edge pixels over them (same inputs, uniforms).
-        self.bind_gather_inputs(&self.gather, mid, w_left)?;
-        pass.draw_fullscreen(&self.vao);
-        // Edge mixing changes colour only: without a colour attachment there is nothing to mix.
-        if let Some(color) = fb.color(0) {
-            // The list and its counts before the edge pass reads them.
-            gpu.memory_barrier(Barrier::StorageAndCommand);
-            self.bind_gather_inputs(&self.edges, mid, w_left)?;
-            let _image = color.bind_image(0)?;
-            self.edges.set_i32("u_color_out", 0);
-            self.edges.dispatch_indirect(edges, 1);
-            // The rewritten texels before the readback.
-            gpu.memory_barrier(Barrier::Framebuffer);
+        steps.push(Step::WriteBuffer {
+            buffer: t.edges.id(),
+            words: &[0, 0, 1, 1],
+        });
+        // Pass 2: gather and merge, listing the edge pixels.
+        steps.push(Step::Draw(Draw {
+            program: self.gather,
+            params: bytemuck::bytes_of(&gather),
+            images: &gather_images,
+            buffers: &edges,
+            viewport: [0, 0, w, h],
+        }));
+        // Pass 3: the listed pixels' colour mixed (colour only: without it, nothing to mix).
+        if self.outputs.color {
+            steps.push(Step::Dispatch(Dispatch {
+                program: self.edges,
+                params: bytemuck::bytes_of(&gather),
+                images: &gather_images,
+                storage_images: &color_out,
+                buffers: &edges,
+                groups: Groups::Indirect {
+                    buffer: t.edges.id(),
+                    offset_words: 1,
+                },
+            }));
         }
-        drop(pass);
-        gpu.check("cyclopean splat gather")?;
-        let out = super::render::read_output(fb, self.rows)?;
-        let timing = timer.stop();
-        Ok((out, timing))
-    }
-
-    /// Binds `p` (the gather draw or the edge pass: one set of inputs, splat_gather.glsl) and
-    /// sets its uniforms for view `mid`: each eye's texture units (colour 3k, distance 3k + 1,
-    /// splat 3k + 2, bound by the caller) and cameras, the middle camera, the rig's constants.
-    fn bind_gather_inputs(&self, p: &Program, mid: &MiddleCamera, w_left: f64) -> Result<()> {
-        let inv = |m: &Mat4, what: &str| mat4::inverse(m).ok_or_else(|| Error::param(what.to_string(), "singular"));
-        p.bind();
-        for (k, (eye, sfx)) in self.eyes.iter().zip(["l", "r"]).enumerate() {
-            p.set_i32(&format!("u_color_{sfx}"), 3 * k as i32);
-            p.set_i32(&format!("u_dist_{sfx}"), 3 * k as i32 + 1);
-            p.set_i32(&format!("u_splat_{sfx}"), 3 * k as i32 + 2);
-            p.set_mat4_rows(&format!("u_view_proj_{sfx}"), &mat4::mul(&eye.proj, &eye.view));
-            p.set_mat4_rows(&format!("u_view_{sfx}"), &eye.view);
-            p.set_mat4_rows(&format!("u_inv_view_{sfx}"), &inv(&eye.view, "eye view")?);
-            p.set_mat4_rows(&format!("u_inv_proj_{sfx}"), &inv(&eye.proj, "eye projection")?);
-        }
-        p.set_mat4_rows("u_view_m", &mid.view);
-        p.set_mat4_rows("u_inv_view_m", &inv(&mid.view, "middle view")?);
-        p.set_mat4_rows("u_inv_proj_m", &inv(&mid.proj, "middle projection")?);
-        p.set_vec2("u_size_m", [mid.width as f32, mid.height as f32]);
-        p.set_f32("u_parallax_px", self.parallax_px as f32);
-        p.set_f32("u_tolerance_px", self.params.surface_tolerance_px as f32);
-        p.set_f32("u_w_left", w_left as f32);
-        Ok(())
+        let target = Target {
+            width: w,
+            height: h,
+            outputs: vec![
+                self.outputs.color.then_some(Format::Rgba8),
+                self.outputs.depth.then_some(Format::R32F),
+                Some(Format::R8),
+            ],
+            rows: self.rows,
+        };
+        let mut out = self.device.run(Some(&target), &steps)?;
+        let color = out.outputs[0]
+            .take()
+            .map(|c| crate::io::RgbImage::new(w, h, c))
+            .transpose()?;
+        let depth = out.outputs[1]
+            .take()
+            .map(|d| crate::io::DepthMap::new(w, h, bytemuck::pod_collect_to_vec(&d)))
+            .transpose()?;
+        let sources = out.take(2, "cyclopean splat-gather")?;
+        Ok((CyclopeanOutput { color, depth, sources }, out.timing))
     }
 }

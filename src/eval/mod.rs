@@ -10,6 +10,7 @@
 //!   their difference as PNG under `target/` for a person to look at.
 //! - [`run_report`]: all rows into report.{md,csv,svg}.
 
+pub mod backends;
 pub mod block_match;
 pub mod cyclopean;
 pub mod image_check;

@@ -145,3 +145,78 @@ impl Drop for StorageBuffer {
         self.gpu.deleted(GlObject::Buffer);
     }
 }
+
+/// A GL_UNIFORM_BUFFER holding the std140 parameter blocks of a pass's draws, one per slot of
+/// [`UniformBuffer::slot_bytes`] (the block size rounded up to the context's offset alignment).
+/// Grown, never shrunk: a steady stream of frames rewrites it without reallocating.
+pub struct UniformBuffer {
+    gpu: Gpu,
+    raw: glow::Buffer,
+    /// Allocated bytes.
+    capacity: usize,
+}
+
+impl UniformBuffer {
+    /// An empty buffer (storage comes with the first [`UniformBuffer::write`]).
+    pub fn new(gpu: &Gpu) -> Result<Self> {
+        // SAFETY: a fresh buffer name, labelled once bound.
+        unsafe {
+            let gl = gpu.gl();
+            let raw = gl.create_buffer().map_err(Error::Gl)?;
+            gpu.created(GlObject::Buffer);
+            gl.bind_buffer(glow::UNIFORM_BUFFER, Some(raw));
+            gl.bind_buffer(glow::UNIFORM_BUFFER, None);
+            gpu.label(glow::BUFFER, raw.0.get(), "viewsynth pass parameters");
+            Ok(UniformBuffer {
+                gpu: gpu.clone(),
+                raw,
+                capacity: 0,
+            })
+        }
+    }
+
+    /// The context's GL_UNIFORM_BUFFER_OFFSET_ALIGNMENT: slots start at multiples of it.
+    pub fn offset_alignment(&self) -> usize {
+        // SAFETY: plain state query.
+        let a = unsafe { self.gpu.gl().get_parameter_i32(glow::UNIFORM_BUFFER_OFFSET_ALIGNMENT) };
+        a.max(1) as usize
+    }
+
+    /// Replace the contents with `bytes` (growing the store when needed).
+    pub fn write(&mut self, bytes: &[u8]) -> Result<()> {
+        let gl = self.gpu.gl();
+        // SAFETY: the buffer is owned; the store is (re)allocated before a write that needs it.
+        unsafe {
+            gl.bind_buffer(glow::UNIFORM_BUFFER, Some(self.raw));
+            if bytes.len() > self.capacity {
+                gl.buffer_data_size(glow::UNIFORM_BUFFER, bytes.len() as i32, glow::DYNAMIC_DRAW);
+                self.capacity = bytes.len();
+            }
+            gl.buffer_sub_data_u8_slice(glow::UNIFORM_BUFFER, 0, bytes);
+            gl.bind_buffer(glow::UNIFORM_BUFFER, None);
+        }
+        self.gpu.check("uniform buffer write")
+    }
+
+    /// Bind bytes `[offset, offset + size)` to uniform block binding `binding`.
+    pub fn bind_range(&self, binding: u32, offset: usize, size: usize) {
+        // SAFETY: valid handle; the range lies inside the store written by `write`.
+        unsafe {
+            self.gpu.gl().bind_buffer_range(
+                glow::UNIFORM_BUFFER,
+                binding,
+                Some(self.raw),
+                offset as i32,
+                size as i32,
+            )
+        }
+    }
+}
+
+impl Drop for UniformBuffer {
+    fn drop(&mut self) {
+        // SAFETY: handle owned by self.
+        unsafe { self.gpu.gl().delete_buffer(self.raw) }
+        self.gpu.deleted(GlObject::Buffer);
+    }
+}

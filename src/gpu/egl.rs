@@ -194,8 +194,10 @@ impl EglContext {
             })
         };
         let clip_control = khronos::gl::Gl::load_with(khronos::egl_loader(&egl));
-        if !clip_control.ClipControl.is_loaded() {
-            return Err(Error::Egl("glClipControl missing (needs GL 4.5)".into()));
+        if !clip_control.ClipControl.is_loaded() || !clip_control.ClearTexImage.is_loaded() {
+            return Err(Error::Egl(
+                "glClipControl or glClearTexImage missing (needs GL 4.5)".into(),
+            ));
         }
         let egl_version = egl
             .query_string(Some(display), egl::VERSION)

@@ -35,7 +35,7 @@ pub mod egl {
     include!(concat!(env!("OUT_DIR"), "/egl_ext_bindings.rs"));
 }
 
-/// GL: `glClipControl` (GL 4.5).
+/// GL: `glClipControl` (GL 4.5) and `glClearTexImage` (GL 4.4).
 pub mod gl {
     include!(concat!(env!("OUT_DIR"), "/gl_ext_bindings.rs"));
 }

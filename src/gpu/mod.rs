@@ -27,7 +27,7 @@ mod texture;
 mod timer;
 mod vertex_array;
 
-pub use buffer::{IndexBuffer, StorageBuffer};
+pub use buffer::{IndexBuffer, StorageBuffer, UniformBuffer};
 pub use census::LiveObjects;
 pub use devices::EglDevice;
 pub use egl::{DeviceChoice, EglContext, GpuInfo};
@@ -166,6 +166,7 @@ impl Gpu {
             Barrier::TextureFetch => glow::TEXTURE_FETCH_BARRIER_BIT,
             Barrier::StorageAndCommand => glow::SHADER_STORAGE_BARRIER_BIT | glow::COMMAND_BARRIER_BIT,
             Barrier::Framebuffer => glow::FRAMEBUFFER_BARRIER_BIT,
+            Barrier::All => glow::ALL_BARRIER_BITS,
         };
         // SAFETY: plain synchronisation command.
         unsafe { self.gl().memory_barrier(bits) }
@@ -185,4 +186,6 @@ pub enum Barrier {
     /// Later reads of framebuffer attachments, readback included (a compute pass rewrote some
     /// texels of a colour attachment through an image).
     Framebuffer,
+    /// Every kind above (the pass executor between steps it cannot tell apart).
+    All,
 }

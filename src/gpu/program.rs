@@ -125,6 +125,37 @@ impl Program {
         }
     }
 
+    /// The std140 layout the GL compiler gave uniform block `block`: its data size and each
+    /// active member's name (arrays as `name[0]`) and byte offset, sorted by offset; None when
+    /// the program has no such block. For the test that holds every Rust parameter block
+    /// against its GLSL mirror.
+    pub fn uniform_block_layout(&self, block: &str) -> Option<(usize, Vec<(String, usize)>)> {
+        let gl = self.gpu.gl();
+        // SAFETY: introspection queries on a linked program; the index slice is sized by the
+        // count GL reports.
+        unsafe {
+            let index = gl.get_uniform_block_index(self.raw, block)?;
+            let size = gl.get_active_uniform_block_parameter_i32(self.raw, index, glow::UNIFORM_BLOCK_DATA_SIZE);
+            let n = gl.get_active_uniform_block_parameter_i32(self.raw, index, glow::UNIFORM_BLOCK_ACTIVE_UNIFORMS);
+            let mut members = vec![0i32; n.max(0) as usize];
+            gl.get_active_uniform_block_parameter_i32_slice(
+                self.raw,
+                index,
+                glow::UNIFORM_BLOCK_ACTIVE_UNIFORM_INDICES,
+                &mut members,
+            );
+            let members: Vec<u32> = members.into_iter().map(|m| m as u32).collect();
+            let offsets = gl.get_active_uniforms_parameter(self.raw, &members, glow::UNIFORM_OFFSET);
+            let mut out: Vec<(String, usize)> = members
+                .iter()
+                .zip(offsets)
+                .filter_map(|(&m, o)| Some((gl.get_active_uniform(self.raw, m)?.name, o as usize)))
+                .collect();
+            out.sort_by_key(|(_, o)| *o);
+            Some((size as usize, out))
+        }
+    }
+
     /// Makes this the current program (glUseProgram).
     pub fn bind(&self) {
         // SAFETY: valid program handle.

@@ -69,6 +69,12 @@ impl ReadFormat {
         ty: glow::FLOAT,
         bytes_per_pixel: 4,
     };
+    /// One unsigned 32-bit integer per pixel (R32UI).
+    pub const R32UI: ReadFormat = ReadFormat {
+        format: glow::RED_INTEGER,
+        ty: glow::UNSIGNED_INT,
+        bytes_per_pixel: 4,
+    };
     /// One byte per pixel (R8).
     pub const R8: ReadFormat = ReadFormat {
         format: glow::RED,

@@ -25,48 +25,37 @@ pub struct ShaderFile {
     pub text: &'static str,
 }
 
-macro_rules! shader_file {
-    ($path:literal) => {
-        ShaderFile {
-            path: $path,
-            text: include_str!(concat!("../../shaders/", $path)),
-        }
-    };
+/// The shader table (program, stages, files, switch values, Vulkan layer) that build.rs reads
+/// too: one list of what each program is made of.
+#[allow(dead_code)]
+mod table {
+    include!("../../shaders/programs.rs");
 }
 
-mod files {
-    use super::ShaderFile;
-    pub const FULLSCREEN_VERT: ShaderFile = shader_file!("common/fullscreen.vert");
-    pub const CAMERA: ShaderFile = shader_file!("common/camera.glsl");
-    pub const DEPTH: ShaderFile = shader_file!("common/depth.glsl");
-    pub const BILINEAR: ShaderFile = shader_file!("common/bilinear.glsl");
-    pub const GRID_MESH: ShaderFile = shader_file!("common/grid_mesh.glsl");
-    pub const MESH_PULL: ShaderFile = shader_file!("common/mesh_pull.glsl");
-    pub const ODS: ShaderFile = shader_file!("common/ods.glsl");
-    pub const REFOCUS_GRID: ShaderFile = shader_file!("common/refocus_grid.glsl");
-    pub const REFOCUS_SAMPLE: ShaderFile = shader_file!("common/refocus_sample.glsl");
-    pub const REFOCUS_FULLSCREEN: ShaderFile = shader_file!("refocus/fullscreen.frag");
-    pub const REFOCUS_INTERIOR_VERT: ShaderFile = shader_file!("refocus/mesh_interior.vert");
-    pub const REFOCUS_INTERIOR_FRAG: ShaderFile = shader_file!("refocus/mesh_interior.frag");
-    pub const REFOCUS_BOUNDARY_VERT: ShaderFile = shader_file!("refocus/mesh_boundary.vert");
-    pub const REFOCUS_BOUNDARY_FRAG: ShaderFile = shader_file!("refocus/mesh_boundary.frag");
-    pub const CYCLOPEAN_GATHER: ShaderFile = shader_file!("cyclopean/gather.frag");
-    pub const CYCLOPEAN_FORWARD_VERT: ShaderFile = shader_file!("cyclopean/forward.vert");
-    pub const CYCLOPEAN_FORWARD_FRAG: ShaderFile = shader_file!("cyclopean/forward.frag");
-    pub const CYCLOPEAN_SPLAT: ShaderFile = shader_file!("cyclopean/splat.comp");
-    pub const CYCLOPEAN_SPLAT_GATHER: ShaderFile = shader_file!("cyclopean/splat_gather.frag");
-    pub const CYCLOPEAN_SPLAT_GATHER_LIB: ShaderFile = shader_file!("cyclopean/splat_gather.glsl");
-    pub const CYCLOPEAN_SPLAT_EDGES: ShaderFile = shader_file!("cyclopean/splat_edges.comp");
-    pub const CYCLOPEAN_EDGE_LIST: ShaderFile = shader_file!("cyclopean/edge_list.glsl");
-    pub const CYCLOPEAN_EDGE_SNAP: ShaderFile = shader_file!("cyclopean/edge_snap.comp");
-    pub const REPROJECT_SHIFT: ShaderFile = shader_file!("reproject/shift.frag");
-    pub const SCENE_RAYTRACE: ShaderFile = shader_file!("scene/raytrace.frag");
-    pub const STITCH: ShaderFile = shader_file!("stitch/stitch.frag");
+/// Every GLSL file below `shaders/`, embedded at build time (the table names them by path).
+const FILES: &[ShaderFile] = &include!(concat!(env!("OUT_DIR"), "/shader_files.rs"));
+
+/// The embedded file at `path` (below `shaders/`); the table and `FILES` come from the same
+/// folder, so a miss is a build defect (caught by the unit test below).
+fn file(path: &str) -> ShaderFile {
+    FILES.iter().copied().find(|f| f.path == path).unwrap_or(ShaderFile {
+        path: "missing",
+        text: "",
+    })
+}
+
+/// The values the shader table gives switch `name` of `program` (what build.rs compiles).
+fn switch_values(program: &str, name: &str) -> &'static [i64] {
+    table::PROGRAMS
+        .iter()
+        .find(|p| p.name == program)
+        .and_then(|p| p.switches.iter().find(|(n, _)| *n == name))
+        .map_or(&[], |(_, v)| *v)
 }
 
 /// Width of the R32UI texture holding kept-triangle codes for vertex pulling (refocus mesh and
 /// cyclopean forward warp): a layout both the uploader and the shaders must agree on.
-pub const TRI_TEX_WIDTH: u32 = 4096;
+pub const TRI_TEX_WIDTH: u32 = table::TRI_TEX_WIDTH as u32;
 
 /// A pipeline stage.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -303,50 +292,31 @@ impl ProgramKind {
         }
     }
 
-    /// The stages and, per stage, the files concatenated in order (shared ones first).
+    /// The stages and, per stage, the files concatenated in order (shared ones first), from
+    /// the shader table.
     fn stages(&self) -> Vec<(Stage, Vec<ShaderFile>)> {
-        use files::*;
-        use Stage::*;
-        let fullscreen = |frag: Vec<ShaderFile>| vec![(Vertex, vec![FULLSCREEN_VERT]), (Fragment, frag)];
-        let refocus_frag = |own| vec![BILINEAR, GRID_MESH, REFOCUS_GRID, REFOCUS_SAMPLE, own];
-        match self {
-            ProgramKind::RefocusFullscreen { .. } => fullscreen(refocus_frag(REFOCUS_FULLSCREEN)),
-            ProgramKind::RefocusMeshInterior { .. } => vec![
-                (Vertex, vec![GRID_MESH, REFOCUS_GRID, REFOCUS_INTERIOR_VERT]),
-                (Fragment, refocus_frag(REFOCUS_INTERIOR_FRAG)),
-            ],
-            ProgramKind::RefocusMeshBoundary { .. } => vec![
-                (Vertex, vec![GRID_MESH, MESH_PULL, REFOCUS_GRID, REFOCUS_BOUNDARY_VERT]),
-                (Fragment, refocus_frag(REFOCUS_BOUNDARY_FRAG)),
-            ],
-            ProgramKind::CyclopeanGather { .. } => fullscreen(vec![CAMERA, DEPTH, BILINEAR, CYCLOPEAN_GATHER]),
-            ProgramKind::CyclopeanForward => vec![
-                (Vertex, vec![CAMERA, GRID_MESH, MESH_PULL, CYCLOPEAN_FORWARD_VERT]),
-                (Fragment, vec![BILINEAR, GRID_MESH, CYCLOPEAN_FORWARD_FRAG]),
-            ],
-            ProgramKind::CyclopeanSplat => vec![(Compute, vec![CAMERA, CYCLOPEAN_SPLAT])],
-            ProgramKind::CyclopeanEdgeSnap => vec![(Compute, vec![CYCLOPEAN_EDGE_SNAP])],
-            ProgramKind::CyclopeanSplatGather => fullscreen(vec![
-                CAMERA,
-                BILINEAR,
-                CYCLOPEAN_EDGE_LIST,
-                CYCLOPEAN_SPLAT_GATHER_LIB,
-                CYCLOPEAN_SPLAT_GATHER,
-            ]),
-            ProgramKind::CyclopeanSplatEdges => vec![(
-                Compute,
-                vec![
-                    CAMERA,
-                    BILINEAR,
-                    CYCLOPEAN_EDGE_LIST,
-                    CYCLOPEAN_SPLAT_GATHER_LIB,
-                    CYCLOPEAN_SPLAT_EDGES,
-                ],
-            )],
-            ProgramKind::ReprojectShift { .. } => fullscreen(vec![DEPTH, REPROJECT_SHIFT]),
-            ProgramKind::SceneRaytrace => fullscreen(vec![CAMERA, DEPTH, ODS, SCENE_RAYTRACE]),
-            ProgramKind::Stitch { .. } => fullscreen(vec![BILINEAR, ODS, STITCH]),
-        }
+        let name = self.name();
+        let Some(entry) = table::PROGRAMS.iter().find(|p| p.name == name) else {
+            return Vec::new();
+        };
+        entry
+            .stages
+            .iter()
+            .map(|(stage, files)| {
+                let stage = match *stage {
+                    "vert" => Stage::Vertex,
+                    "frag" => Stage::Fragment,
+                    _ => Stage::Compute,
+                };
+                (stage, files.iter().map(|f| file(f)).collect())
+            })
+            .collect()
+    }
+
+    /// Whether build.rs compiled this program to SPIR-V (the Vulkan backend runs it).
+    pub fn on_vulkan(&self) -> bool {
+        let name = self.name();
+        table::PROGRAMS.iter().any(|p| p.name == name && p.vulkan.is_some())
     }
 }
 
@@ -381,18 +351,22 @@ impl ShaderProgram {
         ]);
         for depth in [ShiftDepth::ViewZ, ShiftDepth::Device, ShiftDepth::Disparity] {
             for scan in [false, true] {
-                kinds.push(ProgramKind::ReprojectShift {
-                    depth,
-                    scan,
-                    scan_margin: 2,
-                });
+                for &scan_margin in switch_values("reproject/shift", "SCAN_MARGIN") {
+                    kinds.push(ProgramKind::ReprojectShift {
+                        depth,
+                        scan,
+                        scan_margin: scan_margin as u32,
+                    });
+                }
             }
         }
         for method in [StitchBlend::Blend, StitchBlend::BorderWeight, StitchBlend::Reproject] {
-            kinds.push(ProgramKind::Stitch {
-                method,
-                reproject_steps: 3,
-            });
+            for &steps in switch_values("stitch/stitch", "REPROJECT_STEPS") {
+                kinds.push(ProgramKind::Stitch {
+                    method,
+                    reproject_steps: steps as u32,
+                });
+            }
         }
         kinds.into_iter().map(|kind| ShaderProgram { conv, kind }).collect()
     }

@@ -193,6 +193,25 @@ impl Texture {
         })
     }
 
+    /// Fill every texel of a single-channel 32-bit texture (R32UI, R32F) with the 4 bytes of
+    /// `bits` (glClearTexImage: the driver fills it, no upload).
+    pub fn clear_bits(&self, bits: u32) -> Result<()> {
+        let (format, ty, bpp) = self.format.transfer();
+        if bpp != 4 || !matches!(self.format, TextureFormat::R32Ui | TextureFormat::R32F) {
+            return Err(Error::Gl(format!("clear of a {:?} texture", self.format)));
+        }
+        let value = bits.to_ne_bytes();
+        // SAFETY: level 0 of a live texture; `value` holds one texel of its transfer format.
+        unsafe {
+            self.gpu
+                .0
+                .ctx
+                .clip_control
+                .ClearTexImage(self.raw.0.get(), 0, format, ty, value.as_ptr().cast())
+        };
+        self.gpu.check("texture clear")
+    }
+
     /// Bind to texture unit `unit`.
     pub fn bind(&self, unit: u32) {
         // SAFETY: valid handle.

@@ -16,7 +16,6 @@ use crate::cyclopean::{
 use crate::depth::DepthEncoding;
 use crate::io::{self, DepthDecode, DepthMap, DepthSummary, RgbImage};
 use crate::refocus::{BreakRule, OutputSet};
-use crate::vulkan::VkCyclopean;
 use std::path::{Path, PathBuf};
 
 /// How the middle view is synthesised.
@@ -91,7 +90,7 @@ pub struct CyclopeanOptions {
     pub out_dir: PathBuf,
     /// The GPU to render on.
     pub gpu: GpuRequest,
-    /// GL, or Vulkan (methods seed and refine only).
+    /// GL, or Vulkan (every method but the forward warp).
     pub backend: Backend,
 }
 
@@ -206,7 +205,8 @@ impl CyclopeanJob {
             (None, None) => CyclopeanMethod::SplatGather,
         };
         let gathers = matches!(method, CyclopeanMethod::Seed | CyclopeanMethod::Refine);
-        if o.backend == Backend::Vulkan && !gathers {
+        // The forward warp (a depth-tested mesh) is the one method not yet described as passes.
+        if o.backend == Backend::Vulkan && method == CyclopeanMethod::Forward {
             let default = if o.method.is_none() { " (the default)" } else { "" };
             return Err(ArgError::VulkanCyclopeanMethod(method.name(), default));
         }
@@ -319,22 +319,18 @@ impl CyclopeanJob {
             depth: self.outputs.depth,
         };
         let (out, timing) = match (self.backend, self.method, params) {
-            // `new` refused every other method with Vulkan.
-            (Backend::Vulkan, _, Some(p)) => {
-                let vk = host.open_vulkan(&self.gpu)?;
-                VkCyclopean::with_outputs(&vk, &frame, p, wanted)?.render(&mid)?
-            }
+            // `new` refused the forward warp with Vulkan.
             (_, CyclopeanMethod::Seed | CyclopeanMethod::Refine, Some(p)) => {
-                let gpu = host.open_gpu(&self.gpu)?;
-                CyclopeanRenderer::with_outputs(&gpu, &frame, p, wanted)?.render(&mid)?
+                let device = host.open_device(&self.gpu, self.backend)?;
+                CyclopeanRenderer::with_outputs(&device, &frame, p, wanted)?.render(&mid)?
             }
             (_, CyclopeanMethod::Forward, _) => {
                 let gpu = host.open_gpu(&self.gpu)?;
                 ForwardWarp::new(&gpu, &frame, &BreakRule::default())?.render(&mid)?
             }
             _ => {
-                let gpu = host.open_gpu(&self.gpu)?;
-                SplatRenderer::new(&gpu, &frame, SplatParams::default(), wanted)?.render(&mid)?
+                let device = host.open_device(&self.gpu, self.backend)?;
+                SplatRenderer::new(&device, &frame, SplatParams::default(), wanted)?.render(&mid)?
             }
         };
         let mask = io::Mask::new(
@@ -509,11 +505,7 @@ mod tests {
     #[test]
     fn vulkan_backend_refuses_the_methods_it_does_not_run_by_name() {
         use super::Backend;
-        for (method, named) in [
-            (None, "--method splat-gather (the default)"),
-            (Some(CyclopeanMethod::SplatGather), "--method splat-gather "),
-            (Some(CyclopeanMethod::Forward), "--method forward "),
-        ] {
+        for (method, named) in [(Some(CyclopeanMethod::Forward), "--method forward ")] {
             let o = CyclopeanOptions {
                 method,
                 backend: Backend::Vulkan,
@@ -523,9 +515,14 @@ mod tests {
             assert!(matches!(e, ArgError::VulkanCyclopeanMethod(..)), "{e}");
             assert!(e.to_string().contains(named), "{e}");
         }
-        for method in [CyclopeanMethod::Seed, CyclopeanMethod::Refine] {
+        for method in [
+            None,
+            Some(CyclopeanMethod::SplatGather),
+            Some(CyclopeanMethod::Seed),
+            Some(CyclopeanMethod::Refine),
+        ] {
             let o = CyclopeanOptions {
-                method: Some(method),
+                method,
                 backend: Backend::Vulkan,
                 ..disparity_options()
             };

@@ -118,8 +118,8 @@ pub enum ArgError {
     },
     /// `--backend vulkan` with a cyclopean method Vulkan does not run.
     #[error(
-        "--backend vulkan runs the cyclopean methods seed and refine only; --method {0}{1} renders on GL \
-         (give --method seed or refine, or drop --backend)"
+        "--backend vulkan runs the cyclopean methods splat-gather, seed and refine; --method {0}{1} renders on GL \
+         only (give another --method, or drop --backend)"
     )]
     VulkanCyclopeanMethod(&'static str, &'static str),
     /// A seed/refine option with another cyclopean method.

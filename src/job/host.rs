@@ -129,6 +129,14 @@ pub trait Host {
     }
     /// Something to tell the person running the job.
     fn event(&self, event: Event<'_>);
+    /// A pass device on `backend` (`--backend`): GL through [`Host::open_gpu`], Vulkan through
+    /// [`Host::open_vulkan`], each under the request's `--device` and `--require-gpu`.
+    fn open_device(&self, request: &GpuRequest, backend: Backend) -> crate::Result<crate::pass::Device> {
+        match backend {
+            Backend::Gl => crate::pass::Device::gl(&self.open_gpu(request)?),
+            Backend::Vulkan => crate::vulkan::VkExecutor::device(&self.open_vulkan(request)?),
+        }
+    }
 }
 
 #[cfg(test)]

@@ -4,7 +4,7 @@
 
 use super::error::{InContext, OptionsContext};
 use super::write::{write_all_or_none, WriteJob};
-use super::{ArgError, Event, GpuRequest, Host, JobError, SourceIntrinsics};
+use super::{ArgError, Backend, Event, GpuRequest, Host, JobError, SourceIntrinsics};
 use crate::camera::stereo::{Eye, StereoParams};
 use crate::camera::PinholeCamera;
 use crate::convention::{Conventions, DepthPlanes};
@@ -119,6 +119,8 @@ pub struct ReprojectOptions {
     pub conventions: Conventions,
     /// The GPU to render on.
     pub gpu: GpuRequest,
+    /// `--backend`: the API the passes run on.
+    pub backend: Backend,
 }
 
 /// The views and their geometry, checked; the parts that need the source's size wait for it.
@@ -159,6 +161,7 @@ pub struct ReprojectJob {
     files: FileFormats,
     out_dir: PathBuf,
     gpu: GpuRequest,
+    backend: Backend,
 }
 
 /// One target rendered.
@@ -248,6 +251,7 @@ impl ReprojectJob {
             files: o.files,
             out_dir: o.out_dir,
             gpu: o.gpu,
+            backend: o.backend,
         })
     }
 
@@ -265,7 +269,7 @@ impl ReprojectJob {
         let (width, height) = (src.color.width, src.color.height);
         let out_dir = io::OutDir::prepare(&self.out_dir)?;
 
-        let gpu = host.open_gpu(&self.gpu)?;
+        let gpu = host.open_device(&self.gpu, self.backend)?;
         let mut results: Vec<(Eye, ReprojectOutput, Timing, f64)> = Vec::new();
         for (to, geometry) in &targets {
             let t0 = Instant::now();

@@ -2,7 +2,7 @@
 //! depth) ray-traced on the GPU from the demo rig, and the `cameras.json` that `cyclopean` and
 //! `reproject --cameras` read. Every file or none: a failing rerun leaves the previous scene.
 
-use super::{ArgError, GpuRequest, Host, JobError};
+use super::{ArgError, Backend, GpuRequest, Host, JobError};
 use crate::camera::gl_projection;
 use crate::convention::Conventions;
 use crate::cyclopean::scene_frame::StereoRig;
@@ -28,6 +28,8 @@ pub struct SceneOptions {
     pub out_dir: PathBuf,
     /// The GPU to render on.
     pub gpu: GpuRequest,
+    /// `--backend`: the API the passes run on.
+    pub backend: Backend,
 }
 
 /// The scene to trace: built in (known now) or a file (read when the job runs).
@@ -45,6 +47,7 @@ pub struct SceneJob {
     conventions: Conventions,
     out_dir: PathBuf,
     gpu: GpuRequest,
+    backend: Backend,
 }
 
 /// What a scene rendering wrote.
@@ -79,6 +82,7 @@ impl SceneJob {
             conventions: o.conventions,
             out_dir: o.out_dir,
             gpu: o.gpu,
+            backend: o.backend,
         })
     }
 
@@ -102,7 +106,7 @@ impl SceneJob {
         let out = io::OutDir::prepare(&self.out_dir)?;
         let mut set = out.file_set()?;
         let staged = set.staging().to_path_buf();
-        let gpu = host.open_gpu(&self.gpu)?;
+        let gpu = host.open_device(&self.gpu, self.backend)?;
         let mut renderer = SceneRenderer::new(&gpu, scene)?;
         let proj = gl_projection(&rig.camera, &rig.planes, &conv);
         let mut cams = serde_json::Map::new();
@@ -162,6 +166,7 @@ mod tests {
             conventions: Default::default(),
             out_dir: "out".into(),
             gpu: Default::default(),
+            backend: Default::default(),
         }
     }
 

@@ -6,7 +6,7 @@
 use super::error::{InContext, OptionsContext};
 use super::reproject::device_depth;
 use super::write::{write_all_or_none, WriteJob};
-use super::{ArgError, Event, GpuRequest, Host, JobError};
+use super::{ArgError, Backend, Event, GpuRequest, Host, JobError};
 use crate::convention::Conventions;
 use crate::depth::DepthEncoding;
 use crate::eval::stitch::{score_eyes, split_top_bottom, StitchScore};
@@ -88,6 +88,8 @@ pub struct StitchOptions {
     pub out_dir: PathBuf,
     /// The GPU to render on.
     pub gpu: GpuRequest,
+    /// `--backend`: the API the passes run on.
+    pub backend: Backend,
 }
 
 /// A checked stitch.
@@ -106,6 +108,7 @@ pub struct StitchJob {
     truth: bool,
     out_dir: PathBuf,
     gpu: GpuRequest,
+    backend: Backend,
 }
 
 /// The stitched image against the ODS truth.
@@ -227,6 +230,7 @@ impl StitchJob {
             truth: o.truth,
             out_dir: o.out_dir,
             gpu: o.gpu,
+            backend: o.backend,
         })
     }
 
@@ -280,7 +284,7 @@ impl StitchJob {
         let faces_ms = t0.elapsed().as_secs_f64() * 1e3;
         let out_dir = io::OutDir::prepare(&self.out_dir)?;
 
-        let gpu = host.open_gpu(&self.gpu)?;
+        let gpu = host.open_device(&self.gpu, self.backend)?;
         let t0 = Instant::now();
         let mut renderer = StitchRenderer::with_conventions(&gpu, &left, &right, conv)?;
         let setup_ms = t0.elapsed().as_secs_f64() * 1e3;
@@ -364,6 +368,7 @@ mod tests {
             truth: false,
             out_dir: "out".into(),
             gpu: GpuRequest::default(),
+            backend: Default::default(),
         }
     }
 

@@ -7,7 +7,7 @@ use super::reference::reproject_reference;
 use super::render::Reprojector;
 use super::{Geometry, ReprojectParams, ReprojectSource};
 use crate::error::Result;
-use crate::gpu::Gpu;
+use crate::pass::ToDevice;
 use crate::view::ViewOutput;
 
 /// Everything a reprojection needs, GPU and f64 twin alike.
@@ -29,9 +29,9 @@ pub fn target_size(geometry: &Geometry) -> (u32, u32) {
     }
 }
 
-/// The GPU reprojection of `input`, with its times (one [`Reprojector`], one render).
-pub fn gpu(gpu: &Gpu, input: &ReprojectInput) -> Result<ViewOutput> {
-    let (out, timing) = Reprojector::new(gpu, input.source, input.geometry, input.params)?.render()?;
+/// The GPU reprojection of `input` on `device` (GL or Vulkan), with its times (one [`Reprojector`], one render).
+pub fn gpu(device: impl ToDevice, input: &ReprojectInput) -> Result<ViewOutput> {
+    let (out, timing) = Reprojector::new(device, input.source, input.geometry, input.params)?.render()?;
     let (w, h) = target_size(input.geometry);
     Ok(ViewOutput::from_reproject(&out, w, h, Some(timing)))
 }

@@ -1,11 +1,11 @@
 //! GPU reprojection: the shift gathers as one full-screen pass (shaders/reproject/shift.frag),
-//! the 3-D gather through the cyclopean renderer with one eye. Output rows top-down.
+//! the 3-D gather through the cyclopean renderer with one eye; described once
+//! ([`crate::pass`]) and run by the GL or the Vulkan executor. Output rows top-down.
 
 use super::merge_nearer;
 use super::reference::SCAN_MARGIN;
 use super::{
     check, gather3d_params, one_eye_frame, Geometry, Method, ReprojectOutput, ReprojectParams, ReprojectSource,
-    ShiftModel,
 };
 use crate::convention::RowOrder;
 use crate::cyclopean::render::CyclopeanRenderer;
@@ -13,29 +13,29 @@ use crate::cyclopean::{CyclopeanOutputs, MiddleCamera};
 use crate::depth::DepthEncoding;
 use crate::error::{Error, Result};
 use crate::gpu::shaders::ShiftDepth;
-use crate::gpu::{
-    Attachment, DrawState, Framebuffer, Gpu, GpuTimer, Program, ProgramKind, ShaderProgram, Texture, TextureFormat,
-    Timing, VertexArray,
-};
+use crate::gpu::{ProgramKind, ShaderProgram, Timing};
 use crate::io::{DepthMap, RgbImage};
+use crate::pass::{Device, Draw, Format, Image, ImageData, Target, ToDevice};
 
-/// Rows top-down <-> memory order under the row-order convention (an involution).
-fn memory_rows(data: &[u8], row_bytes: usize, flip: bool) -> Vec<u8> {
-    if !flip {
-        return data.to_vec();
+crate::param_block! {
+    /// The shift's parameters: shaders/reproject/shift_params.glsl, member for member.
+    pub struct ShiftParams("ShiftParams") {
+        u_a: f32,
+        u_b: f32,
+        u_alpha: f32,
+        u_beta: f32,
+        u_q_min: f32,
+        u_q_max: f32,
+        u_tau_rel: f32,
+        u_steps: i32,
     }
-    data.chunks_exact(row_bytes).rev().flatten().copied().collect()
 }
 
 struct ShiftPass {
-    program: Program,
-    color: Texture,
-    depth: Texture,
-    vao: VertexArray,
-    framebuffer: Framebuffer,
-    model: ShiftModel,
-    alpha_beta: (f64, f64),
-    q_range: Option<(f64, f64)>,
+    program: ShaderProgram,
+    color: Image,
+    depth: Image,
+    block: ShiftParams,
 }
 
 enum Pass {
@@ -43,11 +43,11 @@ enum Pass {
     Gather3d(Box<([CyclopeanRenderer; 2], MiddleCamera)>),
 }
 
-/// A source view on the GPU, ready to render its reprojection.
+/// A source view on the GPU (GL or Vulkan), ready to render its reprojection.
 pub struct Reprojector {
-    gpu: Gpu,
+    device: Device,
     params: ReprojectParams,
-    flip: bool,
+    rows: RowOrder,
     width: u32,
     height: u32,
     pass: Pass,
@@ -55,10 +55,16 @@ pub struct Reprojector {
 
 impl Reprojector {
     /// Uploads `src` for the target `geometry` and builds the method's programs; checks the inputs first.
-    pub fn new(gpu: &Gpu, src: &ReprojectSource, geometry: &Geometry, params: ReprojectParams) -> Result<Self> {
-        gpu.check_image_size("source size", src.color.width, src.color.height)?;
+    pub fn new(
+        device: impl ToDevice,
+        src: &ReprojectSource,
+        geometry: &Geometry,
+        params: ReprojectParams,
+    ) -> Result<Self> {
+        let device = device.to_device()?;
+        device.check_image_size("source size", src.color.width, src.color.height)?;
         let model = check(src, geometry, &params)?;
-        let flip = src.conv.row_order == RowOrder::BottomUp;
+        let rows = src.conv.row_order;
         let (w, h) = (src.color.width, src.color.height);
         let pass = match (model, params.method) {
             (None, Method::Gather3d { steps }) => {
@@ -71,8 +77,8 @@ impl Reprojector {
                     depth: true,
                 };
                 let r = [
-                    CyclopeanRenderer::with_outputs(gpu, &frame, p0, wanted)?,
-                    CyclopeanRenderer::with_outputs(gpu, &frame, p1, wanted)?,
+                    CyclopeanRenderer::with_outputs(&device, &frame, p0, wanted)?,
+                    CyclopeanRenderer::with_outputs(&device, &frame, p1, wanted)?,
                 ];
                 Pass::Gather3d(Box::new((r, target)))
             }
@@ -87,57 +93,46 @@ impl Reprojector {
                     scan: params.method == Method::ShiftScan,
                     scan_margin: SCAN_MARGIN as u32,
                 };
-                let program = ShaderProgram::new(src.conv, kind).build(gpu)?;
                 let rgba: Vec<u8> = crate::gpu::pixels::rgb_to_rgba(&src.color.data);
                 let depth: Vec<u8> = crate::gpu::pixels::f32_to_bytes(&src.depth.data);
-                let slot = |wanted: bool, format| {
-                    wanted.then_some(Attachment {
+                let image = |bytes: Vec<u8>, format, label| {
+                    device.upload(&ImageData {
+                        width: w,
+                        height: h,
                         format,
-                        clear: [0.0; 4],
+                        bytes: &rows.convert_rows(bytes, w as usize * 4),
+                        label,
                     })
                 };
+                let (alpha, beta) = src.depth_kind.affine_inverse_depth(&src.conv).unwrap_or((0.0, 0.0));
+                // No valid depth: q_max = 0 makes every pixel invalid.
+                let (q_min, q_max) = src.inverse_depth_range().unwrap_or((0.0, 0.0));
+                let steps = match params.method {
+                    Method::Shift { steps } => steps,
+                    _ => 0,
+                };
                 Pass::Shift(Box::new(ShiftPass {
-                    program,
-                    color: Texture::new(
-                        gpu,
-                        w,
-                        h,
-                        TextureFormat::Rgba8,
-                        Some(&memory_rows(&rgba, w as usize * 4, flip)),
-                    )?
-                    .with_label("reproject source colour"),
-                    depth: Texture::new(
-                        gpu,
-                        w,
-                        h,
-                        TextureFormat::R32F,
-                        Some(&memory_rows(&depth, w as usize * 4, flip)),
-                    )?
-                    .with_label("reproject source depth"),
-                    vao: VertexArray::new(gpu)?.with_label("reproject vertex array"),
-                    framebuffer: Framebuffer::new(
-                        gpu,
-                        w,
-                        h,
-                        &[
-                            slot(params.outputs.color, TextureFormat::Rgba8),
-                            slot(params.outputs.depth, TextureFormat::R32F),
-                            slot(true, TextureFormat::R8),
-                        ],
-                        false,
-                    )?
-                    .with_label("reproject target"),
-                    model,
-                    alpha_beta: src.depth_kind.affine_inverse_depth(&src.conv).unwrap_or((0.0, 0.0)),
-                    q_range: src.inverse_depth_range(),
+                    program: ShaderProgram::new(src.conv, kind),
+                    color: image(rgba, Format::Rgba8, "reproject source colour")?,
+                    depth: image(depth, Format::R32F, "reproject source depth")?,
+                    block: ShiftParams {
+                        u_a: model.a_px as f32,
+                        u_b: model.b_px as f32,
+                        u_alpha: alpha as f32,
+                        u_beta: beta as f32,
+                        u_q_min: q_min as f32,
+                        u_q_max: q_max as f32,
+                        u_tau_rel: params.tau_rel as f32,
+                        u_steps: steps as i32,
+                    },
                 }))
             }
             (None, _) => return Err(Error::param("method", "shift method without a shift model")),
         };
         Ok(Reprojector {
-            gpu: gpu.clone(),
+            device,
             params,
-            flip,
+            rows,
             width: w,
             height: h,
             pass,
@@ -194,61 +189,39 @@ impl Reprojector {
             }
             Pass::Shift(s) => {
                 let (w, h) = (self.width, self.height);
-                let p = &s.program;
-                let fb = &s.framebuffer;
-                let timer = GpuTimer::start(&self.gpu);
-                let pass = fb.begin_pass(DrawState::default(), 1.0);
-                p.bind();
-                s.color.bind(0);
-                s.depth.bind(1);
-                p.set_i32("u_color", 0);
-                p.set_i32("u_depth", 1);
-                p.set_f32("u_a", s.model.a_px as f32);
-                p.set_f32("u_b", s.model.b_px as f32);
-                p.set_f32("u_alpha", s.alpha_beta.0 as f32);
-                p.set_f32("u_beta", s.alpha_beta.1 as f32);
-                // No valid depth: q_max = 0 makes every pixel invalid.
-                let (q_min, q_max) = s.q_range.unwrap_or((0.0, 0.0));
-                p.set_f32("u_q_min", q_min as f32);
-                p.set_f32("u_q_max", q_max as f32);
-                p.set_f32("u_tau_rel", self.params.tau_rel as f32);
-                let steps = match self.params.method {
-                    Method::Shift { steps } => steps,
-                    _ => 0,
+                let target = Target {
+                    width: w,
+                    height: h,
+                    outputs: vec![
+                        self.params.outputs.color.then_some(Format::Rgba8),
+                        self.params.outputs.depth.then_some(Format::R32F),
+                        Some(Format::R8),
+                    ],
+                    rows: self.rows,
                 };
-                p.set_i32("u_steps", steps as i32);
-                pass.draw_fullscreen(&s.vao);
-                drop(pass);
-                self.gpu.check("reproject shift draw")?;
-                let read = |i: usize, bpp: usize| -> Result<Option<Vec<u8>>> {
-                    Ok(fb
-                        .read_color(i)?
-                        .map(|data| memory_rows(&data, w as usize * bpp, self.flip)))
+                let images = [s.color.id(), s.depth.id()];
+                let draw = Draw {
+                    program: s.program,
+                    params: bytemuck::bytes_of(&s.block),
+                    images: &images,
+                    buffers: &[],
+                    viewport: [0, 0, w, h],
                 };
-                let (rgba, depth) = (read(0, 4)?, read(1, 4)?);
-                let timing = timer.stop();
-                let mask = read(2, 1)?.ok_or_else(|| Error::Gl("reproject: mask attachment missing".into()))?;
-                Ok((
-                    ReprojectOutput {
-                        color: rgba
-                            .map(|d| RgbImage::new(w, h, crate::gpu::pixels::rgba_to_rgb(&d)))
-                            .transpose()?,
-                        depth: depth
-                            .map(|d| {
-                                DepthMap::new(
-                                    w,
-                                    h,
-                                    crate::gpu::pixels::bytes_to_f32(&d)
-                                        .into_iter()
-                                        .map(|z| if z.is_finite() { z } else { 0.0 })
-                                        .collect(),
-                                )
-                            })
-                            .transpose()?,
-                        mask,
-                    },
-                    timing,
-                ))
+                let mut out = self.device.render(&target, &[draw])?;
+                let color = out.outputs[0].take().map(|c| RgbImage::new(w, h, c)).transpose()?;
+                let depth = out.outputs[1]
+                    .take()
+                    .map(|d| {
+                        let z: Vec<f32> = bytemuck::pod_collect_to_vec(&d);
+                        DepthMap::new(
+                            w,
+                            h,
+                            z.into_iter().map(|z| if z.is_finite() { z } else { 0.0 }).collect(),
+                        )
+                    })
+                    .transpose()?;
+                let mask = out.take(2, "reproject shift")?;
+                Ok((ReprojectOutput { color, depth, mask }, out.timing))
             }
         }
     }

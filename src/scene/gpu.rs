@@ -2,15 +2,34 @@
 //! projection P, conventions), and its f64 twin with the same ray construction. Both give
 //! colour, view distance and window depth, rows top-down.
 
-use super::{pattern_color, Scene, Shape};
+use super::{pattern_color, Scene, Shape, MAX_OBJECTS};
 use crate::camera::mat4::{self, Mat4};
 use crate::convention::{Conventions, DepthPlanes, RowOrder};
 use crate::error::{Error, Result};
-use crate::gpu::{
-    Attachment, DrawState, Framebuffer, Gpu, GpuTimer, Program, ProgramKind, ShaderProgram, TextureFormat, Timing,
-    VertexArray,
-};
+use crate::gpu::{ProgramKind, ShaderProgram, Timing};
 use crate::io::{DepthMap, RgbImage};
+use crate::pass::{mat4_std140, Device, Draw, Format, Target, ToDevice};
+
+crate::param_block! {
+    /// The ray tracer's parameters: shaders/scene/raytrace_params.glsl, member for member.
+    pub struct RaytraceParams("RaytraceParams") {
+        u_inv_view_proj: [[f32; 4]; 4],
+        u_view_proj: [[f32; 4]; 4],
+        u_view: [[f32; 4]; 4],
+        u_eye: [f32; 3],
+        u_ods_radius: f32,
+        u_ods_centre: [f32; 3],
+        u_ods_fade_start: f32,
+        u_size: [f32; 2],
+        u_count: i32,
+        u_ods: i32,
+        u_kind: [[i32; 4]; MAX_OBJECTS],
+        u_a: [[f32; 4]; MAX_OBJECTS],
+        u_b: [[f32; 4]; MAX_OBJECTS],
+        u_c: [[f32; 4]; MAX_OBJECTS],
+        u_d: [[f32; 4]; MAX_OBJECTS],
+    }
+}
 
 /// NDC z of the point each pixel's ray is built through (inside the range of every convention).
 pub const RAY_NDC_Z: f64 = 0.5;
@@ -117,33 +136,20 @@ enum Camera<'a> {
     },
 }
 
-/// A scene uploaded as uniforms, ready to render any GL camera.
+/// A scene as a parameter block, ready to render any GL camera (GL or Vulkan).
 pub struct SceneRenderer {
-    gpu: Gpu,
+    device: Device,
     scene: Scene,
-    programs: Vec<(Conventions, Program)>,
-    vao: VertexArray,
 }
 
 impl SceneRenderer {
-    /// Uploads `scene` (checked first) for rendering; programs are built per convention on first use.
-    pub fn new(gpu: &Gpu, scene: &Scene) -> Result<Self> {
+    /// Checks `scene` for rendering on `device` (the program is built on first use).
+    pub fn new(device: impl ToDevice, scene: &Scene) -> Result<Self> {
         scene.validate()?;
         Ok(SceneRenderer {
-            gpu: gpu.clone(),
+            device: device.to_device()?,
             scene: scene.clone(),
-            programs: Vec::new(),
-            vao: VertexArray::new(gpu)?.with_label("scene vertex array"),
         })
-    }
-
-    fn program(&mut self, conv: Conventions) -> Result<&Program> {
-        if let Some(i) = self.programs.iter().position(|(c, _)| *c == conv) {
-            return Ok(&self.programs[i].1);
-        }
-        let p = ShaderProgram::new(conv, ProgramKind::SceneRaytrace).build(&self.gpu)?;
-        self.programs.push((conv, p));
-        Ok(&self.programs.last().expect("just pushed").1)
     }
 
     /// Ray-traces `cam`'s view (rows top-down), with its times.
@@ -212,33 +218,10 @@ impl SceneRenderer {
         };
         let (vp, inv_vp, eye) = cam.matrices()?;
         let (w, h) = (cam.width, cam.height);
-        self.gpu.check_image_size("camera size", w, h)?;
-        let gpu = self.gpu.clone();
-        let slot = |format| {
-            Some(Attachment {
-                format,
-                clear: [0.0; 4],
-            })
-        };
-        let fb = Framebuffer::new(
-            &gpu,
-            w,
-            h,
-            &[
-                slot(TextureFormat::Rgba8),
-                slot(TextureFormat::R32F),
-                slot(TextureFormat::R32F),
-            ],
-            false,
-        )?
-        .with_label("scene target");
-        let objects = self.scene.objects.clone();
-        let p = self.program(cam.conv)?;
-        let timer = GpuTimer::start(&gpu);
-        let pass = fb.begin_pass(DrawState::default(), 1.0);
-        p.bind();
-        p.set_i32("u_count", objects.len() as i32);
-        for (i, o) in objects.iter().enumerate() {
+        self.device.check_image_size("camera size", w, h)?;
+        let mut block: RaytraceParams = bytemuck::Zeroable::zeroed();
+        block.u_count = self.scene.objects.len() as i32;
+        for (i, o) in self.scene.objects.iter().enumerate() {
             let v4 = |v: [f64; 3], w: f64| [v[0] as f32, v[1] as f32, v[2] as f32, w as f32];
             let (kind, a, b, c, d) = match o.shape {
                 Shape::Plane {
@@ -256,39 +239,45 @@ impl SceneRenderer {
                 Shape::Sphere { center, radius } => (1, v4(center, radius), [0.0; 4], [0.0; 4], [0.0; 4]),
                 Shape::Cuboid { min, max } => (2, v4(min, 0.0), v4(max, 0.0), [0.0; 4], [0.0; 4]),
             };
-            p.set_ivec2(&format!("u_kind[{i}]"), [kind, o.pattern as i32]);
-            p.set_vec4(&format!("u_a[{i}]"), a);
-            p.set_vec4(&format!("u_b[{i}]"), b);
-            p.set_vec4(&format!("u_c[{i}]"), c);
-            p.set_vec4(&format!("u_d[{i}]"), d);
+            block.u_kind[i] = [kind, o.pattern as i32, 0, 0];
+            (block.u_a[i], block.u_b[i], block.u_c[i], block.u_d[i]) = (a, b, c, d);
         }
-        p.set_mat4_rows("u_inv_view_proj", &inv_vp);
-        p.set_mat4_rows("u_view_proj", &vp);
-        p.set_mat4_rows("u_view", &cam.view);
-        p.set_vec3("u_eye", [eye[0] as f32, eye[1] as f32, eye[2] as f32]);
-        p.set_vec2("u_size", [w as f32, h as f32]);
-        p.set_i32("u_ods", ods.is_some() as i32);
+        block.u_inv_view_proj = mat4_std140(&inv_vp);
+        block.u_view_proj = mat4_std140(&vp);
+        block.u_view = mat4_std140(&cam.view);
+        block.u_eye = eye.map(|v| v as f32);
+        block.u_size = [w as f32, h as f32];
+        block.u_ods = ods.is_some() as i32;
         if let Some((centre, radius, fade)) = ods {
-            p.set_vec3("u_ods_centre", centre.map(|v| v as f32));
-            p.set_f32("u_ods_radius", radius as f32);
-            p.set_f32("u_ods_fade_start", fade as f32);
+            block.u_ods_centre = centre.map(|v| v as f32);
+            block.u_ods_radius = radius as f32;
+            block.u_ods_fade_start = fade as f32;
         }
-        pass.draw_fullscreen(&self.vao);
-        drop(pass);
-        gpu.check("scene ray trace")?;
-        let rows = |data: Vec<u8>, bpp: usize| cam.conv.row_order.convert_rows(data, w as usize * bpp);
-        let floats = |b: Vec<u8>| crate::gpu::pixels::bytes_to_f32(&b);
-        let rgba = rows(fb.read_color(0)?.expect("colour"), 4);
-        let view_z = rows(fb.read_color(1)?.expect("view z"), 4);
-        let device = rows(fb.read_color(2)?.expect("device depth"), 4);
-        let timing = timer.stop();
+        let target = Target {
+            width: w,
+            height: h,
+            outputs: vec![Some(Format::Rgba8), Some(Format::R32F), Some(Format::R32F)],
+            rows: cam.conv.row_order,
+        };
+        let draw = Draw {
+            program: ShaderProgram::new(cam.conv, ProgramKind::SceneRaytrace),
+            params: bytemuck::bytes_of(&block),
+            images: &[],
+            buffers: &[],
+            viewport: [0, 0, w, h],
+        };
+        let mut out = self.device.render(&target, &[draw])?;
+        let floats = |b: Vec<u8>| -> Vec<f32> { bytemuck::pod_collect_to_vec(&b) };
+        let color = out.take(0, "scene ray trace")?;
+        let view_z = floats(out.take(1, "scene ray trace")?);
+        let device = floats(out.take(2, "scene ray trace")?);
         Ok((
             SceneImage {
-                color: RgbImage::new(w, h, crate::gpu::pixels::rgba_to_rgb(&rgba))?,
-                view_z: DepthMap::new(w, h, floats(view_z))?,
-                device_depth: DepthMap::new(w, h, floats(device))?,
+                color: RgbImage::new(w, h, color)?,
+                view_z: DepthMap::new(w, h, view_z)?,
+                device_depth: DepthMap::new(w, h, device)?,
             },
-            timing,
+            out.timing,
         ))
     }
 }

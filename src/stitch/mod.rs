@@ -124,13 +124,6 @@ impl Method {
             Method::Reproject => "reproject",
         }
     }
-    pub(crate) fn index(self) -> i32 {
-        match self {
-            Method::Blend => 0,
-            Method::BorderWeight => 1,
-            Method::Reproject => 2,
-        }
-    }
 }
 
 /// One eye of the ODS rig.

@@ -8,7 +8,7 @@ use super::render::StitchRenderer;
 use super::{FaceSet, StitchParams};
 use crate::convention::Conventions;
 use crate::error::Result;
-use crate::gpu::Gpu;
+use crate::pass::ToDevice;
 use crate::view::ViewOutput;
 
 /// Everything a stitch needs, GPU and f64 twin alike.
@@ -25,10 +25,10 @@ pub struct StitchInput<'a> {
     pub conv: Conventions,
 }
 
-/// The GPU stitch of `input`, with its times (one [`StitchRenderer`], one render).
-pub fn gpu(gpu: &Gpu, input: &StitchInput) -> Result<ViewOutput> {
+/// The GPU stitch of `input` on `device` (GL or Vulkan), with its times (one [`StitchRenderer`], one render).
+pub fn gpu(device: impl ToDevice, input: &StitchInput) -> Result<ViewOutput> {
     let (image, timing) =
-        StitchRenderer::with_conventions(gpu, input.left, input.right, input.conv)?.render(&input.params)?;
+        StitchRenderer::with_conventions(device, input.left, input.right, input.conv)?.render(&input.params)?;
     Ok(ViewOutput::color_only(image, Some(timing)))
 }
 

@@ -3,11 +3,12 @@
 //! draw + readback) on the Vulkan device, for the GL-vs-Vulkan comparison.
 
 use super::context::Vk;
-use super::cyclopean::VkCyclopean;
+use super::executor::VkExecutor;
 use super::refocus::VkRefocuser;
 use crate::bench::BenchCase;
 use crate::bench_batch::median;
 use crate::convention::Conventions;
+use crate::cyclopean::render::CyclopeanRenderer;
 use crate::error::Result;
 use crate::refocus::job::TargetSpec;
 use crate::refocus::{BreakRule, Method, OutputSet, RefocusSource};
@@ -87,7 +88,7 @@ pub fn cyclopean_bench(vk: &Vk, width: u32, height: u32, repeats: usize, cases: 
     );
     for (name, params) in crate::eval::cyclopean::cyclopean_methods(3.0) {
         let t0 = Instant::now();
-        let mut r = VkCyclopean::new(vk, &frame, params)?;
+        let mut r = CyclopeanRenderer::new(&VkExecutor::device(vk)?, &frame, params)?;
         r.render(&mid)?; // warm-up: pipeline compile on first use, target allocation
         let setup = t0.elapsed().as_secs_f64() * 1e3;
         let mut runs = Vec::new();

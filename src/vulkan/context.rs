@@ -39,6 +39,8 @@ pub struct VulkanDeviceInfo {
     /// VK_EXT_depth_clip_control: the GL NDC depth range [-1, 1] (the mesh pass needs it for
     /// the `--ndc gl` convention).
     pub depth_clip_control: bool,
+    /// Fragment shaders may write storage buffers (the splat-gather draw lists its edge pixels).
+    pub fragment_stores: bool,
     /// Vulkan 1.3 with dynamic rendering and depth clamp: what the passes need.
     pub usable: bool,
 }
@@ -158,6 +160,7 @@ fn describe(instance: &ash::Instance, index: usize, pd: vk::PhysicalDevice) -> R
             instance.get_physical_device_features2(pd, &mut features);
         }
         let depth_clamp = features.features.depth_clamp == vk::TRUE;
+        let fragment_stores = features.features.fragment_stores_and_atomics == vk::TRUE;
         let text =
             |c: std::result::Result<&CStr, _>| c.map_or(String::new(), |s: &CStr| s.to_string_lossy().into_owned());
         Ok(VulkanDeviceInfo {
@@ -172,6 +175,7 @@ fn describe(instance: &ash::Instance, index: usize, pd: vk::PhysicalDevice) -> R
             device_id: props.device_id,
             max_image_dimension_2d: props.limits.max_image_dimension2_d,
             depth_clip_control: has_clip_control && clip.depth_clip_control == vk::TRUE,
+            fragment_stores,
             usable: props.api_version >= vk::API_VERSION_1_3 && v13.dynamic_rendering == vk::TRUE && depth_clamp,
         })
     }
@@ -282,8 +286,14 @@ impl VulkanContext {
                 .queue_priorities(&priorities)];
             let mut ext_names = Vec::new();
             let mut clip = vk::PhysicalDeviceDepthClipControlFeaturesEXT::default().depth_clip_control(true);
-            let mut v13 = vk::PhysicalDeviceVulkan13Features::default().dynamic_rendering(true);
-            let base = vk::PhysicalDeviceFeatures::default().depth_clamp(true);
+            // maintenance4 (required of every Vulkan 1.3 device): glslang's compute SPIR-V for
+            // Vulkan 1.3 declares its work-group size with LocalSizeId, which needs it.
+            let mut v13 = vk::PhysicalDeviceVulkan13Features::default()
+                .dynamic_rendering(true)
+                .maintenance4(true);
+            let base = vk::PhysicalDeviceFeatures::default()
+                .depth_clamp(true)
+                .fragment_stores_and_atomics(info.fragment_stores);
             let mut features = vk::PhysicalDeviceFeatures2::default()
                 .features(base)
                 .push_next(&mut v13);
@@ -399,6 +409,7 @@ mod tests {
             device_id: 0,
             max_image_dimension_2d: 16384,
             depth_clip_control: true,
+            fragment_stores: true,
             usable,
         }
     }

@@ -9,14 +9,17 @@
 //!   preamble) and graphics pipelines with dynamic rendering.
 //! - `refocus`: the refocus full-screen and mesh passes; `bench`: their timings; `report`: the
 //!   demo's GL-vs-Vulkan table.
-//! - `cyclopean`: the cyclopean gather pass (methods seed and refine).
-//! - `targets`: the colour attachments both passes render into and their readback.
+//! - `executor`: runs the backend-neutral pass descriptions (`crate::pass`): the cyclopean
+//!   gather, the reprojection shift, the stitch and the scene ray tracer, from the same GLSL as
+//!   the GL executor.
+//! - `targets`: the colour attachments the passes render into and their readback.
 //!
-//! Scope: refocus and the cyclopean gather; every other capability renders on GL.
+//! Scope: refocus single frames and every full-screen pass; the compute passes (splat-gather,
+//! edge snap), the forward warp and the refocus batch render on GL.
 
 pub mod bench;
 mod context;
-mod cyclopean;
+mod executor;
 mod pipeline;
 mod refocus;
 pub mod report;
@@ -24,5 +27,5 @@ mod resources;
 mod targets;
 
 pub use context::{auto_pick, check_policy, list_devices, Vk, VulkanContext, VulkanDeviceChoice, VulkanDeviceInfo};
-pub use cyclopean::{preamble as cyclopean_preamble, VkCyclopean};
+pub use executor::VkExecutor;
 pub use refocus::{preamble as refocus_preamble, VkRefocuser};

@@ -145,6 +145,30 @@ impl Pipeline {
     }
 }
 
+impl Pipeline {
+    /// A compute pipeline of `program`'s `comp` stage compiled with `preamble`.
+    pub fn compute(vk: &Vk, layout: vk::PipelineLayout, program: &str, preamble: &str) -> Result<Pipeline> {
+        let d = &vk.device;
+        let words = spirv(program, "comp", preamble)?;
+        // SAFETY: create infos reference locals that outlive the calls; the module is destroyed
+        // after pipeline creation on every path.
+        unsafe {
+            let module = d
+                .create_shader_module(&vk::ShaderModuleCreateInfo::default().code(&words), None)
+                .map_err(|r| Error::Vulkan(format!("vkCreateShaderModule {program}: {r}")))?;
+            let stage = vk::PipelineShaderStageCreateInfo::default()
+                .stage(vk::ShaderStageFlags::COMPUTE)
+                .module(module)
+                .name(c"main");
+            let info = vk::ComputePipelineCreateInfo::default().stage(stage).layout(layout);
+            let result = d.create_compute_pipelines(vk::PipelineCache::null(), &[info], None);
+            d.destroy_shader_module(module, None);
+            let raw = result.map_err(|(_, r)| Error::Vulkan(format!("vkCreateComputePipelines {program}: {r}")))?[0];
+            Ok(Pipeline { vk: vk.clone(), raw })
+        }
+    }
+}
+
 impl Drop for Pipeline {
     fn drop(&mut self) {
         // SAFETY: owned handle; no pending GPU work uses it.
@@ -174,24 +198,30 @@ mod tests {
         }
     }
 
-    /// Every convention and every gather switch (depth kind, seed/refine, hard/soft blend) finds
-    /// its SPIR-V: build.rs's preamble is `ShaderProgram::preamble` of `CyclopeanGather`.
+    /// Every program the shader table marks for Vulkan, at every switch value `ShaderProgram::all`
+    /// lists and under every convention, finds its SPIR-V for every stage: build.rs's preamble
+    /// is `ShaderProgram::preamble`, and the table's switch values cover the typed ones.
     #[test]
-    fn every_cyclopean_gather_variant_is_compiled_with_the_gl_preamble() {
-        use crate::gpu::{ProgramKind, ShaderProgram};
+    fn every_vulkan_program_variant_is_compiled_with_the_gl_preamble() {
+        use crate::gpu::shaders::Stage;
+        use crate::gpu::ShaderProgram;
+        let mut found = 0;
         for conv in Conventions::all() {
-            for bits in 0..8u8 {
-                let kind = ProgramKind::CyclopeanGather {
-                    depth_is_device: bits & 1 != 0,
-                    refine: bits & 2 != 0,
-                    blend_soft: bits & 4 != 0,
-                };
-                let preamble = ShaderProgram::new(conv, kind).preamble();
-                for stage in ["vert", "frag"] {
-                    let words = spirv("cyclopean/gather", stage, &preamble).unwrap();
-                    assert_eq!(words[0], 0x0723_0203, "SPIR-V magic of cyclopean/gather.{stage}");
+            for program in ShaderProgram::all(conv).into_iter().filter(|p| p.kind.on_vulkan()) {
+                let preamble = program.preamble();
+                for (stage, _) in program.sources() {
+                    let stage = match stage {
+                        Stage::Vertex => "vert",
+                        Stage::Fragment => "frag",
+                        Stage::Compute => "comp",
+                    };
+                    let words = spirv(program.kind.name(), stage, &preamble).unwrap();
+                    assert_eq!(words[0], 0x0723_0203, "SPIR-V magic of {}.{stage}", program.kind.name());
+                    found += 1;
                 }
             }
         }
+        // refocus 3 x 2, gather 8, shift 6, stitch 3, ray tracer 1 programs; 2 stages; 8 conventions.
+        assert_eq!(found, (6 + 8 + 6 + 3 + 1) * 2 * 8);
     }
 }

@@ -7,7 +7,7 @@
 //! derived in tests/integration/vulkan_cyclopean.rs).
 
 use super::context::{Vk, VulkanContext, VulkanDeviceChoice};
-use super::cyclopean::VkCyclopean;
+use super::executor::VkExecutor;
 use super::refocus::VkRefocuser;
 use crate::camera::PinholeCamera;
 use crate::convention::Conventions;
@@ -145,7 +145,7 @@ fn cyclopean_table(gpu: &Gpu, vk: &Vk, s: &mut String) -> Result<()> {
     for conv in Conventions::all() {
         let (frame, mid, _) = scene_frame(&rig, conv, FrameDepth::Device);
         let (a, ta) = CyclopeanRenderer::new(gpu, &frame, params)?.render(&mid)?;
-        let (b, tb) = VkCyclopean::new(vk, &frame, params)?.render(&mid)?;
+        let (b, tb) = CyclopeanRenderer::new(&VkExecutor::device(vk)?, &frame, params)?.render(&mid)?;
         let d = cyclopean_diff(&a, &b);
         writeln!(
             s,

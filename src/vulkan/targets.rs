@@ -18,27 +18,53 @@ pub struct ColorTargets {
     pub width: u32,
     /// Height in pixels.
     pub height: u32,
-    color: Vec<Image>,
-    readback: Vec<Buffer>,
+    /// Per output location; None: no attachment (the shader's writes there are discarded).
+    color: Vec<Option<Image>>,
+    readback: Vec<Option<Buffer>>,
     texel_bytes: Vec<usize>,
 }
 
 impl ColorTargets {
     /// One attachment per format (in output-location order), `texel_bytes[i]` bytes per texel.
     pub fn new(vk: &Vk, width: u32, height: u32, formats: &[vk::Format], texel_bytes: &[usize]) -> Result<Self> {
+        let some: Vec<_> = formats.iter().map(|f| Some(*f)).collect();
+        Self::with_slots(vk, width, height, &some, texel_bytes)
+    }
+
+    /// As [`Self::new`], with no attachment (nor host buffer) where `formats[i]` is None.
+    pub fn with_slots(
+        vk: &Vk,
+        width: u32,
+        height: u32,
+        formats: &[Option<vk::Format>],
+        texel_bytes: &[usize],
+    ) -> Result<Self> {
         let usage = vk::ImageUsageFlags::COLOR_ATTACHMENT | vk::ImageUsageFlags::TRANSFER_SRC;
+        // RGBA8 and R32F support storage on every device (the spec's required formats), so a
+        // compute step can rewrite what the draws wrote (the splat-gather edge pass).
+        let storage = |f: vk::Format| match f {
+            vk::Format::R8G8B8A8_UNORM | vk::Format::R32_SFLOAT => vk::ImageUsageFlags::STORAGE,
+            _ => vk::ImageUsageFlags::empty(),
+        };
         let color = formats
             .iter()
-            .map(|&f| Image::new(vk, width, height, f, usage))
+            .map(|f| {
+                f.map(|f| Image::new(vk, width, height, f, usage | storage(f)))
+                    .transpose()
+            })
             .collect::<Result<Vec<_>>>()?;
-        let readback = texel_bytes
+        let readback = formats
             .iter()
-            .map(|&b| {
-                Buffer::new(
-                    vk,
-                    width as usize * height as usize * b,
-                    vk::BufferUsageFlags::TRANSFER_DST,
-                )
+            .zip(texel_bytes)
+            .map(|(f, &b)| {
+                f.map(|_| {
+                    Buffer::new(
+                        vk,
+                        width as usize * height as usize * b,
+                        vk::BufferUsageFlags::TRANSFER_DST,
+                    )
+                })
+                .transpose()
             })
             .collect::<Result<Vec<_>>>()?;
         Ok(ColorTargets {
@@ -56,7 +82,7 @@ impl ColorTargets {
     /// viewport and scissor to the whole image.
     pub fn record_begin(&self, cb: vk::CommandBuffer, depth: Option<&vk::RenderingAttachmentInfo>) {
         use vk::{AccessFlags as A, ImageLayout as L, PipelineStageFlags as S};
-        for c in &self.color {
+        for c in self.color.iter().flatten() {
             c.transition(
                 cb,
                 L::UNDEFINED,
@@ -72,7 +98,7 @@ impl ColorTargets {
             .iter()
             .map(|c| {
                 vk::RenderingAttachmentInfo::default()
-                    .image_view(c.view)
+                    .image_view(c.as_ref().map_or(vk::ImageView::null(), |c| c.view))
                     .image_layout(L::COLOR_ATTACHMENT_OPTIMAL)
                     .load_op(vk::AttachmentLoadOp::CLEAR)
                     .store_op(vk::AttachmentStoreOp::STORE)
@@ -120,7 +146,9 @@ impl ColorTargets {
         // buffers live until the submit has been waited for.
         unsafe {
             d.cmd_end_rendering(cb);
-            for ((c, buf), _) in self.color.iter().zip(&self.readback).zip(wanted).filter(|(_, w)| **w) {
+            let present = self.color.iter().zip(&self.readback).zip(wanted);
+            for ((c, buf), _) in present.filter(|(_, w)| **w) {
+                let (Some(c), Some(buf)) = (c, buf) else { continue };
                 c.transition(
                     cb,
                     L::COLOR_ATTACHMENT_OPTIMAL,
@@ -147,14 +175,68 @@ impl ColorTargets {
         }
     }
 
+    /// Attachment `i`'s view (None without an attachment there).
+    pub fn view(&self, i: usize) -> Option<vk::ImageView> {
+        self.color.get(i).and_then(Option::as_ref).map(|c| c.view)
+    }
+
+    /// Record: end the rendering begun by [`Self::record_begin`] and move every attachment to
+    /// GENERAL, where compute steps may load and store it and the readback copies it.
+    pub fn record_end_to_general(&self, cb: vk::CommandBuffer) {
+        use vk::{AccessFlags as A, ImageLayout as L, PipelineStageFlags as S};
+        // SAFETY: recording into `cb` inside the rendering begun by record_begin.
+        unsafe { self.vk.device.cmd_end_rendering(cb) };
+        for c in self.color.iter().flatten() {
+            c.transition(
+                cb,
+                L::COLOR_ATTACHMENT_OPTIMAL,
+                L::GENERAL,
+                S::COLOR_ATTACHMENT_OUTPUT,
+                A::COLOR_ATTACHMENT_WRITE,
+                S::ALL_COMMANDS,
+                A::MEMORY_READ | A::MEMORY_WRITE,
+            );
+        }
+    }
+
+    /// Record: after [`Self::record_end_to_general`] and the steps that followed (and a barrier
+    /// making their writes visible), copy the attachments with `wanted[i]` set into their host
+    /// buffers and make the copies visible to the host.
+    pub fn record_readback_from_general(&self, cb: vk::CommandBuffer, wanted: &[bool]) {
+        use vk::{AccessFlags as A, ImageLayout as L, PipelineStageFlags as S};
+        let d = &self.vk.device;
+        // SAFETY: recording into `cb` outside any rendering; images and buffers live until the
+        // submit has been waited for.
+        unsafe {
+            let present = self.color.iter().zip(&self.readback).zip(wanted);
+            for ((c, buf), _) in present.filter(|(_, w)| **w) {
+                let (Some(c), Some(buf)) = (c, buf) else { continue };
+                d.cmd_copy_image_to_buffer(cb, c.raw, L::GENERAL, buf.raw, &[c.copy_region()]);
+            }
+            let to_host = vk::MemoryBarrier::default()
+                .src_access_mask(A::TRANSFER_WRITE)
+                .dst_access_mask(A::HOST_READ);
+            d.cmd_pipeline_barrier(
+                cb,
+                S::TRANSFER,
+                S::HOST,
+                vk::DependencyFlags::empty(),
+                &[to_host],
+                &[],
+                &[],
+            );
+        }
+    }
+
     /// Attachment `i`'s texels as read back (after the submit has been waited for), rows
     /// top-down: files are top-down, so a bottom-up memory order is flipped here (GL does it
     /// on the GPU).
+    /// Empty for a location without an attachment.
     pub fn read_rows(&self, i: usize, order: RowOrder) -> Vec<u8> {
         let row_bytes = self.width as usize * self.texel_bytes[i];
-        order.convert_rows(
-            self.readback[i].read(row_bytes * self.height as usize).to_vec(),
-            row_bytes,
-        )
+        let Some(buffer) = &self.readback[i] else {
+            return Vec::new();
+        };
+        order.convert_rows(buffer.read(row_bytes * self.height as usize).to_vec(), row_bytes)
     }
 }

@@ -34,7 +34,15 @@ use viewsynth::io::{self, DepthDecode, DepthMap, RgbImage};
 use viewsynth::metrics;
 
 fn splat_gpu(frame: &StereoFrame, mid: &viewsynth::cyclopean::MiddleCamera) -> CyclopeanOutput {
-    SplatRenderer::new(&gpu(), frame, SplatParams::default(), CyclopeanOutputs::default())
+    splat_on(&viewsynth::pass::Device::gl(&gpu()).unwrap(), frame, mid)
+}
+
+fn splat_on(
+    device: &viewsynth::pass::Device,
+    frame: &StereoFrame,
+    mid: &viewsynth::cyclopean::MiddleCamera,
+) -> CyclopeanOutput {
+    SplatRenderer::new(device, frame, SplatParams::default(), CyclopeanOutputs::default())
         .unwrap()
         .render(mid)
         .unwrap()
@@ -102,8 +110,14 @@ fn dump(tag: &str, out: &CyclopeanOutput, r: &CyclopeanReference, w: u32, h: u32
 
 /// At most `max_fraction` of the pixels may differ (in source bits, colour beyond one level or
 /// depth beyond 2e-5 relative).
-fn check_twin(tag: &str, frame: &StereoFrame, mid: &viewsynth::cyclopean::MiddleCamera, max_fraction: f64) {
-    let out = splat_gpu(frame, mid);
+fn check_twin(
+    device: &viewsynth::pass::Device,
+    tag: &str,
+    frame: &StereoFrame,
+    mid: &viewsynth::cyclopean::MiddleCamera,
+    max_fraction: f64,
+) {
+    let out = splat_on(device, frame, mid);
     let r = splat_reference(frame, mid, &SplatParams::default()).unwrap();
     let (src, col, z) = compare(&out, &r);
     let n = r.depth.len();
@@ -117,17 +131,28 @@ fn check_twin(tag: &str, frame: &StereoFrame, mid: &viewsynth::cyclopean::Middle
 
 #[test]
 fn splat_gather_gpu_matches_its_f64_twin() {
+    splat_gather_twin(&viewsynth::pass::Device::gl(&gpu()).unwrap());
+}
+
+/// The Vulkan executor running the same pass descriptions meets the GL bounds above.
+#[test]
+fn vulkan_splat_gather_matches_its_f64_twin() {
+    splat_gather_twin(&viewsynth::vulkan::VkExecutor::device(&crate::vulkan_refocus::vulkan()).unwrap());
+}
+
+fn splat_gather_twin(device: &viewsynth::pass::Device) {
+    eprintln!("splat-gather twin check on {:?}", device.api());
     let mut rig = StereoRig::demo(160, 120);
     rig.ipd = 0.2;
     for conv in Conventions::all() {
         for kind in [FrameDepth::Device, FrameDepth::ViewZ] {
             let (frame, mid, _) = scene_frame(&rig, conv, kind);
-            check_twin(&format!("scene-{}-{kind:?}", conv.label()), &frame, &mid, 0.001);
+            check_twin(device, &format!("scene-{}-{kind:?}", conv.label()), &frame, &mid, 0.001);
         }
     }
     let (l, r, _) = cones();
     let (frame, mid) = disparity_frame(l, r, &DisparityRig::middle(400.0, 0.1), Conventions::default()).unwrap();
-    check_twin("cones", &frame, &mid, 0.015);
+    check_twin(device, "cones", &frame, &mid, 0.015);
 }
 
 type Eye = (RgbImage, DepthMap);
@@ -712,5 +737,11 @@ fn edge_pass_mixes_more_edge_pixels_than_the_work_group_limit() {
     };
     let (frame, mid) =
         disparity_frame(eye(), eye(), &DisparityRig::middle(1000.0, 0.1), Conventions::default()).unwrap();
-    check_twin("edge-list-beyond-the-group-limit", &frame, &mid, 0.001);
+    check_twin(
+        &viewsynth::pass::Device::gl(&gpu()).unwrap(),
+        "edge-list-beyond-the-group-limit",
+        &frame,
+        &mid,
+        0.001,
+    );
 }

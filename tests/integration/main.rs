@@ -29,4 +29,5 @@ mod stitch;
 mod stress;
 mod vulkan_cli;
 mod vulkan_cyclopean;
+mod vulkan_passes;
 mod vulkan_refocus;

@@ -16,6 +16,7 @@
 //!   off is allowed only where a rounding tie flips (0.1 % of pixels).
 
 use crate::common::{data_dir, gpu};
+use crate::vulkan_refocus::vulkan;
 use viewsynth::camera::stereo::{Eye, StereoParams};
 use viewsynth::camera::{Intrinsics, PinholeCamera};
 use viewsynth::convention::Conventions;
@@ -25,6 +26,7 @@ use viewsynth::eval::image_check;
 use viewsynth::eval::reproject::{methods, motorcycle_case, run_timed, scene_cases, score, teddy_case, Case};
 use viewsynth::io::{DepthMap, RgbImage};
 use viewsynth::metrics;
+use viewsynth::pass::{Device, ToDevice};
 use viewsynth::reproject::reference::{reproject_reference, ReprojectReference};
 use viewsynth::reproject::render::Reprojector;
 use viewsynth::reproject::{
@@ -32,6 +34,7 @@ use viewsynth::reproject::{
     ShiftModel,
 };
 use viewsynth::view::ViewOutput;
+use viewsynth::vulkan::VkExecutor;
 
 const DEPTH_REL_TOL: f64 = 3e-5;
 
@@ -78,7 +81,7 @@ fn views(out: &ReprojectOutput, reference: &ReprojectReference) -> (ViewOutput, 
 }
 
 /// Through the pass/twin contract: [`pass::gpu`] against [`pass::reference`].
-fn check_against_reference(g: &viewsynth::gpu::Gpu, case: &Case, params: ReprojectParams, tag: &str) -> ViewOutput {
+fn check_against_reference(g: impl ToDevice, case: &Case, params: ReprojectParams, tag: &str) -> ViewOutput {
     let input = ReprojectInput {
         source: &case.source,
         geometry: &case.geometry,
@@ -109,14 +112,24 @@ fn check_against_reference(g: &viewsynth::gpu::Gpu, case: &Case, params: Reproje
 
 #[test]
 fn gpu_matches_the_f64_reference_under_every_convention_and_depth_kind() {
-    let g = gpu();
+    twin_under_every_convention_and_depth_kind(&Device::gl(&gpu()).unwrap());
+}
+
+/// The Vulkan executor running the same pass descriptions meets the GL bounds above.
+#[test]
+fn vulkan_matches_the_f64_reference_under_every_convention_and_depth_kind() {
+    twin_under_every_convention_and_depth_kind(&VkExecutor::device(&vulkan()).unwrap());
+}
+
+fn twin_under_every_convention_and_depth_kind(g: &Device) {
+    eprintln!("reproject twin check on {:?}", g.api());
     let mut base: Vec<Option<ViewOutput>> = vec![None; 3 * 3 * 2];
     for conv in Conventions::all() {
         for (ki, kind) in [FrameDepth::Device, FrameDepth::ViewZ].into_iter().enumerate() {
             for (ci, case) in scene_cases(160, 120, 0.2, conv, kind).unwrap().into_iter().enumerate() {
                 for (mi, params) in methods().into_iter().enumerate() {
                     let tag = format!("{} {}", conv.label(), case.name);
-                    let out = check_against_reference(&g, &case, params, &tag);
+                    let out = check_against_reference(g, &case, params, &tag);
                     // Convention independence: same mask, depth within the tolerance.
                     let slot = &mut base[(ki * 3 + ci) * 3 + mi];
                     match slot {

@@ -8,12 +8,15 @@
 //! and window depth within 2e-6 (f32 clip z / w near 1).
 
 use crate::common::gpu;
+use crate::vulkan_refocus::vulkan;
 use viewsynth::camera::mat4::Mat4;
 use viewsynth::camera::stereo::{stereo_projection_gl, Eye, Frustum, StereoParams};
 use viewsynth::camera::{gl_projection, Pose};
 use viewsynth::convention::{Conventions, DepthPlanes};
+use viewsynth::pass::Device;
 use viewsynth::scene::gpu::{trace_gl_reference, GlCamera, SceneImage, SceneRenderer};
 use viewsynth::scene::{builtin, Scene};
+use viewsynth::vulkan::VkExecutor;
 
 fn check(tag: &str, gpu_img: &SceneImage, reference: &SceneImage) {
     let n = reference.view_z.data.len();
@@ -47,12 +50,22 @@ fn scenes() -> Vec<Scene> {
 
 #[test]
 fn gpu_ray_tracer_matches_f64_for_posed_pinholes() {
-    let g = gpu();
+    posed_pinholes_against_the_twin(&Device::gl(&gpu()).unwrap());
+}
+
+/// The Vulkan executor running the same pass description meets the GL bounds above.
+#[test]
+fn vulkan_ray_tracer_matches_f64_for_posed_pinholes() {
+    posed_pinholes_against_the_twin(&VkExecutor::device(&vulkan()).unwrap());
+}
+
+fn posed_pinholes_against_the_twin(g: &Device) {
+    eprintln!("scene twin check on {:?}", g.api());
     let cam = viewsynth::scene::demo_camera(160, 120);
     let pose = Pose::yawed(0.15, [0.2, -0.1, 0.3]);
     let planes = DepthPlanes { near: 0.05, far: 50.0 };
     for scene in scenes() {
-        let mut r = SceneRenderer::new(&g, &scene).unwrap();
+        let mut r = SceneRenderer::new(g, &scene).unwrap();
         for conv in Conventions::all() {
             let glc = GlCamera {
                 view: pose.gl_view(),

@@ -10,14 +10,17 @@
 //! at most 0.5 % of pixels may be off by more than 1 level; the rest must round the same.
 
 use crate::common::gpu;
+use crate::vulkan_refocus::vulkan;
 use viewsynth::convention::Conventions;
 use viewsynth::eval::image_check;
 use viewsynth::eval::stitch::{score_eyes, split_top_bottom, StitchScore};
+use viewsynth::pass::Device;
 use viewsynth::stitch::faces::{faces_from_images, scene_faces};
 use viewsynth::stitch::reference::stitch_reference;
 use viewsynth::stitch::render::StitchRenderer;
 use viewsynth::stitch::truth::ods_truth;
 use viewsynth::stitch::{pass, seam_band_mask, top_bottom, FaceSet, Method, OdsRig, Side, StitchInput, StitchParams};
+use viewsynth::vulkan::VkExecutor;
 use viewsynth::{metrics, Error};
 
 const N: u32 = 128;
@@ -163,17 +166,30 @@ fn print_stitch_measurements() {
 /// Through the pass/twin contract: [`pass::gpu`] against [`pass::reference`].
 #[test]
 fn gpu_matches_the_f64_reference_for_every_method() {
-    let g = gpu();
+    twin_for_every_method(&Device::gl(&gpu()).unwrap());
+}
+
+/// The Vulkan executor running the same pass description meets the GL bound above, under every
+/// row order (the only convention that reaches this pass).
+#[test]
+fn vulkan_matches_the_f64_reference_for_every_method() {
+    twin_for_every_method(&VkExecutor::device(&vulkan()).unwrap());
+}
+
+fn twin_for_every_method(g: &Device) {
+    eprintln!("stitch twin check on {:?}", g.api());
     for overlap in [5.0, 20.0] {
         let (l, r) = faces(overlap);
         for m in Method::ALL {
+            // The row order is the one convention this pass sees: both, by overlap.
+            let conv = Conventions::all()[if overlap > 10.0 { 4 } else { 0 }];
             let input = StitchInput {
                 left: &l,
                 right: &r,
                 params: params(m, overlap),
-                conv: Conventions::default(),
+                conv,
             };
-            let out = pass::gpu(&g, &input).unwrap();
+            let out = pass::gpu(g, &input).unwrap();
             assert_eq!((out.width, out.height), (W, 2 * H));
             let twin = pass::reference(&input).unwrap();
             let reference = &twin.exact.as_ref().expect("an f64 twin's view").color;

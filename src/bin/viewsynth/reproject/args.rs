@@ -1,6 +1,6 @@
 //! `viewsynth reproject` options and their conversion into a checked library job.
 
-use crate::options::{ConventionArgs, FileOutputArgs, GpuArgs, IntrinsicsArgs};
+use crate::options::{BackendArg, ConventionArgs, FileOutputArgs, GpuArgs, IntrinsicsArgs};
 use clap::{Args, ValueEnum};
 use std::path::PathBuf;
 use viewsynth::camera::stereo::Eye;
@@ -119,6 +119,10 @@ pub(crate) struct ReprojectArgs {
     conv: ConventionArgs,
     #[command(flatten)]
     gpu: GpuArgs,
+    /// Rendering API: gl, or vulkan (the same shaders as SPIR-V on a Vulkan 1.3 device;
+    /// --device an index of `viewsynth info --backend vulkan`).
+    #[arg(long, value_enum, default_value = "gl")]
+    backend: BackendArg,
 }
 
 impl TryFrom<ReprojectArgs> for ReprojectJob {
@@ -166,6 +170,7 @@ impl TryFrom<ReprojectArgs> for ReprojectJob {
             out_dir: a.out_dir,
             conventions: a.conv.into(),
             gpu: a.gpu.try_into()?,
+            backend: a.backend.into(),
         })
     }
 }

@@ -1,6 +1,6 @@
 //! `viewsynth scene` options and their conversion into a checked library job.
 
-use crate::options::{ConventionArgs, GpuArgs};
+use crate::options::{BackendArg, ConventionArgs, GpuArgs};
 use clap::Args;
 use std::path::PathBuf;
 use viewsynth::io;
@@ -26,6 +26,10 @@ pub(crate) struct SceneArgs {
     out_dir: PathBuf,
     #[command(flatten)]
     gpu: GpuArgs,
+    /// Rendering API: gl, or vulkan (the same shaders as SPIR-V on a Vulkan 1.3 device;
+    /// --device an index of `viewsynth info --backend vulkan`).
+    #[arg(long, value_enum, default_value = "gl")]
+    backend: BackendArg,
 }
 
 impl TryFrom<SceneArgs> for SceneJob {
@@ -39,6 +43,7 @@ impl TryFrom<SceneArgs> for SceneJob {
             conventions: a.conv.into(),
             out_dir: a.out_dir,
             gpu: a.gpu.try_into()?,
+            backend: a.backend.into(),
         })
     }
 }

@@ -1,7 +1,7 @@
 //! `viewsynth stitch` options (the face-folder convention is in the help) and their conversion
 //! into a checked library job.
 
-use crate::options::{ConventionArgs, GpuArgs};
+use crate::options::{BackendArg, ConventionArgs, GpuArgs};
 use clap::{Args, ValueEnum};
 use std::path::PathBuf;
 use viewsynth::io;
@@ -97,6 +97,10 @@ pub(crate) struct StitchArgs {
     out_dir: PathBuf,
     #[command(flatten)]
     gpu: GpuArgs,
+    /// Rendering API: gl, or vulkan (the same shaders as SPIR-V on a Vulkan 1.3 device;
+    /// --device an index of `viewsynth info --backend vulkan`).
+    #[arg(long, value_enum, default_value = "gl")]
+    backend: BackendArg,
 }
 
 impl TryFrom<StitchArgs> for StitchJob {
@@ -130,6 +134,7 @@ impl TryFrom<StitchArgs> for StitchJob {
             truth: a.truth,
             out_dir: a.out_dir,
             gpu: a.gpu.try_into()?,
+            backend: a.backend.into(),
         })
     }
 }

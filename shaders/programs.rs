@@ -1,0 +1,212 @@
+// The shader library's one table: every program, its stages with the files each concatenates
+// (shared ones first), the values its own `#define` switches take, and whether it is compiled
+// to SPIR-V for the Vulkan backend. Read by build.rs (which compiles every Vulkan variant with
+// glslangValidator) and by src/gpu/shaders.rs (the GL loader's file lists), through `include!`,
+// so the two cannot drift. Plain data only: no crate items are visible here.
+//
+// Switch order is the order `ProgramKind::defines` renders them in; the SPIR-V lookup is by the
+// exact preamble text, so a drift fails loudly (tests in src/vulkan/pipeline.rs).
+
+/// One program of the library.
+#[allow(dead_code)]
+pub struct ProgramEntry {
+    /// `ProgramKind::name()`, e.g. "reproject/shift".
+    pub name: &'static str,
+    /// Per stage ("vert", "frag", "comp"): files below `shaders/`, concatenated in order.
+    pub stages: &'static [(&'static str, &'static [&'static str])],
+    /// Each switch's `#define` name and every value it takes.
+    pub switches: &'static [(&'static str, &'static [i64])],
+    /// Compiled for Vulkan, with these files (below `shaders/`) between the common Vulkan layer
+    /// and the body; `None`: GL only.
+    pub vulkan: Option<&'static [&'static str]>,
+}
+
+/// Width of the R32UI texture holding kept-triangle codes (refocus mesh, forward warp).
+pub const TRI_TEX_WIDTH: i64 = 4096;
+
+const FULLSCREEN_VERT: &[&str] = &["common/fullscreen.vert"];
+const REFOCUS_FRAG: [&str; 4] = [
+    "common/bilinear.glsl",
+    "common/grid_mesh.glsl",
+    "common/refocus_grid.glsl",
+    "common/refocus_sample.glsl",
+];
+const REFOCUS_SWITCHES: &[(&str, &[i64])] = &[("WANT_RGB", &[0, 1]), ("TRI_TEX_WIDTH", &[TRI_TEX_WIDTH])];
+const SPLAT_GATHER_COMMON: [&str; 5] = [
+    "common/bindings.glsl",
+    "common/camera.glsl",
+    "common/bilinear.glsl",
+    "cyclopean/edge_list.glsl",
+    "cyclopean/splat_gather.glsl",
+];
+
+pub const PROGRAMS: &[ProgramEntry] = &[
+    ProgramEntry {
+        name: "refocus/fullscreen",
+        stages: &[
+            ("vert", FULLSCREEN_VERT),
+            (
+                "frag",
+                &[REFOCUS_FRAG[0], REFOCUS_FRAG[1], REFOCUS_FRAG[2], REFOCUS_FRAG[3], "refocus/fullscreen.frag"],
+            ),
+        ],
+        switches: REFOCUS_SWITCHES,
+        vulkan: Some(&["refocus/vulkan_interface.glsl"]),
+    },
+    ProgramEntry {
+        name: "refocus/mesh_interior",
+        stages: &[
+            (
+                "vert",
+                &["common/grid_mesh.glsl", "common/refocus_grid.glsl", "refocus/mesh_interior.vert"],
+            ),
+            (
+                "frag",
+                &[REFOCUS_FRAG[0], REFOCUS_FRAG[1], REFOCUS_FRAG[2], REFOCUS_FRAG[3], "refocus/mesh_interior.frag"],
+            ),
+        ],
+        switches: REFOCUS_SWITCHES,
+        vulkan: Some(&["refocus/vulkan_interface.glsl"]),
+    },
+    ProgramEntry {
+        name: "refocus/mesh_boundary",
+        stages: &[
+            (
+                "vert",
+                &[
+                    "common/grid_mesh.glsl",
+                    "common/mesh_pull.glsl",
+                    "common/refocus_grid.glsl",
+                    "refocus/mesh_boundary.vert",
+                ],
+            ),
+            (
+                "frag",
+                &[REFOCUS_FRAG[0], REFOCUS_FRAG[1], REFOCUS_FRAG[2], REFOCUS_FRAG[3], "refocus/mesh_boundary.frag"],
+            ),
+        ],
+        switches: REFOCUS_SWITCHES,
+        vulkan: Some(&["refocus/vulkan_interface.glsl"]),
+    },
+    ProgramEntry {
+        name: "cyclopean/gather",
+        stages: &[
+            ("vert", FULLSCREEN_VERT),
+            (
+                "frag",
+                &[
+                    "common/camera.glsl",
+                    "common/depth.glsl",
+                    "common/bilinear.glsl",
+                    "cyclopean/gather_params.glsl",
+                    "cyclopean/gather.frag",
+                ],
+            ),
+        ],
+        switches: &[("DEPTH_IS_DEVICE", &[0, 1]), ("REFINE", &[0, 1]), ("BLEND_SOFT", &[0, 1])],
+        vulkan: Some(&[]),
+    },
+    ProgramEntry {
+        name: "cyclopean/forward",
+        stages: &[
+            (
+                "vert",
+                &[
+                    "common/camera.glsl",
+                    "common/grid_mesh.glsl",
+                    "common/mesh_pull.glsl",
+                    "cyclopean/forward.vert",
+                ],
+            ),
+            ("frag", &["common/bilinear.glsl", "common/grid_mesh.glsl", "cyclopean/forward.frag"]),
+        ],
+        switches: &[("TRI_TEX_WIDTH", &[TRI_TEX_WIDTH])],
+        vulkan: None,
+    },
+    ProgramEntry {
+        name: "cyclopean/splat",
+        stages: &[("comp", &["common/bindings.glsl", "common/camera.glsl", "cyclopean/splat.comp"])],
+        switches: &[],
+        vulkan: Some(&[]),
+    },
+    ProgramEntry {
+        name: "cyclopean/splat_gather",
+        stages: &[
+            ("vert", FULLSCREEN_VERT),
+            (
+                "frag",
+                &[
+                    SPLAT_GATHER_COMMON[0],
+                    SPLAT_GATHER_COMMON[1],
+                    SPLAT_GATHER_COMMON[2],
+                    SPLAT_GATHER_COMMON[3],
+                    SPLAT_GATHER_COMMON[4],
+                    "cyclopean/splat_gather.frag",
+                ],
+            ),
+        ],
+        switches: &[],
+        vulkan: Some(&[]),
+    },
+    ProgramEntry {
+        name: "cyclopean/splat_edges",
+        stages: &[(
+            "comp",
+            &[
+                SPLAT_GATHER_COMMON[0],
+                SPLAT_GATHER_COMMON[1],
+                SPLAT_GATHER_COMMON[2],
+                SPLAT_GATHER_COMMON[3],
+                SPLAT_GATHER_COMMON[4],
+                "cyclopean/splat_edges.comp",
+            ],
+        )],
+        switches: &[],
+        vulkan: Some(&[]),
+    },
+    ProgramEntry {
+        name: "cyclopean/edge_snap",
+        stages: &[("comp", &["common/bindings.glsl", "cyclopean/edge_snap.comp"])],
+        switches: &[],
+        vulkan: Some(&[]),
+    },
+    ProgramEntry {
+        name: "reproject/shift",
+        stages: &[
+            ("vert", FULLSCREEN_VERT),
+            ("frag", &["common/depth.glsl", "reproject/shift_params.glsl", "reproject/shift.frag"]),
+        ],
+        switches: &[("DEPTH_MODE", &[0, 1, 2]), ("SCAN", &[0, 1]), ("SCAN_MARGIN", &[1])],
+        vulkan: Some(&[]),
+    },
+    ProgramEntry {
+        name: "scene/raytrace",
+        stages: &[
+            ("vert", FULLSCREEN_VERT),
+            (
+                "frag",
+                &[
+                    "common/camera.glsl",
+                    "common/depth.glsl",
+                    "common/ods.glsl",
+                    "scene/raytrace_params.glsl",
+                    "scene/raytrace.frag",
+                ],
+            ),
+        ],
+        switches: &[],
+        vulkan: Some(&[]),
+    },
+    ProgramEntry {
+        name: "stitch/stitch",
+        stages: &[
+            ("vert", FULLSCREEN_VERT),
+            (
+                "frag",
+                &["common/bilinear.glsl", "common/ods.glsl", "stitch/stitch_params.glsl", "stitch/stitch.frag"],
+            ),
+        ],
+        switches: &[("METHOD", &[0, 1, 2]), ("REPROJECT_STEPS", &[3])],
+        vulkan: Some(&[]),
+    },
+];

@@ -1,0 +1,323 @@
+//! The GL executor: runs [`super::Draw`]s with the GPU layer's RAII objects (no raw GL here).
+//! Programs are built once per [`ShaderProgram`], framebuffers once per size and output set
+//! (the last few kept), the parameter blocks of a pass go into one uniform buffer at aligned
+//! offsets (one `glBufferSubData` a pass), and outputs are read through the pooled pixel-pack
+//! buffers with the row flip and RGB packing done on the GPU. Compute steps bind storage images
+//! to image units and storage buffers to their bindings from 0 (shaders/common/bindings.glsl),
+//! with `glMemoryBarrier(ALL)` between steps.
+
+use super::{Api, BufferId, Executor, Format, Groups, ImageData, ImageId, Rendered, Step, StorageImage, Target};
+use crate::convention::RowOrder;
+use crate::error::{Error, Result};
+use crate::gpu::{
+    Attachment, Barrier, DrawState, Framebuffer, Gpu, GpuTimer, Program, ReadFormat, ShaderProgram, StorageBuffer,
+    Texture, TextureFormat, UniformBuffer, VertexArray,
+};
+
+/// Framebuffers kept for reuse (sizes and output sets seen most recently).
+const KEPT_TARGETS: usize = 4;
+
+fn texture_format(f: Format) -> TextureFormat {
+    match f {
+        Format::Rgba8 => TextureFormat::Rgba8,
+        Format::R32F => TextureFormat::R32F,
+        Format::R8 => TextureFormat::R8,
+        Format::R32Ui => TextureFormat::R32Ui,
+    }
+}
+
+fn read_format(f: Format) -> ReadFormat {
+    match f {
+        Format::Rgba8 => ReadFormat::RGB8,
+        Format::R32F => ReadFormat::R32F,
+        Format::R8 => ReadFormat::R8,
+        Format::R32Ui => ReadFormat::R32UI,
+    }
+}
+
+/// Passes on an OpenGL context.
+pub struct GlExecutor {
+    gpu: Gpu,
+    vao: VertexArray,
+    params: UniformBuffer,
+    programs: Vec<(ShaderProgram, Program)>,
+    targets: Vec<((u32, u32, Vec<Option<Format>>), Framebuffer)>,
+    images: Vec<Option<Texture>>,
+    buffers: Vec<Option<StorageBuffer>>,
+}
+
+impl GlExecutor {
+    /// An executor on `gpu`.
+    pub fn new(gpu: &Gpu) -> Result<Self> {
+        Ok(GlExecutor {
+            gpu: gpu.clone(),
+            vao: VertexArray::new(gpu)?.with_label("pass vertex array"),
+            params: UniformBuffer::new(gpu)?,
+            programs: Vec::new(),
+            targets: Vec::new(),
+            images: Vec::new(),
+            buffers: Vec::new(),
+        })
+    }
+
+    fn program(&mut self, spec: ShaderProgram) -> Result<usize> {
+        if let Some(i) = self.programs.iter().position(|(s, _)| *s == spec) {
+            return Ok(i);
+        }
+        let p = spec.build(&self.gpu)?;
+        self.programs.push((spec, p));
+        Ok(self.programs.len() - 1)
+    }
+
+    fn target(&mut self, t: &Target) -> Result<usize> {
+        let key = (t.width, t.height, t.outputs.clone());
+        if let Some(i) = self.targets.iter().position(|(k, _)| *k == key) {
+            return Ok(i);
+        }
+        if self.targets.len() >= KEPT_TARGETS {
+            self.targets.remove(0);
+        }
+        let attachments: Vec<Option<Attachment>> = t
+            .outputs
+            .iter()
+            .map(|o| {
+                o.map(|f| Attachment {
+                    format: texture_format(f),
+                    clear: [0.0; 4],
+                })
+            })
+            .collect();
+        let fb = Framebuffer::new(&self.gpu, t.width, t.height, &attachments, false)?.with_label("pass target");
+        self.targets.push((key, fb));
+        Ok(self.targets.len() - 1)
+    }
+}
+
+/// `n` rounded up to a multiple of `a`.
+fn align(n: usize, a: usize) -> usize {
+    n.div_ceil(a) * a
+}
+
+impl Executor for GlExecutor {
+    fn api(&self) -> Api {
+        Api::Gl
+    }
+
+    fn max_image_side(&self) -> u32 {
+        self.gpu.max_image_side()
+    }
+
+    fn upload(&mut self, image: &ImageData) -> Result<ImageId> {
+        let t = Texture::new(
+            &self.gpu,
+            image.width,
+            image.height,
+            texture_format(image.format),
+            Some(image.bytes),
+        )?
+        .with_label(image.label);
+        let slot = self
+            .images
+            .iter()
+            .position(Option::is_none)
+            .unwrap_or(self.images.len());
+        if slot == self.images.len() {
+            self.images.push(None);
+        }
+        self.images[slot] = Some(t);
+        Ok(ImageId(slot))
+    }
+
+    fn free(&mut self, id: ImageId) {
+        if let Some(slot) = self.images.get_mut(id.0) {
+            *slot = None;
+        }
+    }
+
+    fn create_image(&mut self, width: u32, height: u32, format: Format, label: &str) -> Result<ImageId> {
+        let t = Texture::new(&self.gpu, width, height, texture_format(format), None)?.with_label(label);
+        Ok(self.store_image(t))
+    }
+
+    fn create_buffer(&mut self, words: usize, label: &str) -> Result<BufferId> {
+        let b = StorageBuffer::new(&self.gpu, words)?.with_label(label);
+        let slot = self
+            .buffers
+            .iter()
+            .position(Option::is_none)
+            .unwrap_or(self.buffers.len());
+        if slot == self.buffers.len() {
+            self.buffers.push(None);
+        }
+        self.buffers[slot] = Some(b);
+        Ok(BufferId(slot))
+    }
+
+    fn free_buffer(&mut self, id: BufferId) {
+        if let Some(slot) = self.buffers.get_mut(id.0) {
+            *slot = None;
+        }
+    }
+
+    fn run(&mut self, target: Option<&Target>, steps: &[Step]) -> Result<Rendered> {
+        // Programs first (compiles happen once per program), then the target.
+        let mut programs = Vec::with_capacity(steps.len());
+        for step in steps {
+            programs.push(match step {
+                Step::Draw(d) => Some(self.program(d.program)?),
+                Step::Dispatch(d) => Some(self.program(d.program)?),
+                _ => None,
+            });
+        }
+        let fb = target.map(|t| self.target(t)).transpose()?;
+        // Every step's block in one buffer, each at an aligned offset.
+        let alignment = self.params.offset_alignment();
+        let mut blocks = Vec::new();
+        let mut offsets = Vec::with_capacity(steps.len());
+        for step in steps {
+            offsets.push(blocks.len());
+            let params = match step {
+                Step::Draw(d) => d.params,
+                Step::Dispatch(d) => d.params,
+                _ => &[],
+            };
+            blocks.extend_from_slice(params);
+            blocks.resize(align(blocks.len(), alignment), 0);
+        }
+        if !blocks.is_empty() {
+            self.params.write(&blocks)?;
+        }
+        let fb = fb.map(|i| &self.targets[i].1);
+        let timer = GpuTimer::start(&self.gpu);
+        let mut pass = None;
+        for (k, step) in steps.iter().enumerate() {
+            if k > 0 && !matches!((&steps[k - 1], step), (Step::Draw(_), Step::Draw(_))) {
+                // What earlier steps wrote, before this one reads it.
+                self.gpu.memory_barrier(Barrier::All);
+            }
+            if !matches!(step, Step::Draw(_)) {
+                pass = None;
+            }
+            match step {
+                Step::Clear { image, bits } => self.image(*image)?.clear_bits(*bits)?,
+                Step::WriteBuffer { buffer, words } => self.buffer(*buffer)?.write_head(words),
+                Step::Draw(d) => {
+                    let fb = fb.ok_or_else(|| Error::Gl("a draw without a target".into()))?;
+                    if pass.is_none() {
+                        pass = Some(fb.begin_pass(DrawState::default(), 1.0));
+                    }
+                    let p = &self.programs[programs[k].expect("built above")].1;
+                    p.bind();
+                    if !d.params.is_empty() {
+                        self.params.bind_range(0, offsets[k], d.params.len());
+                    }
+                    self.bind_samplers(p.name(), d.images)?;
+                    for (b, id) in d.buffers.iter().enumerate() {
+                        self.buffer(*id)?.bind_storage(b as u32);
+                    }
+                    let [x, y, w, h] = d.viewport;
+                    let pass = pass.as_ref().expect("begun above");
+                    pass.viewport(x, y, w, h);
+                    pass.draw_fullscreen(&self.vao);
+                }
+                Step::Dispatch(d) => {
+                    let p = &self.programs[programs[k].expect("built above")].1;
+                    p.bind();
+                    if !d.params.is_empty() {
+                        self.params.bind_range(0, offsets[k], d.params.len());
+                    }
+                    self.bind_samplers(p.name(), d.images)?;
+                    for (b, id) in d.buffers.iter().enumerate() {
+                        self.buffer(*id)?.bind_storage(b as u32);
+                    }
+                    // Bound while the dispatch runs, unbound when these drop.
+                    let mut bound = Vec::with_capacity(d.storage_images.len());
+                    for (unit, s) in d.storage_images.iter().enumerate() {
+                        let t = match s {
+                            StorageImage::Image(id) => self.image(*id)?,
+                            StorageImage::Output(i) => fb
+                                .and_then(|f| f.color(*i))
+                                .ok_or_else(|| Error::Gl(format!("{}: no output {i} to store to", p.name())))?,
+                        };
+                        bound.push(t.bind_image(unit as u32)?);
+                    }
+                    match d.groups {
+                        Groups::Fixed(g) => p.dispatch(g),
+                        Groups::Indirect { buffer, offset_words } => {
+                            p.dispatch_indirect(self.buffer(buffer)?, offset_words)
+                        }
+                    }
+                    drop(bound);
+                }
+            }
+        }
+        drop(pass);
+        self.gpu.check("pass steps")?;
+        let (Some(target), Some(fb)) = (target, fb) else {
+            return Ok(Rendered {
+                outputs: Vec::new(),
+                timing: timer.stop(),
+            });
+        };
+        // What the steps wrote, before the readback; every read queued before the first wait.
+        self.gpu.memory_barrier(Barrier::All);
+        let flip = target.rows == RowOrder::BottomUp;
+        let reads = target
+            .outputs
+            .iter()
+            .enumerate()
+            .map(|(i, f)| match f {
+                Some(f) => fb.read_async(i, read_format(*f), flip),
+                None => Ok(None),
+            })
+            .collect::<Result<Vec<_>>>()?;
+        let outputs = reads
+            .into_iter()
+            .map(|r| r.map(|r| r.finish()).transpose())
+            .collect::<Result<Vec<_>>>()?;
+        Ok(Rendered {
+            outputs,
+            timing: timer.stop(),
+        })
+    }
+}
+
+impl GlExecutor {
+    fn store_image(&mut self, t: Texture) -> ImageId {
+        let slot = self
+            .images
+            .iter()
+            .position(Option::is_none)
+            .unwrap_or(self.images.len());
+        if slot == self.images.len() {
+            self.images.push(None);
+        }
+        self.images[slot] = Some(t);
+        ImageId(slot)
+    }
+
+    fn image(&self, id: ImageId) -> Result<&Texture> {
+        self.images
+            .get(id.0)
+            .and_then(Option::as_ref)
+            .ok_or_else(|| Error::Gl(format!("pass image {} was freed", id.0)))
+    }
+
+    fn buffer(&self, id: BufferId) -> Result<&StorageBuffer> {
+        self.buffers
+            .get(id.0)
+            .and_then(Option::as_ref)
+            .ok_or_else(|| Error::Gl(format!("pass buffer {} was freed", id.0)))
+    }
+
+    /// Sampled images at texture units 1, 2, ... (the GLSL `layout(binding = k)`).
+    fn bind_samplers(&self, program: &str, images: &[ImageId]) -> Result<()> {
+        for (k, id) in images.iter().enumerate() {
+            let t = self
+                .image(*id)
+                .map_err(|_| Error::Gl(format!("{program}: image {} was freed", id.0)))?;
+            t.bind(k as u32 + 1);
+        }
+        Ok(())
+    }
+}

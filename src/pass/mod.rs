@@ -1,0 +1,434 @@
+//! Backend-neutral render passes: what a capability asks the GPU to do, described once and run
+//! by either executor (OpenGL: [`gl::GlExecutor`]; Vulkan: `crate::vulkan::VkExecutor`).
+//!
+//! Design (after vello's recorded passes): a capability describes a pass as data and never
+//! calls a graphics API. A [`Draw`] names
+//! - the program (a [`ShaderProgram`]: the registry's `ProgramKind` and its typed switches under
+//!   the conventions), which both backends build from the same GLSL (SPIR-V by build.rs);
+//! - one parameter block: the bytes of a `#[repr(C)]` bytemuck `Pod` struct made with
+//!   [`param_block!`], mirrored field for field by a std140 uniform block (binding 0) in one
+//!   `*_params.glsl` file that both backends include, so there are no loose uniforms and no
+//!   hand-packed byte offsets (the layout test holds every block against the offsets the GL
+//!   compiler reports);
+//! - the images it samples, bound at bindings 1, 2, ... in the order listed;
+//! - its viewport inside the [`Target`] (the colour attachments, one per fragment output
+//!   location; an output not asked for gets no attachment and no readback).
+//!
+//! Rows: images are uploaded and attachments read in *memory* order, row 0 = NDC y = -1 in both
+//! APIs; [`Target::rows`] says how memory rows map to the top-down files, and the executor
+//! returns top-down rows (GL flips on the GPU while reading, Vulkan while copying out).
+//!
+//! A [`Device`] is a shared handle to one executor: renderers keep a clone, upload their inputs
+//! once ([`Device::upload`], freed when the [`Image`] drops) and render many times; executors
+//! cache programs/pipelines and targets, so a steady state creates nothing.
+
+pub mod gl;
+
+use crate::convention::RowOrder;
+use crate::error::Result;
+use crate::gpu::{ShaderProgram, Timing};
+use std::cell::RefCell;
+use std::rc::Rc;
+
+/// Texel formats a pass samples or renders into.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub enum Format {
+    /// 8-bit RGBA, normalised; read back as RGB (3 bytes a pixel).
+    Rgba8,
+    /// 32-bit float, single channel.
+    R32F,
+    /// 8-bit single channel, normalised.
+    R8,
+    /// 32-bit unsigned integer, single channel (atomics; sampled with a `usampler2D`).
+    R32Ui,
+}
+
+impl Format {
+    /// Bytes a texel of an uploaded image.
+    pub fn texel_bytes(self) -> usize {
+        match self {
+            Format::Rgba8 | Format::R32F | Format::R32Ui => 4,
+            Format::R8 => 1,
+        }
+    }
+
+    /// Bytes a pixel of a read-back output (RGBA8 comes back as RGB).
+    pub fn output_bytes(self) -> usize {
+        match self {
+            Format::Rgba8 => 3,
+            Format::R32F | Format::R32Ui => 4,
+            Format::R8 => 1,
+        }
+    }
+}
+
+/// Host texels of an image to upload, rows in memory order.
+#[derive(Debug, Clone, Copy)]
+pub struct ImageData<'a> {
+    /// Width in texels.
+    pub width: u32,
+    /// Height in texels.
+    pub height: u32,
+    /// Texel format of `bytes`.
+    pub format: Format,
+    /// `width * height * format.texel_bytes()` bytes.
+    pub bytes: &'a [u8],
+    /// Debugger name (GL object label, Vulkan debug-utils name).
+    pub label: &'a str,
+}
+
+/// An executor's handle of an uploaded or created image.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub struct ImageId(pub usize);
+
+/// An executor's handle of a storage buffer (u32 words).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub struct BufferId(pub usize);
+
+/// An image a step loads, stores or updates atomically.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum StorageImage {
+    /// A created image ([`Device::create_image`]).
+    Image(ImageId),
+    /// Output location `k` of the run's target, after its draws (e.g. a compute pass rewriting
+    /// some texels of the colour the draws wrote).
+    Output(usize),
+}
+
+/// How many work groups a dispatch runs.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Groups {
+    /// x, y (z = 1).
+    Fixed([u32; 2]),
+    /// The 3 words at `offset_words` of `buffer`, which an earlier step wrote.
+    Indirect {
+        /// The buffer holding the counts.
+        buffer: BufferId,
+        /// Word offset of x (then y, z).
+        offset_words: usize,
+    },
+}
+
+/// A compute dispatch.
+#[derive(Debug, Clone)]
+pub struct Dispatch<'a> {
+    /// The program and its switches.
+    pub program: ShaderProgram,
+    /// The std140 parameter block (binding 0).
+    pub params: &'a [u8],
+    /// Sampled images, at bindings 1, 2, ... in this order.
+    pub images: &'a [ImageId],
+    /// Storage images, at `STORAGE_IMAGE(0)`, `(1)`, ... (shaders/common/bindings.glsl).
+    pub storage_images: &'a [StorageImage],
+    /// Storage buffers, at `STORAGE_BUFFER(0)`, `(1)`, ...
+    pub buffers: &'a [BufferId],
+    /// Work groups.
+    pub groups: Groups,
+}
+
+/// One step of a run, executed in order; every step sees what the steps before it wrote (the
+/// executors put a barrier between steps; consecutive draws share one render pass).
+#[derive(Debug, Clone)]
+pub enum Step<'a> {
+    /// Fill a created single-channel 32-bit image with the 4 bytes of a value.
+    Clear {
+        /// The image (R32UI or R32F).
+        image: ImageId,
+        /// The texel's bits.
+        bits: u32,
+    },
+    /// Write `words` at the start of `buffer`.
+    WriteBuffer {
+        /// The buffer.
+        buffer: BufferId,
+        /// The words (at most the buffer's size).
+        words: &'a [u32],
+    },
+    /// A compute dispatch.
+    Dispatch(Dispatch<'a>),
+    /// A full-screen draw into the run's target.
+    Draw(Draw<'a>),
+}
+
+/// The colour attachments of a pass.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct Target {
+    /// Width in pixels.
+    pub width: u32,
+    /// Height in pixels.
+    pub height: u32,
+    /// Per fragment output location: its format, or None when not asked for (no attachment,
+    /// nothing read back).
+    pub outputs: Vec<Option<Format>>,
+    /// How memory rows map to the top-down rows returned.
+    pub rows: RowOrder,
+}
+
+/// One full-screen triangle.
+#[derive(Debug, Clone)]
+pub struct Draw<'a> {
+    /// The program and its switches.
+    pub program: ShaderProgram,
+    /// The std140 parameter block (binding 0): `bytemuck::bytes_of` of a [`param_block!`] struct.
+    pub params: &'a [u8],
+    /// Sampled images, at bindings 1, 2, ... in this order.
+    pub images: &'a [ImageId],
+    /// Storage buffers, at `STORAGE_BUFFER(0)`, `(1)`, ... (shaders/common/bindings.glsl).
+    pub buffers: &'a [BufferId],
+    /// x, y (memory rows), width, height inside the target.
+    pub viewport: [u32; 4],
+}
+
+/// What a pass read back: per output location, top-down bytes where asked for.
+#[derive(Debug)]
+pub struct Rendered {
+    /// Per location of [`Target::outputs`].
+    pub outputs: Vec<Option<Vec<u8>>>,
+    /// Wall time of draws and readback (and GPU time where the backend measures it).
+    pub timing: Timing,
+}
+
+impl Rendered {
+    /// Output `i` (asked for, so present), or an error naming the pass.
+    pub fn take(&mut self, i: usize, what: &str) -> Result<Vec<u8>> {
+        self.outputs
+            .get_mut(i)
+            .and_then(Option::take)
+            .ok_or_else(|| crate::Error::Gl(format!("{what}: output {i} was not rendered")))
+    }
+}
+
+/// The graphics API under a [`Device`].
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Api {
+    /// OpenGL 4.5 core over EGL.
+    Gl,
+    /// Vulkan 1.3.
+    Vulkan,
+}
+
+/// Runs pass descriptions on one graphics API.
+pub trait Executor {
+    /// Which API this is.
+    fn api(&self) -> Api;
+    /// Largest image side this device renders and samples.
+    fn max_image_side(&self) -> u32;
+    /// Upload `image`; the handle is valid until [`Executor::free`].
+    fn upload(&mut self, image: &ImageData) -> Result<ImageId>;
+    /// An image a step can store to and sample, contents undefined until written.
+    fn create_image(&mut self, width: u32, height: u32, format: Format, label: &str) -> Result<ImageId>;
+    /// Release an uploaded or created image.
+    fn free(&mut self, id: ImageId);
+    /// A storage buffer of `words` u32 words (also usable for indirect dispatch counts).
+    fn create_buffer(&mut self, words: usize, label: &str) -> Result<BufferId>;
+    /// Release a buffer.
+    fn free_buffer(&mut self, id: BufferId);
+    /// Run `steps` in order; the draws (at most one contiguous group) render into `target`,
+    /// whose attachments are cleared to 0 first and read back at the end.
+    fn run(&mut self, target: Option<&Target>, steps: &[Step]) -> Result<Rendered>;
+}
+
+/// The draws of `steps` form one contiguous group (one render pass), and need a target.
+pub(crate) fn check_steps(target: Option<&Target>, steps: &[Step]) -> Result<()> {
+    let draws: Vec<usize> = (0..steps.len())
+        .filter(|&i| matches!(steps[i], Step::Draw(_)))
+        .collect();
+    if let (Some(first), Some(last)) = (draws.first(), draws.last()) {
+        if last - first + 1 != draws.len() {
+            return Err(crate::Error::param(
+                "pass steps",
+                "draws must be contiguous (one render pass)",
+            ));
+        }
+        if target.is_none() {
+            return Err(crate::Error::param("pass steps", "draws without a target"));
+        }
+    }
+    Ok(())
+}
+
+/// A shared handle to an executor (renderers keep clones).
+#[derive(Clone)]
+pub struct Device(Rc<RefCell<Box<dyn Executor>>>);
+
+impl Device {
+    /// A device over `executor`.
+    pub fn new(executor: impl Executor + 'static) -> Self {
+        Device(Rc::new(RefCell::new(Box::new(executor))))
+    }
+
+    /// OpenGL on `gpu`.
+    pub fn gl(gpu: &crate::gpu::Gpu) -> Result<Self> {
+        Ok(Device::new(gl::GlExecutor::new(gpu)?))
+    }
+
+    /// Which API runs the passes.
+    pub fn api(&self) -> Api {
+        self.0.borrow().api()
+    }
+
+    /// [`crate::gpu::check_image_size`] against this device's limit.
+    pub fn check_image_size(&self, name: &str, width: u32, height: u32) -> Result<()> {
+        let max = self.0.borrow().max_image_side();
+        crate::gpu::check_image_size(name, width.into(), height.into(), max)
+    }
+
+    /// Upload `image` (checked against the device's size limit first).
+    pub fn upload(&self, image: &ImageData) -> Result<Image> {
+        self.check_image_size(image.label, image.width, image.height)?;
+        let expected = image.width as usize * image.height as usize * image.format.texel_bytes();
+        if image.bytes.len() != expected {
+            return Err(crate::Error::param(
+                image.label.to_string(),
+                format!(
+                    "{} bytes for {}x{} {:?}",
+                    image.bytes.len(),
+                    image.width,
+                    image.height,
+                    image.format
+                ),
+            ));
+        }
+        let id = self.0.borrow_mut().upload(image)?;
+        Ok(Image {
+            device: self.clone(),
+            id,
+        })
+    }
+
+    /// Run one pass: `draws` into `target`, outputs read back top-down.
+    pub fn render(&self, target: &Target, draws: &[Draw]) -> Result<Rendered> {
+        let steps: Vec<Step> = draws.iter().cloned().map(Step::Draw).collect();
+        self.run(Some(target), &steps)
+    }
+
+    /// Run `steps` in order (draws into `target`, read back top-down at the end).
+    pub fn run(&self, target: Option<&Target>, steps: &[Step]) -> Result<Rendered> {
+        if let Some(t) = target {
+            self.check_image_size("render target", t.width, t.height)?;
+        }
+        check_steps(target, steps)?;
+        self.0.borrow_mut().run(target, steps)
+    }
+
+    /// A storage image of `width` x `height` (checked against the device's limit).
+    pub fn create_image(&self, width: u32, height: u32, format: Format, label: &str) -> Result<Image> {
+        self.check_image_size(label, width, height)?;
+        let id = self.0.borrow_mut().create_image(width, height, format, label)?;
+        Ok(Image {
+            device: self.clone(),
+            id,
+        })
+    }
+
+    /// A storage buffer of `words` u32 words.
+    pub fn create_buffer(&self, words: usize, label: &str) -> Result<Buffer> {
+        let id = self.0.borrow_mut().create_buffer(words, label)?;
+        Ok(Buffer {
+            device: self.clone(),
+            id,
+        })
+    }
+}
+
+/// A storage buffer, released when dropped.
+pub struct Buffer {
+    device: Device,
+    id: BufferId,
+}
+
+impl Buffer {
+    /// The handle steps list.
+    pub fn id(&self) -> BufferId {
+        self.id
+    }
+}
+
+impl Drop for Buffer {
+    fn drop(&mut self) {
+        self.device.0.borrow_mut().free_buffer(self.id);
+    }
+}
+
+/// An uploaded image, released when dropped.
+pub struct Image {
+    device: Device,
+    id: ImageId,
+}
+
+impl Image {
+    /// The handle draws list.
+    pub fn id(&self) -> ImageId {
+        self.id
+    }
+}
+
+impl Drop for Image {
+    fn drop(&mut self) {
+        self.device.0.borrow_mut().free(self.id);
+    }
+}
+
+/// A pass's parameter block: a `#[repr(C)]` Pod struct mirrored by a std140 GLSL block.
+pub trait ParamBlock: bytemuck::Pod {
+    /// The GLSL block name (its mirror in `shaders/<capability>/*_params.glsl`).
+    const BLOCK: &'static str;
+    /// Each field's GLSL name and byte offset in the Rust struct (`offset_of!`).
+    const FIELDS: &'static [(&'static str, usize)];
+}
+
+/// Declares a parameter block: a `#[repr(C)]` Pod struct whose field names are the GLSL member
+/// names, and its [`ParamBlock`] table (block name, field offsets) for the layout test. Fields
+/// must be laid out so that std140 needs no padding the struct lacks (vec3 followed by a float,
+/// arrays of 16-byte elements); the test catches any mismatch.
+#[macro_export]
+macro_rules! param_block {
+    ($(#[$m:meta])* $vis:vis struct $name:ident ($block:literal) { $($(#[$fm:meta])* $field:ident : $ty:ty),* $(,)? }) => {
+        $(#[$m])*
+        #[repr(C)]
+        #[derive(Debug, Clone, Copy, bytemuck::Pod, bytemuck::Zeroable)]
+        #[allow(non_snake_case, missing_docs)]
+        $vis struct $name { $($(#[$fm])* pub $field: $ty),* }
+
+        impl $crate::pass::ParamBlock for $name {
+            const BLOCK: &'static str = $block;
+            const FIELDS: &'static [(&'static str, usize)] =
+                &[$((stringify!($field), std::mem::offset_of!($name, $field))),*];
+        }
+    };
+}
+
+/// A row-major f64 matrix as std140 `mat4` (column-major f32), as GLSL reads it.
+pub fn mat4_std140(rows: &[[f64; 4]; 4]) -> [[f32; 4]; 4] {
+    let mut cols = [[0f32; 4]; 4];
+    for (r, row) in rows.iter().enumerate() {
+        for (c, v) in row.iter().enumerate() {
+            cols[c][r] = *v as f32;
+        }
+    }
+    cols
+}
+
+/// The whole target as a draw's viewport.
+pub fn full_viewport(target: &Target) -> [u32; 4] {
+    [0, 0, target.width, target.height]
+}
+
+/// What a renderer can be opened on: an existing [`Device`] (shared), or a GL context (a new GL
+/// executor on it), so GL callers keep passing `&Gpu`.
+pub trait ToDevice {
+    /// The device to render on.
+    fn to_device(self) -> Result<Device>;
+}
+
+impl ToDevice for &Device {
+    fn to_device(self) -> Result<Device> {
+        Ok(self.clone())
+    }
+}
+
+impl ToDevice for &crate::gpu::Gpu {
+    fn to_device(self) -> Result<Device> {
+        Device::gl(self)
+    }
+}

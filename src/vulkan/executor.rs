@@ -1,0 +1,779 @@
+//! The Vulkan executor: runs the same [`Draw`]s as the GL executor (src/pass/gl.rs), from the
+//! same GLSL compiled to SPIR-V by build.rs, looked up by the GL preamble.
+//!
+//! Interface (every `*_params.glsl`): descriptor set 0 holds the parameter block at binding 0
+//! (a uniform buffer), the sampled images at bindings 1..=7 (combined image samplers, nearest,
+//! clamp to edge), exactly the GL bindings, then the storage images at 8 + k and the storage
+//! buffers at 12 + k (GL's image unit and buffer binding k: shaders/common/bindings.glsl). One
+//! host-visible uniform buffer carries every step's block at 256-byte offsets (the largest
+//! `minUniformBufferOffsetAlignment` the spec allows); descriptor sets come from one pool reset
+//! at each run. Pipelines are cached per program, output set and binding counts; targets per
+//! size and output set (the last few). Each run is one command buffer waited for with a fence:
+//! consecutive draws in one dynamic rendering, a full memory barrier between other steps,
+//! attachments moved to GENERAL after the draws (so compute steps may rewrite them), then the
+//! copies into host buffers. Created images live in GENERAL; uploaded ones are read-only.
+//!
+//! Rows: memory rows mean what they mean under GL (NDC y = -1 and `gl_FragCoord.y` = 0.5 are
+//! memory row 0 in both APIs), so images are uploaded in the same memory order and the rows are
+//! flipped to top-down on the way out, as the GL executor does on the GPU.
+
+use super::context::{vk_err, Vk};
+use super::pipeline::{Pipeline, PipelineDesc};
+use super::resources::{sampled_image, sampler_and_set_layout, Buffer, Image};
+use super::targets::ColorTargets;
+use crate::error::{Error, Result};
+use crate::gpu::{ShaderProgram, Timing};
+use crate::pass::{
+    Api, BufferId, Dispatch, Executor, Format, Groups, ImageData, ImageId, Rendered, Step, StorageImage, Target,
+};
+use ash::vk;
+use std::time::Instant;
+
+/// Targets kept for reuse.
+const KEPT_TARGETS: usize = 4;
+/// Parameter blocks start at multiples of this (the spec's upper bound on the device limit).
+const BLOCK_ALIGNMENT: usize = 256;
+
+fn vk_format(f: Format) -> vk::Format {
+    match f {
+        Format::Rgba8 => vk::Format::R8G8B8A8_UNORM,
+        Format::R32F => vk::Format::R32_SFLOAT,
+        Format::R8 => vk::Format::R8_UNORM,
+        Format::R32Ui => vk::Format::R32_UINT,
+    }
+}
+
+/// Binding of storage image k (shaders/common/bindings.glsl).
+const STORAGE_IMAGE_BASE: u32 = 8;
+/// Binding of storage buffer k.
+const STORAGE_BUFFER_BASE: u32 = 12;
+/// At most this many sampled images a step (bindings 1..=7).
+const MAX_SAMPLED: usize = 7;
+
+/// Binding counts of a step: sampled images, storage images, storage buffers.
+type Counts = (usize, usize, usize);
+
+/// A descriptor set layout (UBO + the counts' bindings) and its pipeline layout.
+struct Layout {
+    counts: Counts,
+    set: vk::DescriptorSetLayout,
+    pipeline: vk::PipelineLayout,
+}
+
+struct CachedPipeline {
+    program: ShaderProgram,
+    /// The target's outputs (graphics pipelines; empty for compute).
+    outputs: Vec<Option<Format>>,
+    counts: Counts,
+    pipeline: Pipeline,
+}
+
+/// An image on the device and the layout it is kept in.
+struct StoredImage {
+    image: Image,
+    layout: vk::ImageLayout,
+    format: Format,
+}
+
+/// Passes on a Vulkan device.
+pub struct VkExecutor {
+    vk: Vk,
+    sampler: vk::Sampler,
+    layouts: Vec<Layout>,
+    pipelines: Vec<CachedPipeline>,
+    targets: Vec<((u32, u32, Vec<Option<Format>>), ColorTargets)>,
+    images: Vec<Option<StoredImage>>,
+    buffers: Vec<Option<Buffer>>,
+    params: Option<Buffer>,
+    pool: vk::DescriptorPool,
+    pool_sets: usize,
+}
+
+fn bindings((samplers, images, buffers): Counts) -> Vec<vk::DescriptorSetLayoutBinding<'static>> {
+    let stages = vk::ShaderStageFlags::VERTEX | vk::ShaderStageFlags::FRAGMENT | vk::ShaderStageFlags::COMPUTE;
+    let one = |binding: u32, ty: vk::DescriptorType| {
+        vk::DescriptorSetLayoutBinding::default()
+            .binding(binding)
+            .descriptor_type(ty)
+            .descriptor_count(1)
+            .stage_flags(stages)
+    };
+    let mut b = vec![one(0, vk::DescriptorType::UNIFORM_BUFFER)];
+    b.extend((1..=samplers as u32).map(|i| one(i, vk::DescriptorType::COMBINED_IMAGE_SAMPLER)));
+    b.extend((0..images as u32).map(|i| one(STORAGE_IMAGE_BASE + i, vk::DescriptorType::STORAGE_IMAGE)));
+    b.extend((0..buffers as u32).map(|i| one(STORAGE_BUFFER_BASE + i, vk::DescriptorType::STORAGE_BUFFER)));
+    b
+}
+
+/// What a draw or dispatch binds, backend-neutral.
+struct Binds<'a> {
+    program: ShaderProgram,
+    params: &'a [u8],
+    images: &'a [ImageId],
+    storage_images: &'a [StorageImage],
+    buffers: &'a [BufferId],
+}
+
+impl<'a> Binds<'a> {
+    fn of(step: &'a Step) -> Option<Binds<'a>> {
+        match step {
+            Step::Draw(d) => Some(Binds {
+                program: d.program,
+                params: d.params,
+                images: d.images,
+                storage_images: &[],
+                buffers: d.buffers,
+            }),
+            Step::Dispatch(d) => Some(Binds {
+                program: d.program,
+                params: d.params,
+                images: d.images,
+                storage_images: d.storage_images,
+                buffers: d.buffers,
+            }),
+            _ => None,
+        }
+    }
+
+    fn counts(&self) -> Counts {
+        (self.images.len(), self.storage_images.len(), self.buffers.len())
+    }
+}
+
+impl VkExecutor {
+    /// An executor on `vk`.
+    pub fn new(vk: &Vk) -> Result<Self> {
+        let (sampler, set) = sampler_and_set_layout(vk, &bindings((0, 0, 0)))?;
+        let mut me = VkExecutor {
+            vk: vk.clone(),
+            sampler,
+            layouts: Vec::new(),
+            pipelines: Vec::new(),
+            targets: Vec::new(),
+            images: Vec::new(),
+            buffers: Vec::new(),
+            params: None,
+            pool: vk::DescriptorPool::null(),
+            pool_sets: 0,
+        };
+        me.push_layout((0, 0, 0), set)?;
+        Ok(me)
+    }
+
+    /// A [`crate::pass::Device`] running on `vk`.
+    pub fn device(vk: &Vk) -> Result<crate::pass::Device> {
+        Ok(crate::pass::Device::new(VkExecutor::new(vk)?))
+    }
+
+    fn push_layout(&mut self, counts: Counts, set: vk::DescriptorSetLayout) -> Result<usize> {
+        let sets = [set];
+        // SAFETY: plain object creation; on failure the set layout, owned by no one yet, goes.
+        let pipeline = unsafe {
+            match self
+                .vk
+                .device
+                .create_pipeline_layout(&vk::PipelineLayoutCreateInfo::default().set_layouts(&sets), None)
+            {
+                Ok(p) => p,
+                Err(r) => {
+                    self.vk.device.destroy_descriptor_set_layout(set, None);
+                    return Err(vk_err("vkCreatePipelineLayout")(r));
+                }
+            }
+        };
+        self.layouts.push(Layout { counts, set, pipeline });
+        Ok(self.layouts.len() - 1)
+    }
+
+    fn layout(&mut self, counts: Counts) -> Result<usize> {
+        if let Some(i) = self.layouts.iter().position(|l| l.counts == counts) {
+            return Ok(i);
+        }
+        let b = bindings(counts);
+        // SAFETY: plain object creation; handed to push_layout, which owns it from then on.
+        let set = unsafe {
+            self.vk
+                .device
+                .create_descriptor_set_layout(&vk::DescriptorSetLayoutCreateInfo::default().bindings(&b), None)
+                .map_err(vk_err("vkCreateDescriptorSetLayout"))?
+        };
+        self.push_layout(counts, set)
+    }
+
+    /// The pipeline (graphics with `target`'s outputs, or compute) and layout of a step.
+    fn pipeline(&mut self, binds: &Binds, outputs: Option<&[Option<Format>]>) -> Result<(usize, usize)> {
+        let counts = binds.counts();
+        if counts.0 > MAX_SAMPLED {
+            return Err(Error::Vulkan(format!(
+                "{}: more than {MAX_SAMPLED} sampled images",
+                binds.program.kind.name()
+            )));
+        }
+        let layout = self.layout(counts)?;
+        let outputs_key = outputs.map_or(Vec::new(), <[_]>::to_vec);
+        let found = self
+            .pipelines
+            .iter()
+            .position(|p| p.program == binds.program && p.outputs == outputs_key && p.counts == counts);
+        if let Some(i) = found {
+            return Ok((i, layout));
+        }
+        if !binds.program.kind.on_vulkan() {
+            return Err(Error::Vulkan(format!(
+                "{} is not compiled for Vulkan (shaders/programs.rs)",
+                binds.program.kind.name()
+            )));
+        }
+        let preamble = binds.program.preamble();
+        let raw_layout = self.layouts[layout].pipeline;
+        let pipeline = match outputs {
+            Some(outputs) => {
+                let formats: Vec<vk::Format> = outputs
+                    .iter()
+                    .map(|f| f.map_or(vk::Format::UNDEFINED, vk_format))
+                    .collect();
+                let desc = PipelineDesc {
+                    program: binds.program.kind.name(),
+                    preamble: &preamble,
+                    color_formats: &formats,
+                    depth: None,
+                    ndc_minus_one_to_one: false,
+                };
+                Pipeline::new(&self.vk, raw_layout, &desc)?
+            }
+            None => Pipeline::compute(&self.vk, raw_layout, binds.program.kind.name(), &preamble)?,
+        };
+        self.pipelines.push(CachedPipeline {
+            program: binds.program,
+            outputs: outputs_key,
+            counts,
+            pipeline,
+        });
+        Ok((self.pipelines.len() - 1, layout))
+    }
+
+    fn target(&mut self, t: &Target) -> Result<usize> {
+        let key = (t.width, t.height, t.outputs.clone());
+        if let Some(i) = self.targets.iter().position(|(k, _)| *k == key) {
+            return Ok(i);
+        }
+        if self.targets.len() >= KEPT_TARGETS {
+            self.targets.remove(0);
+        }
+        let formats: Vec<Option<vk::Format>> = t.outputs.iter().map(|f| f.map(vk_format)).collect();
+        let bytes: Vec<usize> = t.outputs.iter().map(|f| f.map_or(0, Format::texel_bytes)).collect();
+        let targets = ColorTargets::with_slots(&self.vk, t.width, t.height, &formats, &bytes)?;
+        self.targets.push((key, targets));
+        Ok(self.targets.len() - 1)
+    }
+
+    /// A pool with room for `sets` sets (reset, or made larger, for each run).
+    fn reset_pool(&mut self, sets: usize) -> Result<()> {
+        let d = &self.vk.device;
+        // SAFETY: no submit is pending (each run is waited for), so no set of the pool is in
+        // use; the old pool is destroyed before its handle is replaced.
+        unsafe {
+            if sets <= self.pool_sets {
+                return d
+                    .reset_descriptor_pool(self.pool, vk::DescriptorPoolResetFlags::empty())
+                    .map_err(vk_err("vkResetDescriptorPool"));
+            }
+            d.destroy_descriptor_pool(self.pool, None);
+            self.pool = vk::DescriptorPool::null();
+            self.pool_sets = 0;
+            let n = sets.next_power_of_two().max(4) as u32;
+            let sizes = [
+                vk::DescriptorPoolSize::default()
+                    .ty(vk::DescriptorType::UNIFORM_BUFFER)
+                    .descriptor_count(n),
+                vk::DescriptorPoolSize::default()
+                    .ty(vk::DescriptorType::COMBINED_IMAGE_SAMPLER)
+                    .descriptor_count(MAX_SAMPLED as u32 * n),
+                vk::DescriptorPoolSize::default()
+                    .ty(vk::DescriptorType::STORAGE_IMAGE)
+                    .descriptor_count(4 * n),
+                vk::DescriptorPoolSize::default()
+                    .ty(vk::DescriptorType::STORAGE_BUFFER)
+                    .descriptor_count(4 * n),
+            ];
+            self.pool = d
+                .create_descriptor_pool(
+                    &vk::DescriptorPoolCreateInfo::default().max_sets(n).pool_sizes(&sizes),
+                    None,
+                )
+                .map_err(vk_err("vkCreateDescriptorPool"))?;
+            self.pool_sets = n as usize;
+        }
+        Ok(())
+    }
+
+    fn stored(&self, id: ImageId, program: &str) -> Result<&StoredImage> {
+        self.images
+            .get(id.0)
+            .and_then(Option::as_ref)
+            .ok_or_else(|| Error::Vulkan(format!("{program}: image {} was freed", id.0)))
+    }
+
+    fn buffer(&self, id: BufferId) -> Result<&Buffer> {
+        self.buffers
+            .get(id.0)
+            .and_then(Option::as_ref)
+            .ok_or_else(|| Error::Vulkan(format!("pass buffer {} was freed", id.0)))
+    }
+
+    fn store_image(&mut self, stored: StoredImage) -> ImageId {
+        let slot = self
+            .images
+            .iter()
+            .position(Option::is_none)
+            .unwrap_or(self.images.len());
+        if slot == self.images.len() {
+            self.images.push(None);
+        }
+        self.images[slot] = Some(stored);
+        ImageId(slot)
+    }
+
+    /// One descriptor set for a step: its block at `offset`, images, storage images, buffers.
+    fn write_set(
+        &self,
+        binds: &Binds,
+        layout: usize,
+        params: (vk::Buffer, u64, u64),
+        target: Option<&ColorTargets>,
+    ) -> Result<vk::DescriptorSet> {
+        let d = &self.vk.device;
+        let name = binds.program.kind.name();
+        let layouts = [self.layouts[layout].set];
+        // SAFETY: the pool has room for one set per step (reset_pool); the writes reference
+        // locals that outlive the call, and objects that live until the submit is waited for.
+        unsafe {
+            let set = d
+                .allocate_descriptor_sets(
+                    &vk::DescriptorSetAllocateInfo::default()
+                        .descriptor_pool(self.pool)
+                        .set_layouts(&layouts),
+                )
+                .map_err(vk_err("vkAllocateDescriptorSets"))?[0];
+            let buffer_info = [vk::DescriptorBufferInfo::default()
+                .buffer(params.0)
+                .offset(params.1)
+                .range(params.2)];
+            let sampled = binds
+                .images
+                .iter()
+                .map(|id| {
+                    let s = self.stored(*id, name)?;
+                    Ok([vk::DescriptorImageInfo::default()
+                        .sampler(self.sampler)
+                        .image_view(s.image.view)
+                        .image_layout(s.layout)])
+                })
+                .collect::<Result<Vec<_>>>()?;
+            let storage = binds
+                .storage_images
+                .iter()
+                .map(|s| {
+                    let view = match s {
+                        StorageImage::Image(id) => self.stored(*id, name)?.image.view,
+                        StorageImage::Output(i) => target
+                            .and_then(|t| t.view(*i))
+                            .ok_or_else(|| Error::Vulkan(format!("{name}: no output {i} to store to")))?,
+                    };
+                    Ok([vk::DescriptorImageInfo::default()
+                        .image_view(view)
+                        .image_layout(vk::ImageLayout::GENERAL)])
+                })
+                .collect::<Result<Vec<_>>>()?;
+            let buffers = binds
+                .buffers
+                .iter()
+                .map(|id| {
+                    let b = self.buffer(*id)?;
+                    Ok([vk::DescriptorBufferInfo::default()
+                        .buffer(b.raw)
+                        .offset(0)
+                        .range(vk::WHOLE_SIZE)])
+                })
+                .collect::<Result<Vec<_>>>()?;
+            let mut writes = vec![vk::WriteDescriptorSet::default()
+                .dst_set(set)
+                .dst_binding(0)
+                .descriptor_type(vk::DescriptorType::UNIFORM_BUFFER)
+                .buffer_info(&buffer_info)];
+            for (i, info) in sampled.iter().enumerate() {
+                writes.push(
+                    vk::WriteDescriptorSet::default()
+                        .dst_set(set)
+                        .dst_binding(i as u32 + 1)
+                        .descriptor_type(vk::DescriptorType::COMBINED_IMAGE_SAMPLER)
+                        .image_info(info),
+                );
+            }
+            for (i, info) in storage.iter().enumerate() {
+                writes.push(
+                    vk::WriteDescriptorSet::default()
+                        .dst_set(set)
+                        .dst_binding(STORAGE_IMAGE_BASE + i as u32)
+                        .descriptor_type(vk::DescriptorType::STORAGE_IMAGE)
+                        .image_info(info),
+                );
+            }
+            for (i, info) in buffers.iter().enumerate() {
+                writes.push(
+                    vk::WriteDescriptorSet::default()
+                        .dst_set(set)
+                        .dst_binding(STORAGE_BUFFER_BASE + i as u32)
+                        .descriptor_type(vk::DescriptorType::STORAGE_BUFFER)
+                        .buffer_info(info),
+                );
+            }
+            d.update_descriptor_sets(&writes, &[]);
+            Ok(set)
+        }
+    }
+}
+
+/// Every earlier write (shader, transfer, attachment) before every later access.
+fn full_barrier(d: &ash::Device, cb: vk::CommandBuffer) {
+    let all = vk::MemoryBarrier::default()
+        .src_access_mask(vk::AccessFlags::MEMORY_WRITE)
+        .dst_access_mask(vk::AccessFlags::MEMORY_READ | vk::AccessFlags::MEMORY_WRITE);
+    // SAFETY: recording into `cb` outside any rendering.
+    unsafe {
+        d.cmd_pipeline_barrier(
+            cb,
+            vk::PipelineStageFlags::ALL_COMMANDS,
+            vk::PipelineStageFlags::ALL_COMMANDS,
+            vk::DependencyFlags::empty(),
+            &[all],
+            &[],
+            &[],
+        )
+    }
+}
+
+impl Executor for VkExecutor {
+    fn api(&self) -> Api {
+        Api::Vulkan
+    }
+
+    fn max_image_side(&self) -> u32 {
+        self.vk.info().max_image_dimension_2d
+    }
+
+    fn upload(&mut self, image: &ImageData) -> Result<ImageId> {
+        let img = sampled_image(
+            &self.vk,
+            image.width,
+            image.height,
+            vk_format(image.format),
+            image.bytes,
+        )?;
+        Ok(self.store_image(StoredImage {
+            image: img,
+            layout: vk::ImageLayout::SHADER_READ_ONLY_OPTIMAL,
+            format: image.format,
+        }))
+    }
+
+    fn create_image(&mut self, width: u32, height: u32, format: Format, _label: &str) -> Result<ImageId> {
+        use vk::ImageUsageFlags as U;
+        let usage = U::SAMPLED | U::STORAGE | U::TRANSFER_DST | U::TRANSFER_SRC;
+        let image = Image::new(&self.vk, width, height, vk_format(format), usage)?;
+        // Kept in GENERAL for its whole life: sampled, stored and cleared there.
+        self.vk.run_commands(|cb| {
+            image.transition(
+                cb,
+                vk::ImageLayout::UNDEFINED,
+                vk::ImageLayout::GENERAL,
+                vk::PipelineStageFlags::TOP_OF_PIPE,
+                vk::AccessFlags::empty(),
+                vk::PipelineStageFlags::ALL_COMMANDS,
+                vk::AccessFlags::MEMORY_READ | vk::AccessFlags::MEMORY_WRITE,
+            )
+        })?;
+        Ok(self.store_image(StoredImage {
+            image,
+            layout: vk::ImageLayout::GENERAL,
+            format,
+        }))
+    }
+
+    fn free(&mut self, id: ImageId) {
+        if let Some(slot) = self.images.get_mut(id.0) {
+            *slot = None;
+        }
+    }
+
+    fn create_buffer(&mut self, words: usize, _label: &str) -> Result<BufferId> {
+        use vk::BufferUsageFlags as U;
+        let b = Buffer::new(
+            &self.vk,
+            words * 4,
+            U::STORAGE_BUFFER | U::INDIRECT_BUFFER | U::TRANSFER_DST,
+        )?;
+        let slot = self
+            .buffers
+            .iter()
+            .position(Option::is_none)
+            .unwrap_or(self.buffers.len());
+        if slot == self.buffers.len() {
+            self.buffers.push(None);
+        }
+        self.buffers[slot] = Some(b);
+        Ok(BufferId(slot))
+    }
+
+    fn free_buffer(&mut self, id: BufferId) {
+        if let Some(slot) = self.buffers.get_mut(id.0) {
+            *slot = None;
+        }
+    }
+
+    fn run(&mut self, target: Option<&Target>, steps: &[Step]) -> Result<Rendered> {
+        // Pipelines and layouts, then the target.
+        let mut chosen = Vec::with_capacity(steps.len());
+        for step in steps {
+            chosen.push(match Binds::of(step) {
+                Some(b) => {
+                    let outputs = match step {
+                        Step::Draw(_) => Some(
+                            target
+                                .ok_or_else(|| Error::Vulkan("a draw without a target".into()))?
+                                .outputs
+                                .as_slice(),
+                        ),
+                        _ => None,
+                    };
+                    Some(self.pipeline(&b, outputs)?)
+                }
+                None => None,
+            });
+        }
+        let t = target.map(|t| self.target(t)).transpose()?;
+        // Every step's block at its aligned offset in one buffer (grown when needed).
+        let block_bytes = steps
+            .iter()
+            .filter_map(Binds::of)
+            .map(|b| b.params.len().max(16))
+            .max()
+            .unwrap_or(16);
+        let slot = block_bytes.div_ceil(BLOCK_ALIGNMENT) * BLOCK_ALIGNMENT;
+        let total = slot * steps.len().max(1);
+        if self.params.as_ref().is_none_or(|b| b.size < total) {
+            self.params = None;
+            self.params = Some(Buffer::new(&self.vk, total, vk::BufferUsageFlags::UNIFORM_BUFFER)?);
+        }
+        let mut blocks = vec![0u8; total];
+        for (k, b) in steps
+            .iter()
+            .enumerate()
+            .filter_map(|(k, s)| Binds::of(s).map(|b| (k, b)))
+        {
+            blocks[k * slot..k * slot + b.params.len()].copy_from_slice(b.params);
+        }
+        let params = self.params.as_ref().expect("allocated above");
+        // No submit is pending (each is waited for), so the buffer is free to overwrite.
+        params.write(&blocks);
+        let params_raw = params.raw;
+        self.reset_pool(steps.len())?;
+        let targets = t.map(|t| &self.targets[t].1);
+        let mut sets = Vec::with_capacity(steps.len());
+        for (k, step) in steps.iter().enumerate() {
+            sets.push(match (Binds::of(step), chosen[k]) {
+                (Some(b), Some((_, layout))) => {
+                    Some(self.write_set(&b, layout, (params_raw, (k * slot) as u64, block_bytes as u64), targets)?)
+                }
+                _ => None,
+            });
+        }
+        // Raw handles the recording needs (checked above).
+        let mut raw_steps = Vec::with_capacity(steps.len());
+        for step in steps {
+            raw_steps.push(match step {
+                Step::Clear { image, bits } => {
+                    let s = self.stored(*image, "clear")?;
+                    Some((s.image.raw, s.format, *bits))
+                }
+                _ => None,
+            });
+        }
+        let buffers_raw: Vec<Option<vk::Buffer>> = self.buffers.iter().map(|b| b.as_ref().map(|b| b.raw)).collect();
+        let buffer_raw = |id: BufferId| -> Result<vk::Buffer> {
+            buffers_raw
+                .get(id.0)
+                .copied()
+                .flatten()
+                .ok_or_else(|| Error::Vulkan(format!("pass buffer {} was freed", id.0)))
+        };
+        // Indirect and written buffers resolved before recording.
+        let mut step_buffers = Vec::with_capacity(steps.len());
+        for step in steps {
+            step_buffers.push(match step {
+                Step::WriteBuffer { buffer, .. } => Some(buffer_raw(*buffer)?),
+                Step::Dispatch(Dispatch {
+                    groups: Groups::Indirect { buffer, .. },
+                    ..
+                }) => Some(buffer_raw(*buffer)?),
+                _ => None,
+            });
+        }
+        let t0 = Instant::now();
+        let d = &self.vk.device;
+        let pipelines = &self.pipelines;
+        let layouts = &self.layouts;
+        let wanted: Vec<bool> = target.map_or(Vec::new(), |t| t.outputs.iter().map(Option::is_some).collect());
+        self.vk.run_commands(|cb| {
+            let mut rendering = false;
+            let mut drawn = false;
+            for (k, step) in steps.iter().enumerate() {
+                let draw = matches!(step, Step::Draw(_));
+                if rendering && !draw {
+                    targets.expect("draws have a target").record_end_to_general(cb);
+                    rendering = false;
+                }
+                if k > 0 && !(draw && matches!(steps[k - 1], Step::Draw(_))) {
+                    full_barrier(d, cb);
+                }
+                // SAFETY: recording into `cb`; every handle lives until the submit has been
+                // waited for; draws inside the rendering begun here, the rest outside it.
+                unsafe {
+                    match step {
+                        Step::Clear { .. } => {
+                            let (image, format, bits) = raw_steps[k].expect("resolved above");
+                            let value = match format {
+                                Format::R32Ui => vk::ClearColorValue { uint32: [bits; 4] },
+                                _ => vk::ClearColorValue {
+                                    float32: [f32::from_bits(bits); 4],
+                                },
+                            };
+                            d.cmd_clear_color_image(
+                                cb,
+                                image,
+                                vk::ImageLayout::GENERAL,
+                                &value,
+                                &[super::resources::range(vk::ImageAspectFlags::COLOR)],
+                            );
+                        }
+                        Step::WriteBuffer { words, .. } => {
+                            let buffer = step_buffers[k].expect("resolved above");
+                            d.cmd_update_buffer(cb, buffer, 0, bytemuck::cast_slice(words));
+                        }
+                        Step::Draw(draw) => {
+                            let targets = targets.expect("draws have a target");
+                            if !rendering {
+                                targets.record_begin(cb, None);
+                                rendering = true;
+                                drawn = true;
+                            }
+                            let (p, l) = chosen[k].expect("chosen above");
+                            let [x, y, w, h] = draw.viewport;
+                            let viewport = vk::Viewport {
+                                x: x as f32,
+                                y: y as f32,
+                                width: w as f32,
+                                height: h as f32,
+                                min_depth: 0.0,
+                                max_depth: 1.0,
+                            };
+                            let scissor = vk::Rect2D {
+                                offset: vk::Offset2D {
+                                    x: x as i32,
+                                    y: y as i32,
+                                },
+                                extent: vk::Extent2D { width: w, height: h },
+                            };
+                            d.cmd_bind_pipeline(cb, vk::PipelineBindPoint::GRAPHICS, pipelines[p].pipeline.raw);
+                            d.cmd_bind_descriptor_sets(
+                                cb,
+                                vk::PipelineBindPoint::GRAPHICS,
+                                layouts[l].pipeline,
+                                0,
+                                &[sets[k].expect("written above")],
+                                &[],
+                            );
+                            d.cmd_set_viewport(cb, 0, &[viewport]);
+                            d.cmd_set_scissor(cb, 0, &[scissor]);
+                            d.cmd_draw(cb, 3, 1, 0, 0);
+                        }
+                        Step::Dispatch(dispatch) => {
+                            let (p, l) = chosen[k].expect("chosen above");
+                            d.cmd_bind_pipeline(cb, vk::PipelineBindPoint::COMPUTE, pipelines[p].pipeline.raw);
+                            d.cmd_bind_descriptor_sets(
+                                cb,
+                                vk::PipelineBindPoint::COMPUTE,
+                                layouts[l].pipeline,
+                                0,
+                                &[sets[k].expect("written above")],
+                                &[],
+                            );
+                            match dispatch.groups {
+                                Groups::Fixed([x, y]) => d.cmd_dispatch(cb, x, y, 1),
+                                Groups::Indirect { offset_words, .. } => d.cmd_dispatch_indirect(
+                                    cb,
+                                    step_buffers[k].expect("resolved above"),
+                                    4 * offset_words as u64,
+                                ),
+                            }
+                        }
+                    }
+                }
+            }
+            if let Some(targets) = targets {
+                if rendering {
+                    targets.record_end_to_general(cb);
+                }
+                if drawn {
+                    full_barrier(d, cb);
+                    targets.record_readback_from_general(cb, &wanted);
+                }
+            }
+        })?;
+        let outputs = match (target, targets) {
+            (Some(target), Some(targets)) => target
+                .outputs
+                .iter()
+                .enumerate()
+                .map(|(i, f)| {
+                    f.map(|f| {
+                        let rows = targets.read_rows(i, target.rows);
+                        match f {
+                            // Files hold RGB; the GL executor packs on the GPU, here while copying out.
+                            Format::Rgba8 => rows.chunks_exact(4).flat_map(|p| [p[0], p[1], p[2]]).collect(),
+                            _ => rows,
+                        }
+                    })
+                })
+                .collect(),
+            _ => Vec::new(),
+        };
+        Ok(Rendered {
+            outputs,
+            timing: Timing {
+                gpu_ms: None,
+                wall_ms: t0.elapsed().as_secs_f64() * 1e3,
+            },
+        })
+    }
+}
+
+impl Drop for VkExecutor {
+    fn drop(&mut self) {
+        self.pipelines.clear();
+        self.targets.clear();
+        self.images.clear();
+        self.buffers.clear();
+        self.params = None;
+        let d = &self.vk.device;
+        // SAFETY: owned handles (null ones are ignored by Vulkan); no submit is pending.
+        unsafe {
+            d.destroy_descriptor_pool(self.pool, None);
+            for l in &self.layouts {
+                d.destroy_pipeline_layout(l.pipeline, None);
+                d.destroy_descriptor_set_layout(l.set, None);
+            }
+            d.destroy_sampler(self.sampler, None);
+        }
+    }
+}

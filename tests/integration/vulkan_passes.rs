@@ -1,0 +1,512 @@
+//! The backend-neutral passes (src/pass/): every parameter block laid out as the GL compiler
+//! lays out its GLSL mirror; GL against Vulkan for every full-screen pass under all eight
+//! conventions; the commands' `--backend vulkan` runs writing what their GL runs write; and
+//! those runs clean under the Khronos validation layer. A missing Vulkan loader, driver or
+//! validation layer fails these tests, never skips them.
+//!
+//! GL-vs-Vulkan bounds (the issue of record's agreement rule, `eval::backends`): masks differ
+//! on at most 0.5 % of pixels, colour within one level on at least 99.5 %, depth within 1e-4
+//! relative on at least 99.5 % of the pixels valid in both. Why they hold: both executors run
+//! the same GLSL on the same f32 inputs (images in the same memory rows, parameter blocks of
+//! identical bytes), so the outputs differ only where the two compilers (Mesa's GLSL front end
+//! against glslang + SPIR-V to NIR) order or fuse f32 arithmetic differently. Each pass's own
+//! GPU-vs-f64 derivation (tests/integration/{reproject,scene,stitch,cyclopean}.rs) bounds either
+//! backend's distance to the twin by e (depth: 3e-5 reproject, 2e-5 scene and gather), so two
+//! backends are within 2e of each other, inside 1e-4; a decision (mask, surface, rounding tie)
+//! flips only for values within a few ulp of a threshold, which the twin tests put at under
+//! 0.1 % of pixels per backend. Measured values are printed.
+
+use crate::cli::{bin, scratch};
+use crate::common::{cyclopean_cli, data_dir, gpu, write_cyclopean_files};
+use crate::vulkan_refocus::vulkan;
+use std::path::Path;
+use viewsynth::convention::Conventions;
+use viewsynth::cyclopean::render::{CyclopeanRenderer, GatherParams};
+use viewsynth::cyclopean::scene_frame::{scene_frame, StereoRig};
+use viewsynth::cyclopean::splat::{EdgeSnapBlock, SplatBlock, SplatGatherBlock, SplatParams, SplatRenderer};
+use viewsynth::cyclopean::{CyclopeanOutputs, CyclopeanParams, FrameDepth, Method};
+use viewsynth::eval::backends::{backend_diff, BackendDiff};
+use viewsynth::eval::reproject::{methods, scene_cases};
+use viewsynth::gpu::shaders::{ShiftDepth, StitchBlend};
+use viewsynth::gpu::{ProgramKind, ShaderProgram};
+use viewsynth::pass::{Device, ParamBlock};
+use viewsynth::reproject::render::ShiftParams;
+use viewsynth::reproject::{self, ReprojectInput};
+use viewsynth::scene::gpu::{GlCamera, RaytraceParams, SceneRenderer};
+use viewsynth::stitch::faces::scene_faces;
+use viewsynth::stitch::render::StitchBlock;
+use viewsynth::stitch::{self, Method as StitchMethod, OdsRig, Side, StitchInput, StitchParams};
+use viewsynth::view::ViewOutput;
+use viewsynth::vulkan::VkExecutor;
+
+/// Rust offsets and size against what the GL compiler reports for `P`'s block in `program`.
+fn check_block<P: ParamBlock>(program: ProgramKind) {
+    let g = gpu();
+    let built = ShaderProgram::new(Conventions::default(), program).build(&g).unwrap();
+    let (size, members) = built
+        .uniform_block_layout(P::BLOCK)
+        .unwrap_or_else(|| panic!("{}: no uniform block {}", program.name(), P::BLOCK));
+    // std140 rounds a block's size up to a multiple of 16 bytes.
+    assert_eq!(
+        size,
+        std::mem::size_of::<P>().div_ceil(16) * 16,
+        "{}: block size",
+        P::BLOCK
+    );
+    assert_eq!(members.len(), P::FIELDS.len(), "{}: members {members:?}", P::BLOCK);
+    for (name, offset) in &members {
+        let name = name.strip_suffix("[0]").unwrap_or(name);
+        let rust = P::FIELDS
+            .iter()
+            .find(|(f, _)| *f == name)
+            .unwrap_or_else(|| panic!("{}: GLSL member {name} has no Rust field", P::BLOCK));
+        assert_eq!(rust.1, *offset, "{}: offset of {name}", P::BLOCK);
+    }
+}
+
+#[test]
+fn every_parameter_block_has_the_layout_the_gl_compiler_reports() {
+    check_block::<GatherParams>(ProgramKind::CyclopeanGather {
+        depth_is_device: true,
+        refine: true,
+        blend_soft: true,
+    });
+    check_block::<ShiftParams>(ProgramKind::ReprojectShift {
+        depth: ShiftDepth::Device,
+        scan: false,
+        scan_margin: 1,
+    });
+    check_block::<StitchBlock>(ProgramKind::Stitch {
+        method: StitchBlend::Reproject,
+        reproject_steps: 3,
+    });
+    check_block::<RaytraceParams>(ProgramKind::SceneRaytrace);
+    check_block::<SplatBlock>(ProgramKind::CyclopeanSplat);
+    check_block::<EdgeSnapBlock>(ProgramKind::CyclopeanEdgeSnap);
+    check_block::<SplatGatherBlock>(ProgramKind::CyclopeanSplatGather);
+    check_block::<SplatGatherBlock>(ProgramKind::CyclopeanSplatEdges);
+}
+
+fn devices() -> (Device, Device) {
+    (Device::gl(&gpu()).unwrap(), VkExecutor::device(&vulkan()).unwrap())
+}
+
+fn assert_agree(tag: &str, d: &BackendDiff) {
+    println!("{tag}: {d:?}");
+    assert!(d.agrees(), "{tag}: GL and Vulkan differ beyond the bounds: {d:?}");
+}
+
+#[test]
+fn reproject_shift_scan_and_gather3d_agree_between_gl_and_vulkan_under_every_convention() {
+    let (gl, vk) = devices();
+    for conv in Conventions::all() {
+        for kind in [FrameDepth::Device, FrameDepth::ViewZ] {
+            for case in scene_cases(96, 72, 0.2, conv, kind).unwrap() {
+                for params in methods() {
+                    let input = ReprojectInput {
+                        source: &case.source,
+                        geometry: &case.geometry,
+                        params,
+                    };
+                    let a = reproject::pass::gpu(&gl, &input).unwrap();
+                    let b = reproject::pass::gpu(&vk, &input).unwrap();
+                    let tag = format!("{} {} {}", conv.label(), case.name, params.method.label());
+                    assert_agree(&tag, &backend_diff(&a, &b));
+                }
+            }
+        }
+    }
+}
+
+#[test]
+fn scene_ray_tracer_agrees_between_gl_and_vulkan_under_every_convention() {
+    let (gl, vk) = devices();
+    let scene = viewsynth::scene::builtin("demo").unwrap();
+    let rig = StereoRig::demo(120, 90);
+    for conv in Conventions::all() {
+        let (frame, _, _) = scene_frame(&rig, conv, FrameDepth::Device);
+        let cam = GlCamera {
+            view: frame.left.view,
+            proj: frame.left.proj,
+            width: 120,
+            height: 90,
+            conv,
+        };
+        let a = SceneRenderer::new(&gl, &scene).unwrap().render(&cam).unwrap().0;
+        let b = SceneRenderer::new(&vk, &scene).unwrap().render(&cam).unwrap().0;
+        let view = |img: &viewsynth::scene::gpu::SceneImage, depth: &viewsynth::io::DepthMap| ViewOutput {
+            width: 120,
+            height: 90,
+            color: Some(img.color.clone()),
+            depth: Some(depth.clone()),
+            mask: None,
+            timing: None,
+            exact: None,
+        };
+        let tag = conv.label();
+        assert_agree(
+            &format!("scene {tag} view Z"),
+            &backend_diff(&view(&a, &a.view_z), &view(&b, &b.view_z)),
+        );
+        assert_agree(
+            &format!("scene {tag} device depth"),
+            &backend_diff(&view(&a, &a.device_depth), &view(&b, &b.device_depth)),
+        );
+    }
+}
+
+#[test]
+fn stitch_methods_agree_between_gl_and_vulkan_under_every_convention() {
+    let (gl, vk) = devices();
+    let rig = OdsRig::demo();
+    let fov = 90.0 + 2.0 * 10.0;
+    let left = scene_faces(&rig, Side::Left, 48, fov).unwrap();
+    let right = scene_faces(&rig, Side::Right, 48, fov).unwrap();
+    for conv in Conventions::all() {
+        for method in StitchMethod::ALL {
+            let input = StitchInput {
+                left: &left,
+                right: &right,
+                params: StitchParams {
+                    method,
+                    overlap_deg: 10.0,
+                    width: 128,
+                    height: 64,
+                },
+                conv,
+            };
+            let a = stitch::pass::gpu(&gl, &input).unwrap();
+            let b = stitch::pass::gpu(&vk, &input).unwrap();
+            assert_agree(&format!("stitch {} {method:?}", conv.label()), &backend_diff(&a, &b));
+        }
+    }
+}
+
+/// The splat-gather method (edge snap, splat with atomics, gather listing edge pixels, indirect
+/// edge pass rewriting the colour) on both executors, under every convention and both depth
+/// kinds, with and without colour (no colour: no edge pass). Its twin check on Vulkan is in
+/// tests/integration/cyclopean_real.rs.
+#[test]
+fn splat_gather_agrees_between_gl_and_vulkan_under_every_convention() {
+    let (gl, vk) = devices();
+    for conv in Conventions::all() {
+        for kind in [FrameDepth::Device, FrameDepth::ViewZ] {
+            let (frame, mid, _) = scene_frame(&StereoRig::demo(96, 72), conv, kind);
+            for outputs in [
+                CyclopeanOutputs::default(),
+                CyclopeanOutputs {
+                    color: false,
+                    depth: true,
+                },
+            ] {
+                let render = |d: &Device| {
+                    let (out, _) = SplatRenderer::new(d, &frame, SplatParams::default(), outputs)
+                        .unwrap()
+                        .render(&mid)
+                        .unwrap();
+                    ViewOutput::from_cyclopean(&out, mid.width, mid.height, None)
+                };
+                let (a, b) = (render(&gl), render(&vk));
+                assert_eq!(a.color.is_some(), outputs.color);
+                assert_agree(
+                    &format!("splat-gather {} {kind:?} colour {}", conv.label(), outputs.color),
+                    &backend_diff(&a, &b),
+                );
+            }
+        }
+    }
+}
+
+#[test]
+fn cyclopean_gather_renders_on_one_shared_device_for_every_convention() {
+    // The renderer's images are freed with it and the device's caches stay bounded: many
+    // renderers on one Vulkan device in a row (as `report` and reproject's gather3d make them).
+    let vk = VkExecutor::device(&vulkan()).unwrap();
+    for conv in Conventions::all() {
+        let (frame, mid, _) = scene_frame(&StereoRig::demo(64, 48), conv, FrameDepth::ViewZ);
+        let params = CyclopeanParams {
+            method: Method::Refine { steps: 2 },
+            ..CyclopeanParams::seed(3.0)
+        };
+        let (out, _) = CyclopeanRenderer::new(&vk, &frame, params)
+            .unwrap()
+            .render(&mid)
+            .unwrap();
+        assert!(out.sources.iter().filter(|s| **s != 0).count() * 2 > out.sources.len());
+    }
+}
+
+/// Every file `gl` holds is in `vk` with the same shape, within the agreement rule.
+fn compare_folders(tag: &str, gl: &Path, vk: &Path) {
+    let mut names: Vec<_> = std::fs::read_dir(gl)
+        .unwrap()
+        .map(|e| e.unwrap().file_name().into_string().unwrap())
+        .collect();
+    names.sort();
+    assert!(!names.is_empty(), "{tag}: the GL run wrote nothing");
+    for name in names {
+        let (a, b) = (gl.join(&name), vk.join(&name));
+        assert!(b.exists(), "{tag}: the Vulkan run did not write {name}");
+        let what = format!("{tag} {name}");
+        let d = if name.ends_with("_mask.png") {
+            let (ma, mb) = (
+                viewsynth::io::load_mask_png(&a).unwrap(),
+                viewsynth::io::load_mask_png(&b).unwrap(),
+            );
+            assert_eq!((ma.width, ma.height), (mb.width, mb.height), "{what}: size");
+            BackendDiff {
+                pixels: ma.data.len(),
+                mask_mismatches: ma
+                    .data
+                    .iter()
+                    .zip(&mb.data)
+                    .filter(|(x, y)| (**x != 0) != (**y != 0))
+                    .count(),
+                ..Default::default()
+            }
+        } else if name.ends_with(".png") {
+            let (ca, cb) = (
+                viewsynth::io::load_rgb(&a).unwrap(),
+                viewsynth::io::load_rgb(&b).unwrap(),
+            );
+            assert_eq!((ca.width, ca.height), (cb.width, cb.height), "{what}: size");
+            backend_diff(&ViewOutput::color_only(ca, None), &ViewOutput::color_only(cb, None))
+        } else if name.ends_with(".npy") || name.ends_with(".exr") {
+            let load = |p: &Path| viewsynth::io::load_depth(p, &Default::default()).unwrap();
+            let (za, zb) = (load(&a), load(&b));
+            assert_eq!((za.width, za.height), (zb.width, zb.height), "{what}: size");
+            let view = |z: viewsynth::io::DepthMap| ViewOutput {
+                width: z.width,
+                height: z.height,
+                color: None,
+                depth: Some(z),
+                mask: None,
+                timing: None,
+                exact: None,
+            };
+            backend_diff(&view(za), &view(zb))
+        } else {
+            // JSON (cameras, manifests): same keys at the top level.
+            let keys = |p: &Path| {
+                let v: serde_json::Value = serde_json::from_slice(&std::fs::read(p).unwrap()).unwrap();
+                v.as_object().map(|o| o.keys().cloned().collect::<Vec<_>>())
+            };
+            assert_eq!(keys(&a), keys(&b), "{what}");
+            continue;
+        };
+        assert_agree(&what, &d);
+    }
+}
+
+fn run_both(tag: &str, dir: &Path, args: &[&str]) {
+    for backend in ["gl", "vulkan"] {
+        let out = dir.join(format!("{tag}-{backend}"));
+        let o = bin()
+            .args(args)
+            .args(["--backend", backend, "--out-dir"])
+            .arg(&out)
+            .output()
+            .unwrap();
+        assert!(
+            o.status.success(),
+            "{tag} --backend {backend}: {}",
+            String::from_utf8_lossy(&o.stderr)
+        );
+    }
+    compare_folders(tag, &dir.join(format!("{tag}-gl")), &dir.join(format!("{tag}-vulkan")));
+}
+
+#[test]
+fn reproject_stitch_scene_and_cyclopean_commands_write_the_same_files_on_vulkan() {
+    let dir = scratch("vulkan-passes-cli");
+    let tum = data_dir().join("rgbd_open3d_testdata");
+    let (rgb, depth) = (tum.join("TUM_color.png"), tum.join("TUM_depth.png"));
+    let (rgb, depth) = (rgb.to_str().unwrap(), depth.to_str().unwrap());
+    for method in ["shift", "shift-scan", "gather3d"] {
+        run_both(
+            &format!("reproject-{method}"),
+            &dir,
+            &[
+                "reproject",
+                "--rgb",
+                rgb,
+                "--depth",
+                depth,
+                "--depth-scale",
+                "5000",
+                "--fx",
+                "525",
+                "--fy",
+                "525",
+                "--cx",
+                "319.5",
+                "--cy",
+                "239.5",
+                "--baseline",
+                "0.064",
+                "--depth-format",
+                "npy",
+                "--method",
+                method,
+            ],
+        );
+    }
+    for method in ["blend", "border-weight", "reproject"] {
+        run_both(
+            &format!("stitch-{method}"),
+            &dir,
+            &[
+                "stitch",
+                "--scene",
+                "demo",
+                "--face-size",
+                "64",
+                "--width",
+                "256",
+                "--height",
+                "128",
+                "--method",
+                method,
+            ],
+        );
+    }
+    run_both("scene", &dir, &["scene", "--width", "160", "--height", "120"]);
+    // The README's Cones example: the default method from Middlebury disparities.
+    let cones = data_dir().join("middlebury2003_cones");
+    let file = |f: &str| cones.join(f).to_str().unwrap().to_string();
+    let (l, r, dl, dr) = (file("im2.png"), file("im6.png"), file("disp2.pgm"), file("disp6.pgm"));
+    run_both(
+        "cones",
+        &dir,
+        &[
+            "cyclopean",
+            "--left-rgb",
+            &l,
+            "--right-rgb",
+            &r,
+            "--left-disparity",
+            &dl,
+            "--right-disparity",
+            &dr,
+            "--disparity-scale",
+            "4",
+        ],
+    );
+    // The cyclopean gather from the scene's own files (seed and refine run on Vulkan).
+    let (frame, mid, _) = scene_frame(&StereoRig::demo(96, 72), Conventions::all()[6], FrameDepth::Device);
+    write_cyclopean_files(&dir, &frame, &mid);
+    for method in ["splat-gather", "seed", "refine"] {
+        let (gl, vk) = (
+            dir.join(format!("cyc-{method}-gl")),
+            dir.join(format!("cyc-{method}-vulkan")),
+        );
+        for (backend, out) in [("gl", &gl), ("vulkan", &vk)] {
+            let o = cyclopean_cli(&dir, "cams.json", &["--method", method, "--backend", backend], out);
+            assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+        }
+        compare_folders(&format!("cyclopean {method}"), &gl, &vk);
+    }
+}
+
+/// One run of each Vulkan pass under VK_LAYER_KHRONOS_validation (Debian package
+/// `vulkan-validationlayers`): any validation message fails. The loader's own log proves the
+/// layer was inserted, so a missing layer cannot pass silently.
+#[test]
+fn every_vulkan_pass_runs_clean_under_the_validation_layer() {
+    let dir = scratch("vulkan-validation");
+    let tum = data_dir().join("rgbd_open3d_testdata");
+    let (rgb, depth) = (tum.join("TUM_color.png"), tum.join("TUM_depth.png"));
+    let (rgb, depth) = (rgb.to_str().unwrap(), depth.to_str().unwrap());
+    let intrinsics = ["--fx", "525", "--fy", "525", "--cx", "319.5", "--cy", "239.5"];
+    let (frame, mid, _) = scene_frame(&StereoRig::demo(64, 48), Conventions::default(), FrameDepth::Device);
+    write_cyclopean_files(&dir, &frame, &mid);
+    let mut runs: Vec<Vec<String>> = Vec::new();
+    let s = |v: &[&str]| v.iter().map(|x| x.to_string()).collect::<Vec<_>>();
+    for method in ["shift", "shift-scan", "gather3d"] {
+        let mut a = s(&["reproject", "--rgb", rgb, "--depth", depth, "--depth-scale", "5000"]);
+        a.extend(s(&intrinsics));
+        a.extend(s(&["--baseline", "0.064", "--method", method]));
+        runs.push(a);
+    }
+    for method in ["blend", "border-weight", "reproject"] {
+        runs.push(s(&[
+            "stitch",
+            "--scene",
+            "demo",
+            "--face-size",
+            "32",
+            "--width",
+            "128",
+            "--height",
+            "64",
+            "--method",
+            method,
+        ]));
+    }
+    runs.push(s(&["scene", "--width", "64", "--height", "48"]));
+    for method in ["fullscreen", "mesh"] {
+        let mut a = s(&["refocus", "--rgb", rgb, "--depth", depth, "--depth-scale", "5000"]);
+        a.extend(s(&intrinsics));
+        a.extend(s(&["--zoom-range", "0.5,2", "--method", method]));
+        runs.push(a);
+    }
+    for (k, args) in runs.iter().enumerate() {
+        let out = dir.join(format!("run{k}"));
+        let o = bin()
+            .args(args)
+            .args(["--backend", "vulkan", "--out-dir"])
+            .arg(&out)
+            .env("VK_INSTANCE_LAYERS", "VK_LAYER_KHRONOS_validation")
+            .env("VK_LOADER_DEBUG", "layer")
+            .output()
+            .unwrap();
+        let text = format!(
+            "{}{}",
+            String::from_utf8_lossy(&o.stdout),
+            String::from_utf8_lossy(&o.stderr)
+        );
+        assert!(o.status.success(), "{args:?}: {text}");
+        assert!(
+            text.contains("Insert instance layer \"VK_LAYER_KHRONOS_validation\""),
+            "{args:?}: the validation layer was not loaded (install vulkan-validationlayers):\n{text}"
+        );
+        for bad in ["Validation Error", "VUID-", "Validation Warning"] {
+            assert!(!text.contains(bad), "{args:?}: {bad}:\n{text}");
+        }
+    }
+    for method in ["splat-gather", "seed", "refine"] {
+        let out = dir.join(format!("cyc-{method}"));
+        let o = std::process::Command::new(env!("CARGO_BIN_EXE_viewsynth"))
+            .arg("cyclopean")
+            .args(["--method", method, "--backend", "vulkan"])
+            .arg("--left-rgb")
+            .arg(dir.join("left.png"))
+            .arg("--left-depth")
+            .arg(dir.join("left.exr"))
+            .arg("--right-rgb")
+            .arg(dir.join("right.png"))
+            .arg("--right-depth")
+            .arg(dir.join("right.exr"))
+            .arg("--cameras")
+            .arg(dir.join("cams.json"))
+            .arg("--out-dir")
+            .arg(&out)
+            .env("VK_INSTANCE_LAYERS", "VK_LAYER_KHRONOS_validation")
+            .env("VK_LOADER_DEBUG", "layer")
+            .output()
+            .unwrap();
+        let text = format!(
+            "{}{}",
+            String::from_utf8_lossy(&o.stdout),
+            String::from_utf8_lossy(&o.stderr)
+        );
+        assert!(o.status.success(), "cyclopean {method}: {text}");
+        assert!(
+            text.contains("Insert instance layer \"VK_LAYER_KHRONOS_validation\""),
+            "{text}"
+        );
+        for bad in ["Validation Error", "VUID-", "Validation Warning"] {
+            assert!(!text.contains(bad), "cyclopean {method}: {bad}:\n{text}");
+        }
+    }
+}
