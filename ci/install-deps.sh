@@ -27,6 +27,9 @@ PKGS+=(python3 python3-venv)
 # The Vulkan backend (--backend vulkan, its tests): the loader, Mesa's lavapipe (software
 # Vulkan) and glslangValidator, which build.rs runs to compile the shaders to SPIR-V.
 PKGS+=(libvulkan1 mesa-vulkan-drivers glslang-tools)
+# The Khronos validation layer: a test runs one case of every Vulkan pass under it and fails on
+# any message (tests/integration/vulkan_passes.rs).
+PKGS+=(vulkan-validationlayers)
 missing=()
 if command -v dpkg >/dev/null 2>&1; then
   for p in "${PKGS[@]}"; do

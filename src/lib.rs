@@ -34,17 +34,17 @@
 //! - [`eval`]: every method's error against ground truth next to its run time, one file per
 //!   capability, and the GPU-vs-reference image check.
 //! - [`report`]: the evaluation written as Markdown, CSV and SVG.
-//! - [`bench`](mod@bench): single-frame timings of refocus and cyclopean.
-//! - [`bench_batch`]: the pipelined refocus batch against its synchronous baseline.
+//! - [`bench`](mod@bench): every benchmark: single-frame timings, the pipelined refocus batch
+//!   against its synchronous baseline (`bench::batch`), GL against Vulkan (`bench::vulkan`).
 //! - [`stress`]: stiff and extreme cases of every capability, GPU f32 against f64.
 //! - [`demo`]: the built-in scene rendered, refocused and synthesised, with its report.
-//! - [`vulkan`]: a headless Vulkan backend (ash) running the refocus passes from the same GLSL.
+//! - [`pass`]: backend-neutral pass descriptions and the GL executor; [`vulkan`]: the Vulkan
+//!   backend (ash) with its executor, running the same GLSL.
 //! - [`job`]: one checked job per command-line command, and the code that runs it.
 
 #![warn(missing_docs)]
 
 pub mod bench;
-pub mod bench_batch;
 pub mod camera;
 pub mod compare;
 pub mod convention;

@@ -1,7 +1,6 @@
 // Colour of the warped eye at the exact eye position of this fragment's surface point.
 
-uniform sampler2D u_color;  // RGBA8 eye colour, memory order
-uniform int u_eye_bit;
+// Parameters and images: shaders/cyclopean/forward_params.glsl (one block, both backends).
 
 const float FORWARD_CELL_EPS = 1e-3;
 

@@ -7,18 +7,7 @@
 // the fill rule or the row order. Eye clip (x, y, w) and the middle view distance are linear in
 // 3-D, so they interpolate exactly.
 
-uniform usampler2D u_tris;     // R32UI kept-triangle codes, TRI_TEX_WIDTH wide
-uniform sampler2D u_distance;  // R32F eye view distance, memory order (0 = invalid)
-uniform ivec2 u_eye_size;
-uniform mat4 u_inv_view_e, u_inv_proj_e, u_view_proj_e;
-uniform mat4 u_view_m, u_view_proj_m, u_inv_view_proj_m;
-uniform vec2 u_size_m;
-uniform vec3 u_middle_centre;
-uniform float u_expand_px;
-// Relative push away from the middle camera for this eye's depth test only: where both eyes
-// saw the same surface their depths differ by float rounding, which the depth buffer would
-// resolve differently under each convention; the pushed eye wins only when nearer by more.
-uniform float u_depth_bias;
+// Parameters and images: shaders/cyclopean/forward_params.glsl (one block, both backends).
 
 flat out ivec3 v_cell;         // cell i, j (image grid coordinates) and triangle
 out vec3 v_eye_clip;           // eye clip (x, y, w)

@@ -8,11 +8,11 @@ use super::{CyclopeanOutput, EyeInput, FrameDepth, MiddleCamera, StereoFrame};
 use crate::camera::mat4::{self, Mat4};
 use crate::convention::RowOrder;
 use crate::error::{Error, Result};
-use crate::gpu::{
-    Attachment, DrawState, Framebuffer, Gpu, GpuTimer, Program, ProgramKind, ShaderProgram, Texture, TextureFormat,
-    Timing, VertexArray,
-};
-use crate::refocus::code_texture;
+use crate::gpu::shaders::TRI_TEX_WIDTH;
+use crate::gpu::{ProgramKind, ShaderProgram, Timing};
+use crate::io::{DepthMap, RgbImage};
+use crate::pass::{mat4_std140, Device, Draw, Format, Image, ImageData, Step, Target, ToDevice};
+use crate::refocus::mesh::code_rows;
 use crate::refocus::{BreakRule, Grid};
 
 /// The right eye replaces the left only where it is nearer by more than this (relative): ties
@@ -47,132 +47,181 @@ pub fn eye_distances(eye: &EyeInput, kind: FrameDepth, conv: &crate::convention:
     Ok(out)
 }
 
+crate::param_block! {
+    /// One eye's draw: shaders/cyclopean/forward_params.glsl, member for member.
+    pub struct ForwardParams("ForwardParams") {
+        u_inv_view_e: [[f32; 4]; 4],
+        u_inv_proj_e: [[f32; 4]; 4],
+        u_view_proj_e: [[f32; 4]; 4],
+        u_view_m: [[f32; 4]; 4],
+        u_view_proj_m: [[f32; 4]; 4],
+        u_inv_view_proj_m: [[f32; 4]; 4],
+        u_middle_centre: [f32; 3],
+        u_expand_px: f32,
+        u_size_m: [f32; 2],
+        u_eye_size: [i32; 2],
+        u_depth_bias: f32,
+        u_eye_bit: i32,
+    }
+}
+
 struct EyeMesh {
-    color: Texture,
-    distance: Texture,
-    tris: Option<Texture>,
+    color: Image,
+    distance: Image,
+    tris: Option<Image>,
     count: usize,
     view: Mat4,
     proj: Mat4,
     size: (u32, u32),
 }
 
-/// The forward warp of a stereo frame on the GPU: both eyes' meshes uploaded, ready for any middle camera.
+/// The forward warp of a stereo frame on the GPU (GL or Vulkan): both eyes' meshes uploaded,
+/// ready for any middle camera.
 pub struct ForwardWarp {
-    gpu: Gpu,
-    program: Program,
+    device: Device,
+    program: ShaderProgram,
     eyes: [EyeMesh; 2],
     conv: crate::convention::Conventions,
-    vao: VertexArray,
 }
 
 impl ForwardWarp {
     /// `rule` breaks the mesh at eye-depth discontinuities (the refocus rule on view distance).
-    pub fn new(gpu: &Gpu, frame: &StereoFrame, rule: &BreakRule) -> Result<Self> {
+    pub fn new(device: impl ToDevice, frame: &StereoFrame, rule: &BreakRule) -> Result<Self> {
         frame.validate()?;
         rule.validate()?;
+        let device = device.to_device()?;
         let mesh = |eye: &EyeInput| -> Result<EyeMesh> {
             let (w, h) = (eye.color.width, eye.color.height);
+            device.check_image_size("eye size", w, h)?;
             let dist = eye_distances(eye, frame.depth_kind, &frame.conv)?;
             let grid = Grid { width: w, height: h };
             let keep = grid.keep_mask(&dist, rule);
             let codes = grid.kept_triangles(&keep);
             let rgba: Vec<u8> = crate::gpu::pixels::rgb_to_rgba(&eye.color.data);
             let dbytes: Vec<u8> = crate::gpu::pixels::f32_to_bytes(&dist);
+            let image = |width, height, format, bytes: &[u8], label| {
+                device.upload(&ImageData {
+                    width,
+                    height,
+                    format,
+                    bytes,
+                    label,
+                })
+            };
+            let tris = match code_rows(&codes, u32::MAX)? {
+                Some((rows, bytes)) => Some(image(
+                    TRI_TEX_WIDTH,
+                    rows,
+                    Format::R32Ui,
+                    &bytes,
+                    "kept triangle codes",
+                )?),
+                None => None,
+            };
             Ok(EyeMesh {
-                color: Texture::new(
-                    gpu,
+                color: image(
                     w,
                     h,
-                    TextureFormat::Rgba8,
-                    Some(&frame.conv.row_order.convert_rows(rgba, w as usize * 4)),
-                )?
-                .with_label("forward warp eye colour"),
-                distance: Texture::new(
-                    gpu,
+                    Format::Rgba8,
+                    &frame.conv.row_order.convert_rows(rgba, w as usize * 4),
+                    "forward warp eye colour",
+                )?,
+                distance: image(
                     w,
                     h,
-                    TextureFormat::R32F,
-                    Some(&frame.conv.row_order.convert_rows(dbytes, w as usize * 4)),
-                )?
-                .with_label("forward warp eye distance"),
-                tris: code_texture(gpu, &codes)?,
+                    Format::R32F,
+                    &frame.conv.row_order.convert_rows(dbytes, w as usize * 4),
+                    "forward warp eye distance",
+                )?,
+                tris,
                 count: codes.len(),
                 view: eye.view,
                 proj: eye.proj,
                 size: (w, h),
             })
         };
-        let program = ShaderProgram::new(frame.conv, ProgramKind::CyclopeanForward).build(gpu)?;
         Ok(ForwardWarp {
-            gpu: gpu.clone(),
-            program,
+            program: ShaderProgram::new(frame.conv, ProgramKind::CyclopeanForward),
             eyes: [mesh(&frame.left)?, mesh(&frame.right)?],
+            device,
             conv: frame.conv,
-            vao: VertexArray::new(gpu)?.with_label("forward warp vertex array"),
         })
     }
 
     /// Renders the middle view of camera `mid`, with its times.
     pub fn render(&mut self, mid: &MiddleCamera) -> Result<(CyclopeanOutput, Timing)> {
         let (w, h) = (mid.width, mid.height);
-        self.gpu.check_image_size("middle size", w, h)?;
-        let slot = |format| {
-            Some(Attachment {
-                format,
-                clear: [0.0; 4],
-            })
-        };
-        let fb = Framebuffer::new(
-            &self.gpu,
-            w,
-            h,
-            &[
-                slot(TextureFormat::Rgba8),
-                slot(TextureFormat::R32F),
-                slot(TextureFormat::R8),
-            ],
-            true,
-        )?
-        .with_label("forward warp target");
-        let p = &self.program;
-        let gpu = &self.gpu;
-        let timer = GpuTimer::start(gpu);
-        // The eyes merge by depth: nearest surface wins under the conventions' depth test.
-        let pass = fb.begin_pass(DrawState::depth_tested(&self.conv), self.conv.clear_depth() as f32);
-        p.bind();
-        p.set_mat4_rows("u_view_m", &mid.view);
-        p.set_mat4_rows("u_view_proj_m", &mat4::mul(&mid.proj, &mid.view));
+        self.device.check_image_size("middle size", w, h)?;
         let vp_m = mat4::mul(&mid.proj, &mid.view);
         let centre = crate::scene::gpu::projection_centre(&vp_m)
             .ok_or_else(|| Error::param("middle projection", "not perspective"))?;
-        p.set_vec3("u_middle_centre", centre.map(|v| v as f32));
-        p.set_i32("u_color", 0);
-        p.set_i32("u_distance", 1);
-        p.set_i32("u_tris", 2);
-        p.set_vec2("u_size_m", [w as f32, h as f32]);
-        p.set_f32("u_expand_px", 1.0 / 32.0);
-        let inv_vp_m = mat4::inverse(&mat4::mul(&mid.proj, &mid.view))
-            .ok_or_else(|| Error::param("middle view-projection", "singular"))?;
-        p.set_mat4_rows("u_inv_view_proj_m", &inv_vp_m);
+        let inv_vp_m = mat4::inverse(&vp_m).ok_or_else(|| Error::param("middle view-projection", "singular"))?;
+        let inv = |m: &Mat4, what: &str| {
+            mat4::inverse(m)
+                .map(|m| mat4_std140(&m))
+                .ok_or_else(|| Error::param(what.to_string(), "singular"))
+        };
+        let mut blocks = Vec::new();
+        let mut images = Vec::new();
         for (bit, eye) in [(1, &self.eyes[0]), (2, &self.eyes[1])] {
             let Some(tris) = &eye.tris else { continue };
-            let inv = |m: &Mat4, what: &str| mat4::inverse(m).ok_or_else(|| Error::param(what.to_string(), "singular"));
-            eye.color.bind(0);
-            eye.distance.bind(1);
-            p.set_mat4_rows("u_inv_view_e", &inv(&eye.view, "eye view")?);
-            p.set_mat4_rows("u_inv_proj_e", &inv(&eye.proj, "eye projection")?);
-            p.set_mat4_rows("u_view_proj_e", &mat4::mul(&eye.proj, &eye.view));
-            p.set_ivec2("u_eye_size", [eye.size.0 as i32, eye.size.1 as i32]);
-            p.set_i32("u_eye_bit", bit);
-            p.set_f32("u_depth_bias", if bit == 2 { RIGHT_EYE_DEPTH_BIAS } else { 0.0 });
-            tris.bind(2);
-            pass.draw_triangles(&self.vao, eye.count);
+            blocks.push(ForwardParams {
+                u_inv_view_e: inv(&eye.view, "eye view")?,
+                u_inv_proj_e: inv(&eye.proj, "eye projection")?,
+                u_view_proj_e: mat4_std140(&mat4::mul(&eye.proj, &eye.view)),
+                u_view_m: mat4_std140(&mid.view),
+                u_view_proj_m: mat4_std140(&vp_m),
+                u_inv_view_proj_m: mat4_std140(&inv_vp_m),
+                u_middle_centre: centre.map(|v| v as f32),
+                u_expand_px: 1.0 / 32.0,
+                u_size_m: [w as f32, h as f32],
+                u_eye_size: [eye.size.0 as i32, eye.size.1 as i32],
+                u_depth_bias: if bit == 2 { RIGHT_EYE_DEPTH_BIAS } else { 0.0 },
+                u_eye_bit: bit,
+            });
+            images.push(([eye.color.id(), eye.distance.id(), tris.id()], eye.count as u32));
         }
-        drop(pass);
-        gpu.check("forward warp")?;
-        let out = super::render::read_output(&fb, self.conv.row_order)?;
-        let timing = timer.stop();
-        Ok((out, timing))
+        // The eyes merge by depth: nearest surface wins under the conventions' depth test.
+        let steps: Vec<Step> = blocks
+            .iter()
+            .zip(&images)
+            .map(|(block, (images, count))| {
+                Step::Draw(Draw {
+                    program: self.program,
+                    params: bytemuck::bytes_of(block),
+                    images,
+                    buffers: &[],
+                    viewport: [0, 0, w, h],
+                    triangles: *count,
+                })
+            })
+            .collect();
+        let target = Target {
+            width: w,
+            height: h,
+            outputs: vec![Some(Format::Rgba8), Some(Format::R32F), Some(Format::R8)],
+            rows: self.conv.row_order,
+            depth_test: Some(self.conv),
+        };
+        let mut out = if steps.is_empty() {
+            // Neither eye kept a triangle: an empty view (a run without draws reads nothing).
+            let n = w as usize * h as usize;
+            crate::pass::Rendered {
+                outputs: vec![Some(vec![0; 3 * n]), Some(vec![0; 4 * n]), Some(vec![0; n])],
+                timing: Timing {
+                    gpu_ms: None,
+                    wall_ms: 0.0,
+                },
+            }
+        } else {
+            self.device.run(Some(&target), &steps)?
+        };
+        let color = out.outputs[0].take().map(|c| RgbImage::new(w, h, c)).transpose()?;
+        let depth = out.outputs[1]
+            .take()
+            .map(|d| DepthMap::new(w, h, bytemuck::pod_collect_to_vec(&d)))
+            .transpose()?;
+        let sources = out.take(2, "cyclopean forward warp")?;
+        Ok((CyclopeanOutput { color, depth, sources }, out.timing))
     }
 }

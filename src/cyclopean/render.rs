@@ -8,7 +8,7 @@ use super::{
 use crate::camera::mat4::{self, Mat4};
 use crate::convention::RowOrder;
 use crate::error::{Error, Result};
-use crate::gpu::{Framebuffer, ProgramKind, ShaderProgram, Timing};
+use crate::gpu::{ProgramKind, ShaderProgram, Timing};
 use crate::io::{DepthMap, RgbImage};
 use crate::pass::{mat4_std140, Device, Draw, Format, Image, ImageData, Target, ToDevice};
 
@@ -159,6 +159,7 @@ impl CyclopeanRenderer {
                 Some(Format::R8),
             ],
             rows: self.rows,
+            depth_test: None,
         };
         let images = [
             self.left.color.id(),
@@ -172,6 +173,7 @@ impl CyclopeanRenderer {
             images: &images,
             buffers: &[],
             viewport: [0, 0, w, h],
+            triangles: 1,
         };
         let mut out = self.device.render(&target, &[draw])?;
         let color = out.outputs[0].take().map(|c| RgbImage::new(w, h, c)).transpose()?;
@@ -182,24 +184,4 @@ impl CyclopeanRenderer {
         let sources = out.take(2, "cyclopean gather")?;
         Ok((CyclopeanOutput { color, depth, sources }, out.timing))
     }
-}
-
-/// Read a middle-view framebuffer (RGBA8 colour, R32F depth, R8 source bits) back top-down;
-/// colour and depth only where the framebuffer has them. All reads are queued before the first
-/// is waited for; the GPU flips the rows (GL row order) and packs RGB, so the mapped bytes are
-/// the images' bytes.
-pub(crate) fn read_output(fb: &Framebuffer, rows: RowOrder) -> Result<CyclopeanOutput> {
-    use crate::gpu::ReadFormat;
-    let (w, h) = (fb.width(), fb.height());
-    let flip = rows == RowOrder::BottomUp;
-    let sources = fb
-        .read_async(2, ReadFormat::R8, flip)?
-        .ok_or_else(|| Error::Gl("middle framebuffer lacks the source bits".into()))?;
-    let color = fb.read_async(0, ReadFormat::RGB8, flip)?;
-    let depth = fb.read_async(1, ReadFormat::R32F, flip)?;
-    Ok(CyclopeanOutput {
-        sources: sources.finish()?,
-        color: color.map(|r| RgbImage::new(w, h, r.finish()?)).transpose()?,
-        depth: depth.map(|r| DepthMap::new(w, h, r.finish_f32()?)).transpose()?,
-    })
 }

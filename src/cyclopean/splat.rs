@@ -418,6 +418,7 @@ impl SplatRenderer {
             images: &gather_images,
             buffers: &edges,
             viewport: [0, 0, w, h],
+            triangles: 1,
         }));
         // Pass 3: the listed pixels' colour mixed (colour only: without it, nothing to mix).
         if self.outputs.color {
@@ -442,6 +443,7 @@ impl SplatRenderer {
                 Some(Format::R8),
             ],
             rows: self.rows,
+            depth_test: None,
         };
         let mut out = self.device.run(Some(&target), &steps)?;
         let color = out.outputs[0]

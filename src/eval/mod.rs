@@ -17,6 +17,7 @@ pub mod image_check;
 pub mod refocus;
 pub mod reproject;
 pub mod stitch;
+pub mod vulkan;
 
 use crate::error::Result;
 use crate::gpu::{Gpu, Timing};

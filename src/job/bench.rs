@@ -4,8 +4,8 @@
 
 use super::host::HostStages;
 use super::{ArgError, Event, GpuRequest, Host, JobError};
+use crate::bench::batch::{batch_bench, BatchBench, BatchInput};
 use crate::bench::{cyclopean_bench, refocus_bench, BenchCase};
-use crate::bench_batch::{batch_bench, BatchBench, BatchInput};
 use crate::io;
 use crate::progress::Progress as _;
 use crate::refocus::job::FileFormats;
@@ -135,15 +135,15 @@ impl BenchJob {
                     if !*with_vulkan {
                         return Ok((tables, None));
                     }
-                    stages.stage(4, total, "bench: refocus and cyclopean on Vulkan");
+                    stages.stage(4, total, "bench: every pass, GL against Vulkan");
                     let request = GpuRequest {
                         device: crate::gpu::DeviceChoice::Auto,
                         ..self.gpu
                     };
                     let vk = host.open_vulkan(&request)?;
-                    tables.push(crate::vulkan::bench::refocus_bench(&vk, sizes, *repeats, &mut cases)?);
-                    tables.push(crate::vulkan::bench::cyclopean_bench(
-                        &vk, 1280, 720, *repeats, &mut cases,
+                    tables.push(crate::bench::vulkan::refocus_bench(&vk, sizes, *repeats, &mut cases)?);
+                    tables.push(crate::bench::vulkan::passes_bench(
+                        &gpu, &vk, 640, 480, *repeats, &mut cases,
                     )?);
                     Ok((tables, Some(vk.info().name.clone())))
                 })();

@@ -90,7 +90,7 @@ pub struct CyclopeanOptions {
     pub out_dir: PathBuf,
     /// The GPU to render on.
     pub gpu: GpuRequest,
-    /// GL, or Vulkan (every method but the forward warp).
+    /// GL, or Vulkan (every method).
     pub backend: Backend,
 }
 
@@ -205,11 +205,6 @@ impl CyclopeanJob {
             (None, None) => CyclopeanMethod::SplatGather,
         };
         let gathers = matches!(method, CyclopeanMethod::Seed | CyclopeanMethod::Refine);
-        // The forward warp (a depth-tested mesh) is the one method not yet described as passes.
-        if o.backend == Backend::Vulkan && method == CyclopeanMethod::Forward {
-            let default = if o.method.is_none() { " (the default)" } else { "" };
-            return Err(ArgError::VulkanCyclopeanMethod(method.name(), default));
-        }
         if !gathers {
             for (flag, given) in [
                 ("--refine-steps", o.refine_steps.is_some()),
@@ -319,14 +314,13 @@ impl CyclopeanJob {
             depth: self.outputs.depth,
         };
         let (out, timing) = match (self.backend, self.method, params) {
-            // `new` refused the forward warp with Vulkan.
             (_, CyclopeanMethod::Seed | CyclopeanMethod::Refine, Some(p)) => {
                 let device = host.open_device(&self.gpu, self.backend)?;
                 CyclopeanRenderer::with_outputs(&device, &frame, p, wanted)?.render(&mid)?
             }
             (_, CyclopeanMethod::Forward, _) => {
-                let gpu = host.open_gpu(&self.gpu)?;
-                ForwardWarp::new(&gpu, &frame, &BreakRule::default())?.render(&mid)?
+                let device = host.open_device(&self.gpu, self.backend)?;
+                ForwardWarp::new(&device, &frame, &BreakRule::default())?.render(&mid)?
             }
             _ => {
                 let device = host.open_device(&self.gpu, self.backend)?;
@@ -503,23 +497,14 @@ mod tests {
     }
 
     #[test]
-    fn vulkan_backend_refuses_the_methods_it_does_not_run_by_name() {
+    fn vulkan_backend_takes_every_method() {
         use super::Backend;
-        for (method, named) in [(Some(CyclopeanMethod::Forward), "--method forward ")] {
-            let o = CyclopeanOptions {
-                method,
-                backend: Backend::Vulkan,
-                ..disparity_options()
-            };
-            let e = CyclopeanJob::new(o).unwrap_err();
-            assert!(matches!(e, ArgError::VulkanCyclopeanMethod(..)), "{e}");
-            assert!(e.to_string().contains(named), "{e}");
-        }
         for method in [
             None,
             Some(CyclopeanMethod::SplatGather),
             Some(CyclopeanMethod::Seed),
             Some(CyclopeanMethod::Refine),
+            Some(CyclopeanMethod::Forward),
         ] {
             let o = CyclopeanOptions {
                 method,

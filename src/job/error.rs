@@ -116,12 +116,6 @@ pub enum ArgError {
         #[source]
         source: std::num::ParseFloatError,
     },
-    /// `--backend vulkan` with a cyclopean method Vulkan does not run.
-    #[error(
-        "--backend vulkan runs the cyclopean methods splat-gather, seed and refine; --method {0}{1} renders on GL \
-         only (give another --method, or drop --backend)"
-    )]
-    VulkanCyclopeanMethod(&'static str, &'static str),
     /// A seed/refine option with another cyclopean method.
     #[error("{0} applies to --method seed or refine only")]
     GatherOptionOnly(&'static str),

@@ -35,13 +35,16 @@ fn read_format(f: Format) -> ReadFormat {
     }
 }
 
+/// Size, outputs and whether there is a depth buffer.
+type TargetKey = (u32, u32, Vec<Option<Format>>, bool);
+
 /// Passes on an OpenGL context.
 pub struct GlExecutor {
     gpu: Gpu,
     vao: VertexArray,
     params: UniformBuffer,
     programs: Vec<(ShaderProgram, Program)>,
-    targets: Vec<((u32, u32, Vec<Option<Format>>), Framebuffer)>,
+    targets: Vec<(TargetKey, Framebuffer)>,
     images: Vec<Option<Texture>>,
     buffers: Vec<Option<StorageBuffer>>,
 }
@@ -70,7 +73,7 @@ impl GlExecutor {
     }
 
     fn target(&mut self, t: &Target) -> Result<usize> {
-        let key = (t.width, t.height, t.outputs.clone());
+        let key = (t.width, t.height, t.outputs.clone(), t.depth_test.is_some());
         if let Some(i) = self.targets.iter().position(|(k, _)| *k == key) {
             return Ok(i);
         }
@@ -87,7 +90,8 @@ impl GlExecutor {
                 })
             })
             .collect();
-        let fb = Framebuffer::new(&self.gpu, t.width, t.height, &attachments, false)?.with_label("pass target");
+        let fb = Framebuffer::new(&self.gpu, t.width, t.height, &attachments, t.depth_test.is_some())?
+            .with_label("pass target");
         self.targets.push((key, fb));
         Ok(self.targets.len() - 1)
     }
@@ -204,7 +208,11 @@ impl Executor for GlExecutor {
                 Step::Draw(d) => {
                     let fb = fb.ok_or_else(|| Error::Gl("a draw without a target".into()))?;
                     if pass.is_none() {
-                        pass = Some(fb.begin_pass(DrawState::default(), 1.0));
+                        let (state, clear) = match target.and_then(|t| t.depth_test) {
+                            Some(conv) => (DrawState::depth_tested(&conv), conv.clear_depth() as f32),
+                            None => (DrawState::default(), 1.0),
+                        };
+                        pass = Some(fb.begin_pass(state, clear));
                     }
                     let p = &self.programs[programs[k].expect("built above")].1;
                     p.bind();
@@ -218,7 +226,7 @@ impl Executor for GlExecutor {
                     let [x, y, w, h] = d.viewport;
                     let pass = pass.as_ref().expect("begun above");
                     pass.viewport(x, y, w, h);
-                    pass.draw_fullscreen(&self.vao);
+                    pass.draw_triangles(&self.vao, d.triangles as usize);
                 }
                 Step::Dispatch(d) => {
                     let p = &self.programs[programs[k].expect("built above")].1;

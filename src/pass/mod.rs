@@ -24,6 +24,7 @@
 
 pub mod gl;
 
+pub use crate::convention::Conventions;
 use crate::convention::RowOrder;
 use crate::error::Result;
 use crate::gpu::{ShaderProgram, Timing};
@@ -162,6 +163,10 @@ pub struct Target {
     pub outputs: Vec<Option<Format>>,
     /// How memory rows map to the top-down rows returned.
     pub rows: RowOrder,
+    /// A depth buffer, cleared to these conventions' far value and tested with their compare
+    /// (less, or greater under reversed-Z; GL's NDC depth range where they say so); None: no
+    /// depth buffer.
+    pub depth_test: Option<crate::convention::Conventions>,
 }
 
 /// One full-screen triangle.
@@ -177,6 +182,9 @@ pub struct Draw<'a> {
     pub buffers: &'a [BufferId],
     /// x, y (memory rows), width, height inside the target.
     pub viewport: [u32; 4],
+    /// Triangles drawn (3 vertices each, pulled by the vertex shader: no vertex buffers); 1
+    /// for the full-screen triangle.
+    pub triangles: u32,
 }
 
 /// What a pass read back: per output location, top-down bytes where asked for.

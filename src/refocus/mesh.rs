@@ -40,11 +40,22 @@ pub struct MeshPass {
 
 /// Kept-triangle codes as an R32UI texture `TRI_TEX_WIDTH` wide, for vertex pulling.
 pub fn code_texture(gpu: &Gpu, codes: &[u32]) -> Result<Option<Texture>> {
+    let Some((rows, bytes)) = code_rows(codes, gpu.max_image_side())? else {
+        return Ok(None);
+    };
+    Ok(Some(
+        Texture::new(gpu, TRI_TEX_WIDTH, rows, TextureFormat::R32Ui, Some(&bytes))?.with_label("kept triangle codes"),
+    ))
+}
+
+/// The rows and R32UI texels of [`code_texture`] (None without triangles), refused beyond a
+/// device's `max_side` or GL's vertex count.
+pub fn code_rows(codes: &[u32], max_side: u32) -> Result<Option<(u32, Vec<u8>)>> {
     if codes.is_empty() {
         return Ok(None);
     }
     let rows = codes.len().div_ceil(TRI_TEX_WIDTH as usize);
-    if rows > gpu.max_image_side() as usize || codes.len().checked_mul(3).is_none_or(|v| v > i32::MAX as usize) {
+    if rows > max_side as usize || codes.len().checked_mul(3).is_none_or(|v| v > i32::MAX as usize) {
         return Err(Error::param(
             "source size",
             format!(
@@ -55,11 +66,7 @@ pub fn code_texture(gpu: &Gpu, codes: &[u32]) -> Result<Option<Texture>> {
     }
     let mut padded = codes.to_vec();
     padded.resize(rows * TRI_TEX_WIDTH as usize, 0);
-    let bytes: Vec<u8> = padded.iter().flat_map(|c| c.to_ne_bytes()).collect();
-    Ok(Some(
-        Texture::new(gpu, TRI_TEX_WIDTH, rows as u32, TextureFormat::R32Ui, Some(&bytes))?
-            .with_label("kept triangle codes"),
-    ))
+    Ok(Some((rows as u32, bytemuck::cast_slice(&padded).to_vec())))
 }
 
 impl MeshPass {

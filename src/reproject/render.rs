@@ -198,6 +198,7 @@ impl Reprojector {
                         Some(Format::R8),
                     ],
                     rows: self.rows,
+                    depth_test: None,
                 };
                 let images = [s.color.id(), s.depth.id()];
                 let draw = Draw {
@@ -206,6 +207,7 @@ impl Reprojector {
                     images: &images,
                     buffers: &[],
                     viewport: [0, 0, w, h],
+                    triangles: 1,
                 };
                 let mut out = self.device.render(&target, &[draw])?;
                 let color = out.outputs[0].take().map(|c| RgbImage::new(w, h, c)).transpose()?;

@@ -258,6 +258,7 @@ impl SceneRenderer {
             height: h,
             outputs: vec![Some(Format::Rgba8), Some(Format::R32F), Some(Format::R32F)],
             rows: cam.conv.row_order,
+            depth_test: None,
         };
         let draw = Draw {
             program: ShaderProgram::new(cam.conv, ProgramKind::SceneRaytrace),
@@ -265,6 +266,7 @@ impl SceneRenderer {
             images: &[],
             buffers: &[],
             viewport: [0, 0, w, h],
+            triangles: 1,
         };
         let mut out = self.device.render(&target, &[draw])?;
         let floats = |b: Vec<u8>| -> Vec<f32> { bytemuck::pod_collect_to_vec(&b) };

@@ -182,6 +182,7 @@ impl StitchRenderer {
                 buffers: &[],
                 // One full-screen triangle into this eye's half of the target.
                 viewport: [0, row0, w, h],
+                triangles: 1,
             })
             .collect();
         let target = Target {
@@ -189,6 +190,7 @@ impl StitchRenderer {
             height: 2 * h,
             outputs: vec![Some(Format::Rgba8)],
             rows: self.conv.row_order,
+            depth_test: None,
         };
         let mut out = self.device.render(&target, &draws)?;
         let rgb = out.take(0, "stitch")?;

@@ -60,8 +60,32 @@ struct Layout {
     pipeline: vk::PipelineLayout,
 }
 
+/// The depth test of a graphics pipeline: compare op and GL's NDC depth range.
+type DepthKey = Option<(vk::CompareOp, bool)>;
+
+fn depth_key(conv: Option<crate::pass::Conventions>) -> DepthKey {
+    conv.map(|c| {
+        // As the GL executor's DrawState::depth_tested: LEQUAL, GEQUAL under reversed-Z, with
+        // depth clamp (set by the pipeline when a depth test is on).
+        let op = if c.reversed_z {
+            vk::CompareOp::GREATER_OR_EQUAL
+        } else {
+            vk::CompareOp::LESS_OR_EQUAL
+        };
+        (op, c.ndc_depth == crate::convention::NdcDepthRange::MinusOneToOne)
+    })
+}
+
+/// A target's colour attachments and its depth buffer, if any.
+struct CachedTarget {
+    key: (u32, u32, Vec<Option<Format>>, bool),
+    color: ColorTargets,
+    depth: Option<Image>,
+}
+
 struct CachedPipeline {
     program: ShaderProgram,
+    depth: DepthKey,
     /// The target's outputs (graphics pipelines; empty for compute).
     outputs: Vec<Option<Format>>,
     counts: Counts,
@@ -81,7 +105,7 @@ pub struct VkExecutor {
     sampler: vk::Sampler,
     layouts: Vec<Layout>,
     pipelines: Vec<CachedPipeline>,
-    targets: Vec<((u32, u32, Vec<Option<Format>>), ColorTargets)>,
+    targets: Vec<CachedTarget>,
     images: Vec<Option<StoredImage>>,
     buffers: Vec<Option<Buffer>>,
     params: Option<Buffer>,
@@ -201,7 +225,12 @@ impl VkExecutor {
     }
 
     /// The pipeline (graphics with `target`'s outputs, or compute) and layout of a step.
-    fn pipeline(&mut self, binds: &Binds, outputs: Option<&[Option<Format>]>) -> Result<(usize, usize)> {
+    fn pipeline(
+        &mut self,
+        binds: &Binds,
+        outputs: Option<&[Option<Format>]>,
+        depth: DepthKey,
+    ) -> Result<(usize, usize)> {
         let counts = binds.counts();
         if counts.0 > MAX_SAMPLED {
             return Err(Error::Vulkan(format!(
@@ -211,10 +240,9 @@ impl VkExecutor {
         }
         let layout = self.layout(counts)?;
         let outputs_key = outputs.map_or(Vec::new(), <[_]>::to_vec);
-        let found = self
-            .pipelines
-            .iter()
-            .position(|p| p.program == binds.program && p.outputs == outputs_key && p.counts == counts);
+        let found = self.pipelines.iter().position(|p| {
+            p.program == binds.program && p.outputs == outputs_key && p.counts == counts && p.depth == depth
+        });
         if let Some(i) = found {
             return Ok((i, layout));
         }
@@ -236,8 +264,8 @@ impl VkExecutor {
                     program: binds.program.kind.name(),
                     preamble: &preamble,
                     color_formats: &formats,
-                    depth: None,
-                    ndc_minus_one_to_one: false,
+                    depth: depth.map(|(op, _)| op),
+                    ndc_minus_one_to_one: depth.is_some_and(|(_, gl_range)| gl_range),
                 };
                 Pipeline::new(&self.vk, raw_layout, &desc)?
             }
@@ -245,6 +273,7 @@ impl VkExecutor {
         };
         self.pipelines.push(CachedPipeline {
             program: binds.program,
+            depth,
             outputs: outputs_key,
             counts,
             pipeline,
@@ -253,8 +282,8 @@ impl VkExecutor {
     }
 
     fn target(&mut self, t: &Target) -> Result<usize> {
-        let key = (t.width, t.height, t.outputs.clone());
-        if let Some(i) = self.targets.iter().position(|(k, _)| *k == key) {
+        let key = (t.width, t.height, t.outputs.clone(), t.depth_test.is_some());
+        if let Some(i) = self.targets.iter().position(|c| c.key == key) {
             return Ok(i);
         }
         if self.targets.len() >= KEPT_TARGETS {
@@ -262,8 +291,20 @@ impl VkExecutor {
         }
         let formats: Vec<Option<vk::Format>> = t.outputs.iter().map(|f| f.map(vk_format)).collect();
         let bytes: Vec<usize> = t.outputs.iter().map(|f| f.map_or(0, Format::texel_bytes)).collect();
-        let targets = ColorTargets::with_slots(&self.vk, t.width, t.height, &formats, &bytes)?;
-        self.targets.push((key, targets));
+        let color = ColorTargets::with_slots(&self.vk, t.width, t.height, &formats, &bytes)?;
+        let depth = t
+            .depth_test
+            .map(|_| {
+                Image::new(
+                    &self.vk,
+                    t.width,
+                    t.height,
+                    super::pipeline::DEPTH_FORMAT,
+                    vk::ImageUsageFlags::DEPTH_STENCIL_ATTACHMENT,
+                )
+            })
+            .transpose()?;
+        self.targets.push(CachedTarget { key, color, depth });
         Ok(self.targets.len() - 1)
     }
 
@@ -546,7 +587,7 @@ impl Executor for VkExecutor {
                         ),
                         _ => None,
                     };
-                    Some(self.pipeline(&b, outputs)?)
+                    Some(self.pipeline(&b, outputs, depth_key(target.and_then(|t| t.depth_test)))?)
                 }
                 None => None,
             });
@@ -578,7 +619,11 @@ impl Executor for VkExecutor {
         params.write(&blocks);
         let params_raw = params.raw;
         self.reset_pool(steps.len())?;
-        let targets = t.map(|t| &self.targets[t].1);
+        let targets = t.map(|t| &self.targets[t].color);
+        let depth_image = t.and_then(|t| self.targets[t].depth.as_ref());
+        let clear_depth = target
+            .and_then(|t| t.depth_test)
+            .map_or(1.0, |c| c.clear_depth() as f32);
         let mut sets = Vec::with_capacity(steps.len());
         for (k, step) in steps.iter().enumerate() {
             sets.push(match (Binds::of(step), chosen[k]) {
@@ -663,7 +708,30 @@ impl Executor for VkExecutor {
                         Step::Draw(draw) => {
                             let targets = targets.expect("draws have a target");
                             if !rendering {
-                                targets.record_begin(cb, None);
+                                use vk::{AccessFlags as A, ImageLayout as L, PipelineStageFlags as S};
+                                let attachment = depth_image.map(|dpt| {
+                                    dpt.transition(
+                                        cb,
+                                        L::UNDEFINED,
+                                        L::DEPTH_ATTACHMENT_OPTIMAL,
+                                        S::TOP_OF_PIPE,
+                                        A::empty(),
+                                        S::EARLY_FRAGMENT_TESTS | S::LATE_FRAGMENT_TESTS,
+                                        A::DEPTH_STENCIL_ATTACHMENT_READ | A::DEPTH_STENCIL_ATTACHMENT_WRITE,
+                                    );
+                                    vk::RenderingAttachmentInfo::default()
+                                        .image_view(dpt.view)
+                                        .image_layout(L::DEPTH_ATTACHMENT_OPTIMAL)
+                                        .load_op(vk::AttachmentLoadOp::CLEAR)
+                                        .store_op(vk::AttachmentStoreOp::DONT_CARE)
+                                        .clear_value(vk::ClearValue {
+                                            depth_stencil: vk::ClearDepthStencilValue {
+                                                depth: clear_depth,
+                                                stencil: 0,
+                                            },
+                                        })
+                                });
+                                targets.record_begin(cb, attachment.as_ref());
                                 rendering = true;
                                 drawn = true;
                             }
@@ -695,7 +763,7 @@ impl Executor for VkExecutor {
                             );
                             d.cmd_set_viewport(cb, 0, &[viewport]);
                             d.cmd_set_scissor(cb, 0, &[scissor]);
-                            d.cmd_draw(cb, 3, 1, 0, 0);
+                            d.cmd_draw(cb, 3 * draw.triangles, 1, 0, 0);
                         }
                         Step::Dispatch(dispatch) => {
                             let (p, l) = chosen[k].expect("chosen above");

@@ -7,8 +7,7 @@
 //! - `resources`: host-visible buffers (uploads, indices, readback) and device-local images.
 //! - `pipeline`: SPIR-V variants compiled by build.rs from the GL sources (looked up by the GL
 //!   preamble) and graphics pipelines with dynamic rendering.
-//! - `refocus`: the refocus full-screen and mesh passes; `bench`: their timings; `report`: the
-//!   demo's GL-vs-Vulkan table.
+//! - `refocus`: the refocus full-screen and mesh passes (not yet a pass description).
 //! - `executor`: runs the backend-neutral pass descriptions (`crate::pass`): the cyclopean
 //!   gather, the reprojection shift, the stitch and the scene ray tracer, from the same GLSL as
 //!   the GL executor.
@@ -17,12 +16,10 @@
 //! Scope: refocus single frames and every full-screen pass; the compute passes (splat-gather,
 //! edge snap), the forward warp and the refocus batch render on GL.
 
-pub mod bench;
 mod context;
 mod executor;
 mod pipeline;
 mod refocus;
-pub mod report;
 mod resources;
 mod targets;
 

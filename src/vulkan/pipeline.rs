@@ -221,7 +221,8 @@ mod tests {
                 }
             }
         }
-        // refocus 3 x 2, gather 8, shift 6, stitch 3, ray tracer 1 programs; 2 stages; 8 conventions.
-        assert_eq!(found, (6 + 8 + 6 + 3 + 1) * 2 * 8);
+        // Under each of 8 conventions: refocus 3 x 2, gather 8, shift 6, stitch 3, ray tracer 1
+        // and splat-gather's draw 1 programs of 2 stages; splat, edge snap and edge pass 1 stage.
+        assert_eq!(found, ((6 + 8 + 6 + 3 + 1 + 1) * 2 + 3) * 8);
     }
 }

@@ -163,7 +163,7 @@ fn vulkan_reads_back_only_the_requested_outputs() {
 /// agrees with the GL run of the same command within the bounds above; splat-gather and forward
 /// are refused by name (exit 1, as the binary's other option checks) with nothing written.
 #[test]
-fn cli_backend_vulkan_writes_the_gather_view_and_refuses_other_methods() {
+fn cli_backend_vulkan_writes_the_gather_view() {
     let v = vulkan();
     let rig = StereoRig::demo(96, 72);
     let conv = Conventions::all()[5];
@@ -215,17 +215,5 @@ fn cli_backend_vulkan_writes_the_gather_view_and_refuses_other_methods() {
         } else {
             assert_eq!(*b, 0.0);
         }
-    }
-
-    for (extra, named) in [(&["--method", "forward"][..], "--method forward")] {
-        let out = dir.join("refused");
-        let args: Vec<&str> = ["--backend", "vulkan"].iter().chain(extra).copied().collect();
-        let o = run(&args, &out);
-        let err = String::from_utf8_lossy(&o.stderr);
-        // Refused in the job's option check (ArgError), which the binary exits 1 for as every
-        // checked-option error; only clap's own usage errors exit 2.
-        assert_eq!(o.status.code(), Some(1), "{err}");
-        assert!(err.contains(named) && !err.contains("panicked"), "{err}");
-        assert!(!out.exists(), "a refused run wrote {}", out.display());
     }
 }

@@ -21,6 +21,7 @@ use crate::common::{cyclopean_cli, data_dir, gpu, write_cyclopean_files};
 use crate::vulkan_refocus::vulkan;
 use std::path::Path;
 use viewsynth::convention::Conventions;
+use viewsynth::cyclopean::forward::{ForwardParams, ForwardWarp};
 use viewsynth::cyclopean::render::{CyclopeanRenderer, GatherParams};
 use viewsynth::cyclopean::scene_frame::{scene_frame, StereoRig};
 use viewsynth::cyclopean::splat::{EdgeSnapBlock, SplatBlock, SplatGatherBlock, SplatParams, SplatRenderer};
@@ -30,6 +31,7 @@ use viewsynth::eval::reproject::{methods, scene_cases};
 use viewsynth::gpu::shaders::{ShiftDepth, StitchBlend};
 use viewsynth::gpu::{ProgramKind, ShaderProgram};
 use viewsynth::pass::{Device, ParamBlock};
+use viewsynth::refocus::BreakRule;
 use viewsynth::reproject::render::ShiftParams;
 use viewsynth::reproject::{self, ReprojectInput};
 use viewsynth::scene::gpu::{GlCamera, RaytraceParams, SceneRenderer};
@@ -85,6 +87,7 @@ fn every_parameter_block_has_the_layout_the_gl_compiler_reports() {
     check_block::<EdgeSnapBlock>(ProgramKind::CyclopeanEdgeSnap);
     check_block::<SplatGatherBlock>(ProgramKind::CyclopeanSplatGather);
     check_block::<SplatGatherBlock>(ProgramKind::CyclopeanSplatEdges);
+    check_block::<ForwardParams>(ProgramKind::CyclopeanForward);
 }
 
 fn devices() -> (Device, Device) {
@@ -213,6 +216,28 @@ fn splat_gather_agrees_between_gl_and_vulkan_under_every_convention() {
                     &backend_diff(&a, &b),
                 );
             }
+        }
+    }
+}
+
+/// The forward warp (both eyes' depth meshes, vertex pulling, a depth test per the conventions,
+/// the GL NDC range through VK_EXT_depth_clip_control) on both executors, every convention.
+#[test]
+fn forward_warp_agrees_between_gl_and_vulkan_under_every_convention() {
+    let (gl, vk) = devices();
+    for conv in Conventions::all() {
+        for kind in [FrameDepth::Device, FrameDepth::ViewZ] {
+            let (frame, mid, _) = scene_frame(&StereoRig::demo(96, 72), conv, kind);
+            let render = |d: &Device| {
+                let (out, _) = ForwardWarp::new(d, &frame, &BreakRule::default())
+                    .unwrap()
+                    .render(&mid)
+                    .unwrap();
+                ViewOutput::from_cyclopean(&out, mid.width, mid.height, None)
+            };
+            let (a, b) = (render(&gl), render(&vk));
+            assert!(a.valid().unwrap().iter().filter(|v| **v).count() * 2 > a.width as usize * a.height as usize);
+            assert_agree(&format!("forward {} {kind:?}", conv.label()), &backend_diff(&a, &b));
         }
     }
 }
@@ -395,7 +420,7 @@ fn reproject_stitch_scene_and_cyclopean_commands_write_the_same_files_on_vulkan(
     // The cyclopean gather from the scene's own files (seed and refine run on Vulkan).
     let (frame, mid, _) = scene_frame(&StereoRig::demo(96, 72), Conventions::all()[6], FrameDepth::Device);
     write_cyclopean_files(&dir, &frame, &mid);
-    for method in ["splat-gather", "seed", "refine"] {
+    for method in ["splat-gather", "seed", "refine", "forward"] {
         let (gl, vk) = (
             dir.join(format!("cyc-{method}-gl")),
             dir.join(format!("cyc-{method}-vulkan")),
@@ -474,7 +499,7 @@ fn every_vulkan_pass_runs_clean_under_the_validation_layer() {
             assert!(!text.contains(bad), "{args:?}: {bad}:\n{text}");
         }
     }
-    for method in ["splat-gather", "seed", "refine"] {
+    for method in ["splat-gather", "seed", "refine", "forward"] {
         let out = dir.join(format!("cyc-{method}"));
         let o = std::process::Command::new(env!("CARGO_BIN_EXE_viewsynth"))
             .arg("cyclopean")

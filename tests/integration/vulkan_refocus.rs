@@ -158,7 +158,7 @@ fn demo_section_tables_every_path_and_convention_within_the_bounds() {
     }
     .targets(&src.camera())
     .unwrap()[0];
-    let md = viewsynth::vulkan::report::gl_vs_vulkan_section(&gpu(), &src, &target);
+    let md = viewsynth::eval::vulkan::gl_vs_vulkan_section(&gpu(), &src, &target);
     assert!(!md.contains("Vulkan not run"), "{md}");
     let rows: Vec<Vec<&str>> = md
         .lines()

@@ -102,7 +102,7 @@ pub(crate) struct CyclopeanArgs {
     #[command(flatten)]
     gpu: GpuArgs,
     /// Rendering API: gl, or vulkan (the same gather shader as SPIR-V on a Vulkan device,
-    /// --device an index of `viewsynth info --backend vulkan`; every method but forward).
+    /// --device an index of `viewsynth info --backend vulkan`).
     #[arg(long, value_enum, default_value = "gl")]
     backend: BackendArg,
 }

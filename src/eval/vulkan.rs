@@ -6,9 +6,6 @@
 //! with its bounds (source bits identical, colour within one level, depth within 4e-5;
 //! derived in tests/integration/vulkan_cyclopean.rs).
 
-use super::context::{Vk, VulkanContext, VulkanDeviceChoice};
-use super::executor::VkExecutor;
-use super::refocus::VkRefocuser;
 use crate::camera::PinholeCamera;
 use crate::convention::Conventions;
 use crate::cyclopean::render::CyclopeanRenderer;
@@ -17,6 +14,7 @@ use crate::cyclopean::{CyclopeanOutput, CyclopeanParams, FrameDepth, Method as C
 use crate::error::Result;
 use crate::gpu::{Gpu, GpuPolicy};
 use crate::refocus::{BreakRule, Method, OutputSet, RefocusOutput, RefocusSource, Refocuser};
+use crate::vulkan::{Vk, VkExecutor, VkRefocuser, VulkanContext, VulkanDeviceChoice};
 use std::fmt::Write as _;
 
 /// Differences between a GL and a Vulkan output of the same target.

@@ -3,6 +3,9 @@
 //! render + readback) for each GPU path, the f64 CPU reference as the in-run baseline, and the
 //! whole job with file writing. Printed as a Markdown table; nothing here asserts a time.
 
+pub mod batch;
+pub mod vulkan;
+
 use crate::convention::Conventions;
 use crate::error::Result;
 use crate::gpu::Gpu;
@@ -12,7 +15,7 @@ use crate::scene;
 use std::fmt::Write as _;
 use std::time::Instant;
 
-use crate::bench_batch::median;
+use crate::bench::batch::median;
 
 /// One measured case, for `bench --json`.
 #[derive(Debug, Clone, serde::Serialize)]

@@ -1,0 +1,295 @@
+//! `viewsynth bench --with-vulkan`: the refocus timings of `bench.rs` (built-in scene, 5 focal
+//! scales, render + readback, medians) and its cyclopean gather timings (seed and refine methods,
+//! draw + readback) on the Vulkan device, for the GL-vs-Vulkan comparison.
+
+use super::BenchCase;
+use crate::bench::batch::median;
+use crate::convention::Conventions;
+use crate::cyclopean::render::CyclopeanRenderer;
+use crate::error::Result;
+use crate::refocus::job::TargetSpec;
+use crate::refocus::{BreakRule, Method, OutputSet, RefocusSource};
+use crate::scene;
+use crate::vulkan::{Vk, VkExecutor, VkRefocuser};
+use std::fmt::Write as _;
+use std::time::Instant;
+
+const SCALES: [f64; 5] = [0.5, 0.75, 1.0, 1.5, 2.0];
+
+/// One Markdown table; every case also goes to `cases` (as `vulkan-fullscreen`, `vulkan-mesh`).
+pub fn refocus_bench(vk: &Vk, sizes: &[(u32, u32)], repeats: usize, cases: &mut Vec<BenchCase>) -> Result<String> {
+    let info = vk.info();
+    let mut t = format!(
+        "refocus benchmark on Vulkan device '{}' ({}, {}), {repeats} repeats, medians\n\n\
+         | size | path | setup ms | ms / frame (5 scales) | ms / scale |\n|---|---|---|---|---|\n",
+        info.name,
+        info.device_type,
+        if info.software { "software" } else { "hardware" }
+    );
+    for &(w, h) in sizes {
+        let cam = scene::demo_camera(w, h);
+        let (rgb, depth) = scene::render(&cam);
+        let src = RefocusSource::new(rgb, depth, cam.k)?;
+        let targets = TargetSpec {
+            scales: SCALES.to_vec(),
+            size: None,
+            principal: None,
+        }
+        .targets(&cam)?;
+        for method in [Method::Fullscreen, Method::Mesh] {
+            let t0 = Instant::now();
+            let mut r = VkRefocuser::new(
+                vk,
+                &src,
+                &BreakRule::default(),
+                method,
+                OutputSet::default(),
+                Conventions::default(),
+            )?;
+            r.render(&targets[0])?; // warm-up: pipeline compile on first use, target allocation
+            let setup = t0.elapsed().as_secs_f64() * 1e3;
+            let mut frame = Vec::new();
+            for _ in 0..repeats.max(1) {
+                let t0 = Instant::now();
+                for target in &targets {
+                    r.render(target)?;
+                }
+                frame.push(t0.elapsed().as_secs_f64() * 1e3);
+            }
+            let m = median(frame);
+            let case = match method {
+                Method::Mesh => "vulkan-mesh",
+                Method::Fullscreen => "vulkan-fullscreen",
+            };
+            cases.push(BenchCase::new("refocus", case, format!("{w}x{h}"), Some(setup), m));
+            writeln!(t, "| {w}x{h} | {case} | {setup:.1} | {m:.2} | {:.2} |", m / 5.0).expect("write to String");
+        }
+    }
+    Ok(t)
+}
+
+/// A renderer's one frame, as a closure over its renderer.
+type Frame<'a> = Box<dyn FnMut() -> Result<()> + 'a>;
+
+/// Median ms of `repeats` frames after a warm-up (pipelines compile on first use, targets are
+/// allocated).
+fn time(repeats: usize, frame: Result<Frame>) -> Result<f64> {
+    let mut frame = frame?;
+    frame()?;
+    let mut runs = Vec::new();
+    for _ in 0..repeats.max(1) {
+        let t0 = Instant::now();
+        frame()?;
+        runs.push(t0.elapsed().as_secs_f64() * 1e3);
+    }
+    Ok(median(runs))
+}
+
+/// Every pass on both APIs from one run, same inputs, render + readback, medians of `repeats`
+/// after a warm-up (pipelines, targets): refocus (5 focal scales a frame), cyclopean seed,
+/// refine and splat-gather, reproject shift, shift-scan and 3-D gather, stitch's three methods
+/// (one stereo equirect) and the scene ray tracer, at `width` x `height`. One Markdown table;
+/// every case also goes to `cases` (`gl-<pass>`, `vulkan-<pass>`).
+pub fn passes_bench(
+    gpu: &crate::gpu::Gpu,
+    vk: &Vk,
+    width: u32,
+    height: u32,
+    repeats: usize,
+    cases: &mut Vec<BenchCase>,
+) -> Result<String> {
+    use crate::cyclopean::scene_frame::{scene_frame, StereoRig};
+    use crate::cyclopean::splat::{SplatParams, SplatRenderer};
+    use crate::cyclopean::{CyclopeanOutputs, CyclopeanParams, FrameDepth, Method as Cm};
+    use crate::pass::Device;
+    use crate::refocus::Refocuser;
+    use crate::reproject::render::Reprojector;
+    use crate::scene::gpu::{GlCamera, SceneRenderer};
+    use crate::stitch::render::StitchRenderer;
+    use crate::stitch::{faces::scene_faces, Method as Sm, OdsRig, Side, StitchParams};
+
+    let devices = [Device::gl(gpu)?, VkExecutor::device(vk)?];
+    let (frame, mid, _) = scene_frame(
+        &StereoRig::demo(width, height),
+        Conventions::default(),
+        FrameDepth::Device,
+    );
+    let cam = scene::demo_camera(width, height);
+    let (rgb, depth) = scene::render(&cam);
+    let src = RefocusSource::new(rgb, depth, cam.k)?;
+    let targets = TargetSpec {
+        scales: SCALES.to_vec(),
+        size: None,
+        principal: None,
+    }
+    .targets(&cam)?;
+    let reproject_case =
+        crate::eval::reproject::scene_cases(width, height, 0.064, Conventions::default(), FrameDepth::Device)?
+            .into_iter()
+            .next()
+            .ok_or_else(|| crate::Error::param("bench", "no reprojection case"))?;
+    let rig = OdsRig::demo();
+    let face = (width / 4).max(16);
+    let faces = [Side::Left, Side::Right].map(|side| scene_faces(&rig, side, face, 110.0));
+    let [left, right] = faces;
+    let (left, right) = (left?, right?);
+    let scene = crate::scene::builtin("demo")?;
+    let gl_cam = GlCamera {
+        view: frame.left.view,
+        proj: frame.left.proj,
+        width,
+        height,
+        conv: Conventions::default(),
+    };
+    let seed = CyclopeanParams::seed(3.0);
+    let refine = CyclopeanParams {
+        method: Cm::Refine { steps: 3 },
+        ..seed
+    };
+
+    let mut t = format!(
+        "every pass, GL against Vulkan: {width}x{height} (refocus: 5 focal scales a frame; stitch: \
+         {0}x{1} per eye from {face} px faces), render + readback, {repeats} repeats, medians; \
+         Vulkan device '{2}'\n\n| pass | GL ms | Vulkan ms | Vulkan / GL |\n|---|---|---|---|\n",
+        2 * width,
+        width,
+        vk.info().name
+    );
+    let mut row = |name: &str, ms: [f64; 2], cases: &mut Vec<BenchCase>| {
+        writeln!(t, "| {name} | {:.2} | {:.2} | {:.2} |", ms[0], ms[1], ms[1] / ms[0]).expect("write to String");
+        for (api, m) in ["gl", "vulkan"].iter().zip(ms) {
+            cases.push(BenchCase::new(
+                "passes",
+                &format!("{api}-{name}"),
+                format!("{width}x{height}"),
+                None,
+                m,
+            ));
+        }
+    };
+    for method in [Method::Fullscreen, Method::Mesh] {
+        let rule = BreakRule::default();
+        let gl = time(
+            repeats,
+            (|| -> Result<Frame> {
+                let mut r = Refocuser::new(gpu, &src, &rule, method, OutputSet::default(), Conventions::default())?;
+                let targets = &targets;
+                Ok(Box::new(move || targets.iter().try_for_each(|c| r.render(c).map(drop))) as Frame)
+            })(),
+        )?;
+        let vulkan = time(
+            repeats,
+            (|| -> Result<Frame> {
+                let mut r = VkRefocuser::new(vk, &src, &rule, method, OutputSet::default(), Conventions::default())?;
+                let targets = &targets;
+                Ok(Box::new(move || targets.iter().try_for_each(|c| r.render(c).map(drop))) as Frame)
+            })(),
+        )?;
+        let name = match method {
+            Method::Fullscreen => "refocus fullscreen",
+            Method::Mesh => "refocus mesh",
+        };
+        row(name, [gl, vulkan], cases);
+    }
+    for (name, params) in [("cyclopean seed", seed), ("cyclopean refine 3", refine)] {
+        let ms = devices.each_ref().map(|d| {
+            time(
+                repeats,
+                (|| -> Result<Frame> {
+                    let mut r = CyclopeanRenderer::new(d, &frame, params)?;
+                    let mid = &mid;
+                    Ok(Box::new(move || r.render(mid).map(drop)) as Frame)
+                })(),
+            )
+        });
+        row(
+            name,
+            {
+                let [a, b] = ms;
+                [a?, b?]
+            },
+            cases,
+        );
+    }
+    let ms = devices.each_ref().map(|d| {
+        time(
+            repeats,
+            (|| -> Result<Frame> {
+                let mut r = SplatRenderer::new(d, &frame, SplatParams::default(), CyclopeanOutputs::default())?;
+                let mid = &mid;
+                Ok(Box::new(move || r.render(mid).map(drop)) as Frame)
+            })(),
+        )
+    });
+    row(
+        "cyclopean splat-gather",
+        {
+            let [a, b] = ms;
+            [a?, b?]
+        },
+        cases,
+    );
+    for params in crate::eval::reproject::methods() {
+        let ms = devices.each_ref().map(|d| {
+            time(
+                repeats,
+                (|| -> Result<Frame> {
+                    let mut r = Reprojector::new(d, &reproject_case.source, &reproject_case.geometry, params)?;
+                    Ok(Box::new(move || r.render().map(drop)) as Frame)
+                })(),
+            )
+        });
+        row(
+            &format!("reproject {}", params.method.label()),
+            {
+                let [a, b] = ms;
+                [a?, b?]
+            },
+            cases,
+        );
+    }
+    for method in Sm::ALL {
+        let params = StitchParams {
+            method,
+            overlap_deg: 10.0,
+            width: 2 * width,
+            height: width,
+        };
+        let ms = devices.each_ref().map(|d| {
+            time(
+                repeats,
+                (|| -> Result<Frame> {
+                    let mut r = StitchRenderer::new(d, &left, &right)?;
+                    Ok(Box::new(move || r.render(&params).map(drop)) as Frame)
+                })(),
+            )
+        });
+        row(
+            &format!("stitch {}", method.label()),
+            {
+                let [a, b] = ms;
+                [a?, b?]
+            },
+            cases,
+        );
+    }
+    let ms = devices.each_ref().map(|d| {
+        time(
+            repeats,
+            (|| -> Result<Frame> {
+                let mut r = SceneRenderer::new(d, &scene)?;
+                let cam = &gl_cam;
+                Ok(Box::new(move || r.render(cam).map(drop)) as Frame)
+            })(),
+        )
+    });
+    row(
+        "scene ray tracer",
+        {
+            let [a, b] = ms;
+            [a?, b?]
+        },
+        cases,
+    );
+    Ok(t)
+}
