@@ -5,6 +5,8 @@
 //! never leaves a partial file under the final name. Loaders refuse width or height of 0 or
 //! above [`MAX_DIMENSION`] before allocating pixel memory.
 
+pub(crate) use crate::error::excerpt;
+
 mod atomic;
 mod decode;
 mod depth;
