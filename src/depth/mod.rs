@@ -41,15 +41,21 @@ pub fn usable_depth_value(v: f32) -> bool {
     v == 0.0 || (v.is_finite() && (MIN_DEPTH_VALUE..=MAX_DEPTH_VALUE).contains(&v.abs()))
 }
 
+/// Whether `v` is finite but outside [`usable_depth_value`]: the values the rule turns into
+/// holes (NaN and infinities are holes already and are kept as they are).
+#[inline]
+fn out_of_range(v: f32) -> bool {
+    v.is_finite() && !usable_depth_value(v)
+}
+
 /// Makes every stored value outside [`usable_depth_value`] a hole (NaN), the one rule that
 /// every depth input (files, Python arrays, stress cases) goes through before a pass sees it,
 /// so that a pixel the mask calls valid has finite outputs. Returns how many were changed.
 pub fn clear_unusable_depth(data: &mut [f32]) -> usize {
     let mut n = 0;
-    for v in data.iter_mut().filter(|v| !usable_depth_value(**v)) {
-        // NaN and infinities were holes already; only count what changes meaning.
-        n += usize::from(v.is_finite());
+    for v in data.iter_mut().filter(|v| out_of_range(**v)) {
         *v = f32::NAN;
+        n += 1;
     }
     n
 }
