@@ -194,7 +194,7 @@ pub fn remove_orphan_temporaries(dir: &Path) -> usize {
                 },
                 Err(_) => false,
             },
-            Ok(t) if t.is_symlink() => fs::remove_file(e.path()).is_ok(),
+            // Never ours (we make none) and harmless: left alone.
             _ => false,
         };
         removed += usize::from(ok);
@@ -339,7 +339,12 @@ mod tests {
         let locked = format!("{TEMP_PREFIX}{}-abc.tmp", u32::MAX - 1);
         for n in [&unlocked, &locked, &"keep.png".to_string()] {
             fs::write(dir.join(n), b"x").unwrap();
-            File::options().write(true).open(dir.join(n)).unwrap().set_modified(old).unwrap();
+            File::options()
+                .write(true)
+                .open(dir.join(n))
+                .unwrap()
+                .set_modified(old)
+                .unwrap();
         }
         let holder = File::open(dir.join(&locked)).unwrap();
         assert!(try_lock(&holder).unwrap());

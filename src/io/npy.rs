@@ -140,8 +140,8 @@ pub(crate) fn open_npy_stream<R: std::io::Read>(
     let (text, _) = split_header(&head).map_err(bad)?;
     let header = parse_header(text).map_err(bad)?;
     let have = len.saturating_sub(head.len() as u64);
-    let need = payload_extent(&header, have, max_values, "; refused before inflating")
-        .map_err(|e| e.into_message(|m| m))?;
+    let need =
+        payload_extent(&header, have, max_values, "; refused before inflating").map_err(|e| e.into_message(|m| m))?;
     Ok(NpyStream { reader, header, need })
 }
 

@@ -145,6 +145,23 @@ pub enum ArgError {
     /// A reprojection rig neither rectified nor game-engine.
     #[error("give the rig: --baseline B (rectified, metres) or --separation S --convergence C (game-engine stereo)")]
     NoRig,
+    /// Both rigs given.
+    #[error(
+        "--baseline (rectified rig) and --separation/--convergence (game-engine rig) conflict: give one \
+         (--baseline goes with --separation only to make --depth-kind disparity metric)"
+    )]
+    RigConflict,
+    /// `stress --only` given but naming nothing.
+    #[error("--only '{0}': names no capability (omit --only to sweep them all)")]
+    StressNothing(String),
+    /// A scale option outside (0, inf).
+    #[error("invalid {option} {value}: must be finite and > 0")]
+    Scale {
+        /// The option, e.g. `--disparity-scale`.
+        option: &'static str,
+        /// The value given.
+        value: f64,
+    },
     /// A camera file's source must be an eye.
     #[error("--cameras holds the two eyes: --from left or right")]
     CameraFileFromCentre,

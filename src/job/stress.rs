@@ -32,6 +32,10 @@ impl StressJob {
                 })?;
             capabilities.push(*known);
         }
+        // `--only ""` or `--only ,`: asked for a subset and named none (0 rows must not pass).
+        if !only.is_empty() && capabilities.is_empty() {
+            return Err(ArgError::StressNothing(only.join(",")));
+        }
         Ok(StressJob {
             capabilities,
             quick,

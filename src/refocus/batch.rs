@@ -99,10 +99,14 @@ pub fn load_manifest(path: &Path) -> Result<Vec<BatchFrame>> {
                 }
             })
             .collect();
-        if safe.is_empty() || safe.starts_with('.') || !seen.insert(safe.clone()) {
+        // A folder name: at most 255 bytes (NAME_MAX), so a huge cell is refused here, quoted short.
+        if safe.is_empty() || safe.starts_with('.') || safe.len() > 255 || !seen.insert(safe.clone()) {
             return Err(Error::decode(
                 path,
-                format!("frame {i}: name '{name}' is empty, hidden or repeated"),
+                format!(
+                    "frame {i}: name '{}' is empty, hidden, longer than 255 bytes or repeated",
+                    crate::error::excerpt(&name)
+                ),
             ));
         }
         f.name = Some(safe);

@@ -86,6 +86,7 @@ struct Cli {
 #[derive(Subcommand)]
 enum Command {
     /// Print the GPU, GL version, EGL platform/device and limits this machine renders with.
+    #[command(allow_negative_numbers = true)]
     Info(info::args::InfoArgs),
     /// Re-render RGB + metric depth at other focal lengths (same pose).
     #[command(allow_negative_numbers = true)]
@@ -105,24 +106,30 @@ enum Command {
     /// Ray-trace a ground-truth scene (built-in or JSON) on the GPU from a stereo rig: left, right
     /// and middle colour, view distance and device depth, and a cameras.json that
     /// `viewsynth cyclopean` reads.
+    #[command(allow_negative_numbers = true)]
     Scene(scene::args::SceneArgs),
     /// Compare two renderings (e.g. ours and a Vulkan renderer's) after converting row order,
     /// NDC depth range, reversed-Z and device vs linear depth; names a convention that fits far
     /// better than the declared one. Writes a diff image.
+    #[command(allow_negative_numbers = true)]
     Compare(Box<compare::args::CompareArgs>),
     /// Render the built-in scene, refocus it at 5 scales, synthesise the cyclopean middle view of
     /// a stereo pair with each method, and write every output plus the error/run-time report.
+    #[command(allow_negative_numbers = true)]
     Demo(demo::args::DemoArgs),
     /// Measure every method's error against ground truth (built-in scene, and real data when
     /// --data-dir holds ../shared/data's sets) next to its run time: report.{md,csv,svg}.
+    #[command(allow_negative_numbers = true)]
     Report(report::args::ReportArgs),
     /// Benchmark refocus (mesh and full-screen paths) and cyclopean (2 x 1280x720 eyes) and print
     /// median timings.
+    #[command(allow_negative_numbers = true)]
     Bench(bench::args::BenchArgs),
     /// Sweep stiff and extreme cases of every capability (focal scales 0.05..20, 1 mm..100 km,
     /// near/far 1e-7, standard vs reversed-Z, NaN/Inf depth, 1x1 to the largest image, parallel
     /// gaze, zero IPD, ...): GPU f32 against the f64 reference, as a table with the first failing
     /// case. Exits 1 if any case fails.
+    #[command(allow_negative_numbers = true)]
     Stress(stress::args::StressArgs),
 }
 
