@@ -216,9 +216,8 @@ fn cli_backend_vulkan_writes_the_gather_view_and_refuses_other_methods() {
         let args: Vec<&str> = ["--backend", "vulkan"].iter().chain(extra).copied().collect();
         let o = run(&args, &out);
         let err = String::from_utf8_lossy(&o.stderr);
-        // Refused in the job's option check (ArgError), which the binary exits 1 for as every
-        // checked-option error; only clap's own usage errors exit 2.
-        assert_eq!(o.status.code(), Some(1), "{err}");
+        // Refused in the job's option check (ArgError): a usage error, exit 2 like clap's own.
+        assert_eq!(o.status.code(), Some(2), "{err}");
         assert!(err.contains(named) && !err.contains("panicked"), "{err}");
         assert!(!out.exists(), "a refused run wrote {}", out.display());
     }

@@ -164,7 +164,12 @@ fn main() -> ExitCode {
         Ok(code) => code,
         Err(e) => {
             eprintln!("error: {}", error_chain(&e));
-            ExitCode::from(if e.is::<Usage>() { USAGE_ERROR } else { RUN_ERROR })
+            if e.is::<Usage>() {
+                // As clap ends its own usage errors: both kinds read alike.
+                eprintln!("\nFor more information, try '--help'.");
+                return ExitCode::from(USAGE_ERROR);
+            }
+            ExitCode::from(RUN_ERROR)
         }
     }
 }
