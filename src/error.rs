@@ -84,6 +84,26 @@ pub enum Error {
     Vulkan(String),
 }
 
+/// Most characters of an input a message quotes (a name, a key, a line).
+pub const MAX_EXCERPT: usize = 120;
+/// Most characters of any error message built by [`Error::decode`], [`Error::encode`] or
+/// [`Error::param`]: whatever an input holds (a 15 MB JSON key, a huge line), the message
+/// quoting it stays short.
+pub const MAX_MESSAGE: usize = 2048;
+
+/// `text` cut to `max` characters, with how much was left out.
+fn cut(text: &str, max: usize) -> String {
+    match text.char_indices().nth(max) {
+        None => text.to_string(),
+        Some((at, _)) => format!("{}... ({} bytes in all)", &text[..at], text.len()),
+    }
+}
+
+/// `text` (taken from an input) cut to [`MAX_EXCERPT`] characters for a message.
+pub fn excerpt(text: &str) -> String {
+    cut(text, MAX_EXCERPT)
+}
+
 impl Error {
     /// An [`Error::Io`] on `path`.
     pub fn io(path: impl Into<PathBuf>, source: std::io::Error) -> Self {
@@ -96,21 +116,21 @@ impl Error {
     pub fn decode(path: impl Into<PathBuf>, message: impl Into<String>) -> Self {
         Error::Decode {
             path: path.into(),
-            message: message.into(),
+            message: cut(&message.into(), MAX_MESSAGE),
         }
     }
     /// An [`Error::Encode`] of `path`.
     pub fn encode(path: impl Into<PathBuf>, message: impl Into<String>) -> Self {
         Error::Encode {
             path: path.into(),
-            message: message.into(),
+            message: cut(&message.into(), MAX_MESSAGE),
         }
     }
     /// An [`Error::InvalidParameter`] naming `name`.
     pub fn param(name: impl Into<String>, message: impl Into<String>) -> Self {
         Error::InvalidParameter {
-            name: name.into(),
-            message: message.into(),
+            name: cut(&name.into(), MAX_EXCERPT),
+            message: cut(&message.into(), MAX_MESSAGE),
         }
     }
 }

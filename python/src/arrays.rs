@@ -91,7 +91,9 @@ pub fn rgb_image(obj: &Bound<'_, PyAny>, name: &str) -> PyResult<RgbImage> {
 pub fn float_map(obj: &Bound<'_, PyAny>, name: &str) -> PyResult<DepthMap> {
     let array = checked::<f32>(obj, name, 2, "float32[H, W]")?;
     let (w, h) = size(array.shape(), name)?;
-    let data = array.readonly().as_slice()?.to_vec();
+    let mut data = array.readonly().as_slice()?.to_vec();
+    // The library's rule for every depth input: magnitudes no pass computes finitely are holes.
+    viewsynth::depth::clear_unusable_depth(&mut data);
     DepthMap::new(w, h, data).map_err(errors::from_library)
 }
 
@@ -134,7 +136,11 @@ pub fn depth_faces(obj: &Bound<'_, PyAny>, name: &str) -> PyResult<Vec<DepthMap>
     let data = array.readonly();
     let data = data.as_slice()?;
     data.chunks_exact(data.len() / 6)
-        .map(|face| DepthMap::new(n, n, face.to_vec()).map_err(errors::from_library))
+        .map(|face| {
+            let mut face = face.to_vec();
+            viewsynth::depth::clear_unusable_depth(&mut face);
+            DepthMap::new(n, n, face).map_err(errors::from_library)
+        })
         .collect()
 }
 

@@ -4,6 +4,14 @@
 use crate::error::{Error, Result};
 use serde::{Deserialize, Serialize};
 
+/// Largest magnitude of an intrinsic (pixels): the bound of every real-valued option
+/// (`job::MAX_OPTION_MAGNITUDE`), so an intrinsics file is held to what the flags accept.
+pub const MAX_INTRINSIC: f64 = 1e6;
+/// Smallest focal length (pixels): below it the field of view is within a hair of 180 degrees
+/// and back-projection divides by a number whose reciprocal leaves f32's precision (5e-324
+/// made every ray infinite).
+pub const MIN_FOCAL_PX: f64 = 1e-3;
+
 /// Pinhole intrinsics in pixels, OpenCV convention: pixel (u, v) has its centre at (u, v), v grows
 /// downwards, and a view-space point (x, y, z) lands at (fx x / z + cx, fy y / z + cy).
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
@@ -19,7 +27,8 @@ pub struct Intrinsics {
 }
 
 impl Intrinsics {
-    /// Finite values and positive focal lengths; `what` names the camera in the error.
+    /// Finite values, focal lengths in [[`MIN_FOCAL_PX`], [`MAX_INTRINSIC`]] and principal point
+    /// magnitudes at most [`MAX_INTRINSIC`]; `what` names the camera in the error.
     pub fn validate(&self, what: &str) -> Result<()> {
         for (name, v) in [("fx", self.fx), ("fy", self.fy), ("cx", self.cx), ("cy", self.cy)] {
             if !v.is_finite() {
@@ -27,8 +36,19 @@ impl Intrinsics {
             }
         }
         for (name, v) in [("fx", self.fx), ("fy", self.fy)] {
-            if v <= 0.0 {
-                return Err(Error::param(format!("{what} {name}"), format!("{v} must be > 0")));
+            if !(MIN_FOCAL_PX..=MAX_INTRINSIC).contains(&v) {
+                return Err(Error::param(
+                    format!("{what} {name}"),
+                    format!("{v:e} must be in [{MIN_FOCAL_PX:e}, {MAX_INTRINSIC:e}] px"),
+                ));
+            }
+        }
+        for (name, v) in [("cx", self.cx), ("cy", self.cy)] {
+            if v.abs() > MAX_INTRINSIC {
+                return Err(Error::param(
+                    format!("{what} {name}"),
+                    format!("{v:e}: magnitude must be <= {MAX_INTRINSIC:e} px"),
+                ));
             }
         }
         Ok(())

@@ -21,6 +21,10 @@ use std::path::Path;
 use super::Intrinsics;
 use crate::error::{Error, Result};
 
+/// Largest intrinsics file read: a K, an Open3D JSON, a calib.txt or a cameras.txt of one
+/// camera are well under 1 KiB; 1 MiB leaves room for comments and many-camera files.
+pub const MAX_INTRINSICS_BYTES: u64 = 1 << 20;
+
 /// Which format a file was read as.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum IntrinsicsFormat {
@@ -74,7 +78,9 @@ pub struct IntrinsicsFile {
 impl IntrinsicsFile {
     /// Reads and parses `path`; errors name the file.
     pub fn load(path: &Path) -> Result<Self> {
-        let text = std::fs::read_to_string(path).map_err(|e| Error::io(path, e))?;
+        // The input layer's rule: a regular file (FIFOs and devices refused before opening),
+        // its size checked before it is read.
+        let text = crate::io::read_text(path, MAX_INTRINSICS_BYTES)?;
         Self::parse(&text).map_err(|m| Error::decode(path, m))
     }
 

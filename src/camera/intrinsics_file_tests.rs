@@ -146,7 +146,23 @@ fn malformed_files_name_the_problem() {
         ("words.txt", "hello world", "not a recognised intrinsics file"),
         ("obj.json", r#"{"fx": 500}"#, "intrinsic_matrix"),
         ("bad.json", "{", "invalid JSON"),
-        ("neg.txt", "-500 0 320 0 500 240 0 0 1", "must be > 0"),
+        ("neg.txt", "-500 0 320 0 500 240 0 0 1", "must be in [1e-3, 1e6]"),
+        // The flags' bounds hold for files too: huge and subnormal focal lengths, huge centres.
+        (
+            "huge_f.txt",
+            "1e300 0 320 0 500 240 0 0 1",
+            "fx: 1e300 must be in [1e-3, 1e6]",
+        ),
+        (
+            "tiny_f.txt",
+            "500 0 320 0 5e-324 240 0 0 1",
+            "fy: 5e-324 must be in [1e-3, 1e6]",
+        ),
+        (
+            "huge_c.txt",
+            "500 0 1e7 0 500 240 0 0 1",
+            "cx: 1e7: magnitude must be <= 1e6",
+        ),
         (
             "half.json",
             r#"{"K": [1,0,0,0,1,0,0,0,1], "width": 640}"#,

@@ -2,17 +2,108 @@
 //!
 //! Temporaries are made by the `tempfile` crate in the destination folder: a fresh random
 //! name opened with `O_CREAT | O_EXCL` (a planted symlink or file under that name makes the
-//! open fail, it is never followed or truncated), named `.viewsynth-<pid>-<random>` so that
-//! [`remove_orphan_temporaries`] can tell a killed run's leftovers from a live run's.
+//! open fail, it is never followed or truncated), named `.viewsynth-<pid>-<random>`. Each is
+//! held under an exclusive `flock(2)` while its writer lives (a staging folder through the
+//! lock file inside it), so [`remove_orphan_temporaries`] tells a killed run's leftovers from a
+//! live run's by trying the lock: unlike a pid, a lock means the same in every PID namespace
+//! and container sharing the volume, and it is released by the kernel when its holder dies.
 
 use std::fs::{self, File};
 use std::io::{self, BufWriter, Write};
+use std::os::unix::fs::{FileTypeExt, OpenOptionsExt};
 use std::path::Path;
+use std::time::{Duration, SystemTime};
 
 use crate::error::{Error, Result};
 
 /// Prefix of every temporary file or folder this crate creates beside its outputs.
 pub const TEMP_PREFIX: &str = ".viewsynth-";
+
+/// A temporary that holds no lock is only removed once this old: its creator takes the lock
+/// microseconds after creating it, so a younger one may be a live run's, not yet locked.
+const UNLOCKED_GRACE: Duration = Duration::from_secs(2);
+
+/// Takes `file`'s exclusive lock without waiting: Ok(true) when taken, Ok(false) when another
+/// open file holds it.
+pub(crate) fn try_lock(file: &File) -> io::Result<bool> {
+    use rustix::fs::{flock, FlockOperation};
+    match flock(file, FlockOperation::NonBlockingLockExclusive) {
+        Ok(()) => Ok(true),
+        Err(e) if e == rustix::io::Errno::WOULDBLOCK => Ok(false),
+        Err(e) => Err(e.into()),
+    }
+}
+
+/// Opens an existing temporary to try its lock: never through a symlink, never blocking on
+/// a FIFO planted under our prefix.
+pub(crate) fn open_for_lock(path: &Path) -> io::Result<File> {
+    fs::OpenOptions::new()
+        .read(true)
+        .custom_flags(rustix::fs::OFlags::NOFOLLOW.bits() as i32 | rustix::fs::OFlags::NONBLOCK.bits() as i32)
+        .open(path)
+}
+
+/// Refuses to replace anything at `path` but a regular file or a symlink (which is replaced,
+/// never followed): a folder, FIFO, socket or device (`--json /dev/null` run as root) stays.
+pub(crate) fn check_replaceable(path: &Path) -> Result<()> {
+    let t = match fs::symlink_metadata(path) {
+        Ok(m) => m.file_type(),
+        Err(e) if e.kind() == io::ErrorKind::NotFound => return Ok(()),
+        Err(e) => return Err(Error::io(path, e)),
+    };
+    let what = if t.is_file() || t.is_symlink() {
+        return Ok(());
+    } else if t.is_dir() {
+        "a folder"
+    } else if t.is_fifo() {
+        "a FIFO"
+    } else if t.is_char_device() || t.is_block_device() {
+        "a device"
+    } else {
+        "not a regular file"
+    };
+    Err(Error::io(
+        path,
+        io::Error::new(
+            io::ErrorKind::AlreadyExists,
+            format!("{what} is in the way of this output: only regular files are replaced"),
+        ),
+    ))
+}
+
+/// The fault-injection hook of the file layer, for tests of the commit protocol:
+/// `VIEWSYNTH_FAULT_AFTER=<k>` ends the process at once with status 137 (as SIGKILL would) right after the
+/// k-th step (1-based) of the process's commits, `<k>:fail` returns an error there instead.
+/// Steps: a set's journal written, each rename, the staging folder removed. Unset: no effect.
+pub(crate) fn fault_point(what: &str) -> Result<()> {
+    use std::sync::atomic::{AtomicU64, Ordering};
+    use std::sync::OnceLock;
+    static PLAN: OnceLock<Option<(u64, bool)>> = OnceLock::new();
+    static STEP: AtomicU64 = AtomicU64::new(0);
+    let plan = PLAN.get_or_init(|| {
+        let v = std::env::var("VIEWSYNTH_FAULT_AFTER").ok()?;
+        let (k, fail) = match v.split_once(':') {
+            Some((k, "fail")) => (k, true),
+            Some(_) => return None,
+            None => (v.as_str(), false),
+        };
+        Some((k.parse().ok()?, fail))
+    });
+    let Some((k, fail)) = *plan else { return Ok(()) };
+    let step = STEP.fetch_add(1, Ordering::SeqCst) + 1;
+    if step != k {
+        return Ok(());
+    }
+    if fail {
+        return Err(Error::io(
+            what,
+            io::Error::other(format!("injected fault after step {k} (VIEWSYNTH_FAULT_AFTER)")),
+        ));
+    }
+    // At once, without destructors (staging folders stay, locks are released by the kernel),
+    // as SIGKILL leaves things; 137 is the shell's status of a SIGKILLed process.
+    std::process::exit(137)
+}
 
 /// The prefix of this process's temporaries: `.viewsynth-<pid>-`.
 pub(crate) fn own_prefix() -> String {
@@ -29,15 +120,18 @@ pub(crate) fn parent_dir(path: &Path) -> &Path {
 
 /// A new temporary file in `dir`, created exclusively (never through an existing name).
 /// Errors name `shown`.
+/// Held under its lock (see the module notes) until closed.
 pub(crate) fn temp_file_in(dir: &Path, shown: &Path) -> Result<tempfile::NamedTempFile> {
     use std::os::unix::fs::PermissionsExt;
-    tempfile::Builder::new()
+    let temp = tempfile::Builder::new()
         .prefix(&own_prefix())
         .suffix(".tmp")
         // What a plain create gives (the umask applies), not tempfile's private 0600.
         .permissions(fs::Permissions::from_mode(0o666))
         .tempfile_in(dir)
-        .map_err(|e| Error::io(shown, e))
+        .map_err(|e| Error::io(shown, e))?;
+    try_lock(temp.as_file()).map_err(|e| Error::io(shown, e))?;
+    Ok(temp)
 }
 
 /// Writes `path` atomically: `write` fills a fresh temporary in the same folder (so the final
@@ -52,6 +146,7 @@ pub fn atomic_write(path: &Path, write: impl FnOnce(&mut BufWriter<File>) -> Res
             io::Error::new(io::ErrorKind::InvalidInput, "path has no file name"),
         ));
     }
+    check_replaceable(path)?;
     let temp = temp_file_in(parent_dir(path), path)?;
     let (file, temp_path) = temp.into_parts();
     let mut writer = BufWriter::new(file);
@@ -59,9 +154,12 @@ pub fn atomic_write(path: &Path, write: impl FnOnce(&mut BufWriter<File>) -> Res
     writer.flush().map_err(|e| Error::io(path, e))?;
     let file = writer.into_inner().map_err(|e| Error::io(path, e.into_error()))?;
     file.sync_all().map_err(|e| Error::io(path, e))?;
-    drop(file);
+    // Checked again just before the rename: the path may have changed while writing.
+    check_replaceable(path)?;
     // `persist` renames; on failure the TempPath it hands back removes the file when dropped.
+    // The file (and its lock) is closed only after the rename.
     temp_path.persist(path).map_err(|e| Error::io(path, e.error))?;
+    drop(file);
     Ok(())
 }
 
@@ -72,43 +170,43 @@ pub fn probe_writable(dir: &Path) -> Result<()> {
     temp.close().map_err(|e| Error::io(dir, e))
 }
 
-/// Removes the temporaries (files or staging folders named `.viewsynth-<pid>-…`) that a run
-/// killed before it could clean up left in `dir`. Only those whose process no longer exists
-/// are removed: a concurrent run's temporaries are never touched. Returns how many were
-/// removed. Where liveness cannot be checked (no `/proc`), nothing is removed.
+/// Removes the temporaries (files or staging folders named `.viewsynth-…`) that a run killed
+/// before it could clean up left in `dir`; returns how many were removed. A temporary whose
+/// lock another process holds is a live run's and is never touched, whatever its pid says (a
+/// pid is meaningless across PID namespaces). A staging folder killed after its journal was
+/// written is first rolled forward (its remaining files renamed into `dir`, the manifest
+/// last), so a set is always either the old one or the new one, complete.
 pub fn remove_orphan_temporaries(dir: &Path) -> usize {
-    if !Path::new("/proc/self").exists() {
-        return 0;
-    }
     let Ok(entries) = fs::read_dir(dir) else { return 0 };
     let mut removed = 0;
     for e in entries.flatten() {
         let name = e.file_name();
-        let Some(pid) = name.to_str().and_then(temp_owner) else {
-            continue;
-        };
-        if pid == std::process::id() || Path::new(&format!("/proc/{pid}")).exists() {
+        if !name.to_str().is_some_and(|n| n.starts_with(TEMP_PREFIX)) {
             continue;
         }
         // file_type does not follow symlinks: a planted link is removed, not its target.
         let ok = match e.file_type() {
-            Ok(t) if t.is_dir() => fs::remove_dir_all(e.path()).is_ok(),
-            Ok(_) => fs::remove_file(e.path()).is_ok(),
-            Err(_) => false,
+            Ok(t) if t.is_dir() => super::file_set::recover_staging(dir, &e.path()),
+            Ok(t) if t.is_file() => match open_for_lock(&e.path()) {
+                Ok(f) => match try_lock(&f) {
+                    Ok(true) if older_than(&e.path(), UNLOCKED_GRACE) => fs::remove_file(e.path()).is_ok(),
+                    _ => false,
+                },
+                Err(_) => false,
+            },
+            // Never ours (we make none) and harmless: left alone.
+            _ => false,
         };
         removed += usize::from(ok);
     }
     removed
 }
 
-/// The pid in a temporary's name `.viewsynth-<pid>-<random>`, if it is one.
-fn temp_owner(name: &str) -> Option<u32> {
-    let rest = name.strip_prefix(TEMP_PREFIX)?;
-    let (pid, random) = rest.split_once('-')?;
-    if random.is_empty() {
-        return None;
-    }
-    pid.parse().ok()
+/// Whether `path` (not followed) was last modified longer than `age` ago.
+pub(crate) fn older_than(path: &Path, age: Duration) -> bool {
+    fs::symlink_metadata(path)
+        .and_then(|m| m.modified())
+        .is_ok_and(|t| SystemTime::now().duration_since(t).is_ok_and(|d| d > age))
 }
 
 #[cfg(test)]
@@ -233,21 +331,52 @@ mod tests {
     }
 
     #[test]
-    fn orphan_clean_up_spares_live_processes() {
+    fn orphan_clean_up_spares_locked_temporaries_whatever_their_pid() {
         let dir = scratch_dir("atomic-orphans");
-        let own = format!("{}abc.tmp", own_prefix());
-        // pid 1 is always alive; u32::MAX - 1 is above any pid_max.
-        let live = format!("{TEMP_PREFIX}1-abc.tmp");
-        let dead = format!("{TEMP_PREFIX}{}-abc.tmp", u32::MAX - 1);
-        let dead_dir = format!("{TEMP_PREFIX}{}-set", u32::MAX - 1);
-        for n in [&own, &live, &dead, &"keep.png".to_string()] {
+        let old = SystemTime::now() - Duration::from_secs(3600);
+        // pid 1 is alive here, u32::MAX - 1 is no pid: neither decides any more, the lock does.
+        let unlocked = format!("{TEMP_PREFIX}1-abc.tmp");
+        let locked = format!("{TEMP_PREFIX}{}-abc.tmp", u32::MAX - 1);
+        for n in [&unlocked, &locked, &"keep.png".to_string()] {
             fs::write(dir.join(n), b"x").unwrap();
+            File::options()
+                .write(true)
+                .open(dir.join(n))
+                .unwrap()
+                .set_modified(old)
+                .unwrap();
         }
-        fs::create_dir(dir.join(&dead_dir)).unwrap();
-        fs::write(dir.join(&dead_dir).join("a.png"), b"x").unwrap();
-        assert_eq!(remove_orphan_temporaries(&dir), 2);
-        let mut want = vec![own, live, "keep.png".to_string()];
+        let holder = File::open(dir.join(&locked)).unwrap();
+        assert!(try_lock(&holder).unwrap());
+        // A young unlocked temporary may be a live run's that has not locked it yet.
+        let young = format!("{TEMP_PREFIX}2-young.tmp");
+        fs::write(dir.join(&young), b"x").unwrap();
+        assert_eq!(remove_orphan_temporaries(&dir), 1);
+        let mut want = vec![locked.clone(), young, "keep.png".to_string()];
         want.sort();
         assert_eq!(list_dir(&dir), want);
+        drop(holder);
+        assert_eq!(remove_orphan_temporaries(&dir), 1);
+    }
+
+    #[test]
+    fn non_regular_destinations_are_never_replaced() {
+        let dir = scratch_dir("atomic-nonregular");
+        let fifo = dir.join("fifo");
+        rustix::fs::mknodat(
+            rustix::fs::CWD,
+            &fifo,
+            rustix::fs::FileType::Fifo,
+            rustix::fs::Mode::from_raw_mode(0o600),
+            0,
+        )
+        .unwrap();
+        let err = atomic_write(&fifo, |w| w.write_all(b"x").map_err(|e| Error::io("x", e))).unwrap_err();
+        assert!(err.to_string().contains("FIFO"), "{err}");
+        assert!(fs::symlink_metadata(&fifo).unwrap().file_type().is_fifo());
+        let err = atomic_write(Path::new("/dev/null"), |_| Ok(())).unwrap_err();
+        assert!(err.to_string().contains("device"), "{err}");
+        assert!(fs::symlink_metadata("/dev/null").unwrap().file_type().is_char_device());
+        assert_eq!(list_dir(&dir), ["fifo"]);
     }
 }

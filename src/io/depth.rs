@@ -11,7 +11,7 @@ use super::image_types::{decode_dims, encode_dims, DepthMap};
 use super::input::max_pixels;
 use super::netpbm::netpbm_dimensions;
 use super::npy::{open_npy, read_npy, save_npy_f32, NpyArray, NpyDtype};
-use super::npz::load_npz_array;
+use super::npz::load_npz_array_within;
 use super::raw_depth::{RawDepth, RawSamples};
 use super::rgb::lowercase_extension;
 use super::{pfm, pgm};
@@ -64,9 +64,10 @@ pub fn load_depth_with_key(path: &Path, npz_key: Option<&str>, decode: &DepthDec
             from_npy(path, read_npy(path, file)?)?
         }
         "npz" => {
-            // Bounded by the pixel budget inside the archive reader.
-            let (key, array) = load_npz_array(path, npz_key)?;
-            npy_dims(path, &array.shape)?;
+            // The member's declared shape is checked (one value per budget pixel, (H, W) or
+            // (H, W, 1)) before anything of it is inflated.
+            let check = |shape: &[usize]| npy_dims(path, shape).map(|_| ());
+            let (key, array) = load_npz_array_within(path, npz_key, max_pixels(), &check)?;
             from_npy(path, array).map_err(|e| match e {
                 Error::Decode { path, message } => Error::decode(path, format!("array '{key}': {message}")),
                 other => other,
@@ -256,6 +257,8 @@ fn to_metres(path: &Path, raw: RawDepth, decode: &DepthDecode) -> Result<DepthMa
         },
         RawSamples::F64(v) => v.into_iter().map(|x| (x / scale.unwrap_or(1.0)) as f32).collect(),
     };
+    let mut data = data;
+    crate::depth::clear_unusable_depth(&mut data);
     DepthMap::new(raw.width, raw.height, data).map_err(|e| Error::decode(path, e.to_string()))
 }
 

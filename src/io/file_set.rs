@@ -9,6 +9,21 @@
 //! every file was written. Until then the previous run's files stay untouched; on an error or
 //! a drop without commit only the set's own staging folder is removed.
 //!
+//! The commit protocol survives a kill at any instruction:
+//! 1. the staging folder is owned by an exclusive `flock` on `.viewsynth-lock` inside it,
+//!    held until the set is done (a killed owner's lock is released by the kernel);
+//! 2. every file is written and synced in the staging folder;
+//! 3. a journal `.viewsynth-commit` listing the names in rename order (the manifest last) is
+//!    written and synced: from here on the set is the new one;
+//! 4. the files are renamed into place in that order, the manifest last, then the folder is
+//!    removed.
+//!
+//! A later run that finds an unlocked staging folder ([`remove_orphan_temporaries`]) removes
+//! it when it has no journal (killed before step 3: the old set is untouched) and otherwise
+//! finishes step 4 (rolls forward to the new set). So after any kill and the next run's
+//! start, a folder holds the old set or the new set, complete. `VIEWSYNTH_FAULT_AFTER` injects
+//! a kill or a failure after any step (see [`super::atomic`]).
+//!
 //! ```no_run
 //! # fn main() -> viewsynth::Result<()> {
 //! use std::io::Write;
@@ -24,7 +39,20 @@ use std::fs::{self, File};
 use std::io::{self, BufWriter, Write};
 use std::path::{Component, Path, PathBuf};
 
-use super::atomic::{own_prefix, probe_writable, remove_orphan_temporaries, TEMP_PREFIX};
+use super::atomic::{
+    check_replaceable, fault_point, older_than, open_for_lock, own_prefix, probe_writable, remove_orphan_temporaries,
+    try_lock, TEMP_PREFIX,
+};
+
+/// The lock file inside a staging folder (see the module notes).
+const LOCK_NAME: &str = ".viewsynth-lock";
+/// The journal naming a committing set's files in rename order.
+const JOURNAL_NAME: &str = ".viewsynth-commit";
+/// The name renamed last in every set: its presence marks the set complete.
+pub const MANIFEST_NAME: &str = "manifest.json";
+/// A staging folder without its lock file is only taken as orphaned once this old (its creator
+/// makes the lock file right after the folder).
+const UNLOCKED_FOLDER_GRACE: std::time::Duration = std::time::Duration::from_secs(60);
 use crate::error::{Error, Result};
 
 /// An output folder that exists, accepts files, and bounds where outputs may go.
@@ -157,6 +185,8 @@ pub struct FileSet {
     dir: PathBuf,
     shown: PathBuf,
     staging: tempfile::TempDir,
+    /// The staging folder's lock, held while this set lives.
+    _lock: File,
     /// Names written through [`FileSet::write`], in order.
     written: Vec<String>,
 }
@@ -169,10 +199,21 @@ impl FileSet {
             .prefix(&own_prefix())
             .tempdir_in(dir)
             .map_err(|e| Error::io(dir, e))?;
+        // Locked under a temporary name, then renamed to the lock's name: a cleaner that can
+        // open the lock file finds it already locked.
+        let lock = tempfile::Builder::new()
+            .prefix(TEMP_PREFIX)
+            .tempfile_in(staging.path())
+            .map_err(|e| Error::io(dir, e))?;
+        try_lock(lock.as_file()).map_err(|e| Error::io(dir, e))?;
+        let lock = lock
+            .persist(staging.path().join(LOCK_NAME))
+            .map_err(|e| Error::io(dir, e.error))?;
         Ok(Self {
             dir: dir.to_path_buf(),
             shown: dir.to_path_buf(),
             staging,
+            _lock: lock,
             written: Vec::new(),
         })
     }
@@ -241,9 +282,12 @@ impl FileSet {
 
     /// Renames every staged file into the destination and returns the final paths: files put
     /// into [`FileSet::staging`] directly first (by name), then those of [`FileSet::write`] in
-    /// the order written (so a completion marker written last lands last). Before the first
-    /// rename, every destination is checked not to be a folder. Nothing is renamed if the
-    /// staging folder holds anything but regular files.
+    /// the order written, and [`MANIFEST_NAME`] always last (it marks the set complete). Before
+    /// the first rename every destination is checked to be absent, a regular file or a
+    /// symlink (a folder, FIFO or device is never replaced), and the journal is written (see
+    /// the module notes). Nothing is renamed if the staging folder holds anything but regular
+    /// files. A rename that fails leaves the journalled staging folder for the next run to
+    /// roll forward.
     pub fn commit(self) -> Result<Vec<PathBuf>> {
         let mut direct = Vec::new();
         let entries = fs::read_dir(self.staging.path()).map_err(|e| Error::io(&self.shown, e))?;
@@ -255,6 +299,9 @@ impl FileSet {
                     format!("non-UTF-8 name staged for {}", self.shown.display()),
                 )
             })?;
+            if name == LOCK_NAME {
+                continue;
+            }
             let regular = e.file_type().map(|t| t.is_file()).unwrap_or(false);
             if !regular {
                 return Err(Error::io(
@@ -268,29 +315,146 @@ impl FileSet {
             }
         }
         direct.sort();
-        let order: Vec<String> = direct.into_iter().chain(self.written.iter().cloned()).collect();
+        let mut order: Vec<String> = direct.into_iter().chain(self.written.iter().cloned()).collect();
+        if let Some(i) = order.iter().position(|n| n == MANIFEST_NAME) {
+            let manifest = order.remove(i);
+            order.push(manifest);
+        }
         for name in &order {
-            if fs::symlink_metadata(self.dir.join(name)).is_ok_and(|m| m.is_dir()) {
-                return Err(Error::io(
-                    self.final_path(name),
-                    io::Error::new(io::ErrorKind::IsADirectory, "a folder is in the way of this output"),
-                ));
+            check_replaceable(&self.dir.join(name)).map_err(|e| self.final_error_for(name, e))?;
+        }
+        let FileSet {
+            dir,
+            shown,
+            staging,
+            _lock: lock,
+            ..
+        } = self;
+        let final_path = |name: &str| shown.join(name);
+        let journal = order.join("\n");
+        let journal_path = staging.path().join(JOURNAL_NAME);
+        let mut file = File::create_new(&journal_path).map_err(|e| Error::io(&shown, e))?;
+        file.write_all(journal.as_bytes())
+            .and_then(|()| file.sync_all())
+            .map_err(|e| Error::io(&shown, e))?;
+        sync_dir(staging.path());
+        // From here on the set is the new one: a failure leaves the journalled folder (still
+        // ours, unlocked once this process ends) for the next run to roll forward.
+        let staging = staging.keep();
+        let result = (|| -> Result<Vec<PathBuf>> {
+            fault_point("journal written")?;
+            let mut done = Vec::with_capacity(order.len());
+            for name in &order {
+                fs::rename(staging.join(name), dir.join(name)).map_err(|e| Error::io(final_path(name), e))?;
+                fault_point("renamed")?;
+                done.push(final_path(name));
             }
+            // Make the renames durable; failure to sync the folder is not worth failing the run.
+            sync_dir(&dir);
+            fs::remove_dir_all(&staging).map_err(|e| Error::io(&shown, e))?;
+            fault_point("staging removed")?;
+            Ok(done)
+        })();
+        if result.is_err() {
+            // Finish what can be finished now (a later run retries the rest).
+            roll_forward(&dir, &staging);
         }
-        let mut done = Vec::with_capacity(order.len());
-        for name in &order {
-            fs::rename(self.staging.path().join(name), self.dir.join(name))
-                .map_err(|e| Error::io(self.final_path(name), e))?;
-            done.push(self.final_path(name));
+        drop(lock);
+        result
+    }
+
+    fn final_error_for(&self, name: &str, e: Error) -> Error {
+        match e {
+            Error::Io { source, .. } => Error::io(self.final_path(name), source),
+            other => other,
         }
-        // Make the renames durable; failure to sync the folder is not worth failing the run.
-        if let Ok(d) = File::open(&self.dir) {
-            let _ = d.sync_all();
-        }
-        self.staging.close().map_err(|e| Error::io(&self.shown, e))?;
-        Ok(done)
     }
 }
+
+fn sync_dir(dir: &Path) {
+    if let Ok(d) = File::open(dir) {
+        let _ = d.sync_all();
+    }
+}
+
+/// Renames the files a journalled staging folder still holds into `dir`, in the journal's
+/// order, then removes the folder. True when the folder is gone.
+fn roll_forward(dir: &Path, staging: &Path) -> bool {
+    let Ok(journal) = fs::read_to_string(staging.join(JOURNAL_NAME)) else {
+        return false;
+    };
+    for name in journal.lines() {
+        // Names were checked when the set was made; anything else is not ours to move.
+        if check_plain_name(name, dir).is_err() {
+            return false;
+        }
+        let from = staging.join(name);
+        match fs::symlink_metadata(&from) {
+            Ok(m) if m.is_file() => {
+                if check_replaceable(&dir.join(name)).is_err() || fs::rename(&from, dir.join(name)).is_err() {
+                    return false;
+                }
+            }
+            Ok(_) => return false,
+            Err(_) => {} // renamed before the kill
+        }
+    }
+    sync_dir(dir);
+    fs::remove_dir_all(staging).is_ok()
+}
+
+/// What a later run does with a staging folder `staging` in `dir` (see the module notes):
+/// nothing while its lock is held; else rolled forward when journalled, removed otherwise.
+/// True when the folder is gone.
+pub(crate) fn recover_staging(dir: &Path, staging: &Path) -> bool {
+    let lock = match open_for_lock(&staging.join(LOCK_NAME)) {
+        Ok(f) => f,
+        // No lock file: a folder being created (or one from before locks): only an old one.
+        Err(_) => {
+            return older_than(staging, UNLOCKED_FOLDER_GRACE) && fs::remove_dir_all(staging).is_ok();
+        }
+    };
+    if !try_lock(&lock).unwrap_or(false) {
+        return false;
+    }
+    if staging.join(JOURNAL_NAME).exists() {
+        roll_forward(dir, staging)
+    } else {
+        fs::remove_dir_all(staging).is_ok()
+    }
+}
+
+/// Writes files at arbitrary paths (e.g. `compare --diff D --json J`) all-or-none: each is
+/// staged in a [`FileSet`] of its own folder, and nothing is renamed until every one was
+/// written and every destination checked (absent, a regular file or a symlink; never a
+/// folder, FIFO or device). Returns the paths written.
+pub fn write_paths_all_or_none(jobs: Vec<(PathBuf, PathWriter<'_>)>) -> Result<Vec<PathBuf>> {
+    let mut sets = Vec::with_capacity(jobs.len());
+    for (path, _) in &jobs {
+        if path.file_name().is_none() {
+            return Err(Error::io(
+                path,
+                io::Error::new(io::ErrorKind::InvalidInput, "path has no file name"),
+            ));
+        }
+        check_replaceable(path)?;
+    }
+    for (path, write) in jobs {
+        let dir = super::atomic::parent_dir(&path).to_path_buf();
+        let name = path.file_name().map(|n| n.to_os_string()).unwrap_or_default();
+        let set = FileSet::new(&dir)?.shown_as(&dir);
+        write(&set.staging().join(&name)).map_err(|e| set.final_error(e))?;
+        sets.push(set);
+    }
+    let mut done = Vec::new();
+    for set in sets {
+        done.extend(set.commit()?);
+    }
+    Ok(done)
+}
+
+/// Writes one file given its path (the path-based savers: `io::save_rgb`, ...).
+pub type PathWriter<'a> = Box<dyn FnOnce(&Path) -> Result<()> + 'a>;
 
 #[cfg(test)]
 mod tests {

@@ -5,6 +5,8 @@
 //! never leaves a partial file under the final name. Loaders refuse width or height of 0 or
 //! above [`MAX_DIMENSION`] before allocating pixel memory.
 
+pub(crate) use crate::error::excerpt;
+
 mod atomic;
 mod decode;
 mod depth;
@@ -42,7 +44,7 @@ pub use depth_preview::{depth_preview, depth_preview_range, save_depth_preview, 
 pub use depth_summary::{DepthSummary, DepthWarning, PLAUSIBLE_MEDIAN_M};
 pub use depth_trunc::{check_depth_trunc, truncate_depth};
 pub use encoding::{Encoding, ExrCompression, PngCompression};
-pub use file_set::{FileSet, OutDir};
+pub use file_set::{write_paths_all_or_none, FileSet, OutDir, PathWriter, MANIFEST_NAME};
 pub use image_types::{DepthMap, Mask, RgbImage, MAX_DIMENSION};
 pub use input::{check_output_pixels, max_pixels, set_max_pixels, DEFAULT_MAX_PIXELS};
 pub use json::{load_json, read_text, MAX_JSON_BYTES, MAX_JSON_MAGNITUDE};

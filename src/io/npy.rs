@@ -106,14 +106,91 @@ fn decode_payload(h: Header, payload: &[u8]) -> NpyArray {
     }
 }
 
-/// The `.npy` bytes of an `.npz` member (already in memory, its size bounded by the archive
-/// reader); the element count is checked against 4 x the pixel budget like a file's.
-pub(crate) fn decode_npy(bytes: &[u8]) -> std::result::Result<NpyArray, String> {
+/// A `.npy` being read from a stream of known length (an `.npz` member as it is inflated):
+/// the header is read and checked (element count against the budget, length against the
+/// shape) before a byte of the payload is, and the payload is decoded in chunks, so the
+/// stored bytes are never held whole.
+pub(crate) struct NpyStream<R> {
+    reader: R,
+    header: Header,
+    need: usize,
+}
+
+/// Reads the header of a `.npy` stream of exactly `len` bytes and checks its extent.
+pub(crate) fn open_npy_stream<R: std::io::Read>(
+    mut reader: R,
+    len: u64,
+    max_values: u64,
+) -> std::result::Result<NpyStream<R>, String> {
     let bad = |msg: String| format!("invalid NPY: {msg}");
-    let (header, payload) = split_header(bytes).map_err(bad)?;
-    let h = parse_header(header).map_err(bad)?;
-    payload_extent(&h, payload.len() as u64, max_pixels().saturating_mul(4), "").map_err(|e| e.into_message(|m| m))?;
-    Ok(decode_payload(h, payload))
+    let mut head = vec![0u8; 8];
+    read_all(&mut reader, &mut head).map_err(bad)?;
+    let len_bytes = match head.get(6..8) {
+        Some([1, 0]) => 2,
+        _ => 4,
+    };
+    head.resize(8 + len_bytes, 0);
+    read_all(&mut reader, &mut head[8..]).map_err(bad)?;
+    let (prefix_len, header_len) = header_extent(&head).map_err(bad)?;
+    if header_len > MAX_HEADER {
+        return Err(bad(format!("header length {header_len} exceeds {MAX_HEADER} bytes")));
+    }
+    head.resize(prefix_len + header_len, 0);
+    read_all(&mut reader, &mut head[prefix_len..]).map_err(bad)?;
+    let (text, _) = split_header(&head).map_err(bad)?;
+    let header = parse_header(text).map_err(bad)?;
+    let have = len.saturating_sub(head.len() as u64);
+    let need =
+        payload_extent(&header, have, max_values, "; refused before inflating").map_err(|e| e.into_message(|m| m))?;
+    Ok(NpyStream { reader, header, need })
+}
+
+impl<R: std::io::Read> NpyStream<R> {
+    pub(crate) fn shape(&self) -> &[usize] {
+        &self.header.shape
+    }
+
+    pub(crate) fn dtype(&self) -> NpyDtype {
+        self.header.dtype
+    }
+
+    /// Decodes the payload chunk by chunk; the stream must end exactly where it does.
+    pub(crate) fn read(mut self) -> std::result::Result<NpyArray, String> {
+        let item = self.header.item_size;
+        let count = self.need / item;
+        let mut data = Vec::new();
+        data.try_reserve_exact(count)
+            .map_err(|_| format!("cannot allocate {count} values"))?;
+        let mut chunk = vec![0u8; item * 8192];
+        let mut left = self.need;
+        while left > 0 {
+            let n = left.min(chunk.len());
+            read_all(&mut self.reader, &mut chunk[..n]).map_err(|m| format!("invalid NPY: {m}"))?;
+            data.extend(chunk[..n].chunks_exact(item).map(self.header.decode));
+            left -= n;
+        }
+        let mut extra = [0u8; 1];
+        if self.reader.read(&mut extra).map_err(|e| e.to_string())? != 0 {
+            return Err("invalid NPY: trailing bytes after the declared payload".into());
+        }
+        let data = if self.header.fortran_order {
+            fortran_to_c(&self.header.shape, &data)
+        } else {
+            data
+        };
+        Ok(NpyArray {
+            shape: self.header.shape,
+            dtype: self.header.dtype,
+            data,
+        })
+    }
+}
+
+fn read_all(r: &mut impl std::io::Read, buf: &mut [u8]) -> std::result::Result<(), String> {
+    r.read_exact(buf).map_err(|e| match e.kind() {
+        std::io::ErrorKind::UnexpectedEof => "truncated: the data ends early".to_string(),
+        _ => e.to_string(),
+    })
 }
 
 /// Why a header's extent was refused: over the pixel budget, or malformed (overflow, or a

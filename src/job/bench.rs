@@ -97,7 +97,12 @@ impl BenchJob {
                 let mut sizes = Vec::new();
                 for s in &o.sizes {
                     let (w, h) = s.split_once('x').ok_or_else(|| ArgError::BenchSize(s.clone()))?;
-                    sizes.push((w.parse::<u32>()?, h.parse::<u32>()?));
+                    let (w, h) = (w.parse::<u32>()?, h.parse::<u32>()?);
+                    if w == 0 || h == 0 {
+                        return Err(ArgError::BenchSize(s.clone()));
+                    }
+                    io::check_output_pixels("--sizes", w, h)?;
+                    sizes.push((w, h));
                 }
                 Bench::Frames {
                     sizes,

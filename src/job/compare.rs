@@ -189,16 +189,25 @@ impl CompareJob {
         };
         let json =
             serde_json::to_string_pretty(&summary).map_err(|e| crate::Error::encode("summary", e.to_string()))?;
+        // Both files or neither (`--diff d.png --json /nonexistent/x.json` leaves no d.png).
+        let mut files: Vec<(std::path::PathBuf, io::PathWriter<'_>)> = Vec::new();
         if let Some(p) = &self.diff {
-            io::save_rgb(p, &diff).within(|| format!("writing {}", p.display()))?;
+            files.push((p.clone(), Box::new(|staged: &Path| io::save_rgb(staged, &diff))));
         }
         if let Some(JsonOutput::File(p)) = &self.json {
-            io::atomic_write(p, |w| {
-                use std::io::Write;
-                w.write_all(json.as_bytes()).map_err(|e| crate::Error::io(p, e))
-            })
-            .within(|| format!("writing {}", p.display()))?;
+            let json = &json;
+            files.push((
+                p.clone(),
+                Box::new(move |staged: &Path| {
+                    std::fs::write(staged, json.as_bytes()).map_err(|e| crate::Error::io(staged, e))
+                }),
+            ));
         }
+        if !files.is_empty() {
+            let names: Vec<String> = files.iter().map(|(p, _)| p.display().to_string()).collect();
+            io::write_paths_all_or_none(files).within(|| format!("writing {}", names.join(" and ")))?;
+        }
+        let json = json.clone();
         Ok(CompareReport {
             comparison,
             broken,

@@ -225,6 +225,19 @@ impl CyclopeanJob {
                 if o.depth_scale.is_some() {
                     return Err(ArgError::DepthScaleWithDisparity);
                 }
+                check_scale("--disparity-scale", o.disparity_scale)?;
+                if !o.doffs.is_finite() {
+                    return Err(ArgError::Invalid(crate::Error::param(
+                        "--doffs",
+                        format!("{} must be finite", o.doffs),
+                    )));
+                }
+                if let Some(p) = o.position.filter(|p| !(0.0..=1.0).contains(p)) {
+                    return Err(ArgError::Invalid(crate::Error::param(
+                        "--position",
+                        format!("{p} outside [0, 1] (0 = left eye, 1 = right eye)"),
+                    )));
+                }
                 let input = Input::Disparity(DisparityInput {
                     left: left.clone(),
                     right,
@@ -250,6 +263,7 @@ impl CyclopeanJob {
                 let (Some(left), Some(right)) = (o.left_depth.clone(), o.right_depth.clone()) else {
                     return Err(ArgError::CameraFileWithoutDepth);
                 };
+                check_scale("--depth-scale", o.depth_scale)?;
                 let input = Input::CameraFile(CameraFileInput {
                     cameras: cameras.clone(),
                     left,
@@ -461,6 +475,15 @@ fn view_z_in_metres(eye: &EyeInput, kind: FrameDepth, conv: &Conventions) -> cra
         },
     };
     Ok(input.view_z_map(conv, &eye.depth))
+}
+
+/// A scale option, when given, must be finite and > 0 (refused by its own name, before any
+/// input is read).
+pub(crate) fn check_scale(option: &'static str, value: Option<f64>) -> Result<(), ArgError> {
+    match value {
+        Some(v) if !(v.is_finite() && v > 0.0) => Err(ArgError::Scale { option, value: v }),
+        _ => Ok(()),
+    }
 }
 
 #[cfg(test)]

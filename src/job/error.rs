@@ -73,10 +73,10 @@ pub enum ArgError {
     #[error("--batch {0}: at most 100000 frames of the built-in scene")]
     TooManyBenchFrames(usize),
     /// A `bench --sizes` entry without the `x`.
-    #[error("--sizes '{0}': expected WxH")]
+    #[error("--sizes '{0}': expected WxH with W, H >= 1")]
     BenchSize(String),
     /// A `bench --sizes` side that is no number.
-    #[error(transparent)]
+    #[error("--sizes: a side is no whole number")]
     BenchSide(#[from] std::num::ParseIntError),
     /// `stress --only` names no capability.
     #[error("--only '{given}': expected a list of {known}")]
@@ -139,6 +139,23 @@ pub enum ArgError {
     /// A reprojection rig neither rectified nor game-engine.
     #[error("give the rig: --baseline B (rectified, metres) or --separation S --convergence C (game-engine stereo)")]
     NoRig,
+    /// Both rigs given.
+    #[error(
+        "--baseline (rectified rig) and --separation/--convergence (game-engine rig) conflict: give one \
+         (--baseline goes with --separation only to make --depth-kind disparity metric)"
+    )]
+    RigConflict,
+    /// `stress --only` given but naming nothing.
+    #[error("--only '{0}': names no capability (omit --only to sweep them all)")]
+    StressNothing(String),
+    /// A scale option outside (0, inf).
+    #[error("invalid {option} {value}: must be finite and > 0")]
+    Scale {
+        /// The option, e.g. `--disparity-scale`.
+        option: &'static str,
+        /// The value given.
+        value: f64,
+    },
     /// A camera file's source must be an eye.
     #[error("--cameras holds the two eyes: --from left or right")]
     CameraFileFromCentre,
@@ -195,6 +212,19 @@ pub enum ArgError {
         /// `--far`.
         far: f64,
     },
+}
+
+impl ArgError {
+    /// Whether the command line itself is at fault (exit 2): true for every refusal except
+    /// one found reading a file an option names (`--intrinsics FILE` that does not parse,
+    /// does not exist, ...), which is an input found while running (exit 1).
+    pub fn is_usage(&self) -> bool {
+        let lib = match self {
+            ArgError::Invalid(e) | ArgError::InvalidOptions { source: e, .. } => e,
+            _ => return true,
+        };
+        !matches!(lib, crate::Error::Io { .. } | crate::Error::Decode { .. })
+    }
 }
 
 /// Options that hold for one frame, refused with `refocus --batch`.

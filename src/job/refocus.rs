@@ -116,11 +116,26 @@ pub struct RefocusBatchJob {
 impl RefocusCommand {
     /// Checks the options against each other and the library's rules.
     pub fn new(o: RefocusOptions) -> Result<Self, ArgError> {
+        super::cyclopean::check_scale("--depth-scale", o.decode.scale)?;
+        let (option, values) = match &o.focals {
+            Focals::List(list) => ("--focal-list", list),
+            Focals::Scales(scales) => ("--zoom-range", scales),
+        };
+        for &v in values {
+            super::cyclopean::check_scale(option, Some(v))?;
+        }
         if let Some(manifest) = o.manifest.clone() {
             if o.backend == Backend::Vulkan {
                 return Err(ArgError::VulkanBatch);
             }
             return RefocusBatchJob::new(manifest, o).map(RefocusCommand::Batch);
+        }
+        // Batch-only options are refused by name rather than ignored.
+        if o.shard.is_some() {
+            return Err(ArgError::Invalid(crate::Error::param(
+                "--shard",
+                "applies with --batch only (it picks the manifest rows a run takes)",
+            )));
         }
         // clap requires both without --batch.
         let (Some(rgb), Some(depth)) = (o.rgb.clone(), o.depth.clone()) else {

@@ -237,6 +237,7 @@ impl ReprojectJob {
             Some(path) => camera_file_views(&o, path)?,
             None => rig_views(&o)?,
         };
+        super::cyclopean::check_scale("--depth-scale", o.depth_scale)?;
         Ok(ReprojectJob {
             decode: DepthDecode {
                 scale: o.depth_scale,
@@ -485,6 +486,11 @@ fn rig_views(o: &ReprojectOptions) -> Result<Views, ArgError> {
         (Some(s), Some(c)) => Some(StereoParams::new(s, c).for_options("--separation/--convergence")?),
         _ => None,
     };
+    // --baseline places a rectified rig; with a game-engine rig it would be ignored, unless it
+    // makes disparity depth metric.
+    if seed.is_some() && o.baseline.is_some() && o.depth_kind != SourceDepth::Disparity {
+        return Err(ArgError::RigConflict);
+    }
     let rectified = match (seed, o.baseline) {
         (Some(_), _) => Vec::new(),
         (None, Some(b)) => targets

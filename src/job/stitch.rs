@@ -213,6 +213,7 @@ impl StitchJob {
         if o.faces.is_none() && o.depth_kind != FaceDepth::ViewZ {
             return Err(ArgError::FaceDepthKindWithoutFaces);
         }
+        super::cyclopean::check_scale("--depth-scale", o.depth_scale)?;
         Ok(StitchJob {
             faces: o.faces,
             face_size: o.face_size,

@@ -32,6 +32,10 @@ impl StressJob {
                 })?;
             capabilities.push(*known);
         }
+        // `--only ""` or `--only ,`: asked for a subset and named none (0 rows must not pass).
+        if !only.is_empty() && capabilities.is_empty() {
+            return Err(ArgError::StressNothing(only.join(",")));
+        }
         Ok(StressJob {
             capabilities,
             quick,
@@ -61,10 +65,12 @@ impl StressJob {
     /// Writes the rows as JSON where `--json` asked (after the table is shown).
     pub fn write_json(&self, rows: &[StressRow]) -> Result<(), JobError> {
         if let Some(path) = &self.json {
-            crate::io::atomic_write(path, |w| {
-                serde_json::to_writer_pretty(w, rows).map_err(|e| crate::Error::param("json", e.to_string()))
-            })
-            .within(|| format!("writing {}", path.display()))?;
+            // The file layer every output goes through (a FIFO or device at the path is refused).
+            let text = serde_json::to_string_pretty(rows).map_err(|e| crate::Error::param("json", e.to_string()))?;
+            let write: crate::io::PathWriter<'_> =
+                Box::new(|staged| std::fs::write(staged, text.as_bytes()).map_err(|e| crate::Error::io(staged, e)));
+            crate::io::write_paths_all_or_none(vec![(path.clone(), write)])
+                .within(|| format!("writing {}", path.display()))?;
         }
         Ok(())
     }

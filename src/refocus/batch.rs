@@ -99,10 +99,14 @@ pub fn load_manifest(path: &Path) -> Result<Vec<BatchFrame>> {
                 }
             })
             .collect();
-        if safe.is_empty() || safe.starts_with('.') || !seen.insert(safe.clone()) {
+        // A folder name: at most 255 bytes (NAME_MAX), so a huge cell is refused here, quoted short.
+        if safe.is_empty() || safe.starts_with('.') || safe.len() > 255 || !seen.insert(safe.clone()) {
             return Err(Error::decode(
                 path,
-                format!("frame {i}: name '{name}' is empty, hidden or repeated"),
+                format!(
+                    "frame {i}: name '{}' is empty, hidden, longer than 255 bytes or repeated",
+                    crate::error::excerpt(&name)
+                ),
             ));
         }
         f.name = Some(safe);
@@ -342,15 +346,23 @@ fn frame_settings(frame: &BatchFrame, opts: &BatchOptions) -> serde_json::Value 
     settings
 }
 
-/// A frame is finished when its manifest was written with the same settings and every file it
-/// lists is there with the size it recorded.
+/// A frame is finished when its folder is a plain folder (not a symlink: it would resolve
+/// outside --out-dir; writing it again refuses it by name), its manifest was written with the
+/// same settings, and every file it lists is there, regular, with the size and CRC-32 it
+/// recorded (files of another run under the same names, left by a kill, make it unfinished).
 fn frame_finished(dir: &Path, settings: &serde_json::Value) -> bool {
-    let path = dir.join("manifest.json");
-    // A manifest is a few kB; anything far larger is not ours.
-    if std::fs::metadata(&path).map_or(true, |m| !m.is_file() || m.len() > 16 << 20) {
+    if !std::fs::symlink_metadata(dir).is_ok_and(|m| m.is_dir()) {
         return false;
     }
-    let Ok(text) = std::fs::read_to_string(&path) else {
+    // A set a killed run had journalled is finished first (rolled forward), so what is judged
+    // is what the folder will hold.
+    crate::io::remove_orphan_temporaries(dir);
+    let path = dir.join(crate::io::MANIFEST_NAME);
+    // A manifest is a few kB; anything far larger, or not a regular file, is not ours.
+    if std::fs::symlink_metadata(&path).map_or(true, |m| !m.is_file() || m.len() > 16 << 20) {
+        return false;
+    }
+    let Ok(text) = crate::io::read_text(&path, 16 << 20) else {
         return false;
     };
     let Ok(m) = serde_json::from_str::<serde_json::Value>(&text) else {
@@ -364,9 +376,10 @@ fn frame_finished(dir: &Path, settings: &serde_json::Value) -> bool {
     };
     !files.is_empty()
         && files.iter().all(|f| {
-            let (Some(name), Some(bytes)) = (
+            let (Some(name), Some(bytes), Some(crc)) = (
                 f.get("name").and_then(|v| v.as_str()),
                 f.get("bytes").and_then(|v| v.as_u64()),
+                f.get("crc32").and_then(|v| v.as_u64()),
             ) else {
                 return false;
             };
@@ -374,6 +387,7 @@ fn frame_finished(dir: &Path, settings: &serde_json::Value) -> bool {
             !name.contains('/')
                 && !name.starts_with('.')
                 && std::fs::symlink_metadata(dir.join(name)).is_ok_and(|m| m.is_file() && m.len() == bytes)
+                && job::file_crc32(&dir.join(name)).is_ok_and(|c| u64::from(c) == crc)
         })
 }
 

@@ -235,6 +235,25 @@ pub struct FileRecord {
     pub name: String,
     /// Size in bytes.
     pub bytes: u64,
+    /// CRC-32 of the contents: the file's identity, so that resume tells this set's files from
+    /// another run's of the same names and sizes (a set mixed by a kill is redone).
+    #[serde(default)]
+    pub crc32: Option<u32>,
+}
+
+/// CRC-32 of the file at `path`, read in chunks.
+pub fn file_crc32(path: &Path) -> std::io::Result<u32> {
+    use std::io::Read;
+    let mut f = std::fs::File::open(path)?;
+    let mut crc = flate2::Crc::new();
+    let mut buf = vec![0u8; 1 << 16];
+    loop {
+        let n = f.read(&mut buf)?;
+        if n == 0 {
+            return Ok(crc.sum());
+        }
+        crc.update(&buf[..n]);
+    }
 }
 
 /// The files `entries` name, with their sizes on disk.
@@ -257,6 +276,7 @@ pub fn file_records(dir: &Path, entries: &[ManifestEntry]) -> Result<Vec<FileRec
             out.push(FileRecord {
                 name: name.clone(),
                 bytes,
+                crc32: Some(file_crc32(&path).map_err(|e| Error::io(&path, e))?),
             });
         }
     }

@@ -94,9 +94,10 @@ fn refocus_writes_requested_files_and_a_manifest() {
 
 pub(crate) fn assert_clean_failure(o: &Output, needle: &str, out: &Path) {
     let err = String::from_utf8_lossy(&o.stderr);
-    // A value outside an option's stated range is a usage error reported by the argument
-    // parser (exit 2); everything found while running is a run error (exit 1).
-    let usage = err.contains("invalid value '") && err.contains("try '--help'");
+    // Anything wrong with the command line (clap's refusals and the job's option checks) is a
+    // usage error (exit 2, ending "try '--help'"); everything found while running is a run
+    // error (exit 1).
+    let usage = err.contains("try '--help'");
     assert_eq!(o.status.code(), Some(if usage { 2 } else { 1 }), "stderr: {err}");
     assert!(
         err.contains("error:") && err.contains(needle),
@@ -138,7 +139,7 @@ fn bad_input_fails_cleanly() {
     );
     assert_clean_failure(
         &refocus(&rgb, &depth, &out, &["--zoom-range", "0"]),
-        "focal scale",
+        "--zoom-range 0",
         &out,
     );
     assert_clean_failure(&refocus(&rgb, &depth, &out, &["--tau-rel=-1"]), "tau-rel", &out);
@@ -248,7 +249,15 @@ fn batch_reports_a_corrupt_frame_completes_the_rest_and_resumes() {
     // temporary left by an interrupted write in the unfinished frame is cleared.
     std::fs::create_dir_all(out.join("frame1")).unwrap();
     // (pid 999999999 cannot run: above Linux's pid_max, so the temporary is stale)
-    std::fs::write(out.join("frame1").join(".viewsynth-999999999-stale.tmp"), b"partial").unwrap();
+    let stale = out.join("frame1").join(".viewsynth-999999999-stale.tmp");
+    std::fs::write(&stale, b"partial").unwrap();
+    // Unlocked and not touched for a while: a killed writer's (a live one holds its lock).
+    std::fs::File::options()
+        .write(true)
+        .open(&stale)
+        .unwrap()
+        .set_modified(std::time::SystemTime::now() - std::time::Duration::from_secs(3600))
+        .unwrap();
     let (rgb, _) = inputs(&d.join("f1"), 32, 24);
     assert!(rgb.is_file());
     let o = run(&out, &[]);

@@ -566,15 +566,17 @@ fn cli_rectified_pair_matches_the_library_and_refuses_bad_input_cleanly() {
         known.len()
     );
 
-    // Bad input: a clear message naming the flag or file, exit 1, nothing written.
-    for (args, extra, needle) in [
-        (vec!["--outputs", "rgb,depth"], None, "--focal"),
-        (vec!["--position", "1.5"], None, "position"),
-        (vec!["--method", "forward", "--blend", "soft"], None, "--blend"),
+    // Bad input: a clear message naming the flag (usage, exit 2) or file (run error, exit 1),
+    // nothing written.
+    for (args, extra, needle, code) in [
+        (vec!["--outputs", "rgb,depth"], None, "--focal", 2),
+        (vec!["--position", "1.5"], None, "position", 2),
+        (vec!["--method", "forward", "--blend", "soft"], None, "--blend", 2),
         (
             vec![],
             Some(("--right-disparity", dir.join("missing.pgm"))),
             "missing.pgm",
+            1,
         ),
     ] {
         let bad = out.join("bad");
@@ -591,7 +593,7 @@ fn cli_rectified_pair_matches_the_library_and_refuses_bad_input_cleanly() {
         a.extend(args);
         let o = viewsynth(&a, &p);
         let err = String::from_utf8_lossy(&o.stderr);
-        assert_eq!(o.status.code(), Some(1), "{a:?}: {err}");
+        assert_eq!(o.status.code(), Some(code), "{a:?}: {err}");
         assert!(err.contains(needle) && !err.contains("panicked"), "{a:?}: {err}");
         assert!(!bad.exists(), "{a:?}: nothing written");
     }

@@ -729,7 +729,7 @@ fn numeric_options_are_range_checked_as_usage_errors() {
     for (label, args, needle) in cases {
         sb.refuses(&mut failures, label, &args, 2, &[needle]);
     }
-    // Checked while running (exit 1), still before any output.
+    // Values that parse but are out of range for the job: usage errors too (exit 2).
     let mut run_errors = 0;
     for (label, args, needle) in [
         (
@@ -747,22 +747,19 @@ fn numeric_options_are_range_checked_as_usage_errors() {
             refocus(&["--width-out", "16384", "--height-out", "16384"]),
             "pixel budget",
         ),
-        (
-            "batch empty manifest",
-            {
-                std::fs::write(d.join("empty.csv"), "").unwrap();
-                with(
-                    with(os(&["refocus"]), "--batch", &d.join("empty.csv")),
-                    "--out-dir",
-                    &out,
-                )
-            },
-            "empty.csv",
-        ),
     ] {
         run_errors += 1;
-        sb.refuses(&mut failures, label, &args, 1, &[needle]);
+        sb.refuses(&mut failures, label, &args, 2, &[needle]);
     }
+    // Found while running (exit 1): an input's contents, still before any output.
+    std::fs::write(d.join("empty.csv"), "").unwrap();
+    let args = with(
+        with(os(&["refocus"]), "--batch", &d.join("empty.csv")),
+        "--out-dir",
+        &out,
+    );
+    run_errors += 1;
+    sb.refuses(&mut failures, "batch empty manifest", &args, 1, &["empty.csv"]);
     assert_no_failures(failures, n + run_errors);
 }
 
@@ -987,13 +984,22 @@ fn kill_9_mid_run_then_rerun_leaves_no_temporaries() {
     let (rgb, depth) = write_inputs(&sb.root, W, H, "");
     let out = &sb.out;
     std::fs::create_dir_all(out).unwrap();
-    // Leftovers: a killed run's staging folder (its pid is above any pid_max) and a live
-    // process's temporary (pid 1), which must survive.
-    let dead = out.join(format!(".viewsynth-{}-AbC123", u32::MAX - 1));
+    // Leftovers: a killed run's staging folder (its lock file unlocked), and a live run's
+    // temporary and staging folder in another PID namespace (their pids mean nothing here:
+    // pid 1 and one above any pid_max), owned through their locks, which must survive.
+    let dead = out.join(".viewsynth-1-AbC123");
     std::fs::create_dir(&dead).unwrap();
     std::fs::write(dead.join("s1_rgb.png"), b"partial").unwrap();
+    std::fs::write(dead.join(".viewsynth-lock"), b"").unwrap();
     let live = out.join(".viewsynth-1-XyZ789.tmp");
     std::fs::write(&live, b"someone else's").unwrap();
+    let live_lock = std::fs::File::open(&live).unwrap();
+    rustix::fs::flock(&live_lock, rustix::fs::FlockOperation::NonBlockingLockExclusive).unwrap();
+    let foreign = out.join(format!(".viewsynth-{}-Other1", u32::MAX - 1));
+    std::fs::create_dir(&foreign).unwrap();
+    std::fs::write(foreign.join(".viewsynth-lock"), b"").unwrap();
+    let foreign_lock = std::fs::File::open(foreign.join(".viewsynth-lock")).unwrap();
+    rustix::fs::flock(&foreign_lock, rustix::fs::FlockOperation::NonBlockingLockExclusive).unwrap();
     let mut child = bin()
         .args(["refocus", "--fx", "40", "--fy", "40", "--cx", "15.5", "--cy", "11.5"])
         .args([
@@ -1025,8 +1031,14 @@ fn kill_9_mid_run_then_rerun_leaves_no_temporaries() {
     assert!(finals.is_empty() || finals.len() == 19, "{finals:?}");
     let o = refocus_ok(&rgb, &depth, out, &["--zoom-range", "1"]);
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
-    assert_eq!(temporaries(out), [".viewsynth-1-XyZ789.tmp"]);
+    let mut want = vec![
+        ".viewsynth-1-XyZ789.tmp".to_string(),
+        format!(".viewsynth-{}-Other1", u32::MAX - 1),
+    ];
+    want.sort();
+    assert_eq!(temporaries(out), want);
     assert_eq!(std::fs::read(&live).unwrap(), b"someone else's");
+    drop((live_lock, foreign_lock));
     assert!(files_in(out).contains(&"s1_rgb.png".to_string()));
 }
 

@@ -16,6 +16,7 @@ mod device_choice;
 mod gl_objects;
 mod gpu_context;
 mod hostile;
+mod hostile_round3;
 mod limits;
 mod pass_contract;
 mod readback;

@@ -66,6 +66,6 @@ fn cli_prints_the_table_writes_json_and_refuses_an_unknown_capability() {
         .output()
         .unwrap();
     let err = String::from_utf8_lossy(&o.stderr);
-    assert_eq!(o.status.code(), Some(1), "{err}");
+    assert_eq!(o.status.code(), Some(2), "{err}");
     assert!(err.contains("--only 'warp'") && !err.contains("panicked"), "{err}");
 }
