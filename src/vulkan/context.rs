@@ -228,8 +228,38 @@ pub struct VulkanContext {
     pool: vk::CommandPool,
     memory: vk::PhysicalDeviceMemoryProperties,
     info: VulkanDeviceInfo,
+    /// The one command buffer and fence every submit reuses (made on first use): a steady
+    /// stream of frames allocates neither.
+    submit: std::cell::Cell<Option<(vk::CommandBuffer, vk::Fence)>>,
+    /// What was created on the device so far.
+    census: std::cell::Cell<VkCensus>,
     // Last: dropped after the device.
     _instance: Instance,
+}
+
+/// Objects created (and waits) on a device since it opened: a steady state adds nothing
+/// (tests/integration/vulkan_passes.rs holds every pass to it, as gpu/census.rs does for GL).
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub struct VkCensus {
+    /// Graphics and compute pipelines.
+    pub pipelines: usize,
+    /// Device memory allocations (each image and buffer has its own).
+    pub allocations: usize,
+    /// Descriptor pools.
+    pub descriptor_pools: usize,
+    /// Command buffers allocated and fences created.
+    pub submit_objects: usize,
+    /// vkQueueWaitIdle / vkDeviceWaitIdle calls (never on the frame path).
+    pub wait_idles: usize,
+}
+
+/// What [`VulkanContext::count`] adds to.
+#[derive(Debug, Clone, Copy)]
+pub(crate) enum Created {
+    Pipeline,
+    Allocation,
+    DescriptorPool,
+    SubmitObject,
 }
 
 /// Shared handle to a [`VulkanContext`].
@@ -324,6 +354,8 @@ impl VulkanContext {
                 pool,
                 memory,
                 info,
+                submit: std::cell::Cell::new(None),
+                census: std::cell::Cell::new(VkCensus::default()),
                 _instance: instance,
             }))
         }
@@ -340,11 +372,31 @@ impl VulkanContext {
             .find(|&i| bits & (1 << i) != 0 && self.memory.memory_types[i as usize].property_flags.contains(flags))
     }
 
-    /// Record `record` into a one-time command buffer, submit it and wait for it to finish.
-    pub(crate) fn run_commands(&self, record: impl FnOnce(vk::CommandBuffer)) -> Result<()> {
+    /// What was created on this device so far ([`VkCensus`]).
+    pub fn census(&self) -> VkCensus {
+        self.census.get()
+    }
+
+    /// Count one more created object.
+    pub(crate) fn count(&self, what: Created) {
+        let mut c = self.census.get();
+        match what {
+            Created::Pipeline => c.pipelines += 1,
+            Created::Allocation => c.allocations += 1,
+            Created::DescriptorPool => c.descriptor_pools += 1,
+            Created::SubmitObject => c.submit_objects += 1,
+        }
+        self.census.set(c);
+    }
+
+    /// The reused command buffer and fence, made on first use.
+    fn submit_objects(&self) -> Result<(vk::CommandBuffer, vk::Fence)> {
+        if let Some(s) = self.submit.get() {
+            return Ok(s);
+        }
         let d = &self.device;
-        // SAFETY: the command buffer and fence are created, used and freed here; the queue is
-        // used from this thread only (the context is not Send).
+        // SAFETY: plain allocation from the context's pool; on the fence's failure the command
+        // buffer is freed here. Both are owned by the context from then on (freed in Drop).
         unsafe {
             let alloc = vk::CommandBufferAllocateInfo::default()
                 .command_pool(self.pool)
@@ -353,29 +405,43 @@ impl VulkanContext {
             let cb = d
                 .allocate_command_buffers(&alloc)
                 .map_err(vk_err("vkAllocateCommandBuffers"))?[0];
-            let result = (|| {
-                let begin = vk::CommandBufferBeginInfo::default().flags(vk::CommandBufferUsageFlags::ONE_TIME_SUBMIT);
-                d.begin_command_buffer(cb, &begin)
-                    .map_err(vk_err("vkBeginCommandBuffer"))?;
-                record(cb);
-                d.end_command_buffer(cb).map_err(vk_err("vkEndCommandBuffer"))?;
-                let fence = d
-                    .create_fence(&vk::FenceCreateInfo::default(), None)
-                    .map_err(vk_err("vkCreateFence"))?;
-                let cbs = [cb];
-                let submit = [vk::SubmitInfo::default().command_buffers(&cbs)];
-                let waited = d
-                    .queue_submit(self.queue, &submit, fence)
-                    .map_err(vk_err("vkQueueSubmit"))
-                    .and_then(|_| {
-                        d.wait_for_fences(&[fence], true, u64::MAX)
-                            .map_err(vk_err("vkWaitForFences"))
-                    });
-                d.destroy_fence(fence, None);
-                waited
-            })();
-            d.free_command_buffers(self.pool, &[cb]);
-            result
+            let fence = match d.create_fence(&vk::FenceCreateInfo::default(), None) {
+                Ok(f) => f,
+                Err(r) => {
+                    d.free_command_buffers(self.pool, &[cb]);
+                    return Err(vk_err("vkCreateFence")(r));
+                }
+            };
+            self.count(Created::SubmitObject);
+            self.count(Created::SubmitObject);
+            self.submit.set(Some((cb, fence)));
+            Ok((cb, fence))
+        }
+    }
+
+    /// Record `record` into the context's command buffer, submit it and wait for its fence.
+    /// Synchronous: no submit is pending when this returns, so every object a recording used is
+    /// free again.
+    pub(crate) fn run_commands(&self, record: impl FnOnce(vk::CommandBuffer)) -> Result<()> {
+        let d = &self.device;
+        let (cb, fence) = self.submit_objects()?;
+        // SAFETY: the command buffer and fence are not in use (the last submit was waited for);
+        // the queue is used from this thread only (the context is not Send).
+        unsafe {
+            d.reset_command_buffer(cb, vk::CommandBufferResetFlags::empty())
+                .map_err(vk_err("vkResetCommandBuffer"))?;
+            d.reset_fences(&[fence]).map_err(vk_err("vkResetFences"))?;
+            let begin = vk::CommandBufferBeginInfo::default().flags(vk::CommandBufferUsageFlags::ONE_TIME_SUBMIT);
+            d.begin_command_buffer(cb, &begin)
+                .map_err(vk_err("vkBeginCommandBuffer"))?;
+            record(cb);
+            d.end_command_buffer(cb).map_err(vk_err("vkEndCommandBuffer"))?;
+            let cbs = [cb];
+            let submit = [vk::SubmitInfo::default().command_buffers(&cbs)];
+            d.queue_submit(self.queue, &submit, fence)
+                .map_err(vk_err("vkQueueSubmit"))?;
+            d.wait_for_fences(&[fence], true, u64::MAX)
+                .map_err(vk_err("vkWaitForFences"))
         }
     }
 }
@@ -386,6 +452,10 @@ impl Drop for VulkanContext {
         // idle after the last synchronous submit, and waiting again is harmless.
         unsafe {
             let _ = self.device.device_wait_idle();
+            if let Some((cb, fence)) = self.submit.get() {
+                self.device.destroy_fence(fence, None);
+                self.device.free_command_buffers(self.pool, &[cb]);
+            }
             self.device.destroy_command_pool(self.pool, None);
             self.device.destroy_device(None);
         }

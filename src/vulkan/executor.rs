@@ -343,6 +343,7 @@ impl VkExecutor {
                     None,
                 )
                 .map_err(vk_err("vkCreateDescriptorPool"))?;
+            self.vk.count(super::context::Created::DescriptorPool);
             self.pool_sets = n as usize;
         }
         Ok(())

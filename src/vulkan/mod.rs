@@ -23,6 +23,8 @@ mod refocus;
 mod resources;
 mod targets;
 
-pub use context::{auto_pick, check_policy, list_devices, Vk, VulkanContext, VulkanDeviceChoice, VulkanDeviceInfo};
+pub use context::{
+    auto_pick, check_policy, list_devices, Vk, VkCensus, VulkanContext, VulkanDeviceChoice, VulkanDeviceInfo,
+};
 pub use executor::VkExecutor;
 pub use refocus::{preamble as refocus_preamble, VkRefocuser};

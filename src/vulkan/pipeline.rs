@@ -140,6 +140,7 @@ impl Pipeline {
             d.destroy_shader_module(fs, None);
             let raw =
                 result.map_err(|(_, r)| Error::Vulkan(format!("vkCreateGraphicsPipelines {}: {r}", desc.program)))?[0];
+            vk.count(super::context::Created::Pipeline);
             Ok(Pipeline { vk: vk.clone(), raw })
         }
     }
@@ -164,6 +165,7 @@ impl Pipeline {
             let result = d.create_compute_pipelines(vk::PipelineCache::null(), &[info], None);
             d.destroy_shader_module(module, None);
             let raw = result.map_err(|(_, r)| Error::Vulkan(format!("vkCreateComputePipelines {program}: {r}")))?[0];
+            vk.count(super::context::Created::Pipeline);
             Ok(Pipeline { vk: vk.clone(), raw })
         }
     }
@@ -221,8 +223,9 @@ mod tests {
                 }
             }
         }
-        // Under each of 8 conventions: refocus 3 x 2, gather 8, shift 6, stitch 3, ray tracer 1
-        // and splat-gather's draw 1 programs of 2 stages; splat, edge snap and edge pass 1 stage.
-        assert_eq!(found, ((6 + 8 + 6 + 3 + 1 + 1) * 2 + 3) * 8);
+        // Under each of 8 conventions: refocus 3 x 2, gather 8, shift 6, stitch 3, ray tracer 1,
+        // splat-gather's draw 1 and forward warp 1 programs of 2 stages; splat, edge snap and
+        // edge pass 1 stage.
+        assert_eq!(found, ((6 + 8 + 6 + 3 + 1 + 1 + 1) * 2 + 3) * 8);
     }
 }

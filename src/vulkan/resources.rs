@@ -251,6 +251,7 @@ fn allocate(vk: &Vk, req: &vk::MemoryRequirements, index: u32, undo: impl FnOnce
     let alloc = vk::MemoryAllocateInfo::default()
         .allocation_size(req.size)
         .memory_type_index(index);
+    vk.count(super::context::Created::Allocation);
     // SAFETY: plain allocation; the caller owns the memory and frees it in its Drop.
     unsafe { vk.device.allocate_memory(&alloc, None) }.map_err(|r| {
         undo();
@@ -345,6 +346,7 @@ pub(crate) fn pool_with_one_set(
                 None,
             )
             .map_err(|r| Error::Vulkan(format!("vkCreateDescriptorPool: {r}")))?;
+        vk.count(super::context::Created::DescriptorPool);
         match d.allocate_descriptor_sets(
             &vk::DescriptorSetAllocateInfo::default()
                 .descriptor_pool(pool)

@@ -242,6 +242,66 @@ fn forward_warp_agrees_between_gl_and_vulkan_under_every_convention() {
     }
 }
 
+/// One more frame of every pass creates nothing on either API: no pipeline, memory allocation,
+/// descriptor pool, command buffer or fence on Vulkan (and no device or queue wait), no GL
+/// object (`Gpu::live_objects`): the executors cache programs, pipelines and targets, and
+/// renderers keep their images. The Vulkan counterpart of ../shared/tools/gl-calls.
+#[test]
+fn a_steady_state_frame_creates_nothing_on_either_api() {
+    let g = gpu();
+    let v = vulkan();
+    let devices = [Device::gl(&g).unwrap(), VkExecutor::device(&v).unwrap()];
+    let conv = Conventions::all()[5];
+    let (frame, mid, _) = scene_frame(&StereoRig::demo(64, 48), conv, FrameDepth::Device);
+    let case = scene_cases(64, 48, 0.2, conv, FrameDepth::Device).unwrap().remove(0);
+    let rig = OdsRig::demo();
+    let (left, right) = (
+        scene_faces(&rig, Side::Left, 32, 110.0).unwrap(),
+        scene_faces(&rig, Side::Right, 32, 110.0).unwrap(),
+    );
+    let scene = viewsynth::scene::builtin("demo").unwrap();
+    let cam = GlCamera {
+        view: frame.left.view,
+        proj: frame.left.proj,
+        width: 64,
+        height: 48,
+        conv,
+    };
+    for d in &devices {
+        type Frame<'a> = Box<dyn FnMut() + 'a>;
+        let mut gather = CyclopeanRenderer::new(d, &frame, CyclopeanParams::seed(3.0)).unwrap();
+        let mut splat = SplatRenderer::new(d, &frame, SplatParams::default(), CyclopeanOutputs::default()).unwrap();
+        let mut forward = ForwardWarp::new(d, &frame, &BreakRule::default()).unwrap();
+        let mut shift =
+            viewsynth::reproject::render::Reprojector::new(d, &case.source, &case.geometry, methods()[0]).unwrap();
+        let mut stitch = viewsynth::stitch::render::StitchRenderer::new(d, &left, &right).unwrap();
+        let mut tracer = SceneRenderer::new(d, &scene).unwrap();
+        let stitch_params = StitchParams {
+            method: StitchMethod::Reproject,
+            overlap_deg: 10.0,
+            width: 64,
+            height: 32,
+        };
+        let frames: Vec<(&str, Frame)> = vec![
+            ("gather", Box::new(|| drop(gather.render(&mid).unwrap()))),
+            ("splat-gather", Box::new(|| drop(splat.render(&mid).unwrap()))),
+            ("forward", Box::new(|| drop(forward.render(&mid).unwrap()))),
+            ("reproject shift", Box::new(|| drop(shift.render().unwrap()))),
+            ("stitch", Box::new(|| drop(stitch.render(&stitch_params).unwrap()))),
+            ("ray tracer", Box::new(|| drop(tracer.render(&cam).unwrap()))),
+        ];
+        for (name, mut frame) in frames {
+            frame();
+            let (gl_before, vk_before) = (g.live_objects(), v.census());
+            frame();
+            frame();
+            assert_eq!(g.live_objects(), gl_before, "{name} on {:?}: GL objects", d.api());
+            assert_eq!(v.census(), vk_before, "{name} on {:?}: Vulkan objects", d.api());
+        }
+    }
+    assert_eq!(v.census().wait_idles, 0);
+}
+
 #[test]
 fn cyclopean_gather_renders_on_one_shared_device_for_every_convention() {
     // The renderer's images are freed with it and the device's caches stay bounded: many
