@@ -10,18 +10,13 @@
 //! rounding tie may go either way).
 //!
 //! Each capability's `pass` module (`refocus::pass`, `cyclopean::pass`, `reproject::pass`,
-//! `stitch::pass`) holds the contract: one input type and `gpu(&Gpu, &input)` /
-//! `reference(&input)`, both returning a `ViewOutput`.
+//! `stitch::pass`) holds the contract: one input type and `gpu(device, &input)` /
+//! `reference(&input)`, both returning a `ViewOutput`, and the conversions from its own output
+//! types (`ViewOutput::from_refocus`, ...), so this module imports no capability.
 
-use crate::cyclopean::reference::CyclopeanReference;
-use crate::cyclopean::CyclopeanOutput;
 use crate::gpu::Timing;
 use crate::io::{DepthMap, Mask, RgbImage};
 use crate::metrics::quantize_u8;
-use crate::refocus::reference::ReferenceImage;
-use crate::refocus::RefocusOutput;
-use crate::reproject::reference::ReprojectReference;
-use crate::reproject::ReprojectOutput;
 
 /// A synthesised view, rows top-down; every plane is `width` x `height` when present.
 #[derive(Debug, Clone)]
@@ -94,114 +89,51 @@ impl ViewOutput {
         }
     }
 
-    /// A refocus GPU output.
-    pub fn from_refocus(out: &RefocusOutput) -> Self {
+    /// A GPU output: planes as the pass read them back, `mask` nonzero where valid.
+    pub fn from_gpu(
+        width: u32,
+        height: u32,
+        color: Option<RgbImage>,
+        depth: Option<DepthMap>,
+        mask: Vec<u8>,
+        timing: Option<Timing>,
+    ) -> Self {
         ViewOutput {
-            width: out.camera.width,
-            height: out.camera.height,
-            color: out.rgb.clone(),
-            depth: out.depth.clone(),
-            mask: out.mask.clone(),
-            timing: Some(out.render),
+            width,
+            height,
+            color,
+            depth,
+            mask: Mask::new(width, height, mask).ok(),
+            timing,
             exact: None,
         }
     }
 
-    /// The refocus f64 twin; the mask is 255 where covered, as the GPU writes it.
-    pub fn from_refocus_reference(r: &ReferenceImage) -> Self {
-        Self::from_f64_twin(r.width, r.height, &r.rgb, &r.depth, &r.mask)
+    /// An f64 twin's colour, depth and validity rounded to the GPU's output types; the mask is
+    /// 255 where valid, as the GPU writes it.
+    pub fn from_f64_twin(width: u32, height: u32, color: &[[f64; 3]], depth: &[f64], mask: &[bool]) -> Self {
+        Self::from_f64_twin_mask(
+            width,
+            height,
+            color,
+            depth,
+            mask.iter().map(|&m| if m { 255 } else { 0 }).collect(),
+        )
     }
 
-    /// An f64 twin's colour, depth and validity rounded to the GPU's output types.
-    fn from_f64_twin(width: u32, height: u32, color: &[[f64; 3]], depth: &[f64], mask: &[bool]) -> Self {
+    /// As [`Self::from_f64_twin`] with the mask bytes given (cyclopean: the source-eye bits).
+    pub fn from_f64_twin_mask(width: u32, height: u32, color: &[[f64; 3]], depth: &[f64], mask: Vec<u8>) -> Self {
         ViewOutput {
             width,
             height,
             color: rounded_color(width, height, color),
             depth: f32_depth(width, height, depth),
-            mask: Mask::new(width, height, mask.iter().map(|&m| if m { 255 } else { 0 }).collect()).ok(),
+            mask: Mask::new(width, height, mask).ok(),
             timing: None,
             exact: Some(ExactView {
                 color: color.to_vec(),
                 depth: Some(depth.to_vec()),
             }),
         }
-    }
-
-    /// A cyclopean GPU output of a `width` x `height` middle camera.
-    pub fn from_cyclopean(out: &CyclopeanOutput, width: u32, height: u32, timing: Option<Timing>) -> Self {
-        ViewOutput {
-            width,
-            height,
-            color: out.color.clone(),
-            depth: out.depth.clone(),
-            mask: Mask::new(width, height, out.sources.clone()).ok(),
-            timing,
-            exact: None,
-        }
-    }
-
-    /// The cyclopean f64 twin of a `width` x `height` middle camera.
-    pub fn from_cyclopean_reference(r: &CyclopeanReference, width: u32, height: u32) -> Self {
-        ViewOutput {
-            width,
-            height,
-            color: rounded_color(width, height, &r.color),
-            depth: f32_depth(width, height, &r.depth),
-            mask: Mask::new(width, height, r.sources.clone()).ok(),
-            timing: None,
-            exact: Some(ExactView {
-                color: r.color.clone(),
-                depth: Some(r.depth.clone()),
-            }),
-        }
-    }
-
-    /// A reprojection GPU output of a `width` x `height` target.
-    pub fn from_reproject(out: &ReprojectOutput, width: u32, height: u32, timing: Option<Timing>) -> Self {
-        ViewOutput {
-            width,
-            height,
-            color: out.color.clone(),
-            depth: out.depth.clone(),
-            mask: Mask::new(width, height, out.mask.clone()).ok(),
-            timing,
-            exact: None,
-        }
-    }
-
-    /// The reprojection f64 twin; the mask is 255 where valid, as the GPU writes it.
-    pub fn from_reproject_reference(r: &ReprojectReference) -> Self {
-        Self::from_f64_twin(r.width, r.height, &r.color, &r.depth, &r.mask)
-    }
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn a_twin_converts_to_what_its_gpu_pass_writes() {
-        let r = ReprojectReference {
-            width: 2,
-            height: 1,
-            color: vec![[0.4, 127.5, 254.6], [0.0; 3]],
-            depth: vec![1.25, 0.0],
-            mask: vec![true, false],
-        };
-        let twin = ViewOutput::from_reproject_reference(&r);
-        // The same rounding as the reference's own conversion to the GPU output types.
-        let gpu_shaped = ViewOutput::from_reproject(&r.to_output().unwrap(), 2, 1, None);
-        for v in [&twin, &gpu_shaped] {
-            assert_eq!(v.color.as_ref().unwrap().data, vec![0, 128, 255, 0, 0, 0]);
-            assert_eq!(v.depth.as_ref().unwrap().data, vec![1.25, 0.0]);
-            assert_eq!(v.mask.as_ref().unwrap().data, vec![255, 0]);
-        }
-        let stitch = ViewOutput::from_color_f64(1, 1, &[[1.5, 2.49, -3.0]]);
-        assert_eq!(stitch.color.unwrap().data, vec![2, 2, 0]);
-        assert!(stitch.depth.is_none() && stitch.mask.is_none() && stitch.timing.is_none());
-        assert_eq!(stitch.exact.unwrap().color, vec![[1.5, 2.49, -3.0]]);
-        assert_eq!(twin.exact.unwrap().depth, Some(vec![1.25, 0.0]));
-        assert!(gpu_shaped.exact.is_none());
     }
 }

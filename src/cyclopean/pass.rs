@@ -68,3 +68,27 @@ pub fn reference(input: &CyclopeanInput) -> Result<ViewOutput> {
     }
     Ok(view)
 }
+
+impl ViewOutput {
+    /// A cyclopean GPU output of a `width` x `height` middle camera (mask: the source bits).
+    pub fn from_cyclopean(
+        out: &super::CyclopeanOutput,
+        width: u32,
+        height: u32,
+        timing: Option<crate::gpu::Timing>,
+    ) -> Self {
+        Self::from_gpu(
+            width,
+            height,
+            out.color.clone(),
+            out.depth.clone(),
+            out.sources.clone(),
+            timing,
+        )
+    }
+
+    /// The cyclopean f64 twin of a `width` x `height` middle camera.
+    pub fn from_cyclopean_reference(r: &super::reference::CyclopeanReference, width: u32, height: u32) -> Self {
+        Self::from_f64_twin_mask(width, height, &r.color, &r.depth, r.sources.clone())
+    }
+}

@@ -54,3 +54,23 @@ pub fn reference(input: &RefocusInput) -> Result<ViewOutput> {
     }
     Ok(view)
 }
+
+impl ViewOutput {
+    /// A refocus GPU output.
+    pub fn from_refocus(out: &super::RefocusOutput) -> Self {
+        ViewOutput {
+            width: out.camera.width,
+            height: out.camera.height,
+            color: out.rgb.clone(),
+            depth: out.depth.clone(),
+            mask: out.mask.clone(),
+            timing: Some(out.render),
+            exact: None,
+        }
+    }
+
+    /// The refocus f64 twin; the mask is 255 where covered, as the GPU writes it.
+    pub fn from_refocus_reference(r: &super::reference::ReferenceImage) -> Self {
+        Self::from_f64_twin(r.width, r.height, &r.rgb, &r.depth, &r.mask)
+    }
+}

@@ -48,3 +48,58 @@ pub fn reference(input: &ReprojectInput) -> Result<ViewOutput> {
     }
     Ok(view)
 }
+
+impl ViewOutput {
+    /// A reprojection GPU output of a `width` x `height` target.
+    pub fn from_reproject(
+        out: &super::ReprojectOutput,
+        width: u32,
+        height: u32,
+        timing: Option<crate::gpu::Timing>,
+    ) -> Self {
+        Self::from_gpu(
+            width,
+            height,
+            out.color.clone(),
+            out.depth.clone(),
+            out.mask.clone(),
+            timing,
+        )
+    }
+
+    /// The reprojection f64 twin; the mask is 255 where valid, as the GPU writes it.
+    pub fn from_reproject_reference(r: &super::reference::ReprojectReference) -> Self {
+        Self::from_f64_twin(r.width, r.height, &r.color, &r.depth, &r.mask)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::reproject::reference::ReprojectReference;
+
+    #[test]
+    fn a_twin_converts_to_what_its_gpu_pass_writes() {
+        let r = ReprojectReference {
+            width: 2,
+            height: 1,
+            color: vec![[0.4, 127.5, 254.6], [0.0; 3]],
+            depth: vec![1.25, 0.0],
+            mask: vec![true, false],
+        };
+        let twin = ViewOutput::from_reproject_reference(&r);
+        // The same rounding as the reference's own conversion to the GPU output types.
+        let gpu_shaped = ViewOutput::from_reproject(&r.to_output().unwrap(), 2, 1, None);
+        for v in [&twin, &gpu_shaped] {
+            assert_eq!(v.color.as_ref().unwrap().data, vec![0, 128, 255, 0, 0, 0]);
+            assert_eq!(v.depth.as_ref().unwrap().data, vec![1.25, 0.0]);
+            assert_eq!(v.mask.as_ref().unwrap().data, vec![255, 0]);
+        }
+        let stitch = ViewOutput::from_color_f64(1, 1, &[[1.5, 2.49, -3.0]]);
+        assert_eq!(stitch.color.unwrap().data, vec![2, 2, 0]);
+        assert!(stitch.depth.is_none() && stitch.mask.is_none() && stitch.timing.is_none());
+        assert_eq!(stitch.exact.unwrap().color, vec![[1.5, 2.49, -3.0]]);
+        assert_eq!(twin.exact.unwrap().depth, Some(vec![1.25, 0.0]));
+        assert!(gpu_shaped.exact.is_none());
+    }
+}
