@@ -87,7 +87,7 @@ fn time(repeats: usize, frame: Result<Frame>) -> Result<f64> {
 
 /// Every pass on both APIs from one run, same inputs, render + readback, medians of `repeats`
 /// after a warm-up (pipelines, targets): refocus (5 focal scales a frame), cyclopean seed,
-/// refine and splat-gather, reproject shift, shift-scan and 3-D gather, stitch's three methods
+/// refine, splat-gather and forward warp, reproject shift, shift-scan and 3-D gather, stitch's three methods
 /// (one stereo equirect) and the scene ray tracer, at `width` x `height`. One Markdown table;
 /// every case also goes to `cases` (`gl-<pass>`, `vulkan-<pass>`).
 pub fn passes_bench(
@@ -229,6 +229,18 @@ pub fn passes_bench(
         },
         cases,
     );
+    let ms = devices.each_ref().map(|d| {
+        time(
+            repeats,
+            (|| -> Result<Frame> {
+                let mut r = crate::cyclopean::forward::ForwardWarp::new(d, &frame, &BreakRule::default())?;
+                let mid = &mid;
+                Ok(Box::new(move || r.render(mid).map(drop)) as Frame)
+            })(),
+        )
+    });
+    let [a, b] = ms;
+    row("cyclopean forward", [a?, b?], cases);
     for params in crate::eval::reproject::methods() {
         let ms = devices.each_ref().map(|d| {
             time(
