@@ -103,6 +103,9 @@ struct Instance {
     // The entry keeps libvulkan loaded for as long as the instance lives.
     _entry: ash::Entry,
     raw: ash::Instance,
+    /// VK_EXT_debug_utils was enabled: objects can carry names for RenderDoc and the validation
+    /// layer's messages.
+    debug_utils: bool,
 }
 
 impl Drop for Instance {
@@ -125,14 +128,27 @@ fn create_instance() -> Result<Instance> {
         .application_name(c"viewsynth")
         .engine_name(c"viewsynth")
         .api_version(vk::API_VERSION_1_3);
-    let info = vk::InstanceCreateInfo::default().application_info(&app);
-    // SAFETY: valid create info with no extensions or layers.
+    // SAFETY: plain query of the loader's instance extensions.
+    let debug_utils = unsafe { entry.enumerate_instance_extension_properties(None) }
+        .unwrap_or_default()
+        .iter()
+        .any(|e| e.extension_name_as_c_str() == Ok(ash::ext::debug_utils::NAME));
+    let extensions = [ash::ext::debug_utils::NAME.as_ptr()];
+    let mut info = vk::InstanceCreateInfo::default().application_info(&app);
+    if debug_utils {
+        info = info.enabled_extension_names(&extensions);
+    }
+    // SAFETY: valid create info; the one extension (when enabled) is one the loader listed.
     let raw = unsafe { entry.create_instance(&info, None) }.map_err(|r| {
         Error::Vulkan(format!(
             "vkCreateInstance: {r} (is a Vulkan driver installed? Debian/Ubuntu: mesa-vulkan-drivers)"
         ))
     })?;
-    Ok(Instance { _entry: entry, raw })
+    Ok(Instance {
+        _entry: entry,
+        raw,
+        debug_utils,
+    })
 }
 
 fn describe(instance: &ash::Instance, index: usize, pd: vk::PhysicalDevice) -> Result<VulkanDeviceInfo> {
@@ -233,6 +249,8 @@ pub struct VulkanContext {
     submit: std::cell::Cell<Option<(vk::CommandBuffer, vk::Fence)>>,
     /// What was created on the device so far.
     census: std::cell::Cell<VkCensus>,
+    /// Object naming (VK_EXT_debug_utils), where the instance has it.
+    names: Option<ash::ext::debug_utils::Device>,
     // Last: dropped after the device.
     _instance: Instance,
 }
@@ -348,6 +366,9 @@ impl VulkanContext {
                 }
             };
             let memory = raw.get_physical_device_memory_properties(pd);
+            let names = instance
+                .debug_utils
+                .then(|| ash::ext::debug_utils::Device::new(raw, &device));
             Ok(Rc::new(VulkanContext {
                 device,
                 queue,
@@ -356,6 +377,7 @@ impl VulkanContext {
                 info,
                 submit: std::cell::Cell::new(None),
                 census: std::cell::Cell::new(VkCensus::default()),
+                names,
                 _instance: instance,
             }))
         }
@@ -370,6 +392,19 @@ impl VulkanContext {
     pub(crate) fn memory_type(&self, bits: u32, flags: vk::MemoryPropertyFlags) -> Option<u32> {
         (0..self.memory.memory_type_count)
             .find(|&i| bits & (1 << i) != 0 && self.memory.memory_types[i as usize].property_flags.contains(flags))
+    }
+
+    /// Name `handle` for debuggers (RenderDoc) and the validation layer's messages, where
+    /// VK_EXT_debug_utils is there (wgpu-hal's object labels); otherwise nothing.
+    pub(crate) fn name<H: vk::Handle>(&self, handle: H, name: &str) {
+        let (Some(names), Ok(name)) = (&self.names, std::ffi::CString::new(name)) else {
+            return;
+        };
+        let info = vk::DebugUtilsObjectNameInfoEXT::default()
+            .object_handle(handle)
+            .object_name(&name);
+        // SAFETY: `handle` is a live object of this device; the name outlives the call.
+        let _ = unsafe { names.set_debug_utils_object_name(&info) };
     }
 
     /// What was created on this device so far ([`VkCensus`]).

@@ -271,6 +271,7 @@ impl VkExecutor {
             }
             None => Pipeline::compute(&self.vk, raw_layout, binds.program.kind.name(), &preamble)?,
         };
+        self.vk.name(pipeline.raw, binds.program.kind.name());
         self.pipelines.push(CachedPipeline {
             program: binds.program,
             depth,
@@ -512,6 +513,7 @@ impl Executor for VkExecutor {
             vk_format(image.format),
             image.bytes,
         )?;
+        self.vk.name(img.raw, image.label);
         Ok(self.store_image(StoredImage {
             image: img,
             layout: vk::ImageLayout::SHADER_READ_ONLY_OPTIMAL,
@@ -519,10 +521,11 @@ impl Executor for VkExecutor {
         }))
     }
 
-    fn create_image(&mut self, width: u32, height: u32, format: Format, _label: &str) -> Result<ImageId> {
+    fn create_image(&mut self, width: u32, height: u32, format: Format, label: &str) -> Result<ImageId> {
         use vk::ImageUsageFlags as U;
         let usage = U::SAMPLED | U::STORAGE | U::TRANSFER_DST | U::TRANSFER_SRC;
         let image = Image::new(&self.vk, width, height, vk_format(format), usage)?;
+        self.vk.name(image.raw, label);
         // Kept in GENERAL for its whole life: sampled, stored and cleared there.
         self.vk.run_commands(|cb| {
             image.transition(
@@ -548,13 +551,14 @@ impl Executor for VkExecutor {
         }
     }
 
-    fn create_buffer(&mut self, words: usize, _label: &str) -> Result<BufferId> {
+    fn create_buffer(&mut self, words: usize, label: &str) -> Result<BufferId> {
         use vk::BufferUsageFlags as U;
         let b = Buffer::new(
             &self.vk,
             words * 4,
             U::STORAGE_BUFFER | U::INDIRECT_BUFFER | U::TRANSFER_DST,
         )?;
+        self.vk.name(b.raw, label);
         let slot = self
             .buffers
             .iter()
