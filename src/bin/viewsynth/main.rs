@@ -129,6 +129,7 @@ enum Command {
 const RUN_ERROR: u8 = 1;
 
 fn main() -> ExitCode {
+    quiet_on_closed_pipe();
     let cli = Cli::parse();
     let result = io::set_max_pixels(cli.max_pixels)
         .map_err(anyhow::Error::from)
@@ -139,6 +140,21 @@ fn main() -> ExitCode {
             eprintln!("error: {}", error_chain(&e));
             ExitCode::from(RUN_ERROR)
         }
+    }
+}
+
+/// A closed stdout or stderr (`viewsynth demo | head`) ends the process as it ends `cat` or
+/// `grep`: killed by SIGPIPE, status 141 in a shell, no message. Rust ignores SIGPIPE, so every
+/// `println!`/`eprintln!` would panic (exit 101) on EPIPE instead; restoring the default
+/// disposition covers every print site at once (ours, clap's, indicatif's, worker threads'),
+/// where catching `BrokenPipe` would have to be repeated at each of them and a missed one
+/// panics. Outputs are staged and renamed only when complete, so a run cut short this way
+/// leaves the previous files as they were. The process writes to no other pipe or socket.
+fn quiet_on_closed_pipe() {
+    #[cfg(unix)]
+    // SAFETY: at the start of main, before any thread exists; SIG_DFL is a valid disposition.
+    unsafe {
+        libc::signal(libc::SIGPIPE, libc::SIG_DFL);
     }
 }
 
@@ -169,8 +185,14 @@ fn run(command: Command) -> Result<ExitCode> {
         Command::Stitch(a) => stitch::run::stitch(&(*a).try_into()?)?,
         Command::Scene(a) => scene::run::scene(&a.try_into()?)?,
         Command::Compare(a) => return compare::run::compare(&(*a).try_into()?),
-        Command::Demo(a) => demo::run::demo(&a.try_into()?)?,
-        Command::Report(a) => report::run::report(&a.try_into()?)?,
+        Command::Demo(a) => {
+            let verbose = a.verbose;
+            demo::run::demo(&a.try_into()?, verbose)?
+        }
+        Command::Report(a) => {
+            let verbose = a.verbose;
+            report::run::report(&a.try_into()?, verbose)?
+        }
         Command::Bench(a) => {
             let json = a.json;
             bench::run::bench(&a.try_into()?, json)?

@@ -11,6 +11,10 @@ pub(crate) struct DemoArgs {
     /// Output folder (created if missing).
     #[arg(long, default_value = "out/demo")]
     out_dir: PathBuf,
+    /// Print the whole report table to stdout (by default a summary per method; the table is
+    /// in <out-dir>/report.md either way).
+    #[arg(long, short)]
+    pub verbose: bool,
     #[command(flatten)]
     gpu: GpuArgs,
 }

@@ -22,6 +22,10 @@ pub(crate) struct ReportArgs {
     /// Timed repetitions per row (the median is reported).
     #[arg(long, default_value_t = 3, value_parser = clap::builder::RangedU64ValueParser::<usize>::new().range(0..=1000))]
     repeats: usize,
+    /// Print the whole report table to stdout (by default a summary per method; the table is
+    /// in <out-dir>/report.md either way).
+    #[arg(long, short)]
+    pub verbose: bool,
     #[command(flatten)]
     gpu: GpuArgs,
 }
