@@ -1,29 +1,38 @@
 //! `viewsynth scene` options and their conversion into a checked library job.
 
 use crate::options::{ConventionArgs, GpuArgs};
+use crate::options::{INPUTS, OUTPUTS, TARGETS};
 use clap::Args;
 use std::path::PathBuf;
 use viewsynth::io;
 use viewsynth::job::scene::{SceneJob, SceneOptions};
 use viewsynth::job::{finite_value, ArgError};
 
+/// The example under `viewsynth scene --help` (paths from the repository root, as in the README).
+pub(crate) const EXAMPLES: &str = "\
+Examples:
+  viewsynth scene --width 320 --height 240 --out-dir out/scene     # a stereo frame + cameras.json
+  viewsynth scene --cube-faces 128 --out-dir out/faces             # also 6 faces per eye for stitch --faces";
+
 #[derive(Args)]
 pub(crate) struct SceneArgs {
     /// `demo`, `boxes`, or a scene JSON file of planes, spheres and boxes.
-    #[arg(long, default_value = "demo")]
+    #[arg(help_heading = INPUTS, long, default_value = "demo")]
     scene: String,
-    #[arg(long, default_value_t = 640, value_parser = clap::value_parser!(u32).range(1..=i64::from(io::MAX_DIMENSION)))]
+    /// Image width of each view, pixels.
+    #[arg(help_heading = TARGETS, long, default_value_t = 640, value_parser = clap::value_parser!(u32).range(1..=i64::from(io::MAX_DIMENSION)))]
     width: u32,
-    #[arg(long, default_value_t = 480, value_parser = clap::value_parser!(u32).range(1..=i64::from(io::MAX_DIMENSION)))]
+    /// Image height of each view, pixels.
+    #[arg(help_heading = TARGETS, long, default_value_t = 480, value_parser = clap::value_parser!(u32).range(1..=i64::from(io::MAX_DIMENSION)))]
     height: u32,
     /// Interocular distance in metres.
-    #[arg(long, default_value_t = 0.064, value_parser = finite_value)]
+    #[arg(help_heading = TARGETS, long, default_value_t = 0.064, value_parser = finite_value)]
     ipd: f64,
+    /// Output folder (created if missing).
+    #[arg(help_heading = OUTPUTS, long, default_value = "out/scene")]
+    out_dir: PathBuf,
     #[command(flatten)]
     conv: ConventionArgs,
-    /// Output folder (created if missing).
-    #[arg(long, default_value = "out/scene")]
-    out_dir: PathBuf,
     #[command(flatten)]
     gpu: GpuArgs,
 }
