@@ -149,3 +149,22 @@ fn demo_prints_a_summary_and_report_verbose_the_whole_table() {
     assert!(out.starts_with(&table), "--verbose prints report.md as written:\n{out}");
     assert!(out.lines().count() > table.lines().count(), "{out}");
 }
+
+#[test]
+fn a_shard_from_unset_slurm_variables_is_a_usage_error_naming_them() {
+    let d = scratch("shard");
+    // What `--shard "$SLURM_ARRAY_TASK_ID/$SLURM_ARRAY_TASK_COUNT"` expands to outside an array
+    // job, then one with a count but no index, then one out of range.
+    for (shard, hint) in [("/", true), ("/4", true), ("4/4", false)] {
+        let o = bin()
+            .args(["refocus", "--batch", "frames.csv", "--shard", shard, "--out-dir"])
+            .arg(&d)
+            .output()
+            .unwrap();
+        let err = String::from_utf8_lossy(&o.stderr);
+        assert_eq!(o.status.code(), Some(2), "--shard {shard}: {err}");
+        assert!(err.contains("--shard") && err.contains("0 <= K < N"), "{err}");
+        assert_eq!(err.contains("SLURM_ARRAY_TASK_ID"), hint, "{err}");
+        assert!(!err.contains("panicked"), "{err}");
+    }
+}

@@ -3,10 +3,11 @@
 //! job and prints the result. This file only parses, dispatches and maps failures to exit codes:
 //!
 //! - 0: success;
-//! - 2: the command line does not parse (unknown option, a value outside its stated range:
-//!   clap's own usage error, printed with `try '--help'`);
+//! - 2: the command line does not parse (unknown option, a value outside its stated range, a
+//!   malformed `--shard`: clap's own usage error, printed with `try '--help'`);
 //! - 1: anything found after parsing: options the library refuses in the conversion, inputs,
-//!   the GPU, output files, a failed batch frame or stress case, a broken compare threshold.
+//!   the GPU, output files, a failed batch frame or stress case, a broken compare threshold;
+//! - killed by SIGPIPE (141 in a shell): stdout or stderr was closed early (`| head`).
 //!
 //! anyhow lives here only, at the edge; the library's errors are typed.
 

@@ -6,7 +6,7 @@ use clap::{Args, ValueEnum};
 use std::path::PathBuf;
 use viewsynth::io::{self, DepthDecode};
 use viewsynth::job::refocus::{Focals, RefocusCommand, RefocusOptions};
-use viewsynth::job::{file_formats, finite_or_inf, finite_value, ArgError};
+use viewsynth::job::{file_formats, finite_or_inf, finite_value, shard_value, ArgError};
 use viewsynth::refocus::{BreakRule, Method};
 
 #[derive(Clone, Copy, ValueEnum)]
@@ -103,7 +103,7 @@ pub(crate) struct RefocusArgs {
     jobs: Option<usize>,
     /// With --batch: process only shard K of N (frames whose manifest index i has i % N == K,
     /// K from 0), e.g. one Slurm array task or Kubernetes indexed Job per shard.
-    #[arg(help_heading = BATCH, long)]
+    #[arg(help_heading = BATCH, long, value_name = "K/N", value_parser = shard_value)]
     shard: Option<String>,
     #[command(flatten)]
     conv: ConventionArgs,
