@@ -31,6 +31,14 @@ pub(crate) struct SceneArgs {
     /// Output folder (created if missing).
     #[arg(help_heading = OUTPUTS, long, default_value = "out/scene")]
     out_dir: PathBuf,
+    /// Also write each eye's six cube faces, N x N pixels, as `viewsynth stitch --faces` reads
+    /// them: {left,right}_{pz,nz,up,down,px,nx}.png and _depth.exr (view Z), ray-traced on the CPU
+    /// from a 360 rig at --ipd, with stitch's default pole fade.
+    #[arg(help_heading = OUTPUTS, long, value_name = "N", value_parser = clap::value_parser!(u32).range(2..=i64::from(io::MAX_DIMENSION)))]
+    cube_faces: Option<u32>,
+    /// Field of view of the cube faces, degrees, in (90, 178): give stitch the same --fov.
+    #[arg(help_heading = OUTPUTS, long, default_value_t = 110.0, requires = "cube_faces", value_parser = finite_value)]
+    face_fov: f64,
     #[command(flatten)]
     conv: ConventionArgs,
     #[command(flatten)]
@@ -44,6 +52,8 @@ impl TryFrom<SceneArgs> for SceneJob {
             scene: a.scene,
             width: a.width,
             height: a.height,
+            cube_faces: a.cube_faces,
+            face_fov: a.face_fov,
             ipd: a.ipd,
             conventions: a.conv.into(),
             out_dir: a.out_dir,
