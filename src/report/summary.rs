@@ -4,9 +4,12 @@ use super::table::{fixed, md_inline, sig};
 use super::Report;
 use std::fmt::Write as _;
 
+/// One summary line's rows: (capability, method), their PSNRs and their wall times.
+type Group<'a> = ((&'a str, &'a str), Vec<f64>, Vec<f64>);
+
 pub(super) fn summary(report: &Report) -> String {
-    // (capability, method) in first-seen order, each with its PSNRs and wall times.
-    let mut groups: Vec<((&str, &str), Vec<f64>, Vec<f64>)> = Vec::new();
+    // (capability, method) in first-seen order.
+    let mut groups: Vec<Group<'_>> = Vec::new();
     for r in &report.rows {
         let key = (r.capability.as_str(), r.method.as_str());
         let i = match groups.iter().position(|g| g.0 == key) {
