@@ -74,14 +74,19 @@ if ! have rust:1-bookworm && ! docker pull -q rust:1-bookworm >/dev/null 2>&1; t
   SYSROOT=$(rustc --print sysroot)
   say "no registry: rust:1-bookworm from this machine's toolchain ($("$SYSROOT/bin/rustc" --version))"
   # The official image's layout: the toolchain under /usr/local, a C toolchain for linking.
-  mkdir -p "$WORK/rust"
+  mkdir -p "$WORK/rust/ca"
   tar -C "$SYSROOT" -c bin/cargo bin/rustc bin/rustdoc lib libexec | tar -C "$WORK/rust" -x
+  # This machine's own CA certificates (a TLS-intercepting proxy's, say): cargo in the image
+  # then reaches crates.io as cargo here does.
+  find /usr/local/share/ca-certificates -name '*.crt' -exec cp {} "$WORK/rust/ca/" \; 2>/dev/null || true
   cat >"$WORK/rust/Dockerfile" <<'EOF'
 FROM debian:bookworm-slim
 RUN apt-get update -qq \
  && DEBIAN_FRONTEND=noninteractive apt-get install -y -qq --no-install-recommends \
       ca-certificates gcc libc6-dev pkg-config \
  && rm -rf /var/lib/apt/lists/*
+COPY ca /usr/local/share/ca-certificates
+RUN update-ca-certificates
 COPY bin /usr/local/bin
 COPY lib /usr/local/lib
 COPY libexec /usr/local/libexec
