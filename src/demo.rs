@@ -8,21 +8,22 @@ use crate::gpu::Gpu;
 use crate::metrics;
 use crate::refocus::job::{self, FileFormats};
 use crate::refocus::{reference, BreakRule, Method, OutputSet, RefocusSource, Refocuser};
+use crate::report::WrittenReport;
 use crate::{io, scene};
 use std::fmt::Write as _;
-use std::path::{Path, PathBuf};
+use std::path::Path;
 
 /// The focal scales the demo refocuses at.
 pub const DEMO_SCALES: [f64; 5] = [0.5, 0.75, 1.0, 1.5, 2.0];
 
-/// Run the demo into `out_dir`; returns the path of the Markdown report.
-pub fn run(gpu: &Gpu, out_dir: &Path) -> Result<PathBuf> {
+/// Run the demo into `out_dir`; returns the report, its files and, last, refocus_check.md.
+pub fn run(gpu: &Gpu, out_dir: &Path) -> Result<WrittenReport> {
     run_with_progress(gpu, out_dir, &crate::progress::Silent)
 }
 
 /// [`run`] with each stage reported to `progress` as it starts: the two refocus methods, the
 /// cyclopean, reprojection and stitching outputs, then the report's stages.
-pub fn run_with_progress(gpu: &Gpu, out_dir: &Path, progress: &dyn crate::progress::Progress) -> Result<PathBuf> {
+pub fn run_with_progress(gpu: &Gpu, out_dir: &Path, progress: &dyn crate::progress::Progress) -> Result<WrittenReport> {
     let stages = crate::progress::Stages::new(progress, 5 + crate::eval::report_stage_count(None, &[]));
     // Subfolders through OutDir::subdir: a symlinked one is refused, never written through.
     // All of them first, so a refused one fails the run before any rendering.
@@ -127,11 +128,9 @@ pub fn run_with_progress(gpu: &Gpu, out_dir: &Path, progress: &dyn crate::progre
     reproject_outputs(gpu, &reproject_dir)?;
     stages.start("demo: stitched stereo panoramas");
     stitch_outputs(gpu, &stitch_dir)?;
-    let files = crate::eval::report_stages(gpu, out_dir, None, &[], 3, &stages)?;
-    Ok(files
-        .into_iter()
-        .find(|p| p.extension().is_some_and(|e| e == "md"))
-        .unwrap_or(path))
+    let mut written = crate::eval::report_stages(gpu, out_dir, None, &[], 3, &stages)?;
+    written.files.push(path);
+    Ok(written)
 }
 
 /// The built-in stereo pair (64 mm IPD, device depth, GL conventions), its ray-traced middle

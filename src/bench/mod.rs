@@ -211,6 +211,15 @@ pub fn cyclopean_bench(
     Ok(t)
 }
 
+/// The stitch table's heading, naming the number of timed runs its medians are of.
+fn stitch_table_head(renderer: &str, trace_ms: f64, setup_ms: f64, repeats: usize) -> String {
+    format!(
+        "stitch benchmark on {renderer} (6 faces 1024^2 per eye, overlap 10 deg, 4096x2048 per eye, top-bottom)\n\
+         face ray tracing {trace_ms:.0} ms (CPU), upload + shader compile {setup_ms:.0} ms\n\n\
+         | method | ms / stereo equirect (median of {repeats}) |\n|---|---|\n"
+    )
+}
+
 /// (setup ms, median ms) of a pass: setup is `make` plus one warm-up `run` (shader JIT,
 /// framebuffer allocation), then the median of `repeats` (at least 1) timed runs.
 fn setup_and_median<R, T>(
@@ -232,8 +241,9 @@ fn setup_and_median<R, T>(
 }
 
 /// Benchmark: ms per 4096 x 2048 stereo equirect (both eyes, readback included) from 6 faces
-/// of 1024 x 1024 per eye, overlap 10 deg, per method (median of 5 after a warm-up). Not asserted.
-pub fn stitch_bench(gpu: &Gpu, cases: &mut Vec<BenchCase>) -> Result<String> {
+/// of 1024 x 1024 per eye, overlap 10 deg, per method (median of `repeats`, at least 1, after a
+/// warm-up). Not asserted.
+pub fn stitch_bench(gpu: &Gpu, repeats: usize, cases: &mut Vec<BenchCase>) -> Result<String> {
     use crate::stitch::faces::scene_faces;
     use crate::stitch::render::StitchRenderer;
     use crate::stitch::{Method, OdsRig, Side, StitchParams};
@@ -246,12 +256,8 @@ pub fn stitch_bench(gpu: &Gpu, cases: &mut Vec<BenchCase>) -> Result<String> {
     let t0 = Instant::now();
     let mut r = StitchRenderer::new(gpu, &left, &right)?;
     let setup_ms = t0.elapsed().as_secs_f64() * 1e3;
-    let mut t = format!(
-        "stitch benchmark on {} (6 faces 1024^2 per eye, overlap 10 deg, 4096x2048 per eye, top-bottom)\n\
-         face ray tracing {trace_ms:.0} ms (CPU), upload + shader compile {setup_ms:.0} ms\n\n\
-         | method | ms / stereo equirect (median of 5) |\n|---|---|\n",
-        gpu.info().renderer
-    );
+    let repeats = repeats.max(1);
+    let mut t = stitch_table_head(&gpu.info().renderer, trace_ms, setup_ms, repeats);
     for method in Method::ALL {
         let params = StitchParams {
             method,
@@ -261,7 +267,7 @@ pub fn stitch_bench(gpu: &Gpu, cases: &mut Vec<BenchCase>) -> Result<String> {
         };
         r.render(&params)?;
         let mut times = Vec::new();
-        for _ in 0..5 {
+        for _ in 0..repeats {
             times.push(r.render(&params)?.1.wall_ms);
         }
         let m = median(times);
@@ -275,4 +281,14 @@ pub fn stitch_bench(gpu: &Gpu, cases: &mut Vec<BenchCase>) -> Result<String> {
         let _ = writeln!(t, "| {} | {m:.1} |", method.label());
     }
     Ok(t)
+}
+
+#[cfg(test)]
+mod tests {
+    #[test]
+    fn the_stitch_table_names_the_repeats_it_ran() {
+        let head = super::stitch_table_head("llvmpipe", 1.0, 2.0, 3);
+        assert!(head.contains("(median of 3)"), "{head}");
+        assert!(!head.contains("median of 5"), "{head}");
+    }
 }

@@ -202,7 +202,7 @@ fn real_runs(
 /// Report names of the CPU baselines.
 pub const SPLAT_BASELINE_NAME: &str = "baseline: forward splat (CPU, nearest wins, mean within 1 px)";
 /// Report name of issue 13's forward splat: the same with numpy's rounding of halves to even.
-pub const NUMPY_SPLAT_NAME: &str = "baseline: forward splat, numpy rounding (issue 13's, CPU)";
+pub const NUMPY_SPLAT_NAME: &str = "baseline: forward splat, numpy rounding (halves to even, CPU)";
 /// Report name of the no-warp baseline.
 pub const NO_WARP_NAME: &str = "baseline: no warp (mean of both eyes, CPU)";
 
@@ -247,7 +247,7 @@ fn real_rows(scene: &str, setting: &str, runs: &[RealRun], truth: &RgbImage) -> 
                 "cyclopean",
                 scene,
                 *name,
-                format!("{setting}; pixels common with issue 13's numpy splat"),
+                format!("{setting}; pixels common with the numpy-rounding splat"),
                 t.wall_ms,
             );
             row.gpu_ms = t.gpu_ms;

@@ -22,7 +22,7 @@ pub mod vulkan;
 use crate::error::Result;
 use crate::gpu::{Gpu, Timing};
 use crate::io::{DepthMap, RgbImage};
-use crate::report::{Report, ReportRow};
+use crate::report::{Report, ReportRow, WrittenReport};
 use crate::{metrics, ssim};
 use std::path::{Path, PathBuf};
 
@@ -78,7 +78,7 @@ pub(crate) fn score(
 }
 
 /// Run everything and write report.{md,csv,svg} into `out_dir`.
-pub fn run_report(gpu: &Gpu, out_dir: &Path, data_dir: Option<&Path>, repeats: usize) -> Result<Vec<PathBuf>> {
+pub fn run_report(gpu: &Gpu, out_dir: &Path, data_dir: Option<&Path>, repeats: usize) -> Result<WrittenReport> {
     run_report_with_cases(gpu, out_dir, data_dir, &[], repeats)
 }
 
@@ -89,7 +89,7 @@ pub fn run_report_with_cases(
     data_dir: Option<&Path>,
     cases: &[PathBuf],
     repeats: usize,
-) -> Result<Vec<PathBuf>> {
+) -> Result<WrittenReport> {
     run_report_with_progress(gpu, out_dir, data_dir, cases, repeats, &crate::progress::Silent)
 }
 
@@ -101,7 +101,7 @@ pub fn run_report_with_progress(
     cases: &[PathBuf],
     repeats: usize,
     progress: &dyn crate::progress::Progress,
-) -> Result<Vec<PathBuf>> {
+) -> Result<WrittenReport> {
     let stages = crate::progress::Stages::new(progress, report_stage_count(data_dir, cases));
     report_stages(gpu, out_dir, data_dir, cases, repeats, &stages)
 }
@@ -126,7 +126,7 @@ pub fn report_stages(
     cases: &[PathBuf],
     repeats: usize,
     stages: &crate::progress::Stages,
-) -> Result<Vec<PathBuf>> {
+) -> Result<WrittenReport> {
     std::fs::create_dir_all(out_dir).map_err(|e| crate::Error::io(out_dir, e))?;
     stages.start("report: refocus rows");
     let mut rows = refocus::refocus_rows(gpu, repeats)?;
@@ -170,5 +170,6 @@ pub fn report_stages(
         rows,
         notes,
     };
-    report.write(out_dir, "report")
+    let files = report.write(out_dir, "report")?;
+    Ok(WrittenReport { report, files })
 }

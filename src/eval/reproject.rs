@@ -327,7 +327,7 @@ fn mesh_row(case: &Case, scene: &str, out: &ReprojectOutput, t: Timing) -> Resul
     let mut r = ReportRow::new(
         "reproject",
         scene,
-        "mesh warp (foundation mesh path)",
+        "mesh warp (source depth mesh rasterised)",
         case.name.clone(),
         t.wall_ms,
     );

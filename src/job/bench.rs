@@ -136,7 +136,7 @@ impl BenchJob {
                     stages.stage(2, total, "bench: cyclopean");
                     tables.push(cyclopean_bench(&gpu, 1280, 720, *repeats, &mut cases)?);
                     stages.stage(3, total, "bench: stitch");
-                    tables.push(crate::bench::stitch_bench(&gpu, &mut cases)?);
+                    tables.push(crate::bench::stitch_bench(&gpu, *repeats, &mut cases)?);
                     if !*with_vulkan {
                         return Ok((tables, None));
                     }

@@ -176,6 +176,9 @@ pub enum ArgError {
     /// The face field of view outside (90, 178) degrees.
     #[error("--fov {0}: the face field of view must be in (90, 178) degrees")]
     FaceFov(f64),
+    /// `scene --face-fov` outside (90, 178) degrees.
+    #[error("--face-fov {0}: the cube faces' field of view must be in (90, 178) degrees (stitch --faces needs over-wide faces)")]
+    CubeFaceFov(f64),
     /// A scene other than `demo` for stitching.
     #[error("--scene '{0}': only the built-in `demo` scene has cube faces (use --faces DIR for your own)")]
     StitchScene(String),

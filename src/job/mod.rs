@@ -46,6 +46,14 @@ pub fn finite_value(text: &str) -> Result<f64, String> {
     }
 }
 
+/// A `--shard K/N` as the command line's parser checks it (a malformed one is a usage error,
+/// as a number out of range is): the text back, or why it is not a shard.
+pub fn shard_value(text: &str) -> Result<String, String> {
+    text.parse::<crate::refocus::batch::Shard>()
+        .map(|_| text.to_string())
+        .map_err(|e| e.to_string())
+}
+
 /// As [`finite_value`], or `inf` where infinity has a meaning (a far plane, a disabled limit).
 pub fn finite_or_inf(text: &str) -> Result<f64, String> {
     match text.trim().parse::<f64>() {

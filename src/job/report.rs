@@ -3,6 +3,7 @@
 
 use super::host::HostStages;
 use super::{ArgError, Event, GpuRequest, Host, JobError};
+use crate::report::WrittenReport;
 use std::path::{Path, PathBuf};
 
 /// A checked report run.
@@ -21,8 +22,8 @@ pub struct ReportJob {
 }
 
 impl ReportJob {
-    /// Measures every row and writes the report files; returns their paths.
-    pub fn run(&self, host: &dyn Host) -> Result<Vec<PathBuf>, JobError> {
+    /// Measures every row and writes the report files; returns the report and their paths.
+    pub fn run(&self, host: &dyn Host) -> Result<WrittenReport, JobError> {
         if let Some(d) = &self.data_dir {
             if !d.is_dir() {
                 return Err(ArgError::DataDirMissing(d.clone()).into());
@@ -56,8 +57,8 @@ pub struct DemoJob {
 }
 
 impl DemoJob {
-    /// Renders everything; returns the report's Markdown file.
-    pub fn run(&self, host: &dyn Host) -> Result<PathBuf, JobError> {
+    /// Renders everything; returns the report, its files and, last, refocus_check.md.
+    pub fn run(&self, host: &dyn Host) -> Result<WrittenReport, JobError> {
         let gpu = host.open_gpu(&self.gpu)?;
         let report = crate::demo::run_with_progress(&gpu, Path::new(&self.out_dir), &HostStages(host));
         host.event(Event::Finished);

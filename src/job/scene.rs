@@ -1,6 +1,7 @@
 //! `scene`: a ground-truth stereo frame (left, right and middle colour, view distance, device
 //! depth) ray-traced on the GPU from the demo rig, and the `cameras.json` that `cyclopean` and
-//! `reproject --cameras` read. Every file or none: a failing rerun leaves the previous scene.
+//! `reproject --cameras` read; with `cube_faces`, also the 6 over-wide cube faces per eye that
+//! `stitch --faces` reads. Every file or none: a failing rerun leaves the previous scene.
 
 use super::{ArgError, Backend, GpuRequest, Host, JobError};
 use crate::camera::gl_projection;
@@ -9,6 +10,8 @@ use crate::cyclopean::scene_frame::StereoRig;
 use crate::io;
 use crate::scene::gpu::{GlCamera, SceneRenderer};
 use crate::scene::{builtin, Scene};
+use crate::stitch::faces::{scene_faces_of, FACE_TAGS};
+use crate::stitch::{OdsRig, Side};
 use std::path::{Path, PathBuf};
 
 /// The scene options as given.
@@ -24,6 +27,10 @@ pub struct SceneOptions {
     pub ipd: f64,
     /// Conventions of the projections and the device depth written.
     pub conventions: Conventions,
+    /// Also write each eye's six cube faces, N x N, as `stitch --faces` reads them.
+    pub cube_faces: Option<u32>,
+    /// The cube faces' horizontal and vertical field of view, degrees (> 90: they overlap).
+    pub face_fov: f64,
     /// Output folder.
     pub out_dir: PathBuf,
     /// The GPU to render on.
@@ -45,6 +52,8 @@ pub struct SceneJob {
     scene: SceneSource,
     rig: StereoRig,
     conventions: Conventions,
+    /// Cube faces to write: the ODS rig (stitch's defaults, at the same IPD), side and FOV.
+    faces: Option<(OdsRig, u32, f64)>,
     out_dir: PathBuf,
     gpu: GpuRequest,
     backend: Backend,
@@ -59,6 +68,9 @@ pub struct SceneReport {
     pub size: (u32, u32),
     /// Each eye (left, right, middle) and its render time in milliseconds.
     pub eyes: Vec<(&'static str, f64)>,
+    /// The cube faces written, if asked: side N, field of view in degrees, and the ray-tracing
+    /// time in milliseconds (CPU, f64).
+    pub faces: Option<(u32, f64, f64)>,
 }
 
 impl SceneJob {
@@ -76,10 +88,29 @@ impl SceneJob {
         let mut rig = StereoRig::demo(o.width, o.height);
         rig.camera.validate("scene camera")?;
         rig.ipd = o.ipd;
+        let faces = match o.cube_faces {
+            None => None,
+            Some(n) => {
+                if !(o.face_fov > 90.0 && o.face_fov < 178.0) {
+                    return Err(ArgError::CubeFaceFov(o.face_fov));
+                }
+                io::check_output_pixels("--cube-faces", n, n)?;
+                // stitch's rig for a face folder, at this IPD: the faces are taken from the
+                // evaluation rig's centre (inside the built-in scenes), which stitch does not
+                // need to know (only the eyes' offsets from it matter).
+                let ods = OdsRig {
+                    ipd: o.ipd,
+                    ..OdsRig::demo()
+                };
+                ods.validate().map_err(ArgError::from)?;
+                Some((ods, n, o.face_fov))
+            }
+        };
         Ok(SceneJob {
             scene,
             rig,
             conventions: o.conventions,
+            faces,
             out_dir: o.out_dir,
             gpu: o.gpu,
             backend: o.backend,
@@ -144,11 +175,29 @@ impl SceneJob {
             w.write_all(text.as_bytes())
                 .map_err(|e| crate::Error::io(&cameras_json, e))
         })?;
+        let faces = match self.faces {
+            None => None,
+            Some((ods, n, fov)) => {
+                let t0 = std::time::Instant::now();
+                for (side, eye) in [(Side::Left, "left"), (Side::Right, "right")] {
+                    let faces = scene_faces_of(scene, &ods, side, n, fov)?;
+                    for (face, tag) in faces.faces.iter().zip(FACE_TAGS) {
+                        io::save_rgb(&staged.join(format!("{eye}_{tag}.png")), &face.color)
+                            .and_then(|()| {
+                                io::save_depth_exr(&staged.join(format!("{eye}_{tag}_depth.exr")), &face.depth)
+                            })
+                            .map_err(|e| set.final_error(e))?;
+                    }
+                }
+                Some((n, fov, t0.elapsed().as_secs_f64() * 1e3))
+            }
+        };
         set.commit()?;
         Ok(SceneReport {
             name: scene.name.clone(),
             size: (width, height),
             eyes,
+            faces,
         })
     }
 }
@@ -164,6 +213,8 @@ mod tests {
             height: 48,
             ipd,
             conventions: Default::default(),
+            cube_faces: None,
+            face_fov: 110.0,
             out_dir: "out".into(),
             gpu: Default::default(),
             backend: Default::default(),

@@ -221,6 +221,19 @@ impl std::str::FromStr for Shard {
     fn from_str(s: &str) -> Result<Self> {
         let bad = || Error::param("shard", format!("'{s}': expected K/N with 0 <= K < N, e.g. 0/4"));
         let (k, n) = s.split_once('/').ok_or_else(bad)?;
+        if k.trim().is_empty() || n.trim().is_empty() {
+            // "/" or "3/" is what `--shard "$SLURM_ARRAY_TASK_ID/$SLURM_ARRAY_TASK_COUNT"` gives
+            // outside an array job: say so rather than only that the value is malformed.
+            return Err(Error::param(
+                "shard",
+                format!(
+                    "'{s}': K or N is empty (expected K/N with 0 <= K < N, e.g. 0/4); a variable \
+                     it was built from is unset or empty, e.g. SLURM_ARRAY_TASK_ID / \
+                     SLURM_ARRAY_TASK_COUNT outside a Slurm array job, or JOB_COMPLETION_INDEX \
+                     outside a Kubernetes indexed Job"
+                ),
+            ));
+        }
         let (index, count): (usize, usize) = (
             k.trim().parse().map_err(|_| bad())?,
             n.trim().parse().map_err(|_| bad())?,

@@ -4,6 +4,7 @@
 
 mod csv_file;
 mod plot;
+mod summary;
 mod table;
 #[cfg(test)]
 mod tests;
@@ -66,6 +67,25 @@ impl ReportRow {
     }
 }
 
+/// A report and the files [`Report::write`] made of it.
+#[derive(Debug, Clone)]
+pub struct WrittenReport {
+    /// The measured rows (its [`Report::summary`] is the terminal's short form).
+    pub report: Report,
+    /// The files written: `{stem}.md`, `{stem}.csv`, `{stem}.svg` (and any a caller adds).
+    pub files: Vec<PathBuf>,
+}
+
+impl WrittenReport {
+    /// The Markdown file among [`WrittenReport::files`] (the first, where a caller added one).
+    pub fn markdown(&self) -> Option<&Path> {
+        self.files
+            .iter()
+            .find(|p| p.extension().is_some_and(|e| e == "md"))
+            .map(PathBuf::as_path)
+    }
+}
+
 /// A titled set of rows with the renderer they ran on and free-form notes.
 #[derive(Debug, Clone, Default, serde::Serialize)]
 pub struct Report {
@@ -114,6 +134,13 @@ impl Report {
     /// at the top of the axis with an "inf" label. Each marker has a tooltip naming the row.
     pub fn to_svg(&self) -> String {
         plot::render(self)
+    }
+
+    /// The headline figures for a terminal: the renderer, then per capability and method (in
+    /// table order) the number of rows, the median PSNR over rows that have one, and the median
+    /// wall time. One line per method however many scenes and settings the table holds.
+    pub fn summary(&self) -> String {
+        summary::summary(self)
     }
 
     /// Writes `{stem}.md`, `{stem}.csv` and `{stem}.svg` into `dir`, each atomically, and

@@ -506,3 +506,25 @@ fn csv_bytes_are_the_rfc_4180_form() {
     );
     assert_eq!(Report::default().to_csv(), format!("{}\r\n", CSV_HEADER.join(",")));
 }
+
+#[test]
+fn summary_has_one_line_per_method_with_medians() {
+    let mut r = sample();
+    r.rows.push(row("seed", "s=1", Some(35.0), 2.0));
+    r.rows.push(row("seed", "s=4", Some(f64::NAN), 100.0));
+    let s = r.summary();
+    let lines: Vec<&str> = s.lines().collect();
+    // Title line, header, then seed, k-step(3), mesh, mesh|pipe in table order.
+    assert_eq!(lines.len(), 6, "{s}");
+    assert!(lines[0].contains("llvmpipe (LLVM 17.0, 256 bits)"), "{s}");
+    let cells = |l: &str| l.split_whitespace().map(str::to_string).collect::<Vec<_>>();
+    // seed: 4 rows; PSNRs 31.25, 35, inf (NaN skipped): median 35; walls 0.5, 2, 3, 100: 2.5.
+    assert_eq!(
+        cells(lines[2]),
+        ["refocus", "seed", "4", "35.00", "dB", "2.50", "ms"],
+        "{s}"
+    );
+    assert_eq!(cells(lines[3])[1..4], ["k-step(3)", "1", "40.00"], "{s}");
+    assert_eq!(cells(lines[4])[1..4], ["mesh", "1", "-"], "{s}");
+    assert_eq!(cells(lines[5])[1], "mesh|pipe", "{s}");
+}

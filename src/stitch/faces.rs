@@ -20,6 +20,11 @@ use crate::scene;
 /// The six faces of `side`, N x N, FOV `fov_deg`, from the f64 ray tracer: colour rounded to
 /// 8 bits, view-space Z, 0 where no surface is hit.
 pub fn scene_faces(rig: &OdsRig, side: Side, n: u32, fov_deg: f64) -> Result<FaceSet> {
+    scene_faces_of(&scene::demo_scene(), rig, side, n, fov_deg)
+}
+
+/// [`scene_faces`] for any scene (built in or loaded).
+pub fn scene_faces_of(scene: &scene::Scene, rig: &OdsRig, side: Side, n: u32, fov_deg: f64) -> Result<FaceSet> {
     rig.validate()?;
     if !(2..=crate::io::MAX_DIMENSION).contains(&n) {
         return Err(Error::param("face size", format!("{n} outside 2..=16384")));
@@ -33,7 +38,7 @@ pub fn scene_faces(rig: &OdsRig, side: Side, n: u32, fov_deg: f64) -> Result<Fac
             .iter()
             .map(|f| {
                 let pose = f.pose(rig, side);
-                s.spawn(move || scene::render_posed(&cam, &pose))
+                s.spawn(move || scene::render_scene(scene, &cam, &pose))
             })
             .collect();
         handles

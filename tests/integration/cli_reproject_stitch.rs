@@ -830,3 +830,72 @@ fn reproject_with_full_eye_matrices_from_a_cameras_file() {
     .concat());
     assert_clean_failure(&o, "come from the file", &bad);
 }
+
+/// `scene --cube-faces` writes a face folder `stitch --faces` reads as is: stitched, it gives
+/// the image `stitch --scene demo` gives from the same faces ray-traced in memory (up to the
+/// last f32 rounding of the rig's centre, which the face folder does not carry).
+#[test]
+fn scene_cube_faces_feed_stitch_faces() {
+    let d = scratch("scene-cube-faces");
+    let faces = d.join("faces");
+    let f = faces.display().to_string();
+    let o = ok(&run(&[
+        "scene",
+        "--width",
+        "32",
+        "--height",
+        "24",
+        "--cube-faces",
+        "32",
+        "--out-dir",
+        &f,
+    ]));
+    assert!(o.contains("cube faces: 12 of 32x32, fov 110 deg"), "{o}");
+    let names = files_in(&faces);
+    for eye in ["left", "right"] {
+        for tag in viewsynth::stitch::faces::FACE_TAGS {
+            for file in [format!("{eye}_{tag}.png"), format!("{eye}_{tag}_depth.exr")] {
+                assert!(names.contains(&file), "{file} missing: {names:?}");
+            }
+        }
+    }
+    let size = ["--width", "128", "--height", "64"];
+    let from_faces = d.join("from_faces").display().to_string();
+    ok(&run(&[
+        &["stitch", "--faces", &f, "--fov", "110"],
+        &size[..],
+        &["--out-dir", &from_faces],
+    ]
+    .concat()));
+    let from_scene = d.join("from_scene").display().to_string();
+    ok(&run(&[
+        &["stitch", "--scene", "demo", "--face-size", "32"],
+        &size[..],
+        &["--out-dir", &from_scene],
+    ]
+    .concat()));
+    let a = io::load_rgb(&Path::new(&from_faces).join("ods_top_bottom.png")).unwrap();
+    let b = io::load_rgb(&Path::new(&from_scene).join("ods_top_bottom.png")).unwrap();
+    assert_eq!((a.width, a.height), (128, 128));
+    let diff: Vec<i32> = a
+        .data
+        .iter()
+        .zip(&b.data)
+        .map(|(x, y)| (*x as i32 - *y as i32).abs())
+        .collect();
+    let off = diff.iter().filter(|v| **v > 0).count();
+    assert!(diff.iter().all(|v| *v <= 1), "max difference {:?}", diff.iter().max());
+    assert!(off * 1000 < diff.len(), "{off} of {} values differ", diff.len());
+    // A face FOV stitch cannot use is refused before anything is written.
+    let bad = d.join("bad");
+    let o = run(&[
+        "scene",
+        "--cube-faces",
+        "16",
+        "--face-fov",
+        "90",
+        "--out-dir",
+        &bad.display().to_string(),
+    ]);
+    assert_clean_failure(&o, "--face-fov 90", &bad);
+}

@@ -7,6 +7,7 @@ mod cli_cameras_cv;
 mod cli_compare;
 mod cli_depth_out;
 mod cli_formats;
+mod cli_output;
 mod cli_reproject_stitch;
 mod common;
 mod compare;

@@ -331,7 +331,7 @@ fn print_stitch_report_and_bench() {
     let g = gpu();
     let (_, notes) = viewsynth::eval::stitch::stitch_rows(&g, 3).unwrap();
     println!("{}", notes.join("\n"));
-    println!("{}", viewsynth::bench::stitch_bench(&g, &mut Vec::new()).unwrap());
+    println!("{}", viewsynth::bench::stitch_bench(&g, 5, &mut Vec::new()).unwrap());
 }
 
 #[test]

@@ -4,10 +4,12 @@
 //!
 //! - 0: success;
 //! - 2: anything wrong with the command line: it does not parse (clap's own usage error,
-//!   printed with `try '--help'`), or a value parses but the job's conversion refuses it (out
-//!   of range, conflicting options; [`viewsynth::job::ArgError::is_usage`]);
+//!   printed with `try '--help'`; a malformed `--shard` included), or a value parses but the
+//!   job's conversion refuses it (out of range, conflicting options;
+//!   [`viewsynth::job::ArgError::is_usage`]);
 //! - 1: anything found while running: inputs (a file named by an option included), the GPU,
-//!   output files, a failed batch frame or stress case, a broken compare threshold.
+//!   output files, a failed batch frame or stress case, a broken compare threshold;
+//! - killed by SIGPIPE (141 in a shell): stdout or stderr was closed early (`| head`).
 //!
 //! anyhow lives here only, at the edge; the library's errors are typed.
 
@@ -78,7 +80,7 @@ struct Cli {
     /// Largest image (width x height) any input may declare or any output may have; checked
     /// from file headers before pixels are read (default 8192 x 8192, about 1.5 GB for the
     /// heaviest command).
-    #[arg(long, global = true, default_value_t = io::DEFAULT_MAX_PIXELS,
+    #[arg(long, global = true, default_value_t = io::DEFAULT_MAX_PIXELS, help_heading = options::INPUTS,
           value_parser = clap::value_parser!(u64).range(1..=(1u64 << 32)))]
     max_pixels: u64,
 }
@@ -86,50 +88,50 @@ struct Cli {
 #[derive(Subcommand)]
 enum Command {
     /// Print the GPU, GL version, EGL platform/device and limits this machine renders with.
-    #[command(allow_negative_numbers = true)]
+    #[command(allow_negative_numbers = true, after_help = info::args::EXAMPLES)]
     Info(info::args::InfoArgs),
     /// Re-render RGB + metric depth at other focal lengths (same pose).
-    #[command(allow_negative_numbers = true)]
+    #[command(allow_negative_numbers = true, after_help = refocus::args::EXAMPLES)]
     Refocus(Box<refocus::args::RefocusArgs>),
     /// Synthesise the middle (spectator) view of a stereo pair from each eye's colour and depth.
-    #[command(allow_negative_numbers = true)]
+    #[command(allow_negative_numbers = true, after_help = cyclopean::args::EXAMPLES)]
     Cyclopean(Box<cyclopean::args::CyclopeanArgs>),
     /// Reproject one view of a parallel stereo rig (left eye, centre view or right eye) to the
     /// other eye(s) from colour + depth (view Z, device depth or disparity); disocclusions stay
     /// invalid (mask 0), nothing is hole-filled.
-    #[command(allow_negative_numbers = true)]
+    #[command(allow_negative_numbers = true, after_help = reproject::args::EXAMPLES)]
     Reproject(Box<reproject::args::ReprojectArgs>),
     /// Stitch an omni-directional stereo (ODS) 360 equirect (top-bottom, left eye on top) from
     /// six over-wide cube faces per eye: the built-in scene's, or your own from --faces DIR.
-    #[command(allow_negative_numbers = true)]
+    #[command(allow_negative_numbers = true, after_help = stitch::args::EXAMPLES)]
     Stitch(Box<stitch::args::StitchArgs>),
     /// Ray-trace a ground-truth scene (built-in or JSON) on the GPU from a stereo rig: left, right
     /// and middle colour, view distance and device depth, and a cameras.json that
     /// `viewsynth cyclopean` reads.
-    #[command(allow_negative_numbers = true)]
+    #[command(allow_negative_numbers = true, after_help = scene::args::EXAMPLES)]
     Scene(scene::args::SceneArgs),
     /// Compare two renderings (e.g. ours and a Vulkan renderer's) after converting row order,
     /// NDC depth range, reversed-Z and device vs linear depth; names a convention that fits far
     /// better than the declared one. Writes a diff image.
-    #[command(allow_negative_numbers = true)]
+    #[command(allow_negative_numbers = true, after_help = compare::args::EXAMPLES)]
     Compare(Box<compare::args::CompareArgs>),
     /// Render the built-in scene, refocus it at 5 scales, synthesise the cyclopean middle view of
     /// a stereo pair with each method, and write every output plus the error/run-time report.
-    #[command(allow_negative_numbers = true)]
+    #[command(allow_negative_numbers = true, after_help = demo::args::EXAMPLES)]
     Demo(demo::args::DemoArgs),
     /// Measure every method's error against ground truth (built-in scene, and real data when
     /// --data-dir holds ../shared/data's sets) next to its run time: report.{md,csv,svg}.
-    #[command(allow_negative_numbers = true)]
+    #[command(allow_negative_numbers = true, after_help = report::args::EXAMPLES)]
     Report(report::args::ReportArgs),
     /// Benchmark refocus (mesh and full-screen paths) and cyclopean (2 x 1280x720 eyes) and print
     /// median timings.
-    #[command(allow_negative_numbers = true)]
+    #[command(allow_negative_numbers = true, after_help = bench::args::EXAMPLES)]
     Bench(bench::args::BenchArgs),
     /// Sweep stiff and extreme cases of every capability (focal scales 0.05..20, 1 mm..100 km,
     /// near/far 1e-7, standard vs reversed-Z, NaN/Inf depth, 1x1 to the largest image, parallel
     /// gaze, zero IPD, ...): GPU f32 against the f64 reference, as a table with the first failing
     /// case. Exits 1 if any case fails.
-    #[command(allow_negative_numbers = true)]
+    #[command(allow_negative_numbers = true, after_help = stress::args::EXAMPLES)]
     Stress(stress::args::StressArgs),
 }
 
@@ -156,6 +158,7 @@ fn job<A, J: TryFrom<A, Error = viewsynth::job::ArgError>>(args: A) -> Result<J>
 }
 
 fn main() -> ExitCode {
+    quiet_on_closed_pipe();
     let cli = Cli::parse();
     let result = io::set_max_pixels(cli.max_pixels)
         .map_err(anyhow::Error::from)
@@ -171,6 +174,21 @@ fn main() -> ExitCode {
             }
             ExitCode::from(RUN_ERROR)
         }
+    }
+}
+
+/// A closed stdout or stderr (`viewsynth demo | head`) ends the process as it ends `cat` or
+/// `grep`: killed by SIGPIPE, status 141 in a shell, no message. Rust ignores SIGPIPE, so every
+/// `println!`/`eprintln!` would panic (exit 101) on EPIPE instead; restoring the default
+/// disposition covers every print site at once (ours, clap's, indicatif's, worker threads'),
+/// where catching `BrokenPipe` would have to be repeated at each of them and a missed one
+/// panics. Outputs are staged and renamed only when complete, so a run cut short this way
+/// leaves the previous files as they were. The process writes to no other pipe or socket.
+fn quiet_on_closed_pipe() {
+    #[cfg(unix)]
+    // SAFETY: at the start of main, before any thread exists; SIG_DFL is a valid disposition.
+    unsafe {
+        libc::signal(libc::SIGPIPE, libc::SIG_DFL);
     }
 }
 
@@ -201,8 +219,14 @@ fn run(command: Command) -> Result<ExitCode> {
         Command::Stitch(a) => stitch::run::stitch(&job(*a)?)?,
         Command::Scene(a) => scene::run::scene(&job(a)?)?,
         Command::Compare(a) => return compare::run::compare(&job(*a)?),
-        Command::Demo(a) => demo::run::demo(&job(a)?)?,
-        Command::Report(a) => report::run::report(&job(a)?)?,
+        Command::Demo(a) => {
+            let verbose = a.verbose;
+            demo::run::demo(&job(a)?, verbose)?
+        }
+        Command::Report(a) => {
+            let verbose = a.verbose;
+            report::run::report(&job(a)?, verbose)?
+        }
         Command::Bench(a) => {
             let json = a.json;
             bench::run::bench(&job(a)?, json)?
@@ -210,4 +234,48 @@ fn run(command: Command) -> Result<ExitCode> {
         Command::Stress(a) => stress::run::stress(&job(a)?)?,
     }
     Ok(ExitCode::SUCCESS)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::Cli;
+    use clap::CommandFactory;
+
+    /// `--help` teaches: every option of every command says what it does and sits under a
+    /// heading (inputs, intrinsics, targets, ...), and every command shows an example.
+    #[test]
+    fn every_option_is_described_under_a_heading_and_every_command_has_an_example() {
+        let mut cli = Cli::command();
+        cli.build();
+        let mut options = 0;
+        for sub in cli.get_subcommands() {
+            let name = sub.get_name();
+            if name == "help" {
+                continue;
+            }
+            for arg in sub.get_arguments() {
+                let id = arg.get_id().as_str();
+                let help = arg
+                    .get_long_help()
+                    .or(arg.get_help())
+                    .map(|h| h.to_string())
+                    .unwrap_or_default();
+                assert!(!help.trim().is_empty(), "viewsynth {name} --{id} has no description");
+                if !["help", "version"].contains(&id) {
+                    assert!(
+                        arg.get_help_heading().is_some(),
+                        "viewsynth {name} --{id} has no heading"
+                    );
+                    options += 1;
+                }
+            }
+            let after = sub.get_after_help().map(|h| h.to_string()).unwrap_or_default();
+            assert!(
+                after.starts_with("Examples:") && after.contains(&format!("viewsynth {name}")),
+                "viewsynth {name} --help shows no example of itself: {after:?}"
+            );
+        }
+        // Guards the walk itself: the commands hold well over a hundred options.
+        assert!(options > 150, "only {options} options seen");
+    }
 }

@@ -1,36 +1,44 @@
 //! `viewsynth bench` options.
 
 use crate::options::GpuArgs;
+use crate::options::{MEASURE, OUTPUTS};
 use clap::Args;
 use viewsynth::job::bench::{BenchJob, BenchOptions};
 use viewsynth::job::ArgError;
 
+/// The example under `viewsynth bench --help` (paths from the repository root, as in the README).
+pub(crate) const EXAMPLES: &str = "\
+Examples:
+  viewsynth bench --sizes 640x480 --repeats 3
+  viewsynth bench --batch 20 --jobs 2          # the pipelined refocus batch on 20 frames
+  viewsynth bench --sizes 640x480 --json";
+
 #[derive(Args)]
 pub(crate) struct BenchArgs {
     /// Sizes WxH to measure.
-    #[arg(long, value_delimiter = ',', default_value = "640x480,1280x720")]
+    #[arg(help_heading = MEASURE, long, value_delimiter = ',', default_value = "640x480,1280x720")]
     sizes: Vec<String>,
     /// Repetitions per measurement (the median is reported).
-    #[arg(long, default_value_t = 7, value_parser = clap::builder::RangedU64ValueParser::<usize>::new().range(0..=1000))]
+    #[arg(help_heading = MEASURE, long, default_value_t = 7, value_parser = clap::builder::RangedU64ValueParser::<usize>::new().range(0..=1000))]
     repeats: usize,
     /// Benchmark the pipelined refocus batch instead: N frames of the built-in scene, or a
     /// manifest FILE; runs the synchronous batch as the in-run baseline and prints frames/s,
     /// per-stage medians and the stage that bounds the throughput.
-    #[arg(long, value_name = "N|FILE")]
+    #[arg(help_heading = MEASURE, long, value_name = "N|FILE")]
     batch: Option<String>,
     /// With --batch: threads per CPU pool (default: the number of cores).
-    #[arg(long, requires = "batch")]
+    #[arg(help_heading = MEASURE, long, requires = "batch")]
     jobs: Option<usize>,
     /// With --batch: PNG compression (fast, default, best).
-    #[arg(long, default_value = "fast", requires = "batch")]
+    #[arg(help_heading = MEASURE, long, default_value = "fast", requires = "batch")]
     png_compression: String,
-    /// Print one JSON object instead of the tables.
-    #[arg(long)]
-    pub json: bool,
     /// Also time refocus and the cyclopean gather (seed/refine) on the Vulkan device (`--device
     /// auto`; the same shaders as SPIR-V).
-    #[arg(long, conflicts_with = "batch")]
+    #[arg(help_heading = MEASURE, long, conflicts_with = "batch")]
     with_vulkan: bool,
+    /// Print one JSON object instead of the tables.
+    #[arg(help_heading = OUTPUTS, long)]
+    pub json: bool,
     #[command(flatten)]
     gpu: GpuArgs,
 }

@@ -1,6 +1,7 @@
 //! `viewsynth compare` options and their conversion into a checked library job.
 
 use crate::options::{conventions, NdcArg, RowsArg};
+use crate::options::{CONVENTIONS, INPUTS, OUTPUTS, THRESHOLDS};
 use clap::{Args, ValueEnum};
 use std::path::{Path, PathBuf};
 use viewsynth::compare::Thresholds;
@@ -15,68 +16,82 @@ pub(crate) enum DepthKindArg {
     ViewZ,
 }
 
+/// The example under `viewsynth compare --help` (paths from the repository root, as in the README).
+pub(crate) const EXAMPLES: &str = "\
+Examples:
+  # a cyclopean middle view of Cones against the real middle view, where it is valid
+  viewsynth compare --a-rgb out/cones/middle_rgb.png --b-rgb ../shared/data/middlebury2003_cones/im4.png \\
+      --mask out/cones/middle_mask.png --min-psnr 25 --json out/cones/compare.json";
+
 #[derive(Args)]
 pub(crate) struct CompareArgs {
     /// A's colour (e.g. ours).
-    #[arg(long)]
+    #[arg(help_heading = INPUTS, long)]
     a_rgb: PathBuf,
     /// B's colour (e.g. the other renderer's), the same size.
-    #[arg(long)]
+    #[arg(help_heading = INPUTS, long)]
     b_rgb: PathBuf,
     /// A's depth (EXR, NPY, NPZ, PFM), as --a-depth-kind says.
-    #[arg(long, requires = "b_depth")]
+    #[arg(help_heading = INPUTS, long, requires = "b_depth")]
     a_depth: Option<PathBuf>,
     /// B's depth, as --b-depth-kind says.
-    #[arg(long, requires = "a_depth")]
+    #[arg(help_heading = INPUTS, long, requires = "a_depth")]
     b_depth: Option<PathBuf>,
-    #[arg(long, value_enum, default_value = "view-z")]
-    a_depth_kind: DepthKindArg,
-    #[arg(long, value_enum, default_value = "view-z")]
-    b_depth_kind: DepthKindArg,
-    #[arg(long, value_enum, default_value = "gl")]
-    a_ndc: NdcArg,
-    #[arg(long, value_enum, default_value = "gl")]
-    b_ndc: NdcArg,
-    /// A's device depth was written with reversed-Z (near at the top of the range).
-    #[arg(long)]
-    a_reversed_z: bool,
-    /// B's device depth was written with reversed-Z.
-    #[arg(long)]
-    b_reversed_z: bool,
-    /// Row order each file is stored in (image files are normally top-down).
-    #[arg(long, value_enum, default_value = "top-down")]
-    a_rows: RowsArg,
-    #[arg(long, value_enum, default_value = "top-down")]
-    b_rows: RowsArg,
     /// Array of an .npz depth file (both sides) to read (default: the only array, else the first
     /// floating-point one).
-    #[arg(long, value_name = "NAME")]
+    #[arg(help_heading = INPUTS, long, value_name = "NAME")]
     npz_key: Option<String>,
-    /// Near/far planes of the device depth (metres; far may be inf).
-    #[arg(long, default_value_t = 0.1)]
-    near: f64,
-    #[arg(long, default_value_t = 1000.0)]
-    far: f64,
-    /// Write the colour difference here: |A - B| per channel, scaled so that the largest
-    /// difference is white (x 255 / max; the factor is printed and in the JSON).
-    #[arg(long)]
-    diff: Option<PathBuf>,
     /// Compare only where this image (rows top-down, the images' size) is nonzero.
-    #[arg(long, value_name = "FILE")]
+    #[arg(help_heading = INPUTS, long, value_name = "FILE")]
     mask: Option<PathBuf>,
     /// Fail (exit 1) when the colour RMSE exceeds X (8-bit levels).
-    #[arg(long, visible_alias = "max-color-rmse", value_name = "X")]
+    #[arg(help_heading = THRESHOLDS, long, visible_alias = "max-color-rmse", value_name = "X")]
     max_colour_rmse: Option<f64>,
     /// Fail (exit 1) when the colour PSNR is below X dB.
-    #[arg(long, value_name = "X")]
+    #[arg(help_heading = THRESHOLDS, long, value_name = "X")]
     min_psnr: Option<f64>,
     /// Fail (exit 1) when the largest relative depth error (pixels valid in both) exceeds X.
-    #[arg(long, value_name = "X", requires = "a_depth")]
+    #[arg(help_heading = THRESHOLDS, long, value_name = "X", requires = "a_depth")]
     max_depth_rel: Option<f64>,
+    /// Write the colour difference here: |A - B| per channel, scaled so that the largest
+    /// difference is white (x 255 / max; the factor is printed and in the JSON).
+    #[arg(help_heading = OUTPUTS, long)]
+    diff: Option<PathBuf>,
     /// Write the summary as JSON to FILE (without FILE, or "-": print it instead of text).
     /// An infinite PSNR is written as the string "inf".
-    #[arg(long, value_name = "FILE", num_args = 0..=1, default_missing_value = "-")]
+    #[arg(help_heading = OUTPUTS, long, value_name = "FILE", num_args = 0..=1, default_missing_value = "-")]
     json: Option<PathBuf>,
+    /// What A's depth holds: view-z (metres) or device (window depth under --a-ndc and
+    /// --a-reversed-z, with --near/--far).
+    #[arg(help_heading = CONVENTIONS, long, value_enum, default_value = "view-z")]
+    a_depth_kind: DepthKindArg,
+    /// What B's depth holds: view-z (metres) or device (under --b-ndc and --b-reversed-z).
+    #[arg(help_heading = CONVENTIONS, long, value_enum, default_value = "view-z")]
+    b_depth_kind: DepthKindArg,
+    /// NDC depth range A's device depth was written under: gl [-1, 1] or vulkan [0, 1].
+    #[arg(help_heading = CONVENTIONS, long, value_enum, default_value = "gl")]
+    a_ndc: NdcArg,
+    /// NDC depth range B's device depth was written under: gl [-1, 1] or vulkan [0, 1].
+    #[arg(help_heading = CONVENTIONS, long, value_enum, default_value = "gl")]
+    b_ndc: NdcArg,
+    /// A's device depth was written with reversed-Z (near at the top of the range).
+    #[arg(help_heading = CONVENTIONS, long)]
+    a_reversed_z: bool,
+    /// B's device depth was written with reversed-Z.
+    #[arg(help_heading = CONVENTIONS, long)]
+    b_reversed_z: bool,
+    /// Row order each file is stored in (image files are normally top-down).
+    #[arg(help_heading = CONVENTIONS, long, value_enum, default_value = "top-down")]
+    a_rows: RowsArg,
+    /// Row order B's files are stored in (see --a-rows).
+    #[arg(help_heading = CONVENTIONS, long, value_enum, default_value = "top-down")]
+    b_rows: RowsArg,
+    /// Near plane of the device depth (metres), with --far.
+    #[arg(help_heading = CONVENTIONS, long, default_value_t = 0.1)]
+    near: f64,
+    /// Far plane of the device depth (metres; may be inf), with --near.
+    #[arg(help_heading = CONVENTIONS, long, default_value_t = 1000.0)]
+    far: f64,
 }
 
 fn side_depth(kind: DepthKindArg) -> SideDepth {

@@ -3,6 +3,7 @@
 //! depth and a camera file (`--left-depth/--right-depth --cameras`).
 
 use crate::options::{BackendArg, GpuArgs};
+use crate::options::{GPU, INPUTS, INTRINSICS, METHOD, OUTPUTS, TARGETS};
 use clap::{Args, ValueEnum};
 use std::path::PathBuf;
 use viewsynth::cyclopean::Blend;
@@ -28,82 +29,95 @@ pub(crate) enum MethodArg {
     Forward,
 }
 
+/// The example under `viewsynth cyclopean --help` (paths from the repository root, as in the README).
+pub(crate) const EXAMPLES: &str = "\
+Examples:
+  # the middle view of Middlebury Cones from both eyes and their disparities (stored x4)
+  viewsynth cyclopean --left-rgb ../shared/data/middlebury2003_cones/im2.png \\
+      --right-rgb ../shared/data/middlebury2003_cones/im6.png \\
+      --left-disparity ../shared/data/middlebury2003_cones/disp2.pgm \\
+      --right-disparity ../shared/data/middlebury2003_cones/disp6.pgm --disparity-scale 4 --out-dir out/cones
+  # any pair with depth and a camera file (as `viewsynth scene` writes it)
+  viewsynth cyclopean --left-rgb out/scene/left_rgb.png --left-depth out/scene/left_device_depth.exr \\
+      --right-rgb out/scene/right_rgb.png --right-depth out/scene/right_device_depth.exr \\
+      --cameras out/scene/cameras.json --out-dir out/scene_middle";
+
 #[derive(Args)]
 pub(crate) struct CyclopeanArgs {
     /// Left eye colour (PNG, JPEG, PPM, EXR), rows top-down.
-    #[arg(long)]
+    #[arg(help_heading = INPUTS, long)]
     left_rgb: PathBuf,
     /// Right eye colour.
-    #[arg(long)]
+    #[arg(help_heading = INPUTS, long)]
     right_rgb: PathBuf,
     /// Left disparity of a rectified pair, pixels (x_right = x_left - d); 0 or non-finite =
     /// unknown. PGM/PNG (8/16-bit), PFM, NPY or EXR.
-    #[arg(long, conflicts_with_all = ["left_depth", "cameras"])]
+    #[arg(help_heading = INPUTS, long, conflicts_with_all = ["left_depth", "cameras"])]
     left_disparity: Option<PathBuf>,
     /// Right disparity, pixels (x_left = x_right + d).
-    #[arg(long, conflicts_with_all = ["right_depth", "cameras"])]
+    #[arg(help_heading = INPUTS, long, conflicts_with_all = ["right_depth", "cameras"])]
     right_disparity: Option<PathBuf>,
     /// Raw disparity units per pixel (4 for Middlebury 2003 PGMs; default 1).
-    #[arg(long)]
+    #[arg(help_heading = INPUTS, long)]
     disparity_scale: Option<f64>,
-    /// Right principal point minus left, pixels (Middlebury 2014 `doffs`): depth = f B / (d + doffs).
-    #[arg(long, default_value_t = 0.0)]
-    doffs: f64,
-    /// Focal length, pixels; with --baseline the view's metric depth is written.
-    #[arg(long, requires = "baseline")]
-    focal: Option<f64>,
-    /// Baseline, metres.
-    #[arg(long, requires = "focal")]
-    baseline: Option<f64>,
-    /// Where the view sits between the eyes: 0 = left, 0.5 = middle, 1 = right.
-    #[arg(long)]
-    position: Option<f64>,
     /// Left depth: device (window) depth or view distance, as `depth_kind` in the camera file.
-    #[arg(long, requires = "cameras")]
+    #[arg(help_heading = INPUTS, long, requires = "cameras")]
     left_depth: Option<PathBuf>,
     /// Right depth, as --left-depth.
-    #[arg(long, requires = "cameras")]
+    #[arg(help_heading = INPUTS, long, requires = "cameras")]
     right_depth: Option<PathBuf>,
     /// Camera JSON: per-eye GL view and projection (row-major 4x4), middle projection and size,
     /// gaze rays or fixation distance, conventions, depth kind (device or view-z); `viewsynth
     /// scene` writes one.
-    #[arg(long, requires_all = ["left_depth", "right_depth"])]
+    #[arg(help_heading = INPUTS, long, requires_all = ["left_depth", "right_depth"])]
     cameras: Option<PathBuf>,
     /// Raw units per unit of depth for integer depth files.
-    #[arg(long, value_parser = finite_value)]
+    #[arg(help_heading = INPUTS, long, value_parser = finite_value)]
     depth_scale: Option<f64>,
     /// Array of an .npz depth or disparity file (both eyes) to read (default: the only array,
     /// else the first floating-point one).
-    #[arg(long, value_name = "NAME")]
+    #[arg(help_heading = INPUTS, long, value_name = "NAME")]
     npz_key: Option<String>,
+    /// Right principal point minus left, pixels (Middlebury 2014 `doffs`): depth = f B / (d + doffs).
+    #[arg(help_heading = INTRINSICS, long, default_value_t = 0.0)]
+    doffs: f64,
+    /// Focal length, pixels; with --baseline the view's metric depth is written.
+    #[arg(help_heading = INTRINSICS, long, requires = "baseline")]
+    focal: Option<f64>,
+    /// Baseline, metres.
+    #[arg(help_heading = INTRINSICS, long, requires = "focal")]
+    baseline: Option<f64>,
+    /// Where the view sits between the eyes: 0 = left, 0.5 = middle, 1 = right.
+    #[arg(help_heading = TARGETS, long)]
+    position: Option<f64>,
     /// Method (default splat-gather; a lone --refine-steps selects seed (0) or refine as before).
-    #[arg(long, value_enum)]
+    #[arg(help_heading = METHOD, long, value_enum)]
     method: Option<MethodArg>,
     /// Refinement steps of the refine method after the seed's step (0 = the seed alone).
-    #[arg(long, value_parser = clap::value_parser!(u32).range(0..=16))]
+    #[arg(help_heading = METHOD, long, value_parser = clap::value_parser!(u32).range(0..=16))]
     refine_steps: Option<u32>,
     /// Seed/refine only.
-    #[arg(long, value_enum)]
+    #[arg(help_heading = METHOD, long, value_enum)]
     blend: Option<BlendArg>,
     /// Seed/refine only: middle-space depth disagreement (metres) treated as different surfaces
     /// (default: the seed's clamp(0.02 * fixation, 0.02, 0.25)).
-    #[arg(long, value_parser = finite_value)]
+    #[arg(help_heading = METHOD, long, value_parser = finite_value)]
     z_threshold: Option<f64>,
     /// Seed/refine only: dominant eye and its blend weight, e.g. `left:0.7`.
-    #[arg(long)]
+    #[arg(help_heading = METHOD, long)]
     dominant: Option<String>,
     /// Outputs to write: any of rgb (or color), depth, mask. Default all (disparity input: depth
     /// only with --focal and --baseline). Colour and depth not listed are not read back.
-    #[arg(long)]
+    #[arg(help_heading = OUTPUTS, long)]
     outputs: Option<String>,
     /// Writes middle_rgb.png, middle_depth.exr, middle_mask.png (those in --outputs).
-    #[arg(long)]
+    #[arg(help_heading = OUTPUTS, long)]
     out_dir: PathBuf,
     #[command(flatten)]
     gpu: GpuArgs,
     /// Rendering API: gl, or vulkan (the same gather shader as SPIR-V on a Vulkan device,
     /// --device an index of `viewsynth info --backend vulkan`).
-    #[arg(long, value_enum, default_value = "gl")]
+    #[arg(help_heading = GPU, long, value_enum, default_value = "gl")]
     backend: BackendArg,
 }
 

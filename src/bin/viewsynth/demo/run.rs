@@ -1,12 +1,16 @@
-//! `viewsynth demo`: renders everything and prints the report.
+//! `viewsynth demo`: renders everything and prints a summary (the whole report with --verbose).
 
 use crate::host::CliHost;
 use anyhow::Result;
 use viewsynth::job::report::DemoJob;
 
-pub(crate) fn demo(job: &DemoJob) -> Result<()> {
-    let report = job.run(&CliHost::default())?;
-    println!("{}", std::fs::read_to_string(&report)?);
-    println!("demo outputs and report written to {}", job.out_dir.display());
+pub(crate) fn demo(job: &DemoJob, verbose: bool) -> Result<()> {
+    let written = job.run(&CliHost::default())?;
+    crate::report::run::print_report(&written, verbose)?;
+    println!(
+        "demo outputs in {}: fullscreen/ and mesh/ (refocus at 5 scales, refocus_check.md), \
+         cyclopean/, reproject/, stitch/",
+        job.out_dir.display()
+    );
     Ok(())
 }

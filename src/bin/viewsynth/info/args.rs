@@ -1,18 +1,26 @@
 //! `viewsynth info` options.
 
 use crate::options::{BackendArg, GpuArgs};
+use crate::options::{GPU, OUTPUTS};
 use clap::Args;
 use viewsynth::job::{ArgError, GpuRequest};
 
+/// The example under `viewsynth info --help` (paths from the repository root, as in the README).
+pub(crate) const EXAMPLES: &str = "\
+Examples:
+  viewsynth info                    # the GPU, GL version, every EGL device and the one auto picks
+  viewsynth info --json
+  viewsynth info --backend vulkan   # the Vulkan devices";
+
 #[derive(Args)]
 pub(crate) struct InfoArgs {
+    /// Print JSON instead of text.
+    #[arg(help_heading = OUTPUTS, long)]
+    json: bool,
     #[command(flatten)]
     gpu: GpuArgs,
-    /// Print JSON instead of text.
-    #[arg(long)]
-    json: bool,
     /// gl: the EGL/OpenGL context; vulkan: every Vulkan device and the one auto picks.
-    #[arg(long, value_enum, default_value = "gl")]
+    #[arg(help_heading = GPU, long, value_enum, default_value = "gl")]
     backend: BackendArg,
 }
 

@@ -4,6 +4,7 @@ use clap::{Args, ValueEnum};
 use viewsynth::convention::{Conventions, NdcDepthRange, RowOrder};
 
 #[derive(Args, Clone, Copy)]
+#[command(next_help_heading = super::CONVENTIONS)]
 pub(crate) struct ConventionArgs {
     /// NDC depth range of the GPU passes (and of device depth read or written).
     #[arg(long, value_enum, default_value = "gl")]

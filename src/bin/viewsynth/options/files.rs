@@ -12,10 +12,12 @@ enum RgbFormatArg {
 }
 
 #[derive(Args, Clone)]
+#[command(next_help_heading = super::OUTPUTS)]
 pub(crate) struct FileOutputArgs {
     /// Outputs to produce: any of rgb (or color), depth, mask.
     #[arg(long, default_value = "rgb,depth,mask")]
     outputs: String,
+    /// Colour file format: png (8-bit RGB), jpeg or exr.
     #[arg(long, value_enum, default_value = "png")]
     rgb_format: RgbFormatArg,
     /// Depth file formats, any of: exr (float32 metres), npy (float32 metres), png16 (uint16

@@ -4,6 +4,7 @@ use clap::Args;
 use viewsynth::job::{ArgError, GpuRequest};
 
 #[derive(Args, Clone)]
+#[command(next_help_heading = super::GPU)]
 pub(crate) struct GpuArgs {
     /// EGL device: auto (CUDA_VISIBLE_DEVICES match, else the first hardware device, else the
     /// software one, else Mesa surfaceless), an index from `viewsynth info`, or `surfaceless`.

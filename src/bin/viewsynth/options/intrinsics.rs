@@ -6,6 +6,7 @@ use std::path::PathBuf;
 use viewsynth::job::finite_value;
 
 #[derive(Args, Clone)]
+#[command(next_help_heading = super::INTRINSICS)]
 pub(crate) struct IntrinsicsArgs {
     /// Source intrinsics from a file, the format told from its content: a 3x3 K (JSON, nested
     /// or 9 numbers, or whitespace text), Open3D PinholeCameraIntrinsic JSON, Middlebury

@@ -1,11 +1,12 @@
 //! `viewsynth refocus` options and their conversion into a checked library job.
 
 use crate::options::{BackendArg, ConventionArgs, FileOutputArgs, GpuArgs, IntrinsicsArgs};
+use crate::options::{BATCH, GPU, INPUTS, METHOD, OUTPUTS, TARGETS};
 use clap::{Args, ValueEnum};
 use std::path::PathBuf;
 use viewsynth::io::{self, DepthDecode};
 use viewsynth::job::refocus::{Focals, RefocusCommand, RefocusOptions};
-use viewsynth::job::{file_formats, finite_or_inf, finite_value, ArgError};
+use viewsynth::job::{file_formats, finite_or_inf, finite_value, shard_value, ArgError};
 use viewsynth::refocus::{BreakRule, Method};
 
 #[derive(Clone, Copy, ValueEnum)]
@@ -14,91 +15,103 @@ pub(crate) enum MethodArg {
     Fullscreen,
 }
 
+/// The example under `viewsynth refocus --help` (paths from the repository root, as in the README).
+pub(crate) const EXAMPLES: &str = "\
+Examples:
+  # TUM RGB-D frame at five focal scales (s0.5_rgb.png ... s2_mask.png, manifest.json)
+  viewsynth refocus --rgb ../shared/data/rgbd_open3d_testdata/TUM_color.png \\
+      --depth ../shared/data/rgbd_open3d_testdata/TUM_depth.png --depth-scale 5000 \\
+      --fx 525 --fy 525 --cx 319.5 --cy 239.5 --zoom-range 0.5,0.75,1,1.5,2 --out-dir out/tum
+  # every frame of a manifest, one shard of four
+  viewsynth refocus --batch frames.csv --zoom-range 0.5,2 --shard 0/4 --out-dir out/batch";
+
 #[derive(Args)]
 pub(crate) struct RefocusArgs {
     /// Source colour (PNG, JPEG, PPM, EXR).
-    #[arg(long, required_unless_present = "batch")]
+    #[arg(help_heading = INPUTS, long, required_unless_present = "batch")]
     rgb: Option<PathBuf>,
     /// Source metric depth, view-space Z (EXR, NPY/NPZ f32/f64/u16, 16-bit PNG/PGM with --depth-scale, PFM).
-    #[arg(long, required_unless_present = "batch")]
+    #[arg(help_heading = INPUTS, long, required_unless_present = "batch")]
     depth: Option<PathBuf>,
+    /// Raw units per metre for integer depth: 5000 for TUM, 1000 for SUN RGB-D (with
+    /// --sun-bit-rotate) and millimetre PNGs. Divides float depth too when given. (NYU v2 raw PGM
+    /// holds Kinect disparity, not depth: no scale fits; convert it first.)
+    #[arg(help_heading = INPUTS, long, value_parser = finite_value)]
+    depth_scale: Option<f64>,
+    /// Array of an .npz depth file to read (default: the only array, else the first
+    /// floating-point one).
+    #[arg(help_heading = INPUTS, long, value_name = "NAME")]
+    npz_key: Option<String>,
+    /// Treat input depth beyond M metres as invalid (as Open3D's depth_trunc), after
+    /// --depth-scale.
+    #[arg(help_heading = INPUTS, long, value_name = "M", value_parser = finite_value)]
+    depth_trunc: Option<f64>,
+    /// SUN RGB-D PNG depth: rotate the 16-bit value right by 3 bits before scaling.
+    #[arg(help_heading = INPUTS, long)]
+    sun_bit_rotate: bool,
+    #[command(flatten)]
+    intrinsics: IntrinsicsArgs,
+    /// Target focal lengths fx' in pixels (fy' keeps the source fy/fx); files are named by
+    /// them, e.g. f571.4_rgb.png.
+    #[arg(help_heading = TARGETS, long, value_delimiter = ',', conflicts_with = "zoom_range", value_parser = finite_value)]
+    focal_list: Option<Vec<f64>>,
+    /// Target focal scales s (fx' = s fx).
+    #[arg(help_heading = TARGETS, long, value_delimiter = ',', default_value = "0.5,0.75,1,1.5,2", value_parser = finite_value)]
+    zoom_range: Vec<f64>,
+    /// Output width in pixels (default: the source's; with --height-out).
+    #[arg(help_heading = TARGETS, long, requires = "height_out", value_parser = clap::value_parser!(u32).range(1..=i64::from(io::MAX_DIMENSION)))]
+    width_out: Option<u32>,
+    /// Output height in pixels (default: the source's; with --width-out).
+    #[arg(help_heading = TARGETS, long, requires = "width_out", value_parser = clap::value_parser!(u32).range(1..=i64::from(io::MAX_DIMENSION)))]
+    height_out: Option<u32>,
+    /// Output principal point x in pixels (default: the source's offset from the image centre:
+    /// cx' = cx + (W' - W) / 2; with --cy-out).
+    #[arg(help_heading = TARGETS, long, requires = "cy_out", value_parser = finite_value)]
+    cx_out: Option<f64>,
+    /// Output principal point y in pixels (default: cy' = cy + (H' - H) / 2; with --cx-out).
+    #[arg(help_heading = TARGETS, long, requires = "cx_out", value_parser = finite_value)]
+    cy_out: Option<f64>,
+    /// Break an edge when |za - zb| > tau_rel * min(za, zb).
+    #[arg(help_heading = METHOD, long, default_value_t = BreakRule::default().tau_rel, value_parser = finite_value)]
+    tau_rel: f64,
+    /// Break an edge when |za - zb| > tau_abs (metres; "inf" disables).
+    #[arg(help_heading = METHOD, long, default_value_t = BreakRule::default().tau_abs, value_parser = finite_or_inf)]
+    tau_abs: f64,
+    /// GPU path: fullscreen (one full-screen pass evaluating the kept triangles analytically; the
+    /// default) or mesh (the triangles rasterised); both give the same output.
+    #[arg(help_heading = METHOD, long, value_enum, default_value = "fullscreen")]
+    method: MethodArg,
+    /// Output folder (created if missing): per zoom scale s, s{s}_rgb.png, s{s}_depth.exr,
+    /// s{s}_mask.png (those in --outputs; f{fx'}_rgb.png etc. with --focal-list), and
+    /// manifest.json.
+    #[arg(help_heading = OUTPUTS, long)]
+    out_dir: PathBuf,
+    #[command(flatten)]
+    files: FileOutputArgs,
     /// Refocus every frame of a manifest into <out-dir>/<name>/, with one GL context, files
     /// encoded on writer threads, and resume. CSV with a header row rgb,depth,fx,fy,cx,cy and
     /// optional depth_scale,name columns, or a JSON array of objects with those keys (and
     /// sun_bit_rotate); relative paths are relative to the manifest.
-    #[arg(long, conflicts_with_all = ["rgb", "depth"])]
+    #[arg(help_heading = BATCH, long, conflicts_with_all = ["rgb", "depth"])]
     batch: Option<PathBuf>,
     /// With --batch: render every frame again, even those finished with the same settings.
-    #[arg(long, alias = "no-resume")]
+    #[arg(help_heading = BATCH, long, alias = "no-resume")]
     force: bool,
     /// With --batch: threads in each CPU pool (decoding inputs, encoding files) around the GL
     /// thread; 0 runs every stage in turn on one thread. Default: the number of cores.
-    #[arg(long, alias = "writer-threads", value_parser = clap::builder::RangedU64ValueParser::<usize>::new().range(0..=viewsynth::refocus::batch::MAX_JOBS as u64))]
+    #[arg(help_heading = BATCH, long, alias = "writer-threads", value_parser = clap::builder::RangedU64ValueParser::<usize>::new().range(0..=viewsynth::refocus::batch::MAX_JOBS as u64))]
     jobs: Option<usize>,
     /// With --batch: process only shard K of N (frames whose manifest index i has i % N == K,
     /// K from 0), e.g. one Slurm array task or Kubernetes indexed Job per shard.
-    #[arg(long)]
+    #[arg(help_heading = BATCH, long, value_name = "K/N", value_parser = shard_value)]
     shard: Option<String>,
-    /// Raw units per metre for integer depth: 5000 for TUM, 1000 for SUN RGB-D (with
-    /// --sun-bit-rotate) and millimetre PNGs. Divides float depth too when given. (NYU v2 raw PGM
-    /// holds Kinect disparity, not depth: no scale fits; convert it first.)
-    #[arg(long, value_parser = finite_value)]
-    depth_scale: Option<f64>,
-    /// Array of an .npz depth file to read (default: the only array, else the first
-    /// floating-point one).
-    #[arg(long, value_name = "NAME")]
-    npz_key: Option<String>,
-    /// Treat input depth beyond M metres as invalid (as Open3D's depth_trunc), after
-    /// --depth-scale.
-    #[arg(long, value_name = "M", value_parser = finite_value)]
-    depth_trunc: Option<f64>,
-    /// SUN RGB-D PNG depth: rotate the 16-bit value right by 3 bits before scaling.
-    #[arg(long)]
-    sun_bit_rotate: bool,
-    #[command(flatten)]
-    intrinsics: IntrinsicsArgs,
-    /// Output folder (created if missing): per zoom scale s, s{s}_rgb.png, s{s}_depth.exr,
-    /// s{s}_mask.png (those in --outputs; f{fx'}_rgb.png etc. with --focal-list), and
-    /// manifest.json.
-    #[arg(long)]
-    out_dir: PathBuf,
-    /// Target focal lengths fx' in pixels (fy' keeps the source fy/fx); files are named by
-    /// them, e.g. f571.4_rgb.png.
-    #[arg(long, value_delimiter = ',', conflicts_with = "zoom_range", value_parser = finite_value)]
-    focal_list: Option<Vec<f64>>,
-    /// Target focal scales s (fx' = s fx).
-    #[arg(long, value_delimiter = ',', default_value = "0.5,0.75,1,1.5,2", value_parser = finite_value)]
-    zoom_range: Vec<f64>,
-    /// Break an edge when |za - zb| > tau_rel * min(za, zb).
-    #[arg(long, default_value_t = BreakRule::default().tau_rel, value_parser = finite_value)]
-    tau_rel: f64,
-    /// Break an edge when |za - zb| > tau_abs (metres; "inf" disables).
-    #[arg(long, default_value_t = BreakRule::default().tau_abs, value_parser = finite_or_inf)]
-    tau_abs: f64,
-    /// Output width in pixels (default: the source's; with --height-out).
-    #[arg(long, requires = "height_out", value_parser = clap::value_parser!(u32).range(1..=i64::from(io::MAX_DIMENSION)))]
-    width_out: Option<u32>,
-    /// Output height in pixels (default: the source's; with --width-out).
-    #[arg(long, requires = "width_out", value_parser = clap::value_parser!(u32).range(1..=i64::from(io::MAX_DIMENSION)))]
-    height_out: Option<u32>,
-    /// Output principal point x in pixels (default: the source's offset from the image centre:
-    /// cx' = cx + (W' - W) / 2; with --cy-out).
-    #[arg(long, requires = "cy_out", value_parser = finite_value)]
-    cx_out: Option<f64>,
-    /// Output principal point y in pixels (default: cy' = cy + (H' - H) / 2; with --cx-out).
-    #[arg(long, requires = "cx_out", value_parser = finite_value)]
-    cy_out: Option<f64>,
-    #[command(flatten)]
-    files: FileOutputArgs,
-    #[arg(long, value_enum, default_value = "fullscreen")]
-    method: MethodArg,
     #[command(flatten)]
     conv: ConventionArgs,
     #[command(flatten)]
     gpu: GpuArgs,
     /// Rendering API: gl, or vulkan (the same shaders as SPIR-V on a Vulkan device, --device
     /// an index of `viewsynth info --backend vulkan`; single frames, not --batch).
-    #[arg(long, value_enum, default_value = "gl")]
+    #[arg(help_heading = GPU, long, value_enum, default_value = "gl")]
     backend: BackendArg,
 }
 

@@ -1,27 +1,38 @@
 //! `viewsynth report` options.
 
 use crate::options::GpuArgs;
+use crate::options::{INPUTS, MEASURE, OUTPUTS};
 use clap::Args;
 use std::path::PathBuf;
 use viewsynth::job::report::ReportJob;
 use viewsynth::job::ArgError;
 
+/// The example under `viewsynth report --help` (paths from the repository root, as in the README).
+pub(crate) const EXAMPLES: &str = "\
+Examples:
+  viewsynth report --data-dir ../shared/data --out-dir out/report
+  viewsynth report --case out/scene --out-dir out/report_case   # with a user stereo case";
+
 #[derive(Args)]
 pub(crate) struct ReportArgs {
-    /// Output folder (created if missing): report.md, report.csv, report.svg.
-    #[arg(long, default_value = "out/report")]
-    out_dir: PathBuf,
     /// Folder with middlebury2003_cones/ and middlebury2003_teddy/ (skipped when absent).
-    #[arg(long)]
+    #[arg(help_heading = INPUTS, long)]
     data_dir: Option<PathBuf>,
     /// A user cyclopean case with a reference middle view, laid out as `viewsynth scene`
     /// writes it (cameras.json, {left,right}_rgb.png, *_device_depth.exr, middle_rgb.png).
     /// Repeatable.
-    #[arg(long = "case")]
+    #[arg(help_heading = INPUTS, long = "case")]
     cases: Vec<PathBuf>,
     /// Timed repetitions per row (the median is reported).
-    #[arg(long, default_value_t = 3, value_parser = clap::builder::RangedU64ValueParser::<usize>::new().range(0..=1000))]
+    #[arg(help_heading = MEASURE, long, default_value_t = 3, value_parser = clap::builder::RangedU64ValueParser::<usize>::new().range(0..=1000))]
     repeats: usize,
+    /// Output folder (created if missing): report.md, report.csv, report.svg.
+    #[arg(help_heading = OUTPUTS, long, default_value = "out/report")]
+    out_dir: PathBuf,
+    /// Print the whole report table to stdout (by default a summary per method; the table is
+    /// in <out-dir>/report.md either way).
+    #[arg(help_heading = OUTPUTS, long, short)]
+    pub verbose: bool,
     #[command(flatten)]
     gpu: GpuArgs,
 }

@@ -1,6 +1,7 @@
 //! `viewsynth reproject` options and their conversion into a checked library job.
 
 use crate::options::{BackendArg, ConventionArgs, FileOutputArgs, GpuArgs, IntrinsicsArgs};
+use crate::options::{GPU, INPUTS, INTRINSICS, METHOD, OUTPUTS, TARGETS};
 use clap::{Args, ValueEnum};
 use std::path::PathBuf;
 use viewsynth::camera::stereo::Eye;
@@ -46,74 +47,86 @@ pub(crate) enum ReprojectMethodArg {
     Gather3d,
 }
 
+/// The example under `viewsynth reproject --help` (paths from the repository root, as in the README).
+pub(crate) const EXAMPLES: &str = "\
+Examples:
+  # the TUM frame as seen by a right eye 64 mm to the right
+  viewsynth reproject --color ../shared/data/rgbd_open3d_testdata/TUM_color.png \\
+      --depth ../shared/data/rgbd_open3d_testdata/TUM_depth.png --depth-scale 5000 \\
+      --fx 525 --fy 525 --cx 319.5 --cy 239.5 --baseline 0.064 --out-dir out/tum_right";
+
 #[derive(Args)]
 pub(crate) struct ReprojectArgs {
     /// Source colour (PNG, JPEG, PPM, EXR), rows top-down.
-    #[arg(long, visible_alias = "rgb")]
+    #[arg(help_heading = INPUTS, long, visible_alias = "rgb")]
     color: PathBuf,
     /// Source depth (EXR, NPY, NPZ, 16-bit PNG/PGM with --depth-scale, PFM), holding --depth-kind.
-    #[arg(long)]
+    #[arg(help_heading = INPUTS, long)]
     depth: PathBuf,
-    #[arg(long, value_enum, default_value = "view-z")]
+    /// What --depth holds: view-z (alias metric, metres), device (window depth, with --near/--far,
+    /// --ndc and --reversed-z) or disparity (pixels, with --baseline and --focal/--doffs).
+    #[arg(help_heading = INPUTS, long, value_enum, default_value = "view-z")]
     depth_kind: ReprojectDepthArg,
     /// Raw units per unit of the depth file for integer files (1000 for mm, 4 for Middlebury 2003
     /// disparity PGMs); divides float depth too when given.
-    #[arg(long, value_parser = finite_value)]
+    #[arg(help_heading = INPUTS, long, value_parser = finite_value)]
     depth_scale: Option<f64>,
     /// Array of an .npz depth file to read (default: the only array, else the first
     /// floating-point one).
-    #[arg(long, value_name = "NAME")]
+    #[arg(help_heading = INPUTS, long, value_name = "NAME")]
     npz_key: Option<String>,
     /// Near plane (metres) the device depth was written with (--depth-kind device).
-    #[arg(long, value_parser = finite_value)]
+    #[arg(help_heading = INPUTS, long, value_parser = finite_value)]
     near: Option<f64>,
     /// Far plane (metres; may be inf) the device depth was written with (--depth-kind device).
-    #[arg(long, value_parser = finite_or_inf)]
+    #[arg(help_heading = INPUTS, long, value_parser = finite_or_inf)]
     far: Option<f64>,
-    /// Source intrinsics (with a rig).
-    #[command(flatten)]
-    intrinsics: IntrinsicsArgs,
     /// Full eye matrices instead of a rig: a cameras.json as `viewsynth scene` writes it (left
     /// and right GL view and projection, conventions, depth kind: those of the file apply).
     /// The source is --from's eye, the target the other eye; --method gather3d only.
-    #[arg(long, conflicts_with_all = ["intrinsics", "fx", "fy", "cx", "cy", "baseline", "separation", "near", "far", "focal"])]
+    #[arg(help_heading = INPUTS, long, conflicts_with_all = ["intrinsics", "fx", "fy", "cx", "cy", "baseline", "separation", "near", "far", "focal"])]
     cameras: Option<PathBuf>,
-    /// Rectified rig: distance between the eyes in metres (x_right = x_left + doffs - f B / Z).
-    /// Also the baseline of --depth-kind disparity.
-    #[arg(long, value_parser = finite_value)]
-    baseline: Option<f64>,
+    /// Source intrinsics (with a rig).
+    #[command(flatten)]
+    intrinsics: IntrinsicsArgs,
     /// Focal length (pixels) of the rectified rig and of disparity (default: --fx).
-    #[arg(long, value_parser = finite_value)]
+    #[arg(help_heading = INTRINSICS, long, value_parser = finite_value)]
     focal: Option<f64>,
     /// cx_right - cx_left in pixels (Middlebury's doffs) of the rectified rig and of disparity.
-    #[arg(long, default_value_t = 0.0, value_parser = finite_value)]
+    #[arg(help_heading = INTRINSICS, long, default_value_t = 0.0, value_parser = finite_value)]
     doffs: f64,
+    /// Rectified rig: distance between the eyes in metres (x_right = x_left + doffs - f B / Z).
+    /// Also the baseline of --depth-kind disparity.
+    #[arg(help_heading = TARGETS, long, value_parser = finite_value)]
+    baseline: Option<f64>,
     /// A game-engine stereo rig instead of --baseline: separation = interaxial / screen width (texture
     /// units; the eyes move +-S/2 (1 - c/Z) in texture x), with --convergence.
-    #[arg(long, requires = "convergence", value_parser = finite_value)]
+    #[arg(help_heading = TARGETS, long, requires = "convergence", value_parser = finite_value)]
     separation: Option<f64>,
     /// Zero-parallax distance c in metres (with --separation).
-    #[arg(long, requires = "separation", value_parser = finite_value)]
+    #[arg(help_heading = TARGETS, long, requires = "separation", value_parser = finite_value)]
     convergence: Option<f64>,
     /// The source view.
-    #[arg(long, value_enum, default_value = "left")]
+    #[arg(help_heading = TARGETS, long, value_enum, default_value = "left")]
     from: FromArg,
     /// The target view(s).
-    #[arg(long, value_enum, default_value = "right")]
+    #[arg(help_heading = TARGETS, long, value_enum, default_value = "right")]
     to: ToArg,
-    #[arg(long, value_enum, default_value = "shift-scan")]
+    /// How each target pixel finds its source: shift-scan (exact, default), shift (fixed-point
+    /// walk, --steps) or gather3d (the cyclopean 3-D walk, --steps).
+    #[arg(help_heading = METHOD, long, value_enum, default_value = "shift-scan")]
     method: ReprojectMethodArg,
     /// Steps of the shift walk / 3-D gather (1..=16).
-    #[arg(long, default_value_t = 3, value_parser = clap::value_parser!(u32).range(1..=16))]
+    #[arg(help_heading = METHOD, long, default_value_t = 3, value_parser = clap::value_parser!(u32).range(1..=16))]
     steps: u32,
     /// A row segment breaks (an unseen surface) where |Z_a - Z_b| > tau_rel * min(Z_a, Z_b).
-    #[arg(long, default_value_t = 0.05, value_parser = finite_value)]
+    #[arg(help_heading = METHOD, long, default_value_t = 0.05, value_parser = finite_value)]
     tau_rel: f64,
     #[command(flatten)]
     files: FileOutputArgs,
     /// Output folder (created if missing): <target>_rgb.png, <target>_depth.exr,
     /// <target>_mask.png (target = left, right; those in --outputs).
-    #[arg(long)]
+    #[arg(help_heading = OUTPUTS, long)]
     out_dir: PathBuf,
     #[command(flatten)]
     conv: ConventionArgs,
@@ -121,7 +134,7 @@ pub(crate) struct ReprojectArgs {
     gpu: GpuArgs,
     /// Rendering API: gl, or vulkan (the same shaders as SPIR-V on a Vulkan 1.3 device;
     /// --device an index of `viewsynth info --backend vulkan`).
-    #[arg(long, value_enum, default_value = "gl")]
+    #[arg(help_heading = GPU, long, value_enum, default_value = "gl")]
     backend: BackendArg,
 }
 

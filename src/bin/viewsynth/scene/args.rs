@@ -1,34 +1,51 @@
 //! `viewsynth scene` options and their conversion into a checked library job.
 
 use crate::options::{BackendArg, ConventionArgs, GpuArgs};
+use crate::options::{GPU, INPUTS, OUTPUTS, TARGETS};
 use clap::Args;
 use std::path::PathBuf;
 use viewsynth::io;
 use viewsynth::job::scene::{SceneJob, SceneOptions};
 use viewsynth::job::{finite_value, ArgError};
 
+/// The example under `viewsynth scene --help` (paths from the repository root, as in the README).
+pub(crate) const EXAMPLES: &str = "\
+Examples:
+  viewsynth scene --width 320 --height 240 --out-dir out/scene     # a stereo frame + cameras.json
+  viewsynth scene --cube-faces 128 --out-dir out/faces             # also 6 faces per eye for stitch --faces";
+
 #[derive(Args)]
 pub(crate) struct SceneArgs {
     /// `demo`, `boxes`, or a scene JSON file of planes, spheres and boxes.
-    #[arg(long, default_value = "demo")]
+    #[arg(help_heading = INPUTS, long, default_value = "demo")]
     scene: String,
-    #[arg(long, default_value_t = 640, value_parser = clap::value_parser!(u32).range(1..=i64::from(io::MAX_DIMENSION)))]
+    /// Image width of each view, pixels.
+    #[arg(help_heading = TARGETS, long, default_value_t = 640, value_parser = clap::value_parser!(u32).range(1..=i64::from(io::MAX_DIMENSION)))]
     width: u32,
-    #[arg(long, default_value_t = 480, value_parser = clap::value_parser!(u32).range(1..=i64::from(io::MAX_DIMENSION)))]
+    /// Image height of each view, pixels.
+    #[arg(help_heading = TARGETS, long, default_value_t = 480, value_parser = clap::value_parser!(u32).range(1..=i64::from(io::MAX_DIMENSION)))]
     height: u32,
     /// Interocular distance in metres.
-    #[arg(long, default_value_t = 0.064, value_parser = finite_value)]
+    #[arg(help_heading = TARGETS, long, default_value_t = 0.064, value_parser = finite_value)]
     ipd: f64,
+    /// Output folder (created if missing).
+    #[arg(help_heading = OUTPUTS, long, default_value = "out/scene")]
+    out_dir: PathBuf,
+    /// Also write each eye's six cube faces, N x N pixels, as `viewsynth stitch --faces` reads
+    /// them: {left,right}_{pz,nz,up,down,px,nx}.png and _depth.exr (view Z), ray-traced on the CPU
+    /// from a 360 rig at --ipd, with stitch's default pole fade.
+    #[arg(help_heading = OUTPUTS, long, value_name = "N", value_parser = clap::value_parser!(u32).range(2..=i64::from(io::MAX_DIMENSION)))]
+    cube_faces: Option<u32>,
+    /// Field of view of the cube faces, degrees, in (90, 178): give stitch the same --fov.
+    #[arg(help_heading = OUTPUTS, long, default_value_t = 110.0, requires = "cube_faces", value_parser = finite_value)]
+    face_fov: f64,
     #[command(flatten)]
     conv: ConventionArgs,
-    /// Output folder (created if missing).
-    #[arg(long, default_value = "out/scene")]
-    out_dir: PathBuf,
     #[command(flatten)]
     gpu: GpuArgs,
     /// Rendering API: gl, or vulkan (the same shaders as SPIR-V on a Vulkan 1.3 device;
     /// --device an index of `viewsynth info --backend vulkan`).
-    #[arg(long, value_enum, default_value = "gl")]
+    #[arg(help_heading = GPU, long, value_enum, default_value = "gl")]
     backend: BackendArg,
 }
 
@@ -39,6 +56,8 @@ impl TryFrom<SceneArgs> for SceneJob {
             scene: a.scene,
             width: a.width,
             height: a.height,
+            cube_faces: a.cube_faces,
+            face_fov: a.face_fov,
             ipd: a.ipd,
             conventions: a.conv.into(),
             out_dir: a.out_dir,

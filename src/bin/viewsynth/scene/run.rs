@@ -10,6 +10,12 @@ pub(crate) fn scene(job: &SceneJob) -> Result<()> {
     for (eye, ms) in &r.eyes {
         println!("{eye}: {width}x{height} in {ms:.1} ms");
     }
+    if let Some((n, fov, ms)) = r.faces {
+        println!(
+            "cube faces: 12 of {n}x{n}, fov {fov} deg, ray-traced in {ms:.0} ms (read by `viewsynth stitch --faces {} --fov {fov}`)",
+            job.out_dir().display()
+        );
+    }
     println!(
         "scene '{}' written to {} (cameras.json feeds `viewsynth cyclopean`)",
         r.name,

@@ -2,6 +2,7 @@
 //! into a checked library job.
 
 use crate::options::{BackendArg, ConventionArgs, GpuArgs};
+use crate::options::{GPU, INPUTS, METHOD, OUTPUTS, TARGETS};
 use clap::{Args, ValueEnum};
 use std::path::PathBuf;
 use viewsynth::io;
@@ -29,77 +30,88 @@ pub(crate) enum FaceDepthArg {
     Device,
 }
 
+/// The example under `viewsynth stitch --help` (paths from the repository root, as in the README).
+pub(crate) const EXAMPLES: &str = "\
+Examples:
+  # ODS 360 of the built-in scene, scored against its ray-traced truth
+  viewsynth stitch --scene demo --face-size 128 --width 512 --height 256 --truth --out-dir out/ods
+  # your own cube faces (here the ones `viewsynth scene --cube-faces` writes)
+  viewsynth scene --cube-faces 128 --out-dir out/faces
+  viewsynth stitch --faces out/faces --fov 110 --width 512 --height 256 --per-eye --out-dir out/ods_faces";
+
 #[derive(Args)]
 pub(crate) struct StitchArgs {
     /// Ray-trace the faces of a built-in scene (only `demo`, the scene of the ODS rig).
-    #[arg(long, required_unless_present = "faces", conflicts_with = "faces")]
+    #[arg(help_heading = INPUTS, long, required_unless_present = "faces", conflicts_with = "faces")]
     scene: Option<String>,
     /// Folder with the 12 faces: {left,right}_{pz,nz,px,nx,up,down}.png (colour) and
     /// {left,right}_{pz,nz,px,nx,up,down}_depth.{exr,npy,npz,pfm,png} (view-space Z,
     /// 0/NaN/inf = background; integer PNG with --depth-scale);
     /// see README for the poses and orientations.
-    #[arg(long)]
+    #[arg(help_heading = INPUTS, long)]
     faces: Option<PathBuf>,
     /// Face field of view in degrees, in (90, 178) (default 90 + 2 x overlap).
-    #[arg(long, value_parser = finite_value)]
+    #[arg(help_heading = INPUTS, long, value_parser = finite_value)]
     fov: Option<f64>,
-    /// Seam band half-width in degrees, in (0, (fov - 90) / 2] (default (fov - 90) / 2 with
-    /// --fov, else 10).
-    #[arg(long, value_parser = finite_value)]
-    overlap: Option<f64>,
-    #[arg(long, value_enum, default_value = "reproject")]
-    method: StitchMethodArg,
-    /// Equirect width per eye.
-    #[arg(long, default_value_t = 2048, value_parser = clap::value_parser!(u32).range(1..=i64::from(io::MAX_DIMENSION)))]
-    width: u32,
-    /// Equirect height per eye (the top-bottom image is twice as high).
-    #[arg(long, default_value_t = 1024, value_parser = clap::value_parser!(u32).range(1..=i64::from(io::MAX_DIMENSION)))]
-    height: u32,
     /// Face side in pixels with --scene.
-    #[arg(long, default_value_t = 512, value_parser = clap::value_parser!(u32).range(1..=i64::from(io::MAX_DIMENSION)))]
+    #[arg(help_heading = INPUTS, long, default_value_t = 512, value_parser = clap::value_parser!(u32).range(1..=i64::from(io::MAX_DIMENSION)))]
     face_size: u32,
-    /// Interpupillary distance (metres, the faces' units).
-    #[arg(long, default_value_t = 0.064, value_parser = finite_value)]
-    ipd: f64,
-    /// Latitude (deg) above which the eye radius fades to 0 at the poles.
-    #[arg(long, default_value_t = 45.0, value_parser = finite_value)]
-    pole_fade: f64,
     /// Raw units per metre for integer face depth files.
-    #[arg(long, value_parser = finite_value)]
+    #[arg(help_heading = INPUTS, long, value_parser = finite_value)]
     depth_scale: Option<f64>,
     /// Array of .npz face depth files to read (default: the only array, else the first
     /// floating-point one).
-    #[arg(long, value_name = "NAME", requires = "faces")]
+    #[arg(help_heading = INPUTS, long, value_name = "NAME", requires = "faces")]
     npz_key: Option<String>,
     /// What the face depth files hold (with --faces): view-z, or device depth written with
     /// --near/--far under --ndc and --reversed-z (converted to view Z before stitching).
-    #[arg(long, value_enum, default_value = "view-z")]
+    #[arg(help_heading = INPUTS, long, value_enum, default_value = "view-z")]
     depth_kind: FaceDepthArg,
     /// Near plane of device-depth faces (metres).
-    #[arg(long, value_parser = finite_value)]
+    #[arg(help_heading = INPUTS, long, value_parser = finite_value)]
     near: Option<f64>,
     /// Far plane of device-depth faces (metres; may be inf).
-    #[arg(long, value_parser = finite_or_inf)]
+    #[arg(help_heading = INPUTS, long, value_parser = finite_or_inf)]
     far: Option<f64>,
-    /// Conventions of device-depth faces; the row order also sets the GPU pass's memory order.
-    #[command(flatten)]
-    conv: ConventionArgs,
+    /// Equirect width per eye.
+    #[arg(help_heading = TARGETS, long, default_value_t = 2048, value_parser = clap::value_parser!(u32).range(1..=i64::from(io::MAX_DIMENSION)))]
+    width: u32,
+    /// Equirect height per eye (the top-bottom image is twice as high).
+    #[arg(help_heading = TARGETS, long, default_value_t = 1024, value_parser = clap::value_parser!(u32).range(1..=i64::from(io::MAX_DIMENSION)))]
+    height: u32,
+    /// Interpupillary distance (metres, the faces' units).
+    #[arg(help_heading = TARGETS, long, default_value_t = 0.064, value_parser = finite_value)]
+    ipd: f64,
+    /// Seam band half-width in degrees, in (0, (fov - 90) / 2] (default (fov - 90) / 2 with
+    /// --fov, else 10).
+    #[arg(help_heading = METHOD, long, value_parser = finite_value)]
+    overlap: Option<f64>,
+    /// Stitching method: blend (feather the overlap), border-weight, or reproject (depth-aware
+    /// along the ODS ray; the default).
+    #[arg(help_heading = METHOD, long, value_enum, default_value = "reproject")]
+    method: StitchMethodArg,
+    /// Latitude (deg) above which the eye radius fades to 0 at the poles.
+    #[arg(help_heading = METHOD, long, default_value_t = 45.0, value_parser = finite_value)]
+    pole_fade: f64,
     /// Also write each eye's equirect (ods_left.png, ods_right.png).
-    #[arg(long)]
+    #[arg(help_heading = OUTPUTS, long)]
     per_eye: bool,
     /// With --scene: ray-trace the ODS ground truth and print PSNR on the seam band and the
     /// whole image.
-    #[arg(long)]
+    #[arg(help_heading = OUTPUTS, long)]
     truth: bool,
     /// Output folder (created if missing): ods_top_bottom.png (left eye on top), with
     /// --per-eye also ods_left.png and ods_right.png.
-    #[arg(long)]
+    #[arg(help_heading = OUTPUTS, long)]
     out_dir: PathBuf,
+    /// Conventions of device-depth faces; the row order also sets the GPU pass's memory order.
+    #[command(flatten)]
+    conv: ConventionArgs,
     #[command(flatten)]
     gpu: GpuArgs,
     /// Rendering API: gl, or vulkan (the same shaders as SPIR-V on a Vulkan 1.3 device;
     /// --device an index of `viewsynth info --backend vulkan`).
-    #[arg(long, value_enum, default_value = "gl")]
+    #[arg(help_heading = GPU, long, value_enum, default_value = "gl")]
     backend: BackendArg,
 }
 

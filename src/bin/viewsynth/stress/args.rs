@@ -1,25 +1,33 @@
 //! `viewsynth stress` options.
 
 use crate::options::GpuArgs;
+use crate::options::{MEASURE, OUTPUTS};
 use clap::Args;
 use std::path::PathBuf;
 use viewsynth::job::stress::StressJob;
 use viewsynth::job::ArgError;
 
+/// The example under `viewsynth stress --help` (paths from the repository root, as in the README).
+pub(crate) const EXAMPLES: &str = "\
+Examples:
+  viewsynth stress --quick --only refocus,stitch
+  viewsynth stress --json out/stress.json";
+
 #[derive(Args)]
 pub(crate) struct StressArgs {
     /// Smaller images and sub-cases (what the test suite runs).
-    #[arg(long)]
+    #[arg(help_heading = MEASURE, long)]
     quick: bool,
     /// Capabilities to sweep.
     #[arg(
+        help_heading = MEASURE,
         long,
         value_delimiter = ',',
         default_value = "camera,refocus,cyclopean,reproject,stitch"
     )]
     only: Vec<String>,
     /// Also write the rows as JSON here.
-    #[arg(long)]
+    #[arg(help_heading = OUTPUTS, long)]
     json: Option<PathBuf>,
     #[command(flatten)]
     gpu: GpuArgs,

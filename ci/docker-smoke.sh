@@ -1,0 +1,149 @@
+#!/usr/bin/env bash
+# Builds the Docker image and tries it: `info`, a refocus into a mounted folder as a non-root
+# uid, the no-argument run (demo, and where its outputs went), and the VIEWSYNTH_REQUIRE_GPU=1
+# refusal of a software renderer. Prints the build time and the image size.
+#
+# Not part of .ci/run (it compiles the whole crate, about 10 minutes on 2 cores): run it after
+# changing the Dockerfile, docker/, .dockerignore or the build. Needs root (or a docker group
+# member) and the test data (../shared/data or VIEWSYNTH_DATA_DIR).
+#
+# Where no image registry is reachable, it makes the base images itself: a Debian bookworm root
+# from debootstrap, imported as debian:bookworm-slim, and rust:1-bookworm built on it from this
+# machine's Rust toolchain. Where no daemon runs, it starts one as
+# `dockerd --iptables=false --bridge=none --storage-driver=vfs` (builds then use --network host).
+#
+#   VIEWSYNTH_IMAGE   tag to build (viewsynth:smoke)
+#   DEBIAN_MIRROR     debootstrap mirror (http://deb.debian.org/debian)
+set -euo pipefail
+cd "$(dirname "$0")/.."
+ROOT=$PWD
+IMAGE=${VIEWSYNTH_IMAGE:-viewsynth:smoke}
+DATA=${VIEWSYNTH_DATA_DIR:-$ROOT/../shared/data}
+MIRROR=${DEBIAN_MIRROR:-http://deb.debian.org/debian}
+WORK=$(mktemp -d "${TMPDIR:-/tmp}/viewsynth-docker.XXXXXX")
+DOCKERD_PID=
+
+say() { echo "docker-smoke: $*" >&2; }
+die() {
+  say "FAILED: $*"
+  exit 1
+}
+cleanup() {
+  rm -rf "$WORK"
+  if [ -n "$DOCKERD_PID" ]; then
+    say "stopping the dockerd this script started (pid $DOCKERD_PID)"
+    kill "$DOCKERD_PID" 2>/dev/null || true
+    wait "$DOCKERD_PID" 2>/dev/null || true
+  fi
+}
+trap cleanup EXIT
+[ -d "$DATA" ] || die "test data missing: $DATA (set VIEWSYNTH_DATA_DIR)"
+DATA=$(cd "$DATA" && pwd)
+command -v docker >/dev/null || die "no docker client (Debian: apt-get install docker.io)"
+
+# --- a daemon ----------------------------------------------------------------------------------
+if ! docker info >/dev/null 2>&1; then
+  command -v dockerd >/dev/null || die "no docker daemon and no dockerd to start (Debian: apt-get install docker.io)"
+  [ "$(id -u)" -eq 0 ] || die "no docker daemon running, and starting one needs root"
+  say "starting dockerd (vfs storage, no bridge, no iptables)"
+  dockerd --iptables=false --bridge=none --storage-driver=vfs >"$WORK/dockerd.log" 2>&1 &
+  DOCKERD_PID=$!
+  for _ in $(seq 60); do
+    docker info >/dev/null 2>&1 && break
+    kill -0 "$DOCKERD_PID" 2>/dev/null || die "dockerd exited: $(tail -5 "$WORK/dockerd.log")"
+    sleep 1
+  done
+  docker info >/dev/null 2>&1 || die "dockerd did not answer within 60 s: $(tail -5 "$WORK/dockerd.log")"
+fi
+
+# --- base images ---------------------------------------------------------------------------------
+have() { docker image inspect "$1" >/dev/null 2>&1; }
+if ! have debian:bookworm-slim && ! docker pull -q debian:bookworm-slim >/dev/null 2>&1; then
+  command -v debootstrap >/dev/null || die "debian:bookworm-slim cannot be pulled and there is no debootstrap (apt-get install debootstrap)"
+  say "no registry: debootstrap a bookworm root as debian:bookworm-slim (a few minutes)"
+  t0=$(date +%s)
+  debootstrap --variant=minbase bookworm "$WORK/rootfs" "$MIRROR" >"$WORK/debootstrap.log" 2>&1 ||
+    die "debootstrap failed: $(tail -5 "$WORK/debootstrap.log")"
+  rm -rf "$WORK/rootfs/var/cache/apt/archives/"*.deb "$WORK/rootfs/var/lib/apt/lists/"*
+  tar -C "$WORK/rootfs" -c . | docker import - debian:bookworm-slim >/dev/null
+  rm -rf "$WORK/rootfs"
+  say "debian:bookworm-slim made in $(($(date +%s) - t0)) s"
+fi
+if ! have rust:1-bookworm && ! docker pull -q rust:1-bookworm >/dev/null 2>&1; then
+  command -v rustc >/dev/null || die "rust:1-bookworm cannot be pulled and this machine has no Rust toolchain to build it from"
+  SYSROOT=$(rustc --print sysroot)
+  say "no registry: rust:1-bookworm from this machine's toolchain ($("$SYSROOT/bin/rustc" --version))"
+  # The official image's layout: the toolchain under /usr/local, a C toolchain for linking.
+  mkdir -p "$WORK/rust/ca"
+  tar -C "$SYSROOT" -c bin/cargo bin/rustc bin/rustdoc lib libexec | tar -C "$WORK/rust" -x
+  # This machine's own CA certificates (a TLS-intercepting proxy's, say): cargo in the image
+  # then reaches crates.io as cargo here does.
+  find /usr/local/share/ca-certificates -name '*.crt' -exec cp {} "$WORK/rust/ca/" \; 2>/dev/null || true
+  cat >"$WORK/rust/Dockerfile" <<'EOF'
+FROM debian:bookworm-slim
+RUN apt-get update -qq \
+ && DEBIAN_FRONTEND=noninteractive apt-get install -y -qq --no-install-recommends \
+      ca-certificates gcc libc6-dev pkg-config \
+ && rm -rf /var/lib/apt/lists/*
+COPY ca /usr/local/share/ca-certificates
+RUN update-ca-certificates
+COPY bin /usr/local/bin
+COPY lib /usr/local/lib
+COPY libexec /usr/local/libexec
+ENV CARGO_HOME=/usr/local/cargo PATH=/usr/local/cargo/bin:/usr/local/bin:/usr/sbin:/usr/bin:/sbin:/bin
+RUN ldconfig && cargo --version && rustc --version
+EOF
+  docker build -q --network host -t rust:1-bookworm "$WORK/rust" >/dev/null || die "building rust:1-bookworm failed"
+  rm -rf "$WORK/rust"
+fi
+
+# --- the image -----------------------------------------------------------------------------------
+say "building $IMAGE"
+t0=$(date +%s)
+docker build --network host -t "$IMAGE" . >"$WORK/build.log" 2>&1 || {
+  tail -30 "$WORK/build.log" >&2
+  die "docker build failed"
+}
+BUILD_S=$(($(date +%s) - t0))
+SIZE=$(docker image inspect "$IMAGE" --format '{{.Size}}')
+say "built $IMAGE in ${BUILD_S} s; image size $((SIZE / 1000000)) MB"
+
+run() { docker run --rm --network none "$@"; }
+
+# info: the renderer and the devices.
+out=$(run "$IMAGE" info) || die "info failed"
+grep -q "^renderer:" <<<"$out" || die "info printed no renderer: $out"
+grep -q "^EGL devices:" <<<"$out" || die "info printed no EGL devices: $out"
+say "info: $(grep '^renderer:' <<<"$out")"
+
+# A refocus into a mounted folder as a non-root uid other than the image's (1000).
+mkdir -p "$WORK/mnt/out"
+chown -R 1234:1234 "$WORK/mnt"
+run --user 1234:1234 -v "$WORK/mnt:/work" -v "$DATA:/data:ro" "$IMAGE" \
+  refocus --rgb /data/rgbd_open3d_testdata/TUM_color.png --depth /data/rgbd_open3d_testdata/TUM_depth.png \
+  --depth-scale 5000 --fx 525 --fy 525 --cx 319.5 --cy 239.5 --zoom-range 0.5,2 --out-dir out/tum \
+  >"$WORK/refocus.log" 2>&1 || die "refocus failed: $(cat "$WORK/refocus.log")"
+for f in s0.5_rgb.png s2_depth.exr s2_mask.png manifest.json; do
+  [ -f "$WORK/mnt/out/tum/$f" ] || die "refocus did not write out/tum/$f into the mounted folder"
+done
+[ "$(stat -c %u "$WORK/mnt/out/tum/manifest.json")" = 1234 ] || die "the outputs are not owned by the container's uid"
+grep -q "not a mounted folder" "$WORK/refocus.log" && die "the entry point warned although /work is mounted"
+say "refocus as uid 1234 into a mounted folder: $(ls "$WORK/mnt/out/tum" | wc -l) files"
+
+# No arguments, no mount: info, the demo, and the note that its outputs are not kept.
+run "$IMAGE" >"$WORK/demo.log" 2>&1 || die "the no-argument run failed: $(tail -20 "$WORK/demo.log")"
+grep -q "demo outputs: /work/out/demo inside the container (not kept)" "$WORK/demo.log" ||
+  die "the no-argument run did not say where the demo went: $(tail -5 "$WORK/demo.log")"
+grep -q -- '-v "$PWD/out:/work/out"' "$WORK/demo.log" || die "the no-argument run did not say how to mount"
+say "no-argument run: demo written, and the mount hint given"
+
+# VIEWSYNTH_REQUIRE_GPU=1 refuses the software renderer (no GPU is passed in).
+set +e
+err=$(run -e VIEWSYNTH_REQUIRE_GPU=1 "$IMAGE" scene --width 8 --height 8 --out-dir /tmp/scene 2>&1)
+rc=$?
+set -e
+[ "$rc" -eq 1 ] || die "VIEWSYNTH_REQUIRE_GPU=1 on llvmpipe: exit $rc, expected 1: $err"
+grep -qi "software" <<<"$err" || die "the refusal does not name the software renderer: $err"
+say "VIEWSYNTH_REQUIRE_GPU=1: refused (exit 1): $(grep -i software <<<"$err" | head -1)"
+
+echo "docker-smoke: ok: $IMAGE built in ${BUILD_S} s, $((SIZE / 1000000)) MB"
