@@ -7,6 +7,7 @@ use crate::bench::batch::median;
 use crate::convention::Conventions;
 use crate::cyclopean::render::CyclopeanRenderer;
 use crate::error::Result;
+use crate::pass::Device;
 use crate::refocus::job::TargetSpec;
 use crate::refocus::{BreakRule, Method, OutputSet, RefocusSource};
 use crate::scene;
@@ -85,6 +86,15 @@ fn time(repeats: usize, frame: Result<Frame>) -> Result<f64> {
     Ok(median(runs))
 }
 
+/// [`time`] of the frame `make` gives on each device.
+fn both<'a>(
+    devices: &'a [Device; 2],
+    repeats: usize,
+    make: impl Fn(&'a Device) -> Result<Frame<'a>>,
+) -> Result<[f64; 2]> {
+    Ok([time(repeats, make(&devices[0]))?, time(repeats, make(&devices[1]))?])
+}
+
 /// Every pass on both APIs from one run, same inputs, render + readback, medians of `repeats`
 /// after a warm-up (pipelines, targets): refocus (5 focal scales a frame), cyclopean seed,
 /// refine, splat-gather and forward warp, reproject shift, shift-scan and 3-D gather, stitch's three methods
@@ -101,7 +111,6 @@ pub fn passes_bench(
     use crate::cyclopean::scene_frame::{scene_frame, StereoRig};
     use crate::cyclopean::splat::{SplatParams, SplatRenderer};
     use crate::cyclopean::{CyclopeanOutputs, CyclopeanParams, FrameDepth, Method as Cm};
-    use crate::pass::Device;
     use crate::refocus::Refocuser;
     use crate::reproject::render::Reprojector;
     use crate::scene::gpu::{GlCamera, SceneRenderer};
@@ -192,73 +201,31 @@ pub fn passes_bench(
         row(name, [gl, vulkan], cases);
     }
     for (name, params) in [("cyclopean seed", seed), ("cyclopean refine 3", refine)] {
-        let ms = devices.each_ref().map(|d| {
-            time(
-                repeats,
-                (|| -> Result<Frame> {
-                    let mut r = CyclopeanRenderer::new(d, &frame, params)?;
-                    let mid = &mid;
-                    Ok(Box::new(move || r.render(mid).map(drop)) as Frame)
-                })(),
-            )
-        });
-        row(
-            name,
-            {
-                let [a, b] = ms;
-                [a?, b?]
-            },
-            cases,
-        );
+        let ms = both(&devices, repeats, |d| {
+            let mut r = CyclopeanRenderer::new(d, &frame, params)?;
+            let mid = &mid;
+            Ok(Box::new(move || r.render(mid).map(drop)) as Frame)
+        })?;
+        row(name, ms, cases);
     }
-    let ms = devices.each_ref().map(|d| {
-        time(
-            repeats,
-            (|| -> Result<Frame> {
-                let mut r = SplatRenderer::new(d, &frame, SplatParams::default(), CyclopeanOutputs::default())?;
-                let mid = &mid;
-                Ok(Box::new(move || r.render(mid).map(drop)) as Frame)
-            })(),
-        )
-    });
-    row(
-        "cyclopean splat-gather",
-        {
-            let [a, b] = ms;
-            [a?, b?]
-        },
-        cases,
-    );
-    let ms = devices.each_ref().map(|d| {
-        time(
-            repeats,
-            (|| -> Result<Frame> {
-                let mut r = crate::cyclopean::forward::ForwardWarp::new(d, &frame, &BreakRule::default())?;
-                let mid = &mid;
-                Ok(Box::new(move || r.render(mid).map(drop)) as Frame)
-            })(),
-        )
-    });
-    let [a, b] = ms;
-    row("cyclopean forward", [a?, b?], cases);
+    let ms = both(&devices, repeats, |d| {
+        let mut r = SplatRenderer::new(d, &frame, SplatParams::default(), CyclopeanOutputs::default())?;
+        let mid = &mid;
+        Ok(Box::new(move || r.render(mid).map(drop)) as Frame)
+    })?;
+    row("cyclopean splat-gather", ms, cases);
+    let ms = both(&devices, repeats, |d| {
+        let mut r = crate::cyclopean::forward::ForwardWarp::new(d, &frame, &BreakRule::default())?;
+        let mid = &mid;
+        Ok(Box::new(move || r.render(mid).map(drop)) as Frame)
+    })?;
+    row("cyclopean forward", ms, cases);
     for params in crate::eval::reproject::methods() {
-        let ms = devices.each_ref().map(|d| {
-            time(
-                repeats,
-                (|| -> Result<Frame> {
-                    let mut r = Reprojector::new(d, &reproject_case.source, &reproject_case.geometry, params)?;
-                    Ok(Box::new(move || r.render().map(drop)) as Frame)
-                })(),
-            )
-        });
-        row(
-            &format!("reproject {}", params.method.label()),
-            {
-                let [a, b] = ms;
-                [a?, b?]
-            },
-            cases,
-        );
+        let ms = both(&devices, repeats, |d| {
+            let mut r = Reprojector::new(d, &reproject_case.source, &reproject_case.geometry, params)?;
+            Ok(Box::new(move || r.render().map(drop)) as Frame)
+        })?;
+        row(&format!("reproject {}", params.method.label()), ms, cases);
     }
     for method in Sm::ALL {
         let params = StitchParams {
@@ -267,41 +234,17 @@ pub fn passes_bench(
             width: 2 * width,
             height: width,
         };
-        let ms = devices.each_ref().map(|d| {
-            time(
-                repeats,
-                (|| -> Result<Frame> {
-                    let mut r = StitchRenderer::new(d, &left, &right)?;
-                    Ok(Box::new(move || r.render(&params).map(drop)) as Frame)
-                })(),
-            )
-        });
-        row(
-            &format!("stitch {}", method.label()),
-            {
-                let [a, b] = ms;
-                [a?, b?]
-            },
-            cases,
-        );
+        let ms = both(&devices, repeats, |d| {
+            let mut r = StitchRenderer::new(d, &left, &right)?;
+            Ok(Box::new(move || r.render(&params).map(drop)) as Frame)
+        })?;
+        row(&format!("stitch {}", method.label()), ms, cases);
     }
-    let ms = devices.each_ref().map(|d| {
-        time(
-            repeats,
-            (|| -> Result<Frame> {
-                let mut r = SceneRenderer::new(d, &scene)?;
-                let cam = &gl_cam;
-                Ok(Box::new(move || r.render(cam).map(drop)) as Frame)
-            })(),
-        )
-    });
-    row(
-        "scene ray tracer",
-        {
-            let [a, b] = ms;
-            [a?, b?]
-        },
-        cases,
-    );
+    let ms = both(&devices, repeats, |d| {
+        let mut r = SceneRenderer::new(d, &scene)?;
+        let cam = &gl_cam;
+        Ok(Box::new(move || r.render(cam).map(drop)) as Frame)
+    })?;
+    row("scene ray tracer", ms, cases);
     Ok(t)
 }

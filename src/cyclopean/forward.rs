@@ -10,7 +10,6 @@ use crate::convention::RowOrder;
 use crate::error::{Error, Result};
 use crate::gpu::shaders::TRI_TEX_WIDTH;
 use crate::gpu::{ProgramKind, ShaderProgram, Timing};
-use crate::io::{DepthMap, RgbImage};
 use crate::pass::{mat4_std140, Device, Draw, Format, Image, ImageData, Step, Target, ToDevice};
 use crate::refocus::mesh::code_rows;
 use crate::refocus::{BreakRule, Grid};
@@ -197,11 +196,8 @@ impl ForwardWarp {
             })
             .collect();
         let target = Target {
-            width: w,
-            height: h,
-            outputs: vec![Some(Format::Rgba8), Some(Format::R32F), Some(Format::R8)],
-            rows: self.conv.row_order,
             depth_test: Some(self.conv),
+            ..Target::view(w, h, true, true, self.conv.row_order)
         };
         let mut out = if steps.is_empty() {
             // Neither eye kept a triangle: an empty view (a run without draws reads nothing).
@@ -212,15 +208,12 @@ impl ForwardWarp {
                     gpu_ms: None,
                     wall_ms: 0.0,
                 },
+                size: (w, h),
             }
         } else {
             self.device.run(Some(&target), &steps)?
         };
-        let color = out.outputs[0].take().map(|c| RgbImage::new(w, h, c)).transpose()?;
-        let depth = out.outputs[1]
-            .take()
-            .map(|d| DepthMap::new(w, h, bytemuck::pod_collect_to_vec(&d)))
-            .transpose()?;
+        let (color, depth) = (out.color(0)?, out.depth(1)?);
         let sources = out.take(2, "cyclopean forward warp")?;
         Ok((CyclopeanOutput { color, depth, sources }, out.timing))
     }

@@ -9,7 +9,6 @@ use crate::camera::mat4::{self, Mat4};
 use crate::convention::RowOrder;
 use crate::error::{Error, Result};
 use crate::gpu::{ProgramKind, ShaderProgram, Timing};
-use crate::io::{DepthMap, RgbImage};
 use crate::pass::{mat4_std140, Device, Draw, Format, Image, ImageData, Target, ToDevice};
 
 crate::param_block! {
@@ -150,17 +149,7 @@ impl CyclopeanRenderer {
         let (w, h) = (mid.width, mid.height);
         self.device.check_image_size("middle size", w, h)?;
         let block = self.block(mid)?;
-        let target = Target {
-            width: w,
-            height: h,
-            outputs: vec![
-                self.outputs.color.then_some(Format::Rgba8),
-                self.outputs.depth.then_some(Format::R32F),
-                Some(Format::R8),
-            ],
-            rows: self.rows,
-            depth_test: None,
-        };
+        let target = Target::view(w, h, self.outputs.color, self.outputs.depth, self.rows);
         let images = [
             self.left.color.id(),
             self.right.color.id(),
@@ -176,11 +165,7 @@ impl CyclopeanRenderer {
             triangles: 1,
         };
         let mut out = self.device.render(&target, &[draw])?;
-        let color = out.outputs[0].take().map(|c| RgbImage::new(w, h, c)).transpose()?;
-        let depth = out.outputs[1]
-            .take()
-            .map(|d| DepthMap::new(w, h, bytemuck::pod_collect_to_vec(&d)))
-            .transpose()?;
+        let (color, depth) = (out.color(0)?, out.depth(1)?);
         let sources = out.take(2, "cyclopean gather")?;
         Ok((CyclopeanOutput { color, depth, sources }, out.timing))
     }

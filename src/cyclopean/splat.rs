@@ -434,26 +434,9 @@ impl SplatRenderer {
                 },
             }));
         }
-        let target = Target {
-            width: w,
-            height: h,
-            outputs: vec![
-                self.outputs.color.then_some(Format::Rgba8),
-                self.outputs.depth.then_some(Format::R32F),
-                Some(Format::R8),
-            ],
-            rows: self.rows,
-            depth_test: None,
-        };
+        let target = Target::view(w, h, self.outputs.color, self.outputs.depth, self.rows);
         let mut out = self.device.run(Some(&target), &steps)?;
-        let color = out.outputs[0]
-            .take()
-            .map(|c| crate::io::RgbImage::new(w, h, c))
-            .transpose()?;
-        let depth = out.outputs[1]
-            .take()
-            .map(|d| crate::io::DepthMap::new(w, h, bytemuck::pod_collect_to_vec(&d)))
-            .transpose()?;
+        let (color, depth) = (out.color(0)?, out.depth(1)?);
         let sources = out.take(2, "cyclopean splat-gather")?;
         Ok((CyclopeanOutput { color, depth, sources }, out.timing))
     }

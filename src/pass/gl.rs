@@ -6,7 +6,7 @@
 //! to image units and storage buffers to their bindings from 0 (shaders/common/bindings.glsl),
 //! with `glMemoryBarrier(ALL)` between steps.
 
-use super::{Api, BufferId, Executor, Format, Groups, ImageData, ImageId, Rendered, Step, StorageImage, Target};
+use super::{Api, BufferId, Executor, Format, Groups, ImageData, ImageId, Rendered, Slots, Step, StorageImage, Target};
 use crate::convention::RowOrder;
 use crate::error::{Error, Result};
 use crate::gpu::{
@@ -45,8 +45,8 @@ pub struct GlExecutor {
     params: UniformBuffer,
     programs: Vec<(ShaderProgram, Program)>,
     targets: Vec<(TargetKey, Framebuffer)>,
-    images: Vec<Option<Texture>>,
-    buffers: Vec<Option<StorageBuffer>>,
+    images: Slots<Texture>,
+    buffers: Slots<StorageBuffer>,
 }
 
 impl GlExecutor {
@@ -58,8 +58,8 @@ impl GlExecutor {
             params: UniformBuffer::new(gpu)?,
             programs: Vec::new(),
             targets: Vec::new(),
-            images: Vec::new(),
-            buffers: Vec::new(),
+            images: Slots::default(),
+            buffers: Slots::default(),
         })
     }
 
@@ -120,47 +120,25 @@ impl Executor for GlExecutor {
             Some(image.bytes),
         )?
         .with_label(image.label);
-        let slot = self
-            .images
-            .iter()
-            .position(Option::is_none)
-            .unwrap_or(self.images.len());
-        if slot == self.images.len() {
-            self.images.push(None);
-        }
-        self.images[slot] = Some(t);
-        Ok(ImageId(slot))
+        Ok(ImageId(self.images.insert(t)))
     }
 
     fn free(&mut self, id: ImageId) {
-        if let Some(slot) = self.images.get_mut(id.0) {
-            *slot = None;
-        }
+        self.images.remove(id.0);
     }
 
     fn create_image(&mut self, width: u32, height: u32, format: Format, label: &str) -> Result<ImageId> {
         let t = Texture::new(&self.gpu, width, height, texture_format(format), None)?.with_label(label);
-        Ok(self.store_image(t))
+        Ok(ImageId(self.images.insert(t)))
     }
 
     fn create_buffer(&mut self, words: usize, label: &str) -> Result<BufferId> {
         let b = StorageBuffer::new(&self.gpu, words)?.with_label(label);
-        let slot = self
-            .buffers
-            .iter()
-            .position(Option::is_none)
-            .unwrap_or(self.buffers.len());
-        if slot == self.buffers.len() {
-            self.buffers.push(None);
-        }
-        self.buffers[slot] = Some(b);
-        Ok(BufferId(slot))
+        Ok(BufferId(self.buffers.insert(b)))
     }
 
     fn free_buffer(&mut self, id: BufferId) {
-        if let Some(slot) = self.buffers.get_mut(id.0) {
-            *slot = None;
-        }
+        self.buffers.remove(id.0);
     }
 
     fn run(&mut self, target: Option<&Target>, steps: &[Step]) -> Result<Rendered> {
@@ -215,14 +193,7 @@ impl Executor for GlExecutor {
                         pass = Some(fb.begin_pass(state, clear));
                     }
                     let p = &self.programs[programs[k].expect("built above")].1;
-                    p.bind();
-                    if !d.params.is_empty() {
-                        self.params.bind_range(0, offsets[k], d.params.len());
-                    }
-                    self.bind_samplers(p.name(), d.images)?;
-                    for (b, id) in d.buffers.iter().enumerate() {
-                        self.buffer(*id)?.bind_storage(b as u32);
-                    }
+                    self.bind(p, (offsets[k], d.params.len()), d.images, d.buffers)?;
                     let [x, y, w, h] = d.viewport;
                     let pass = pass.as_ref().expect("begun above");
                     pass.viewport(x, y, w, h);
@@ -230,14 +201,7 @@ impl Executor for GlExecutor {
                 }
                 Step::Dispatch(d) => {
                     let p = &self.programs[programs[k].expect("built above")].1;
-                    p.bind();
-                    if !d.params.is_empty() {
-                        self.params.bind_range(0, offsets[k], d.params.len());
-                    }
-                    self.bind_samplers(p.name(), d.images)?;
-                    for (b, id) in d.buffers.iter().enumerate() {
-                        self.buffer(*id)?.bind_storage(b as u32);
-                    }
+                    self.bind(p, (offsets[k], d.params.len()), d.images, d.buffers)?;
                     // Bound while the dispatch runs, unbound when these drop.
                     let mut bound = Vec::with_capacity(d.storage_images.len());
                     for (unit, s) in d.storage_images.iter().enumerate() {
@@ -265,6 +229,7 @@ impl Executor for GlExecutor {
             return Ok(Rendered {
                 outputs: Vec::new(),
                 timing: timer.stop(),
+                size: (0, 0),
             });
         };
         // What the steps wrote, before the readback; every read queued before the first wait.
@@ -286,45 +251,40 @@ impl Executor for GlExecutor {
         Ok(Rendered {
             outputs,
             timing: timer.stop(),
+            size: (0, 0),
         })
     }
 }
 
 impl GlExecutor {
-    fn store_image(&mut self, t: Texture) -> ImageId {
-        let slot = self
-            .images
-            .iter()
-            .position(Option::is_none)
-            .unwrap_or(self.images.len());
-        if slot == self.images.len() {
-            self.images.push(None);
-        }
-        self.images[slot] = Some(t);
-        ImageId(slot)
-    }
-
     fn image(&self, id: ImageId) -> Result<&Texture> {
         self.images
             .get(id.0)
-            .and_then(Option::as_ref)
             .ok_or_else(|| Error::Gl(format!("pass image {} was freed", id.0)))
     }
 
     fn buffer(&self, id: BufferId) -> Result<&StorageBuffer> {
         self.buffers
             .get(id.0)
-            .and_then(Option::as_ref)
             .ok_or_else(|| Error::Gl(format!("pass buffer {} was freed", id.0)))
     }
 
-    /// Sampled images at texture units 1, 2, ... (the GLSL `layout(binding = k)`).
-    fn bind_samplers(&self, program: &str, images: &[ImageId]) -> Result<()> {
+    /// Make `p` current with its parameter block (`block`: offset and length in the uniform
+    /// buffer) at binding 0, the sampled images at texture units 1, 2, ... (the GLSL
+    /// `layout(binding = k)`) and the storage buffers at their bindings from 0.
+    fn bind(&self, p: &Program, block: (usize, usize), images: &[ImageId], buffers: &[BufferId]) -> Result<()> {
+        p.bind();
+        if block.1 > 0 {
+            self.params.bind_range(0, block.0, block.1);
+        }
         for (k, id) in images.iter().enumerate() {
             let t = self
                 .image(*id)
-                .map_err(|_| Error::Gl(format!("{program}: image {} was freed", id.0)))?;
+                .map_err(|_| Error::Gl(format!("{}: image {} was freed", p.name(), id.0)))?;
             t.bind(k as u32 + 1);
+        }
+        for (b, id) in buffers.iter().enumerate() {
+            self.buffer(*id)?.bind_storage(b as u32);
         }
         Ok(())
     }

@@ -194,9 +194,47 @@ pub struct Rendered {
     pub outputs: Vec<Option<Vec<u8>>>,
     /// Wall time of draws and readback (and GPU time where the backend measures it).
     pub timing: Timing,
+    /// The target's width and height (0 x 0 without one).
+    pub size: (u32, u32),
+}
+
+impl Target {
+    /// A view pass's target: colour (RGBA8, read as RGB) and depth (R32F) at locations 0 and 1
+    /// where asked for, the mask or source bits (R8) at 2 always; no depth test.
+    pub fn view(width: u32, height: u32, color: bool, depth: bool, rows: RowOrder) -> Target {
+        Target {
+            width,
+            height,
+            outputs: vec![
+                color.then_some(Format::Rgba8),
+                depth.then_some(Format::R32F),
+                Some(Format::R8),
+            ],
+            rows,
+            depth_test: None,
+        }
+    }
 }
 
 impl Rendered {
+    /// Output `i` as an RGB image, where it was rendered.
+    pub fn color(&mut self, i: usize) -> Result<Option<crate::io::RgbImage>> {
+        let (w, h) = self.size;
+        self.outputs[i]
+            .take()
+            .map(|c| crate::io::RgbImage::new(w, h, c))
+            .transpose()
+    }
+
+    /// Output `i` as a depth map (its f32 texels), where it was rendered.
+    pub fn depth(&mut self, i: usize) -> Result<Option<crate::io::DepthMap>> {
+        let (w, h) = self.size;
+        self.outputs[i]
+            .take()
+            .map(|d| crate::io::DepthMap::new(w, h, bytemuck::pod_collect_to_vec(&d)))
+            .transpose()
+    }
+
     /// Output `i` (asked for, so present), or an error naming the pass.
     pub fn take(&mut self, i: usize, what: &str) -> Result<Vec<u8>> {
         self.outputs
@@ -316,7 +354,9 @@ impl Device {
             self.check_image_size("render target", t.width, t.height)?;
         }
         check_steps(target, steps)?;
-        self.0.borrow_mut().run(target, steps)
+        let mut out = self.0.borrow_mut().run(target, steps)?;
+        out.size = target.map_or((0, 0), |t| (t.width, t.height));
+        Ok(out)
     }
 
     /// A storage image of `width` x `height` (checked against the device's limit).
@@ -438,5 +478,48 @@ impl ToDevice for &Device {
 impl ToDevice for &crate::gpu::Gpu {
     fn to_device(self) -> Result<Device> {
         Device::gl(self)
+    }
+}
+
+/// Objects an executor holds by handle (images, buffers): a freed slot is reused by the next
+/// insert, so handles stay small and a steady state does not grow the table.
+pub(crate) struct Slots<T>(Vec<Option<T>>);
+
+impl<T> Default for Slots<T> {
+    fn default() -> Self {
+        Slots(Vec::new())
+    }
+}
+
+impl<T> Slots<T> {
+    /// Store `value`; its handle.
+    pub(crate) fn insert(&mut self, value: T) -> usize {
+        match self.0.iter().position(Option::is_none) {
+            Some(i) => {
+                self.0[i] = Some(value);
+                i
+            }
+            None => {
+                self.0.push(Some(value));
+                self.0.len() - 1
+            }
+        }
+    }
+
+    /// The value at `i`, unless freed.
+    pub(crate) fn get(&self, i: usize) -> Option<&T> {
+        self.0.get(i).and_then(Option::as_ref)
+    }
+
+    /// Free slot `i` (dropping its value).
+    pub(crate) fn remove(&mut self, i: usize) {
+        if let Some(slot) = self.0.get_mut(i) {
+            *slot = None;
+        }
+    }
+
+    /// Drop every value.
+    pub(crate) fn clear(&mut self) {
+        self.0.clear();
     }
 }

@@ -189,17 +189,8 @@ impl Reprojector {
             }
             Pass::Shift(s) => {
                 let (w, h) = (self.width, self.height);
-                let target = Target {
-                    width: w,
-                    height: h,
-                    outputs: vec![
-                        self.params.outputs.color.then_some(Format::Rgba8),
-                        self.params.outputs.depth.then_some(Format::R32F),
-                        Some(Format::R8),
-                    ],
-                    rows: self.rows,
-                    depth_test: None,
-                };
+                let outputs = self.params.outputs;
+                let target = Target::view(w, h, outputs.color, outputs.depth, self.rows);
                 let images = [s.color.id(), s.depth.id()];
                 let draw = Draw {
                     program: s.program,
@@ -210,18 +201,11 @@ impl Reprojector {
                     triangles: 1,
                 };
                 let mut out = self.device.render(&target, &[draw])?;
-                let color = out.outputs[0].take().map(|c| RgbImage::new(w, h, c)).transpose()?;
-                let depth = out.outputs[1]
-                    .take()
-                    .map(|d| {
-                        let z: Vec<f32> = bytemuck::pod_collect_to_vec(&d);
-                        DepthMap::new(
-                            w,
-                            h,
-                            z.into_iter().map(|z| if z.is_finite() { z } else { 0.0 }).collect(),
-                        )
-                    })
-                    .transpose()?;
+                let color = out.color(0)?;
+                let depth = out.depth(1)?.map(|mut d| {
+                    d.data.iter_mut().filter(|z| !z.is_finite()).for_each(|z| *z = 0.0);
+                    d
+                });
                 let mask = out.take(2, "reproject shift")?;
                 Ok((ReprojectOutput { color, depth, mask }, out.timing))
             }

@@ -24,7 +24,7 @@ use super::targets::ColorTargets;
 use crate::error::{Error, Result};
 use crate::gpu::{ShaderProgram, Timing};
 use crate::pass::{
-    Api, BufferId, Dispatch, Executor, Format, Groups, ImageData, ImageId, Rendered, Step, StorageImage, Target,
+    Api, BufferId, Dispatch, Executor, Format, Groups, ImageData, ImageId, Rendered, Slots, Step, StorageImage, Target,
 };
 use ash::vk;
 use std::time::Instant;
@@ -106,8 +106,8 @@ pub struct VkExecutor {
     layouts: Vec<Layout>,
     pipelines: Vec<CachedPipeline>,
     targets: Vec<CachedTarget>,
-    images: Vec<Option<StoredImage>>,
-    buffers: Vec<Option<Buffer>>,
+    images: Slots<StoredImage>,
+    buffers: Slots<Buffer>,
     params: Option<Buffer>,
     pool: vk::DescriptorPool,
     pool_sets: usize,
@@ -174,8 +174,8 @@ impl VkExecutor {
             layouts: Vec::new(),
             pipelines: Vec::new(),
             targets: Vec::new(),
-            images: Vec::new(),
-            buffers: Vec::new(),
+            images: Slots::default(),
+            buffers: Slots::default(),
             params: None,
             pool: vk::DescriptorPool::null(),
             pool_sets: 0,
@@ -353,28 +353,17 @@ impl VkExecutor {
     fn stored(&self, id: ImageId, program: &str) -> Result<&StoredImage> {
         self.images
             .get(id.0)
-            .and_then(Option::as_ref)
             .ok_or_else(|| Error::Vulkan(format!("{program}: image {} was freed", id.0)))
     }
 
     fn buffer(&self, id: BufferId) -> Result<&Buffer> {
         self.buffers
             .get(id.0)
-            .and_then(Option::as_ref)
             .ok_or_else(|| Error::Vulkan(format!("pass buffer {} was freed", id.0)))
     }
 
     fn store_image(&mut self, stored: StoredImage) -> ImageId {
-        let slot = self
-            .images
-            .iter()
-            .position(Option::is_none)
-            .unwrap_or(self.images.len());
-        if slot == self.images.len() {
-            self.images.push(None);
-        }
-        self.images[slot] = Some(stored);
-        ImageId(slot)
+        ImageId(self.images.insert(stored))
     }
 
     /// One descriptor set for a step: its block at `offset`, images, storage images, buffers.
@@ -546,9 +535,7 @@ impl Executor for VkExecutor {
     }
 
     fn free(&mut self, id: ImageId) {
-        if let Some(slot) = self.images.get_mut(id.0) {
-            *slot = None;
-        }
+        self.images.remove(id.0);
     }
 
     fn create_buffer(&mut self, words: usize, label: &str) -> Result<BufferId> {
@@ -559,22 +546,11 @@ impl Executor for VkExecutor {
             U::STORAGE_BUFFER | U::INDIRECT_BUFFER | U::TRANSFER_DST,
         )?;
         self.vk.name(b.raw, label);
-        let slot = self
-            .buffers
-            .iter()
-            .position(Option::is_none)
-            .unwrap_or(self.buffers.len());
-        if slot == self.buffers.len() {
-            self.buffers.push(None);
-        }
-        self.buffers[slot] = Some(b);
-        Ok(BufferId(slot))
+        Ok(BufferId(self.buffers.insert(b)))
     }
 
     fn free_buffer(&mut self, id: BufferId) {
-        if let Some(slot) = self.buffers.get_mut(id.0) {
-            *slot = None;
-        }
+        self.buffers.remove(id.0);
     }
 
     fn run(&mut self, target: Option<&Target>, steps: &[Step]) -> Result<Rendered> {
@@ -649,14 +625,7 @@ impl Executor for VkExecutor {
                 _ => None,
             });
         }
-        let buffers_raw: Vec<Option<vk::Buffer>> = self.buffers.iter().map(|b| b.as_ref().map(|b| b.raw)).collect();
-        let buffer_raw = |id: BufferId| -> Result<vk::Buffer> {
-            buffers_raw
-                .get(id.0)
-                .copied()
-                .flatten()
-                .ok_or_else(|| Error::Vulkan(format!("pass buffer {} was freed", id.0)))
-        };
+        let buffer_raw = |id: BufferId| -> Result<vk::Buffer> { Ok(self.buffer(id)?.raw) };
         // Indirect and written buffers resolved before recording.
         let mut step_buffers = Vec::with_capacity(steps.len());
         for step in steps {
@@ -713,29 +682,8 @@ impl Executor for VkExecutor {
                         Step::Draw(draw) => {
                             let targets = targets.expect("draws have a target");
                             if !rendering {
-                                use vk::{AccessFlags as A, ImageLayout as L, PipelineStageFlags as S};
-                                let attachment = depth_image.map(|dpt| {
-                                    dpt.transition(
-                                        cb,
-                                        L::UNDEFINED,
-                                        L::DEPTH_ATTACHMENT_OPTIMAL,
-                                        S::TOP_OF_PIPE,
-                                        A::empty(),
-                                        S::EARLY_FRAGMENT_TESTS | S::LATE_FRAGMENT_TESTS,
-                                        A::DEPTH_STENCIL_ATTACHMENT_READ | A::DEPTH_STENCIL_ATTACHMENT_WRITE,
-                                    );
-                                    vk::RenderingAttachmentInfo::default()
-                                        .image_view(dpt.view)
-                                        .image_layout(L::DEPTH_ATTACHMENT_OPTIMAL)
-                                        .load_op(vk::AttachmentLoadOp::CLEAR)
-                                        .store_op(vk::AttachmentStoreOp::DONT_CARE)
-                                        .clear_value(vk::ClearValue {
-                                            depth_stencil: vk::ClearDepthStencilValue {
-                                                depth: clear_depth,
-                                                stencil: 0,
-                                            },
-                                        })
-                                });
+                                let attachment =
+                                    depth_image.map(|dpt| super::targets::depth_attachment(cb, dpt, clear_depth));
                                 targets.record_begin(cb, attachment.as_ref());
                                 rendering = true;
                                 drawn = true;
@@ -827,6 +775,7 @@ impl Executor for VkExecutor {
                 gpu_ms: None,
                 wall_ms: t0.elapsed().as_secs_f64() * 1e3,
             },
+            size: (0, 0),
         })
     }
 }

@@ -395,33 +395,12 @@ impl VkRefocuser {
         let method = self.method;
         let (pipelines, layout, set) = (&self.pipelines, self.layout, self.set);
         self.vk.run_commands(|cb| {
-            use vk::{AccessFlags as A, ImageLayout as L, PipelineStageFlags as S};
             t.cols.record_upload(cb, &t.cols_staging);
             t.rows.record_upload(cb, &t.rows_staging);
-            if let Some(depth) = &t.depth {
-                depth.transition(
-                    cb,
-                    L::UNDEFINED,
-                    L::DEPTH_ATTACHMENT_OPTIMAL,
-                    S::TOP_OF_PIPE,
-                    A::empty(),
-                    S::EARLY_FRAGMENT_TESTS | S::LATE_FRAGMENT_TESTS,
-                    A::DEPTH_STENCIL_ATTACHMENT_READ | A::DEPTH_STENCIL_ATTACHMENT_WRITE,
-                );
-            }
-            let depth_attachment = t.depth.as_ref().map(|dpt| {
-                vk::RenderingAttachmentInfo::default()
-                    .image_view(dpt.view)
-                    .image_layout(L::DEPTH_ATTACHMENT_OPTIMAL)
-                    .load_op(vk::AttachmentLoadOp::CLEAR)
-                    .store_op(vk::AttachmentStoreOp::DONT_CARE)
-                    .clear_value(vk::ClearValue {
-                        depth_stencil: vk::ClearDepthStencilValue {
-                            depth: clear_depth,
-                            stencil: 0,
-                        },
-                    })
-            });
+            let depth_attachment = t
+                .depth
+                .as_ref()
+                .map(|dpt| super::targets::depth_attachment(cb, dpt, clear_depth));
             t.color.record_begin(cb, depth_attachment.as_ref());
             // SAFETY: recording into `cb` inside the rendering; every handle lives until the
             // submit has been waited for.

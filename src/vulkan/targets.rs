@@ -141,24 +141,34 @@ impl ColorTargets {
     /// buffers, and make the copies visible to the host.
     pub fn record_end_and_readback(&self, cb: vk::CommandBuffer, wanted: &[bool]) {
         use vk::{AccessFlags as A, ImageLayout as L, PipelineStageFlags as S};
+        // SAFETY: recording into `cb` inside the rendering begun by record_begin.
+        unsafe { self.vk.device.cmd_end_rendering(cb) };
+        self.record_copies(cb, wanted, L::TRANSFER_SRC_OPTIMAL, |c| {
+            c.transition(
+                cb,
+                L::COLOR_ATTACHMENT_OPTIMAL,
+                L::TRANSFER_SRC_OPTIMAL,
+                S::COLOR_ATTACHMENT_OUTPUT,
+                A::COLOR_ATTACHMENT_WRITE,
+                S::TRANSFER,
+                A::TRANSFER_READ,
+            )
+        });
+    }
+
+    /// Record, outside any rendering: `prepare` each wanted attachment, copy it (in `layout`)
+    /// into its host buffer, and make the copies visible to the host.
+    fn record_copies(&self, cb: vk::CommandBuffer, wanted: &[bool], layout: vk::ImageLayout, prepare: impl Fn(&Image)) {
+        use vk::{AccessFlags as A, PipelineStageFlags as S};
         let d = &self.vk.device;
-        // SAFETY: recording into `cb` inside the rendering begun by record_begin; the images and
-        // buffers live until the submit has been waited for.
+        // SAFETY: recording into `cb`; the images and buffers live until the submit has been
+        // waited for.
         unsafe {
-            d.cmd_end_rendering(cb);
             let present = self.color.iter().zip(&self.readback).zip(wanted);
             for ((c, buf), _) in present.filter(|(_, w)| **w) {
                 let (Some(c), Some(buf)) = (c, buf) else { continue };
-                c.transition(
-                    cb,
-                    L::COLOR_ATTACHMENT_OPTIMAL,
-                    L::TRANSFER_SRC_OPTIMAL,
-                    S::COLOR_ATTACHMENT_OUTPUT,
-                    A::COLOR_ATTACHMENT_WRITE,
-                    S::TRANSFER,
-                    A::TRANSFER_READ,
-                );
-                d.cmd_copy_image_to_buffer(cb, c.raw, L::TRANSFER_SRC_OPTIMAL, buf.raw, &[c.copy_region()]);
+                prepare(c);
+                d.cmd_copy_image_to_buffer(cb, c.raw, layout, buf.raw, &[c.copy_region()]);
             }
             let to_host = vk::MemoryBarrier::default()
                 .src_access_mask(A::TRANSFER_WRITE)
@@ -203,29 +213,7 @@ impl ColorTargets {
     /// making their writes visible), copy the attachments with `wanted[i]` set into their host
     /// buffers and make the copies visible to the host.
     pub fn record_readback_from_general(&self, cb: vk::CommandBuffer, wanted: &[bool]) {
-        use vk::{AccessFlags as A, ImageLayout as L, PipelineStageFlags as S};
-        let d = &self.vk.device;
-        // SAFETY: recording into `cb` outside any rendering; images and buffers live until the
-        // submit has been waited for.
-        unsafe {
-            let present = self.color.iter().zip(&self.readback).zip(wanted);
-            for ((c, buf), _) in present.filter(|(_, w)| **w) {
-                let (Some(c), Some(buf)) = (c, buf) else { continue };
-                d.cmd_copy_image_to_buffer(cb, c.raw, L::GENERAL, buf.raw, &[c.copy_region()]);
-            }
-            let to_host = vk::MemoryBarrier::default()
-                .src_access_mask(A::TRANSFER_WRITE)
-                .dst_access_mask(A::HOST_READ);
-            d.cmd_pipeline_barrier(
-                cb,
-                S::TRANSFER,
-                S::HOST,
-                vk::DependencyFlags::empty(),
-                &[to_host],
-                &[],
-                &[],
-            );
-        }
+        self.record_copies(cb, wanted, vk::ImageLayout::GENERAL, |_| {});
     }
 
     /// Attachment `i`'s texels as read back (after the submit has been waited for), rows
@@ -239,4 +227,30 @@ impl ColorTargets {
         };
         order.convert_rows(buffer.read(row_bytes * self.height as usize).to_vec(), row_bytes)
     }
+}
+
+/// Record: `depth` to DEPTH_ATTACHMENT_OPTIMAL (its contents discarded) and return it as the
+/// depth attachment of the next rendering, cleared to `clear` (the conventions' far value).
+pub fn depth_attachment(cb: vk::CommandBuffer, depth: &Image, clear: f32) -> vk::RenderingAttachmentInfo<'static> {
+    use vk::{AccessFlags as A, ImageLayout as L, PipelineStageFlags as S};
+    depth.transition(
+        cb,
+        L::UNDEFINED,
+        L::DEPTH_ATTACHMENT_OPTIMAL,
+        S::TOP_OF_PIPE,
+        A::empty(),
+        S::EARLY_FRAGMENT_TESTS | S::LATE_FRAGMENT_TESTS,
+        A::DEPTH_STENCIL_ATTACHMENT_READ | A::DEPTH_STENCIL_ATTACHMENT_WRITE,
+    );
+    vk::RenderingAttachmentInfo::default()
+        .image_view(depth.view)
+        .image_layout(L::DEPTH_ATTACHMENT_OPTIMAL)
+        .load_op(vk::AttachmentLoadOp::CLEAR)
+        .store_op(vk::AttachmentStoreOp::DONT_CARE)
+        .clear_value(vk::ClearValue {
+            depth_stencil: vk::ClearDepthStencilValue {
+                depth: clear,
+                stencil: 0,
+            },
+        })
 }
