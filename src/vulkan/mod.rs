@@ -17,6 +17,7 @@
 //! edge snap), the forward warp and the refocus batch render on GL.
 
 mod context;
+mod devices;
 mod executor;
 mod pipeline;
 mod refocus;
