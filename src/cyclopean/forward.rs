@@ -222,6 +222,6 @@ impl ForwardWarp {
             .map(|d| DepthMap::new(w, h, bytemuck::pod_collect_to_vec(&d)))
             .transpose()?;
         let sources = out.take(2, "cyclopean forward warp")?;
-        Ok((CyclopeanOutput { color, depth, sources }, out.timing))
+        Ok((CyclopeanOutput { color, depth, sources }.finite(), out.timing))
     }
 }

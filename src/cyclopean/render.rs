@@ -182,6 +182,6 @@ impl CyclopeanRenderer {
             .map(|d| DepthMap::new(w, h, bytemuck::pod_collect_to_vec(&d)))
             .transpose()?;
         let sources = out.take(2, "cyclopean gather")?;
-        Ok((CyclopeanOutput { color, depth, sources }, out.timing))
+        Ok((CyclopeanOutput { color, depth, sources }.finite(), out.timing))
     }
 }

@@ -455,6 +455,6 @@ impl SplatRenderer {
             .map(|d| crate::io::DepthMap::new(w, h, bytemuck::pod_collect_to_vec(&d)))
             .transpose()?;
         let sources = out.take(2, "cyclopean splat-gather")?;
-        Ok((CyclopeanOutput { color, depth, sources }, out.timing))
+        Ok((CyclopeanOutput { color, depth, sources }.finite(), out.timing))
     }
 }

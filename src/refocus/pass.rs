@@ -40,6 +40,9 @@ pub fn gpu(gpu: &Gpu, input: &RefocusInput) -> Result<ViewOutput> {
 /// The float64 twin of `input`, with the planes `input.outputs` leaves out removed.
 pub fn reference(input: &RefocusInput) -> Result<ViewOutput> {
     input.rule.validate()?;
+    input.source.validate()?;
+    // As the renderer does: the twin refuses what the GPU refuses.
+    input.target.validate("target camera")?;
     let r = refocus_reference(input.source, &input.rule, input.target);
     let mut view = ViewOutput::from_refocus_reference(&r);
     let o = input.outputs;

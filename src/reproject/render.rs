@@ -183,7 +183,8 @@ impl Reprojector {
                             .then(|| DepthMap::new(target.width, target.height, depth))
                             .transpose()?,
                         mask,
-                    },
+                    }
+                    .finite(),
                     timing,
                 ))
             }
@@ -223,7 +224,7 @@ impl Reprojector {
                     })
                     .transpose()?;
                 let mask = out.take(2, "reproject shift")?;
-                Ok((ReprojectOutput { color, depth, mask }, out.timing))
+                Ok((ReprojectOutput { color, depth, mask }.finite(), out.timing))
             }
         }
     }
