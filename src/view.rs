@@ -53,7 +53,10 @@ impl RefocusOutput {
 impl CyclopeanOutput {
     /// [`clear_non_finite`] on the planes read back (the source bits are the mask).
     pub fn finite(mut self) -> Self {
-        clear_non_finite(self.depth.as_mut().map(|d| d.data.as_mut_slice()), Some(&mut self.sources));
+        clear_non_finite(
+            self.depth.as_mut().map(|d| d.data.as_mut_slice()),
+            Some(&mut self.sources),
+        );
         self
     }
 }

@@ -158,7 +158,11 @@ fn check_offset_table(path: &Path, meta: &MetaData, counted: &mut Counted<impl R
     };
     let (mut file, _) = open_regular(path)?;
     let mut seen = std::collections::HashSet::with_capacity(count as usize);
-    for (i, (entry, block)) in table.chunks_exact(8).zip(header.blocks_increasing_y_order()).enumerate() {
+    for (i, (entry, block)) in table
+        .chunks_exact(8)
+        .zip(header.blocks_increasing_y_order())
+        .enumerate()
+    {
         let offset = u64::from_le_bytes(entry.try_into().expect("8 bytes"));
         let need = prefix + if scan_lines.is_some() { 4 } else { 16 };
         if offset < table_end || offset.saturating_add(need) > len || !seen.insert(offset) {
@@ -177,10 +181,15 @@ fn check_offset_table(path: &Path, meta: &MetaData, counted: &mut Counted<impl R
         let loc = block.location;
         let expected: Vec<i64> = match scan_lines {
             Some(lines) => vec![header.own_attributes.layer_position.y() as i64 + loc.tile_index.y() as i64 * lines],
-            None => [loc.tile_index.x(), loc.tile_index.y(), loc.level_index.x(), loc.level_index.y()]
-                .iter()
-                .map(|&v| v as i64)
-                .collect(),
+            None => [
+                loc.tile_index.x(),
+                loc.tile_index.y(),
+                loc.level_index.x(),
+                loc.level_index.y(),
+            ]
+            .iter()
+            .map(|&v| v as i64)
+            .collect(),
         };
         if ints != expected {
             return Err(bad(format!(

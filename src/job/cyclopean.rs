@@ -237,7 +237,10 @@ impl CyclopeanJob {
                 // a length, held to the options' magnitude.
                 use crate::camera::{MAX_INTRINSIC, MIN_FOCAL_PX};
                 let min_baseline = f64::from(crate::depth::MIN_DEPTH_VALUE);
-                for (flag, v, lo) in [("--focal", o.focal, MIN_FOCAL_PX), ("--baseline", o.baseline, min_baseline)] {
+                for (flag, v, lo) in [
+                    ("--focal", o.focal, MIN_FOCAL_PX),
+                    ("--baseline", o.baseline, min_baseline),
+                ] {
                     if let Some(v) = v.filter(|v| !(v.is_finite() && (lo..=MAX_INTRINSIC).contains(v))) {
                         return Err(ArgError::Invalid(crate::Error::param(
                             flag,

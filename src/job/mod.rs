@@ -51,7 +51,10 @@ pub fn finite_value(text: &str) -> Result<f64, String> {
 pub(crate) fn check_npz_key(key: Option<&str>, depths: &[&std::path::Path]) -> Result<(), ArgError> {
     let Some(key) = key else { return Ok(()) };
     if key.is_empty() {
-        return Err(ArgError::Invalid(crate::Error::param("--npz-key", "an empty name names no array")));
+        return Err(ArgError::Invalid(crate::Error::param(
+            "--npz-key",
+            "an empty name names no array",
+        )));
     }
     let is_npz = |p: &std::path::Path| p.extension().is_some_and(|e| e.eq_ignore_ascii_case("npz"));
     match depths.iter().find(|p| !is_npz(p)) {

@@ -83,12 +83,20 @@ const CSV_BUFFER: usize = 8 << 10;
 /// streamed (see the module notes): memory is bounded per row, never the file's size twice.
 pub fn load_manifest(path: &Path) -> Result<Vec<BatchFrame>> {
     let json = path.extension().is_some_and(|e| e.eq_ignore_ascii_case("json"));
-    let most = if json { MAX_JSON_MANIFEST_BYTES } else { MAX_MANIFEST_BYTES };
+    let most = if json {
+        MAX_JSON_MANIFEST_BYTES
+    } else {
+        MAX_MANIFEST_BYTES
+    };
     let (file, len) = crate::io::open_regular(path)?;
     crate::io::check_file_len(path, len, most, "a batch manifest")?;
     // Spreadsheets save CSV (and editors JSON) with a UTF-8 byte-order mark: skipped.
     let mut file = std::io::BufReader::with_capacity(CSV_BUFFER, file.take(most));
-    if file.fill_buf().map_err(|e| Error::io(path, e))?.starts_with(b"\xef\xbb\xbf") {
+    if file
+        .fill_buf()
+        .map_err(|e| Error::io(path, e))?
+        .starts_with(b"\xef\xbb\xbf")
+    {
         file.consume(3);
     }
     let mut frames: Vec<BatchFrame> = if json {
@@ -881,13 +889,19 @@ mod tests {
         let (r, taken) = rows(100_000, false);
         let f = parse_csv(Path::new("m.csv"), r).unwrap();
         assert_eq!(f.len(), 100_000);
-        assert_eq!((f[99_999].rgb.clone(), f[99_999].fx), (PathBuf::from("r99999.png"), 99_999.0));
+        assert_eq!(
+            (f[99_999].rgb.clone(), f[99_999].fx),
+            (PathBuf::from("r99999.png"), 99_999.0)
+        );
         assert!(taken.get() > 2_000_000, "{}", taken.get());
         // One endless row after 10 good ones: refused by its length, having read at most the
         // rows before it, one row's bound and the reader's buffer (twice: a refill in flight).
         let (r, taken) = rows(10, true);
         let e = parse_csv(Path::new("m.csv"), r).unwrap_err().to_string();
-        assert!(e.contains(&format!("longer than {MAX_MANIFEST_ROW_BYTES} bytes")), "{e}");
+        assert!(
+            e.contains(&format!("longer than {MAX_MANIFEST_ROW_BYTES} bytes")),
+            "{e}"
+        );
         let bound = 400 + MAX_MANIFEST_ROW_BYTES + 2 * CSV_BUFFER as u64;
         assert!(taken.get() <= bound, "read {} bytes, bound {bound}", taken.get());
         // A quote never closed is one endless row too.
@@ -906,7 +920,11 @@ mod tests {
         std::fs::write(&p, "\u{feff}rgb,depth,fx,fy,cx,cy\na.png,a.npy,1,2,3,4\n").unwrap();
         assert_eq!(load_manifest(&p).unwrap()[0].cy, 4.0);
         let j = dir.join("frames.json");
-        std::fs::write(&j, "\u{feff}[{\"rgb\":\"a\",\"depth\":\"b\",\"fx\":1,\"fy\":1,\"cx\":0,\"cy\":0}]").unwrap();
+        std::fs::write(
+            &j,
+            "\u{feff}[{\"rgb\":\"a\",\"depth\":\"b\",\"fx\":1,\"fy\":1,\"cx\":0,\"cy\":0}]",
+        )
+        .unwrap();
         assert_eq!(load_manifest(&j).unwrap().len(), 1);
         // Larger than the JSON cap: refused from its size, before a byte is parsed.
         let f = std::fs::File::create(&j).unwrap();

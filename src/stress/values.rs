@@ -144,7 +144,8 @@ impl Sweep {
              same refusals{}",
             self.runs,
             self.refused,
-            self.first_bad.map_or(String::new(), |b| format!("; first problem: {b}"))
+            self.first_bad
+                .map_or(String::new(), |b| format!("; first problem: {b}"))
         );
         row
     }
@@ -153,7 +154,12 @@ impl Sweep {
 /// Valid pixels (mask nonzero) whose depth is not finite.
 fn valid_non_finite(v: &ViewOutput) -> usize {
     match (&v.depth, &v.mask) {
-        (Some(d), Some(m)) => d.data.iter().zip(&m.data).filter(|(z, m)| **m != 0 && !z.is_finite()).count(),
+        (Some(d), Some(m)) => d
+            .data
+            .iter()
+            .zip(&m.data)
+            .filter(|(z, m)| **m != 0 && !z.is_finite())
+            .count(),
         (Some(d), None) => d.data.iter().filter(|z| !z.is_finite()).count(),
         _ => 0,
     }
@@ -219,7 +225,13 @@ fn refocus_rows(gpu: &Gpu, opts: StressOptions) -> Result<Vec<StressRow>> {
                 let mut target = src.camera();
                 target.k.fx *= scale;
                 target.k.fy *= scale;
-                run(&mut depth_sweep, &format!("depth {v:e} scale {scale:e}"), &src, &target, !cleared);
+                run(
+                    &mut depth_sweep,
+                    &format!("depth {v:e} scale {scale:e}"),
+                    &src,
+                    &target,
+                    !cleared,
+                );
             }
         }
     }
@@ -244,7 +256,10 @@ fn refocus_rows(gpu: &Gpu, opts: StressOptions) -> Result<Vec<StressRow>> {
         run(&mut focal_sweep, &format!("target fx=fy {f:e}"), &demo, &target, false);
     }
     Ok(vec![
-        depth_sweep.row("refocus", "value sweep: depth 1e-45 .. f32::MAX, target focal 1e-3 .. 1e6 px"),
+        depth_sweep.row(
+            "refocus",
+            "value sweep: depth 1e-45 .. f32::MAX, target focal 1e-3 .. 1e6 px",
+        ),
         focal_sweep.row("refocus", "value sweep: source/target focal 5e-324 .. 1e300 px"),
     ])
 }
@@ -396,7 +411,10 @@ fn stitch_rows(gpu: &Gpu, opts: StressOptions) -> Result<Vec<StressRow>> {
             }
         }
     }
-    Ok(vec![s.row("stitch", "value sweep: face depth 1e-45 .. f32::MAX (3 methods)")])
+    Ok(vec![s.row(
+        "stitch",
+        "value sweep: face depth 1e-45 .. f32::MAX (3 methods)",
+    )])
 }
 
 /// The value-sweep rows of `capability` (none for `camera`, whose sweeps are its own rows).

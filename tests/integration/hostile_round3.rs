@@ -858,7 +858,12 @@ fn refused_naming_depth<T>(res: viewsynth::Result<T>) -> Result<(), String> {
 /// Pixels the mask marks valid whose depth is not finite (every plane the view has).
 fn valid_non_finite(v: &viewsynth::view::ViewOutput) -> usize {
     match (&v.depth, &v.mask) {
-        (Some(d), Some(m)) => d.data.iter().zip(&m.data).filter(|(z, m)| **m != 0 && !z.is_finite()).count(),
+        (Some(d), Some(m)) => d
+            .data
+            .iter()
+            .zip(&m.data)
+            .filter(|(z, m)| **m != 0 && !z.is_finite())
+            .count(),
         _ => 0,
     }
 }
@@ -1227,25 +1232,94 @@ fn round3_class6_leftovers_are_refused_by_name() {
     let npz_key_lines: Vec<(&str, Vec<String>)> = vec![
         (
             "refocus",
-            s(&["refocus", "--rgb", &r, "--depth", &d, "--fx", "40", "--fy", "40", "--cx", "15.5", "--cy", "11.5", "--out-dir", &o]),
+            s(&[
+                "refocus",
+                "--rgb",
+                &r,
+                "--depth",
+                &d,
+                "--fx",
+                "40",
+                "--fy",
+                "40",
+                "--cx",
+                "15.5",
+                "--cy",
+                "11.5",
+                "--out-dir",
+                &o,
+            ]),
         ),
         (
             "reproject",
-            s(&["reproject", "--color", &r, "--depth", &d, "--fx", "40", "--fy", "40", "--cx", "15.5", "--cy", "11.5", "--baseline", "0.1", "--out-dir", &o]),
+            s(&[
+                "reproject",
+                "--color",
+                &r,
+                "--depth",
+                &d,
+                "--fx",
+                "40",
+                "--fy",
+                "40",
+                "--cx",
+                "15.5",
+                "--cy",
+                "11.5",
+                "--baseline",
+                "0.1",
+                "--out-dir",
+                &o,
+            ]),
         ),
         (
             "cyclopean",
-            s(&["cyclopean", "--left-rgb", &r, "--right-rgb", &r, "--left-disparity", &d, "--right-disparity", &d, "--out-dir", &o]),
+            s(&[
+                "cyclopean",
+                "--left-rgb",
+                &r,
+                "--right-rgb",
+                &r,
+                "--left-disparity",
+                &d,
+                "--right-disparity",
+                &d,
+                "--out-dir",
+                &o,
+            ]),
         ),
-        ("compare", s(&["compare", "--a-rgb", &r, "--b-rgb", &r, "--a-depth", &d, "--b-depth", &d])),
-        ("stitch (built-in scene)", s(&["stitch", "--scene", "demo", "--out-dir", &o])),
+        (
+            "compare",
+            s(&[
+                "compare",
+                "--a-rgb",
+                &r,
+                "--b-rgb",
+                &r,
+                "--a-depth",
+                &d,
+                "--b-depth",
+                &d,
+            ]),
+        ),
+        (
+            "stitch (built-in scene)",
+            s(&["stitch", "--scene", "demo", "--out-dir", &o]),
+        ),
     ];
     for (cmd, args) in npz_key_lines {
         for key in ["depth", "arr_0", ""] {
             let mut a = args.clone();
             a.extend(s(&["--npz-key", key]));
             cases += 1;
-            expect_exit(&out, &format!("{cmd} --npz-key '{key}'"), a, 2, &["--npz-key"], &mut failures);
+            expect_exit(
+                &out,
+                &format!("{cmd} --npz-key '{key}'"),
+                a,
+                2,
+                &["--npz-key"],
+                &mut failures,
+            );
         }
     }
 
@@ -1264,7 +1338,19 @@ fn round3_class6_leftovers_are_refused_by_name() {
 
     // cyclopean rig values: out of the flags' bounds (exit 2), or in bounds but putting every
     // disparity outside the usable depths (exit 1), named either way, never a silent 0 % view.
-    let cyc = s(&["cyclopean", "--left-rgb", &r, "--right-rgb", &r, "--left-disparity", &d, "--right-disparity", &d, "--out-dir", &o]);
+    let cyc = s(&[
+        "cyclopean",
+        "--left-rgb",
+        &r,
+        "--right-rgb",
+        &r,
+        "--left-disparity",
+        &d,
+        "--right-disparity",
+        &d,
+        "--out-dir",
+        &o,
+    ]);
     for (focal, baseline, code, name) in [
         ("1e300", "0.1", 2, "--focal"),
         ("5e-324", "0.1", 2, "--focal"),
@@ -1277,7 +1363,14 @@ fn round3_class6_leftovers_are_refused_by_name() {
         let mut a = cyc.clone();
         a.extend(s(&["--focal", focal, "--baseline", baseline]));
         cases += 1;
-        expect_exit(&out, &format!("cyclopean --focal {focal} --baseline {baseline}"), a, code, &[name], &mut failures);
+        expect_exit(
+            &out,
+            &format!("cyclopean --focal {focal} --baseline {baseline}"),
+            a,
+            code,
+            &[name],
+            &mut failures,
+        );
     }
 
     // compare: all-NaN depth on both sides compares no depth, so a depth limit fails.
@@ -1285,13 +1378,33 @@ fn round3_class6_leftovers_are_refused_by_name() {
     io::save_depth_npy(&nan, &DepthMap::new(W, H, vec![f32::NAN; (W * H) as usize]).unwrap()).unwrap();
     let n = p(&nan);
     for extra in [vec![], s(&["--b-depth-kind", "view-z"])] {
-        let mut a = s(&["compare", "--a-rgb", &r, "--b-rgb", &r, "--a-depth", &n, "--b-depth", &n, "--max-depth-rel", "0.001"]);
+        let mut a = s(&[
+            "compare",
+            "--a-rgb",
+            &r,
+            "--b-rgb",
+            &r,
+            "--a-depth",
+            &n,
+            "--b-depth",
+            &n,
+            "--max-depth-rel",
+            "0.001",
+        ]);
         a.extend(extra);
         cases += 1;
         let res = run(&a);
-        let text = format!("{}{}", String::from_utf8_lossy(&res.stdout), String::from_utf8_lossy(&res.stderr));
+        let text = format!(
+            "{}{}",
+            String::from_utf8_lossy(&res.stdout),
+            String::from_utf8_lossy(&res.stderr)
+        );
         if res.status.success() || !text.contains("no depth was compared") {
-            failures.push(format!("compare all-NaN depth: exit {:?} -- {}", res.status.code(), text.trim()));
+            failures.push(format!(
+                "compare all-NaN depth: exit {:?} -- {}",
+                res.status.code(),
+                text.trim()
+            ));
         }
     }
     // ... while one finite pixel on each side is compared (and passes).
@@ -1301,9 +1414,24 @@ fn round3_class6_leftovers_are_refused_by_name() {
     io::save_depth_npy(&one_path, &DepthMap::new(W, H, one).unwrap()).unwrap();
     let o1 = p(&one_path);
     cases += 1;
-    let res = run(&s(&["compare", "--a-rgb", &r, "--b-rgb", &r, "--a-depth", &o1, "--b-depth", &o1, "--max-depth-rel", "0.001"]));
+    let res = run(&s(&[
+        "compare",
+        "--a-rgb",
+        &r,
+        "--b-rgb",
+        &r,
+        "--a-depth",
+        &o1,
+        "--b-depth",
+        &o1,
+        "--max-depth-rel",
+        "0.001",
+    ]));
     if !res.status.success() {
-        failures.push(format!("compare with one finite depth: {}", String::from_utf8_lossy(&res.stderr)));
+        failures.push(format!(
+            "compare with one finite depth: {}",
+            String::from_utf8_lossy(&res.stderr)
+        ));
     }
 
     // Corrupt EXR offset tables: every entry at line 0, past the end, before the table,
@@ -1359,7 +1487,23 @@ fn round3_class6_leftovers_are_refused_by_name() {
         expect_exit(
             &out,
             &format!("refocus with an EXR whose table has {what}"),
-            s(&["refocus", "--rgb", &r, "--depth", &b, "--fx", "40", "--fy", "40", "--cx", "15.5", "--cy", "11.5", "--out-dir", &o]),
+            s(&[
+                "refocus",
+                "--rgb",
+                &r,
+                "--depth",
+                &b,
+                "--fx",
+                "40",
+                "--fy",
+                "40",
+                "--cx",
+                "15.5",
+                "--cy",
+                "11.5",
+                "--out-dir",
+                &o,
+            ]),
             1,
             &["bad.exr", "offset table"],
             &mut failures,

@@ -33,7 +33,10 @@ fn quick_sweep_of_every_capability_passes_with_no_nan_or_inf() {
         assert!(!sweeps.is_empty(), "no value sweep for {cap}");
         for r in sweeps {
             assert!(r.pass && r.non_finite == 0 && r.pixels > 0, "{r:?}");
-            assert!(r.note.contains("refused on both sides") && !r.note.contains("first problem"), "{r:?}");
+            assert!(
+                r.note.contains("refused on both sides") && !r.note.contains("first problem"),
+                "{r:?}"
+            );
         }
     }
     // One past the context's largest image side is refused, naming the size and the limit, by
