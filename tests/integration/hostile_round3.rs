@@ -1444,7 +1444,8 @@ fn round3_class6_leftovers_are_refused_by_name() {
     assert!(count >= 2, "{count} chunks: too few to corrupt");
     assert_eq!(io::load_depth(&exr, &Default::default()).unwrap().data, depth);
     let entry = |b: &[u8], i: usize| b[table + 8 * i..table + 8 * i + 8].to_vec();
-    let corruptions: Vec<(&str, Box<dyn Fn(&mut Vec<u8>)>)> = vec![
+    type Corrupt<'a> = Box<dyn Fn(&mut Vec<u8>) + 'a>;
+    let corruptions: Vec<(&str, Corrupt)> = vec![
         (
             "every entry at the first chunk",
             Box::new(|b: &mut Vec<u8>| {
