@@ -61,7 +61,7 @@ pub(crate) fn check_npz_key(key: Option<&str>, depths: &[&std::path::Path]) -> R
         Some(p) => Err(ArgError::Invalid(crate::Error::param(
             "--npz-key",
             format!(
-                "names an array of a .npz depth file, but {} is not one",
+                "{}: applies to .npz files only (it names an array of one)",
                 crate::error::excerpt(&p.display().to_string())
             ),
         ))),
