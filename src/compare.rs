@@ -236,9 +236,13 @@ pub fn compare_masked(a: &Side, b: &Side, mask: Option<&Mask>) -> Result<(Compar
     };
     let za = a.depth.as_ref().map(|d| view_z(d, a.storage, &a.conv));
     if let (Some(za), Some(db)) = (&za, &b.depth) {
-        let (abs, rel, disagree, _) = depth_error(za, &view_z(db, b.storage, &b.conv), &selected);
-        cmp.depth_max_abs = Some(abs);
-        cmp.depth_max_rel = Some(rel);
+        let (abs, rel, disagree, both) = depth_error(za, &view_z(db, b.storage, &b.conv), &selected);
+        // No pixel with depth on both sides (all NaN, say) compares nothing: no error is
+        // measured, so a depth limit fails ("no depth was compared") instead of passing at 0.
+        if both > 0 {
+            cmp.depth_max_abs = Some(abs);
+            cmp.depth_max_rel = Some(rel);
+        }
         cmp.mask_disagreement = Some(disagree);
     }
     cmp.suspicion = diagnose(b, &ca, za.as_deref(), &selected, &cmp);

@@ -18,6 +18,24 @@ use crate::gpu::Timing;
 use crate::io::{DepthMap, Mask, RgbImage};
 use crate::metrics::quantize_u8;
 
+/// The output rule of every pass, applied once after readback (and to the f64 twins when they
+/// are rounded to f32): a pixel whose depth is not finite is invalid, mask 0 and depth 0, so
+/// that no caller sees NaN or Inf where the mask says valid, whatever the inputs did inside
+/// the pass. Colour is 8-bit and always finite. Returns how many pixels it invalidated. A
+/// plane that was not requested is left alone (without depth there is nothing to test).
+pub fn clear_non_finite(depth: Option<&mut [f32]>, mut mask: Option<&mut [u8]>) -> usize {
+    let Some(depth) = depth else { return 0 };
+    let mut n = 0;
+    for (i, z) in depth.iter_mut().enumerate().filter(|(_, z)| !z.is_finite()) {
+        *z = 0.0;
+        if let Some(m) = mask.as_deref_mut().and_then(|m| m.get_mut(i)) {
+            n += usize::from(*m != 0);
+            *m = 0;
+        }
+    }
+    n
+}
+
 /// A synthesised view, rows top-down; every plane is `width` x `height` when present.
 #[derive(Debug, Clone)]
 pub struct ViewOutput {
@@ -58,6 +76,21 @@ impl ViewOutput {
     /// Per pixel, whether the mask marks it valid (nonzero); None when the view has no mask.
     pub fn valid(&self) -> Option<Vec<bool>> {
         self.mask.as_ref().map(|m| m.data.iter().map(|&v| v != 0).collect())
+    }
+
+    /// Whether every pixel the mask marks valid has a finite depth (true without depth or mask).
+    pub fn finite_where_valid(&self) -> bool {
+        match (&self.depth, &self.mask) {
+            (Some(d), Some(m)) => d.data.iter().zip(&m.data).all(|(z, &v)| v == 0 || z.is_finite()),
+            _ => true,
+        }
+    }
+
+    /// [`clear_non_finite`] on this view's depth and mask.
+    fn finite(mut self) -> Self {
+        let mask = self.mask.as_mut().map(|m| m.data.as_mut_slice());
+        clear_non_finite(self.depth.as_mut().map(|d| d.data.as_mut_slice()), mask);
+        self
     }
 
     /// A colour-only view (the stitch's equirect).
@@ -135,5 +168,6 @@ impl ViewOutput {
                 depth: Some(depth.to_vec()),
             }),
         }
+        .finite()
     }
 }

@@ -8,6 +8,7 @@ mod batch;
 mod context;
 mod cyclopean;
 mod errors;
+mod ints;
 mod renderer;
 mod reproject;
 mod stitch;

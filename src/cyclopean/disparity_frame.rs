@@ -105,7 +105,10 @@ pub fn disparity_frame(
                 0.0
             }
         });
-        DepthMap::new(w, h, z.collect()).expect("same size")
+        let mut z: Vec<f32> = z.collect();
+        // f B / d leaves the usable magnitudes for tiny disparities: holes, as a loader makes them.
+        crate::depth::clear_unusable_depth(&mut z);
+        DepthMap::new(w, h, z).expect("same size")
     };
     let eye = |(color, disparity): (RgbImage, DepthMap), side: f64, shift: f64| EyeInput {
         depth: to_depth(&disparity),

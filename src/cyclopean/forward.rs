@@ -215,6 +215,6 @@ impl ForwardWarp {
         };
         let (color, depth) = (out.color(0)?, out.depth(1)?);
         let sources = out.take(2, "cyclopean forward warp")?;
-        Ok((CyclopeanOutput { color, depth, sources }, out.timing))
+        Ok((CyclopeanOutput { color, depth, sources }.finite(), out.timing))
     }
 }

@@ -270,7 +270,8 @@ impl CyclopeanOutput {
 }
 
 impl StereoFrame {
-    /// Refuses colour and depth of different sizes, and non-finite or singular eye matrices.
+    /// Refuses colour and depth of different sizes, depth values outside the usable magnitudes
+    /// ([`crate::depth::check_usable_depth`]), and non-finite or singular eye matrices.
     pub fn validate(&self) -> Result<()> {
         for (name, eye) in [("left", &self.left), ("right", &self.right)] {
             if (eye.color.width, eye.color.height) != (eye.depth.width, eye.depth.height) {
@@ -281,6 +282,7 @@ impl StereoFrame {
                     ),
                 });
             }
+            crate::depth::check_usable_depth(&format!("{name} eye depth"), &eye.depth.data)?;
             for (what, m) in [("view", &eye.view), ("projection", &eye.proj)] {
                 if m.iter().flatten().any(|v| !v.is_finite()) || mat4::inverse(m).is_none() {
                     return Err(Error::param(

@@ -69,6 +69,17 @@ pub fn reference(input: &CyclopeanInput) -> Result<ViewOutput> {
     Ok(view)
 }
 
+impl super::CyclopeanOutput {
+    /// [`crate::view::clear_non_finite`] on the planes read back (the source bits are the mask).
+    pub fn finite(mut self) -> Self {
+        crate::view::clear_non_finite(
+            self.depth.as_mut().map(|d| d.data.as_mut_slice()),
+            Some(&mut self.sources),
+        );
+        self
+    }
+}
+
 impl ViewOutput {
     /// A cyclopean GPU output of a `width` x `height` middle camera (mask: the source bits).
     pub fn from_cyclopean(

@@ -167,6 +167,6 @@ impl CyclopeanRenderer {
         let mut out = self.device.render(&target, &[draw])?;
         let (color, depth) = (out.color(0)?, out.depth(1)?);
         let sources = out.take(2, "cyclopean gather")?;
-        Ok((CyclopeanOutput { color, depth, sources }, out.timing))
+        Ok((CyclopeanOutput { color, depth, sources }.finite(), out.timing))
     }
 }

@@ -73,6 +73,9 @@ fn eye_input(rig: &StereoRig, pose: &Pose, conv: &Conventions, kind: FrameDepth)
             DepthMap::new(z.width, z.height, data).expect("same size")
         }
     };
+    // Reversed-Z device depth of far surfaces can fall below the usable magnitudes: holes.
+    let mut depth = depth;
+    crate::depth::clear_unusable_depth(&mut depth.data);
     EyeInput {
         color,
         depth,

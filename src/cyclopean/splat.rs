@@ -438,6 +438,6 @@ impl SplatRenderer {
         let mut out = self.device.run(Some(&target), &steps)?;
         let (color, depth) = (out.color(0)?, out.depth(1)?);
         let sources = out.take(2, "cyclopean splat-gather")?;
-        Ok((CyclopeanOutput { color, depth, sources }, out.timing))
+        Ok((CyclopeanOutput { color, depth, sources }.finite(), out.timing))
     }
 }

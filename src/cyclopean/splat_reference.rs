@@ -218,6 +218,7 @@ impl Ctx<'_> {
 /// The splat-gather middle view in f64 (rows top-down; colour 0 where no eye answers).
 pub fn splat_reference(frame: &StereoFrame, mid: &MiddleCamera, params: &SplatParams) -> Result<CyclopeanReference> {
     params.validate()?;
+    frame.validate()?;
     let geo = SplatGeometry::new(frame, mid)?;
     let flip = frame.conv.row_order == RowOrder::BottomUp;
     let eyes: Vec<Eye> = [(&frame.left, &geo.dist_mem[0]), (&frame.right, &geo.dist_mem[1])]

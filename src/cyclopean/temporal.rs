@@ -110,7 +110,8 @@ impl TemporalAccumulator {
             color: Some(color),
             depth: Some(depth),
             sources,
-        };
+        }
+        .finite();
         self.history = Some((out.clone(), *mid));
         Ok(out)
     }

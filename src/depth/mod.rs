@@ -12,6 +12,14 @@
 //!
 //! Conventions (NDC range, reversed-Z) are an argument, not part of the encoding: a frame's
 //! conventions also fix its row order, so they travel with the frame and are passed here.
+//!
+//! **Valid implies finite** (the one rule, for every capability): a stored depth value is
+//! usable when it is 0 or its magnitude is in [[`MIN_DEPTH_VALUE`], [`MAX_DEPTH_VALUE`]].
+//! Loaders and the Python bindings turn the others into holes ([`clear_unusable_depth`]);
+//! every pass's input check refuses them from library callers ([`check_usable_depth`]:
+//! `RefocusSource::validate`, `StereoFrame::validate`, `ReprojectSource::validate`,
+//! `FaceSet::validate`); and after readback any pixel whose depth is still not finite gets
+//! mask 0 and depth 0 ([`crate::view::clear_non_finite`]).
 
 pub mod background;
 mod encoding;
@@ -58,6 +66,29 @@ pub fn clear_unusable_depth(data: &mut [f32]) -> usize {
         n += 1;
     }
     n
+}
+
+/// Refuses a depth map holding a finite value outside [`usable_depth_value`] (the values
+/// [`clear_unusable_depth`] makes holes), naming `what`, how many and the first one.
+///
+/// This is the input check of every pass (refocus, cyclopean, reproject, stitch): the loaders
+/// and the Python bindings apply [`clear_unusable_depth`] first, so only a library caller who
+/// builds a [`crate::io::DepthMap`] by hand can meet it, and gets an error instead of NaN where
+/// the mask says valid. NaN and +-Inf are holes and pass.
+pub fn check_usable_depth(what: &str, data: &[f32]) -> crate::Result<()> {
+    let mut bad = data.iter().enumerate().filter(|(_, v)| out_of_range(**v));
+    let Some((i, v)) = bad.next() else {
+        return Ok(());
+    };
+    let n = 1 + bad.count();
+    Err(crate::Error::param(
+        what,
+        format!(
+            "{n} value(s) outside the usable magnitudes [{MIN_DEPTH_VALUE:e}, {MAX_DEPTH_VALUE:e}] \
+             (first {v:e} at index {i}); make them holes first with \
+             viewsynth::depth::clear_unusable_depth, as the loaders do"
+        ),
+    ))
 }
 
 /// An encoding's name, without its parameters (the vocabulary of JSON files and CLI flags).

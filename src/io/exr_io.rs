@@ -1,7 +1,7 @@
 //! OpenEXR through the `exr` crate: one depth channel in, f32 channels out.
 
 use std::fs::File;
-use std::io::{BufReader, BufWriter};
+use std::io::{BufReader, BufWriter, Read, Seek, SeekFrom};
 use std::path::Path;
 
 use exr::prelude::{
@@ -32,7 +32,11 @@ pub(crate) fn exr_dimensions(path: &Path) -> Result<(u32, u32)> {
 pub(crate) fn read_depth_channel(path: &Path) -> Result<RawDepth> {
     // Headers first, so the size checks happen before the body is read or pixels allocated.
     let (file, len) = open_regular(path)?;
-    let meta = MetaData::read_from_buffered(BufReader::new(file), false).map_err(|e| exr_error(path, e))?;
+    let mut counted = Counted {
+        inner: BufReader::new(file),
+        n: 0,
+    };
+    let meta = MetaData::read_from_buffered(&mut counted, false).map_err(|e| exr_error(path, e))?;
     let header = match meta.headers.as_slice() {
         [h] => h,
         hs => {
@@ -69,6 +73,7 @@ pub(crate) fn read_depth_channel(path: &Path) -> Result<RawDepth> {
             ),
         ));
     }
+    check_offset_table(path, &meta, &mut counted, len)?;
     let (file, _) = open_regular(path)?;
 
     let image = exr::prelude::read()
@@ -113,6 +118,86 @@ pub(crate) fn read_depth_channel(path: &Path) -> Result<RawDepth> {
         ));
     }
     Ok(RawDepth { width, height, samples })
+}
+
+/// Counts the bytes read through it: where the headers end, the offset table starts.
+struct Counted<R> {
+    inner: R,
+    n: u64,
+}
+
+impl<R: Read> Read for Counted<R> {
+    fn read(&mut self, buf: &mut [u8]) -> std::io::Result<usize> {
+        let n = self.inner.read(buf)?;
+        self.n += n as u64;
+        Ok(n)
+    }
+}
+
+/// Refuses a chunk offset table that does not point each entry at its own chunk. The `exr`
+/// crate reads the chunks the table points at (in table order, without pedantic checks), so a
+/// table pointing every entry at line 0 decoded line 0 again and again and left the rest of
+/// the image 0 -- a few percent valid depth, no error. Each entry (in increasing-y block order,
+/// as the crate's reader indexes it) must lie inside the file after the table, and the chunk
+/// there must name that block: its first scan line, or its tile and level.
+fn check_offset_table(path: &Path, meta: &MetaData, counted: &mut Counted<impl Read>, len: u64) -> Result<()> {
+    let header = &meta.headers[0];
+    let bad = |what: String| Error::decode(path, format!("corrupt EXR offset table: {what}"));
+    let count = header.chunk_count as u64;
+    let table_end = counted.n.saturating_add(count.saturating_mul(8));
+    if table_end > len {
+        return Err(bad(format!("{count} entries do not fit in the file")));
+    }
+    let mut table = vec![0u8; count as usize * 8];
+    counted.read_exact(&mut table).map_err(|e| Error::io(path, e))?;
+    // Multi-part files prefix each chunk with its part number.
+    let prefix = if meta.requirements.has_multiple_layers { 4 } else { 0 };
+    let scan_lines = match header.blocks {
+        exr::meta::BlockDescription::ScanLines => Some(header.compression.scan_lines_per_block() as i64),
+        exr::meta::BlockDescription::Tiles(_) => None,
+    };
+    let (mut file, _) = open_regular(path)?;
+    let mut seen = std::collections::HashSet::with_capacity(count as usize);
+    for (i, (entry, block)) in table
+        .chunks_exact(8)
+        .zip(header.blocks_increasing_y_order())
+        .enumerate()
+    {
+        let offset = u64::from_le_bytes(entry.try_into().expect("8 bytes"));
+        let need = prefix + if scan_lines.is_some() { 4 } else { 16 };
+        if offset < table_end || offset.saturating_add(need) > len || !seen.insert(offset) {
+            return Err(bad(format!(
+                "entry {i} = {offset} is outside the chunks ({table_end}..{len}) or repeated"
+            )));
+        }
+        let mut head = [0u8; 20];
+        let head = &mut head[..need as usize];
+        file.seek(SeekFrom::Start(offset)).map_err(|e| Error::io(path, e))?;
+        file.read_exact(head).map_err(|e| Error::io(path, e))?;
+        let ints: Vec<i64> = head[prefix as usize..]
+            .chunks_exact(4)
+            .map(|b| i64::from(i32::from_le_bytes(b.try_into().expect("4 bytes"))))
+            .collect();
+        let loc = block.location;
+        let expected: Vec<i64> = match scan_lines {
+            Some(lines) => vec![header.own_attributes.layer_position.y() as i64 + loc.tile_index.y() as i64 * lines],
+            None => [
+                loc.tile_index.x(),
+                loc.tile_index.y(),
+                loc.level_index.x(),
+                loc.level_index.y(),
+            ]
+            .iter()
+            .map(|&v| v as i64)
+            .collect(),
+        };
+        if ints != expected {
+            return Err(bad(format!(
+                "entry {i} points at the chunk of block {ints:?}, not {expected:?}"
+            )));
+        }
+    }
+    Ok(())
 }
 
 fn choose_channel(names: &[String]) -> Option<usize> {

@@ -103,6 +103,12 @@ impl CompareJob {
     /// Checks the thresholds and the depth planes.
     pub fn new(o: CompareOptions) -> Result<Self, ArgError> {
         o.thresholds.validate()?;
+        let depths: Vec<&std::path::Path> = [&o.a.depth, &o.b.depth]
+            .into_iter()
+            .flatten()
+            .map(|p| p.as_path())
+            .collect();
+        super::check_npz_key(o.npz_key.as_deref(), &depths)?;
         if !(o.near.is_finite() && o.near > 0.0 && o.far > o.near) {
             return Err(ArgError::ComparePlanes {
                 near: o.near,

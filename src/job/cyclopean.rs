@@ -222,6 +222,7 @@ impl CyclopeanJob {
                 let Some(right) = o.right_disparity.clone() else {
                     return Err(ArgError::RightDisparityMissing);
                 };
+                super::check_npz_key(o.npz_key.as_deref(), &[left, &right])?;
                 if o.depth_scale.is_some() {
                     return Err(ArgError::DepthScaleWithDisparity);
                 }
@@ -231,6 +232,21 @@ impl CyclopeanJob {
                         "--doffs",
                         format!("{} must be finite", o.doffs),
                     )));
+                }
+                // The bounds of focal lengths everywhere (intrinsics, flags, files); a baseline is
+                // a length, held to the options' magnitude.
+                use crate::camera::{MAX_INTRINSIC, MIN_FOCAL_PX};
+                let min_baseline = f64::from(crate::depth::MIN_DEPTH_VALUE);
+                for (flag, v, lo) in [
+                    ("--focal", o.focal, MIN_FOCAL_PX),
+                    ("--baseline", o.baseline, min_baseline),
+                ] {
+                    if let Some(v) = v.filter(|v| !(v.is_finite() && (lo..=MAX_INTRINSIC).contains(v))) {
+                        return Err(ArgError::Invalid(crate::Error::param(
+                            flag,
+                            format!("{v} must be in [{lo:e}, {MAX_INTRINSIC:e}]"),
+                        )));
+                    }
                 }
                 if let Some(p) = o.position.filter(|p| !(0.0..=1.0).contains(p)) {
                     return Err(ArgError::Invalid(crate::Error::param(
@@ -263,6 +279,7 @@ impl CyclopeanJob {
                 let (Some(left), Some(right)) = (o.left_depth.clone(), o.right_depth.clone()) else {
                     return Err(ArgError::CameraFileWithoutDepth);
                 };
+                super::check_npz_key(o.npz_key.as_deref(), &[&left, &right])?;
                 check_scale("--depth-scale", o.depth_scale)?;
                 let input = Input::CameraFile(CameraFileInput {
                     cameras: cameras.clone(),
@@ -408,7 +425,23 @@ impl CyclopeanJob {
             doffs: *doffs,
             position: *position,
         };
+        let known = l.1.data.iter().any(|&d| d.is_finite() && d > 0.0);
         let (frame, mid) = disparity_frame(l, r, &rig, Conventions::default())?;
+        // f B / d outside the usable depths makes holes (the one depth rule); all of them is the
+        // rig's fault, said by name rather than a silent 0 % valid view.
+        if known && !frame.left.depth.data.iter().any(|z| z.is_finite() && *z > 0.0) {
+            return Err(crate::Error::param(
+                "--focal/--baseline",
+                format!(
+                    "f B / disparity = {:e} m / px puts every known disparity of {} outside the usable depths [{:e}, {:e}] m",
+                    rig.focal_px * rig.baseline,
+                    left.display(),
+                    crate::depth::MIN_DEPTH_VALUE,
+                    crate::depth::MAX_DEPTH_VALUE
+                ),
+            )
+            .into());
+        }
         let fixation = crate::cyclopean::disparity_frame::median_fixation(&frame)
             .ok_or_else(|| crate::Error::decode(left, "no known disparity (all 0 or non-finite)"))?;
         Ok((frame, mid, fixation))

@@ -54,6 +54,29 @@ pub fn shard_value(text: &str) -> Result<String, String> {
         .map_err(|e| e.to_string())
 }
 
+/// Refuses `--npz-key` when a depth file it would apply to is not a `.npz` (by its name), and
+/// an empty key: the command line is wrong (exit 2), seen before any file is read.
+pub(crate) fn check_npz_key(key: Option<&str>, depths: &[&std::path::Path]) -> Result<(), ArgError> {
+    let Some(key) = key else { return Ok(()) };
+    if key.is_empty() {
+        return Err(ArgError::Invalid(crate::Error::param(
+            "--npz-key",
+            "an empty name names no array",
+        )));
+    }
+    let is_npz = |p: &std::path::Path| p.extension().is_some_and(|e| e.eq_ignore_ascii_case("npz"));
+    match depths.iter().find(|p| !is_npz(p)) {
+        Some(p) => Err(ArgError::Invalid(crate::Error::param(
+            "--npz-key",
+            format!(
+                "{}: applies to .npz files only (it names an array of one)",
+                crate::error::excerpt(&p.display().to_string())
+            ),
+        ))),
+        None => Ok(()),
+    }
+}
+
 /// As [`finite_value`], or `inf` where infinity has a meaning (a far plane, a disabled limit).
 pub fn finite_or_inf(text: &str) -> Result<f64, String> {
     match text.trim().parse::<f64>() {

@@ -141,6 +141,7 @@ impl RefocusCommand {
         let (Some(rgb), Some(depth)) = (o.rgb.clone(), o.depth.clone()) else {
             return Err(ArgError::PerFrameInput);
         };
+        super::check_npz_key(o.npz_key.as_deref(), &[&depth])?;
         let intrinsics = SourceIntrinsics::resolve(o.intrinsics_file.as_deref(), o.intrinsics)?;
         o.rule.validate()?;
         if let Some((w, h)) = o.size {

@@ -22,8 +22,24 @@ pub struct ReportJob {
 }
 
 impl ReportJob {
+    /// Refuses a `--case` that is no case folder (one `viewsynth scene` wrote, with its
+    /// cameras.json): a wrong command line (exit 2), seen before the GPU opens or a row is measured.
+    pub fn check_cases(cases: &[PathBuf]) -> Result<(), ArgError> {
+        match cases.iter().find(|c| !c.join("cameras.json").is_file()) {
+            Some(case) => Err(ArgError::Invalid(crate::Error::param(
+                "--case",
+                format!(
+                    "{} is not a case folder (no cameras.json; `viewsynth scene --out-dir` writes one)",
+                    crate::error::excerpt(&case.display().to_string())
+                ),
+            ))),
+            None => Ok(()),
+        }
+    }
+
     /// Measures every row and writes the report files; returns the report and their paths.
     pub fn run(&self, host: &dyn Host) -> Result<WrittenReport, JobError> {
+        Self::check_cases(&self.cases)?;
         if let Some(d) = &self.data_dir {
             if !d.is_dir() {
                 return Err(ArgError::DataDirMissing(d.clone()).into());

@@ -218,6 +218,7 @@ pub(crate) fn device_depth(near: Option<f64>, far: Option<f64>, what: &'static s
 impl ReprojectJob {
     /// Checks the options against each other and the library's rules.
     pub fn new(o: ReprojectOptions) -> Result<Self, ArgError> {
+        super::check_npz_key(o.npz_key.as_deref(), &[&o.depth])?;
         let method = match o.method {
             MethodChoice::Shift => Method::Shift { steps: o.steps },
             MethodChoice::ShiftScan => Method::ShiftScan,

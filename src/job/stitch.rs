@@ -148,6 +148,15 @@ pub struct StitchReport {
 impl StitchJob {
     /// Checks the options against each other and the library's rules.
     pub fn new(o: StitchOptions) -> Result<Self, ArgError> {
+        // Face files are named by the folder, found while running; an empty key, or a key with
+        // the built-in scene (no depth files at all), is wrong on the command line.
+        super::check_npz_key(o.npz_key.as_deref(), &[])?;
+        if o.npz_key.is_some() && o.faces.is_none() {
+            return Err(ArgError::Invalid(crate::Error::param(
+                "--npz-key",
+                "applies to --faces depth files only (the built-in scene has none)",
+            )));
+        }
         if let (None, Some(overlap)) = (o.fov, o.overlap) {
             if !(overlap > 0.0 && overlap < 44.0) {
                 return Err(ArgError::Overlap(overlap));

@@ -9,6 +9,9 @@
 //! Manifest: CSV with a header naming the columns `rgb,depth,fx,fy,cx,cy` and optionally
 //! `depth_scale`, `name`, `sun_bit_rotate` (read by the `csv` crate: quoted cells may hold
 //! commas, `#` starts a comment line), or a JSON array of objects with the same fields. Relative paths are relative to the manifest.
+//! Both are streamed from the file, never read whole: a CSV row is parsed into its frame one at
+//! a time, at most [`MAX_MANIFEST_ROW_BYTES`] each, and a frame costs its paths and name until
+//! it is rendered (the settings a resume compares are computed when they are needed).
 //! Each frame writes into `<out>/<name>/`; its `manifest.json` is written last, atomically, and
 //! marks the frame finished.
 
@@ -20,6 +23,7 @@ use crate::error::{Error, Result};
 use crate::gpu::Gpu;
 use crate::io::{self, DepthDecode};
 use serde::{Deserialize, Serialize};
+use std::io::{BufRead, Read};
 use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicUsize, Ordering};
 use std::sync::{mpsc, Arc, Mutex};
@@ -63,15 +67,49 @@ impl BatchFrame {
     }
 }
 
-/// Read a CSV or JSON manifest; every frame gets a unique, filesystem-safe name.
+/// Largest CSV manifest: about 10^6 rows of absolute paths.
+pub const MAX_MANIFEST_BYTES: u64 = 256 << 20;
+/// Largest JSON manifest (the JSON inputs' cap).
+pub const MAX_JSON_MANIFEST_BYTES: u64 = crate::io::MAX_JSON_BYTES;
+/// Largest CSV row: two paths of PATH_MAX and the numbers fit; a longer row is refused before
+/// more of it is buffered.
+pub const MAX_MANIFEST_ROW_BYTES: u64 = 16 << 10;
+/// Most frames one manifest lists (each costs its paths and name in memory until rendered).
+pub const MAX_MANIFEST_ROWS: usize = 1_000_000;
+/// The csv reader's buffer: what it may read ahead of the row being parsed.
+const CSV_BUFFER: usize = 8 << 10;
+
+/// Read a CSV or JSON manifest; every frame gets a unique, filesystem-safe name. The file is
+/// streamed (see the module notes): memory is bounded per row, never the file's size twice.
 pub fn load_manifest(path: &Path) -> Result<Vec<BatchFrame>> {
-    // Spreadsheets save CSV with a UTF-8 byte-order mark: skipped.
-    let text = crate::io::read_text(path, crate::io::MAX_JSON_BYTES)?;
-    let mut frames: Vec<BatchFrame> = if path.extension().is_some_and(|e| e.eq_ignore_ascii_case("json")) {
-        serde_json::from_str(&text).map_err(|e| Error::decode(path, e.to_string()))?
+    let json = path.extension().is_some_and(|e| e.eq_ignore_ascii_case("json"));
+    let most = if json {
+        MAX_JSON_MANIFEST_BYTES
     } else {
-        parse_csv(path, &text)?
+        MAX_MANIFEST_BYTES
     };
+    let (file, len) = crate::io::open_regular(path)?;
+    crate::io::check_file_len(path, len, most, "a batch manifest")?;
+    // Spreadsheets save CSV (and editors JSON) with a UTF-8 byte-order mark: skipped.
+    let mut file = std::io::BufReader::with_capacity(CSV_BUFFER, file.take(most));
+    if file
+        .fill_buf()
+        .map_err(|e| Error::io(path, e))?
+        .starts_with(b"\xef\xbb\xbf")
+    {
+        file.consume(3);
+    }
+    let mut frames: Vec<BatchFrame> = if json {
+        serde_json::from_reader(file).map_err(|e| Error::decode(path, e.to_string()))?
+    } else {
+        parse_csv(path, file)?
+    };
+    if frames.len() > MAX_MANIFEST_ROWS {
+        return Err(Error::decode(
+            path,
+            format!("{} frames: at most {MAX_MANIFEST_ROWS} per manifest", frames.len()),
+        ));
+    }
     if frames.is_empty() {
         return Err(Error::decode(path, "the manifest lists no frame"));
     }
@@ -132,13 +170,48 @@ struct CsvFrame {
     sun_bit_rotate: Option<String>,
 }
 
-fn parse_csv(path: &Path, text: &str) -> Result<Vec<BatchFrame>> {
-    // Spreadsheet exports start with a byte-order mark.
-    let text = text.strip_prefix('\u{feff}').unwrap_or(text);
+/// A reader that refuses to read more than `limit` bytes from the start (the parser moves the
+/// limit on after each row), so a row without an end is refused after a bounded read.
+struct RowBound<R> {
+    inner: R,
+    read: u64,
+    limit: std::rc::Rc<std::cell::Cell<u64>>,
+}
+
+/// The error [`RowBound`] reads as, found again by [`csv_error`].
+const ROW_TOO_LONG: &str = "row too long";
+
+impl<R: Read> Read for RowBound<R> {
+    fn read(&mut self, buf: &mut [u8]) -> std::io::Result<usize> {
+        let allowed = self.limit.get().saturating_sub(self.read);
+        if allowed == 0 {
+            // At the limit: only the end of the file is fine.
+            let mut probe = [0u8; 1];
+            return match self.inner.read(&mut probe)? {
+                0 => Ok(0),
+                _ => Err(std::io::Error::other(ROW_TOO_LONG)),
+            };
+        }
+        let n = buf.len().min(usize::try_from(allowed).unwrap_or(usize::MAX));
+        let n = self.inner.read(&mut buf[..n])?;
+        self.read += n as u64;
+        Ok(n)
+    }
+}
+
+fn parse_csv(path: &Path, file: impl Read) -> Result<Vec<BatchFrame>> {
+    // The reader may buffer ahead of the row it parses; the row itself gets MAX_MANIFEST_ROW_BYTES.
+    let slack = MAX_MANIFEST_ROW_BYTES + CSV_BUFFER as u64;
+    let limit = std::rc::Rc::new(std::cell::Cell::new(slack));
     let mut reader = csv::ReaderBuilder::new()
         .comment(Some(b'#'))
         .trim(csv::Trim::All)
-        .from_reader(text.as_bytes());
+        .buffer_capacity(CSV_BUFFER)
+        .from_reader(RowBound {
+            inner: file,
+            read: 0,
+            limit: limit.clone(),
+        });
     let header = reader
         .headers()
         .map_err(|e| csv_error(path, &csv::StringRecord::new(), None, e))?
@@ -155,8 +228,22 @@ fn parse_csv(path: &Path, text: &str) -> Result<Vec<BatchFrame>> {
         }
     }
     let mut frames = Vec::new();
-    for record in reader.records() {
-        let record = record.map_err(|e| csv_error(path, &header, None, e))?;
+    // One record buffer for every row: a row is parsed into its frame, then the buffer reused.
+    let mut record = csv::StringRecord::new();
+    loop {
+        limit.set(reader.position().byte() + slack);
+        if !reader
+            .read_record(&mut record)
+            .map_err(|e| csv_error(path, &header, None, e))?
+        {
+            break;
+        }
+        if frames.len() == MAX_MANIFEST_ROWS {
+            return Err(Error::decode(
+                path,
+                format!("more than {MAX_MANIFEST_ROWS} frames: split the manifest (--shard runs share one)"),
+            ));
+        }
         let row: CsvFrame = record
             .deserialize(Some(&header))
             .map_err(|e| csv_error(path, &header, Some(&record), e))?;
@@ -185,6 +272,9 @@ fn csv_error(path: &Path, header: &csv::StringRecord, record: Option<&csv::Strin
         .or(e.position())
         .map_or(String::new(), |p| format!("line {}: ", p.line()));
     let what = match e.kind() {
+        csv::ErrorKind::Io(io) if io.to_string() == ROW_TOO_LONG => {
+            format!("a row longer than {MAX_MANIFEST_ROW_BYTES} bytes (or a quote never closed)")
+        }
         csv::ErrorKind::UnequalLengths { expected_len, len, .. } => {
             format!("{len} cells, header has {expected_len}")
         }
@@ -553,22 +643,22 @@ pub fn run_batch(
     let root = io::OutDir::prepare(out_dir)?;
     let t_start = Instant::now();
     let mut summary = BatchSummary::default();
-    // The frames this run renders: its shard, less those finished with the same settings.
-    let mut todo = Vec::new();
+    // The frames this run renders: its shard, less those finished with the same settings. Only
+    // the frame is kept (a reference); its name and settings are made again when it is rendered,
+    // so a long manifest costs nothing more per row here.
+    let mut todo: Vec<&BatchFrame> = Vec::new();
     for (i, frame) in frames.iter().enumerate() {
         if opts.shard.is_some_and(|s| i % s.count != s.index) {
             summary.other_shards += 1;
             continue;
         }
-        let name = frame.name.clone().unwrap_or_default();
-        let dir = out_dir.join(&name);
-        let settings = frame_settings(frame, opts);
-        if opts.resume && frame_finished(&dir, &settings) {
+        let name = frame.name.as_deref().unwrap_or_default();
+        if opts.resume && frame_finished(&out_dir.join(name), &frame_settings(frame, opts)) {
             summary.skipped += 1;
             progress();
             continue;
         }
-        todo.push((frame, name, dir, settings));
+        todo.push(frame);
     }
     let mut refocuser = Refocuser::with_settings(gpu, &opts.rule, opts.method, opts.files.outputs, opts.conv)?;
     let files = opts.files;
@@ -576,7 +666,8 @@ pub fn run_batch(
 
     if opts.jobs == 0 {
         // The synchronous baseline: each stage in turn on this thread.
-        for (frame, name, _, settings) in todo {
+        for frame in todo {
+            let (name, settings) = (frame.name.clone().unwrap_or_default(), frame_settings(frame, opts));
             let t0 = Instant::now();
             let result = decode_frame(frame, opts.depth_trunc).and_then(|src| {
                 stages.decode.push(ms_since(t0));
@@ -622,7 +713,7 @@ pub fn run_batch(
             let (tx, next, todo) = (decoded_tx.clone(), &next, &todo);
             scope.spawn(move || loop {
                 let i = next.fetch_add(1, Ordering::Relaxed);
-                let Some((frame, ..)) = todo.get(i) else { break };
+                let Some(frame) = todo.get(i) else { break };
                 let t0 = Instant::now();
                 let src = decode_frame(frame, depth_trunc);
                 if tx.send((i, src, ms_since(t0))).is_err() {
@@ -676,7 +767,7 @@ pub fn run_batch(
                 break;
             };
             stages.wait.push(ms_since(t0));
-            let (_, name, _, settings) = &todo[i];
+            let (name, settings) = (todo[i].name.clone().unwrap_or_default(), frame_settings(todo[i], opts));
             let submitted = src.and_then(|src| {
                 stages.decode.push(decode_ms);
                 submit_frame(
@@ -684,7 +775,7 @@ pub fn run_batch(
                     name.clone(),
                     root.clone(),
                     &src,
-                    settings.clone(),
+                    settings,
                     opts,
                     &mut stages,
                 )
@@ -756,6 +847,103 @@ mod tests {
         let j = dir.join("frames.json");
         std::fs::write(&j, r#"[{"name":"same","rgb":"a","depth":"b","fx":1,"fy":1,"cx":0,"cy":0},{"name":"same","rgb":"c","depth":"d","fx":1,"fy":1,"cx":0,"cy":0}]"#).unwrap();
         assert!(load_manifest(&j).unwrap_err().to_string().contains("repeated"));
+        let _ = std::fs::remove_dir_all(&dir);
+    }
+
+    /// Rows of `n` frames made on the fly, counting the bytes the parser has taken.
+    struct Rows {
+        head: Vec<u8>,
+        next: usize,
+        n: usize,
+        row: Vec<u8>,
+        taken: std::rc::Rc<std::cell::Cell<u64>>,
+        /// After the rows: one endless cell (no newline, no end).
+        endless: bool,
+    }
+
+    impl Read for Rows {
+        fn read(&mut self, buf: &mut [u8]) -> std::io::Result<usize> {
+            if self.row.is_empty() {
+                if !self.head.is_empty() {
+                    self.row = std::mem::take(&mut self.head);
+                } else if self.next < self.n {
+                    self.row = format!("r{0}.png,d{0}.npy,{0},2,3,4\n", self.next).into_bytes();
+                    self.next += 1;
+                } else if self.endless {
+                    self.row = vec![b'a'; 4096];
+                } else {
+                    return Ok(0);
+                }
+            }
+            let k = buf.len().min(self.row.len());
+            buf[..k].copy_from_slice(&self.row[..k]);
+            self.row.drain(..k);
+            self.taken.set(self.taken.get() + k as u64);
+            Ok(k)
+        }
+    }
+
+    fn rows(n: usize, endless: bool) -> (Rows, std::rc::Rc<std::cell::Cell<u64>>) {
+        let taken = std::rc::Rc::new(std::cell::Cell::new(0));
+        let r = Rows {
+            head: b"rgb,depth,fx,fy,cx,cy\n".to_vec(),
+            next: 0,
+            n,
+            row: Vec::new(),
+            taken: taken.clone(),
+            endless,
+        };
+        (r, taken)
+    }
+
+    #[test]
+    fn csv_rows_are_streamed_and_a_row_without_end_is_refused_after_a_bounded_read() {
+        // 10^5 rows parsed from a stream, one at a time, each into its frame.
+        let (r, taken) = rows(100_000, false);
+        let f = parse_csv(Path::new("m.csv"), r).unwrap();
+        assert_eq!(f.len(), 100_000);
+        assert_eq!(
+            (f[99_999].rgb.clone(), f[99_999].fx),
+            (PathBuf::from("r99999.png"), 99_999.0)
+        );
+        assert!(taken.get() > 2_000_000, "{}", taken.get());
+        // One endless row after 10 good ones: refused by its length, having read at most the
+        // rows before it, one row's bound and the reader's buffer (twice: a refill in flight).
+        let (r, taken) = rows(10, true);
+        let e = parse_csv(Path::new("m.csv"), r).unwrap_err().to_string();
+        assert!(
+            e.contains(&format!("longer than {MAX_MANIFEST_ROW_BYTES} bytes")),
+            "{e}"
+        );
+        let bound = 400 + MAX_MANIFEST_ROW_BYTES + 2 * CSV_BUFFER as u64;
+        assert!(taken.get() <= bound, "read {} bytes, bound {bound}", taken.get());
+        // A quote never closed is one endless row too.
+        let (mut r, _) = rows(3, false);
+        r.head = b"rgb,depth,fx,fy,cx,cy\n\"".to_vec();
+        r.endless = true;
+        let e = parse_csv(Path::new("m.csv"), r).unwrap_err().to_string();
+        assert!(e.contains("longer than"), "{e}");
+    }
+
+    #[test]
+    fn a_manifest_with_a_byte_order_mark_and_an_oversized_file_are_handled() {
+        let dir = std::env::temp_dir().join(format!("viewsynth-batch-bom-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let p = dir.join("frames.csv");
+        std::fs::write(&p, "\u{feff}rgb,depth,fx,fy,cx,cy\na.png,a.npy,1,2,3,4\n").unwrap();
+        assert_eq!(load_manifest(&p).unwrap()[0].cy, 4.0);
+        let j = dir.join("frames.json");
+        std::fs::write(
+            &j,
+            "\u{feff}[{\"rgb\":\"a\",\"depth\":\"b\",\"fx\":1,\"fy\":1,\"cx\":0,\"cy\":0}]",
+        )
+        .unwrap();
+        assert_eq!(load_manifest(&j).unwrap().len(), 1);
+        // Larger than the JSON cap: refused from its size, before a byte is parsed.
+        let f = std::fs::File::create(&j).unwrap();
+        f.set_len(MAX_JSON_MANIFEST_BYTES + 1).unwrap();
+        let e = load_manifest(&j).unwrap_err().to_string();
+        assert!(e.contains("frames.json"), "{e}");
         let _ = std::fs::remove_dir_all(&dir);
     }
 }

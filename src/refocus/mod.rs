@@ -39,8 +39,18 @@ pub struct RefocusSource {
 }
 
 impl RefocusSource {
-    /// Checks the intrinsics, that colour and depth are the same size, and that neither side is 0.
+    /// Checks the source ([`RefocusSource::validate`]).
     pub fn new(rgb: RgbImage, depth: DepthMap, k: Intrinsics) -> Result<Self> {
+        let src = RefocusSource { rgb, depth, k };
+        src.validate()?;
+        Ok(src)
+    }
+
+    /// Checks the intrinsics, that colour and depth are the same size, that neither side is 0,
+    /// and that every depth value is usable ([`crate::depth::check_usable_depth`]). The fields
+    /// are public, so the renderers and the twin check again.
+    pub fn validate(&self) -> Result<()> {
+        let RefocusSource { rgb, depth, k } = self;
         k.validate("source intrinsics")?;
         if (rgb.width, rgb.height) != (depth.width, depth.height) {
             return Err(Error::SizeMismatch {
@@ -57,7 +67,7 @@ impl RefocusSource {
                 format!("{}x{} has a zero side", rgb.width, rgb.height),
             ));
         }
-        Ok(RefocusSource { rgb, depth, k })
+        crate::depth::check_usable_depth("source depth", &depth.data)
     }
 
     /// The source camera: intrinsics and image size.

@@ -40,6 +40,9 @@ pub fn gpu(gpu: &Gpu, input: &RefocusInput) -> Result<ViewOutput> {
 /// The float64 twin of `input`, with the planes `input.outputs` leaves out removed.
 pub fn reference(input: &RefocusInput) -> Result<ViewOutput> {
     input.rule.validate()?;
+    input.source.validate()?;
+    // As the renderer does: the twin refuses what the GPU refuses.
+    input.target.validate("target camera")?;
     let r = refocus_reference(input.source, &input.rule, input.target);
     let mut view = ViewOutput::from_refocus_reference(&r);
     let o = input.outputs;
@@ -53,6 +56,15 @@ pub fn reference(input: &RefocusInput) -> Result<ViewOutput> {
         view.mask = None;
     }
     Ok(view)
+}
+
+impl super::RefocusOutput {
+    /// [`crate::view::clear_non_finite`] on the planes read back.
+    pub fn finite(mut self) -> Self {
+        let mask = self.mask.as_mut().map(|m| m.data.as_mut_slice());
+        crate::view::clear_non_finite(self.depth.as_mut().map(|d| d.data.as_mut_slice()), mask);
+        self
+    }
 }
 
 impl ViewOutput {

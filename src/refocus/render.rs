@@ -124,7 +124,8 @@ impl PendingRefocus {
                 wall_ms: self.submit_ms,
             },
             readback_ms,
-        })
+        }
+        .finite())
     }
 }
 
@@ -174,6 +175,7 @@ impl Refocuser {
 
     /// Upload a new source, reusing the previous source's textures when the size matches.
     pub fn set_source(&mut self, src: &RefocusSource) -> Result<()> {
+        src.validate()?;
         let gpu = self.gpu.clone();
         let (w, h) = (src.rgb.width, src.rgb.height);
         // The grid's cells include a half-pixel border ring: (w + 1) x (h + 1) of them, each a

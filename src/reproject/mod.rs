@@ -65,7 +65,9 @@ pub struct ReprojectSource {
 }
 
 impl ReprojectSource {
-    /// Refuses colour and depth of different sizes, fewer than 2 columns, view distance as depth, and bad encoding parameters.
+    /// Refuses colour and depth of different sizes, fewer than 2 columns, view distance as depth,
+    /// bad encoding parameters and depth values outside the usable magnitudes
+    /// ([`crate::depth::check_usable_depth`]).
     pub fn validate(&self) -> Result<()> {
         if (self.color.width, self.color.height) != (self.depth.width, self.depth.height) {
             return Err(Error::SizeMismatch {
@@ -82,7 +84,8 @@ impl ReprojectSource {
             "source depth kind",
             &[DepthKind::ViewZ, DepthKind::Device, DepthKind::Disparity],
         )?;
-        self.depth_kind.validate()
+        self.depth_kind.validate()?;
+        crate::depth::check_usable_depth("source depth", &self.depth.data)
     }
 
     /// Per-pixel inverse depth (rows top-down), None where invalid.
@@ -299,7 +302,12 @@ impl ReprojectOutput {
 fn cyclopean_depth(src: &ReprojectSource) -> (DepthMap, FrameDepth) {
     match src.depth_kind {
         DepthEncoding::Device { .. } => (src.depth.clone(), FrameDepth::Device),
-        _ => (src.depth_kind.view_z_map(&src.conv, &src.depth), FrameDepth::ViewZ),
+        _ => {
+            // Disparity -> view Z can leave the usable magnitudes: those become holes.
+            let mut z = src.depth_kind.view_z_map(&src.conv, &src.depth);
+            crate::depth::clear_unusable_depth(&mut z.data);
+            (z, FrameDepth::ViewZ)
+        }
     }
 }
 

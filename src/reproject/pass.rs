@@ -49,6 +49,14 @@ pub fn reference(input: &ReprojectInput) -> Result<ViewOutput> {
     Ok(view)
 }
 
+impl super::ReprojectOutput {
+    /// [`crate::view::clear_non_finite`] on the planes read back.
+    pub fn finite(mut self) -> Self {
+        crate::view::clear_non_finite(self.depth.as_mut().map(|d| d.data.as_mut_slice()), Some(&mut self.mask));
+        self
+    }
+}
+
 impl ViewOutput {
     /// A reprojection GPU output of a `width` x `height` target.
     pub fn from_reproject(

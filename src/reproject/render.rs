@@ -183,7 +183,8 @@ impl Reprojector {
                             .then(|| DepthMap::new(target.width, target.height, depth))
                             .transpose()?,
                         mask,
-                    },
+                    }
+                    .finite(),
                     timing,
                 ))
             }
@@ -201,13 +202,10 @@ impl Reprojector {
                     triangles: 1,
                 };
                 let mut out = self.device.render(&target, &[draw])?;
-                let color = out.color(0)?;
-                let depth = out.depth(1)?.map(|mut d| {
-                    d.data.iter_mut().filter(|z| !z.is_finite()).for_each(|z| *z = 0.0);
-                    d
-                });
+                // A non-finite depth makes its pixel invalid (`finite`, below).
+                let (color, depth) = (out.color(0)?, out.depth(1)?);
                 let mask = out.take(2, "reproject shift")?;
-                Ok((ReprojectOutput { color, depth, mask }, out.timing))
+                Ok((ReprojectOutput { color, depth, mask }.finite(), out.timing))
             }
         }
     }

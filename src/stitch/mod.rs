@@ -320,7 +320,9 @@ impl FaceSet {
         self.faces.first().map_or(0, |f| f.color.width)
     }
 
-    /// Refuses a bad rig, a FOV outside (90, 178) deg, other than six faces, and faces that are not all N x N with 2 <= N <= 16384.
+    /// Refuses a bad rig, a FOV outside (90, 178) deg, other than six faces, faces that are not
+    /// all N x N with 2 <= N <= 16384, and depth values outside the usable magnitudes
+    /// ([`crate::depth::check_usable_depth`]).
     pub fn validate(&self) -> Result<()> {
         self.rig.validate()?;
         if !(self.fov_deg > 90.0 && self.fov_deg < 178.0) {
@@ -355,6 +357,7 @@ impl FaceSet {
                     message: format!("face {}: buffer lengths", f.label()),
                 });
             }
+            crate::depth::check_usable_depth(&format!("face {} depth", f.label()), &d.data)?;
         }
         Ok(())
     }

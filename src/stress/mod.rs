@@ -15,12 +15,15 @@
 //! - [`camera`]: projection matrices as f32 uniforms, parallax, vergence (CPU; the f32 arithmetic
 //!   of a vertex shader emulated, no readback involved).
 //! - [`refocus`], [`cyclopean`], [`reproject`], [`stitch`]: the GPU passes.
+//! - [`values`]: every GPU capability over the whole f32/f64 value range (depth, focal
+//!   lengths), with the rule that a valid pixel has finite outputs (GPU and twin).
 
 pub mod camera;
 pub mod cyclopean;
 pub mod refocus;
 pub mod reproject;
 pub mod stitch;
+pub mod values;
 
 use crate::error::Result;
 use crate::gpu::Gpu;
@@ -296,6 +299,7 @@ pub fn run_stress(gpu: &Gpu, capabilities: &[&str], opts: StressOptions) -> Resu
                 ))
             }
         }
+        rows.extend(values::rows(gpu, cap, opts)?);
     }
     Ok(rows)
 }

@@ -38,7 +38,6 @@ fn type_name(t: vk::PhysicalDeviceType) -> &'static str {
     }
 }
 
-
 struct Instance {
     // The entry keeps libvulkan loaded for as long as the instance lives.
     _entry: ash::Entry,
@@ -151,7 +150,6 @@ pub fn list_devices() -> Result<Vec<VulkanDeviceInfo>> {
     let instance = create_instance()?;
     Ok(enumerate(&instance.raw)?.into_iter().map(|(_, d)| d).collect())
 }
-
 
 /// An open logical device with one graphics queue and a command pool. Shared (`Vk`) by every
 /// object created on it, so it outlives them.

@@ -217,6 +217,7 @@ impl VkRefocuser {
 
     /// Upload a new source (replacing the previous one).
     pub fn set_source(&mut self, src: &RefocusSource) -> Result<()> {
+        src.validate()?;
         let vk = self.vk.clone();
         let (w, h) = (src.rgb.width, src.rgb.height);
         // As under GL: (w + 1) x (h + 1) cells are texels of one image.
@@ -463,7 +464,8 @@ impl VkRefocuser {
                 wall_ms: render_ms,
             },
             readback_ms: t1.elapsed().as_secs_f64() * 1e3,
-        })
+        }
+        .finite())
     }
 }
 

@@ -160,11 +160,6 @@ fn round3_every_option_refuses_an_invalid_value_with_exit_2_naming_it() {
         let options = value_options(cmd);
         assert!(options.len() >= 3, "{cmd}: options not found in --help: {options:?}");
         for opt in options {
-            // Known gaps (see the closing note): an --npz-key for a depth file that is no
-            // .npz, and report's --case names, are found while running (exit 1).
-            if opt == "npz-key" || (*cmd, opt.as_str()) == ("report", "case") {
-                continue;
-            }
             let bad = invalid_value(cmd, &opt);
             let mut args = vec![cmd.to_string()];
             for (k, v) in base.iter().filter(|(k, _)| *k != opt) {
@@ -837,6 +832,683 @@ fn round3_resume_verifies_folders_and_float_settings() {
     cases += 1;
     if before != after {
         failures.push("the folder the symlink points to changed".into());
+    }
+    report(failures, cases);
+}
+
+/// Depth values a library caller can put in a `DepthMap` by hand that every pass must refuse
+/// (the loaders make them holes): subnormals, below 1e-6, above 1e6, up to f32::MAX.
+const UNUSABLE: [f32; 9] = [1e-45, 1e-40, 1e-38, 1e-7, 1.5e6, 1e38, f32::MAX, -1e-40, -1e38];
+
+/// Overwrites every third depth value with `v` (the rest keeps the scene, so the pass has
+/// neighbours of ordinary depth next to the extreme one).
+fn plant(depth: &mut DepthMap, v: f32) {
+    depth.data.iter_mut().step_by(3).for_each(|z| *z = v);
+}
+
+/// Whether `res` is a refusal naming depth (not a panic, not a run).
+fn refused_naming_depth<T>(res: viewsynth::Result<T>) -> Result<(), String> {
+    match res {
+        Ok(_) => Err("accepted".into()),
+        Err(e) if e.to_string().contains("depth") && e.to_string().contains("usable") => Ok(()),
+        Err(e) => Err(format!("refused without naming depth: {e}")),
+    }
+}
+
+/// Pixels the mask marks valid whose depth is not finite (every plane the view has).
+fn valid_non_finite(v: &viewsynth::view::ViewOutput) -> usize {
+    match (&v.depth, &v.mask) {
+        (Some(d), Some(m)) => d
+            .data
+            .iter()
+            .zip(&m.data)
+            .filter(|(z, m)| **m != 0 && !z.is_finite())
+            .count(),
+        _ => 0,
+    }
+}
+
+#[test]
+fn round3_library_passes_refuse_unusable_depth_and_are_finite_where_valid() {
+    use viewsynth::cyclopean::forward::ForwardWarp;
+    use viewsynth::cyclopean::scene_frame::{scene_frame, StereoRig};
+    use viewsynth::cyclopean::splat::SplatParams;
+    use viewsynth::cyclopean::{self, CyclopeanInput, CyclopeanOutputs, CyclopeanParams, CyclopeanPass, FrameDepth};
+    use viewsynth::depth::clear_unusable_depth;
+    use viewsynth::refocus::{self, BreakRule, Method, OutputSet, RefocusInput, RefocusSource};
+    use viewsynth::reproject::{self, ReprojectInput};
+    use viewsynth::stitch::{self, faces::scene_faces, OdsRig, Side, StitchInput, StitchParams};
+    use viewsynth::view::ViewOutput;
+
+    let g = crate::common::gpu();
+    let conv = viewsynth::convention::Conventions::default();
+    let mut failures = Vec::new();
+    let mut cases = 0;
+    let check = |tag: String, views: Vec<viewsynth::Result<ViewOutput>>, failures: &mut Vec<String>| {
+        for v in views {
+            match v {
+                Ok(v) if valid_non_finite(&v) > 0 => {
+                    failures.push(format!("{tag}: {} valid pixels not finite", valid_non_finite(&v)))
+                }
+                Ok(v) if !v.finite_where_valid() => failures.push(format!("{tag}: finite_where_valid false")),
+                Ok(_) => {}
+                Err(e) => failures.push(format!("{tag}: cleared input refused: {e}")),
+            }
+        }
+    };
+
+    // Refocus, both GPU methods and the twin: the source refused, then run once cleared.
+    let base = crate::common::synthetic(W, H);
+    for v in UNUSABLE {
+        let mut depth = base.depth.clone();
+        plant(&mut depth, v);
+        cases += 1;
+        if let Err(e) = refused_naming_depth(RefocusSource::new(base.rgb.clone(), depth.clone(), base.k)) {
+            failures.push(format!("refocus source {v:e}: {e}"));
+        }
+        // Built field by field (the fields are public): the renderer and the twin check too.
+        let raw = RefocusSource {
+            rgb: base.rgb.clone(),
+            depth: depth.clone(),
+            k: base.k,
+        };
+        let target = base.camera();
+        for method in [Method::Fullscreen, Method::Mesh] {
+            let input = RefocusInput {
+                source: &raw,
+                target: &target,
+                rule: BreakRule::default(),
+                method,
+                outputs: OutputSet::default(),
+                conv,
+            };
+            cases += 2;
+            for (side, res) in [
+                ("gpu", refocus::pass::gpu(&g, &input)),
+                ("twin", refocus::pass::reference(&input)),
+            ] {
+                if let Err(e) = refused_naming_depth(res) {
+                    failures.push(format!("refocus {method:?} {side} {v:e}: {e}"));
+                }
+            }
+        }
+        clear_unusable_depth(&mut depth.data);
+        let src = RefocusSource::new(base.rgb.clone(), depth, base.k).unwrap();
+        // Target focal lengths at the bounds of the intrinsics (1e-3 and 1e6 px).
+        for scale in [1.0, 1e-3 / base.k.fx, 1e6 / base.k.fx] {
+            let mut target = src.camera();
+            target.k.fx *= scale;
+            target.k.fy *= scale;
+            for method in [Method::Fullscreen, Method::Mesh] {
+                let input = RefocusInput {
+                    source: &src,
+                    target: &target,
+                    rule: BreakRule::default(),
+                    method,
+                    outputs: OutputSet::default(),
+                    conv,
+                };
+                cases += 1;
+                check(
+                    format!("refocus {method:?} {v:e} scale {scale:e}"),
+                    vec![refocus::pass::gpu(&g, &input), refocus::pass::reference(&input)],
+                    &mut failures,
+                );
+            }
+        }
+    }
+    // Subnormal and out-of-range focal lengths are refused by name, source and target alike.
+    for f in [5e-324, 1e-40, 1e-4, 1.1e6, 1e300] {
+        cases += 2;
+        let mut k = base.k;
+        k.fx = f;
+        match RefocusSource::new(base.rgb.clone(), base.depth.clone(), k) {
+            Err(e) if e.to_string().contains("fx") => {}
+            other => failures.push(format!("source fx {f:e}: {:?}", other.err())),
+        }
+        let mut target = base.camera();
+        target.k.fy = f;
+        let input = RefocusInput {
+            source: &base,
+            target: &target,
+            rule: BreakRule::default(),
+            method: Method::Fullscreen,
+            outputs: OutputSet::default(),
+            conv,
+        };
+        match refocus::pass::gpu(&g, &input) {
+            Err(e) if e.to_string().contains("fy") => {}
+            other => failures.push(format!("target fy {f:e}: {:?}", other.err())),
+        }
+    }
+
+    // Cyclopean: seed, refine, splat-gather (twin and GPU) and the forward warp, either eye.
+    let (frame0, mid, _) = scene_frame(&StereoRig::demo(W, H), conv, FrameDepth::ViewZ);
+    let passes = [
+        CyclopeanPass::Gather(CyclopeanParams::seed(3.0)),
+        CyclopeanPass::Gather(CyclopeanParams {
+            method: cyclopean::Method::Refine { steps: 4 },
+            ..CyclopeanParams::seed(3.0)
+        }),
+        CyclopeanPass::Splat(SplatParams::default()),
+    ];
+    for v in UNUSABLE {
+        for eye in 0..2 {
+            let mut frame = frame0.clone();
+            let e = if eye == 0 { &mut frame.left } else { &mut frame.right };
+            plant(&mut e.depth, v);
+            for pass in passes {
+                let input = CyclopeanInput {
+                    frame: &frame,
+                    mid: &mid,
+                    pass,
+                    outputs: CyclopeanOutputs::default(),
+                };
+                cases += 2;
+                for (side, res) in [
+                    ("gpu", cyclopean::pass::gpu(&g, &input)),
+                    ("twin", cyclopean::pass::reference(&input)),
+                ] {
+                    if let Err(e) = refused_naming_depth(res) {
+                        failures.push(format!("cyclopean {pass:?} {side} eye {eye} {v:e}: {e}"));
+                    }
+                }
+            }
+            cases += 1;
+            if let Err(e) = refused_naming_depth(ForwardWarp::new(&g, &frame, &BreakRule::default())) {
+                failures.push(format!("cyclopean forward eye {eye} {v:e}: {e}"));
+            }
+            for e in [&mut frame.left, &mut frame.right] {
+                clear_unusable_depth(&mut e.depth.data);
+            }
+            for pass in passes {
+                let input = CyclopeanInput {
+                    frame: &frame,
+                    mid: &mid,
+                    pass,
+                    outputs: CyclopeanOutputs::default(),
+                };
+                cases += 1;
+                check(
+                    format!("cyclopean {pass:?} eye {eye} {v:e}"),
+                    vec![cyclopean::pass::gpu(&g, &input), cyclopean::pass::reference(&input)],
+                    &mut failures,
+                );
+            }
+            cases += 1;
+            let fwd = ForwardWarp::new(&g, &frame, &BreakRule::default()).and_then(|mut f| f.render(&mid));
+            check(
+                format!("cyclopean forward eye {eye} {v:e}"),
+                vec![fwd.map(|(o, _)| ViewOutput::from_cyclopean(&o, mid.width, mid.height, None))],
+                &mut failures,
+            );
+        }
+    }
+    // Disparity frames: tiny and huge disparities and focal lengths at the bounds become holes
+    // where f B / d leaves the usable range, never refused, never valid-and-NaN.
+    {
+        use viewsynth::cyclopean::disparity_frame::{disparity_frame, DisparityRig};
+        for focal in [1e-3, 1.0, 1e6] {
+            let mut disp = DepthMap::new(W, H, vec![4.0; (W * H) as usize]).unwrap();
+            for (i, z) in disp.data.iter_mut().enumerate() {
+                *z = [1e-40, 1e-38, 1e-7, 1e38, f32::MAX, 4.0][i % 6];
+            }
+            let rgb = base.rgb.clone();
+            let (frame, mid) = disparity_frame(
+                (rgb.clone(), disp.clone()),
+                (rgb, disp),
+                &DisparityRig::middle(focal, 0.1),
+                conv,
+            )
+            .unwrap();
+            for pass in passes {
+                let input = CyclopeanInput {
+                    frame: &frame,
+                    mid: &mid,
+                    pass,
+                    outputs: CyclopeanOutputs::default(),
+                };
+                cases += 1;
+                check(
+                    format!("disparity frame focal {focal:e} {pass:?}"),
+                    vec![cyclopean::pass::gpu(&g, &input), cyclopean::pass::reference(&input)],
+                    &mut failures,
+                );
+            }
+        }
+    }
+
+    // Reproject: shift, shift-scan and gather3d, view Z and device depth sources.
+    for kind in [FrameDepth::ViewZ, FrameDepth::Device] {
+        let cases0 = viewsynth::eval::reproject::scene_cases(W, H, 0.2, conv, kind).unwrap();
+        let case = &cases0[0];
+        for v in UNUSABLE {
+            let mut source = case.source.clone();
+            plant(&mut source.depth, v);
+            for params in viewsynth::eval::reproject::methods() {
+                let input = ReprojectInput {
+                    source: &source,
+                    geometry: &case.geometry,
+                    params,
+                };
+                cases += 2;
+                for (side, res) in [
+                    ("gpu", reproject::pass::gpu(&g, &input)),
+                    ("twin", reproject::pass::reference(&input)),
+                ] {
+                    if let Err(e) = refused_naming_depth(res) {
+                        failures.push(format!("reproject {kind:?} {:?} {side} {v:e}: {e}", params.method));
+                    }
+                }
+            }
+            clear_unusable_depth(&mut source.depth.data);
+            for params in viewsynth::eval::reproject::methods() {
+                let input = ReprojectInput {
+                    source: &source,
+                    geometry: &case.geometry,
+                    params,
+                };
+                cases += 1;
+                check(
+                    format!("reproject {kind:?} {:?} {v:e}", params.method),
+                    vec![reproject::pass::gpu(&g, &input), reproject::pass::reference(&input)],
+                    &mut failures,
+                );
+            }
+        }
+    }
+
+    // Stitch (colour only): refused on any face of either eye, and runs once cleared.
+    let rig = OdsRig::demo();
+    let (l0, r0) = (
+        scene_faces(&rig, Side::Left, 8, 100.0).unwrap(),
+        scene_faces(&rig, Side::Right, 8, 100.0).unwrap(),
+    );
+    let params = StitchParams {
+        method: stitch::Method::ALL[0],
+        overlap_deg: 5.0,
+        width: 32,
+        height: 16,
+    };
+    for v in UNUSABLE {
+        for face in [0, 5] {
+            let mut l = l0.clone();
+            plant(&mut l.faces[face].depth, v);
+            let input = StitchInput {
+                left: &l,
+                right: &r0,
+                params,
+                conv,
+            };
+            cases += 2;
+            for (side, res) in [
+                ("gpu", stitch::pass::gpu(&g, &input)),
+                ("twin", stitch::pass::reference(&input)),
+            ] {
+                if let Err(e) = refused_naming_depth(res) {
+                    failures.push(format!("stitch face {face} {side} {v:e}: {e}"));
+                }
+            }
+            clear_unusable_depth(&mut l.faces[face].depth.data);
+            let input = StitchInput {
+                left: &l,
+                right: &r0,
+                params,
+                conv,
+            };
+            cases += 1;
+            check(
+                format!("stitch face {face} {v:e}"),
+                vec![stitch::pass::gpu(&g, &input), stitch::pass::reference(&input)],
+                &mut failures,
+            );
+        }
+    }
+    report(failures, cases);
+}
+
+#[test]
+fn round3_output_rule_invalidates_non_finite_depth() {
+    use viewsynth::view::clear_non_finite;
+    let mut depth = vec![1.0, f32::NAN, f32::INFINITY, -f32::INFINITY, 2.0, f32::NAN];
+    let mut mask = vec![255, 255, 1, 0, 255, 0];
+    // Two valid pixels had non-finite depth; the two already invalid are not counted.
+    assert_eq!(clear_non_finite(Some(&mut depth), Some(&mut mask)), 2);
+    assert_eq!(mask, vec![255, 0, 0, 0, 255, 0]);
+    assert!(depth.iter().all(|z| z.is_finite()));
+    assert_eq!(depth, vec![1.0, 0.0, 0.0, 0.0, 2.0, 0.0]);
+    // Without depth there is nothing to test: the mask is left alone.
+    let mut mask = vec![255; 3];
+    assert_eq!(clear_non_finite(None, Some(&mut mask)), 0);
+    assert_eq!(mask, vec![255; 3]);
+}
+
+/// The chunk offset table of an EXR `save_depth_exr` wrote: (position, entries). Found as the
+/// run of increasing u64s whose first entry points just past the table.
+fn exr_offset_table(bytes: &[u8]) -> (usize, usize) {
+    let at = |p: usize| u64::from_le_bytes(bytes[p..p + 8].try_into().unwrap()) as usize;
+    for count in 1..64 {
+        for p in 8..bytes.len().saturating_sub(8 * count) {
+            if at(p) == p + 8 * count && (1..count).all(|i| at(p + 8 * i) > at(p + 8 * (i - 1))) {
+                return (p, count);
+            }
+        }
+    }
+    panic!("no offset table found");
+}
+
+/// Runs `args`, expecting exit `code`, every one of `words` in stderr and `out` unchanged.
+fn expect_exit(out: &Path, what: &str, args: Vec<String>, code: i32, words: &[&str], failures: &mut Vec<String>) {
+    let before = files_in(out);
+    let res = run(&args);
+    let err = String::from_utf8_lossy(&res.stderr);
+    let mut problems = Vec::new();
+    if res.status.code() != Some(code) {
+        problems.push(format!("exit {:?}, expected {code}", res.status.code()));
+    }
+    for w in words {
+        if !err.contains(w) {
+            problems.push(format!("message lacks '{w}'"));
+        }
+    }
+    if files_in(out) != before {
+        problems.push("the out-dir changed".into());
+    }
+    if !problems.is_empty() {
+        failures.push(format!("{what}: {} -- {}", problems.join("; "), err.trim()));
+    }
+}
+
+#[test]
+fn round3_class6_leftovers_are_refused_by_name() {
+    let root = scratch("r3-class6");
+    let (rgb, npy) = inputs(&root);
+    let out = root.join("out");
+    let (r, d, o) = (p(&rgb), p(&npy), p(&out));
+    let mut failures = Vec::new();
+    let mut cases = 0;
+
+    // --npz-key on a depth file that is no .npz: the command line is wrong, before any work.
+    let npz_key_lines: Vec<(&str, Vec<String>)> = vec![
+        (
+            "refocus",
+            s(&[
+                "refocus",
+                "--rgb",
+                &r,
+                "--depth",
+                &d,
+                "--fx",
+                "40",
+                "--fy",
+                "40",
+                "--cx",
+                "15.5",
+                "--cy",
+                "11.5",
+                "--out-dir",
+                &o,
+            ]),
+        ),
+        (
+            "reproject",
+            s(&[
+                "reproject",
+                "--color",
+                &r,
+                "--depth",
+                &d,
+                "--fx",
+                "40",
+                "--fy",
+                "40",
+                "--cx",
+                "15.5",
+                "--cy",
+                "11.5",
+                "--baseline",
+                "0.1",
+                "--out-dir",
+                &o,
+            ]),
+        ),
+        (
+            "cyclopean",
+            s(&[
+                "cyclopean",
+                "--left-rgb",
+                &r,
+                "--right-rgb",
+                &r,
+                "--left-disparity",
+                &d,
+                "--right-disparity",
+                &d,
+                "--out-dir",
+                &o,
+            ]),
+        ),
+        (
+            "compare",
+            s(&[
+                "compare",
+                "--a-rgb",
+                &r,
+                "--b-rgb",
+                &r,
+                "--a-depth",
+                &d,
+                "--b-depth",
+                &d,
+            ]),
+        ),
+        (
+            "stitch (built-in scene)",
+            s(&["stitch", "--scene", "demo", "--out-dir", &o]),
+        ),
+    ];
+    for (cmd, args) in npz_key_lines {
+        for key in ["depth", "arr_0", ""] {
+            let mut a = args.clone();
+            a.extend(s(&["--npz-key", key]));
+            cases += 1;
+            expect_exit(
+                &out,
+                &format!("{cmd} --npz-key '{key}'"),
+                a,
+                2,
+                &["--npz-key"],
+                &mut failures,
+            );
+        }
+    }
+
+    // report --case that is no case folder: exit 2 naming --case, before the GPU opens.
+    for case in [p(&root.join("no-such-case")), p(&rgb), p(&root)] {
+        cases += 1;
+        expect_exit(
+            &out,
+            &format!("report --case {case}"),
+            s(&["report", "--out-dir", &o, "--case", &case]),
+            2,
+            &["--case", "cameras.json"],
+            &mut failures,
+        );
+    }
+
+    // cyclopean rig values: out of the flags' bounds (exit 2), or in bounds but putting every
+    // disparity outside the usable depths (exit 1), named either way, never a silent 0 % view.
+    let cyc = s(&[
+        "cyclopean",
+        "--left-rgb",
+        &r,
+        "--right-rgb",
+        &r,
+        "--left-disparity",
+        &d,
+        "--right-disparity",
+        &d,
+        "--out-dir",
+        &o,
+    ]);
+    for (focal, baseline, code, name) in [
+        ("1e300", "0.1", 2, "--focal"),
+        ("5e-324", "0.1", 2, "--focal"),
+        ("1e-4", "0.1", 2, "--focal"),
+        ("100", "1e300", 2, "--baseline"),
+        ("100", "1e-300", 2, "--baseline"),
+        ("1e6", "1e6", 1, "--focal/--baseline"),
+        ("1e-3", "1e-6", 1, "--focal/--baseline"),
+    ] {
+        let mut a = cyc.clone();
+        a.extend(s(&["--focal", focal, "--baseline", baseline]));
+        cases += 1;
+        expect_exit(
+            &out,
+            &format!("cyclopean --focal {focal} --baseline {baseline}"),
+            a,
+            code,
+            &[name],
+            &mut failures,
+        );
+    }
+
+    // compare: all-NaN depth on both sides compares no depth, so a depth limit fails.
+    let nan = root.join("nan.npy");
+    io::save_depth_npy(&nan, &DepthMap::new(W, H, vec![f32::NAN; (W * H) as usize]).unwrap()).unwrap();
+    let n = p(&nan);
+    for extra in [vec![], s(&["--b-depth-kind", "view-z"])] {
+        let mut a = s(&[
+            "compare",
+            "--a-rgb",
+            &r,
+            "--b-rgb",
+            &r,
+            "--a-depth",
+            &n,
+            "--b-depth",
+            &n,
+            "--max-depth-rel",
+            "0.001",
+        ]);
+        a.extend(extra);
+        cases += 1;
+        let res = run(&a);
+        let text = format!(
+            "{}{}",
+            String::from_utf8_lossy(&res.stdout),
+            String::from_utf8_lossy(&res.stderr)
+        );
+        if res.status.success() || !text.contains("no depth was compared") {
+            failures.push(format!(
+                "compare all-NaN depth: exit {:?} -- {}",
+                res.status.code(),
+                text.trim()
+            ));
+        }
+    }
+    // ... while one finite pixel on each side is compared (and passes).
+    let mut one = vec![f32::NAN; (W * H) as usize];
+    one[5] = 2.0;
+    let one_path = root.join("one.npy");
+    io::save_depth_npy(&one_path, &DepthMap::new(W, H, one).unwrap()).unwrap();
+    let o1 = p(&one_path);
+    cases += 1;
+    let res = run(&s(&[
+        "compare",
+        "--a-rgb",
+        &r,
+        "--b-rgb",
+        &r,
+        "--a-depth",
+        &o1,
+        "--b-depth",
+        &o1,
+        "--max-depth-rel",
+        "0.001",
+    ]));
+    if !res.status.success() {
+        failures.push(format!(
+            "compare with one finite depth: {}",
+            String::from_utf8_lossy(&res.stderr)
+        ));
+    }
+
+    // Corrupt EXR offset tables: every entry at line 0, past the end, before the table,
+    // swapped; each refused by name (library and CLI), the intact file loads.
+    let exr = root.join("d.exr");
+    let depth: Vec<f32> = (0..W * H).map(|i| 1.0 + 0.01 * (i % W) as f32).collect();
+    io::save_depth_exr(&exr, &DepthMap::new(W, H, depth.clone()).unwrap()).unwrap();
+    let good = std::fs::read(&exr).unwrap();
+    let (table, count) = exr_offset_table(&good);
+    assert!(count >= 2, "{count} chunks: too few to corrupt");
+    assert_eq!(io::load_depth(&exr, &Default::default()).unwrap().data, depth);
+    let entry = |b: &[u8], i: usize| b[table + 8 * i..table + 8 * i + 8].to_vec();
+    type Corrupt<'a> = Box<dyn Fn(&mut Vec<u8>) + 'a>;
+    let corruptions: Vec<(&str, Corrupt)> = vec![
+        (
+            "every entry at the first chunk",
+            Box::new(|b: &mut Vec<u8>| {
+                let first = entry(b, 0);
+                (1..count).for_each(|i| b[table + 8 * i..table + 8 * i + 8].copy_from_slice(&first));
+            }),
+        ),
+        (
+            "an entry past the end",
+            Box::new(|b: &mut Vec<u8>| {
+                let past = (b.len() as u64 + 100).to_le_bytes();
+                b[table + 8..table + 16].copy_from_slice(&past);
+            }),
+        ),
+        (
+            "an entry inside the header",
+            Box::new(|b: &mut Vec<u8>| b[table..table + 8].copy_from_slice(&8u64.to_le_bytes())),
+        ),
+        (
+            "two entries swapped",
+            Box::new(|b: &mut Vec<u8>| {
+                let (a, c) = (entry(b, 0), entry(b, 1));
+                b[table..table + 8].copy_from_slice(&c);
+                b[table + 8..table + 16].copy_from_slice(&a);
+            }),
+        ),
+    ];
+    for (what, corrupt) in corruptions {
+        let mut bytes = good.clone();
+        corrupt(&mut bytes);
+        let bad = root.join("bad.exr");
+        std::fs::write(&bad, &bytes).unwrap();
+        cases += 1;
+        match io::load_depth(&bad, &Default::default()) {
+            Err(e) if e.to_string().contains("bad.exr") && e.to_string().contains("offset table") => {}
+            other => failures.push(format!("EXR {what}: {:?}", other.map(|d| d.data.len()))),
+        }
+        let b = p(&bad);
+        cases += 1;
+        expect_exit(
+            &out,
+            &format!("refocus with an EXR whose table has {what}"),
+            s(&[
+                "refocus",
+                "--rgb",
+                &r,
+                "--depth",
+                &b,
+                "--fx",
+                "40",
+                "--fy",
+                "40",
+                "--cx",
+                "15.5",
+                "--cy",
+                "11.5",
+                "--out-dir",
+                &o,
+            ]),
+            1,
+            &["bad.exr", "offset table"],
+            &mut failures,
+        );
     }
     report(failures, cases);
 }

@@ -23,6 +23,22 @@ fn quick_sweep_of_every_capability_passes_with_no_nan_or_inf() {
     assert!(lossy
         .iter()
         .all(|r| !r.case.contains("reversed-Z") && !r.case.contains("vk-rev")));
+    // The value sweeps (issue 23): every GPU capability over the whole f32/f64 range, GPU and
+    // twin compared, refusals alike, and no valid pixel with a non-finite output.
+    for cap in ["refocus", "cyclopean", "reproject", "stitch"] {
+        let sweeps: Vec<_> = rows
+            .iter()
+            .filter(|r| r.capability == cap && r.case.starts_with("value sweep"))
+            .collect();
+        assert!(!sweeps.is_empty(), "no value sweep for {cap}");
+        for r in sweeps {
+            assert!(r.pass && r.non_finite == 0 && r.pixels > 0, "{r:?}");
+            assert!(
+                r.note.contains("refused on both sides") && !r.note.contains("first problem"),
+                "{r:?}"
+            );
+        }
+    }
     // One past the context's largest image side is refused, naming the size and the limit, by
     // every GPU capability (refocus: its source and its output).
     let limit = g.max_image_side();

@@ -40,6 +40,7 @@ pub(crate) struct ReportArgs {
 impl TryFrom<ReportArgs> for ReportJob {
     type Error = ArgError;
     fn try_from(a: ReportArgs) -> Result<Self, ArgError> {
+        ReportJob::check_cases(&a.cases)?;
         Ok(ReportJob {
             out_dir: a.out_dir,
             data_dir: a.data_dir,
