@@ -87,6 +87,10 @@ fn main() {
     println!("cargo:rerun-if-changed=shaders/programs.rs");
     write_khronos_bindings(&out);
     write_shader_files(&root, &out);
+    // A GL-only build (no `vulkan` feature) compiles no SPIR-V and needs no glslangValidator.
+    if std::env::var_os("CARGO_FEATURE_VULKAN").is_none() {
+        return;
+    }
     let exe = glslang();
     let shader = |rel: &str| read(&root, &format!("shaders/{rel}"));
     let common_layer = shader(VULKAN_COMMON) + "\n";

@@ -67,6 +67,10 @@ pub mod ssim;
 pub mod stitch;
 pub mod stress;
 pub mod view;
+#[cfg(feature = "vulkan")]
+pub mod vulkan;
+#[cfg(not(feature = "vulkan"))]
+#[path = "vulkan_off.rs"]
 pub mod vulkan;
 
 #[cfg(test)]

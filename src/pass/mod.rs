@@ -517,9 +517,4 @@ impl<T> Slots<T> {
             *slot = None;
         }
     }
-
-    /// Drop every value.
-    pub(crate) fn clear(&mut self) {
-        self.0.clear();
-    }
 }

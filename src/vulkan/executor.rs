@@ -784,8 +784,8 @@ impl Drop for VkExecutor {
     fn drop(&mut self) {
         self.pipelines.clear();
         self.targets.clear();
-        self.images.clear();
-        self.buffers.clear();
+        self.images = Slots::default();
+        self.buffers = Slots::default();
         self.params = None;
         let d = &self.vk.device;
         // SAFETY: owned handles (null ones are ignored by Vulkan); no submit is pending.

@@ -136,6 +136,7 @@ fn splat_gather_gpu_matches_its_f64_twin() {
 
 /// The Vulkan executor running the same pass descriptions meets the GL bounds above.
 #[test]
+#[cfg(feature = "vulkan")]
 fn vulkan_splat_gather_matches_its_f64_twin() {
     splat_gather_twin(&viewsynth::vulkan::VkExecutor::device(&crate::vulkan_refocus::vulkan()).unwrap());
 }

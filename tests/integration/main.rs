@@ -29,7 +29,11 @@ mod scene;
 mod shader_library;
 mod stitch;
 mod stress;
+#[cfg(feature = "vulkan")]
 mod vulkan_cli;
+#[cfg(feature = "vulkan")]
 mod vulkan_cyclopean;
+#[cfg(feature = "vulkan")]
 mod vulkan_passes;
+#[cfg(feature = "vulkan")]
 mod vulkan_refocus;

@@ -16,7 +16,6 @@
 //!   off is allowed only where a rounding tie flips (0.1 % of pixels).
 
 use crate::common::{data_dir, gpu};
-use crate::vulkan_refocus::vulkan;
 use viewsynth::camera::stereo::{Eye, StereoParams};
 use viewsynth::camera::{Intrinsics, PinholeCamera};
 use viewsynth::convention::Conventions;
@@ -34,7 +33,6 @@ use viewsynth::reproject::{
     ShiftModel,
 };
 use viewsynth::view::ViewOutput;
-use viewsynth::vulkan::VkExecutor;
 
 const DEPTH_REL_TOL: f64 = 3e-5;
 
@@ -117,8 +115,11 @@ fn gpu_matches_the_f64_reference_under_every_convention_and_depth_kind() {
 
 /// The Vulkan executor running the same pass descriptions meets the GL bounds above.
 #[test]
+#[cfg(feature = "vulkan")]
 fn vulkan_matches_the_f64_reference_under_every_convention_and_depth_kind() {
-    twin_under_every_convention_and_depth_kind(&VkExecutor::device(&vulkan()).unwrap());
+    twin_under_every_convention_and_depth_kind(
+        &viewsynth::vulkan::VkExecutor::device(&crate::vulkan_refocus::vulkan()).unwrap(),
+    );
 }
 
 fn twin_under_every_convention_and_depth_kind(g: &Device) {

@@ -8,7 +8,6 @@
 //! and window depth within 2e-6 (f32 clip z / w near 1).
 
 use crate::common::gpu;
-use crate::vulkan_refocus::vulkan;
 use viewsynth::camera::mat4::Mat4;
 use viewsynth::camera::stereo::{stereo_projection_gl, Eye, Frustum, StereoParams};
 use viewsynth::camera::{gl_projection, Pose};
@@ -16,7 +15,6 @@ use viewsynth::convention::{Conventions, DepthPlanes};
 use viewsynth::pass::Device;
 use viewsynth::scene::gpu::{trace_gl_reference, GlCamera, SceneImage, SceneRenderer};
 use viewsynth::scene::{builtin, Scene};
-use viewsynth::vulkan::VkExecutor;
 
 fn check(tag: &str, gpu_img: &SceneImage, reference: &SceneImage) {
     let n = reference.view_z.data.len();
@@ -55,8 +53,9 @@ fn gpu_ray_tracer_matches_f64_for_posed_pinholes() {
 
 /// The Vulkan executor running the same pass description meets the GL bounds above.
 #[test]
+#[cfg(feature = "vulkan")]
 fn vulkan_ray_tracer_matches_f64_for_posed_pinholes() {
-    posed_pinholes_against_the_twin(&VkExecutor::device(&vulkan()).unwrap());
+    posed_pinholes_against_the_twin(&viewsynth::vulkan::VkExecutor::device(&crate::vulkan_refocus::vulkan()).unwrap());
 }
 
 fn posed_pinholes_against_the_twin(g: &Device) {

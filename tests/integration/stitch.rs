@@ -10,7 +10,6 @@
 //! at most 0.5 % of pixels may be off by more than 1 level; the rest must round the same.
 
 use crate::common::gpu;
-use crate::vulkan_refocus::vulkan;
 use viewsynth::convention::Conventions;
 use viewsynth::eval::image_check;
 use viewsynth::eval::stitch::{score_eyes, split_top_bottom, StitchScore};
@@ -20,7 +19,6 @@ use viewsynth::stitch::reference::stitch_reference;
 use viewsynth::stitch::render::StitchRenderer;
 use viewsynth::stitch::truth::ods_truth;
 use viewsynth::stitch::{pass, seam_band_mask, top_bottom, FaceSet, Method, OdsRig, Side, StitchInput, StitchParams};
-use viewsynth::vulkan::VkExecutor;
 use viewsynth::{metrics, Error};
 
 const N: u32 = 128;
@@ -172,8 +170,9 @@ fn gpu_matches_the_f64_reference_for_every_method() {
 /// The Vulkan executor running the same pass description meets the GL bound above, under every
 /// row order (the only convention that reaches this pass).
 #[test]
+#[cfg(feature = "vulkan")]
 fn vulkan_matches_the_f64_reference_for_every_method() {
-    twin_for_every_method(&VkExecutor::device(&vulkan()).unwrap());
+    twin_for_every_method(&viewsynth::vulkan::VkExecutor::device(&crate::vulkan_refocus::vulkan()).unwrap());
 }
 
 fn twin_for_every_method(g: &Device) {
