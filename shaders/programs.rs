@@ -25,7 +25,8 @@ pub struct ProgramEntry {
 pub const TRI_TEX_WIDTH: i64 = 4096;
 
 const FULLSCREEN_VERT: &[&str] = &["common/fullscreen.vert"];
-const REFOCUS_FRAG: [&str; 4] = [
+const REFOCUS_FRAG: [&str; 5] = [
+    "refocus/refocus_params.glsl",
     "common/bilinear.glsl",
     "common/grid_mesh.glsl",
     "common/refocus_grid.glsl",
@@ -47,26 +48,31 @@ pub const PROGRAMS: &[ProgramEntry] = &[
             ("vert", FULLSCREEN_VERT),
             (
                 "frag",
-                &[REFOCUS_FRAG[0], REFOCUS_FRAG[1], REFOCUS_FRAG[2], REFOCUS_FRAG[3], "refocus/fullscreen.frag"],
+                &[REFOCUS_FRAG[0], REFOCUS_FRAG[1], REFOCUS_FRAG[2], REFOCUS_FRAG[3], REFOCUS_FRAG[4], "refocus/fullscreen.frag"],
             ),
         ],
         switches: REFOCUS_SWITCHES,
-        vulkan: Some(&["refocus/vulkan_interface.glsl"]),
+        vulkan: Some(&[]),
     },
     ProgramEntry {
         name: "refocus/mesh_interior",
         stages: &[
             (
                 "vert",
-                &["common/grid_mesh.glsl", "common/refocus_grid.glsl", "refocus/mesh_interior.vert"],
+                &[
+                    "refocus/refocus_params.glsl",
+                    "common/grid_mesh.glsl",
+                    "common/refocus_grid.glsl",
+                    "refocus/mesh_interior.vert",
+                ],
             ),
             (
                 "frag",
-                &[REFOCUS_FRAG[0], REFOCUS_FRAG[1], REFOCUS_FRAG[2], REFOCUS_FRAG[3], "refocus/mesh_interior.frag"],
+                &[REFOCUS_FRAG[0], REFOCUS_FRAG[1], REFOCUS_FRAG[2], REFOCUS_FRAG[3], REFOCUS_FRAG[4], "refocus/mesh_interior.frag"],
             ),
         ],
         switches: REFOCUS_SWITCHES,
-        vulkan: Some(&["refocus/vulkan_interface.glsl"]),
+        vulkan: Some(&[]),
     },
     ProgramEntry {
         name: "refocus/mesh_boundary",
@@ -74,6 +80,7 @@ pub const PROGRAMS: &[ProgramEntry] = &[
             (
                 "vert",
                 &[
+                    "refocus/refocus_params.glsl",
                     "common/grid_mesh.glsl",
                     "common/mesh_pull.glsl",
                     "common/refocus_grid.glsl",
@@ -82,11 +89,11 @@ pub const PROGRAMS: &[ProgramEntry] = &[
             ),
             (
                 "frag",
-                &[REFOCUS_FRAG[0], REFOCUS_FRAG[1], REFOCUS_FRAG[2], REFOCUS_FRAG[3], "refocus/mesh_boundary.frag"],
+                &[REFOCUS_FRAG[0], REFOCUS_FRAG[1], REFOCUS_FRAG[2], REFOCUS_FRAG[3], REFOCUS_FRAG[4], "refocus/mesh_boundary.frag"],
             ),
         ],
         switches: REFOCUS_SWITCHES,
-        vulkan: Some(&["refocus/vulkan_interface.glsl"]),
+        vulkan: Some(&[]),
     },
     ProgramEntry {
         name: "cyclopean/gather",

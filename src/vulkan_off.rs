@@ -9,11 +9,8 @@ mod devices;
 
 pub use devices::{auto_pick, check_policy, VulkanDeviceChoice, VulkanDeviceInfo};
 
-use crate::camera::PinholeCamera;
-use crate::convention::Conventions;
 use crate::error::{Error, Result};
 use crate::gpu::GpuPolicy;
-use crate::refocus::{BreakRule, Method, OutputSet, RefocusOutput, RefocusSource};
 use std::convert::Infallible;
 use std::rc::Rc;
 
@@ -55,32 +52,5 @@ impl VkExecutor {
     /// Unreachable: needs a device.
     pub fn device(vk: &Vk) -> Result<crate::pass::Device> {
         match vk.0 {}
-    }
-}
-
-/// The refocus passes of the real backend; unreachable here.
-pub struct VkRefocuser(Infallible);
-
-impl VkRefocuser {
-    /// Unreachable: needs a device.
-    pub fn new(
-        vk: &Vk,
-        _src: &RefocusSource,
-        _rule: &BreakRule,
-        _method: Method,
-        _outputs: OutputSet,
-        _conv: Conventions,
-    ) -> Result<Self> {
-        match vk.0 {}
-    }
-
-    /// Unreachable: no refocuser exists.
-    pub fn render(&mut self, _target: &PinholeCamera) -> Result<RefocusOutput> {
-        match self.0 {}
-    }
-
-    /// Unreachable: no refocuser exists.
-    pub fn vk(&self) -> &Vk {
-        match self.0 {}
     }
 }

@@ -1,12 +1,6 @@
 // The refocus grid (see src/refocus/grid.rs and common/grid_mesh.glsl): vertex column i
 // carries the depth of source pixel clamp(i - 1, 0, W - 1).
 
-#ifndef VULKAN  // Vulkan: shaders/refocus/vulkan_interface.glsl
-uniform sampler2D u_src_rgb;    // RGBA8 source colour, row 0 = top of the image
-uniform sampler2D u_src_depth;  // R32F source view-space Z in metres, row 0 = top
-uniform ivec2 u_src_size;       // W, H
-uniform vec4 u_src_k;           // fx, fy, cx, cy of the source
-#endif
 
 // Closed-triangle tolerance in cell units (grid.rs CELL_EPS): pixel centres exactly on an edge
 // are covered by both neighbours whatever the rasteriser's fill rule or the row order. Local

@@ -5,11 +5,6 @@
 // the cell's left/top border, -]; cell < 0 outside the mesh. The same-pose map from target pixel
 // to source point is separable, so it is located in f64 on the CPU: f32 at u ~ 600 px would be
 // off by 6e-5 px, and per-pixel doubles cost llvmpipe more than the rest of the pass.
-#ifndef VULKAN  // Vulkan: shaders/refocus/vulkan_interface.glsl
-uniform sampler2D u_cols;  // RGBA32F, W' x 1
-uniform sampler2D u_rows;  // RGBA32F, H' x 1
-uniform int u_dst_height;
-#endif
 
 // The mask attachment is R8 (normalised): 1/255 stores the byte 1, the in-memory mask's
 // "valid", so its readback is the mask as it is, with no per-pixel conversion.

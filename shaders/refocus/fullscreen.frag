@@ -4,9 +4,7 @@
 
 // R8UI per cell, (W+1) x (H+1): 1 tri1 kept, 2 tri2 kept, 4 left edge, 8 top edge, 16 top-left
 // vertex covered by some kept triangle (grid.rs coverage_flags).
-#ifndef VULKAN  // Vulkan: shaders/refocus/vulkan_interface.glsl
-uniform usampler2D u_keep;
-#endif
+layout(binding = 5) uniform usampler2D u_keep;
 
 layout(location = 0) out vec4 o_rgb;
 layout(location = 1) out float o_depth;

@@ -8,13 +8,7 @@
 // corners are projected with Z = 1 through the target projection (w = 1: the map is affine)
 // and only the depth-test value uses the corner's metric Z.
 
-#ifndef VULKAN  // Vulkan: shaders/refocus/vulkan_interface.glsl
-uniform usampler2D u_tris;        // R32UI kept-triangle codes, TRI_TEX_WIDTH wide
-uniform mat4 u_clip_from_target;  // target projection (OpenCV view space, see projection.rs)
-uniform vec2 u_clip_z;            // z_ndc = x + y / Z under the conventions (convention.rs)
-uniform vec2 u_dst_size;
-uniform float u_expand_px;
-#endif
+layout(binding = 5) uniform usampler2D u_tris;  // R32UI kept-triangle codes, TRI_TEX_WIDTH wide
 
 flat out ivec3 v_cell;  // cell i, j and triangle (0 = tri1, 1 = tri2)
 

@@ -3,10 +3,6 @@
 // Same pose: the corner projects through the target projection with Z = 1 (w = 1: the map is
 // affine); only the depth-test value uses its metric Z.
 
-#ifndef VULKAN  // Vulkan: shaders/refocus/vulkan_interface.glsl
-uniform mat4 u_clip_from_target;  // target projection (OpenCV view space, see projection.rs)
-uniform vec2 u_clip_z;            // z_ndc = x + y / Z under the conventions (convention.rs)
-#endif
 
 void main() {
     int row = u_src_size.x + 2;

@@ -1,6 +1,6 @@
 //! `viewsynth bench --with-vulkan`: the refocus timings of `bench.rs` (built-in scene, 5 focal
-//! scales, render + readback, medians) and its cyclopean gather timings (seed and refine methods,
-//! draw + readback) on the Vulkan device, for the GL-vs-Vulkan comparison.
+//! scales, render + readback, medians) on the Vulkan device, and every pass on both APIs from
+//! one run, for the GL-vs-Vulkan comparison.
 
 use super::BenchCase;
 use crate::bench::batch::median;
@@ -9,9 +9,10 @@ use crate::cyclopean::render::CyclopeanRenderer;
 use crate::error::Result;
 use crate::pass::Device;
 use crate::refocus::job::TargetSpec;
+use crate::refocus::Refocuser;
 use crate::refocus::{BreakRule, Method, OutputSet, RefocusSource};
 use crate::scene;
-use crate::vulkan::{Vk, VkExecutor, VkRefocuser};
+use crate::vulkan::{Vk, VkExecutor};
 use std::fmt::Write as _;
 use std::time::Instant;
 
@@ -39,8 +40,8 @@ pub fn refocus_bench(vk: &Vk, sizes: &[(u32, u32)], repeats: usize, cases: &mut 
         .targets(&cam)?;
         for method in [Method::Fullscreen, Method::Mesh] {
             let t0 = Instant::now();
-            let mut r = VkRefocuser::new(
-                vk,
+            let mut r = Refocuser::new(
+                &VkExecutor::device(vk)?,
                 &src,
                 &BreakRule::default(),
                 method,
@@ -111,7 +112,6 @@ pub fn passes_bench(
     use crate::cyclopean::scene_frame::{scene_frame, StereoRig};
     use crate::cyclopean::splat::{SplatParams, SplatRenderer};
     use crate::cyclopean::{CyclopeanOutputs, CyclopeanParams, FrameDepth, Method as Cm};
-    use crate::refocus::Refocuser;
     use crate::reproject::render::Reprojector;
     use crate::scene::gpu::{GlCamera, SceneRenderer};
     use crate::stitch::render::StitchRenderer;
@@ -178,27 +178,16 @@ pub fn passes_bench(
     };
     for method in [Method::Fullscreen, Method::Mesh] {
         let rule = BreakRule::default();
-        let gl = time(
-            repeats,
-            (|| -> Result<Frame> {
-                let mut r = Refocuser::new(gpu, &src, &rule, method, OutputSet::default(), Conventions::default())?;
-                let targets = &targets;
-                Ok(Box::new(move || targets.iter().try_for_each(|c| r.render(c).map(drop))) as Frame)
-            })(),
-        )?;
-        let vulkan = time(
-            repeats,
-            (|| -> Result<Frame> {
-                let mut r = VkRefocuser::new(vk, &src, &rule, method, OutputSet::default(), Conventions::default())?;
-                let targets = &targets;
-                Ok(Box::new(move || targets.iter().try_for_each(|c| r.render(c).map(drop))) as Frame)
-            })(),
-        )?;
+        let ms = both(&devices, repeats, |d| {
+            let mut r = Refocuser::new(d, &src, &rule, method, OutputSet::default(), Conventions::default())?;
+            let targets = &targets;
+            Ok(Box::new(move || targets.iter().try_for_each(|c| r.render(c).map(drop))) as Frame)
+        })?;
         let name = match method {
             Method::Fullscreen => "refocus fullscreen",
             Method::Mesh => "refocus mesh",
         };
-        row(name, [gl, vulkan], cases);
+        row(name, ms, cases);
     }
     for (name, params) in [("cyclopean seed", seed), ("cyclopean refine 3", refine)] {
         let ms = both(&devices, repeats, |d| {

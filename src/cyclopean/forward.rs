@@ -192,6 +192,7 @@ impl ForwardWarp {
                     buffers: &[],
                     viewport: [0, 0, w, h],
                     triangles: *count,
+                    indices: None,
                 })
             })
             .collect();

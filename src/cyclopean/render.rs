@@ -163,6 +163,7 @@ impl CyclopeanRenderer {
             buffers: &[],
             viewport: [0, 0, w, h],
             triangles: 1,
+            indices: None,
         };
         let mut out = self.device.render(&target, &[draw])?;
         let (color, depth) = (out.color(0)?, out.depth(1)?);

@@ -419,6 +419,7 @@ impl SplatRenderer {
             buffers: &edges,
             viewport: [0, 0, w, h],
             triangles: 1,
+            indices: None,
         }));
         // Pass 3: the listed pixels' colour mixed (colour only: without it, nothing to mix).
         if self.outputs.color {

@@ -14,7 +14,7 @@ use crate::cyclopean::{CyclopeanOutput, CyclopeanParams, FrameDepth, Method as C
 use crate::error::Result;
 use crate::gpu::{Gpu, GpuPolicy};
 use crate::refocus::{BreakRule, Method, OutputSet, RefocusOutput, RefocusSource, Refocuser};
-use crate::vulkan::{Vk, VkExecutor, VkRefocuser, VulkanContext, VulkanDeviceChoice};
+use crate::vulkan::{Vk, VkExecutor, VulkanContext, VulkanDeviceChoice};
 use std::fmt::Write as _;
 
 /// Differences between a GL and a Vulkan output of the same target.
@@ -83,7 +83,14 @@ fn table(gpu: &Gpu, src: &RefocusSource, target: &PinholeCamera, s: &mut String)
     for method in [Method::Fullscreen, Method::Mesh] {
         for conv in Conventions::all() {
             let mut gl = Refocuser::new(gpu, src, &rule, method, OutputSet::default(), conv)?;
-            let mut v = VkRefocuser::new(&vk, src, &rule, method, OutputSet::default(), conv)?;
+            let mut v = Refocuser::new(
+                &VkExecutor::device(&vk)?,
+                src,
+                &rule,
+                method,
+                OutputSet::default(),
+                conv,
+            )?;
             let (a, b) = (gl.render(target)?, v.render(target)?);
             let d = backend_diff(&a, &b);
             writeln!(

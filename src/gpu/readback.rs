@@ -69,6 +69,18 @@ impl ReadFormat {
         ty: glow::FLOAT,
         bytes_per_pixel: 4,
     };
+    /// One unsigned 8-bit integer per pixel (R8UI).
+    pub const R8UI: ReadFormat = ReadFormat {
+        format: glow::RED_INTEGER,
+        ty: glow::UNSIGNED_BYTE,
+        bytes_per_pixel: 1,
+    };
+    /// Four floats per pixel (RGBA32F).
+    pub const RGBA32F: ReadFormat = ReadFormat {
+        format: glow::RGBA,
+        ty: glow::FLOAT,
+        bytes_per_pixel: 16,
+    };
     /// One unsigned 32-bit integer per pixel (R32UI).
     pub const R32UI: ReadFormat = ReadFormat {
         format: glow::RED_INTEGER,

@@ -150,16 +150,17 @@ impl RenderPass<'_> {
         unsafe { self.fb.gpu().gl().draw_arrays(glow::TRIANGLES, 0, (count * 3) as i32) }
     }
 
-    /// The triangles of `indices` (u32) with `vao` and the bound program.
-    pub fn draw_indexed(&self, vao: &VertexArray, indices: &IndexBuffer) {
+    /// The first `triangles` triangles of `indices` (u32) with `vao` and the bound program.
+    pub fn draw_indexed(&self, vao: &VertexArray, indices: &IndexBuffer, triangles: usize) {
         vao.bind();
         indices.bind();
-        // SAFETY: the element buffer is bound to this VAO and holds `count` indices.
+        let count = (3 * triangles).min(indices.count);
+        // SAFETY: the element buffer is bound to this VAO and holds at least `count` indices.
         unsafe {
             self.fb
                 .gpu()
                 .gl()
-                .draw_elements(glow::TRIANGLES, indices.count as i32, glow::UNSIGNED_INT, 0)
+                .draw_elements(glow::TRIANGLES, count as i32, glow::UNSIGNED_INT, 0)
         }
     }
 }

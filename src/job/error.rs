@@ -55,9 +55,6 @@ pub enum ArgError {
     /// An option that holds for one frame given to a batch.
     #[error("{0}")]
     PerFrameInBatch(PerFrameOption),
-    /// `--backend vulkan` with `--batch`.
-    #[error("--backend vulkan renders single frames; --batch runs on GL (drop --backend or --batch)")]
-    VulkanBatch,
     /// More CPU threads than a pool takes.
     #[error("--jobs {jobs}: at most {max}")]
     TooManyJobs {

@@ -9,7 +9,6 @@ use crate::io::{self, DepthDecode, DepthSummary};
 use crate::refocus::batch::{load_manifest, run_batch, BatchOptions, BatchSummary, Shard};
 use crate::refocus::job::{self, FileFormats, Manifest, ManifestEntry, TargetSpec};
 use crate::refocus::{BreakRule, Method, RefocusSource, Refocuser};
-use crate::vulkan::VkRefocuser;
 use std::path::PathBuf;
 
 /// What to check when a refocus input's depth summary looks wrong.
@@ -68,7 +67,7 @@ pub struct RefocusOptions {
     pub out_dir: PathBuf,
     /// The GPU to render on.
     pub gpu: GpuRequest,
-    /// GL, or Vulkan (single frames only).
+    /// GL or Vulkan.
     pub backend: Backend,
 }
 
@@ -111,6 +110,7 @@ pub struct RefocusBatchJob {
     options: BatchOptions,
     out_dir: PathBuf,
     gpu: GpuRequest,
+    backend: Backend,
 }
 
 impl RefocusCommand {
@@ -125,9 +125,6 @@ impl RefocusCommand {
             super::cyclopean::check_scale(option, Some(v))?;
         }
         if let Some(manifest) = o.manifest.clone() {
-            if o.backend == Backend::Vulkan {
-                return Err(ArgError::VulkanBatch);
-            }
             return RefocusBatchJob::new(manifest, o).map(RefocusCommand::Batch);
         }
         // Batch-only options are refused by name rather than ignored.
@@ -177,29 +174,6 @@ impl RefocusCommand {
     }
 }
 
-/// The refocus renderer of the chosen backend.
-enum FrameRenderer {
-    Gl(Box<Refocuser>),
-    Vulkan(Box<VkRefocuser>),
-}
-
-impl FrameRenderer {
-    fn render(&mut self, target: &crate::camera::PinholeCamera) -> crate::Result<crate::refocus::RefocusOutput> {
-        match self {
-            FrameRenderer::Gl(r) => r.render(target),
-            FrameRenderer::Vulkan(r) => r.render(target),
-        }
-    }
-
-    /// The renderer's name for the manifest.
-    fn name(&self) -> String {
-        match self {
-            FrameRenderer::Gl(r) => r.gpu().info().renderer.clone(),
-            FrameRenderer::Vulkan(r) => format!("Vulkan: {}", r.vk().info().name),
-        }
-    }
-}
-
 /// What a refocused frame wrote.
 #[derive(Debug)]
 pub struct RefocusReport {
@@ -243,24 +217,8 @@ impl RefocusJob {
         let out_dir = io::OutDir::prepare(&self.out_dir)?;
 
         let (files, conv) = (&self.files, self.conventions);
-        let mut refocuser = match self.backend {
-            Backend::Gl => {
-                let gpu = host.open_gpu(&self.gpu)?;
-                FrameRenderer::Gl(Box::new(Refocuser::new(
-                    &gpu,
-                    &src,
-                    &self.rule,
-                    self.method,
-                    files.outputs,
-                    conv,
-                )?))
-            }
-            Backend::Vulkan => {
-                let vk = host.open_vulkan(&self.gpu)?;
-                let r = VkRefocuser::new(&vk, &src, &self.rule, self.method, files.outputs, conv)?;
-                FrameRenderer::Vulkan(Box::new(r))
-            }
-        };
+        let device = host.open_device(&self.gpu, self.backend)?;
+        let mut refocuser = Refocuser::new(&device, &src, &self.rule, self.method, files.outputs, conv)?;
         host.event(Event::Started {
             what: "refocus targets",
             total: targets.len() as u64,
@@ -281,7 +239,7 @@ impl RefocusJob {
             method: self.method,
             break_rule: self.rule,
             conventions: conv,
-            renderer: refocuser.name(),
+            renderer: refocuser.renderer(),
             notes: job::MANIFEST_NOTES.to_string(),
             settings: None,
             files: job::file_records(set.staging(), &entries).map_err(|e| set.final_error(e))?,
@@ -348,6 +306,7 @@ impl RefocusBatchJob {
             },
             out_dir: o.out_dir,
             gpu: o.gpu,
+            backend: o.backend,
         })
     }
 
@@ -356,12 +315,12 @@ impl RefocusBatchJob {
     pub fn run(&self, host: &dyn Host) -> Result<RefocusBatchReport, JobError> {
         let frames = load_manifest(&self.manifest)?;
         io::OutDir::prepare(&self.out_dir)?;
-        let gpu = host.open_gpu(&self.gpu)?;
+        let device = host.open_device(&self.gpu, self.backend)?;
         host.event(Event::Started {
             what: "batch frames",
             total: frames.len() as u64,
         });
-        let summary = run_batch(&gpu, &frames, &self.out_dir, &self.options, || {
+        let summary = run_batch(&device, &frames, &self.out_dir, &self.options, || {
             host.event(Event::Advanced)
         })?;
         host.event(Event::Finished);

@@ -4,15 +4,20 @@
 //! offsets (one `glBufferSubData` a pass), and outputs are read through the pooled pixel-pack
 //! buffers with the row flip and RGB packing done on the GPU. Compute steps bind storage images
 //! to image units and storage buffers to their bindings from 0 (shaders/common/bindings.glsl),
-//! with `glMemoryBarrier(ALL)` between steps.
+//! with `glMemoryBarrier(ALL)` between steps. A submit queues every read (fenced pixel-pack
+//! buffers) and a deferred timer query and returns; `wait` maps the reads, so several runs can
+//! be in flight and nothing waits on the GPU until their outputs are wanted.
 
-use super::{Api, BufferId, Executor, Format, Groups, ImageData, ImageId, Rendered, Slots, Step, StorageImage, Target};
+use super::{
+    Api, BufferId, Executor, Format, Groups, ImageData, ImageId, Rendered, Slots, Step, StorageImage, Target, Ticket,
+};
 use crate::convention::RowOrder;
 use crate::error::{Error, Result};
 use crate::gpu::{
-    Attachment, Barrier, DrawState, Framebuffer, Gpu, GpuTimer, Program, ReadFormat, ShaderProgram, StorageBuffer,
-    Texture, TextureFormat, UniformBuffer, VertexArray,
+    Attachment, Barrier, DeferredTimer, DrawState, Framebuffer, Gpu, IndexBuffer, PendingRead, Program, ReadFormat,
+    ShaderProgram, StorageBuffer, Texture, TextureFormat, Timing, UniformBuffer, VertexArray,
 };
+use std::time::Instant;
 
 /// Framebuffers kept for reuse (sizes and output sets seen most recently).
 const KEPT_TARGETS: usize = 4;
@@ -23,6 +28,8 @@ fn texture_format(f: Format) -> TextureFormat {
         Format::R32F => TextureFormat::R32F,
         Format::R8 => TextureFormat::R8,
         Format::R32Ui => TextureFormat::R32Ui,
+        Format::R8Ui => TextureFormat::R8Ui,
+        Format::Rgba32F => TextureFormat::Rgba32F,
     }
 }
 
@@ -32,7 +39,22 @@ fn read_format(f: Format) -> ReadFormat {
         Format::R32F => ReadFormat::R32F,
         Format::R8 => ReadFormat::R8,
         Format::R32Ui => ReadFormat::R32UI,
+        Format::R8Ui => ReadFormat::R8UI,
+        Format::Rgba32F => ReadFormat::RGBA32F,
     }
+}
+
+/// A buffer a step binds: storage (compute, vertex pulling) or indices (indexed draws).
+enum GlBuffer {
+    Storage(StorageBuffer),
+    Index(IndexBuffer),
+}
+
+/// A submitted run: its queued reads and timer.
+struct InFlight {
+    reads: Vec<Option<PendingRead>>,
+    timer: DeferredTimer,
+    submit_ms: f64,
 }
 
 /// Size, outputs and whether there is a depth buffer.
@@ -42,11 +64,14 @@ type TargetKey = (u32, u32, Vec<Option<Format>>, bool);
 pub struct GlExecutor {
     gpu: Gpu,
     vao: VertexArray,
+    /// Indexed draws bind their element buffer here (a VAO's state), pulled draws use `vao`.
+    indexed_vao: VertexArray,
     params: UniformBuffer,
     programs: Vec<(ShaderProgram, Program)>,
     targets: Vec<(TargetKey, Framebuffer)>,
     images: Slots<Texture>,
-    buffers: Slots<StorageBuffer>,
+    buffers: Slots<GlBuffer>,
+    runs: Slots<InFlight>,
 }
 
 impl GlExecutor {
@@ -55,11 +80,13 @@ impl GlExecutor {
         Ok(GlExecutor {
             gpu: gpu.clone(),
             vao: VertexArray::new(gpu)?.with_label("pass vertex array"),
+            indexed_vao: VertexArray::new(gpu)?.with_label("pass indexed vertex array"),
             params: UniformBuffer::new(gpu)?,
             programs: Vec::new(),
             targets: Vec::new(),
             images: Slots::default(),
             buffers: Slots::default(),
+            runs: Slots::default(),
         })
     }
 
@@ -134,14 +161,55 @@ impl Executor for GlExecutor {
 
     fn create_buffer(&mut self, words: usize, label: &str) -> Result<BufferId> {
         let b = StorageBuffer::new(&self.gpu, words)?.with_label(label);
-        Ok(BufferId(self.buffers.insert(b)))
+        Ok(BufferId(self.buffers.insert(GlBuffer::Storage(b))))
+    }
+
+    fn upload_indices(&mut self, indices: &[u32], label: &str) -> Result<BufferId> {
+        let b = IndexBuffer::new(&self.gpu, indices)?.with_label(label);
+        Ok(BufferId(self.buffers.insert(GlBuffer::Index(b))))
+    }
+
+    fn write_image(&mut self, id: ImageId, bytes: &[u8]) -> Result<()> {
+        // glTexSubImage2D: ordered after the draws already queued that sample the old texels.
+        self.image(id)?.upload(bytes)
+    }
+
+    fn renderer(&self) -> String {
+        self.gpu.info().renderer.clone()
+    }
+
+    fn is_ready(&mut self, ticket: Ticket) -> bool {
+        self.runs
+            .get(ticket.0)
+            .is_none_or(|r| r.reads.iter().flatten().all(PendingRead::is_ready))
+    }
+
+    fn wait(&mut self, ticket: Ticket) -> Result<Rendered> {
+        let run = self
+            .runs
+            .take(ticket.0)
+            .ok_or_else(|| Error::Gl(format!("pass run {} was not submitted or was waited for", ticket.0)))?;
+        let outputs = run
+            .reads
+            .into_iter()
+            .map(|r| r.map(PendingRead::finish).transpose())
+            .collect::<Result<Vec<_>>>()?;
+        Ok(Rendered {
+            outputs,
+            timing: Timing {
+                gpu_ms: run.timer.read_ms(),
+                wall_ms: run.submit_ms,
+            },
+            size: (0, 0),
+        })
     }
 
     fn free_buffer(&mut self, id: BufferId) {
         self.buffers.remove(id.0);
     }
 
-    fn run(&mut self, target: Option<&Target>, steps: &[Step]) -> Result<Rendered> {
+    fn submit(&mut self, target: Option<&Target>, steps: &[Step]) -> Result<Ticket> {
+        let t0 = Instant::now();
         // Programs first (compiles happen once per program), then the target.
         let mut programs = Vec::with_capacity(steps.len());
         for step in steps {
@@ -170,8 +238,9 @@ impl Executor for GlExecutor {
             self.params.write(&blocks)?;
         }
         let fb = fb.map(|i| &self.targets[i].1);
-        let timer = GpuTimer::start(&self.gpu);
+        let mut timer = DeferredTimer::begin(&self.gpu);
         let mut pass = None;
+        let mut drawn = false;
         for (k, step) in steps.iter().enumerate() {
             if k > 0 && !matches!((&steps[k - 1], step), (Step::Draw(_), Step::Draw(_))) {
                 // What earlier steps wrote, before this one reads it.
@@ -191,13 +260,20 @@ impl Executor for GlExecutor {
                             None => (DrawState::default(), 1.0),
                         };
                         pass = Some(fb.begin_pass(state, clear));
+                        drawn = true;
                     }
                     let p = &self.programs[programs[k].expect("built above")].1;
                     self.bind(p, (offsets[k], d.params.len()), d.images, d.buffers)?;
                     let [x, y, w, h] = d.viewport;
                     let pass = pass.as_ref().expect("begun above");
                     pass.viewport(x, y, w, h);
-                    pass.draw_triangles(&self.vao, d.triangles as usize);
+                    match d.indices {
+                        Some(id) => match self.buffers.get(id.0) {
+                            Some(GlBuffer::Index(ib)) => pass.draw_indexed(&self.indexed_vao, ib, d.triangles as usize),
+                            _ => return Err(Error::Gl(format!("{}: buffer {} holds no indices", p.name(), id.0))),
+                        },
+                        None => pass.draw_triangles(&self.vao, d.triangles as usize),
+                    }
                 }
                 Step::Dispatch(d) => {
                     let p = &self.programs[programs[k].expect("built above")].1;
@@ -224,35 +300,35 @@ impl Executor for GlExecutor {
             }
         }
         drop(pass);
+        if let (Some(fb), false) = (fb, drawn) {
+            // No draws (e.g. no kept triangles): the target is still cleared before its readback.
+            drop(fb.begin_pass(DrawState::default(), 1.0));
+        }
+        timer.end();
         self.gpu.check("pass steps")?;
-        let (Some(target), Some(fb)) = (target, fb) else {
-            return Ok(Rendered {
-                outputs: Vec::new(),
-                timing: timer.stop(),
-                size: (0, 0),
-            });
+        let reads = match (target, fb) {
+            (Some(target), Some(fb)) => {
+                // What the steps wrote, before the readback.
+                self.gpu.memory_barrier(Barrier::All);
+                let flip = target.rows == RowOrder::BottomUp;
+                target
+                    .outputs
+                    .iter()
+                    .enumerate()
+                    .map(|(i, f)| match f {
+                        Some(f) => fb.read_async(i, read_format(*f), flip),
+                        None => Ok(None),
+                    })
+                    .collect::<Result<Vec<_>>>()?
+            }
+            _ => Vec::new(),
         };
-        // What the steps wrote, before the readback; every read queued before the first wait.
-        self.gpu.memory_barrier(Barrier::All);
-        let flip = target.rows == RowOrder::BottomUp;
-        let reads = target
-            .outputs
-            .iter()
-            .enumerate()
-            .map(|(i, f)| match f {
-                Some(f) => fb.read_async(i, read_format(*f), flip),
-                None => Ok(None),
-            })
-            .collect::<Result<Vec<_>>>()?;
-        let outputs = reads
-            .into_iter()
-            .map(|r| r.map(|r| r.finish()).transpose())
-            .collect::<Result<Vec<_>>>()?;
-        Ok(Rendered {
-            outputs,
-            timing: timer.stop(),
-            size: (0, 0),
-        })
+        let run = InFlight {
+            reads,
+            timer,
+            submit_ms: t0.elapsed().as_secs_f64() * 1e3,
+        };
+        Ok(Ticket(self.runs.insert(run)))
     }
 }
 
@@ -264,9 +340,11 @@ impl GlExecutor {
     }
 
     fn buffer(&self, id: BufferId) -> Result<&StorageBuffer> {
-        self.buffers
-            .get(id.0)
-            .ok_or_else(|| Error::Gl(format!("pass buffer {} was freed", id.0)))
+        match self.buffers.get(id.0) {
+            Some(GlBuffer::Storage(b)) => Ok(b),
+            Some(GlBuffer::Index(_)) => Err(Error::Gl(format!("pass buffer {} holds indices", id.0))),
+            None => Err(Error::Gl(format!("pass buffer {} was freed", id.0))),
+        }
     }
 
     /// Make `p` current with its parameter block (`block`: offset and length in the uniform

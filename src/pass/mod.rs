@@ -42,6 +42,10 @@ pub enum Format {
     R8,
     /// 32-bit unsigned integer, single channel (atomics; sampled with a `usampler2D`).
     R32Ui,
+    /// 8-bit unsigned integer, single channel (flags; sampled with a `usampler2D`).
+    R8Ui,
+    /// 4 x 32-bit float (per-column and per-row lookups located in f64 on the host).
+    Rgba32F,
 }
 
 impl Format {
@@ -49,7 +53,8 @@ impl Format {
     pub fn texel_bytes(self) -> usize {
         match self {
             Format::Rgba8 | Format::R32F | Format::R32Ui => 4,
-            Format::R8 => 1,
+            Format::R8 | Format::R8Ui => 1,
+            Format::Rgba32F => 16,
         }
     }
 
@@ -58,7 +63,8 @@ impl Format {
         match self {
             Format::Rgba8 => 3,
             Format::R32F | Format::R32Ui => 4,
-            Format::R8 => 1,
+            Format::R8 | Format::R8Ui => 1,
+            Format::Rgba32F => 16,
         }
     }
 }
@@ -185,6 +191,10 @@ pub struct Draw<'a> {
     /// Triangles drawn (3 vertices each, pulled by the vertex shader: no vertex buffers); 1
     /// for the full-screen triangle.
     pub triangles: u32,
+    /// An index buffer ([`Device::upload_indices`]): the triangles' vertices are its first
+    /// `3 * triangles` indices (`gl_VertexID` is the index, so the vertex shader runs once per
+    /// shared vertex where the driver caches); None: vertex `3 t + k` is corner k of triangle t.
+    pub indices: Option<BufferId>,
 }
 
 /// What a pass read back: per output location, top-down bytes where asked for.
@@ -253,6 +263,10 @@ pub enum Api {
     Vulkan,
 }
 
+/// A queued run ([`Executor::submit`]); its outputs come with [`Executor::wait`].
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Ticket(pub usize);
+
 /// Runs pass descriptions on one graphics API.
 pub trait Executor {
     /// Which API this is.
@@ -269,9 +283,22 @@ pub trait Executor {
     fn create_buffer(&mut self, words: usize, label: &str) -> Result<BufferId>;
     /// Release a buffer.
     fn free_buffer(&mut self, id: BufferId);
-    /// Run `steps` in order; the draws (at most one contiguous group) render into `target`,
-    /// whose attachments are cleared to 0 first and read back at the end.
-    fn run(&mut self, target: Option<&Target>, steps: &[Step]) -> Result<Rendered>;
+    /// Replace the texels of an uploaded image (same size and format), ordered before every
+    /// later submit and after every earlier one: a stream of same-sized inputs reuses one image.
+    fn write_image(&mut self, id: ImageId, bytes: &[u8]) -> Result<()>;
+    /// An immutable buffer of u32 indices for indexed draws ([`Draw::indices`]); freed with
+    /// [`Executor::free_buffer`].
+    fn upload_indices(&mut self, indices: &[u32], label: &str) -> Result<BufferId>;
+    /// Queue `steps` in order; the draws (at most one contiguous group) render into `target`,
+    /// whose attachments are cleared to 0 first, and its outputs are copied out asynchronously.
+    /// Returns without waiting; several runs may be in flight.
+    fn submit(&mut self, target: Option<&Target>, steps: &[Step]) -> Result<Ticket>;
+    /// Whether a submitted run has finished (never blocks).
+    fn is_ready(&mut self, ticket: Ticket) -> bool;
+    /// Wait for a submitted run and hand out its outputs, top-down (each ticket once).
+    fn wait(&mut self, ticket: Ticket) -> Result<Rendered>;
+    /// The renderer's name for manifests and reports.
+    fn renderer(&self) -> String;
 }
 
 /// The draws of `steps` form one contiguous group (one render pass), and need a target.
@@ -313,6 +340,11 @@ impl Device {
         self.0.borrow().api()
     }
 
+    /// Largest image side this device renders and samples.
+    pub fn max_image_side(&self) -> u32 {
+        self.0.borrow().max_image_side()
+    }
+
     /// [`crate::gpu::check_image_size`] against this device's limit.
     pub fn check_image_size(&self, name: &str, width: u32, height: u32) -> Result<()> {
         let max = self.0.borrow().max_image_side();
@@ -350,13 +382,44 @@ impl Device {
 
     /// Run `steps` in order (draws into `target`, read back top-down at the end).
     pub fn run(&self, target: Option<&Target>, steps: &[Step]) -> Result<Rendered> {
+        self.submit(target, steps)?.wait()
+    }
+
+    /// Queue `steps` (draws into `target`); the outputs come with [`Pending::wait`], so a
+    /// caller can keep several runs in flight.
+    pub fn submit(&self, target: Option<&Target>, steps: &[Step]) -> Result<Pending> {
         if let Some(t) = target {
             self.check_image_size("render target", t.width, t.height)?;
         }
         check_steps(target, steps)?;
-        let mut out = self.0.borrow_mut().run(target, steps)?;
-        out.size = target.map_or((0, 0), |t| (t.width, t.height));
-        Ok(out)
+        let ticket = self.0.borrow_mut().submit(target, steps)?;
+        Ok(Pending {
+            device: self.clone(),
+            ticket: Some(ticket),
+            size: target.map_or((0, 0), |t| (t.width, t.height)),
+        })
+    }
+
+    /// Replace the texels of `image` (its size and format; see [`Executor::write_image`]).
+    pub fn write_image(&self, image: &Image, bytes: &[u8]) -> Result<()> {
+        self.0.borrow_mut().write_image(image.id, bytes)
+    }
+
+    /// An index buffer for [`Draw::indices`].
+    pub fn upload_indices(&self, indices: &[u32], label: &str) -> Result<Buffer> {
+        if indices.is_empty() {
+            return Err(crate::Error::param(label.to_string(), "no indices"));
+        }
+        let id = self.0.borrow_mut().upload_indices(indices, label)?;
+        Ok(Buffer {
+            device: self.clone(),
+            id,
+        })
+    }
+
+    /// The renderer's name (GL_RENDERER, or "Vulkan: " and the device's name).
+    pub fn renderer(&self) -> String {
+        self.0.borrow().renderer()
     }
 
     /// A storage image of `width` x `height` (checked against the device's limit).
@@ -376,6 +439,40 @@ impl Device {
             device: self.clone(),
             id,
         })
+    }
+}
+
+/// A submitted run ([`Device::submit`]); dropping it unwaited waits and discards the outputs.
+pub struct Pending {
+    device: Device,
+    ticket: Option<Ticket>,
+    size: (u32, u32),
+}
+
+impl Pending {
+    /// Whether the outputs have arrived (never blocks).
+    pub fn is_ready(&self) -> bool {
+        self.ticket.is_none_or(|t| self.device.0.borrow_mut().is_ready(t))
+    }
+
+    /// Wait for the run and hand out its outputs, top-down.
+    pub fn wait(mut self) -> Result<Rendered> {
+        let ticket = self
+            .ticket
+            .take()
+            .ok_or_else(|| crate::Error::Gl("run waited twice".into()))?;
+        let mut out = self.device.0.borrow_mut().wait(ticket)?;
+        out.size = self.size;
+        Ok(out)
+    }
+}
+
+impl Drop for Pending {
+    fn drop(&mut self) {
+        if let Some(t) = self.ticket.take() {
+            // An error here has nobody to go to; the executor frees the run's slot either way.
+            let _ = self.device.0.borrow_mut().wait(t);
+        }
     }
 }
 
@@ -509,6 +606,16 @@ impl<T> Slots<T> {
     /// The value at `i`, unless freed.
     pub(crate) fn get(&self, i: usize) -> Option<&T> {
         self.0.get(i).and_then(Option::as_ref)
+    }
+
+    /// The value at `i` to change, unless freed.
+    pub(crate) fn get_mut(&mut self, i: usize) -> Option<&mut T> {
+        self.0.get_mut(i).and_then(Option::as_mut)
+    }
+
+    /// Take the value at `i` out, freeing the slot.
+    pub(crate) fn take(&mut self, i: usize) -> Option<T> {
+        self.0.get_mut(i).and_then(Option::take)
     }
 
     /// Free slot `i` (dropping its value).

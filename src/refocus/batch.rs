@@ -20,8 +20,8 @@ use super::{BreakRule, Method, PendingRefocus, RefocusOutput, RefocusSource, Ref
 use crate::camera::Intrinsics;
 use crate::convention::Conventions;
 use crate::error::{Error, Result};
-use crate::gpu::Gpu;
 use crate::io::{self, DepthDecode};
+use crate::pass::ToDevice;
 use serde::{Deserialize, Serialize};
 use std::io::{BufRead, Read};
 use std::path::{Path, PathBuf};
@@ -575,7 +575,7 @@ fn submit_frame(
         method: opts.method,
         break_rule: opts.rule,
         conventions: opts.conv,
-        renderer: refocuser.gpu().info().renderer.clone(),
+        renderer: refocuser.renderer(),
         notes: job::MANIFEST_NOTES.to_string(),
         settings: Some(settings),
         files: Vec::new(),
@@ -620,7 +620,7 @@ fn collect_frame(f: InFlight, stages: &mut StageTimes) -> std::result::Result<Wr
 
 /// Run the batch. `progress` is called once per frame (rendered, skipped or failed).
 pub fn run_batch(
-    gpu: &Gpu,
+    device: impl ToDevice,
     frames: &[BatchFrame],
     out_dir: &Path,
     opts: &BatchOptions,
@@ -660,7 +660,7 @@ pub fn run_batch(
         }
         todo.push(frame);
     }
-    let mut refocuser = Refocuser::with_settings(gpu, &opts.rule, opts.method, opts.files.outputs, opts.conv)?;
+    let mut refocuser = Refocuser::with_settings(device, &opts.rule, opts.method, opts.files.outputs, opts.conv)?;
     let files = opts.files;
     let mut stages = StageTimes::default();
 

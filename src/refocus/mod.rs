@@ -2,9 +2,10 @@
 //! other focal lengths, same pose. No hole filling: what the source did not see stays invalid.
 //!
 //! - `grid`: the 2.5D grid mesh and its break rule, shared by every path.
-//! - `render`: the GPU refocus (uploads, framebuffer, readback) and its full-screen pass, which
-//!   evaluates the kept triangles analytically per pixel (same pose only); `mesh`: the mesh pass,
-//!   the same triangles rasterised into the MRT framebuffer with a depth test.
+//! - `render`: the GPU refocus, described once as pass steps and run by the GL or the Vulkan
+//!   executor: the full-screen pass, which evaluates the kept triangles analytically per pixel
+//!   (same pose only), or the mesh pass (`mesh`: the same triangles rasterised into the MRT
+//!   target with a depth test).
 //! - [`reference`](mod@reference): the float64 CPU twin both are tested against.
 //! - [`pass`]: the pass/twin contract, [`pass::gpu`] and [`pass::reference`] over one
 //!   [`RefocusInput`], both returning a [`crate::view::ViewOutput`].
@@ -19,9 +20,9 @@ pub mod reference;
 mod render;
 
 pub use grid::{axis_lookup, valid_depth, BreakRule, Grid};
-pub use mesh::{code_texture, TRI_TEX_WIDTH};
+pub use mesh::TRI_TEX_WIDTH;
 pub use pass::RefocusInput;
-pub use render::{PendingRefocus, RefocusOutput, Refocuser};
+pub use render::{PendingRefocus, RefocusOutput, RefocusParams, Refocuser};
 
 use crate::camera::{Intrinsics, PinholeCamera};
 use crate::error::{Error, Result};

@@ -1,28 +1,44 @@
-//! GPU refocus. The programs are compiled once per `Refocuser`; a source (colour, depth and
-//! the kept triangles) is uploaded into textures that the next source of the same size reuses;
-//! each target renders into a framebuffer (kept per output size) holding only the requested
-//! attachments, and its outputs are read back through the streaming readback of `gpu`: the row
-//! order and the RGB packing happen on the GPU, the mapped bytes are the images' bytes.
+//! GPU refocus, described once as pass steps (src/pass) and run by either executor: GL or
+//! Vulkan, the same GLSL and parameter block (shaders/refocus/refocus_params.glsl).
+//!
+//! A source (colour, depth and its kept triangles) is uploaded into images that the next source
+//! of the same size rewrites in place; each target size keeps its per-column and per-row lookup
+//! images (located in f64 on the host, see `grid::axis_lookup`). The full-screen method is one
+//! draw that evaluates the kept triangles per pixel; the mesh method draws the interior
+//! triangles indexed and the boundary ones by vertex pulling, depth-tested under the
+//! conventions (mesh.rs). Outputs not asked for get no attachment and no readback; the executor
+//! reads the rest back top-down, with the RGB packing done on the GPU (GL) or while copying out.
 //!
 //! [`Refocuser::submit`] queues a target and returns at once; [`PendingRefocus::wait`] maps its
 //! outputs later, so a caller can keep several targets (and frames) in flight.
 //! [`Refocuser::render`] is the two in a row.
 
 use super::grid::{axis_lookup, Grid};
-use super::mesh::MeshPass;
+use super::mesh::{MeshGeometry, EXPAND_PX};
 use super::{BreakRule, Method, OutputSet, RefocusSource};
-use crate::camera::PinholeCamera;
-use crate::convention::{Conventions, DepthPlanes, RowOrder};
+use crate::camera::{clip_from_view_opencv, PinholeCamera};
+use crate::convention::{Conventions, DepthPlanes};
 use crate::error::{Error, Result};
-use crate::gpu::{
-    Attachment, DeferredTimer, DrawState, Framebuffer, Gpu, PendingRead, Program, ProgramKind, ReadFormat,
-    ShaderProgram, Texture, TextureFormat, Timing, VertexArray,
-};
+use crate::gpu::{ProgramKind, ShaderProgram, Timing};
 use crate::io::{DepthMap, Mask, RgbImage};
+use crate::pass::{mat4_std140, Device, Draw, Format, Image, ImageData, Pending, Step, Target, ToDevice};
 use std::time::Instant;
 
-/// Output sizes whose framebuffers are kept (a batch uses one; a sweep over sizes a few).
+/// Output sizes whose lookup images are kept (a batch uses one; a sweep over sizes a few).
 const KEEP_TARGET_SIZES: usize = 4;
+
+crate::param_block! {
+    /// Every refocus draw's parameters: shaders/refocus/refocus_params.glsl, member for member.
+    pub struct RefocusParams("RefocusParams") {
+        u_clip_from_target: [[f32; 4]; 4],
+        u_src_k: [f32; 4],
+        u_src_size: [i32; 2],
+        u_clip_z: [f32; 2],
+        u_dst_size: [f32; 2],
+        u_dst_height: i32,
+        u_expand_px: f32,
+    }
+}
 
 /// One refocused view. Images are top-down whatever the row-order convention.
 pub struct RefocusOutput {
@@ -43,188 +59,190 @@ pub struct RefocusOutput {
     pub readback_ms: f64,
 }
 
-enum Geometry {
-    Mesh(MeshPass),
-    Fullscreen { program: Program, keep: Option<Texture> },
-}
-
 /// The uploaded source.
 struct Source {
     camera: PinholeCamera,
     planes: DepthPlanes,
-    rgb: Option<Texture>,
-    depth: Texture,
+    /// Colour, or a 1 x 1 stand-in when colour is not asked for (the programs then never read it).
+    rgb: Image,
+    depth: Image,
+    geometry: Geometry,
 }
 
-/// A framebuffer of one output size and the per-target lookup textures of that size.
-struct TargetSlot {
-    framebuffer: Framebuffer,
-    cols: Texture,
-    rows: Texture,
+/// Per method: the full-screen pass's coverage flags, or the mesh pass's triangles.
+enum Geometry {
+    Fullscreen { keep: Image },
+    Mesh(MeshGeometry),
 }
 
-/// Programs compiled for one set of settings, ready to take any number of sources and targets.
+/// The lookup images of one output size.
+struct Lookups {
+    size: (u32, u32),
+    cols: Image,
+    rows: Image,
+}
+
+/// Refocus for one set of settings on one device, ready to take any number of sources and
+/// targets.
 pub struct Refocuser {
-    gpu: Gpu,
+    device: Device,
     conv: Conventions,
     outputs: OutputSet,
     rule: BreakRule,
+    method: Method,
     source: Option<Source>,
-    geometry: Geometry,
-    vao: VertexArray,
     /// Most recently used last.
-    slots: Vec<TargetSlot>,
+    lookups: Vec<Lookups>,
 }
 
 /// A target queued on the GPU: its outputs arrive through [`PendingRefocus::wait`]. Tied to
-/// the GL thread.
+/// the device's thread.
 pub struct PendingRefocus {
     camera: PinholeCamera,
-    rgb: Option<PendingRead>,
-    depth: Option<PendingRead>,
-    mask: Option<PendingRead>,
-    timer: DeferredTimer,
-    submit_ms: f64,
+    outputs: OutputSet,
+    run: Pending,
 }
 
 impl PendingRefocus {
     /// Whether every output has arrived (never blocks).
     pub fn is_ready(&self) -> bool {
-        [&self.rgb, &self.depth, &self.mask]
-            .into_iter()
-            .flatten()
-            .all(PendingRead::is_ready)
+        self.run.is_ready()
     }
 
     /// Wait for the outputs and hand them out: one copy out of each mapped buffer, no
     /// per-pixel conversion (the GPU packed RGB, flipped rows and wrote the mask as 0/1).
     pub fn wait(self) -> Result<RefocusOutput> {
         let t0 = Instant::now();
+        let mut r = self.run.wait()?;
         let (w, h) = (self.camera.width, self.camera.height);
-        let rgb = match self.rgb {
-            Some(r) => Some(RgbImage::new(w, h, r.finish()?)?),
-            None => None,
+        let o = self.outputs;
+        let rgb = if o.rgb { r.color(0)? } else { None };
+        let depth = if o.depth { r.depth(1)? } else { None };
+        let mask = match o.mask {
+            true => Some(Mask::new(w, h, r.take(2, "refocus mask")?)?),
+            false => None,
         };
-        let depth = match self.depth {
-            Some(r) => Some(DepthMap::new(w, h, r.finish_f32()?)?),
-            None => None,
-        };
-        let mask = match self.mask {
-            Some(r) => Some(Mask::new(w, h, r.finish()?)?),
-            None => None,
-        };
-        let readback_ms = t0.elapsed().as_secs_f64() * 1e3;
         Ok(RefocusOutput {
             camera: self.camera,
             rgb,
             depth,
             mask,
-            render: Timing {
-                gpu_ms: self.timer.read_ms(),
-                wall_ms: self.submit_ms,
-            },
-            readback_ms,
+            render: r.timing,
+            readback_ms: t0.elapsed().as_secs_f64() * 1e3,
         }
         .finite())
     }
 }
 
 impl Refocuser {
-    /// Compile the programs and upload `src`.
+    /// Open on `device` (a [`Device`], or a GL context) and upload `src`.
     pub fn new(
-        gpu: &Gpu,
+        device: impl ToDevice,
         src: &RefocusSource,
         rule: &BreakRule,
         method: Method,
         outputs: OutputSet,
         conv: Conventions,
     ) -> Result<Self> {
-        let mut r = Refocuser::with_settings(gpu, rule, method, outputs, conv)?;
+        let mut r = Refocuser::with_settings(device, rule, method, outputs, conv)?;
         r.set_source(src)?;
         Ok(r)
     }
 
-    /// Compile the programs for these settings; a source comes with [`Refocuser::set_source`].
+    /// Refocus with these settings on `device`; a source comes with [`Refocuser::set_source`].
+    /// The executor builds the programs at the first render and keeps them.
     pub fn with_settings(
-        gpu: &Gpu,
+        device: impl ToDevice,
         rule: &BreakRule,
         method: Method,
         outputs: OutputSet,
         conv: Conventions,
     ) -> Result<Self> {
         rule.validate()?;
-        let geometry = match method {
-            Method::Fullscreen => {
-                let kind = ProgramKind::RefocusFullscreen { want_rgb: outputs.rgb };
-                let program = ShaderProgram::new(conv, kind).build(gpu)?;
-                Geometry::Fullscreen { program, keep: None }
-            }
-            Method::Mesh => Geometry::Mesh(MeshPass::new(gpu, conv, outputs.rgb)?),
-        };
         Ok(Refocuser {
-            gpu: gpu.clone(),
+            device: device.to_device()?,
             conv,
             outputs,
             rule: *rule,
+            method,
             source: None,
-            geometry,
-            vao: VertexArray::new(gpu)?.with_label("refocus vertex array"),
-            slots: Vec::new(),
+            lookups: Vec::new(),
         })
     }
 
-    /// Upload a new source, reusing the previous source's textures when the size matches.
+    /// The device this refocuser renders on.
+    pub fn device(&self) -> &Device {
+        &self.device
+    }
+
+    /// The renderer's name, for manifests.
+    pub fn renderer(&self) -> String {
+        self.device.renderer()
+    }
+
+    /// Upload a new source, rewriting the previous source's images when the size matches.
     pub fn set_source(&mut self, src: &RefocusSource) -> Result<()> {
         src.validate()?;
-        let gpu = self.gpu.clone();
         let (w, h) = (src.rgb.width, src.rgb.height);
         // The grid's cells include a half-pixel border ring: (w + 1) x (h + 1) of them, each a
-        // texel of the coverage texture, so the source side is one less than the GPU's limit.
-        crate::gpu::check_image_size("source size", w.into(), h.into(), super::max_source_side(&gpu))?;
+        // texel of the coverage image, so the source side is one less than the device's limit.
+        let max_side = self.device.max_image_side();
+        crate::gpu::check_image_size("source size", w.into(), h.into(), max_side.saturating_sub(1))?;
         let grid = Grid { width: w, height: h };
         let keep = grid.keep_mask(&src.depth.data, &self.rule);
         let same_size = self
             .source
             .as_ref()
-            .is_some_and(|s| s.camera.width == w && s.camera.height == h);
+            .is_some_and(|s| (s.camera.width, s.camera.height) == (w, h));
         let previous = if same_size { self.source.take() } else { None };
         self.source = None; // free a differently sized source before allocating
-        match &mut self.geometry {
-            Geometry::Fullscreen { keep: keep_tex, .. } => {
-                let flags = grid.coverage_flags(&keep);
-                let (cx, cy) = (grid.cells_x() as u32, grid.cells_y() as u32);
-                match keep_tex {
-                    Some(t) if (t.width(), t.height()) == (cx, cy) => t.upload(&flags)?,
-                    _ => {
-                        *keep_tex = None;
-                        *keep_tex = Some(
-                            Texture::new(&gpu, cx, cy, TextureFormat::R8Ui, Some(&flags))?
-                                .with_label("refocus coverage flags"),
-                        );
-                    }
-                }
-            }
-            Geometry::Mesh(mesh) => mesh.set_geometry(&gpu, &grid, &keep)?,
-        }
-        let rgba: Option<Vec<u8>> = self.outputs.rgb.then(|| crate::gpu::pixels::rgb_to_rgba(&src.rgb.data));
+        let rgba: Vec<u8> = match self.outputs.rgb {
+            true => crate::gpu::pixels::rgb_to_rgba(&src.rgb.data),
+            false => vec![0; 4],
+        };
+        let (rw, rh) = if self.outputs.rgb { (w, h) } else { (1, 1) };
         let depth_bytes: &[u8] = bytemuck::cast_slice(&src.depth.data);
-        let (rgb, depth) = match previous {
+        let (cx, cy) = (grid.cells_x() as u32, grid.cells_y() as u32);
+        let d = &self.device;
+        let upload = |width, height, format, bytes: &[u8], label| {
+            d.upload(&ImageData {
+                width,
+                height,
+                format,
+                bytes,
+                label,
+            })
+        };
+        let flags = |method| (method == Method::Fullscreen).then(|| grid.coverage_flags(&keep));
+        let (rgb, depth, geometry) = match previous {
             Some(p) => {
-                if let (Some(t), Some(d)) = (&p.rgb, &rgba) {
-                    t.upload(d)?;
+                if self.outputs.rgb {
+                    d.write_image(&p.rgb, &rgba)?;
                 }
-                p.depth.upload(depth_bytes)?;
-                (p.rgb, p.depth)
-            }
-            None => (
-                match &rgba {
-                    Some(d) => {
-                        Some(Texture::new(&gpu, w, h, TextureFormat::Rgba8, Some(d))?.with_label("refocus source rgb"))
+                d.write_image(&p.depth, depth_bytes)?;
+                let geometry = match (p.geometry, flags(self.method)) {
+                    (Geometry::Fullscreen { keep }, Some(f)) => {
+                        d.write_image(&keep, &f)?;
+                        Geometry::Fullscreen { keep }
                     }
-                    None => None,
-                },
-                Texture::new(&gpu, w, h, TextureFormat::R32F, Some(depth_bytes))?.with_label("refocus source depth"),
-            ),
+                    (old, _) => {
+                        drop(old); // free the previous triangles before uploading the new ones
+                        Geometry::Mesh(MeshGeometry::new(d, &grid, &keep, max_side)?)
+                    }
+                };
+                (p.rgb, p.depth, geometry)
+            }
+            None => {
+                let rgb = upload(rw, rh, Format::Rgba8, &rgba, "refocus source rgb")?;
+                let depth = upload(w, h, Format::R32F, depth_bytes, "refocus source depth")?;
+                let geometry = match flags(self.method) {
+                    Some(f) => Geometry::Fullscreen {
+                        keep: upload(cx, cy, Format::R8Ui, &f, "refocus coverage flags")?,
+                    },
+                    None => Geometry::Mesh(MeshGeometry::new(d, &grid, &keep, max_side)?),
+                };
+                (rgb, depth, geometry)
+            }
         };
         // Every kept vertex lies in [min, max] of the valid depths; the factor 2 leaves room for
         // the expanded border of each triangle (which the vertex shader keeps within it).
@@ -240,59 +258,49 @@ impl Refocuser {
             planes,
             rgb,
             depth,
+            geometry,
         });
         Ok(())
     }
 
-    /// The context this refocuser renders on.
-    pub fn gpu(&self) -> &Gpu {
-        &self.gpu
-    }
-
     /// Number of kept triangles (mesh path) for reports.
     pub fn triangle_count(&self) -> Option<usize> {
-        match &self.geometry {
+        match &self.source.as_ref()?.geometry {
             Geometry::Mesh(mesh) => Some(mesh.triangle_count()),
             Geometry::Fullscreen { .. } => None,
         }
     }
 
-    /// The slot for output size w x h, most recently used last; allocated on first use.
-    fn slot(&mut self, w: u32, h: u32) -> Result<&TargetSlot> {
-        if let Some(i) = self
-            .slots
-            .iter()
-            .position(|s| (s.framebuffer.width(), s.framebuffer.height()) == (w, h))
-        {
-            let s = self.slots.remove(i);
-            self.slots.push(s);
+    /// The lookups of output size w x h, written with `cols` and `rows`; most recently used
+    /// last, made on first use.
+    fn lookups(&mut self, w: u32, h: u32, cols: &[[f32; 4]], rows: &[[f32; 4]]) -> Result<&Lookups> {
+        let (cols, rows): (&[u8], &[u8]) = (bytemuck::cast_slice(cols), bytemuck::cast_slice(rows));
+        if let Some(i) = self.lookups.iter().position(|l| l.size == (w, h)) {
+            let l = self.lookups.remove(i);
+            self.device.write_image(&l.cols, cols)?;
+            self.device.write_image(&l.rows, rows)?;
+            self.lookups.push(l);
         } else {
-            if self.slots.len() >= KEEP_TARGET_SIZES {
-                self.slots.remove(0); // free the least recently used before allocating
+            if self.lookups.len() >= KEEP_TARGET_SIZES {
+                self.lookups.remove(0); // free the least recently used before allocating
             }
-            let o = self.outputs;
-            let slot = |want: bool, format| {
-                want.then_some(Attachment {
-                    format,
-                    clear: [0.0; 4],
+            let image = |n, bytes, label| {
+                self.device.upload(&ImageData {
+                    width: n,
+                    height: 1,
+                    format: Format::Rgba32F,
+                    bytes,
+                    label,
                 })
             };
-            let attachments = [
-                slot(o.rgb, TextureFormat::Rgba8),
-                slot(o.depth, TextureFormat::R32F),
-                slot(o.mask, TextureFormat::R8),
-            ];
-            let with_depth = matches!(self.geometry, Geometry::Mesh(_));
-            let framebuffer = Framebuffer::new(&self.gpu, w, h, &attachments, with_depth)?.with_label("refocus target");
-            let cols = Texture::new(&self.gpu, w, 1, TextureFormat::Rgba32F, None)?.with_label("refocus column lookup");
-            let rows = Texture::new(&self.gpu, h, 1, TextureFormat::Rgba32F, None)?.with_label("refocus row lookup");
-            self.slots.push(TargetSlot {
-                framebuffer,
-                cols,
-                rows,
-            });
+            let l = Lookups {
+                size: (w, h),
+                cols: image(w, cols, "refocus column lookup")?,
+                rows: image(h, rows, "refocus row lookup")?,
+            };
+            self.lookups.push(l);
         }
-        Ok(self.slots.last().expect("pushed above"))
+        Ok(self.lookups.last().expect("pushed above"))
     }
 
     /// Render `target` (same pose as the source) and read back the requested outputs.
@@ -300,80 +308,105 @@ impl Refocuser {
         self.submit(target)?.wait()
     }
 
-    /// Record the draw of `target` and queue the reads of its outputs; returns without waiting.
+    /// Record the draws of `target` and queue the reads of its outputs; returns without waiting.
     pub fn submit(&mut self, target: &PinholeCamera) -> Result<PendingRefocus> {
-        let t0 = Instant::now();
         target.validate("target camera")?;
-        self.gpu.check_image_size("output size", target.width, target.height)?;
+        self.device
+            .check_image_size("output size", target.width, target.height)?;
         let Some(source) = &self.source else {
             return Err(Error::param("refocus source", "no source uploaded (set_source)"));
         };
-        let (src_cam, planes) = (source.camera, source.planes);
-        let conv = self.conv;
-        let clear_depth = conv.clear_depth() as f32;
-        let gpu = self.gpu.clone();
-        let sk = src_cam.k;
-        let tk = target.k;
+        let (src_cam, planes, conv) = (source.camera, source.planes, self.conv);
+        let (sk, tk) = (src_cam.k, target.k);
         // The pixel -> source-point map in f64, per column and per row (it is separable).
         let cols = axis_lookup(src_cam.width, sk.cx, tk.cx, sk.fx / tk.fx, target.width);
         let rows = axis_lookup(src_cam.height, sk.cy, tk.cy, sk.fy / tk.fy, target.height);
-        self.slot(target.width, target.height)?;
-        let slot = self.slots.last().expect("slot allocated above");
-        slot.cols.upload(bytemuck::cast_slice(&cols))?;
-        slot.rows.upload(bytemuck::cast_slice(&rows))?;
+        let (cols_id, rows_id) = {
+            let l = self.lookups(target.width, target.height, &cols, &rows)?;
+            (l.cols.id(), l.rows.id())
+        };
         let source = self.source.as_ref().expect("checked above");
-        let fb = &slot.framebuffer;
-        let programs: Vec<&Program> = match &self.geometry {
-            Geometry::Fullscreen { program, .. } => vec![program],
-            Geometry::Mesh(mesh) => mesh.programs().to_vec(),
+        let (a, b) = planes.clip_z_coefficients(&conv);
+        let params = RefocusParams {
+            u_clip_from_target: mat4_std140(&clip_from_view_opencv(target, &planes, &conv)),
+            u_src_k: [sk.fx as f32, sk.fy as f32, sk.cx as f32, sk.cy as f32],
+            u_src_size: [src_cam.width as i32, src_cam.height as i32],
+            u_clip_z: [a as f32, b as f32],
+            u_dst_size: [target.width as f32, target.height as f32],
+            u_dst_height: target.height as i32,
+            u_expand_px: EXPAND_PX,
         };
-        let state = match &self.geometry {
-            Geometry::Mesh(_) => DrawState::depth_tested(&conv),
-            Geometry::Fullscreen { .. } => DrawState::default(),
+        let params = bytemuck::bytes_of(&params);
+        let want_rgb = self.outputs.rgb;
+        let program = |kind| ShaderProgram::new(conv, kind);
+        let shared = [source.rgb.id(), source.depth.id(), cols_id, rows_id];
+        let with = |extra| [shared[0], shared[1], shared[2], shared[3], extra];
+        let viewport = [0, 0, target.width, target.height];
+        let draw = |kind, images, triangles, indices| {
+            Step::Draw(Draw {
+                program: program(kind),
+                params,
+                images,
+                buffers: &[],
+                viewport,
+                triangles,
+                indices,
+            })
         };
-        let mut timer = DeferredTimer::begin(&gpu);
-        let pass = fb.begin_pass(state, clear_depth);
-        if let Some(rgb) = &source.rgb {
-            rgb.bind(0);
-        }
-        source.depth.bind(1);
-        slot.cols.bind(3);
-        slot.rows.bind(4);
-        for p in programs {
-            p.bind();
-            p.set_i32("u_src_rgb", 0);
-            p.set_i32("u_src_depth", 1);
-            p.set_i32("u_keep", 2);
-            p.set_i32("u_cols", 3);
-            p.set_i32("u_rows", 4);
-            p.set_ivec2("u_src_size", [src_cam.width as i32, src_cam.height as i32]);
-            p.set_vec4("u_src_k", [sk.fx as f32, sk.fy as f32, sk.cx as f32, sk.cy as f32]);
-            p.set_i32("u_dst_height", target.height as i32);
-        }
-        match &self.geometry {
-            Geometry::Fullscreen { program, keep } => {
-                program.bind();
-                keep.as_ref().expect("uploaded with the source").bind(2);
-                pass.draw_fullscreen(&self.vao);
+        let (keep_images, interior_images, pulled_images);
+        let mut steps = Vec::with_capacity(2);
+        match &source.geometry {
+            Geometry::Fullscreen { keep } => {
+                keep_images = with(keep.id());
+                steps.push(draw(
+                    ProgramKind::RefocusFullscreen { want_rgb },
+                    &keep_images[..],
+                    1,
+                    None,
+                ));
             }
-            Geometry::Mesh(mesh) => mesh.draw(&pass, &self.vao, &src_cam, target, &planes, &conv, 2),
+            Geometry::Mesh(mesh) => {
+                let m = mesh.draws((tk.fx / sk.fx).min(tk.fy / sk.fy));
+                interior_images = shared;
+                if let Some((indices, count)) = m.interior {
+                    steps.push(draw(
+                        ProgramKind::RefocusMeshInterior { want_rgb },
+                        &interior_images[..],
+                        count,
+                        Some(indices),
+                    ));
+                }
+                pulled_images = m.pulled.map(|(codes, _)| with(codes));
+                if let (Some((_, count)), Some(images)) = (m.pulled, &pulled_images) {
+                    steps.push(draw(
+                        ProgramKind::RefocusMeshBoundary { want_rgb },
+                        &images[..],
+                        count,
+                        None,
+                    ));
+                }
+            }
         }
-        drop(pass);
-        timer.end();
-        gpu.check("refocus draw")?;
-        // Files are top-down: under the GL row order the GPU flips while copying.
-        let flip = conv.row_order == RowOrder::BottomUp;
-        let pending = PendingRefocus {
-            camera: *target,
-            rgb: fb.read_async(0, ReadFormat::RGB8, flip)?,
-            depth: fb.read_async(1, ReadFormat::R32F, flip)?,
-            mask: fb.read_async(2, ReadFormat::R8, flip)?,
-            timer,
-            submit_ms: 0.0,
+        let o = self.outputs;
+        let pass_target = Target {
+            width: target.width,
+            height: target.height,
+            outputs: vec![
+                o.rgb.then_some(Format::Rgba8),
+                o.depth.then_some(Format::R32F),
+                o.mask.then_some(Format::R8),
+            ],
+            rows: conv.row_order,
+            // Depth clamp (no near/far clipping) and LEQUAL/GEQUAL come with the depth test: with
+            // a 1e8 depth ratio, standard-Z f32 puts far surfaces on the far plane, where
+            // clipping or a strict test would drop them.
+            depth_test: (self.method == Method::Mesh).then_some(conv),
         };
+        let run = self.device.submit(Some(&pass_target), &steps)?;
         Ok(PendingRefocus {
-            submit_ms: t0.elapsed().as_secs_f64() * 1e3,
-            ..pending
+            camera: *target,
+            outputs: o,
+            run,
         })
     }
 }

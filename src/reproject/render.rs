@@ -200,6 +200,7 @@ impl Reprojector {
                     buffers: &[],
                     viewport: [0, 0, w, h],
                     triangles: 1,
+                    indices: None,
                 };
                 let mut out = self.device.render(&target, &[draw])?;
                 // A non-finite depth makes its pixel invalid (`finite`, below).

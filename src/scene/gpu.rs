@@ -267,6 +267,7 @@ impl SceneRenderer {
             buffers: &[],
             viewport: [0, 0, w, h],
             triangles: 1,
+            indices: None,
         };
         let mut out = self.device.render(&target, &[draw])?;
         let floats = |b: Vec<u8>| -> Vec<f32> { bytemuck::pod_collect_to_vec(&b) };

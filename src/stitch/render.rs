@@ -183,6 +183,7 @@ impl StitchRenderer {
                 // One full-screen triangle into this eye's half of the target.
                 viewport: [0, row0, w, h],
                 triangles: 1,
+                indices: None,
             })
             .collect();
         let target = Target {

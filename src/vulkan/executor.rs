@@ -25,6 +25,7 @@ use crate::error::{Error, Result};
 use crate::gpu::{ShaderProgram, Timing};
 use crate::pass::{
     Api, BufferId, Dispatch, Executor, Format, Groups, ImageData, ImageId, Rendered, Slots, Step, StorageImage, Target,
+    Ticket,
 };
 use ash::vk;
 use std::time::Instant;
@@ -40,6 +41,8 @@ fn vk_format(f: Format) -> vk::Format {
         Format::R32F => vk::Format::R32_SFLOAT,
         Format::R8 => vk::Format::R8_UNORM,
         Format::R32Ui => vk::Format::R32_UINT,
+        Format::R8Ui => vk::Format::R8_UINT,
+        Format::Rgba32F => vk::Format::R32G32B32A32_SFLOAT,
     }
 }
 
@@ -97,6 +100,8 @@ struct StoredImage {
     image: Image,
     layout: vk::ImageLayout,
     format: Format,
+    /// Host buffer of its re-uploads ([`Executor::write_image`]), made on the first one.
+    staging: Option<Buffer>,
 }
 
 /// Passes on a Vulkan device.
@@ -111,6 +116,8 @@ pub struct VkExecutor {
     params: Option<Buffer>,
     pool: vk::DescriptorPool,
     pool_sets: usize,
+    /// Finished runs' outputs until waited for (each run is waited for before submit returns).
+    done: Slots<Rendered>,
 }
 
 fn bindings((samplers, images, buffers): Counts) -> Vec<vk::DescriptorSetLayoutBinding<'static>> {
@@ -179,6 +186,7 @@ impl VkExecutor {
             params: None,
             pool: vk::DescriptorPool::null(),
             pool_sets: 0,
+            done: Slots::default(),
         };
         me.push_layout((0, 0, 0), set)?;
         Ok(me)
@@ -507,6 +515,7 @@ impl Executor for VkExecutor {
             image: img,
             layout: vk::ImageLayout::SHADER_READ_ONLY_OPTIMAL,
             format: image.format,
+            staging: None,
         }))
     }
 
@@ -531,6 +540,7 @@ impl Executor for VkExecutor {
             image,
             layout: vk::ImageLayout::GENERAL,
             format,
+            staging: None,
         }))
     }
 
@@ -553,7 +563,63 @@ impl Executor for VkExecutor {
         self.buffers.remove(id.0);
     }
 
-    fn run(&mut self, target: Option<&Target>, steps: &[Step]) -> Result<Rendered> {
+    fn upload_indices(&mut self, indices: &[u32], label: &str) -> Result<BufferId> {
+        let bytes: &[u8] = bytemuck::cast_slice(indices);
+        let b = Buffer::new(&self.vk, bytes.len(), vk::BufferUsageFlags::INDEX_BUFFER)?;
+        b.write(bytes);
+        self.vk.name(b.raw, label);
+        Ok(BufferId(self.buffers.insert(b)))
+    }
+
+    fn write_image(&mut self, id: ImageId, bytes: &[u8]) -> Result<()> {
+        let vk = self.vk.clone();
+        let stored = self
+            .images
+            .get_mut(id.0)
+            .ok_or_else(|| Error::Vulkan(format!("write_image: image {} was freed", id.0)))?;
+        let need = stored.image.width as usize * stored.image.height as usize * stored.format.texel_bytes();
+        if bytes.len() != need || stored.layout != vk::ImageLayout::SHADER_READ_ONLY_OPTIMAL {
+            return Err(Error::Vulkan(format!(
+                "write_image: {} bytes for an uploaded image of {need}",
+                bytes.len()
+            )));
+        }
+        if stored.staging.is_none() {
+            stored.staging = Some(Buffer::new(&vk, need, vk::BufferUsageFlags::TRANSFER_SRC)?);
+        }
+        let staging = stored.staging.as_ref().expect("made above");
+        // No submit is pending (each is waited for), so the staging buffer is free to overwrite.
+        staging.write(bytes);
+        let image = &stored.image;
+        vk.run_commands(|cb| {
+            full_barrier(&vk.device, cb);
+            image.record_upload(cb, staging);
+        })
+    }
+
+    fn renderer(&self) -> String {
+        format!("Vulkan: {}", self.vk.info().name)
+    }
+
+    fn submit(&mut self, target: Option<&Target>, steps: &[Step]) -> Result<Ticket> {
+        let rendered = self.run_now(target, steps)?;
+        Ok(Ticket(self.done.insert(rendered)))
+    }
+
+    fn is_ready(&mut self, _ticket: Ticket) -> bool {
+        true
+    }
+
+    fn wait(&mut self, ticket: Ticket) -> Result<Rendered> {
+        self.done
+            .take(ticket.0)
+            .ok_or_else(|| Error::Vulkan(format!("pass run {} was not submitted or was waited for", ticket.0)))
+    }
+}
+
+impl VkExecutor {
+    /// Record, submit and wait for `steps`; the outputs, top-down.
+    fn run_now(&mut self, target: Option<&Target>, steps: &[Step]) -> Result<Rendered> {
         // Pipelines and layouts, then the target.
         let mut chosen = Vec::with_capacity(steps.len());
         for step in steps {
@@ -638,6 +704,27 @@ impl Executor for VkExecutor {
                 _ => None,
             });
         }
+        let mut index_buffers = Vec::with_capacity(steps.len());
+        for step in steps {
+            index_buffers.push(match step {
+                Step::Draw(draw) => match draw.indices {
+                    Some(id) => {
+                        let b = self.buffer(id)?;
+                        if b.size < 12 * draw.triangles as usize {
+                            return Err(Error::Vulkan(format!(
+                                "{}: {} triangles from {} bytes of indices",
+                                draw.program.kind.name(),
+                                draw.triangles,
+                                b.size
+                            )));
+                        }
+                        Some(b.raw)
+                    }
+                    None => None,
+                },
+                _ => None,
+            });
+        }
         let t0 = Instant::now();
         let d = &self.vk.device;
         let pipelines = &self.pipelines;
@@ -716,7 +803,13 @@ impl Executor for VkExecutor {
                             );
                             d.cmd_set_viewport(cb, 0, &[viewport]);
                             d.cmd_set_scissor(cb, 0, &[scissor]);
-                            d.cmd_draw(cb, 3 * draw.triangles, 1, 0, 0);
+                            match index_buffers[k] {
+                                Some(indices) => {
+                                    d.cmd_bind_index_buffer(cb, indices, 0, vk::IndexType::UINT32);
+                                    d.cmd_draw_indexed(cb, 3 * draw.triangles, 1, 0, 0, 0);
+                                }
+                                None => d.cmd_draw(cb, 3 * draw.triangles, 1, 0, 0),
+                            }
                         }
                         Step::Dispatch(dispatch) => {
                             let (p, l) = chosen[k].expect("chosen above");
@@ -745,10 +838,13 @@ impl Executor for VkExecutor {
                 if rendering {
                     targets.record_end_to_general(cb);
                 }
-                if drawn {
-                    full_barrier(d, cb);
-                    targets.record_readback_from_general(cb, &wanted);
+                if !drawn {
+                    // No draws (e.g. no kept triangles): the target is still cleared.
+                    targets.record_begin(cb, None);
+                    targets.record_end_to_general(cb);
                 }
+                full_barrier(d, cb);
+                targets.record_readback_from_general(cb, &wanted);
             }
         })?;
         let outputs = match (target, targets) {

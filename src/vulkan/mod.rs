@@ -7,20 +7,15 @@
 //! - `resources`: host-visible buffers (uploads, indices, readback) and device-local images.
 //! - `pipeline`: SPIR-V variants compiled by build.rs from the GL sources (looked up by the GL
 //!   preamble) and graphics pipelines with dynamic rendering.
-//! - `refocus`: the refocus full-screen and mesh passes (not yet a pass description).
-//! - `executor`: runs the backend-neutral pass descriptions (`crate::pass`): the cyclopean
-//!   gather, the reprojection shift, the stitch and the scene ray tracer, from the same GLSL as
-//!   the GL executor.
+//! - `executor`: runs the backend-neutral pass descriptions (`crate::pass`) of every
+//!   capability (refocus, cyclopean, reproject, stitch, the scene ray tracer), from the same
+//!   GLSL as the GL executor.
 //! - `targets`: the colour attachments the passes render into and their readback.
-//!
-//! Scope: refocus single frames and every full-screen pass; the compute passes (splat-gather,
-//! edge snap), the forward warp and the refocus batch render on GL.
 
 mod context;
 mod devices;
 mod executor;
 mod pipeline;
-mod refocus;
 mod resources;
 mod targets;
 
@@ -28,4 +23,3 @@ pub use context::{
     auto_pick, check_policy, list_devices, Vk, VkCensus, VulkanContext, VulkanDeviceChoice, VulkanDeviceInfo,
 };
 pub use executor::VkExecutor;
-pub use refocus::{preamble as refocus_preamble, VkRefocuser};

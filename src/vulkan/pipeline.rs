@@ -183,23 +183,6 @@ mod tests {
     use super::*;
     use crate::convention::Conventions;
 
-    /// Every convention, with and without colour, finds its SPIR-V for every refocus stage:
-    /// build.rs's preamble is the one the GL backend builds (`ShaderProgram::preamble`).
-    #[test]
-    fn every_refocus_variant_is_compiled_with_the_gl_preamble() {
-        for conv in Conventions::all() {
-            for rgb in [false, true] {
-                let preamble = super::super::refocus::preamble(&conv, rgb);
-                for program in ["refocus/fullscreen", "refocus/mesh_interior", "refocus/mesh_boundary"] {
-                    for stage in ["vert", "frag"] {
-                        let words = spirv(program, stage, &preamble).unwrap();
-                        assert_eq!(words[0], 0x0723_0203, "SPIR-V magic of {program}.{stage}");
-                    }
-                }
-            }
-        }
-    }
-
     /// Every program the shader table marks for Vulkan, at every switch value `ShaderProgram::all`
     /// lists and under every convention, finds its SPIR-V for every stage: build.rs's preamble
     /// is `ShaderProgram::preamble`, and the table's switch values cover the typed ones.

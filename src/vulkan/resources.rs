@@ -326,37 +326,3 @@ pub(crate) fn sampler_and_set_layout(
         }
     }
 }
-
-/// A descriptor pool of `sizes` for one set, and that set of `layout`, made together so that a
-/// failure of the second destroys the first. The caller owns the pool (the set goes with it)
-/// and destroys it in its Drop.
-pub(crate) fn pool_with_one_set(
-    vk: &Vk,
-    sizes: &[vk::DescriptorPoolSize],
-    layout: vk::DescriptorSetLayout,
-) -> Result<(vk::DescriptorPool, vk::DescriptorSet)> {
-    let d = &vk.device;
-    let layouts = [layout];
-    // SAFETY: plain object creation on a live device; on the set's failure the pool, owned by
-    // no one yet, is destroyed here.
-    unsafe {
-        let pool = d
-            .create_descriptor_pool(
-                &vk::DescriptorPoolCreateInfo::default().max_sets(1).pool_sizes(sizes),
-                None,
-            )
-            .map_err(|r| Error::Vulkan(format!("vkCreateDescriptorPool: {r}")))?;
-        vk.count(super::context::Created::DescriptorPool);
-        match d.allocate_descriptor_sets(
-            &vk::DescriptorSetAllocateInfo::default()
-                .descriptor_pool(pool)
-                .set_layouts(&layouts),
-        ) {
-            Ok(sets) => Ok((pool, sets[0])),
-            Err(r) => {
-                d.destroy_descriptor_pool(pool, None);
-                Err(Error::Vulkan(format!("vkAllocateDescriptorSets: {r}")))
-            }
-        }
-    }
-}

@@ -25,13 +25,8 @@ pub struct ColorTargets {
 }
 
 impl ColorTargets {
-    /// One attachment per format (in output-location order), `texel_bytes[i]` bytes per texel.
-    pub fn new(vk: &Vk, width: u32, height: u32, formats: &[vk::Format], texel_bytes: &[usize]) -> Result<Self> {
-        let some: Vec<_> = formats.iter().map(|f| Some(*f)).collect();
-        Self::with_slots(vk, width, height, &some, texel_bytes)
-    }
-
-    /// As [`Self::new`], with no attachment (nor host buffer) where `formats[i]` is None.
+    /// One attachment per format (in output-location order), `texel_bytes[i]` bytes per texel;
+    /// no attachment (nor host buffer) where `formats[i]` is None.
     pub fn with_slots(
         vk: &Vk,
         width: u32,
@@ -135,25 +130,6 @@ impl ColorTargets {
             d.cmd_set_viewport(cb, 0, &[viewport]);
             d.cmd_set_scissor(cb, 0, &[area]);
         }
-    }
-
-    /// Record: end rendering, copy the attachments with `wanted[i]` set into their host
-    /// buffers, and make the copies visible to the host.
-    pub fn record_end_and_readback(&self, cb: vk::CommandBuffer, wanted: &[bool]) {
-        use vk::{AccessFlags as A, ImageLayout as L, PipelineStageFlags as S};
-        // SAFETY: recording into `cb` inside the rendering begun by record_begin.
-        unsafe { self.vk.device.cmd_end_rendering(cb) };
-        self.record_copies(cb, wanted, L::TRANSFER_SRC_OPTIMAL, |c| {
-            c.transition(
-                cb,
-                L::COLOR_ATTACHMENT_OPTIMAL,
-                L::TRANSFER_SRC_OPTIMAL,
-                S::COLOR_ATTACHMENT_OUTPUT,
-                A::COLOR_ATTACHMENT_WRITE,
-                S::TRANSFER,
-                A::TRANSFER_READ,
-            )
-        });
     }
 
     /// Record, outside any rendering: `prepare` each wanted attachment, copy it (in `layout`)

@@ -43,9 +43,7 @@ fn every_shader_file_belongs_to_some_program() {
     // The Vulkan layers (build.rs compiles them into the SPIR-V of the programs the table marks
     // for Vulkan, between the preamble and the GL sources; src/vulkan tests that every variant
     // exists).
-    let mut used: BTreeSet<String> = ["common/vulkan.glsl", "refocus/vulkan_interface.glsl"]
-        .map(String::from)
-        .into();
+    let mut used: BTreeSet<String> = ["common/vulkan.glsl"].map(String::from).into();
     for program in ShaderProgram::all(Conventions::default()) {
         for (_, files) in program.sources() {
             for f in files {

@@ -31,7 +31,7 @@ use viewsynth::eval::reproject::{methods, scene_cases};
 use viewsynth::gpu::shaders::{ShiftDepth, StitchBlend};
 use viewsynth::gpu::{ProgramKind, ShaderProgram};
 use viewsynth::pass::{Device, ParamBlock};
-use viewsynth::refocus::BreakRule;
+use viewsynth::refocus::{BreakRule, RefocusParams};
 use viewsynth::reproject::render::ShiftParams;
 use viewsynth::reproject::{self, ReprojectInput};
 use viewsynth::scene::gpu::{GlCamera, RaytraceParams, SceneRenderer};
@@ -88,6 +88,8 @@ fn every_parameter_block_has_the_layout_the_gl_compiler_reports() {
     check_block::<SplatGatherBlock>(ProgramKind::CyclopeanSplatGather);
     check_block::<SplatGatherBlock>(ProgramKind::CyclopeanSplatEdges);
     check_block::<ForwardParams>(ProgramKind::CyclopeanForward);
+    check_block::<RefocusParams>(ProgramKind::RefocusFullscreen { want_rgb: true });
+    check_block::<RefocusParams>(ProgramKind::RefocusMeshBoundary { want_rgb: true });
 }
 
 fn devices() -> (Device, Device) {

@@ -24,7 +24,7 @@ use viewsynth::convention::Conventions;
 use viewsynth::gpu::GpuPolicy;
 use viewsynth::refocus::job::TargetSpec;
 use viewsynth::refocus::{BreakRule, Method, OutputSet, RefocusOutput, RefocusSource, Refocuser};
-use viewsynth::vulkan::{Vk, VkRefocuser, VulkanContext, VulkanDeviceChoice};
+use viewsynth::vulkan::{Vk, VkExecutor, VulkanContext, VulkanDeviceChoice};
 
 /// 32 ulp of f32 relative (derivation above).
 const DEPTH_REL_BOUND: f32 = 32.0 / (1u32 << 24) as f32;
@@ -80,6 +80,7 @@ fn sources() -> Vec<(&'static str, RefocusSource)> {
 /// worst over sources and scales) after asserting the bounds.
 fn gl_and_vulkan_agree(method: Method) {
     let (g, v) = (gpu(), vulkan());
+    let device = VkExecutor::device(&v).unwrap();
     eprintln!(
         "GL '{}' vs Vulkan '{}' ({}), {method:?}",
         g.info().renderer,
@@ -101,7 +102,7 @@ fn gl_and_vulkan_agree(method: Method) {
             .unwrap();
             let rule = BreakRule::default();
             let mut gl = Refocuser::new(&g, &src, &rule, method, OutputSet::default(), conv).unwrap();
-            let mut vk = VkRefocuser::new(&v, &src, &rule, method, OutputSet::default(), conv).unwrap();
+            let mut vk = Refocuser::new(&device, &src, &rule, method, OutputSet::default(), conv).unwrap();
             for (ti, t) in targets.iter().enumerate() {
                 let d = diff(&gl.render(t).unwrap(), &vk.render(t).unwrap());
                 let tag = format!("{name} {method:?} {} scale#{ti}", conv.label());
