@@ -608,11 +608,6 @@ impl<T> Slots<T> {
         self.0.get(i).and_then(Option::as_ref)
     }
 
-    /// The value at `i` to change, unless freed.
-    pub(crate) fn get_mut(&mut self, i: usize) -> Option<&mut T> {
-        self.0.get_mut(i).and_then(Option::as_mut)
-    }
-
     /// Take the value at `i` out, freeing the slot.
     pub(crate) fn take(&mut self, i: usize) -> Option<T> {
         self.0.get_mut(i).and_then(Option::take)

@@ -369,6 +369,69 @@ impl VulkanContext {
         }
     }
 
+    /// A command buffer and fence of a caller's own (an in-flight submission's), freed with
+    /// [`Self::free_submit_slot`].
+    pub(crate) fn new_submit_slot(&self) -> Result<(vk::CommandBuffer, vk::Fence)> {
+        let d = &self.device;
+        // SAFETY: plain allocation from the context's pool; on the fence's failure the command
+        // buffer is freed here.
+        unsafe {
+            let alloc = vk::CommandBufferAllocateInfo::default()
+                .command_pool(self.pool)
+                .level(vk::CommandBufferLevel::PRIMARY)
+                .command_buffer_count(1);
+            let cb = d
+                .allocate_command_buffers(&alloc)
+                .map_err(vk_err("vkAllocateCommandBuffers"))?[0];
+            match d.create_fence(&vk::FenceCreateInfo::default(), None) {
+                Ok(f) => {
+                    self.count(Created::SubmitObject);
+                    self.count(Created::SubmitObject);
+                    Ok((cb, f))
+                }
+                Err(r) => {
+                    d.free_command_buffers(self.pool, &[cb]);
+                    Err(vk_err("vkCreateFence")(r))
+                }
+            }
+        }
+    }
+
+    /// Free a slot of [`Self::new_submit_slot`]; its submission must have finished.
+    pub(crate) fn free_submit_slot(&self, cb: vk::CommandBuffer, fence: vk::Fence) {
+        // SAFETY: the caller's objects, not in use.
+        unsafe {
+            self.device.destroy_fence(fence, None);
+            self.device.free_command_buffers(self.pool, &[cb]);
+        }
+    }
+
+    /// Record `record` into `cb` and submit it, signalling `fence`; returns without waiting.
+    /// Both must be free (their last submission waited for).
+    pub(crate) fn submit_commands(
+        &self,
+        cb: vk::CommandBuffer,
+        fence: vk::Fence,
+        record: impl FnOnce(vk::CommandBuffer),
+    ) -> Result<()> {
+        let d = &self.device;
+        // SAFETY: as in run_commands, without the wait.
+        unsafe {
+            d.reset_command_buffer(cb, vk::CommandBufferResetFlags::empty())
+                .map_err(vk_err("vkResetCommandBuffer"))?;
+            d.reset_fences(&[fence]).map_err(vk_err("vkResetFences"))?;
+            let begin = vk::CommandBufferBeginInfo::default().flags(vk::CommandBufferUsageFlags::ONE_TIME_SUBMIT);
+            d.begin_command_buffer(cb, &begin)
+                .map_err(vk_err("vkBeginCommandBuffer"))?;
+            record(cb);
+            d.end_command_buffer(cb).map_err(vk_err("vkEndCommandBuffer"))?;
+            let cbs = [cb];
+            let submit = [vk::SubmitInfo::default().command_buffers(&cbs)];
+            d.queue_submit(self.queue, &submit, fence)
+                .map_err(vk_err("vkQueueSubmit"))
+        }
+    }
+
     /// Record `record` into the context's command buffer, submit it and wait for its fence.
     /// Synchronous: no submit is pending when this returns, so every object a recording used is
     /// free again.

@@ -6,18 +6,24 @@
 //! clamp to edge), exactly the GL bindings, then the storage images at 8 + k and the storage
 //! buffers at 12 + k (GL's image unit and buffer binding k: shaders/common/bindings.glsl). One
 //! host-visible uniform buffer carries every step's block at 256-byte offsets (the largest
-//! `minUniformBufferOffsetAlignment` the spec allows); descriptor sets come from one pool reset
-//! at each run. Pipelines are cached per program, output set and binding counts; targets per
-//! size and output set (the last few). Each run is one command buffer waited for with a fence:
-//! consecutive draws in one dynamic rendering, a full memory barrier between other steps,
-//! attachments moved to GENERAL after the draws (so compute steps may rewrite them), then the
-//! copies into host buffers. Created images live in GENERAL; uploaded ones are read-only.
+//! `minUniformBufferOffsetAlignment` the spec allows). Pipelines are cached per program, output
+//! set and binding counts; targets per size and output set (the last few). Each run is one
+//! submission of a [`Flight`] (flight.rs: command buffer, fence, parameter buffer, descriptor
+//! pool, staging arena, host readback buffers), reused once waited for, so several runs can be
+//! in flight and a steady state creates nothing. A run's command buffer starts with a full
+//! barrier (runs share attachments and images with those before them), then the image writes
+//! queued for it ([`Executor::write_image`]), then its steps: consecutive draws in one dynamic
+//! rendering, a full memory barrier between other steps, attachments moved to GENERAL after the
+//! draws (so compute steps may rewrite them), then the copies into the flight's host buffers;
+//! `wait` waits for its fence. Objects freed while a run is in flight are kept until none is.
+//! Created images live in GENERAL; uploaded ones are read-only.
 //!
 //! Rows: memory rows mean what they mean under GL (NDC y = -1 and `gl_FragCoord.y` = 0.5 are
 //! memory row 0 in both APIs), so images are uploaded in the same memory order and the rows are
 //! flipped to top-down on the way out, as the GL executor does on the GPU.
 
 use super::context::{vk_err, Vk};
+use super::flight::{Flight, MAX_SAMPLED};
 use super::pipeline::{Pipeline, PipelineDesc};
 use super::resources::{sampled_image, sampler_and_set_layout, Buffer, Image};
 use super::targets::ColorTargets;
@@ -50,8 +56,6 @@ fn vk_format(f: Format) -> vk::Format {
 const STORAGE_IMAGE_BASE: u32 = 8;
 /// Binding of storage buffer k.
 const STORAGE_BUFFER_BASE: u32 = 12;
-/// At most this many sampled images a step (bindings 1..=7).
-const MAX_SAMPLED: usize = 7;
 
 /// Binding counts of a step: sampled images, storage images, storage buffers.
 type Counts = (usize, usize, usize);
@@ -100,8 +104,6 @@ struct StoredImage {
     image: Image,
     layout: vk::ImageLayout,
     format: Format,
-    /// Host buffer of its re-uploads ([`Executor::write_image`]), made on the first one.
-    staging: Option<Buffer>,
 }
 
 /// Passes on a Vulkan device.
@@ -113,11 +115,20 @@ pub struct VkExecutor {
     targets: Vec<CachedTarget>,
     images: Slots<StoredImage>,
     buffers: Slots<Buffer>,
-    params: Option<Buffer>,
-    pool: vk::DescriptorPool,
-    pool_sets: usize,
-    /// Finished runs' outputs until waited for (each run is waited for before submit returns).
-    done: Slots<Rendered>,
+    /// Submissions, reused once waited for; a ticket is a flight's index.
+    flights: Vec<Flight>,
+    /// The flight the next submit uses (image writes are queued into it first).
+    open: Option<usize>,
+    /// Objects freed while a run was in flight, dropped once none is.
+    graveyard: Vec<Grave>,
+}
+
+/// An object a run in flight may still use.
+#[allow(dead_code)] // held only to be dropped later
+enum Grave {
+    Image(StoredImage),
+    Buffer(Buffer),
+    Target(CachedTarget),
 }
 
 fn bindings((samplers, images, buffers): Counts) -> Vec<vk::DescriptorSetLayoutBinding<'static>> {
@@ -183,10 +194,9 @@ impl VkExecutor {
             targets: Vec::new(),
             images: Slots::default(),
             buffers: Slots::default(),
-            params: None,
-            pool: vk::DescriptorPool::null(),
-            pool_sets: 0,
-            done: Slots::default(),
+            flights: Vec::new(),
+            open: None,
+            graveyard: Vec::new(),
         };
         me.push_layout((0, 0, 0), set)?;
         Ok(me)
@@ -296,11 +306,11 @@ impl VkExecutor {
             return Ok(i);
         }
         if self.targets.len() >= KEPT_TARGETS {
-            self.targets.remove(0);
+            let old = self.targets.remove(0);
+            self.bury(Grave::Target(old));
         }
         let formats: Vec<Option<vk::Format>> = t.outputs.iter().map(|f| f.map(vk_format)).collect();
-        let bytes: Vec<usize> = t.outputs.iter().map(|f| f.map_or(0, Format::texel_bytes)).collect();
-        let color = ColorTargets::with_slots(&self.vk, t.width, t.height, &formats, &bytes)?;
+        let color = ColorTargets::with_slots(&self.vk, t.width, t.height, &formats)?;
         let depth = t
             .depth_test
             .map(|_| {
@@ -317,45 +327,30 @@ impl VkExecutor {
         Ok(self.targets.len() - 1)
     }
 
-    /// A pool with room for `sets` sets (reset, or made larger, for each run).
-    fn reset_pool(&mut self, sets: usize) -> Result<()> {
-        let d = &self.vk.device;
-        // SAFETY: no submit is pending (each run is waited for), so no set of the pool is in
-        // use; the old pool is destroyed before its handle is replaced.
-        unsafe {
-            if sets <= self.pool_sets {
-                return d
-                    .reset_descriptor_pool(self.pool, vk::DescriptorPoolResetFlags::empty())
-                    .map_err(vk_err("vkResetDescriptorPool"));
-            }
-            d.destroy_descriptor_pool(self.pool, None);
-            self.pool = vk::DescriptorPool::null();
-            self.pool_sets = 0;
-            let n = sets.next_power_of_two().max(4) as u32;
-            let sizes = [
-                vk::DescriptorPoolSize::default()
-                    .ty(vk::DescriptorType::UNIFORM_BUFFER)
-                    .descriptor_count(n),
-                vk::DescriptorPoolSize::default()
-                    .ty(vk::DescriptorType::COMBINED_IMAGE_SAMPLER)
-                    .descriptor_count(MAX_SAMPLED as u32 * n),
-                vk::DescriptorPoolSize::default()
-                    .ty(vk::DescriptorType::STORAGE_IMAGE)
-                    .descriptor_count(4 * n),
-                vk::DescriptorPoolSize::default()
-                    .ty(vk::DescriptorType::STORAGE_BUFFER)
-                    .descriptor_count(4 * n),
-            ];
-            self.pool = d
-                .create_descriptor_pool(
-                    &vk::DescriptorPoolCreateInfo::default().max_sets(n).pool_sizes(&sizes),
-                    None,
-                )
-                .map_err(vk_err("vkCreateDescriptorPool"))?;
-            self.vk.count(super::context::Created::DescriptorPool);
-            self.pool_sets = n as usize;
+    /// Keep `grave` until no run is in flight (dropped at once when none is).
+    fn bury(&mut self, grave: Grave) {
+        if self.flights.iter().any(|f| f.busy) {
+            self.graveyard.push(grave);
         }
-        Ok(())
+    }
+
+    /// The flight the next submit uses: the open one, else a free one, else a new one.
+    fn open_flight(&mut self) -> Result<usize> {
+        if let Some(i) = self.open {
+            return Ok(i);
+        }
+        let i = match self.flights.iter().position(|f| !f.busy) {
+            Some(i) => i,
+            None => {
+                self.flights.push(Flight::new(&self.vk)?);
+                self.flights.len() - 1
+            }
+        };
+        let f = &mut self.flights[i];
+        f.writes.clear();
+        f.staging_used = 0;
+        self.open = Some(i);
+        Ok(i)
     }
 
     fn stored(&self, id: ImageId, program: &str) -> Result<&StoredImage> {
@@ -377,6 +372,7 @@ impl VkExecutor {
     /// One descriptor set for a step: its block at `offset`, images, storage images, buffers.
     fn write_set(
         &self,
+        pool: vk::DescriptorPool,
         binds: &Binds,
         layout: usize,
         params: (vk::Buffer, u64, u64),
@@ -391,7 +387,7 @@ impl VkExecutor {
             let set = d
                 .allocate_descriptor_sets(
                     &vk::DescriptorSetAllocateInfo::default()
-                        .descriptor_pool(self.pool)
+                        .descriptor_pool(pool)
                         .set_layouts(&layouts),
                 )
                 .map_err(vk_err("vkAllocateDescriptorSets"))?[0];
@@ -515,7 +511,6 @@ impl Executor for VkExecutor {
             image: img,
             layout: vk::ImageLayout::SHADER_READ_ONLY_OPTIMAL,
             format: image.format,
-            staging: None,
         }))
     }
 
@@ -540,12 +535,13 @@ impl Executor for VkExecutor {
             image,
             layout: vk::ImageLayout::GENERAL,
             format,
-            staging: None,
         }))
     }
 
     fn free(&mut self, id: ImageId) {
-        self.images.remove(id.0);
+        if let Some(image) = self.images.take(id.0) {
+            self.bury(Grave::Image(image));
+        }
     }
 
     fn create_buffer(&mut self, words: usize, label: &str) -> Result<BufferId> {
@@ -560,7 +556,9 @@ impl Executor for VkExecutor {
     }
 
     fn free_buffer(&mut self, id: BufferId) {
-        self.buffers.remove(id.0);
+        if let Some(buffer) = self.buffers.take(id.0) {
+            self.bury(Grave::Buffer(buffer));
+        }
     }
 
     fn upload_indices(&mut self, indices: &[u32], label: &str) -> Result<BufferId> {
@@ -572,10 +570,9 @@ impl Executor for VkExecutor {
     }
 
     fn write_image(&mut self, id: ImageId, bytes: &[u8]) -> Result<()> {
-        let vk = self.vk.clone();
         let stored = self
             .images
-            .get_mut(id.0)
+            .get(id.0)
             .ok_or_else(|| Error::Vulkan(format!("write_image: image {} was freed", id.0)))?;
         let need = stored.image.width as usize * stored.image.height as usize * stored.format.texel_bytes();
         if bytes.len() != need || stored.layout != vk::ImageLayout::SHADER_READ_ONLY_OPTIMAL {
@@ -584,17 +581,11 @@ impl Executor for VkExecutor {
                 bytes.len()
             )));
         }
-        if stored.staging.is_none() {
-            stored.staging = Some(Buffer::new(&vk, need, vk::BufferUsageFlags::TRANSFER_SRC)?);
-        }
-        let staging = stored.staging.as_ref().expect("made above");
-        // No submit is pending (each is waited for), so the staging buffer is free to overwrite.
-        staging.write(bytes);
-        let image = &stored.image;
-        vk.run_commands(|cb| {
-            full_barrier(&vk.device, cb);
-            image.record_upload(cb, staging);
-        })
+        // Into the next submission's own staging arena: runs in flight keep reading theirs.
+        let f = self.open_flight()?;
+        let offset = self.flights[f].stage(bytes)?;
+        self.flights[f].writes.push((id, offset));
+        Ok(())
     }
 
     fn renderer(&self) -> String {
@@ -602,24 +593,47 @@ impl Executor for VkExecutor {
     }
 
     fn submit(&mut self, target: Option<&Target>, steps: &[Step]) -> Result<Ticket> {
-        let rendered = self.run_now(target, steps)?;
-        Ok(Ticket(self.done.insert(rendered)))
+        let f = self.open_flight()?;
+        let result = self.record_flight(f, target, steps);
+        // Whatever happened, the next submit starts a fresh flight (queued writes went with this
+        // one, or are dropped with its error).
+        self.open = None;
+        result.map(|()| Ticket(f))
     }
 
-    fn is_ready(&mut self, _ticket: Ticket) -> bool {
-        true
+    fn is_ready(&mut self, ticket: Ticket) -> bool {
+        self.flights.get(ticket.0).is_none_or(Flight::finished)
     }
 
     fn wait(&mut self, ticket: Ticket) -> Result<Rendered> {
-        self.done
-            .take(ticket.0)
-            .ok_or_else(|| Error::Vulkan(format!("pass run {} was not submitted or was waited for", ticket.0)))
+        let f = self
+            .flights
+            .get_mut(ticket.0)
+            .filter(|f| f.busy)
+            .ok_or_else(|| Error::Vulkan(format!("pass run {} was not submitted or was waited for", ticket.0)))?;
+        let waited = f.wait_fence();
+        f.busy = false;
+        waited?;
+        let outputs = (0..f.outputs.len()).map(|i| f.read_output(i)).collect();
+        let timing = Timing {
+            gpu_ms: None,
+            wall_ms: f.submit_ms,
+        };
+        if !self.flights.iter().any(|f| f.busy) {
+            self.graveyard.clear();
+        }
+        Ok(Rendered {
+            outputs,
+            timing,
+            size: (0, 0),
+        })
     }
 }
 
 impl VkExecutor {
-    /// Record, submit and wait for `steps`; the outputs, top-down.
-    fn run_now(&mut self, target: Option<&Target>, steps: &[Step]) -> Result<Rendered> {
+    /// Record `steps` (after the writes queued for it) into flight `f` and submit it.
+    fn record_flight(&mut self, f: usize, target: Option<&Target>, steps: &[Step]) -> Result<()> {
+        let t0 = Instant::now();
         // Pipelines and layouts, then the target.
         let mut chosen = Vec::with_capacity(steps.len());
         for step in steps {
@@ -649,10 +663,6 @@ impl VkExecutor {
             .unwrap_or(16);
         let slot = block_bytes.div_ceil(BLOCK_ALIGNMENT) * BLOCK_ALIGNMENT;
         let total = slot * steps.len().max(1);
-        if self.params.as_ref().is_none_or(|b| b.size < total) {
-            self.params = None;
-            self.params = Some(Buffer::new(&self.vk, total, vk::BufferUsageFlags::UNIFORM_BUFFER)?);
-        }
         let mut blocks = vec![0u8; total];
         for (k, b) in steps
             .iter()
@@ -661,11 +671,17 @@ impl VkExecutor {
         {
             blocks[k * slot..k * slot + b.params.len()].copy_from_slice(b.params);
         }
-        let params = self.params.as_ref().expect("allocated above");
-        // No submit is pending (each is waited for), so the buffer is free to overwrite.
+        // The flight is not in flight, so its buffers are free to overwrite.
+        let params = self.flights[f].params(total)?;
         params.write(&blocks);
         let params_raw = params.raw;
-        self.reset_pool(steps.len())?;
+        self.flights[f].reset_pool(steps.len())?;
+        match target {
+            Some(t) => self.flights[f].readback(t.width, t.height, &t.outputs)?,
+            None => self.flights[f].readback(0, 0, &[])?,
+        }
+        self.flights[f].rows = target.map_or(crate::convention::RowOrder::TopDown, |t| t.rows);
+        let pool = self.flights[f].pool;
         let targets = t.map(|t| &self.targets[t].color);
         let depth_image = t.and_then(|t| self.targets[t].depth.as_ref());
         let clear_depth = target
@@ -674,9 +690,13 @@ impl VkExecutor {
         let mut sets = Vec::with_capacity(steps.len());
         for (k, step) in steps.iter().enumerate() {
             sets.push(match (Binds::of(step), chosen[k]) {
-                (Some(b), Some((_, layout))) => {
-                    Some(self.write_set(&b, layout, (params_raw, (k * slot) as u64, block_bytes as u64), targets)?)
-                }
+                (Some(b), Some((_, layout))) => Some(self.write_set(
+                    pool,
+                    &b,
+                    layout,
+                    (params_raw, (k * slot) as u64, block_bytes as u64),
+                    targets,
+                )?),
                 _ => None,
             });
         }
@@ -725,12 +745,24 @@ impl VkExecutor {
                 _ => None,
             });
         }
-        let t0 = Instant::now();
+        // The image writes queued for this run.
+        let mut writes = Vec::with_capacity(self.flights[f].writes.len());
+        for &(id, offset) in &self.flights[f].writes {
+            writes.push((&self.stored(id, "write_image")?.image, offset));
+        }
         let d = &self.vk.device;
         let pipelines = &self.pipelines;
         let layouts = &self.layouts;
-        let wanted: Vec<bool> = target.map_or(Vec::new(), |t| t.outputs.iter().map(Option::is_some).collect());
-        self.vk.run_commands(|cb| {
+        let flight = &self.flights[f];
+        let destinations: Vec<Option<&Buffer>> = flight.readback.iter().map(Option::as_ref).collect();
+        self.vk.submit_commands(flight.cb, flight.fence, |cb| {
+            // Runs before this one (other flights) used the same attachments and images.
+            full_barrier(d, cb);
+            if let Some(staging) = &flight.staging {
+                for (image, offset) in &writes {
+                    image.record_upload_at(cb, staging, *offset);
+                }
+            }
             let mut rendering = false;
             let mut drawn = false;
             for (k, step) in steps.iter().enumerate() {
@@ -844,49 +876,28 @@ impl VkExecutor {
                     targets.record_end_to_general(cb);
                 }
                 full_barrier(d, cb);
-                targets.record_readback_from_general(cb, &wanted);
+                targets.record_readback(cb, &destinations);
             }
         })?;
-        let outputs = match (target, targets) {
-            (Some(target), Some(targets)) => target
-                .outputs
-                .iter()
-                .enumerate()
-                .map(|(i, f)| {
-                    f.map(|f| {
-                        let rows = targets.read_rows(i, target.rows);
-                        match f {
-                            // Files hold RGB; the GL executor packs on the GPU, here while copying out.
-                            Format::Rgba8 => rows.chunks_exact(4).flat_map(|p| [p[0], p[1], p[2]]).collect(),
-                            _ => rows,
-                        }
-                    })
-                })
-                .collect(),
-            _ => Vec::new(),
-        };
-        Ok(Rendered {
-            outputs,
-            timing: Timing {
-                gpu_ms: None,
-                wall_ms: t0.elapsed().as_secs_f64() * 1e3,
-            },
-            size: (0, 0),
-        })
+        let flight = &mut self.flights[f];
+        flight.busy = true;
+        flight.submit_ms = t0.elapsed().as_secs_f64() * 1e3;
+        Ok(())
     }
 }
 
 impl Drop for VkExecutor {
     fn drop(&mut self) {
+        // Flights first: each waits for its submission before anything it uses goes.
+        self.flights.clear();
+        self.graveyard.clear();
         self.pipelines.clear();
         self.targets.clear();
         self.images = Slots::default();
         self.buffers = Slots::default();
-        self.params = None;
         let d = &self.vk.device;
         // SAFETY: owned handles (null ones are ignored by Vulkan); no submit is pending.
         unsafe {
-            d.destroy_descriptor_pool(self.pool, None);
             for l in &self.layouts {
                 d.destroy_pipeline_layout(l.pipeline, None);
                 d.destroy_descriptor_set_layout(l.set, None);

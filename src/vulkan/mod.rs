@@ -10,11 +10,14 @@
 //! - `executor`: runs the backend-neutral pass descriptions (`crate::pass`) of every
 //!   capability (refocus, cyclopean, reproject, stitch, the scene ray tracer), from the same
 //!   GLSL as the GL executor.
-//! - `targets`: the colour attachments the passes render into and their readback.
+//! - `flight`: one in-flight submission's objects (command buffer, fence, parameter blocks,
+//!   descriptor pool, staging arena, readback buffers), reused once waited for.
+//! - `targets`: the colour attachments the passes render into and their readback copies.
 
 mod context;
 mod devices;
 mod executor;
+mod flight;
 mod pipeline;
 mod resources;
 mod targets;

@@ -67,6 +67,13 @@ impl Buffer {
         unsafe { std::ptr::copy_nonoverlapping(data.as_ptr(), self.ptr, data.len()) }
     }
 
+    /// Copy `data` to `offset` bytes into the buffer (no GPU work may be reading that range).
+    pub fn write_at(&self, offset: usize, data: &[u8]) {
+        assert!(offset + data.len() <= self.size, "buffer write past its end");
+        // SAFETY: the mapping spans `size` bytes; the caller keeps the GPU off this range.
+        unsafe { std::ptr::copy_nonoverlapping(data.as_ptr(), self.ptr.add(offset), data.len()) }
+    }
+
     /// The first `len` bytes (after the GPU work writing them has been waited for).
     pub fn read(&self, len: usize) -> &[u8] {
         assert!(len <= self.size, "buffer read past its end");
@@ -213,6 +220,11 @@ impl Image {
     /// Record an upload from `staging` (tightly packed) that leaves the image readable by
     /// fragment and vertex shaders.
     pub fn record_upload(&self, cb: vk::CommandBuffer, staging: &Buffer) {
+        self.record_upload_at(cb, staging, 0);
+    }
+
+    /// [`Self::record_upload`] from `offset` bytes into `staging`.
+    pub fn record_upload_at(&self, cb: vk::CommandBuffer, staging: &Buffer, offset: usize) {
         use vk::{AccessFlags as A, ImageLayout as L, PipelineStageFlags as S};
         self.transition(
             cb,
@@ -230,7 +242,7 @@ impl Image {
                 staging.raw,
                 self.raw,
                 L::TRANSFER_DST_OPTIMAL,
-                &[self.copy_region()],
+                &[self.copy_region().buffer_offset(offset as u64)],
             )
         }
         self.transition(

@@ -1,17 +1,14 @@
 //! The colour attachments a pass renders into (multiple render targets, one per fragment
-//! output location) and the host buffers they are read back through. Shared by the refocus and
-//! cyclopean passes, which record the same steps around their draws: attachments to
-//! COLOR_ATTACHMENT, dynamic rendering over the whole image with the GL-matching viewport, then
-//! the copies into host buffers and the transfer -> host barrier; after the fence, rows are
-//! converted to file order.
+//! output location): attachments to COLOR_ATTACHMENT, dynamic rendering over the whole image
+//! with the GL-matching viewport, then to GENERAL (compute steps may rewrite them) and the
+//! copies into the submission's host buffers (flight.rs) with the transfer -> host barrier.
 
 use super::context::Vk;
 use super::resources::{Buffer, Image};
-use crate::convention::RowOrder;
 use crate::error::Result;
 use ash::vk;
 
-/// Colour attachments of one size, each with a host buffer for its readback.
+/// Colour attachments of one size.
 pub struct ColorTargets {
     vk: Vk,
     /// Width in pixels.
@@ -20,20 +17,11 @@ pub struct ColorTargets {
     pub height: u32,
     /// Per output location; None: no attachment (the shader's writes there are discarded).
     color: Vec<Option<Image>>,
-    readback: Vec<Option<Buffer>>,
-    texel_bytes: Vec<usize>,
 }
 
 impl ColorTargets {
-    /// One attachment per format (in output-location order), `texel_bytes[i]` bytes per texel;
-    /// no attachment (nor host buffer) where `formats[i]` is None.
-    pub fn with_slots(
-        vk: &Vk,
-        width: u32,
-        height: u32,
-        formats: &[Option<vk::Format>],
-        texel_bytes: &[usize],
-    ) -> Result<Self> {
+    /// One attachment per format (in output-location order); none where `formats[i]` is None.
+    pub fn with_slots(vk: &Vk, width: u32, height: u32, formats: &[Option<vk::Format>]) -> Result<Self> {
         let usage = vk::ImageUsageFlags::COLOR_ATTACHMENT | vk::ImageUsageFlags::TRANSFER_SRC;
         // RGBA8 and R32F support storage on every device (the spec's required formats), so a
         // compute step can rewrite what the draws wrote (the splat-gather edge pass).
@@ -48,27 +36,11 @@ impl ColorTargets {
                     .transpose()
             })
             .collect::<Result<Vec<_>>>()?;
-        let readback = formats
-            .iter()
-            .zip(texel_bytes)
-            .map(|(f, &b)| {
-                f.map(|_| {
-                    Buffer::new(
-                        vk,
-                        width as usize * height as usize * b,
-                        vk::BufferUsageFlags::TRANSFER_DST,
-                    )
-                })
-                .transpose()
-            })
-            .collect::<Result<Vec<_>>>()?;
         Ok(ColorTargets {
             vk: vk.clone(),
             width,
             height,
             color,
-            readback,
-            texel_bytes: texel_bytes.to_vec(),
         })
     }
 
@@ -132,19 +104,18 @@ impl ColorTargets {
         }
     }
 
-    /// Record, outside any rendering: `prepare` each wanted attachment, copy it (in `layout`)
-    /// into its host buffer, and make the copies visible to the host.
-    fn record_copies(&self, cb: vk::CommandBuffer, wanted: &[bool], layout: vk::ImageLayout, prepare: impl Fn(&Image)) {
+    /// Record, outside any rendering, after [`Self::record_end_to_general`] and the steps that
+    /// followed (and a barrier making their writes visible): copy each attachment with a
+    /// destination into it, and make the copies visible to the host.
+    pub fn record_readback(&self, cb: vk::CommandBuffer, destinations: &[Option<&Buffer>]) {
         use vk::{AccessFlags as A, PipelineStageFlags as S};
         let d = &self.vk.device;
         // SAFETY: recording into `cb`; the images and buffers live until the submit has been
         // waited for.
         unsafe {
-            let present = self.color.iter().zip(&self.readback).zip(wanted);
-            for ((c, buf), _) in present.filter(|(_, w)| **w) {
+            for (c, buf) in self.color.iter().zip(destinations) {
                 let (Some(c), Some(buf)) = (c, buf) else { continue };
-                prepare(c);
-                d.cmd_copy_image_to_buffer(cb, c.raw, layout, buf.raw, &[c.copy_region()]);
+                d.cmd_copy_image_to_buffer(cb, c.raw, vk::ImageLayout::GENERAL, buf.raw, &[c.copy_region()]);
             }
             let to_host = vk::MemoryBarrier::default()
                 .src_access_mask(A::TRANSFER_WRITE)
@@ -183,25 +154,6 @@ impl ColorTargets {
                 A::MEMORY_READ | A::MEMORY_WRITE,
             );
         }
-    }
-
-    /// Record: after [`Self::record_end_to_general`] and the steps that followed (and a barrier
-    /// making their writes visible), copy the attachments with `wanted[i]` set into their host
-    /// buffers and make the copies visible to the host.
-    pub fn record_readback_from_general(&self, cb: vk::CommandBuffer, wanted: &[bool]) {
-        self.record_copies(cb, wanted, vk::ImageLayout::GENERAL, |_| {});
-    }
-
-    /// Attachment `i`'s texels as read back (after the submit has been waited for), rows
-    /// top-down: files are top-down, so a bottom-up memory order is flipped here (GL does it
-    /// on the GPU).
-    /// Empty for a location without an attachment.
-    pub fn read_rows(&self, i: usize, order: RowOrder) -> Vec<u8> {
-        let row_bytes = self.width as usize * self.texel_bytes[i];
-        let Some(buffer) = &self.readback[i] else {
-            return Vec::new();
-        };
-        order.convert_rows(buffer.read(row_bytes * self.height as usize).to_vec(), row_bytes)
     }
 }
 
