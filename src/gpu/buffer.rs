@@ -154,6 +154,9 @@ pub struct UniformBuffer {
     raw: glow::Buffer,
     /// Allocated bytes.
     capacity: usize,
+    /// GL_UNIFORM_BUFFER_OFFSET_ALIGNMENT, queried once (a state query per frame is a round trip
+    /// on some drivers).
+    alignment: usize,
 }
 
 impl UniformBuffer {
@@ -167,19 +170,19 @@ impl UniformBuffer {
             gl.bind_buffer(glow::UNIFORM_BUFFER, Some(raw));
             gl.bind_buffer(glow::UNIFORM_BUFFER, None);
             gpu.label(glow::BUFFER, raw.0.get(), "viewsynth pass parameters");
+            let alignment = gl.get_parameter_i32(glow::UNIFORM_BUFFER_OFFSET_ALIGNMENT).max(1) as usize;
             Ok(UniformBuffer {
                 gpu: gpu.clone(),
                 raw,
                 capacity: 0,
+                alignment,
             })
         }
     }
 
     /// The context's GL_UNIFORM_BUFFER_OFFSET_ALIGNMENT: slots start at multiples of it.
     pub fn offset_alignment(&self) -> usize {
-        // SAFETY: plain state query.
-        let a = unsafe { self.gpu.gl().get_parameter_i32(glow::UNIFORM_BUFFER_OFFSET_ALIGNMENT) };
-        a.max(1) as usize
+        self.alignment
     }
 
     /// Replace the contents with `bytes` (growing the store when needed).

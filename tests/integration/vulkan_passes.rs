@@ -278,6 +278,22 @@ fn a_steady_state_frame_creates_nothing_on_either_api() {
             viewsynth::reproject::render::Reprojector::new(d, &case.source, &case.geometry, methods()[0]).unwrap();
         let mut stitch = viewsynth::stitch::render::StitchRenderer::new(d, &left, &right).unwrap();
         let mut tracer = SceneRenderer::new(d, &scene).unwrap();
+        let source = crate::common::synthetic(64, 48);
+        let targets = viewsynth::refocus::job::TargetSpec {
+            scales: vec![0.5, 1.0, 2.0],
+            size: None,
+            principal: None,
+        }
+        .targets(&source.camera())
+        .unwrap();
+        let refocuser = |method| {
+            viewsynth::refocus::Refocuser::new(d, &source, &BreakRule::default(), method, Default::default(), conv)
+                .unwrap()
+        };
+        let (mut fullscreen, mut mesh) = (
+            refocuser(viewsynth::refocus::Method::Fullscreen),
+            refocuser(viewsynth::refocus::Method::Mesh),
+        );
         let stitch_params = StitchParams {
             method: StitchMethod::Reproject,
             overlap_deg: 10.0,
@@ -291,6 +307,19 @@ fn a_steady_state_frame_creates_nothing_on_either_api() {
             ("reproject shift", Box::new(|| drop(shift.render().unwrap()))),
             ("stitch", Box::new(|| drop(stitch.render(&stitch_params).unwrap()))),
             ("ray tracer", Box::new(|| drop(tracer.render(&cam).unwrap()))),
+            (
+                // The batch's frame: a new source of the same size, every target in flight at once.
+                "refocus batch frame",
+                Box::new(|| {
+                    fullscreen.set_source(&source).unwrap();
+                    let pending: Vec<_> = targets.iter().map(|t| fullscreen.submit(t).unwrap()).collect();
+                    pending.into_iter().for_each(|p| drop(p.wait().unwrap()));
+                }),
+            ),
+            (
+                "refocus mesh targets",
+                Box::new(|| targets.iter().for_each(|t| drop(mesh.render(t).unwrap()))),
+            ),
         ];
         for (name, mut frame) in frames {
             frame();
@@ -386,6 +415,12 @@ fn compare_folders(tag: &str, gl: &Path, vk: &Path) {
 }
 
 fn run_both(tag: &str, dir: &Path, args: &[&str]) {
+    run_on_both(tag, dir, args);
+    compare_folders(tag, &dir.join(format!("{tag}-gl")), &dir.join(format!("{tag}-vulkan")));
+}
+
+/// The command on each backend, into `<dir>/<tag>-gl` and `<dir>/<tag>-vulkan`.
+fn run_on_both(tag: &str, dir: &Path, args: &[&str]) {
     for backend in ["gl", "vulkan"] {
         let out = dir.join(format!("{tag}-{backend}"));
         let o = bin()
@@ -400,7 +435,6 @@ fn run_both(tag: &str, dir: &Path, args: &[&str]) {
             String::from_utf8_lossy(&o.stderr)
         );
     }
-    compare_folders(tag, &dir.join(format!("{tag}-gl")), &dir.join(format!("{tag}-vulkan")));
 }
 
 #[test]
@@ -495,6 +529,64 @@ fn reproject_stitch_scene_and_cyclopean_commands_write_the_same_files_on_vulkan(
     }
 }
 
+/// A refocus manifest of the TUM and SUN frames in `dir`.
+fn refocus_manifest(dir: &Path) -> std::path::PathBuf {
+    let d = data_dir().join("rgbd_open3d_testdata");
+    let p = |f: &str| d.join(f).to_str().unwrap().to_string();
+    let csv = format!(
+        "rgb,depth,fx,fy,cx,cy,depth_scale,sun_bit_rotate,name\n\
+         {},{},525,525,319.5,239.5,5000,,tum\n\
+         {},{},525,525,319.5,239.5,1000,true,sun\n",
+        p("TUM_color.png"),
+        p("TUM_depth.png"),
+        p("SUN_color.jpg"),
+        p("SUN_depth.png")
+    );
+    let path = dir.join("frames.csv");
+    std::fs::write(&path, csv).unwrap();
+    path
+}
+
+/// `refocus --batch --backend vulkan`: the pipelined batch (decoder and writer threads, targets
+/// and frames in flight) writes, frame by frame, what the GL batch writes, for both methods.
+#[test]
+fn refocus_batch_writes_the_same_files_on_vulkan() {
+    let dir = scratch("vulkan-batch");
+    let manifest = refocus_manifest(&dir);
+    for method in ["fullscreen", "mesh"] {
+        let tag = format!("batch-{method}");
+        run_on_both(
+            &tag,
+            &dir,
+            &[
+                "refocus",
+                "--batch",
+                manifest.to_str().unwrap(),
+                "--zoom-range",
+                "0.5,1,2",
+                "--jobs",
+                "2",
+                "--method",
+                method,
+            ],
+        );
+        for frame in ["tum", "sun"] {
+            let (gl, vk) = (
+                dir.join(format!("{tag}-gl")).join(frame),
+                dir.join(format!("{tag}-vulkan")).join(frame),
+            );
+            compare_folders(&format!("{tag} {frame}"), &gl, &vk);
+            let m: serde_json::Value =
+                serde_json::from_slice(&std::fs::read(vk.join("manifest.json")).unwrap()).unwrap();
+            assert!(
+                m["renderer"].as_str().unwrap().starts_with("Vulkan: "),
+                "{tag} {frame}: the manifest names {}",
+                m["renderer"]
+            );
+        }
+    }
+}
+
 /// One run of each Vulkan pass under VK_LAYER_KHRONOS_validation (Debian package
 /// `vulkan-validationlayers`): any validation message fails. The loader's own log proves the
 /// layer was inserted, so a missing layer cannot pass silently.
@@ -531,11 +623,24 @@ fn every_vulkan_pass_runs_clean_under_the_validation_layer() {
         ]));
     }
     runs.push(s(&["scene", "--width", "64", "--height", "48"]));
+    let manifest = refocus_manifest(&dir);
     for method in ["fullscreen", "mesh"] {
         let mut a = s(&["refocus", "--rgb", rgb, "--depth", depth, "--depth-scale", "5000"]);
         a.extend(s(&intrinsics));
         a.extend(s(&["--zoom-range", "0.5,2", "--method", method]));
         runs.push(a);
+        // The batch: several runs in flight, image writes staged per flight.
+        runs.push(s(&[
+            "refocus",
+            "--batch",
+            manifest.to_str().unwrap(),
+            "--zoom-range",
+            "0.5,1,2",
+            "--jobs",
+            "2",
+            "--method",
+            method,
+        ]));
     }
     let file = |name: &str| dir.join(name).to_str().unwrap().to_string();
     let (lr, ld, rr, rd, cams) = (
