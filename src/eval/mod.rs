@@ -106,10 +106,11 @@ pub fn run_report_with_progress(
     report_stages(gpu, out_dir, data_dir, cases, repeats, &stages)
 }
 
-/// How many stages [`report_stages`] reports: four on the built-in scenes, one for the real
+/// How many stages [`report_stages`] reports: five on the built-in scenes (the last, GL against
+/// Vulkan on every pass), one for the real
 /// cyclopean data when `data_dir` holds it, one per user case.
 pub fn report_stage_count(data_dir: Option<&Path>, cases: &[PathBuf]) -> usize {
-    4 + data_dir.is_some_and(has_cyclopean_data) as usize + cases.len()
+    5 + data_dir.is_some_and(has_cyclopean_data) as usize + cases.len()
 }
 
 fn has_cyclopean_data(dir: &Path) -> bool {
@@ -170,6 +171,8 @@ pub fn report_stages(
         rows,
         notes,
     };
-    let files = report.write(out_dir, "report")?;
+    let mut files = report.write(out_dir, "report")?;
+    stages.start("report: every pass, GL against Vulkan");
+    files.push(vulkan::write_section(gpu, out_dir)?);
     Ok(WrittenReport { report, files })
 }

@@ -54,6 +54,31 @@ pub fn backend_diff(gl: &RefocusOutput, vk: &RefocusOutput) -> BackendDiff {
     d
 }
 
+/// `gl_vs_vulkan.md` in `out_dir`: [`gl_vs_vulkan_section`] on the built-in scene (refocus at
+/// 1.5x of a 160 x 120 view, then every other pass); its path.
+pub fn write_section(gpu: &Gpu, out_dir: &std::path::Path) -> Result<std::path::PathBuf> {
+    let cam = crate::scene::demo_camera(160, 120);
+    let (rgb, depth) = crate::scene::render(&cam);
+    let src = RefocusSource::new(rgb, depth, cam.k)?;
+    let target = crate::refocus::job::TargetSpec {
+        scales: vec![1.5],
+        size: None,
+        principal: None,
+    }
+    .targets(&cam)?[0];
+    let text = format!(
+        "# viewsynth: every pass, GL against Vulkan\n\nGL renderer: {}\n{}",
+        gpu.info().renderer,
+        gl_vs_vulkan_section(gpu, &src, &target)
+    );
+    let path = out_dir.join("gl_vs_vulkan.md");
+    crate::io::atomic_write(&path, |w| {
+        use std::io::Write;
+        w.write_all(text.as_bytes()).map_err(|e| crate::Error::io(&path, e))
+    })?;
+    Ok(path)
+}
+
 /// The section as Markdown; when no Vulkan device opens, a line saying why (the demo goes on).
 pub fn gl_vs_vulkan_section(gpu: &Gpu, src: &RefocusSource, target: &PinholeCamera) -> String {
     let mut s = String::from("\n## GL vs Vulkan\n\n");
