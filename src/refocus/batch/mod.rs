@@ -27,10 +27,10 @@ pub use manifest::{
 };
 pub use pipeline::{run_batch, BatchSummary, StageTimes};
 
-use super::job::FileFormats;
 use super::{BreakRule, Method};
 use crate::convention::Conventions;
 use crate::error::{Error, Result};
+use crate::io::FileFormats;
 use serde::Serialize;
 
 /// Most threads either pool may have: each holds a frame in memory (VGA x 5 scales: 14 MB),

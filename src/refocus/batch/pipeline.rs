@@ -6,8 +6,9 @@ use super::resume::{frame_finished, frame_settings};
 use super::{BatchFrame, BatchOptions, MAX_JOBS};
 use crate::error::{Error, Result};
 use crate::gpu::Gpu;
+use crate::io::FileFormats;
 use crate::io::{self, DepthDecode};
-use crate::refocus::job::{self, FileFormats, Manifest, TargetSpec};
+use crate::refocus::manifest::{self, Manifest, TargetSpec};
 use crate::refocus::{PendingRefocus, RefocusOutput, RefocusSource, Refocuser};
 use serde::Serialize;
 use std::path::Path;
@@ -70,14 +71,14 @@ struct WriteJob {
 fn write_frame(job: WriteJob, files: &FileFormats) -> Result<()> {
     let dir = job.root.subdir(&job.name)?;
     let mut set = dir.file_set()?;
-    let mut manifest = job.manifest;
-    for (scale, out) in &job.outputs {
-        let entry = job::write_output(set.staging(), *scale, out, files).map_err(|e| set.final_error(e))?;
-        manifest.outputs.push(entry);
+    let mut record = job.manifest;
+    for (scale, out) in job.outputs {
+        let entry = manifest::write_target(&mut set, &manifest::scale_tag(scale), scale, out, files)?;
+        record.outputs.push(entry);
     }
-    manifest.files = job::file_records(set.staging(), &manifest.outputs)?;
+    record.files = manifest::file_records(set.staging(), &record.outputs)?;
     let path = set.final_path("manifest.json");
-    let text = serde_json::to_string_pretty(&manifest).map_err(|e| Error::encode(&path, e.to_string()))?;
+    let text = serde_json::to_string_pretty(&record).map_err(|e| Error::encode(&path, e.to_string()))?;
     // Written last and renamed last: its presence marks the frame finished for resume.
     set.write("manifest.json", |w| {
         use std::io::Write;
@@ -146,7 +147,7 @@ fn submit_frame(
         break_rule: opts.rule,
         conventions: opts.conv,
         renderer: refocuser.gpu().info().renderer.clone(),
-        notes: job::MANIFEST_NOTES.to_string(),
+        notes: manifest::MANIFEST_NOTES.to_string(),
         settings: Some(settings),
         files: Vec::new(),
         outputs: Vec::new(),

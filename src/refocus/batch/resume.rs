@@ -2,7 +2,6 @@
 //! frame's folder holds a finished set made with the same settings.
 
 use super::{BatchFrame, BatchOptions};
-use crate::refocus::job;
 use std::path::Path;
 
 /// What a frame's manifest records of the settings that produced it: a rerun with anything
@@ -83,6 +82,6 @@ pub(super) fn frame_finished(dir: &Path, settings: &serde_json::Value) -> bool {
             !name.contains('/')
                 && !name.starts_with('.')
                 && std::fs::symlink_metadata(dir.join(name)).is_ok_and(|m| m.is_file() && m.len() == bytes)
-                && job::file_crc32(&dir.join(name)).is_ok_and(|c| u64::from(c) == crc)
+                && crate::io::file_crc32(&dir.join(name)).is_ok_and(|c| u64::from(c) == crc)
         })
 }
