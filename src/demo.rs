@@ -5,8 +5,9 @@
 use crate::convention::Conventions;
 use crate::error::{Error, Result};
 use crate::gpu::Gpu;
+use crate::io::FileFormats;
 use crate::metrics;
-use crate::refocus::job::{self, FileFormats};
+use crate::refocus::manifest as job;
 use crate::refocus::{reference, BreakRule, Method, OutputSet, RefocusSource, Refocuser};
 use crate::report::WrittenReport;
 use crate::{io, scene};

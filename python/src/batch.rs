@@ -13,7 +13,7 @@ use viewsynth::convention::Conventions;
 use viewsynth::gpu::Gpu;
 use viewsynth::io::Encoding;
 use viewsynth::refocus::batch::{load_manifest as read_manifest, run_batch, BatchFrame, BatchOptions, Shard};
-use viewsynth::refocus::job::{DepthFormats, FileFormats, RgbFormat};
+use viewsynth::io::{DepthFormats, FileFormats, RgbFormat};
 use viewsynth::refocus::{BreakRule, Method};
 
 /// The keys a frame may have (a manifest's columns).

@@ -10,7 +10,7 @@ use pyo3::types::{PyDict, PyList, PyString};
 use viewsynth::camera::PinholeCamera;
 use viewsynth::convention::Conventions;
 use viewsynth::gpu::Gpu;
-use viewsynth::refocus::job::TargetSpec;
+use viewsynth::refocus::manifest::TargetSpec;
 use viewsynth::refocus::{BreakRule, Method, OutputSet, RefocusOutput, RefocusSource, Refocuser};
 
 /// Moves a value into `Python::detach`, whose closure runs synchronously on the calling thread.

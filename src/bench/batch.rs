@@ -4,8 +4,8 @@
 
 use crate::error::{Error, Result};
 use crate::gpu::Gpu;
+use crate::io::FileFormats;
 use crate::refocus::batch::{load_manifest, run_batch, BatchFrame, BatchOptions, BatchSummary, StageTimes};
-use crate::refocus::job::FileFormats;
 use crate::refocus::{BreakRule, Method};
 use crate::{convention::Conventions, io, scene};
 use serde::Serialize;

@@ -8,7 +8,7 @@ use crate::convention::Conventions;
 use crate::cyclopean::render::CyclopeanRenderer;
 use crate::error::Result;
 use crate::pass::Device;
-use crate::refocus::job::TargetSpec;
+use crate::refocus::manifest::TargetSpec;
 use crate::refocus::Refocuser;
 use crate::refocus::{BreakRule, Method, OutputSet, RefocusSource};
 use crate::scene;

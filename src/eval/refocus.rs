@@ -5,7 +5,7 @@ use super::{score, timed};
 use crate::convention::Conventions;
 use crate::error::Result;
 use crate::gpu::Gpu;
-use crate::refocus::job::TargetSpec;
+use crate::refocus::manifest::TargetSpec;
 use crate::refocus::{BreakRule, Method as RefocusMethod, OutputSet, RefocusSource, Refocuser};
 use crate::report::ReportRow;
 use crate::scene;

@@ -60,7 +60,7 @@ pub fn write_section(gpu: &Gpu, out_dir: &std::path::Path) -> Result<std::path::
     let cam = crate::scene::demo_camera(160, 120);
     let (rgb, depth) = crate::scene::render(&cam);
     let src = RefocusSource::new(rgb, depth, cam.k)?;
-    let target = crate::refocus::job::TargetSpec {
+    let target = crate::refocus::manifest::TargetSpec {
         scales: vec![1.5],
         size: None,
         principal: None,

@@ -105,6 +105,10 @@ pub(crate) fn fault_point(what: &str) -> Result<()> {
     std::process::exit(137)
 }
 
+/// Buffer of the files written: an output of a few MB goes to the kernel in a few writes (8 KiB,
+/// `BufWriter`'s default, cost a VGA frame's files ~300 write calls).
+pub(crate) const WRITE_BUFFER: usize = 1 << 20;
+
 /// The prefix of this process's temporaries: `.viewsynth-<pid>-`.
 pub(crate) fn own_prefix() -> String {
     format!("{TEMP_PREFIX}{}-", std::process::id())
@@ -149,7 +153,7 @@ pub fn atomic_write(path: &Path, write: impl FnOnce(&mut BufWriter<File>) -> Res
     check_replaceable(path)?;
     let temp = temp_file_in(parent_dir(path), path)?;
     let (file, temp_path) = temp.into_parts();
-    let mut writer = BufWriter::new(file);
+    let mut writer = BufWriter::with_capacity(WRITE_BUFFER, file);
     write(&mut writer)?;
     writer.flush().map_err(|e| Error::io(path, e))?;
     let file = writer.into_inner().map_err(|e| Error::io(path, e.into_error()))?;

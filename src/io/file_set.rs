@@ -271,7 +271,7 @@ impl FileSet {
             ));
         }
         let file = File::create_new(self.staging.path().join(name)).map_err(|e| Error::io(&shown, e))?;
-        let mut writer = BufWriter::new(file);
+        let mut writer = BufWriter::with_capacity(super::atomic::WRITE_BUFFER, file);
         write(&mut writer)?;
         writer.flush().map_err(|e| Error::io(&shown, e))?;
         let file = writer.into_inner().map_err(|e| Error::io(&shown, e.into_error()))?;

@@ -24,6 +24,7 @@ mod mask;
 mod netpbm;
 mod npy;
 mod npz;
+mod outputs;
 mod pfm;
 mod pgm;
 mod raw_depth;
@@ -52,4 +53,8 @@ pub use json::{load_json, read_text, MAX_JSON_BYTES, MAX_JSON_MAGNITUDE};
 pub use mask::{load_mask_png, save_mask_png, save_mask_png_with};
 pub use npy::{load_npy, save_npy_f32, NpyArray, NpyDtype};
 pub use npz::load_npz_array;
+pub use outputs::{
+    file_crc32, file_records, write_view, DepthFormats, FileFormats, FileRecord, OutputSet, RgbFormat, ViewFiles,
+    ViewNames,
+};
 pub use rgb::{load_rgb, save_rgb, save_rgb_with};

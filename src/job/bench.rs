@@ -7,8 +7,8 @@ use super::{ArgError, Event, GpuRequest, Host, JobError};
 use crate::bench::batch::{batch_bench, BatchBench, BatchInput};
 use crate::bench::{cyclopean_bench, refocus_bench, BenchCase};
 use crate::io;
+use crate::io::FileFormats;
 use crate::progress::Progress as _;
-use crate::refocus::job::FileFormats;
 use std::path::PathBuf;
 
 /// The bench options as given.

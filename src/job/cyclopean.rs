@@ -2,7 +2,6 @@
 //! disparities or from any pair with depth and a camera file. The options become a
 //! [`CyclopeanJob`]; running it writes `middle_{rgb,depth,mask}` all-or-none.
 
-use super::write::{write_all_or_none, WriteJob};
 use super::{ArgError, Backend, Event, GpuRequest, Host, JobError};
 use crate::convention::{Conventions, DepthPlanes};
 use crate::cyclopean::camera_file::{CameraFile, EyeCameras};
@@ -16,6 +15,7 @@ use crate::cyclopean::{
 use crate::depth::DepthEncoding;
 use crate::io::{self, DepthDecode, DepthMap, DepthSummary, RgbImage};
 use crate::refocus::{BreakRule, OutputSet};
+use crate::view::ViewOutput;
 use std::path::{Path, PathBuf};
 
 /// How the middle view is synthesised.
@@ -363,27 +363,23 @@ impl CyclopeanJob {
             mid.height,
             out.sources.iter().map(|s| (*s != 0) as u8).collect(),
         )?;
-        let mut jobs: Vec<WriteJob> = Vec::new();
-        if let Some(color) = out.color.as_ref().filter(|_| self.outputs.rgb) {
-            jobs.push((
-                "middle_rgb.png".into(),
-                Box::new(move |p: &Path| io::save_rgb(p, color)),
-            ));
-        }
-        if let Some(depth) = out.depth.as_ref().filter(|_| self.outputs.depth) {
-            jobs.push((
-                "middle_depth.exr".into(),
-                Box::new(move |p: &Path| io::save_depth_exr(p, depth)),
-            ));
-        }
-        if self.outputs.mask {
-            jobs.push((
-                "middle_mask.png".into(),
-                Box::new(|p: &Path| io::save_mask_png(p, &mask)),
-            ));
-        }
-        let written = write_all_or_none(&out_dir, jobs)?;
         let valid = out.sources.iter().filter(|s| **s != 0).count();
+        let view = ViewOutput {
+            width: mid.width,
+            height: mid.height,
+            color: out.color,
+            depth: out.depth,
+            mask: Some(mask),
+            timing: Some(timing),
+            exact: None,
+        };
+        let formats = io::FileFormats {
+            outputs: self.outputs,
+            ..Default::default()
+        };
+        let mut set = out_dir.file_set()?;
+        io::write_view(&mut set, &io::ViewNames::tagged("middle"), &view, &formats)?;
+        let written = set.commit()?;
         Ok(CyclopeanReport {
             width: mid.width,
             height: mid.height,

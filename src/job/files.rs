@@ -1,10 +1,10 @@
-//! Output files of refocus, batch and reproject: which outputs, which formats, how encoded,
+//! Output files of refocus, batch and reproject (written by the output layer,
+//! [`crate::io::write_view`]): which outputs, which formats, how encoded,
 //! from the options' text (`--outputs rgb,depth`, `--depth-format exr,png16`, ...).
 
 use super::ArgError;
 use crate::io;
-use crate::refocus::job::{DepthFormats, FileFormats, RgbFormat};
-use crate::refocus::OutputSet;
+use crate::io::{DepthFormats, FileFormats, OutputSet, RgbFormat};
 
 /// The file options as given.
 #[derive(Debug, Clone, Copy)]
@@ -23,19 +23,10 @@ pub struct FileOptions<'a> {
     pub exr_compression: &'a str,
 }
 
-/// The validated file formats of refocus (a preview needs the depth output it colours).
+/// The validated file formats of refocus and reproject (a preview needs the depth output it
+/// colours); the output layer ([`crate::io::write_view`]) writes every one of them.
 pub fn file_formats(o: &FileOptions<'_>) -> Result<FileFormats, ArgError> {
-    let formats = output_formats(o)?;
-    if formats.depth_preview && !formats.outputs.depth {
-        return Err(ArgError::PreviewWithoutDepth);
-    }
-    Ok(formats)
-}
-
-/// The validated file formats of a command that writes no depth preview (reproject: the
-/// option is accepted and has no effect, as in earlier releases).
-pub fn output_formats(o: &FileOptions<'_>) -> Result<FileFormats, ArgError> {
-    Ok(FileFormats {
+    let formats = FileFormats {
         outputs: OutputSet::parse(o.outputs)?,
         rgb: o.rgb,
         depth: depth_formats(o.depth)?,
@@ -44,7 +35,12 @@ pub fn output_formats(o: &FileOptions<'_>) -> Result<FileFormats, ArgError> {
             exr: o.exr_compression.parse()?,
         },
         depth_preview: o.depth_preview,
-    })
+    };
+    if formats.depth_preview && !formats.outputs.depth {
+        return Err(ArgError::PreviewWithoutDepth);
+    }
+    formats.validate()?;
+    Ok(formats)
 }
 
 /// `--depth-format`: a comma-separated list of exr, npy, png16.

@@ -12,7 +12,6 @@ mod error;
 mod files;
 mod host;
 mod intrinsics;
-mod write;
 
 pub mod bench;
 pub mod compare;
@@ -25,7 +24,7 @@ pub mod stitch;
 pub mod stress;
 
 pub use error::{ArgError, JobError, PerFrameOption};
-pub use files::{depth_formats, file_formats, output_formats, FileOptions};
+pub use files::{depth_formats, file_formats, FileOptions};
 pub use host::{Backend, Event, GpuRequest, Host};
 pub use intrinsics::SourceIntrinsics;
 

@@ -5,9 +5,10 @@
 use super::error::InContext;
 use super::{ArgError, Backend, Event, GpuRequest, Host, JobError, PerFrameOption, SourceIntrinsics};
 use crate::convention::Conventions;
+use crate::io::FileFormats;
 use crate::io::{self, DepthDecode, DepthSummary};
 use crate::refocus::batch::{load_manifest, run_batch, BatchOptions, BatchSummary, Shard};
-use crate::refocus::job::{self, FileFormats, Manifest, ManifestEntry, TargetSpec};
+use crate::refocus::manifest::{self as job, Manifest, ManifestEntry, TargetSpec};
 use crate::refocus::{BreakRule, Method, RefocusSource, Refocuser};
 use std::path::PathBuf;
 
@@ -225,11 +226,10 @@ impl RefocusJob {
         });
         let mut entries: Vec<ManifestEntry> = Vec::new();
         // All targets and the manifest, or (on any failure) none: earlier runs' files stay.
-        let set = out_dir.file_set()?;
+        let mut set = out_dir.file_set()?;
         for ((scale, target), tag) in scales.iter().zip(&targets).zip(&self.tags) {
             let out = refocuser.render(target)?;
-            let entry = job::write_output_named(set.staging(), tag, *scale, &out, files);
-            entries.push(entry.map_err(|e| set.final_error(e))?);
+            entries.push(job::write_target(&mut set, tag, *scale, out, files)?);
             host.event(Event::Advanced);
         }
         host.event(Event::Finished);

@@ -3,7 +3,6 @@
 //! options become a [`ReprojectJob`]; running it writes each target's files all-or-none.
 
 use super::error::{InContext, OptionsContext};
-use super::write::{write_all_or_none, WriteJob};
 use super::{ArgError, Backend, Event, GpuRequest, Host, JobError, SourceIntrinsics};
 use crate::camera::stereo::{Eye, StereoParams};
 use crate::camera::PinholeCamera;
@@ -12,12 +11,13 @@ use crate::cyclopean::camera_file::CameraFile;
 use crate::cyclopean::{FrameDepth, MiddleCamera};
 use crate::depth::DepthEncoding;
 use crate::gpu::Timing;
+use crate::io::FileFormats;
 use crate::io::{self, DepthDecode, DepthSummary};
-use crate::refocus::job::FileFormats;
 use crate::reproject::render::Reprojector;
 use crate::reproject::{
     Geometry, Method, ReprojectOutput, ReprojectOutputs, ReprojectParams, ReprojectSource, ShiftModel,
 };
+use crate::view::ViewOutput;
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
@@ -111,7 +111,7 @@ pub struct ReprojectOptions {
     pub steps: u32,
     /// Segment break threshold.
     pub tau_rel: f64,
-    /// Outputs and formats ([`super::output_formats`]).
+    /// Outputs and formats ([`super::file_formats`]).
     pub files: FileFormats,
     /// Output folder.
     pub out_dir: PathBuf,
@@ -280,53 +280,40 @@ impl ReprojectJob {
             let (out, timing) = r.render()?;
             results.push((*to, out, timing, setup_ms));
         }
-        let (enc, rgb_ext, depth_formats) = (self.files.encoding, self.files.rgb.extension(), self.files.depth);
-        let mut jobs: Vec<WriteJob> = Vec::new();
-        for (to, out, _, _) in &results {
-            let name = view_name(Some(*to));
-            if let Some(color) = &out.color {
-                jobs.push((
-                    format!("{name}_rgb.{rgb_ext}"),
-                    Box::new(move |p: &Path| io::save_rgb_with(p, color, &enc)),
-                ));
-            }
-            if let Some(depth) = out.depth.as_ref().filter(|_| depth_formats.exr) {
-                jobs.push((
-                    format!("{name}_depth.exr"),
-                    Box::new(move |p: &Path| io::save_depth_exr_with(p, depth, enc.exr)),
-                ));
-            }
-            if let Some(depth) = out.depth.as_ref().filter(|_| depth_formats.npy) {
-                jobs.push((
-                    format!("{name}_depth.npy"),
-                    Box::new(move |p: &Path| io::save_depth_npy(p, depth)),
-                ));
-            }
-            if self.files.outputs.mask {
-                jobs.push((
-                    format!("{name}_mask.png"),
-                    Box::new(move |p: &Path| {
-                        let bits = out.mask.iter().map(|m| (*m != 0) as u8).collect();
-                        io::save_mask_png_with(p, &io::Mask::new(width, height, bits)?, enc.png)
-                    }),
-                ));
-            }
+        // Every target's files through the output layer, all or none.
+        let mut set = out_dir.file_set()?;
+        let mut reports = Vec::with_capacity(results.len());
+        for (to, out, timing, setup_ms) in results {
+            let coverage = out.coverage();
+            let view = ViewOutput {
+                width,
+                height,
+                color: out.color,
+                depth: out.depth,
+                mask: Some(io::Mask::new(width, height, out.mask)?),
+                timing: Some(timing),
+                exact: None,
+            };
+            io::write_view(
+                &mut set,
+                &io::ViewNames::tagged(view_name(Some(to))),
+                &view,
+                &self.files,
+            )?;
+            reports.push(TargetReport {
+                to,
+                coverage,
+                timing,
+                setup_ms,
+            });
         }
-        let written = write_all_or_none(&out_dir, jobs)?;
+        let written = set.commit()?;
         Ok(ReprojectReport {
             from,
             method: self.params.method.label(),
             width,
             height,
-            targets: results
-                .into_iter()
-                .map(|(to, out, timing, setup_ms)| TargetReport {
-                    to,
-                    coverage: out.coverage(),
-                    timing,
-                    setup_ms,
-                })
-                .collect(),
+            targets: reports,
             written,
         })
     }

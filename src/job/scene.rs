@@ -12,6 +12,7 @@ use crate::scene::gpu::{GlCamera, SceneRenderer};
 use crate::scene::{builtin, Scene};
 use crate::stitch::faces::{scene_faces_of, FACE_TAGS};
 use crate::stitch::{OdsRig, Side};
+use crate::view::ViewOutput;
 use std::path::{Path, PathBuf};
 
 /// The scene options as given.
@@ -136,7 +137,6 @@ impl SceneJob {
         let (width, height) = (rig.camera.width, rig.camera.height);
         let out = io::OutDir::prepare(&self.out_dir)?;
         let mut set = out.file_set()?;
-        let staged = set.staging().to_path_buf();
         let gpu = host.open_device(&self.gpu, self.backend)?;
         let mut renderer = SceneRenderer::new(&gpu, scene)?;
         let proj = gl_projection(&rig.camera, &rig.planes, &conv);
@@ -151,10 +151,17 @@ impl SceneJob {
                 height,
                 conv,
             })?;
-            let saved = io::save_rgb(&staged.join(format!("{eye}_rgb.png")), &img.color)
-                .and_then(|()| io::save_depth_exr(&staged.join(format!("{eye}_view_z.exr")), &img.view_z))
-                .and_then(|()| io::save_depth_exr(&staged.join(format!("{eye}_device_depth.exr")), &img.device_depth));
-            saved.map_err(|e| set.final_error(e))?;
+            let (rgb_depth, depth_only) = (
+                io::FileFormats::of(io::OutputSet::RGB_DEPTH),
+                io::FileFormats::of(io::OutputSet::DEPTH),
+            );
+            let mut planes = ViewOutput::color_only(img.color, None);
+            planes.depth = Some(img.view_z);
+            let names = io::ViewNames::named(&format!("{eye}_rgb"), &format!("{eye}_view_z"));
+            io::write_view(&mut set, &names, &planes, &rgb_depth)?;
+            planes.depth = Some(img.device_depth);
+            let names = io::ViewNames::named("", &format!("{eye}_device_depth"));
+            io::write_view(&mut set, &names, &planes, &depth_only)?;
             let entry = if eye == "middle" {
                 serde_json::json!({ "view": view, "proj": proj, "width": width, "height": height })
             } else {
@@ -181,12 +188,11 @@ impl SceneJob {
                 let t0 = std::time::Instant::now();
                 for (side, eye) in [(Side::Left, "left"), (Side::Right, "right")] {
                     let faces = scene_faces_of(scene, &ods, side, n, fov)?;
-                    for (face, tag) in faces.faces.iter().zip(FACE_TAGS) {
-                        io::save_rgb(&staged.join(format!("{eye}_{tag}.png")), &face.color)
-                            .and_then(|()| {
-                                io::save_depth_exr(&staged.join(format!("{eye}_{tag}_depth.exr")), &face.depth)
-                            })
-                            .map_err(|e| set.final_error(e))?;
+                    for (face, tag) in faces.faces.into_iter().zip(FACE_TAGS) {
+                        let mut view = ViewOutput::color_only(face.color, None);
+                        view.depth = Some(face.depth);
+                        let names = io::ViewNames::named(&format!("{eye}_{tag}"), &format!("{eye}_{tag}_depth"));
+                        io::write_view(&mut set, &names, &view, &io::FileFormats::of(io::OutputSet::RGB_DEPTH))?;
                     }
                 }
                 Some((n, fov, t0.elapsed().as_secs_f64() * 1e3))

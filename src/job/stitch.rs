@@ -5,7 +5,6 @@
 
 use super::error::{InContext, OptionsContext};
 use super::reproject::device_depth;
-use super::write::{write_all_or_none, WriteJob};
 use super::{ArgError, Backend, Event, GpuRequest, Host, JobError};
 use crate::convention::Conventions;
 use crate::depth::DepthEncoding;
@@ -16,7 +15,8 @@ use crate::stitch::faces::{load_face_dir, scene_faces, FaceDepthFiles, FACE_TAGS
 use crate::stitch::render::StitchRenderer;
 use crate::stitch::truth::ods_truth;
 use crate::stitch::{seam_band_mask, FaceSet, Method, OdsRig, Side, StitchParams};
-use std::path::{Path, PathBuf};
+use crate::view::ViewOutput;
+use std::path::PathBuf;
 use std::time::Instant;
 
 /// What to check when the face depth looks wrongly decoded.
@@ -309,12 +309,19 @@ impl StitchJob {
         } else {
             None
         };
-        let mut jobs: Vec<WriteJob> = vec![("ods_top_bottom.png".into(), Box::new(|p: &Path| io::save_rgb(p, &img)))];
-        if let Some([l, r]) = &eyes {
-            jobs.push(("ods_left.png".into(), Box::new(move |p: &Path| io::save_rgb(p, l))));
-            jobs.push(("ods_right.png".into(), Box::new(move |p: &Path| io::save_rgb(p, r))));
+        // Colour-only views through the output layer, all or none.
+        let colour = io::FileFormats::of(io::OutputSet::RGB);
+        let mut set = out_dir.file_set()?;
+        let mut whole = ViewOutput::color_only(img, None);
+        io::write_view(&mut set, &io::ViewNames::named("ods_top_bottom", ""), &whole, &colour)?;
+        if let Some([l, r]) = eyes {
+            for (name, eye) in [("ods_left", l), ("ods_right", r)] {
+                let view = ViewOutput::color_only(eye, None);
+                io::write_view(&mut set, &io::ViewNames::named(name, ""), &view, &colour)?;
+            }
         }
-        let written = write_all_or_none(&out_dir, jobs)?;
+        let written = set.commit()?;
+        let img = whole.color.take().expect("the view holds the image written");
         let truth = match self.truth {
             true => Some(self.score(&img)?),
             false => None,

@@ -9,11 +9,12 @@
 //! - [`reference`](mod@reference): the float64 CPU twin both are tested against.
 //! - [`pass`]: the pass/twin contract, [`pass::gpu`] and [`pass::reference`] over one
 //!   [`RefocusInput`], both returning a [`crate::view::ViewOutput`].
-//! - [`job`]: targets from focal lists or zoom scales, file outputs and the manifest.
+//! - [`manifest`]: targets from focal lists or zoom scales, their file tags and the manifest
+//!   (the files go through the output layer, [`crate::io::write_view`]).
 
 pub mod batch;
 mod grid;
-pub mod job;
+pub mod manifest;
 pub(crate) mod mesh;
 pub mod pass;
 pub mod reference;
@@ -130,51 +131,4 @@ impl std::str::FromStr for Method {
     }
 }
 
-/// Which outputs to produce; nothing is allocated, read back or written for the others.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
-pub struct OutputSet {
-    /// Produce the colour image.
-    pub rgb: bool,
-    /// Produce the view-Z depth.
-    pub depth: bool,
-    /// Produce the validity mask.
-    pub mask: bool,
-}
-
-impl Default for OutputSet {
-    fn default() -> Self {
-        OutputSet {
-            rgb: true,
-            depth: true,
-            mask: true,
-        }
-    }
-}
-
-impl OutputSet {
-    /// Parse "rgb,depth,mask" (any subset, at least one; "color"/"colour" name rgb).
-    pub fn parse(list: &str) -> Result<Self> {
-        let mut out = OutputSet {
-            rgb: false,
-            depth: false,
-            mask: false,
-        };
-        for item in list.split(',').map(str::trim).filter(|s| !s.is_empty()) {
-            match item {
-                "rgb" | "color" | "colour" => out.rgb = true,
-                "depth" => out.depth = true,
-                "mask" => out.mask = true,
-                _ => {
-                    return Err(Error::param(
-                        "outputs",
-                        format!("'{item}': expected rgb, depth or mask"),
-                    ))
-                }
-            }
-        }
-        if !(out.rgb || out.depth || out.mask) {
-            return Err(Error::param("outputs", "at least one of rgb, depth, mask"));
-        }
-        Ok(out)
-    }
-}
+pub use crate::io::OutputSet;

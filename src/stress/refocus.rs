@@ -17,7 +17,7 @@ use crate::convention::Conventions;
 use crate::error::Result;
 use crate::gpu::Gpu;
 use crate::io::{DepthMap, RgbImage};
-use crate::refocus::job::TargetSpec;
+use crate::refocus::manifest::TargetSpec;
 use crate::refocus::reference::refocus_reference;
 use crate::refocus::{BreakRule, Method, OutputSet, RefocusSource, Refocuser};
 

@@ -6,9 +6,9 @@ use super::common::gpu;
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 use viewsynth::convention::Conventions;
+use viewsynth::io::FileFormats;
 use viewsynth::io::{self, Encoding, PngCompression};
 use viewsynth::refocus::batch::{load_manifest, run_batch, BatchOptions, Shard};
-use viewsynth::refocus::job::FileFormats;
 use viewsynth::refocus::{BreakRule, Method, OutputSet};
 use viewsynth::scene;
 
@@ -42,7 +42,7 @@ fn options(jobs: usize) -> BatchOptions {
         conv: Conventions::default(),
         files: FileFormats {
             outputs: OutputSet::default(),
-            depth: viewsynth::refocus::job::DepthFormats {
+            depth: viewsynth::io::DepthFormats {
                 exr: true,
                 npy: true,
                 png16: true,

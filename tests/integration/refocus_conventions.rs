@@ -4,7 +4,7 @@
 
 use crate::common::*;
 use viewsynth::convention::Conventions;
-use viewsynth::refocus::job::TargetSpec;
+use viewsynth::refocus::manifest::TargetSpec;
 use viewsynth::refocus::{BreakRule, Method, OutputSet, Refocuser};
 
 #[test]

@@ -4,7 +4,7 @@ use crate::common::*;
 use viewsynth::camera::{Intrinsics, PinholeCamera};
 use viewsynth::convention::Conventions;
 use viewsynth::io::{DepthMap, RgbImage};
-use viewsynth::refocus::job::TargetSpec;
+use viewsynth::refocus::manifest::TargetSpec;
 use viewsynth::refocus::{BreakRule, Method, OutputSet, RefocusSource, Refocuser};
 
 fn source(w: u32, h: u32, depth: Vec<f32>) -> RefocusSource {

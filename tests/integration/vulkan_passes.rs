@@ -279,7 +279,7 @@ fn a_steady_state_frame_creates_nothing_on_either_api() {
         let mut stitch = viewsynth::stitch::render::StitchRenderer::new(d, &left, &right).unwrap();
         let mut tracer = SceneRenderer::new(d, &scene).unwrap();
         let source = crate::common::synthetic(64, 48);
-        let targets = viewsynth::refocus::job::TargetSpec {
+        let targets = viewsynth::refocus::manifest::TargetSpec {
             scales: vec![0.5, 1.0, 2.0],
             size: None,
             principal: None,

@@ -1,8 +1,8 @@
 //! Which outputs to write and in which file formats (refocus, batch and reproject).
 
 use clap::{Args, ValueEnum};
+use viewsynth::io::RgbFormat;
 use viewsynth::job::FileOptions;
-use viewsynth::refocus::job::RgbFormat;
 
 #[derive(Clone, Copy, ValueEnum)]
 enum RgbFormatArg {

@@ -20,7 +20,7 @@ fn frame(job: &RefocusJob) -> Result<()> {
             e.intrinsics.fx,
             e.width,
             e.height,
-            e.coverage.unwrap_or(f64::NAN) * 100.0,
+            e.files.coverage.unwrap_or(f64::NAN) * 100.0,
             e.render_ms
         );
     }

@@ -6,7 +6,7 @@ use clap::{Args, ValueEnum};
 use std::path::PathBuf;
 use viewsynth::camera::stereo::Eye;
 use viewsynth::job::reproject::{MethodChoice, ReprojectJob, ReprojectOptions, SourceDepth, Target};
-use viewsynth::job::{finite_or_inf, finite_value, output_formats, ArgError};
+use viewsynth::job::{file_formats, finite_or_inf, finite_value, ArgError};
 
 #[derive(Clone, Copy, ValueEnum, PartialEq)]
 pub(crate) enum ReprojectDepthArg {
@@ -141,7 +141,7 @@ pub(crate) struct ReprojectArgs {
 impl TryFrom<ReprojectArgs> for ReprojectJob {
     type Error = ArgError;
     fn try_from(a: ReprojectArgs) -> Result<Self, ArgError> {
-        let files = output_formats(&a.files.options())?;
+        let files = file_formats(&a.files.options())?;
         ReprojectJob::new(ReprojectOptions {
             color: a.color,
             depth: a.depth,

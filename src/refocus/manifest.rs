@@ -1,76 +1,14 @@
-//! A refocus job: which targets to render (focal list or zoom scales, output size, principal
-//! point), where to write what, and the manifest describing it.
+//! Refocus targets and their manifest: which targets to render (focal list or zoom scales,
+//! output size, principal point), the file-name tags, and `manifest.json` describing what was
+//! written (the files themselves are written by the output layer, [`io::write_view`]).
 
-use super::{OutputSet, RefocusOutput};
+use super::RefocusOutput;
 use crate::camera::{Intrinsics, PinholeCamera};
 use crate::error::{Error, Result};
-use crate::io;
+use crate::io::{self, FileFormats, FileRecord, FileSet, ViewFiles, ViewNames};
+use crate::view::ViewOutput;
 use serde::Serialize;
 use std::path::{Path, PathBuf};
-
-/// File format of the colour output.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Default)]
-#[serde(rename_all = "lowercase")]
-pub enum RgbFormat {
-    /// 8-bit PNG (the default).
-    #[default]
-    Png,
-    /// JPEG at quality 95 (lossy).
-    Jpeg,
-    /// OpenEXR, float32 R, G, B in [0, 1] (level / 255).
-    Exr,
-}
-
-impl RgbFormat {
-    /// File extension without the dot: "png", "jpg" or "exr".
-    pub fn extension(self) -> &'static str {
-        match self {
-            RgbFormat::Png => "png",
-            RgbFormat::Jpeg => "jpg",
-            RgbFormat::Exr => "exr",
-        }
-    }
-}
-
-/// File formats of the metric depth output (any combination).
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
-pub struct DepthFormats {
-    /// float32 metres in an OpenEXR file (the default).
-    pub exr: bool,
-    /// float32 metres in a NumPy `.npy` file.
-    pub npy: bool,
-    /// uint16 millimetres in a 16-bit gray PNG (0 = invalid). Left out of the settings JSON
-    /// when off, so batches made before it resume.
-    #[serde(skip_serializing_if = "std::ops::Not::not")]
-    pub png16: bool,
-}
-
-impl Default for DepthFormats {
-    fn default() -> Self {
-        DepthFormats {
-            exr: true,
-            npy: false,
-            png16: false,
-        }
-    }
-}
-
-/// What files a target produces and how they are encoded.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize)]
-pub struct FileFormats {
-    /// Which images are rendered (colour, depth, mask).
-    pub outputs: OutputSet,
-    /// File format of the colour output.
-    pub rgb: RgbFormat,
-    /// File formats of the depth output.
-    pub depth: DepthFormats,
-    /// PNG and EXR compression.
-    pub encoding: io::Encoding,
-    /// A colour-mapped PNG of the depth output beside it (left out of the settings JSON when
-    /// off, so batches made before it resume).
-    #[serde(skip_serializing_if = "std::ops::Not::not")]
-    pub depth_preview: bool,
-}
 
 /// How target cameras are derived from the source.
 #[derive(Debug, Clone, PartialEq)]
@@ -165,29 +103,9 @@ pub struct ManifestEntry {
     pub width: u32,
     /// Output height in pixels.
     pub height: u32,
-    /// Colour file name, relative to the manifest; None when not written.
-    pub rgb: Option<String>,
-    /// Depth EXR file name; None when not written.
-    pub depth_exr: Option<String>,
-    /// Depth NPY file name; None when not written.
-    pub depth_npy: Option<String>,
-    /// Depth 16-bit PNG file name (millimetres); None when not written.
-    #[serde(skip_serializing_if = "Option::is_none")]
-    pub depth_png16: Option<String>,
-    /// Valid pixels written as 0 in the PNG because they lie beyond 65.535 m.
-    #[serde(skip_serializing_if = "Option::is_none")]
-    pub depth_png16_clipped: Option<u64>,
-    /// Depth preview PNG file name; None when not written.
-    #[serde(skip_serializing_if = "Option::is_none")]
-    pub depth_preview: Option<String>,
-    /// Depth in metres at the preview's near (red) and far (blue) colours: the 2nd and 98th
-    /// percentile of the valid depth; absent when no pixel is valid (the preview is black).
-    #[serde(skip_serializing_if = "Option::is_none")]
-    pub depth_preview_range_m: Option<io::PreviewRange>,
-    /// Mask PNG file name; None when not written.
-    pub mask: Option<String>,
-    /// Fraction of output pixels with mask = 1 (when a mask or depth was produced).
-    pub coverage: Option<f64>,
+    /// The files written and the coverage (flattened: the manifest's keys are as before).
+    #[serde(flatten)]
+    pub files: ViewFiles,
     /// Wall time of the target's render, milliseconds.
     pub render_ms: f64,
     /// Wall time of reading the target's outputs back, milliseconds.
@@ -228,59 +146,9 @@ pub struct Manifest {
     pub outputs: Vec<ManifestEntry>,
 }
 
-/// A written file (name relative to the manifest's folder) and its size in bytes.
-#[derive(Debug, Clone, Serialize)]
-pub struct FileRecord {
-    /// File name, relative to the manifest's folder.
-    pub name: String,
-    /// Size in bytes.
-    pub bytes: u64,
-    /// CRC-32 of the contents: the file's identity, so that resume tells this set's files from
-    /// another run's of the same names and sizes (a set mixed by a kill is redone).
-    #[serde(default)]
-    pub crc32: Option<u32>,
-}
-
-/// CRC-32 of the file at `path`, read in chunks.
-pub fn file_crc32(path: &Path) -> std::io::Result<u32> {
-    use std::io::Read;
-    let mut f = std::fs::File::open(path)?;
-    let mut crc = flate2::Crc::new();
-    let mut buf = vec![0u8; 1 << 16];
-    loop {
-        let n = f.read(&mut buf)?;
-        if n == 0 {
-            return Ok(crc.sum());
-        }
-        crc.update(&buf[..n]);
-    }
-}
-
-/// The files `entries` name, with their sizes on disk.
+/// The files `entries` name, with their sizes and CRC-32 on disk (under `dir`).
 pub fn file_records(dir: &Path, entries: &[ManifestEntry]) -> Result<Vec<FileRecord>> {
-    let mut out = Vec::new();
-    for e in entries {
-        for name in [
-            &e.rgb,
-            &e.depth_exr,
-            &e.depth_npy,
-            &e.depth_png16,
-            &e.depth_preview,
-            &e.mask,
-        ]
-        .into_iter()
-        .flatten()
-        {
-            let path = dir.join(name);
-            let bytes = std::fs::metadata(&path).map_err(|e| Error::io(&path, e))?.len();
-            out.push(FileRecord {
-                name: name.clone(),
-                bytes,
-                crc32: Some(file_crc32(&path).map_err(|e| Error::io(&path, e))?),
-            });
-        }
-    }
-    Ok(out)
+    io::file_records(dir, entries.iter().flat_map(|e| e.files.names()))
 }
 
 /// The file-name prefix of a zoom scale: 0.5 -> "s0.5", 1 -> "s1", 1.25 -> "s1.25" (short,
@@ -301,81 +169,53 @@ fn trim_decimals(v: f64) -> String {
         .to_string()
 }
 
-/// Write the requested files of one output under `dir` (atomic: temporary name, then rename),
-/// named by the scale's tag.
-pub fn write_output(dir: &Path, scale: f64, out: &RefocusOutput, files: &FileFormats) -> Result<ManifestEntry> {
-    write_output_named(dir, &scale_tag(scale), scale, out, files)
-}
-
-/// [`write_output`] with the files named `{tag}_rgb.png` etc. (e.g. a [`focal_tag`]).
-pub fn write_output_named(
-    dir: &Path,
+/// Write the requested files of one target into `set` through the output layer, named by
+/// `tag` (a [`scale_tag`] or [`focal_tag`]): `{tag}_rgb.png`, `{tag}_depth.exr`, ...
+pub fn write_target(
+    set: &mut FileSet,
     tag: &str,
     scale: f64,
-    out: &RefocusOutput,
+    out: RefocusOutput,
     files: &FileFormats,
 ) -> Result<ManifestEntry> {
-    let (outputs, rgb_format, depth_formats, enc) = (&files.outputs, files.rgb, files.depth, files.encoding);
     let t0 = std::time::Instant::now();
-    let name = |suffix: &str| -> (PathBuf, String) {
-        let file = format!("{tag}_{suffix}");
-        (dir.join(&file), file)
+    let (camera, render, readback_ms) = (out.camera, out.render, out.readback_ms);
+    let view = ViewOutput {
+        width: camera.width,
+        height: camera.height,
+        color: out.rgb,
+        depth: out.depth,
+        mask: out.mask,
+        timing: Some(render),
+        exact: None,
     };
-    let mut entry = ManifestEntry {
+    let written = io::write_view(set, &ViewNames::tagged(tag), &view, files)?;
+    Ok(ManifestEntry {
         scale,
-        intrinsics: out.camera.k,
-        width: out.camera.width,
-        height: out.camera.height,
-        rgb: None,
-        depth_exr: None,
-        depth_npy: None,
-        depth_png16: None,
-        depth_png16_clipped: None,
-        depth_preview: None,
-        depth_preview_range_m: None,
-        mask: None,
-        coverage: None,
-        render_ms: out.render.wall_ms,
+        intrinsics: camera.k,
+        width: camera.width,
+        height: camera.height,
+        files: written,
+        render_ms: render.wall_ms,
+        readback_ms,
+        write_ms: t0.elapsed().as_secs_f64() * 1e3,
+    })
+}
+
+/// [`write_target`] of one target straight into `dir` (a file set of its own, committed at
+/// once), named by the scale's tag: for tools that write targets one by one (demo, bench).
+pub fn write_output(dir: &Path, scale: f64, out: &RefocusOutput, files: &FileFormats) -> Result<ManifestEntry> {
+    let mut set = FileSet::new(dir)?;
+    let copy = RefocusOutput {
+        camera: out.camera,
+        rgb: out.rgb.clone(),
+        depth: out.depth.clone(),
+        mask: out.mask.clone(),
+        render: out.render,
         readback_ms: out.readback_ms,
-        write_ms: 0.0,
     };
-    if let (true, Some(rgb)) = (outputs.rgb, &out.rgb) {
-        let (path, file) = name(&format!("rgb.{}", rgb_format.extension()));
-        io::save_rgb_with(&path, rgb, &enc)?;
-        entry.rgb = Some(file);
-    }
-    if let (true, Some(depth)) = (outputs.depth, &out.depth) {
-        if depth_formats.exr {
-            let (path, file) = name("depth.exr");
-            io::save_depth_exr_with(&path, depth, enc.exr)?;
-            entry.depth_exr = Some(file);
-        }
-        if depth_formats.npy {
-            let (path, file) = name("depth.npy");
-            io::save_depth_npy(&path, depth)?;
-            entry.depth_npy = Some(file);
-        }
-        if depth_formats.png16 {
-            let (path, file) = name("depth.png");
-            entry.depth_png16_clipped = Some(io::save_depth_png16(&path, depth, enc.png)?);
-            entry.depth_png16 = Some(file);
-        }
-        if files.depth_preview {
-            let (path, file) = name("depth_preview.png");
-            entry.depth_preview_range_m = io::save_depth_preview(&path, depth, &enc)?;
-            entry.depth_preview = Some(file);
-        }
-        let valid = depth.data.iter().filter(|z| **z > 0.0).count();
-        entry.coverage = Some(valid as f64 / depth.data.len() as f64);
-    }
-    if let (true, Some(mask)) = (outputs.mask, &out.mask) {
-        let (path, file) = name("mask.png");
-        io::save_mask_png_with(&path, mask, enc.png)?;
-        entry.mask = Some(file);
-        let valid = mask.data.iter().filter(|m| **m != 0).count();
-        entry.coverage = Some(valid as f64 / mask.data.len() as f64);
-    }
-    entry.write_ms = t0.elapsed().as_secs_f64() * 1e3;
+    let entry = write_target(&mut set, &scale_tag(scale), scale, copy, files)?;
+    set.commit()?;
     Ok(entry)
 }
 
@@ -454,9 +294,9 @@ mod tests {
         );
         let dir = scratch("viewsynth-job-focal-");
         let out = synthetic_output(vec![1.0, 2.0]);
-        let e = write_output_named(dir.path(), "f571.4", 57.14, &out, &FileFormats::default()).unwrap();
-        assert_eq!(e.rgb.as_deref(), Some("f571.4_rgb.png"));
-        assert_eq!(e.depth_exr.as_deref(), Some("f571.4_depth.exr"));
+        let e = write(dir.path(), "f571.4", 57.14, out, &FileFormats::default()).unwrap();
+        assert_eq!(e.files.rgb.as_deref(), Some("f571.4_rgb.png"));
+        assert_eq!(e.files.depth_exr.as_deref(), Some("f571.4_depth.exr"));
         assert_eq!(e.scale, 57.14);
         assert!(dir.path().join("f571.4_mask.png").is_file());
     }
@@ -483,6 +323,14 @@ mod tests {
         }
     }
 
+    /// [`write_target`] into a set committed into `dir`.
+    fn write(dir: &Path, tag: &str, scale: f64, out: RefocusOutput, files: &FileFormats) -> Result<ManifestEntry> {
+        let mut set = io::OutDir::prepare(dir)?.file_set()?;
+        let e = write_target(&mut set, tag, scale, out, files)?;
+        set.commit()?;
+        Ok(e)
+    }
+
     fn scratch(tag: &str) -> tempfile::TempDir {
         tempfile::Builder::new().prefix(tag).tempdir().unwrap()
     }
@@ -492,7 +340,7 @@ mod tests {
         let dir = scratch("viewsynth-job-png16-");
         let out = synthetic_output(vec![1.5, 0.0, 70.0, 65.6]);
         let files = FileFormats {
-            depth: DepthFormats {
+            depth: io::DepthFormats {
                 exr: false,
                 npy: false,
                 png16: true,
@@ -500,8 +348,11 @@ mod tests {
             ..Default::default()
         };
         let e = write_output(dir.path(), 1.0, &out, &files).unwrap();
-        assert_eq!(e.depth_png16.as_deref(), Some("s1_depth.png"));
-        assert_eq!((e.depth_exr.as_deref(), e.depth_png16_clipped), (None, Some(2)));
+        assert_eq!(e.files.depth_png16.as_deref(), Some("s1_depth.png"));
+        assert_eq!(
+            (e.files.depth_exr.as_deref(), e.files.depth_png16_clipped),
+            (None, Some(2))
+        );
         let back = io::load_depth(
             &dir.path().join("s1_depth.png"),
             &io::DepthDecode {
@@ -520,7 +371,7 @@ mod tests {
         let json = serde_json::to_value(&e).unwrap();
         assert_eq!(json["depth_png16_clipped"], 2);
         // Off by default: neither the file nor the keys appear (older manifests stay as they were).
-        let plain = write_output(dir.path(), 2.0, &out, &FileFormats::default()).unwrap();
+        let plain = write(dir.path(), "s2", 2.0, out, &FileFormats::default()).unwrap();
         let json = serde_json::to_value(&plain).unwrap();
         assert!(json.get("depth_png16").is_none() && json.get("depth_png16_clipped").is_none());
         let settings = serde_json::to_value(FileFormats::default()).unwrap();
@@ -536,9 +387,9 @@ mod tests {
             depth_preview: true,
             ..Default::default()
         };
-        let e = write_output(dir.path(), 0.5, &out, &files).unwrap();
-        assert_eq!(e.depth_preview.as_deref(), Some("s0.5_depth_preview.png"));
-        let r = e.depth_preview_range_m.unwrap();
+        let e = write(dir.path(), "s0.5", 0.5, out, &files).unwrap();
+        assert_eq!(e.files.depth_preview.as_deref(), Some("s0.5_depth_preview.png"));
+        let r = e.files.depth_preview_range_m.unwrap();
         assert_eq!((r.min_m, r.max_m), (1.0, 3.0));
         let json = serde_json::to_value(&e).unwrap();
         assert_eq!(json["depth_preview_range_m"]["max_m"], 3.0);

@@ -1,0 +1,456 @@
+//! The output layer: one synthesised view ([`ViewOutput`]), the outputs asked for and their
+//! formats become files in a [`FileSet`] (atomic, all or none) and the manifest entry naming
+//! them. Every command writes its views through [`write_view`], so a format one command
+//! accepts is written the same way by all of them (refocus single frame and batch,
+//! reproject, cyclopean, stitch, scene, and Python's batch).
+//!
+//! Names: `{stem}_rgb.{png,jpg,exr}`, `{stem}_depth.exr`, `{stem}_depth.npy`,
+//! `{stem}_depth.png` (uint16 millimetres), `{stem}_depth_preview.png`, `{stem}_mask.png`;
+//! [`ViewNames`] lets a command keep other names it has always written (stitch's
+//! `ods_left.png`, scene's `left_view_z.exr`).
+
+use super::{Encoding, FileSet, PreviewRange};
+use crate::error::{Error, Result};
+use crate::view::ViewOutput;
+use serde::{Deserialize, Serialize};
+use std::path::Path;
+
+/// Which outputs to produce; nothing is allocated, read back or written for the others.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+pub struct OutputSet {
+    /// Produce the colour image.
+    pub rgb: bool,
+    /// Produce the view-Z depth.
+    pub depth: bool,
+    /// Produce the validity mask.
+    pub mask: bool,
+}
+
+impl Default for OutputSet {
+    fn default() -> Self {
+        OutputSet {
+            rgb: true,
+            depth: true,
+            mask: true,
+        }
+    }
+}
+
+impl OutputSet {
+    /// Parse "rgb,depth,mask" (any subset, at least one; "color"/"colour" name rgb).
+    pub fn parse(list: &str) -> Result<Self> {
+        let mut out = OutputSet {
+            rgb: false,
+            depth: false,
+            mask: false,
+        };
+        for item in list.split(',').map(str::trim).filter(|s| !s.is_empty()) {
+            match item {
+                "rgb" | "color" | "colour" => out.rgb = true,
+                "depth" => out.depth = true,
+                "mask" => out.mask = true,
+                _ => {
+                    return Err(Error::param(
+                        "outputs",
+                        format!("'{item}': expected rgb, depth or mask"),
+                    ))
+                }
+            }
+        }
+        if !(out.rgb || out.depth || out.mask) {
+            return Err(Error::param("outputs", "at least one of rgb, depth, mask"));
+        }
+        Ok(out)
+    }
+}
+
+/// File format of the colour output.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Default)]
+#[serde(rename_all = "lowercase")]
+pub enum RgbFormat {
+    /// 8-bit PNG (the default).
+    #[default]
+    Png,
+    /// JPEG at quality 95 (lossy).
+    Jpeg,
+    /// OpenEXR, float32 R, G, B in [0, 1] (level / 255).
+    Exr,
+}
+
+impl RgbFormat {
+    /// File extension without the dot: "png", "jpg" or "exr".
+    pub fn extension(self) -> &'static str {
+        match self {
+            RgbFormat::Png => "png",
+            RgbFormat::Jpeg => "jpg",
+            RgbFormat::Exr => "exr",
+        }
+    }
+}
+
+/// File formats of the metric depth output (any combination).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+pub struct DepthFormats {
+    /// float32 metres in an OpenEXR file (the default).
+    pub exr: bool,
+    /// float32 metres in a NumPy `.npy` file.
+    pub npy: bool,
+    /// uint16 millimetres in a 16-bit gray PNG (0 = invalid). Left out of the settings JSON
+    /// when off, so batches made before it resume.
+    #[serde(skip_serializing_if = "std::ops::Not::not")]
+    pub png16: bool,
+}
+
+impl Default for DepthFormats {
+    fn default() -> Self {
+        DepthFormats {
+            exr: true,
+            npy: false,
+            png16: false,
+        }
+    }
+}
+
+/// What files a view produces and how they are encoded.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize)]
+pub struct FileFormats {
+    /// Which images are rendered (colour, depth, mask).
+    pub outputs: OutputSet,
+    /// File format of the colour output.
+    pub rgb: RgbFormat,
+    /// File formats of the depth output.
+    pub depth: DepthFormats,
+    /// PNG and EXR compression.
+    pub encoding: Encoding,
+    /// A colour-mapped PNG of the depth output beside it (left out of the settings JSON when
+    /// off, so batches made before it resume).
+    #[serde(skip_serializing_if = "std::ops::Not::not")]
+    pub depth_preview: bool,
+}
+
+impl FileFormats {
+    /// Checks that the choice can be honoured: at least one output, at least one depth format
+    /// when depth is asked for, and a preview only with the depth it colours.
+    pub fn validate(&self) -> Result<()> {
+        let o = self.outputs;
+        if !(o.rgb || o.depth || o.mask) {
+            return Err(Error::param("outputs", "at least one of rgb, depth, mask"));
+        }
+        let d = self.depth;
+        if o.depth && !(d.exr || d.npy || d.png16) {
+            return Err(Error::param("depth-format", "at least one of exr, npy, png16"));
+        }
+        if self.depth_preview && !o.depth {
+            return Err(Error::param(
+                "depth-preview",
+                "colours the depth output: add depth to --outputs",
+            ));
+        }
+        Ok(())
+    }
+}
+
+/// The file-name stems of a view's outputs (without extension).
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct ViewNames {
+    /// Colour: `{rgb}.{png,jpg,exr}`.
+    pub rgb: String,
+    /// Depth: `{depth}.exr`, `{depth}.npy`, `{depth}.png`, `{depth}_preview.png`.
+    pub depth: String,
+    /// Mask: `{mask}.png`.
+    pub mask: String,
+}
+
+impl ViewNames {
+    /// `{tag}_rgb`, `{tag}_depth`, `{tag}_mask`: the names of every view but stitch's and
+    /// scene's special files.
+    pub fn tagged(tag: &str) -> Self {
+        ViewNames {
+            rgb: format!("{tag}_rgb"),
+            depth: format!("{tag}_depth"),
+            mask: format!("{tag}_mask"),
+        }
+    }
+}
+
+impl ViewNames {
+    /// A colour file `{rgb}.png` (stitch's `ods_top_bottom`), with the depth file beside it
+    /// named `{depth}.exr` where a view has one (scene's `left_view_z`).
+    pub fn named(rgb: &str, depth: &str) -> Self {
+        ViewNames {
+            rgb: rgb.to_string(),
+            depth: depth.to_string(),
+            mask: format!("{rgb}_mask"),
+        }
+    }
+}
+
+impl OutputSet {
+    /// Colour only.
+    pub const RGB: OutputSet = OutputSet {
+        rgb: true,
+        depth: false,
+        mask: false,
+    };
+    /// Colour and depth.
+    pub const RGB_DEPTH: OutputSet = OutputSet {
+        rgb: true,
+        depth: true,
+        mask: false,
+    };
+    /// Depth only.
+    pub const DEPTH: OutputSet = OutputSet {
+        rgb: false,
+        depth: true,
+        mask: false,
+    };
+}
+
+impl FileFormats {
+    /// The default formats (PNG colour, EXR depth, default compression) of `outputs`.
+    pub fn of(outputs: OutputSet) -> Self {
+        FileFormats {
+            outputs,
+            ..Default::default()
+        }
+    }
+}
+
+/// The files written for one view, as its manifest entry lists them (the fields, in this
+/// order, of refocus's manifest entries).
+#[derive(Debug, Clone, Default, PartialEq, Serialize)]
+pub struct ViewFiles {
+    /// Colour file name, relative to the manifest; None when not written.
+    pub rgb: Option<String>,
+    /// Depth EXR file name; None when not written.
+    pub depth_exr: Option<String>,
+    /// Depth NPY file name; None when not written.
+    pub depth_npy: Option<String>,
+    /// Depth 16-bit PNG file name (millimetres); None when not written.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub depth_png16: Option<String>,
+    /// Valid pixels written as 0 in the PNG because they lie beyond 65.535 m.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub depth_png16_clipped: Option<u64>,
+    /// Depth preview PNG file name; None when not written.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub depth_preview: Option<String>,
+    /// Depth in metres at the preview's near (red) and far (blue) colours: the 2nd and 98th
+    /// percentile of the valid depth; absent when no pixel is valid (the preview is black).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub depth_preview_range_m: Option<PreviewRange>,
+    /// Mask PNG file name; None when not written.
+    pub mask: Option<String>,
+    /// Fraction of output pixels with mask = 1 (when a mask or depth was produced).
+    pub coverage: Option<f64>,
+}
+
+impl ViewFiles {
+    /// The names written, in the order written.
+    pub fn names(&self) -> impl Iterator<Item = &String> {
+        [
+            &self.rgb,
+            &self.depth_exr,
+            &self.depth_npy,
+            &self.depth_png16,
+            &self.depth_preview,
+            &self.mask,
+        ]
+        .into_iter()
+        .flatten()
+    }
+}
+
+/// A written file (name relative to the manifest's folder) and its size in bytes.
+#[derive(Debug, Clone, Serialize)]
+pub struct FileRecord {
+    /// File name, relative to the manifest's folder.
+    pub name: String,
+    /// Size in bytes.
+    pub bytes: u64,
+    /// CRC-32 of the contents: the file's identity, so that resume tells this set's files from
+    /// another run's of the same names and sizes (a set mixed by a kill is redone).
+    #[serde(default)]
+    pub crc32: Option<u32>,
+}
+
+/// CRC-32 of the file at `path`, read in chunks.
+pub fn file_crc32(path: &Path) -> std::io::Result<u32> {
+    use std::io::Read;
+    let mut f = std::fs::File::open(path)?;
+    let mut crc = flate2::Crc::new();
+    let mut buf = vec![0u8; 1 << 16];
+    loop {
+        let n = f.read(&mut buf)?;
+        if n == 0 {
+            return Ok(crc.sum());
+        }
+        crc.update(&buf[..n]);
+    }
+}
+
+/// The records (size, CRC-32) of files named relative to `dir`.
+pub fn file_records<'a>(dir: &Path, names: impl IntoIterator<Item = &'a String>) -> Result<Vec<FileRecord>> {
+    names
+        .into_iter()
+        .map(|name| {
+            let path = dir.join(name);
+            let bytes = std::fs::metadata(&path).map_err(|e| Error::io(&path, e))?.len();
+            Ok(FileRecord {
+                name: name.clone(),
+                bytes,
+                crc32: Some(file_crc32(&path).map_err(|e| Error::io(&path, e))?),
+            })
+        })
+        .collect()
+}
+
+/// Writes the outputs of `view` that `formats` asks for into `set`, named by `names`, and
+/// returns the entry naming them. An output asked for that the view does not hold is an
+/// error naming it (never a file silently left out); errors name the final paths.
+pub fn write_view(set: &mut FileSet, names: &ViewNames, view: &ViewOutput, formats: &FileFormats) -> Result<ViewFiles> {
+    write_view_in(set.staging(), names, view, formats).map_err(|e| set.final_error(e))
+}
+
+fn missing(what: &str) -> Error {
+    Error::param(
+        "outputs",
+        format!("{what} was asked for but the view has none (the pass did not produce it)"),
+    )
+}
+
+fn write_view_in(dir: &Path, names: &ViewNames, view: &ViewOutput, formats: &FileFormats) -> Result<ViewFiles> {
+    formats.validate()?;
+    let (outputs, enc) = (formats.outputs, formats.encoding);
+    let mut entry = ViewFiles::default();
+    let file = |stem: &str, suffix: &str| -> (std::path::PathBuf, String) {
+        let name = format!("{stem}{suffix}");
+        (dir.join(&name), name)
+    };
+    if outputs.rgb {
+        let rgb = view.color.as_ref().ok_or_else(|| missing("rgb"))?;
+        let (path, name) = file(&names.rgb, &format!(".{}", formats.rgb.extension()));
+        super::save_rgb_with(&path, rgb, &enc)?;
+        entry.rgb = Some(name);
+    }
+    if outputs.depth {
+        let depth = view.depth.as_ref().ok_or_else(|| missing("depth"))?;
+        if formats.depth.exr {
+            let (path, name) = file(&names.depth, ".exr");
+            super::save_depth_exr_with(&path, depth, enc.exr)?;
+            entry.depth_exr = Some(name);
+        }
+        if formats.depth.npy {
+            let (path, name) = file(&names.depth, ".npy");
+            super::save_depth_npy(&path, depth)?;
+            entry.depth_npy = Some(name);
+        }
+        if formats.depth.png16 {
+            let (path, name) = file(&names.depth, ".png");
+            entry.depth_png16_clipped = Some(super::save_depth_png16(&path, depth, enc.png)?);
+            entry.depth_png16 = Some(name);
+        }
+        if formats.depth_preview {
+            let (path, name) = file(&names.depth, "_preview.png");
+            entry.depth_preview_range_m = super::save_depth_preview(&path, depth, &enc)?;
+            entry.depth_preview = Some(name);
+        }
+        let valid = depth.data.iter().filter(|z| **z > 0.0).count();
+        entry.coverage = Some(valid as f64 / depth.data.len().max(1) as f64);
+    }
+    if outputs.mask {
+        let mask = view.mask.as_ref().ok_or_else(|| missing("mask"))?;
+        let (path, name) = file(&names.mask, ".png");
+        super::save_mask_png_with(&path, mask, enc.png)?;
+        entry.mask = Some(name);
+        let valid = mask.data.iter().filter(|m| **m != 0).count();
+        entry.coverage = Some(valid as f64 / mask.data.len().max(1) as f64);
+    }
+    Ok(entry)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::io::{DepthMap, Mask, OutDir, RgbImage};
+
+    fn view(z: Vec<f32>) -> ViewOutput {
+        let (w, h) = (z.len() as u32, 1);
+        ViewOutput {
+            width: w,
+            height: h,
+            color: Some(RgbImage::new(w, h, vec![128; (w * h * 3) as usize]).unwrap()),
+            depth: Some(DepthMap::new(w, h, z).unwrap()),
+            mask: Some(Mask::new(w, h, vec![1, 0, 1, 1]).unwrap()),
+            timing: None,
+            exact: None,
+        }
+    }
+
+    #[test]
+    fn every_format_asked_for_is_written_and_nothing_else() {
+        let dir = crate::io::test_util::scratch_dir("outputs");
+        let out = OutDir::prepare(&dir).unwrap();
+        let mut set = out.file_set().unwrap();
+        let formats = FileFormats {
+            depth: DepthFormats {
+                exr: false,
+                npy: true,
+                png16: true,
+            },
+            depth_preview: true,
+            ..Default::default()
+        };
+        let v = view(vec![1.5, 0.0, 70.0, 2.0]);
+        let e = write_view(&mut set, &ViewNames::tagged("right"), &v, &formats).unwrap();
+        let names: Vec<&String> = e.names().collect();
+        assert_eq!(
+            names,
+            [
+                "right_rgb.png",
+                "right_depth.npy",
+                "right_depth.png",
+                "right_depth_preview.png",
+                "right_mask.png"
+            ]
+        );
+        assert_eq!(e.depth_png16_clipped, Some(1));
+        assert_eq!(e.coverage, Some(0.75));
+        set.commit().unwrap();
+        let mut on_disk = crate::io::test_util::list_dir(&dir);
+        on_disk.retain(|n| !n.starts_with('.'));
+        let mut want: Vec<String> = names.into_iter().cloned().collect();
+        want.sort();
+        assert_eq!(on_disk, want);
+        let back = crate::io::load_depth(
+            &dir.join("right_depth.png"),
+            &crate::io::DepthDecode {
+                scale: Some(1000.0),
+                ..Default::default()
+            },
+        )
+        .unwrap();
+        assert_eq!(back.data, vec![1.5, 0.0, 0.0, 2.0]);
+        let _ = std::fs::remove_dir_all(&dir);
+    }
+
+    #[test]
+    fn an_output_the_view_lacks_or_a_preview_without_depth_is_refused_by_name() {
+        let dir = crate::io::test_util::scratch_dir("outputs-missing");
+        let out = OutDir::prepare(&dir).unwrap();
+        let mut set = out.file_set().unwrap();
+        let mut v = view(vec![1.0; 4]);
+        v.mask = None;
+        let e = write_view(&mut set, &ViewNames::tagged("a"), &v, &FileFormats::default()).unwrap_err();
+        assert!(e.to_string().contains("mask"), "{e}");
+        let formats = FileFormats {
+            outputs: OutputSet::parse("rgb").unwrap(),
+            depth_preview: true,
+            ..Default::default()
+        };
+        let e = write_view(&mut set, &ViewNames::tagged("b"), &view(vec![1.0; 4]), &formats).unwrap_err();
+        assert!(e.to_string().contains("depth-preview"), "{e}");
+        drop(set);
+        let _ = std::fs::remove_dir_all(&dir);
+    }
+}

@@ -1,0 +1,380 @@
+//! The pipelined batch: decode pool -> GL thread (upload, queue the targets, map the previous
+//! frame's outputs) -> encode pool, with bounded queues; or every stage in turn on one thread
+//! (`jobs` = 0, the synchronous baseline).
+
+use super::resume::{frame_finished, frame_settings};
+use super::{BatchFrame, BatchOptions, MAX_JOBS};
+use crate::error::{Error, Result};
+use crate::pass::ToDevice;
+use crate::io::FileFormats;
+use crate::io::{self, DepthDecode};
+use crate::refocus::manifest::{self, Manifest, TargetSpec};
+use crate::refocus::{PendingRefocus, RefocusOutput, RefocusSource, Refocuser};
+use serde::Serialize;
+use std::path::Path;
+use std::sync::atomic::{AtomicUsize, Ordering};
+use std::sync::{mpsc, Arc, Mutex};
+use std::time::Instant;
+
+/// Per-frame milliseconds of each stage, in completion order.
+#[derive(Debug, Clone, Default, Serialize)]
+pub struct StageTimes {
+    /// Reading and decoding colour and depth (a decode thread).
+    pub decode: Vec<f64>,
+    /// Break rule, coverage flags and texture uploads (GL thread).
+    pub upload: Vec<f64>,
+    /// Recording the draws and queueing the reads of every target (GL thread).
+    pub render: Vec<f64>,
+    /// Waiting for the GPU and mapping the outputs (GL thread; a software renderer rasterises
+    /// here).
+    pub readback: Vec<f64>,
+    /// Encoding and writing the files and the manifest (an encode thread).
+    pub encode: Vec<f64>,
+    /// GL thread idle: waiting for a decoded frame or for room in the encode queue.
+    pub wait: Vec<f64>,
+    /// GPU time of the draws (timer queries read after the fence) where the driver's timers
+    /// are meaningful.
+    pub gpu_render: Vec<f64>,
+}
+
+/// What a batch did, printed and written as JSON at the end.
+#[derive(Debug, Clone, Default, Serialize)]
+pub struct BatchSummary {
+    /// Frames rendered and written.
+    pub rendered: usize,
+    /// Frames skipped because they were already finished with the same settings.
+    pub skipped: usize,
+    /// Frames outside this shard.
+    pub other_shards: usize,
+    /// (frame name, error) for every frame that failed; the others completed.
+    pub failed: Vec<(String, String)>,
+    /// Wall time of the whole batch, seconds.
+    pub wall_s: f64,
+    /// Per-frame times of each pipeline stage.
+    pub stages: StageTimes,
+    /// Most frames held in memory at once: decoded and queued, on the GL thread, mapped and
+    /// queued for encoding, being encoded.
+    pub frames_in_flight: usize,
+}
+
+struct WriteJob {
+    name: String,
+    /// The batch's --out-dir; the frame's folder is `name` inside it.
+    root: io::OutDir,
+    outputs: Vec<(f64, RefocusOutput)>,
+    manifest: Manifest,
+}
+
+/// Write a frame's files as one all-or-none set: staged, then renamed into the frame's folder
+/// (a plain folder inside --out-dir, never a symlink) with `manifest.json` last. A failure
+/// leaves the previous run's files of this frame untouched.
+fn write_frame(job: WriteJob, files: &FileFormats) -> Result<()> {
+    let dir = job.root.subdir(&job.name)?;
+    let mut set = dir.file_set()?;
+    let mut record = job.manifest;
+    for (scale, out) in job.outputs {
+        let entry = manifest::write_target(&mut set, &manifest::scale_tag(scale), scale, out, files)?;
+        record.outputs.push(entry);
+    }
+    record.files = manifest::file_records(set.staging(), &record.outputs)?;
+    let path = set.final_path("manifest.json");
+    let text = serde_json::to_string_pretty(&record).map_err(|e| Error::encode(&path, e.to_string()))?;
+    // Written last and renamed last: its presence marks the frame finished for resume.
+    set.write("manifest.json", |w| {
+        use std::io::Write;
+        w.write_all(text.as_bytes()).map_err(|e| Error::io(&path, e))
+    })?;
+    set.commit()?;
+    Ok(())
+}
+
+/// Read and validate one frame's inputs (errors name the frame's files).
+fn decode_frame(frame: &BatchFrame, depth_trunc: Option<f64>) -> Result<RefocusSource> {
+    let decode = DepthDecode {
+        scale: frame.depth_scale,
+        sun_rgbd_bit_rotate: frame.sun_bit_rotate,
+        ..Default::default()
+    };
+    let mut depth = io::load_depth(&frame.depth, &decode)?;
+    if let Some(m) = depth_trunc {
+        io::truncate_depth(&mut depth, m)?;
+    }
+    RefocusSource::new(io::load_rgb(&frame.rgb)?, depth, frame.intrinsics())
+}
+
+fn ms_since(t: Instant) -> f64 {
+    t.elapsed().as_secs_f64() * 1e3
+}
+
+/// A frame on the GL thread: uploaded, its targets queued.
+struct InFlight {
+    name: String,
+    root: io::OutDir,
+    scales: Vec<f64>,
+    pending: Vec<PendingRefocus>,
+    manifest: Manifest,
+}
+
+/// Upload a decoded frame and queue all its targets.
+fn submit_frame(
+    refocuser: &mut Refocuser,
+    name: String,
+    root: io::OutDir,
+    src: &RefocusSource,
+    settings: serde_json::Value,
+    opts: &BatchOptions,
+    stages: &mut StageTimes,
+) -> Result<InFlight> {
+    let t0 = Instant::now();
+    let targets = TargetSpec {
+        scales: opts.scales.clone(),
+        size: opts.size,
+        principal: opts.principal,
+    }
+    .targets(&src.camera())?;
+    refocuser.set_source(src)?;
+    stages.upload.push(ms_since(t0));
+    let t0 = Instant::now();
+    let pending = targets
+        .iter()
+        .map(|t| refocuser.submit(t))
+        .collect::<Result<Vec<_>>>()?;
+    stages.render.push(ms_since(t0));
+    let manifest = Manifest {
+        tool: format!("viewsynth {}", env!("CARGO_PKG_VERSION")),
+        source: src.camera(),
+        method: opts.method,
+        break_rule: opts.rule,
+        conventions: opts.conv,
+        renderer: refocuser.renderer(),
+        notes: manifest::MANIFEST_NOTES.to_string(),
+        settings: Some(settings),
+        files: Vec::new(),
+        outputs: Vec::new(),
+    };
+    Ok(InFlight {
+        name,
+        root,
+        scales: opts.scales.clone(),
+        pending,
+        manifest,
+    })
+}
+
+/// Wait for a frame's outputs (the GPU is by now busy with the next frame).
+fn collect_frame(f: InFlight, stages: &mut StageTimes) -> std::result::Result<WriteJob, (String, Error)> {
+    let t0 = Instant::now();
+    let mut outputs = Vec::with_capacity(f.pending.len());
+    let mut gpu_ms = None;
+    for (s, p) in f.scales.iter().zip(f.pending) {
+        match p.wait() {
+            Ok(o) => {
+                if let Some(g) = o.render.gpu_ms {
+                    *gpu_ms.get_or_insert(0.0) += g;
+                }
+                outputs.push((*s, o));
+            }
+            Err(e) => return Err((f.name, e)),
+        }
+    }
+    stages.readback.push(ms_since(t0));
+    if let Some(g) = gpu_ms {
+        stages.gpu_render.push(g);
+    }
+    Ok(WriteJob {
+        name: f.name,
+        root: f.root,
+        outputs,
+        manifest: f.manifest,
+    })
+}
+
+/// Run the batch. `progress` is called once per frame (rendered, skipped or failed).
+pub fn run_batch(
+    device: impl ToDevice,
+    frames: &[BatchFrame],
+    out_dir: &Path,
+    opts: &BatchOptions,
+    progress: impl Fn(),
+) -> Result<BatchSummary> {
+    if opts.scales.is_empty() {
+        return Err(Error::param("scales", "no focal scale given"));
+    }
+    if let Some(m) = opts.depth_trunc {
+        io::check_depth_trunc(m)?;
+    }
+    if opts.jobs > MAX_JOBS {
+        return Err(Error::param(
+            "jobs",
+            format!("{} exceeds the limit of {MAX_JOBS}", opts.jobs),
+        ));
+    }
+    opts.rule.validate()?;
+    // Creates and checks --out-dir and clears temporaries that killed runs left in it.
+    let root = io::OutDir::prepare(out_dir)?;
+    let t_start = Instant::now();
+    let mut summary = BatchSummary::default();
+    // The frames this run renders: its shard, less those finished with the same settings. Only
+    // the frame is kept (a reference); its name and settings are made again when it is rendered,
+    // so a long manifest costs nothing more per row here.
+    let mut todo: Vec<&BatchFrame> = Vec::new();
+    for (i, frame) in frames.iter().enumerate() {
+        if opts.shard.is_some_and(|s| i % s.count != s.index) {
+            summary.other_shards += 1;
+            continue;
+        }
+        let name = frame.name.as_deref().unwrap_or_default();
+        if opts.resume && frame_finished(&out_dir.join(name), &frame_settings(frame, opts)) {
+            summary.skipped += 1;
+            progress();
+            continue;
+        }
+        todo.push(frame);
+    }
+    let mut refocuser = Refocuser::with_settings(device, &opts.rule, opts.method, opts.files.outputs, opts.conv)?;
+    let files = opts.files;
+    let mut stages = StageTimes::default();
+
+    if opts.jobs == 0 {
+        // The synchronous baseline: each stage in turn on this thread.
+        for frame in todo {
+            let (name, settings) = (frame.name.clone().unwrap_or_default(), frame_settings(frame, opts));
+            let t0 = Instant::now();
+            let result = decode_frame(frame, opts.depth_trunc).and_then(|src| {
+                stages.decode.push(ms_since(t0));
+                submit_frame(
+                    &mut refocuser,
+                    name.clone(),
+                    root.clone(),
+                    &src,
+                    settings,
+                    opts,
+                    &mut stages,
+                )
+            });
+            let result = result
+                .map_err(|e| (name.clone(), e))
+                .and_then(|f| collect_frame(f, &mut stages));
+            match result.and_then(|job| {
+                let t0 = Instant::now();
+                let r = write_frame(job, &files).map_err(|e| (name.clone(), e));
+                stages.encode.push(ms_since(t0));
+                r
+            }) {
+                Ok(()) => summary.rendered += 1,
+                Err((n, e)) => summary.failed.push((n, e.to_string())),
+            }
+            progress();
+        }
+        summary.frames_in_flight = 1;
+        summary.stages = stages;
+        summary.wall_s = t_start.elapsed().as_secs_f64();
+        return Ok(summary);
+    }
+
+    let jobs = opts.jobs;
+    // Decoded frames waiting for the GL thread, and frames waiting for an encoder: `jobs` each.
+    summary.frames_in_flight = jobs + 2 + 2 * jobs;
+    let next = AtomicUsize::new(0);
+    let depth_trunc = opts.depth_trunc;
+    let (result_tx, result_rx) = mpsc::channel::<(String, Result<()>, f64)>();
+    std::thread::scope(|scope| {
+        let (decoded_tx, decoded_rx) = mpsc::sync_channel::<(usize, Result<RefocusSource>, f64)>(jobs);
+        for _ in 0..jobs {
+            let (tx, next, todo) = (decoded_tx.clone(), &next, &todo);
+            scope.spawn(move || loop {
+                let i = next.fetch_add(1, Ordering::Relaxed);
+                let Some(frame) = todo.get(i) else { break };
+                let t0 = Instant::now();
+                let src = decode_frame(frame, depth_trunc);
+                if tx.send((i, src, ms_since(t0))).is_err() {
+                    break;
+                }
+            });
+        }
+        drop(decoded_tx);
+        let (job_tx, job_rx) = mpsc::sync_channel::<WriteJob>(jobs);
+        let job_rx = Arc::new(Mutex::new(job_rx));
+        for _ in 0..jobs {
+            let (rx, tx) = (job_rx.clone(), result_tx.clone());
+            scope.spawn(move || loop {
+                let next = rx.lock().map(|r| r.recv());
+                let Ok(Ok(job)) = next else { break };
+                let name = job.name.clone();
+                let t0 = Instant::now();
+                let r = write_frame(job, &files);
+                let _ = tx.send((name, r, ms_since(t0)));
+            });
+        }
+        let mut in_flight: Option<InFlight> = None;
+        let send = |job: std::result::Result<WriteJob, (String, Error)>, stages: &mut StageTimes| match job {
+            Ok(job) => {
+                let t0 = Instant::now();
+                if let Err(mpsc::SendError(job)) = job_tx.send(job) {
+                    let _ = result_tx.send((job.name, Err(Error::param("batch", "encode threads stopped")), 0.0));
+                }
+                stages.wait.push(ms_since(t0));
+            }
+            Err((name, e)) => {
+                let _ = result_tx.send((name, Err(e), 0.0));
+            }
+        };
+        let mut handle = |(name, r, encode_ms): (String, Result<()>, f64), stages: &mut StageTimes| {
+            match r {
+                Ok(()) => {
+                    summary.rendered += 1;
+                    stages.encode.push(encode_ms);
+                }
+                Err(e) => summary.failed.push((name, e.to_string())),
+            }
+            progress();
+        };
+        loop {
+            while let Ok(done) = result_rx.try_recv() {
+                handle(done, &mut stages);
+            }
+            let t0 = Instant::now();
+            let Ok((i, src, decode_ms)) = decoded_rx.recv() else {
+                break;
+            };
+            stages.wait.push(ms_since(t0));
+            let (name, settings) = (todo[i].name.clone().unwrap_or_default(), frame_settings(todo[i], opts));
+            let submitted = src.and_then(|src| {
+                stages.decode.push(decode_ms);
+                submit_frame(
+                    &mut refocuser,
+                    name.clone(),
+                    root.clone(),
+                    &src,
+                    settings,
+                    opts,
+                    &mut stages,
+                )
+            });
+            // The GPU now works on this frame while the previous one is mapped and handed on.
+            if let Some(prev) = in_flight.take() {
+                let job = collect_frame(prev, &mut stages);
+                send(job, &mut stages);
+            }
+            match submitted {
+                Ok(f) => in_flight = Some(f),
+                Err(e) => {
+                    let _ = result_tx.send((name.clone(), Err(e), 0.0));
+                }
+            }
+        }
+        if let Some(prev) = in_flight.take() {
+            let job = collect_frame(prev, &mut stages);
+            send(job, &mut stages);
+        }
+        drop(job_tx);
+        drop(result_tx);
+        // The last results arrive while the encoders finish; progress counts each frame once.
+        for done in result_rx.iter() {
+            handle(done, &mut stages);
+        }
+    });
+    summary.stages = stages;
+    summary.wall_s = t_start.elapsed().as_secs_f64();
+    Ok(summary)
+}
