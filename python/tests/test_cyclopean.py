@@ -131,9 +131,14 @@ def test_outputs_subset_and_positions(renderer, pair):
     middle = renderer.cyclopean(*pair)
     left = renderer.cyclopean(*pair, position=0.0)
     assert not np.array_equal(middle["rgb"], left["rgb"])
-    # The outputs are new arrays owned by the caller.
-    assert middle["rgb"].flags.owndata or middle["rgb"].base is not None
+    # The outputs are new arrays owned by the caller: writable, and sharing no memory with
+    # another call's (writing one changes nothing the renderer or a later call returns).
+    assert middle["rgb"].flags.writeable
+    again = renderer.cyclopean(*pair)
+    assert np.array_equal(again["rgb"], middle["rgb"])
+    assert not np.shares_memory(again["rgb"], middle["rgb"])
     middle["rgb"][:] = 0
+    assert again["rgb"].any()
     assert renderer.cyclopean(*pair)["rgb"].any()
 
 

@@ -92,13 +92,24 @@ fn refocus_writes_requested_files_and_a_manifest() {
     assert_eq!(files_in(&only_depth), ["manifest.json", "s1_depth.exr"]);
 }
 
-pub(crate) fn assert_clean_failure(o: &Output, needle: &str, out: &Path) {
+/// Exit status of a command-line problem (clap's refusals and the job's option checks); its
+/// message ends "try '--help'".
+pub(crate) const USAGE: i32 = 2;
+/// Exit status of an error found while running (inputs, files, GPU).
+pub(crate) const RUN_ERROR: i32 = 1;
+
+/// A refusal with exit status `code` (pinned by the caller: [`USAGE`] or [`RUN_ERROR`]),
+/// an error message containing `needle`, no panic and nothing left in `out`.
+#[track_caller]
+pub(crate) fn assert_clean_failure(code: i32, o: &Output, needle: &str, out: &Path) {
     let err = String::from_utf8_lossy(&o.stderr);
-    // Anything wrong with the command line (clap's refusals and the job's option checks) is a
-    // usage error (exit 2, ending "try '--help'"); everything found while running is a run
-    // error (exit 1).
-    let usage = err.contains("try '--help'");
-    assert_eq!(o.status.code(), Some(if usage { 2 } else { 1 }), "stderr: {err}");
+    assert_eq!(o.status.code(), Some(code), "stderr: {err}");
+    // The usage hint goes with exit 2 and only with it.
+    assert_eq!(
+        err.contains("try '--help'"),
+        code == USAGE,
+        "usage hint vs exit {code}: {err}"
+    );
     assert!(
         err.contains("error:") && err.contains(needle),
         "expected '{needle}' in: {err}"
@@ -118,32 +129,40 @@ fn bad_input_fails_cleanly() {
     let out = d.join("out");
 
     let missing = d.join("nope.png");
-    assert_clean_failure(&refocus(&missing, &depth, &out, &[]), "nope.png", &out);
+    assert_clean_failure(RUN_ERROR, &refocus(&missing, &depth, &out, &[]), "nope.png", &out);
 
     let small = scratch("bad-small");
     let (_, depth_small) = inputs(&small, 16, 12);
-    assert_clean_failure(&refocus(&rgb, &depth_small, &out, &[]), "size mismatch", &out);
+    assert_clean_failure(
+        RUN_ERROR,
+        &refocus(&rgb, &depth_small, &out, &[]),
+        "size mismatch",
+        &out,
+    );
 
     let empty = d.join("empty.npy");
     std::fs::write(&empty, b"").unwrap();
-    assert_clean_failure(&refocus(&rgb, &empty, &out, &[]), "empty.npy", &out);
+    assert_clean_failure(RUN_ERROR, &refocus(&rgb, &empty, &out, &[]), "empty.npy", &out);
 
     let corrupt = d.join("corrupt.png");
     std::fs::write(&corrupt, b"\x89PNG\r\n\x1a\nthis is not a png").unwrap();
-    assert_clean_failure(&refocus(&corrupt, &depth, &out, &[]), "corrupt.png", &out);
+    assert_clean_failure(RUN_ERROR, &refocus(&corrupt, &depth, &out, &[]), "corrupt.png", &out);
 
     assert_clean_failure(
+        USAGE,
         &refocus(&rgb, &depth, &out, &["--width-out", "16385", "--height-out", "10"]),
         "width",
         &out,
     );
     assert_clean_failure(
+        USAGE,
         &refocus(&rgb, &depth, &out, &["--zoom-range", "0"]),
         "--zoom-range 0",
         &out,
     );
-    assert_clean_failure(&refocus(&rgb, &depth, &out, &["--tau-rel=-1"]), "tau-rel", &out);
+    assert_clean_failure(USAGE, &refocus(&rgb, &depth, &out, &["--tau-rel=-1"]), "tau-rel", &out);
     assert_clean_failure(
+        USAGE,
         &refocus(&rgb, &depth, &out, &["--outputs", "rgb,normals"]),
         "outputs",
         &out,
@@ -170,14 +189,14 @@ fn bad_input_fails_cleanly() {
             .arg(&out)
             .output()
             .unwrap();
-        assert_clean_failure(&o, needle, &out);
+        assert_clean_failure(USAGE, &o, needle, &out);
     }
 
     // Unwritable output directory: a path below a regular file (fails for root too).
     let blocker = d.join("blocker");
     std::fs::write(&blocker, b"x").unwrap();
     let o = refocus(&rgb, &depth, &blocker.join("out"), &[]);
-    assert_clean_failure(&o, "blocker", &blocker.join("out"));
+    assert_clean_failure(RUN_ERROR, &o, "blocker", &blocker.join("out"));
 }
 
 #[test]
@@ -302,10 +321,49 @@ fn bench_batch_prints_throughput_and_stage_medians_as_json() {
     let v: serde_json::Value = serde_json::from_slice(&o.stdout).expect("one JSON object on stdout");
     assert_eq!(v["frames"], 2);
     assert!(v["frames_per_s"].as_f64().unwrap() > 0.0);
-    for stage in ["decode", "upload", "render", "readback", "encode", "wait"] {
-        assert!(v["stages_ms"][stage].as_f64().unwrap() >= 0.0, "stage {stage}: {v}");
+    // Stage medians (ms per frame). Every working stage did work on every frame, so each is
+    // above zero (Instant has ns resolution; a stage never timed reads 0). The synchronous run
+    // does all stages in turn on one thread and never waits: wait is 0 and, over its 2 frames
+    // (median of 2 = mean), the stages add up to at most its wall time. A stage timed in the
+    // wrong unit, twice, or not at all fails one of these.
+    let work = ["decode", "upload", "render", "readback", "encode"];
+    for run in ["pipelined", "synchronous"] {
+        let r = &v[run];
+        let ms = |stage: &str| {
+            r["stages_ms"][stage]
+                .as_f64()
+                .unwrap_or_else(|| panic!("{run} {stage}: {v}"))
+        };
+        for stage in work {
+            assert!(ms(stage) > 0.0 && ms(stage).is_finite(), "{run} {stage}: {v}");
+        }
+        let wall_ms = r["wall_s"].as_f64().unwrap() * 1000.0;
+        let fps = r["frames"].as_f64().unwrap() / r["wall_s"].as_f64().unwrap();
+        assert!(
+            (r["frames_per_s"].as_f64().unwrap() - fps).abs() <= 1e-9 * fps,
+            "{run}: {v}"
+        );
+        if run == "synchronous" {
+            assert_eq!(ms("wait"), 0.0, "{v}");
+            let sum: f64 = work.iter().map(|s| ms(s)).sum();
+            assert!(
+                2.0 * sum <= wall_ms,
+                "{run}: stages {sum} ms x 2 frames > wall {wall_ms} ms: {v}"
+            );
+        } else {
+            assert!(ms("wait") >= 0.0 && ms("wait") < wall_ms, "{v}");
+        }
     }
-    assert!(v["renderer"].as_str().unwrap().contains("llvmpipe") || !v["renderer"].as_str().unwrap().is_empty());
+    assert_eq!(
+        v["stages_ms"], v["pipelined"]["stages_ms"],
+        "the flat fields are the pipelined run's"
+    );
+    // The renderer measured is the one `info` names (GL_RENDERER of the same device choice).
+    let info = bin().args(["info", "--json"]).output().unwrap();
+    assert!(info.status.success(), "{}", String::from_utf8_lossy(&info.stderr));
+    let info: serde_json::Value = serde_json::from_slice(&info.stdout).unwrap();
+    assert_eq!(v["renderer"], info["renderer"], "{v}");
+    assert!(!v["renderer"].as_str().unwrap().is_empty(), "{v}");
     assert_eq!(v["synchronous"]["frames"], 2);
     assert!(!v["bound_by"].as_str().unwrap().is_empty());
     // Bad values are usage errors that name the option, never a panic.

@@ -2,7 +2,7 @@
 //! frame as `viewsynth scene` writes it in GL matrices must give byte-identical outputs through
 //! `reproject --cameras` and `cyclopean --cameras`, and malformed matrices fail cleanly.
 
-use crate::cli::{assert_clean_failure, bin, files_in, scratch};
+use crate::cli::{assert_clean_failure, bin, files_in, scratch, RUN_ERROR};
 use serde_json::{json, Value};
 use std::path::Path;
 use std::process::Output;
@@ -131,7 +131,7 @@ fn cameras_in_k_r_t_form_give_the_outputs_of_the_gl_matrices() {
         .args(["--cameras", s(&bad_path), "--out-dir", s(&out)])
         .output()
         .unwrap();
-    assert_clean_failure(&o, "mirrored.json: invalid left.R: determinant", &out);
+    assert_clean_failure(RUN_ERROR, &o, "mirrored.json: invalid left.R: determinant", &out);
     let wrong_size = cv_form(&gl, 128, 96);
     let size_path = dir.join("other_size.json");
     std::fs::write(&size_path, wrong_size.to_string()).unwrap();
@@ -140,5 +140,5 @@ fn cameras_in_k_r_t_form_give_the_outputs_of_the_gl_matrices() {
         .args(["--cameras", s(&size_path), "--out-dir", s(&out)])
         .output()
         .unwrap();
-    assert_clean_failure(&o, "is 96x72, its camera in the camera file 128x96", &out);
+    assert_clean_failure(RUN_ERROR, &o, "is 96x72, its camera in the camera file 128x96", &out);
 }

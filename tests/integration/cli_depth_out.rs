@@ -78,7 +78,7 @@ fn png16_depth_matches_the_exr_to_half_a_millimetre() {
         .any(|f| f["name"] == "s1_depth.png"));
 
     let o = refocus(&rgb, &depth, &d.join("bad"), &["--depth-format", "exr,png8"]);
-    super::cli::assert_clean_failure(&o, "png16", &d.join("bad"));
+    super::cli::assert_clean_failure(super::cli::USAGE, &o, "png16", &d.join("bad"));
 }
 
 #[test]
@@ -125,7 +125,7 @@ fn depth_preview_is_written_with_its_range() {
 
     let bad = d.join("bad");
     let o = refocus(&rgb, &depth, &bad, &["--depth-preview", "--outputs", "rgb"]);
-    super::cli::assert_clean_failure(&o, "--depth-preview", &bad);
+    super::cli::assert_clean_failure(super::cli::USAGE, &o, "--depth-preview", &bad);
 }
 
 /// Columns of the 32x24 ramp whose depth 1 + 0.1 x lies beyond 2.5 m start at x = 16.
@@ -200,7 +200,7 @@ fn depth_trunc_makes_far_input_holes_single_frame_and_batch() {
 
     for bad in ["0", "-1", "inf"] {
         let o = refocus(&rgb, &depth, &d.join("bad"), &["--depth-trunc", bad]);
-        super::cli::assert_clean_failure(&o, "depth-trunc", &d.join("bad"));
+        super::cli::assert_clean_failure(super::cli::USAGE, &o, "depth-trunc", &d.join("bad"));
     }
 }
 
@@ -232,5 +232,5 @@ fn focal_list_names_files_by_the_focal_given() {
 
     let bad = d.join("bad");
     let o = refocus(&rgb, &depth, &bad, &["--focal-list", "30,57.5,57.50000001"]);
-    super::cli::assert_clean_failure(&o, "f57.5", &bad);
+    super::cli::assert_clean_failure(super::cli::USAGE, &o, "f57.5", &bad);
 }

@@ -1,7 +1,7 @@
 //! The input formats users already have, through the binary: `--intrinsics FILE` (each format,
 //! flags overriding), `.npz` depth (`--npz-key`), and the printed input summary.
 
-use crate::cli::{assert_clean_failure, bin, files_in, scratch};
+use crate::cli::{assert_clean_failure, bin, files_in, scratch, RUN_ERROR, USAGE};
 use std::path::{Path, PathBuf};
 use std::process::Output;
 use viewsynth::io::{self, DepthMap, RgbImage};
@@ -124,11 +124,11 @@ fn bad_intrinsics_files_fail_cleanly() {
         let path = d.join(name);
         std::fs::write(&path, text).unwrap();
         let o = refocus(&rgb, &depth, &out, &["--intrinsics", s(&path)]);
-        assert_clean_failure(&o, needle, &out);
-        assert_clean_failure(&o, name, &out);
+        assert_clean_failure(RUN_ERROR, &o, needle, &out);
+        assert_clean_failure(RUN_ERROR, &o, name, &out);
     }
     let o = refocus(&rgb, &depth, &out, &["--fx", "40", "--fy", "40", "--cx", "15.5"]);
-    assert_clean_failure(&o, "--cy is missing", &out);
+    assert_clean_failure(USAGE, &o, "--cy is missing", &out);
     assert!(files_in(&out).iter().all(|f| f.starts_with(".viewsynth-write-test")));
 }
 
@@ -170,7 +170,7 @@ fn reproject_takes_an_intrinsics_file() {
         );
     }
     let none = d.join("none");
-    assert_clean_failure(&run(&none, &[]), "--intrinsics FILE", &none);
+    assert_clean_failure(USAGE, &run(&none, &[]), "--intrinsics FILE", &none);
 }
 
 #[test]
@@ -240,11 +240,13 @@ fn reproject_motorcycle_from_npz_disparity_with_a_calib_txt() {
     }
     let bad = d.join("bad");
     assert_clean_failure(
+        RUN_ERROR,
         &run(&npz, &bad, &["--intrinsics", s(&calib), "--npz-key", "disp"]),
         "no array 'disp' (arrays: arr_0)",
         &bad,
     );
     assert_clean_failure(
+        USAGE,
         &run(&npy, &bad, &["--intrinsics", s(&calib), "--npz-key", "arr_0"]),
         "applies to .npz files only",
         &bad,

@@ -2,7 +2,7 @@
 //! and the pixels the library gives for the same inputs; bad input exits 1 naming the file or
 //! parameter, without a panic and without output files.
 
-use crate::cli::{assert_clean_failure, bin, files_in, scratch};
+use crate::cli::{assert_clean_failure, bin, files_in, scratch, RUN_ERROR, USAGE};
 use crate::common::gpu;
 use std::path::{Path, PathBuf};
 use std::process::Output;
@@ -295,18 +295,18 @@ fn reproject_bad_input_fails_cleanly() {
         rp(&c, &z, &a.iter().map(String::as_str).collect::<Vec<_>>())
     };
 
-    assert_clean_failure(&rp(&d.join("nope.png"), &z, &base), "nope.png", &out);
-    assert_clean_failure(&rp(&c, &d.join("nope.exr"), &base), "nope.exr", &out);
+    assert_clean_failure(RUN_ERROR, &rp(&d.join("nope.png"), &z, &base), "nope.png", &out);
+    assert_clean_failure(RUN_ERROR, &rp(&c, &d.join("nope.exr"), &base), "nope.exr", &out);
     let small = d.join("small.exr");
     io::save_depth_exr(
         &small,
         &DepthMap::new(W / 2, H / 2, vec![1.0; (W * H / 4) as usize]).unwrap(),
     )
     .unwrap();
-    assert_clean_failure(&rp(&c, &small, &base), "size mismatch", &out);
+    assert_clean_failure(RUN_ERROR, &rp(&c, &small, &base), "size mismatch", &out);
     let corrupt = d.join("corrupt.exr");
     std::fs::write(&corrupt, b"not an exr").unwrap();
-    assert_clean_failure(&rp(&c, &corrupt, &base), "corrupt.exr", &out);
+    assert_clean_failure(RUN_ERROR, &rp(&c, &corrupt, &base), "corrupt.exr", &out);
 
     // Bad intrinsics.
     for (flag, value) in [("--fx", "0"), ("--cy", "nan"), ("--fy", "-2"), ("--cx", "inf")] {
@@ -319,46 +319,51 @@ fn reproject_bad_input_fails_cleanly() {
             .args(base)
             .output()
             .unwrap();
-        assert_clean_failure(&o, &flag[2..], &out);
+        assert_clean_failure(USAGE, &o, &flag[2..], &out);
     }
 
     // Rig and depth kind.
-    assert_clean_failure(&rp(&c, &z, &[]), "--baseline", &out);
+    assert_clean_failure(USAGE, &rp(&c, &z, &[]), "--baseline", &out);
     assert_clean_failure(
+        USAGE,
         &rp(&c, &z, &["--depth-kind", "disparity", "--baseline", "0"]),
         "baseline",
         &out,
     );
     assert_clean_failure(
+        USAGE,
         &rp(&c, &z, &["--depth-kind", "disparity"]),
         "--depth-kind disparity needs --baseline",
         &out,
     );
-    assert_clean_failure(&rpx(&["--depth-kind", "device"]), "--near and --far", &out);
+    assert_clean_failure(USAGE, &rpx(&["--depth-kind", "device"]), "--near and --far", &out);
     assert_clean_failure(
+        USAGE,
         &rpx(&["--depth-kind", "device", "--near", "1", "--far", "0.5"]),
         "--near/--far",
         &out,
     );
     // View Z stored as if it were device depth: all "background".
     assert_clean_failure(
+        RUN_ERROR,
         &rpx(&["--depth-kind", "device", "--near", "0.05", "--far", "100"]),
         "no pixel holds valid depth",
         &out,
     );
     assert_clean_failure(
+        USAGE,
         &rp(&c, &z, &["--separation=-0.1", "--convergence", "3"]),
         "separation",
         &out,
     );
-    assert_clean_failure(&rpx(&["--to", "both"]), "--to both needs --from centre", &out);
-    assert_clean_failure(&rpx(&["--to", "left"]), "source view itself", &out);
+    assert_clean_failure(USAGE, &rpx(&["--to", "both"]), "--to both needs --from centre", &out);
+    assert_clean_failure(USAGE, &rpx(&["--to", "left"]), "source view itself", &out);
 
     // Method parameters and outputs.
-    assert_clean_failure(&rpx(&["--method", "shift", "--steps", "0"]), "steps", &out);
-    assert_clean_failure(&rpx(&["--tau-rel=-1"]), "tau_rel", &out);
-    assert_clean_failure(&rpx(&["--outputs", "rgb,normals"]), "outputs", &out);
-    assert_clean_failure(&rpx(&["--depth-format", "tiff"]), "depth-format", &out);
+    assert_clean_failure(USAGE, &rpx(&["--method", "shift", "--steps", "0"]), "steps", &out);
+    assert_clean_failure(USAGE, &rpx(&["--tau-rel=-1"]), "tau_rel", &out);
+    assert_clean_failure(USAGE, &rpx(&["--outputs", "rgb,normals"]), "outputs", &out);
+    assert_clean_failure(USAGE, &rpx(&["--depth-format", "tiff"]), "depth-format", &out);
 
     // The last file cannot be written (a directory holds its name): the files written before
     // it are removed again.
@@ -538,12 +543,12 @@ fn stitch_faces_with_device_depth_under_vulkan_reversed_z() {
         ])
         .output()
         .unwrap();
-    assert_clean_failure(&o, "--near and --far", &bad);
+    assert_clean_failure(USAGE, &o, "--near and --far", &bad);
     let o = bin()
         .args(["stitch", "--faces", s(&zf), "--near", "0.1", "--out-dir", s(&bad)])
         .output()
         .unwrap();
-    assert_clean_failure(&o, "--depth-kind device only", &bad);
+    assert_clean_failure(USAGE, &o, "--depth-kind device only", &bad);
 }
 
 #[test]
@@ -664,26 +669,39 @@ fn stitch_bad_input_fails_cleanly() {
     let demo = ["--scene", "demo", "--face-size", "16"];
     let demo_with = |extra: &[&str]| st(&demo.iter().chain(extra).copied().collect::<Vec<_>>());
 
-    assert_clean_failure(&demo_with(&["--overlap", "0"]), "overlap", &out);
-    assert_clean_failure(&demo_with(&["--fov", "110", "--overlap", "30"]), "overlap", &out);
-    assert_clean_failure(&demo_with(&["--fov", "80"]), "--fov", &out);
-    assert_clean_failure(&demo_with(&["--ipd=-1"]), "ipd", &out);
-    assert_clean_failure(&st(&["--scene", "demo", "--face-size", "1"]), "face size", &out);
-    assert_clean_failure(&st(&["--scene", "boxes"]), "--scene 'boxes'", &out);
+    assert_clean_failure(USAGE, &demo_with(&["--overlap", "0"]), "overlap", &out);
+    assert_clean_failure(USAGE, &demo_with(&["--fov", "110", "--overlap", "30"]), "overlap", &out);
+    assert_clean_failure(USAGE, &demo_with(&["--fov", "80"]), "--fov", &out);
+    assert_clean_failure(USAGE, &demo_with(&["--ipd=-1"]), "ipd", &out);
     assert_clean_failure(
+        RUN_ERROR,
+        &st(&["--scene", "demo", "--face-size", "1"]),
+        "face size",
+        &out,
+    );
+    assert_clean_failure(USAGE, &st(&["--scene", "boxes"]), "--scene 'boxes'", &out);
+    assert_clean_failure(
+        USAGE,
         &st(&["--faces", f, "--fov", "110", "--truth"]),
         "--truth needs --scene",
         &out,
     );
     assert_clean_failure(
+        RUN_ERROR,
         &st(&["--faces", s(&d.join("none")), "--fov", "110"]),
         "not a directory",
         &out,
     );
     // The overlap must fit the declared face FOV.
-    assert_clean_failure(&st(&["--faces", f, "--fov", "100", "--overlap", "10"]), "overlap", &out);
+    assert_clean_failure(
+        USAGE,
+        &st(&["--faces", f, "--fov", "100", "--overlap", "10"]),
+        "overlap",
+        &out,
+    );
     // --npz-key reaches the face loader: it names an array of .npz files, refused for EXR faces.
     assert_clean_failure(
+        RUN_ERROR,
         &st(&["--faces", f, "--fov", "110", "--npz-key", "z"]),
         "applies to .npz files only",
         &out,
@@ -691,18 +709,18 @@ fn stitch_bad_input_fails_cleanly() {
 
     // A face file missing: the error names the path expected.
     std::fs::remove_file(faces.join("right_px_depth.exr")).unwrap();
-    assert_clean_failure(&st(&["--faces", f]), "right_px_depth.exr", &out);
+    assert_clean_failure(RUN_ERROR, &st(&["--faces", f]), "right_px_depth.exr", &out);
     // A face of another size.
     io::save_depth_exr(
         &faces.join("right_px_depth.exr"),
         &DepthMap::new(N / 2, N / 2, vec![1.0; (N * N / 4) as usize]).unwrap(),
     )
     .unwrap();
-    assert_clean_failure(&st(&["--faces", f]), "size mismatch", &out);
+    assert_clean_failure(RUN_ERROR, &st(&["--faces", f]), "size mismatch", &out);
     // A corrupt colour face.
     write_faces(&faces, 110.0);
     std::fs::write(faces.join("left_up.png"), b"\x89PNG\r\n\x1a\nbroken").unwrap();
-    assert_clean_failure(&st(&["--faces", f]), "left_up.png", &out);
+    assert_clean_failure(RUN_ERROR, &st(&["--faces", f]), "left_up.png", &out);
 }
 
 #[test]
@@ -816,19 +834,19 @@ fn reproject_with_full_eye_matrices_from_a_cameras_file() {
     // The shift methods need a rig; the centre is not in the file.
     let bad = dir.join("bad");
     let o = run(&[&common[..], &["--method", "shift-scan", "--out-dir", s(&bad)]].concat());
-    assert_clean_failure(&o, "--method gather3d", &bad);
+    assert_clean_failure(USAGE, &o, "--method gather3d", &bad);
     let o = run(&[
         &common[..],
         &["--method", "gather3d", "--from", "centre", "--out-dir", s(&bad)],
     ]
     .concat());
-    assert_clean_failure(&o, "--from left or right", &bad);
+    assert_clean_failure(USAGE, &o, "--from left or right", &bad);
     let o = run(&[
         &common[..],
         &["--method", "gather3d", "--reversed-z", "--out-dir", s(&bad)],
     ]
     .concat());
-    assert_clean_failure(&o, "come from the file", &bad);
+    assert_clean_failure(USAGE, &o, "come from the file", &bad);
 }
 
 /// `scene --cube-faces` writes a face folder `stitch --faces` reads as is: stitched, it gives
@@ -897,5 +915,5 @@ fn scene_cube_faces_feed_stitch_faces() {
         "--out-dir",
         &bad.display().to_string(),
     ]);
-    assert_clean_failure(&o, "--face-fov 90", &bad);
+    assert_clean_failure(USAGE, &o, "--face-fov 90", &bad);
 }

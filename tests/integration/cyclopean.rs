@@ -392,7 +392,11 @@ fn temporal_accumulation_fills_disocclusions_from_the_previous_frame() {
         }
     }
     let psnr = metrics::psnr_from_mse(sq / (3 * n.max(1)) as f64);
-    assert!(n > 50 && psnr > 20.0, "{n} filled pixels at {psnr:.1} dB");
+    eprintln!("temporal fill: {n} pixels from history at {psnr:.2} dB");
+    // Measured 44.8 dB over ~2800 filled pixels (llvmpipe). 41 dB lets the squared error grow
+    // 2.4x (edge pixels rasterised differently elsewhere), while a fill from the wrong surface
+    // fails: 1 % of the filled pixels 40 levels off alone is MSE 16, 36.1 dB.
+    assert!(n > 50 && psnr > 41.0, "{n} filled pixels at {psnr:.1} dB");
     assert!(filled.depth().unwrap().data.iter().all(|z| z.is_finite()));
 
     let mut still = TemporalAccumulator::new(0.5, 0.02, conv).unwrap();
@@ -461,4 +465,27 @@ fn unrequested_colour_and_depth_get_no_attachment_and_no_readback() {
     let mut taa = viewsynth::cyclopean::temporal::TemporalAccumulator::new(0.2, 0.05, Conventions::all()[7]).unwrap();
     let err = taa.push(&partial, &mid).unwrap_err();
     assert!(err.to_string().contains("colour and depth"), "{err}");
+    // Last (each new context becomes current on this thread, so `g` is not used after):
+    // counted on a fresh context per choice, renderer alive after one render: left out, an
+    // output costs exactly one render-target texture and one readback (pixel-pack buffer) less
+    // than the full render. An attachment or a read made and thrown away shows here.
+    let census = |color: bool, depth: bool| {
+        let g = gpu();
+        let mut r = CyclopeanRenderer::with_outputs(&g, &frame, params, CyclopeanOutputs { color, depth }).unwrap();
+        r.render(&mid).unwrap();
+        (g.live_objects(), g.readback_buffers_created())
+    };
+    let (full, full_reads) = census(true, true);
+    for (color, depth) in [(false, false), (true, false), (false, true)] {
+        let (live, reads) = census(color, depth);
+        let left_out = usize::from(!color) + usize::from(!depth);
+        let tag = format!("color={color} depth={depth}: {live:?}, {reads} readbacks; full {full:?}, {full_reads}");
+        assert_eq!(live.textures + left_out, full.textures, "{tag}");
+        assert_eq!(reads + left_out, full_reads, "{tag}");
+        assert_eq!(
+            (live.framebuffers, live.programs, live.vertex_arrays),
+            (full.framebuffers, full.programs, full.vertex_arrays),
+            "{tag}"
+        );
+    }
 }

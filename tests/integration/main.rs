@@ -24,6 +24,7 @@ mod readback;
 mod refocus_accuracy;
 mod refocus_conventions;
 mod refocus_edge_cases;
+mod refocus_oracle;
 mod reproject;
 mod scene;
 mod shader_library;

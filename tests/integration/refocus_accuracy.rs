@@ -3,11 +3,15 @@
 //! Tolerances, from the numerics:
 //! - depth: both GPU paths evaluate 1/Z interpolation (full-screen) or perspective-correct
 //!   interpolation (mesh) in f32: a few ulps relative (~3e-7), i.e. ~3e-6 m at 10 m < 1e-5 m.
-//! - colour: bilinear weights in f32 against f64; 8-bit outputs differ by at most one level
-//!   where the exact value sits within ~1e-4 of a rounding boundary: rare, so PSNR >= 60 dB.
+//! - colour: bilinear weights in f32 against f64 (relative error ~1e-7 on values <= 255, i.e.
+//!   < 1e-4 level); [`viewsynth::metrics::quantization_error`] already forgives either neighbour
+//!   of a rounding tie, so every pixel must be within 1 level of the reference
+//!   (`max_color_diff <= 1`): one pixel 2 levels off fails, at any scale and output size. The
+//!   PSNR floor (60 dB) is kept beside it: it bounds how many pixels may sit 1 level off.
 //! - mask: the GPU coverage test is closed with a tolerance of 1e-5 cell (CELL_EPS), the
 //!   reference is exactly closed, so they differ only where a pixel centre falls within 1e-5
-//!   of a kept edge from outside: IoU >= 0.999 (in practice 1.0 on these frames).
+//!   of a kept edge from outside: IoU >= 0.999 (lowest measured on llvmpipe over 7 scales x 3
+//!   sizes: SUN 0.999425, TUM 0.999648, synthetic 0.999852, NYU 1.0).
 
 use crate::common::*;
 use viewsynth::camera::PinholeCamera;
@@ -28,7 +32,7 @@ fn check_source(name: &str, src: &RefocusSource) {
         Some((cam.width + 160, cam.height + 120)),
     ];
     for method in [Method::Fullscreen, Method::Mesh] {
-        let (mut worst_depth, mut worst_psnr, mut worst_iou) = (0f64, f64::INFINITY, 1f64);
+        let (mut worst_depth, mut worst_psnr, mut worst_iou, mut worst_level) = (0f64, f64::INFINITY, 1f64, 0u8);
         for size in sizes {
             let targets = TargetSpec {
                 scales: SCALES.to_vec(),
@@ -50,11 +54,12 @@ fn check_source(name: &str, src: &RefocusSource) {
                 let reference = pass::reference(&input).expect("reference");
                 let a = compare_views(&out, &reference);
                 let tag = format!("{name}_{method:?}_{}x{}_s{s}", target.width, target.height);
-                let ok = a.max_abs_depth <= 1e-5 && a.psnr_db >= 60.0 && a.mask_iou >= 0.999;
+                let ok = a.max_abs_depth <= 1e-5 && a.psnr_db >= 60.0 && a.max_color_diff <= 1 && a.mask_iou >= 0.999;
                 image_check::ensure_views(ok, &format!("refocus {tag}"), &out, &reference, format!("{tag}: {a:?}"));
                 worst_depth = worst_depth.max(a.max_abs_depth);
                 worst_psnr = worst_psnr.min(a.psnr_db);
                 worst_iou = worst_iou.min(a.mask_iou);
+                worst_level = worst_level.max(a.max_color_diff);
                 let covered = reference.valid().unwrap().iter().filter(|m| **m).count();
                 assert!(a.common > 0 || covered == 0, "{tag}: nothing in common");
                 assert!(
@@ -64,7 +69,7 @@ fn check_source(name: &str, src: &RefocusSource) {
             }
         }
         // Shown with --nocapture: the worst case over 7 scales x 3 output sizes.
-        eprintln!("{name} {method:?}: max depth error {worst_depth:.2e} m, min PSNR {worst_psnr:.1} dB, min IoU {worst_iou:.6}");
+        eprintln!("{name} {method:?}: max depth error {worst_depth:.2e} m, min PSNR {worst_psnr:.1} dB, min IoU {worst_iou:.6}, max colour diff {worst_level} level(s)");
     }
 }
 

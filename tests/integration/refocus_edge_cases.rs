@@ -89,7 +89,11 @@ fn nan_inf_negative_and_zero_depth_are_holes_and_never_reach_the_output() {
         assert!(z.iter().all(|v| v.is_finite() && *v >= 0.0), "{tag}");
         let reference = reference(&src, t);
         let a = compare(out, &reference);
-        assert!(a.mask_iou >= 0.999 && a.max_abs_depth <= 1e-5, "{tag}: {a:?}");
+        // Colour within 1 level of the reference on every common pixel (refocus_accuracy.rs).
+        assert!(
+            a.mask_iou >= 0.999 && a.max_abs_depth <= 1e-5 && a.max_color_diff <= 1,
+            "{tag}: {a:?}"
+        );
         assert!(reference.mask.iter().any(|m| !m), "{tag}: holes stay holes");
     });
 }
@@ -112,7 +116,10 @@ fn depth_from_millimetres_to_a_hundred_kilometres_in_one_frame() {
         let reference = reference(&src, t);
         let a = compare(out, &reference);
         // Relative: metres-level absolute error at 100 km is f32's 1e-7 relative.
-        assert!(a.max_rel_depth <= 1e-6 && a.mask_iou >= 0.999, "{tag}: {a:?}");
+        assert!(
+            a.max_rel_depth <= 1e-6 && a.mask_iou >= 0.999 && a.max_color_diff <= 1,
+            "{tag}: {a:?}"
+        );
         assert!(out.depth.as_ref().unwrap().data.iter().all(|z| z.is_finite()), "{tag}");
     });
 }
@@ -123,7 +130,8 @@ fn extreme_focal_scales_match_the_reference() {
     each_method(&src, &[0.05, 0.1, 10.0, 20.0], |tag, out, t| {
         let a = compare(out, &reference(&src, t));
         assert!(
-            a.max_abs_depth <= 1e-5 && a.mask_iou >= 0.999 && a.psnr_db >= 60.0,
+            // Colour within 1 level everywhere (refocus_accuracy.rs), not only on average.
+            a.max_abs_depth <= 1e-5 && a.mask_iou >= 0.999 && a.psnr_db >= 60.0 && a.max_color_diff <= 1,
             "{tag}: {a:?}"
         );
     });

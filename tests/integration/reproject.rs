@@ -488,8 +488,22 @@ fn report_rows_cover_every_method_case_and_dataset() {
             r.coverage.unwrap_or(f64::NAN) * 100.0,
             r.wall_ms
         );
-        assert!(r.psnr_db.is_some_and(|p| p.is_finite() && p > 20.0), "{r:?}");
-        assert!(r.coverage.is_some_and(|c| c > 0.7 && c <= 1.0), "{r:?}");
+        // Floors: each group's lowest measured value (llvmpipe) less 2 dB (1.6x the squared
+        // error) and less 2 points of coverage. Measured minima: built-in scene 38.05 dB (3-D
+        // gather, ipd 200 mm) and 90.6 %; Motorcycle 26.69 dB and 79.0 %; Teddy 29.39 dB and
+        // 86.6 %. The scene is rendered from exact depth; the real pairs from measured
+        // disparity against a real photo (lighting and sensor differences bound them lower).
+        let (min_db, min_cover) = if r.scene.starts_with("builtin:") {
+            (36.0, 0.886)
+        } else if r.scene.contains("Motorcycle") {
+            (24.5, 0.77)
+        } else if r.scene.contains("Teddy") {
+            (27.3, 0.846)
+        } else {
+            panic!("a row of an unknown dataset: {r:?}")
+        };
+        assert!(r.psnr_db.is_some_and(|p| p.is_finite() && p > min_db), "{r:?}");
+        assert!(r.coverage.is_some_and(|c| c > min_cover && c <= 1.0), "{r:?}");
     }
     assert!(notes.len() > 1);
 }
@@ -607,6 +621,41 @@ fn unrequested_colour_and_depth_get_no_attachment_and_no_readback() {
             if let Some(d) = &out.depth {
                 assert_eq!(d.data, all.depth.as_ref().unwrap().data, "{tag}");
             }
+        }
+    }
+    for full in methods() {
+        // Last (each new context becomes current on this thread, so `g` is not used after):
+        // counted on a fresh context per choice, renderer alive after one render: left out, an
+        // output costs exactly one render-target texture and one readback (pixel-pack buffer)
+        // less than the full render. An attachment or a read made and thrown away shows here.
+        let census = |outputs: ReprojectOutputs| {
+            let g = gpu();
+            let mut r =
+                Reprojector::new(&g, &case.source, &case.geometry, ReprojectParams { outputs, ..full }).unwrap();
+            r.render().unwrap();
+            (g.live_objects(), g.readback_buffers_created())
+        };
+        let (all_live, all_reads) = census(ReprojectOutputs {
+            color: true,
+            depth: true,
+        });
+        for (color, depth) in [(false, false), (true, false), (false, true)] {
+            let (live, reads) = census(ReprojectOutputs { color, depth });
+            // The 3-D gather renders depth whatever is asked: its two walks are merged by depth
+            // (src/reproject/render.rs), so there only colour can be left out.
+            let depth_left_out = !depth && !matches!(full.method, Method::Gather3d { .. });
+            let left_out = usize::from(!color) + usize::from(depth_left_out);
+            let tag = format!(
+                "{} color={color} depth={depth}: {live:?}, {reads} readbacks; full {all_live:?}, {all_reads}",
+                full.method.label()
+            );
+            assert_eq!(live.textures + left_out, all_live.textures, "{tag}");
+            assert_eq!(reads + left_out, all_reads, "{tag}");
+            assert_eq!(
+                (live.framebuffers, live.programs, live.vertex_arrays),
+                (all_live.framebuffers, all_live.programs, all_live.vertex_arrays),
+                "{tag}"
+            );
         }
     }
 }

@@ -95,23 +95,38 @@ fn border_weight_stays_within_half_a_db_of_plain_blend_on_the_seam_band() {
 }
 
 /// What the seed claims and what it costs, on the demo rig and on a wide rig where parallax is
-/// larger: (b) is crisper than (a) on the seam band (summed luma gradient closer to the truth's:
-/// less of the blend's doubled, averaged image), but its content is displaced (its effective eye
-/// runs back towards the +Z face's for w > 0.5, mod.rs), so SSIM, the gradient error and the
-/// PSNR over near surfaces (< 3 m) are all worse than the blend's. On the wide rig the sharpness
-/// gain is measured at 0.015-0.025; 0.01 is asserted.
+/// larger. The claim, held as a one-sided bound: (b) is crisper than (a) on the seam band
+/// (summed luma gradient closer to the truth's: less of the blend's doubled, averaged image); on
+/// the wide rig the gain is measured at 0.015-0.025 and 0.01 is asserted. The cost: its content
+/// is displaced (its effective eye runs back towards the +Z face's for w > 0.5, mod.rs), so SSIM,
+/// the gradient error and the PSNR over near surfaces (< 3 m) come out below the blend's. Those
+/// are bounded from one side only, so a fix that removes the cost passes and a change that
+/// makes it larger fails. Largest measured deficit against the blend over overlaps 5/10/20
+/// (print_stitch_measurements):
+///
+/// | rig | SSIM | gradient error | near PSNR |
+/// |---|---|---|---|
+/// | IPD 0.064 | 0.0020 | 0.028 | 0.60 dB |
+/// | IPD 0.25 | 0.0133 | 0.110 | 1.14 dB |
+///
+/// The displacement grows with the parallax between neighbouring face eyes, i.e. linearly with
+/// the IPD; each bound is the rig's largest measured deficit x 1.5 (room for llvmpipe/f64
+/// differences and overlap-to-overlap spread, well below the 4x that a doubling of the
+/// displacement on the wide rig would show).
 #[test]
-fn border_weight_is_crisper_than_plain_blend_but_misplaces_near_surfaces() {
-    for (ipd, min_gain) in [(0.064, 0.0), (WIDE_IPD, 0.01)] {
+fn border_weight_is_crisper_than_plain_blend_and_its_displacement_cost_is_bounded() {
+    for (ipd, min_gain, ssim, edge, near_db) in
+        [(0.064, 0.0, 0.0030, 0.042, 0.90), (WIDE_IPD, 0.01, 0.020, 0.165, 1.71)]
+    {
         let rig = OdsRig { ipd, ..OdsRig::demo() };
         for overlap in [5.0, 10.0, 20.0] {
             let s = method_scores_on(&rig, overlap);
             let (a, b) = (&s[0], &s[1]);
             let at = format!("ipd {ipd} overlap {overlap}: blend {a:?} border weight {b:?}");
             assert!(b.seam_sharpness > a.seam_sharpness + min_gain, "{at}");
-            assert!(b.seam_ssim < a.seam_ssim, "{at}");
-            assert!(b.seam_edge_mae > a.seam_edge_mae, "{at}");
-            assert!(b.seam_near_psnr_db < a.seam_near_psnr_db, "{at}");
+            assert!(b.seam_ssim > a.seam_ssim - ssim, "{at}");
+            assert!(b.seam_edge_mae < a.seam_edge_mae + edge, "{at}");
+            assert!(b.seam_near_psnr_db > a.seam_near_psnr_db - near_db, "{at}");
         }
     }
 }
@@ -136,7 +151,7 @@ fn depth_aware_reprojection_beats_both_on_the_seam_band_and_the_whole_image() {
 
 /// The measurement table of src/stitch/mod.rs ("Measured"), printed (`--ignored --nocapture`).
 #[test]
-#[ignore]
+#[ignore = "prints the table of src/stitch/mod.rs (\"Measured\") to regenerate it; asserts nothing"]
 fn print_stitch_measurements() {
     println!("| IPD | overlap | method | seam PSNR | seam MAE | whole PSNR | seam SSIM | whole SSIM | seam edge MAE | seam sharpness | seam near PSNR | seam far PSNR |");
     for ipd in [0.064, WIDE_IPD] {
@@ -321,16 +336,6 @@ fn bad_input_is_a_typed_error() {
     assert!(faces_from_images(&bad_rig, Side::Left, 100.0, images).is_err());
     assert!(scene_faces(&l.rig, Side::Left, 1, 100.0).is_err());
     assert!(ods_truth(&l.rig, Side::Left, 0, 10).is_err());
-}
-
-/// The report table and the benchmark, printed (`--ignored --nocapture`); nothing asserted.
-#[test]
-#[ignore]
-fn print_stitch_report_and_bench() {
-    let g = gpu();
-    let (_, notes) = viewsynth::eval::stitch::stitch_rows(&g, 3).unwrap();
-    println!("{}", notes.join("\n"));
-    println!("{}", viewsynth::bench::stitch_bench(&g, 5, &mut Vec::new()).unwrap());
 }
 
 #[test]
