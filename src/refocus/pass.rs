@@ -9,7 +9,7 @@ use super::{BreakRule, Method, OutputSet, RefocusSource, Refocuser};
 use crate::camera::PinholeCamera;
 use crate::convention::Conventions;
 use crate::error::Result;
-use crate::gpu::Gpu;
+use crate::pass::ToDevice;
 use crate::view::ViewOutput;
 
 /// Everything a refocus needs, GPU and f64 twin alike.
@@ -30,10 +30,18 @@ pub struct RefocusInput<'a> {
     pub conv: Conventions,
 }
 
-/// The GPU refocus of `input` (one [`Refocuser`], one target).
-pub fn gpu(gpu: &Gpu, input: &RefocusInput) -> Result<ViewOutput> {
-    let out = Refocuser::new(gpu, input.source, &input.rule, input.method, input.outputs, input.conv)?
-        .render(input.target)?;
+/// The GPU refocus of `input` (one [`Refocuser`], one target) on `device`: a GL context or
+/// either executor's [`crate::pass::Device`].
+pub fn gpu(device: impl ToDevice, input: &RefocusInput) -> Result<ViewOutput> {
+    let out = Refocuser::new(
+        device,
+        input.source,
+        &input.rule,
+        input.method,
+        input.outputs,
+        input.conv,
+    )?
+    .render(input.target)?;
     Ok(ViewOutput::from_refocus(&out))
 }
 

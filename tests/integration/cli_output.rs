@@ -135,8 +135,8 @@ fn demo_prints_a_summary_and_report_verbose_the_whole_table() {
     let table = std::fs::read_to_string(d.join("demo/report.md")).unwrap();
     assert!(table.lines().count() > 60, "report.md holds the full table:\n{table}");
     // Progress went to stderr, not stdout.
-    assert!(!out.contains("[1/9]"), "{out}");
-    assert!(String::from_utf8_lossy(&o.stderr).contains("[1/9]"));
+    assert!(!out.contains("[1/10]"), "{out}");
+    assert!(String::from_utf8_lossy(&o.stderr).contains("[1/10]"));
 
     let o = bin()
         .args(["report", "--repeats", "0", "--verbose", "--out-dir"])

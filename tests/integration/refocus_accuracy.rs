@@ -17,14 +17,21 @@ use crate::common::*;
 use viewsynth::camera::PinholeCamera;
 use viewsynth::convention::Conventions;
 use viewsynth::eval::image_check;
+use viewsynth::pass::Device;
 use viewsynth::refocus::manifest::TargetSpec;
 use viewsynth::refocus::{pass, BreakRule, Method, OutputSet, RefocusInput, RefocusSource, Refocuser};
 
 const SCALES: [f64; 7] = [0.25, 0.5, 0.75, 1.0, 1.5, 2.0, 4.0];
 
-/// Every target through the pass/twin contract: [`pass::gpu`] against [`pass::reference`].
+/// Every target through the pass/twin contract: [`pass::gpu`] against [`pass::reference`], on
+/// GL (llvmpipe) unless a device is given.
 fn check_source(name: &str, src: &RefocusSource) {
-    let g = gpu();
+    check_source_on(name, src, &Device::gl(&gpu()).unwrap());
+}
+
+/// [`check_source`] on `device`, with the same bounds whatever its API (both run the same GLSL
+/// on the same f32 inputs; the derivation above holds for either compiler).
+fn check_source_on(name: &str, src: &RefocusSource, device: &Device) {
     let cam = src.camera();
     let sizes = [
         None,
@@ -50,7 +57,7 @@ fn check_source(name: &str, src: &RefocusSource) {
                     outputs: OutputSet::default(),
                     conv: Conventions::default(),
                 };
-                let out = pass::gpu(&g, &input).expect("render");
+                let out = pass::gpu(device, &input).expect("render");
                 let reference = pass::reference(&input).expect("reference");
                 let a = compare_views(&out, &reference);
                 let tag = format!("{name}_{method:?}_{}x{}_s{s}", target.width, target.height);
@@ -76,6 +83,16 @@ fn check_source(name: &str, src: &RefocusSource) {
 #[test]
 fn tum_frame_matches_reference() {
     check_source("TUM", &real_frame("TUM"));
+}
+
+/// The Vulkan executor (lavapipe in CI) against the f64 twin with the GL bounds: the refocus
+/// pass description run by the other API.
+#[cfg(feature = "vulkan")]
+#[test]
+fn tum_frame_on_vulkan_matches_reference() {
+    let device = viewsynth::vulkan::VkExecutor::device(&crate::vulkan_refocus::vulkan()).unwrap();
+    check_source_on("TUM on Vulkan", &real_frame("TUM"), &device);
+    check_source_on("synthetic on Vulkan", &synthetic(320, 240), &device);
 }
 
 #[test]

@@ -5,9 +5,9 @@
 use super::resume::{frame_finished, frame_settings};
 use super::{BatchFrame, BatchOptions, MAX_JOBS};
 use crate::error::{Error, Result};
-use crate::pass::ToDevice;
 use crate::io::FileFormats;
 use crate::io::{self, DepthDecode};
+use crate::pass::ToDevice;
 use crate::refocus::manifest::{self, Manifest, TargetSpec};
 use crate::refocus::{PendingRefocus, RefocusOutput, RefocusSource, Refocuser};
 use serde::Serialize;
