@@ -99,6 +99,8 @@ pub struct BatchBench {
     pub synchronous: BatchRun,
     /// pipelined frames/s over synchronous frames/s.
     pub speedup: f64,
+    /// `--with-vulkan`: the device's name and the same pipelined run on it.
+    pub vulkan: Option<(String, BatchRun)>,
 }
 
 pub(crate) fn median(mut v: Vec<f64>) -> f64 {
@@ -182,8 +184,15 @@ fn scene_manifest(dir: &Path, n: usize) -> Result<PathBuf> {
 }
 
 /// Run the batch twice on the same input (synchronous, then pipelined with `jobs` threads per
-/// pool) into scratch folders that are removed afterwards.
-pub fn batch_bench(gpu: &Gpu, input: &BatchInput, jobs: usize, files: FileFormats) -> Result<BatchBench> {
+/// pool), and a third time pipelined on `vulkan` when given, into scratch folders that are
+/// removed afterwards.
+pub fn batch_bench(
+    gpu: &Gpu,
+    input: &BatchInput,
+    jobs: usize,
+    files: FileFormats,
+    vulkan: Option<&crate::pass::Device>,
+) -> Result<BatchBench> {
     let scratch = tempfile::Builder::new()
         .prefix("viewsynth-bench-batch-")
         .tempdir()
@@ -212,14 +221,19 @@ pub fn batch_bench(gpu: &Gpu, input: &BatchInput, jobs: usize, files: FileFormat
         jobs,
         shard: None,
     };
-    let run = |jobs: usize, name: &str| -> Result<BatchRun> {
+    let run = |device: crate::pass::Device, jobs: usize, name: &str| -> Result<BatchRun> {
         let out = scratch.path().join(name);
-        let s = run_batch(gpu, &frames, &out, &opts(jobs), || ())?;
+        let s = run_batch(&device, &frames, &out, &opts(jobs), || ())?;
         let _ = std::fs::remove_dir_all(&out);
         Ok(summarise(jobs, &s))
     };
-    let synchronous = run(0, "sync")?;
-    let pipelined = run(jobs.max(1), "pipelined")?;
+    let gl = crate::pass::Device::gl(gpu)?;
+    let synchronous = run(gl.clone(), 0, "sync")?;
+    let pipelined = run(gl, jobs.max(1), "pipelined")?;
+    let vulkan = match vulkan {
+        Some(d) => Some((d.renderer(), run(d.clone(), jobs.max(1), "vulkan")?)),
+        None => None,
+    };
     let px = w as usize * h as usize;
     let out_px: usize = scales.len() * px;
     let bytes_per_frame = px * (3 + 4)
@@ -238,6 +252,7 @@ pub fn batch_bench(gpu: &Gpu, input: &BatchInput, jobs: usize, files: FileFormat
         speedup: pipelined.frames_per_s / synchronous.frames_per_s.max(1e-9),
         pipelined,
         synchronous,
+        vulkan,
     })
 }
 
@@ -254,7 +269,11 @@ impl BatchBench {
             self.png_compression,
             self.bytes_per_frame as f64 / 1e6
         );
-        for (name, r) in [("synchronous", &self.synchronous), ("pipelined", &self.pipelined)] {
+        let mut runs = vec![("synchronous", &self.synchronous), ("pipelined", &self.pipelined)];
+        if let Some((_, r)) = &self.vulkan {
+            runs.push(("pipelined, Vulkan", r));
+        }
+        for (name, r) in runs {
             let m = &r.stages_ms;
             let _ = writeln!(
                 t,
@@ -281,6 +300,13 @@ impl BatchBench {
             self.pipelined.frames_in_flight,
             (self.pipelined.frames_in_flight * self.bytes_per_frame) as f64 / 1e6
         );
+        if let Some((device, r)) = &self.vulkan {
+            let _ = writeln!(
+                t,
+                "Vulkan row: {device}, the same pipeline and files; Vulkan / GL frames/s = {:.2}",
+                r.frames_per_s / self.pipelined.frames_per_s.max(1e-9)
+            );
+        }
         t
     }
 }

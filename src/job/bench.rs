@@ -44,6 +44,8 @@ enum Bench {
         input: BatchInput,
         jobs: usize,
         files: FileFormats,
+        /// Also the pipelined run on the Vulkan device.
+        with_vulkan: bool,
     },
 }
 
@@ -91,7 +93,12 @@ impl BenchJob {
                     },
                     ..Default::default()
                 };
-                Bench::Batch { input, jobs, files }
+                Bench::Batch {
+                    input,
+                    jobs,
+                    files,
+                    with_vulkan: o.with_vulkan,
+                }
             }
             None => {
                 let mut sizes = Vec::new();
@@ -114,12 +121,35 @@ impl BenchJob {
         Ok(BenchJob { bench, gpu: o.gpu })
     }
 
+    /// `--device` names an EGL device; the Vulkan side takes the automatic choice.
+    fn vulkan_request(&self) -> GpuRequest {
+        GpuRequest {
+            device: crate::gpu::DeviceChoice::Auto,
+            ..self.gpu
+        }
+    }
+
     /// Measures.
     pub fn run(&self, host: &dyn Host) -> Result<BenchReport, JobError> {
         let gpu = host.open_gpu(&self.gpu)?;
         match &self.bench {
-            Bench::Batch { input, jobs, files } => {
-                Ok(BenchReport::Batch(Box::new(batch_bench(&gpu, input, *jobs, *files)?)))
+            Bench::Batch {
+                input,
+                jobs,
+                files,
+                with_vulkan,
+            } => {
+                let vulkan = match with_vulkan {
+                    true => Some(host.open_device(&self.vulkan_request(), crate::job::Backend::Vulkan)?),
+                    false => None,
+                };
+                Ok(BenchReport::Batch(Box::new(batch_bench(
+                    &gpu,
+                    input,
+                    *jobs,
+                    *files,
+                    vulkan.as_ref(),
+                )?)))
             }
             Bench::Frames {
                 sizes,
@@ -141,11 +171,7 @@ impl BenchJob {
                         return Ok((tables, None));
                     }
                     stages.stage(4, total, "bench: every pass, GL against Vulkan");
-                    let request = GpuRequest {
-                        device: crate::gpu::DeviceChoice::Auto,
-                        ..self.gpu
-                    };
-                    let vk = host.open_vulkan(&request)?;
+                    let vk = host.open_vulkan(&self.vulkan_request())?;
                     tables.push(crate::bench::vulkan::refocus_bench(&vk, sizes, *repeats, &mut cases)?);
                     tables.push(crate::bench::vulkan::passes_bench(
                         &gpu, &vk, 640, 480, *repeats, &mut cases,

@@ -32,9 +32,9 @@ pub(crate) struct BenchArgs {
     /// With --batch: PNG compression (fast, default, best).
     #[arg(help_heading = MEASURE, long, default_value = "fast", requires = "batch")]
     png_compression: String,
-    /// Also time refocus and the cyclopean gather (seed/refine) on the Vulkan device (`--device
-    /// auto`; the same shaders as SPIR-V).
-    #[arg(help_heading = MEASURE, long, conflicts_with = "batch")]
+    /// Also time every pass on the Vulkan device (`--device auto`; the same shaders as SPIR-V)
+    /// beside GL; with --batch, the same pipelined batch on it.
+    #[arg(help_heading = MEASURE, long)]
     with_vulkan: bool,
     /// Print one JSON object instead of the tables.
     #[arg(help_heading = OUTPUTS, long)]
