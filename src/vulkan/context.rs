@@ -415,7 +415,8 @@ impl VulkanContext {
         record: impl FnOnce(vk::CommandBuffer),
     ) -> Result<()> {
         let d = &self.device;
-        // SAFETY: as in run_commands, without the wait.
+        // SAFETY: the command buffer and fence are not in use (their last submit was waited
+        // for); the queue is used from this thread only (the context is not Send).
         unsafe {
             d.reset_command_buffer(cb, vk::CommandBufferResetFlags::empty())
                 .map_err(vk_err("vkResetCommandBuffer"))?;
@@ -436,26 +437,10 @@ impl VulkanContext {
     /// Synchronous: no submit is pending when this returns, so every object a recording used is
     /// free again.
     pub(crate) fn run_commands(&self, record: impl FnOnce(vk::CommandBuffer)) -> Result<()> {
-        let d = &self.device;
         let (cb, fence) = self.submit_objects()?;
-        // SAFETY: the command buffer and fence are not in use (the last submit was waited for);
-        // the queue is used from this thread only (the context is not Send).
-        unsafe {
-            d.reset_command_buffer(cb, vk::CommandBufferResetFlags::empty())
-                .map_err(vk_err("vkResetCommandBuffer"))?;
-            d.reset_fences(&[fence]).map_err(vk_err("vkResetFences"))?;
-            let begin = vk::CommandBufferBeginInfo::default().flags(vk::CommandBufferUsageFlags::ONE_TIME_SUBMIT);
-            d.begin_command_buffer(cb, &begin)
-                .map_err(vk_err("vkBeginCommandBuffer"))?;
-            record(cb);
-            d.end_command_buffer(cb).map_err(vk_err("vkEndCommandBuffer"))?;
-            let cbs = [cb];
-            let submit = [vk::SubmitInfo::default().command_buffers(&cbs)];
-            d.queue_submit(self.queue, &submit, fence)
-                .map_err(vk_err("vkQueueSubmit"))?;
-            d.wait_for_fences(&[fence], true, u64::MAX)
-                .map_err(vk_err("vkWaitForFences"))
-        }
+        self.submit_commands(cb, fence, record)?;
+        // SAFETY: the fence was just submitted with `cb`.
+        unsafe { self.device.wait_for_fences(&[fence], true, u64::MAX) }.map_err(vk_err("vkWaitForFences"))
     }
 }
 

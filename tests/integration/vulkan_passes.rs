@@ -547,6 +547,24 @@ fn refocus_manifest(dir: &Path) -> std::path::PathBuf {
     path
 }
 
+/// `refocus --batch MANIFEST` with 3 scales on 2 threads per pool, `--method METHOD`.
+fn batch_args(manifest: &Path, method: &str) -> Vec<String> {
+    let m = manifest.to_str().unwrap();
+    [
+        "refocus",
+        "--batch",
+        m,
+        "--zoom-range",
+        "0.5,1,2",
+        "--jobs",
+        "2",
+        "--method",
+        method,
+    ]
+    .map(String::from)
+    .to_vec()
+}
+
 /// `refocus --batch --backend vulkan`: the pipelined batch (decoder and writer threads, targets
 /// and frames in flight) writes, frame by frame, what the GL batch writes, for both methods.
 #[test]
@@ -555,21 +573,8 @@ fn refocus_batch_writes_the_same_files_on_vulkan() {
     let manifest = refocus_manifest(&dir);
     for method in ["fullscreen", "mesh"] {
         let tag = format!("batch-{method}");
-        run_on_both(
-            &tag,
-            &dir,
-            &[
-                "refocus",
-                "--batch",
-                manifest.to_str().unwrap(),
-                "--zoom-range",
-                "0.5,1,2",
-                "--jobs",
-                "2",
-                "--method",
-                method,
-            ],
-        );
+        let args = batch_args(&manifest, method);
+        run_on_both(&tag, &dir, &args.iter().map(String::as_str).collect::<Vec<_>>());
         for frame in ["tum", "sun"] {
             let (gl, vk) = (
                 dir.join(format!("{tag}-gl")).join(frame),
@@ -630,17 +635,7 @@ fn every_vulkan_pass_runs_clean_under_the_validation_layer() {
         a.extend(s(&["--zoom-range", "0.5,2", "--method", method]));
         runs.push(a);
         // The batch: several runs in flight, image writes staged per flight.
-        runs.push(s(&[
-            "refocus",
-            "--batch",
-            manifest.to_str().unwrap(),
-            "--zoom-range",
-            "0.5,1,2",
-            "--jobs",
-            "2",
-            "--method",
-            method,
-        ]));
+        runs.push(batch_args(&manifest, method));
     }
     let file = |name: &str| dir.join(name).to_str().unwrap().to_string();
     let (lr, ld, rr, rd, cams) = (
