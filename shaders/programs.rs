@@ -114,6 +114,15 @@ pub const PROGRAMS: &[ProgramEntry] = &[
         vulkan: Some(&[]),
     },
     ProgramEntry {
+        name: "cyclopean/fill",
+        stages: &[
+            ("vert", FULLSCREEN_VERT),
+            ("frag", &["cyclopean/fill_params.glsl", "cyclopean/fill.frag"]),
+        ],
+        switches: &[],
+        vulkan: Some(&[]),
+    },
+    ProgramEntry {
         name: "cyclopean/forward",
         stages: &[
             (

@@ -20,6 +20,7 @@ pub mod camera_file;
 pub mod camera_spec;
 pub mod disparity_frame;
 pub mod edge_snap;
+pub mod fill;
 pub mod forward;
 pub mod frame_depth;
 pub mod pass;

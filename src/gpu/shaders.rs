@@ -138,6 +138,8 @@ pub enum ProgramKind {
     CyclopeanSplatEdges,
     /// cyclopean/edge_snap.comp: depth breaks moved onto colour edges before the splat (compute).
     CyclopeanEdgeSnap,
+    /// cyclopean/fill.frag: holes filled from the background side (`--fill`).
+    CyclopeanFill,
     /// reproject/shift.frag: the row shift as a gather (walk, or the exact scan).
     ReprojectShift {
         /// How the stored source depth is read.
@@ -230,6 +232,7 @@ impl ProgramKind {
             ProgramKind::CyclopeanSplatGather => "cyclopean/splat_gather",
             ProgramKind::CyclopeanSplatEdges => "cyclopean/splat_edges",
             ProgramKind::CyclopeanEdgeSnap => "cyclopean/edge_snap",
+            ProgramKind::CyclopeanFill => "cyclopean/fill",
             ProgramKind::ReprojectShift { .. } => "reproject/shift",
             ProgramKind::SceneRaytrace => "scene/raytrace",
             ProgramKind::Stitch { .. } => "stitch/stitch",
@@ -258,6 +261,7 @@ impl ProgramKind {
             | ProgramKind::CyclopeanSplatGather
             | ProgramKind::CyclopeanSplatEdges
             | ProgramKind::CyclopeanEdgeSnap
+            | ProgramKind::CyclopeanFill
             | ProgramKind::SceneRaytrace => vec![],
             ProgramKind::ReprojectShift {
                 depth,
@@ -347,6 +351,7 @@ impl ShaderProgram {
             ProgramKind::CyclopeanSplatGather,
             ProgramKind::CyclopeanSplatEdges,
             ProgramKind::CyclopeanEdgeSnap,
+            ProgramKind::CyclopeanFill,
             ProgramKind::SceneRaytrace,
         ]);
         for depth in [ShiftDepth::ViewZ, ShiftDepth::Device, ShiftDepth::Disparity] {

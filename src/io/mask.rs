@@ -15,10 +15,22 @@ pub fn save_mask_png(path: &Path, mask: &Mask) -> Result<()> {
     save_mask_png_with(path, mask, super::PngCompression::default())
 }
 
+/// The mask value of a pixel that was filled (cyclopean `--fill`), not rendered: kept as it is
+/// in the PNG, where every other nonzero value is written 255.
+pub const MASK_FILLED: u8 = 128;
+
 /// [`save_mask_png`] with a chosen compression.
 pub fn save_mask_png_with(path: &Path, mask: &Mask, compression: super::PngCompression) -> Result<()> {
     encode_dims(path, mask.width, mask.height, 1, mask.data.len())?;
-    let bytes: Vec<u8> = mask.data.iter().map(|&v| if v == 0 { 0 } else { 255 }).collect();
+    let bytes: Vec<u8> = mask
+        .data
+        .iter()
+        .map(|&v| match v {
+            0 => 0,
+            MASK_FILLED => MASK_FILLED,
+            _ => 255,
+        })
+        .collect();
     atomic_write(path, |out| {
         PngEncoder::new_with_quality(out, compression.image_type(), FilterType::Adaptive)
             .write_image(&bytes, mask.width, mask.height, ExtendedColorType::L8)

@@ -50,7 +50,7 @@ pub use image_types::{DepthMap, Mask, RgbImage, MAX_DIMENSION};
 pub(crate) use input::{check_file_len, open_regular};
 pub use input::{check_output_pixels, max_pixels, set_max_pixels, DEFAULT_MAX_PIXELS};
 pub use json::{load_json, read_text, MAX_JSON_BYTES, MAX_JSON_MAGNITUDE};
-pub use mask::{load_mask_png, save_mask_png, save_mask_png_with};
+pub use mask::{load_mask_png, save_mask_png, save_mask_png_with, MASK_FILLED};
 pub use npy::{load_npy, save_npy_f32, NpyArray, NpyDtype};
 pub use npz::load_npz_array;
 pub use outputs::{

@@ -6,6 +6,7 @@ use super::{ArgError, Backend, Event, GpuRequest, Host, JobError};
 use crate::convention::{Conventions, DepthPlanes};
 use crate::cyclopean::camera_file::{CameraFile, EyeCameras};
 use crate::cyclopean::disparity_frame::{disparity_frame, DisparityRig};
+use crate::cyclopean::fill::{Filler, FILLED};
 use crate::cyclopean::forward::ForwardWarp;
 use crate::cyclopean::render::CyclopeanRenderer;
 use crate::cyclopean::splat::{SplatParams, SplatRenderer};
@@ -86,6 +87,8 @@ pub struct CyclopeanOptions {
     pub dominant: Option<String>,
     /// `--outputs`, when given.
     pub outputs: Option<String>,
+    /// `--fill`: holes filled from the background side (mask 128 there); off, holes stay.
+    pub fill: bool,
     /// Output folder.
     pub out_dir: PathBuf,
     /// The GPU to render on.
@@ -160,6 +163,7 @@ pub struct CyclopeanJob {
     method: CyclopeanMethod,
     gather: Option<GatherSettings>,
     outputs: OutputSet,
+    fill: bool,
     out_dir: PathBuf,
     gpu: GpuRequest,
     backend: Backend,
@@ -320,6 +324,7 @@ impl CyclopeanJob {
             method,
             gather,
             outputs,
+            fill: o.fill,
             out_dir: o.out_dir,
             gpu: o.gpu,
             backend: o.backend,
@@ -340,30 +345,36 @@ impl CyclopeanJob {
         frame.validate()?;
         let params = self.gather.map(|g| g.params(fixation)).transpose()?;
         let out_dir = io::OutDir::prepare(&self.out_dir)?;
+        // The fill reads both planes whatever is written.
         let wanted = CyclopeanOutputs {
-            color: self.outputs.rgb,
-            depth: self.outputs.depth,
+            color: self.outputs.rgb || self.fill,
+            depth: self.outputs.depth || self.fill,
         };
-        let (out, timing) = match (self.backend, self.method, params) {
-            (_, CyclopeanMethod::Seed | CyclopeanMethod::Refine, Some(p)) => {
-                let device = host.open_device(&self.gpu, self.backend)?;
+        let device = host.open_device(&self.gpu, self.backend)?;
+        let (mut out, timing) = match (self.method, params) {
+            (CyclopeanMethod::Seed | CyclopeanMethod::Refine, Some(p)) => {
                 CyclopeanRenderer::with_outputs(&device, &frame, p, wanted)?.render(&mid)?
             }
-            (_, CyclopeanMethod::Forward, _) => {
-                let device = host.open_device(&self.gpu, self.backend)?;
-                ForwardWarp::new(&device, &frame, &BreakRule::default())?.render(&mid)?
-            }
-            _ => {
-                let device = host.open_device(&self.gpu, self.backend)?;
-                SplatRenderer::new(&device, &frame, SplatParams::default(), wanted)?.render(&mid)?
-            }
+            (CyclopeanMethod::Forward, _) => ForwardWarp::new(&device, &frame, &BreakRule::default())?.render(&mid)?,
+            _ => SplatRenderer::new(&device, &frame, SplatParams::default(), wanted)?.render(&mid)?,
         };
+        if self.fill {
+            out = Filler::new(&device)?.fill(&out, mid.width, mid.height)?;
+        }
+        // The mask: 1 where an eye (or the history) gave the pixel, MASK_FILLED where it was filled.
         let mask = io::Mask::new(
             mid.width,
             mid.height,
-            out.sources.iter().map(|s| (*s != 0) as u8).collect(),
+            out.sources
+                .iter()
+                .map(|&s| match s {
+                    0 => 0,
+                    FILLED => io::MASK_FILLED,
+                    _ => 1,
+                })
+                .collect(),
         )?;
-        let valid = out.sources.iter().filter(|s| **s != 0).count();
+        let valid = out.sources.iter().filter(|s| **s != 0 && **s != FILLED).count();
         let view = ViewOutput {
             width: mid.width,
             height: mid.height,

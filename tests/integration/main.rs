@@ -12,6 +12,7 @@ mod cli_reproject_stitch;
 mod common;
 mod compare;
 mod cyclopean;
+mod cyclopean_fill;
 mod cyclopean_real;
 mod device_choice;
 mod gl_objects;

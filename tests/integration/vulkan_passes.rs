@@ -89,6 +89,7 @@ fn every_parameter_block_has_the_layout_the_gl_compiler_reports() {
     check_block::<SplatGatherBlock>(ProgramKind::CyclopeanSplatEdges);
     check_block::<ForwardParams>(ProgramKind::CyclopeanForward);
     check_block::<RefocusParams>(ProgramKind::RefocusFullscreen { want_rgb: true });
+    check_block::<viewsynth::cyclopean::fill::FillParams>(ProgramKind::CyclopeanFill);
     check_block::<RefocusParams>(ProgramKind::RefocusMeshBoundary { want_rgb: true });
 }
 
@@ -662,6 +663,11 @@ fn every_vulkan_pass_runs_clean_under_the_validation_layer() {
             &cams,
         ]));
     }
+    // The fill pass after the default method.
+    let mut filled = runs.last().unwrap().clone();
+    filled[2] = "splat-gather".into();
+    filled.push("--fill".into());
+    runs.push(filled);
     for (k, args) in runs.iter().enumerate() {
         let out = dir.join(format!("run{k}"));
         let o = bin()

@@ -110,6 +110,11 @@ pub(crate) struct CyclopeanArgs {
     /// only with --focal and --baseline). Colour and depth not listed are not read back.
     #[arg(help_heading = OUTPUTS, long)]
     outputs: Option<String>,
+    /// Fill the holes (pixels no eye saw) from the background side along the row, so the frame
+    /// is complete; filled pixels are 128 in middle_mask.png (rendered ones 255). Off: holes
+    /// stay 0.
+    #[arg(help_heading = OUTPUTS, long)]
+    fill: bool,
     /// Writes middle_rgb.png, middle_depth.exr, middle_mask.png (those in --outputs).
     #[arg(help_heading = OUTPUTS, long)]
     out_dir: PathBuf,
@@ -153,6 +158,7 @@ impl TryFrom<CyclopeanArgs> for CyclopeanJob {
             z_threshold: a.z_threshold,
             dominant: a.dominant,
             outputs: a.outputs,
+            fill: a.fill,
             out_dir: a.out_dir,
             gpu: a.gpu.try_into()?,
             backend: a.backend.into(),
