@@ -594,11 +594,10 @@ impl Executor for VkExecutor {
 
     fn submit(&mut self, target: Option<&Target>, steps: &[Step]) -> Result<Ticket> {
         let f = self.open_flight()?;
-        let result = self.record_flight(f, target, steps);
-        // Whatever happened, the next submit starts a fresh flight (queued writes went with this
-        // one, or are dropped with its error).
+        self.record_flight(f, target, steps)?;
+        // Submitted with the writes queued for it; on an error they stay queued for the next.
         self.open = None;
-        result.map(|()| Ticket(f))
+        Ok(Ticket(f))
     }
 
     fn is_ready(&mut self, ticket: Ticket) -> bool {
