@@ -81,9 +81,10 @@ pub(crate) struct RefocusArgs {
     /// default) or mesh (the triangles rasterised); both give the same output.
     #[arg(help_heading = METHOD, long, value_enum, default_value = "fullscreen")]
     method: MethodArg,
-    /// Output folder (created if missing): per zoom scale s, s{s}_rgb.png, s{s}_depth.exr,
-    /// s{s}_mask.png (those in --outputs; f{fx'}_rgb.png etc. with --focal-list), and
-    /// manifest.json.
+    /// Output folder (created if missing): per zoom scale s, s{s}_rgb.png (s{s}_rgb.jpg, s{s}_rgb.exr
+    /// with --rgb-format), s{s}_depth.exr, s{s}_depth.npy, s{s}_depth.png (those in --depth-format),
+    /// s{s}_depth_preview.png (--depth-preview), s{s}_mask.png (those in --outputs; f{fx'}_rgb.png
+    /// etc. with --focal-list), and manifest.json.
     #[arg(help_heading = OUTPUTS, long)]
     out_dir: PathBuf,
     #[command(flatten)]
