@@ -18,12 +18,21 @@ pub fn save_mask_png(path: &Path, mask: &Mask) -> Result<()> {
 /// [`save_mask_png`] with a chosen compression.
 pub fn save_mask_png_with(path: &Path, mask: &Mask, compression: super::PngCompression) -> Result<()> {
     encode_dims(path, mask.width, mask.height, 1, mask.data.len())?;
+    atomic_write(path, |out| encode_mask_png(path, out, mask, compression))
+}
+
+/// Encodes [`save_mask_png_with`]'s file into `out`; errors name `path`.
+pub(crate) fn encode_mask_png(
+    path: &Path,
+    out: &mut std::io::BufWriter<std::fs::File>,
+    mask: &Mask,
+    compression: super::PngCompression,
+) -> Result<()> {
+    encode_dims(path, mask.width, mask.height, 1, mask.data.len())?;
     let bytes: Vec<u8> = mask.data.iter().map(|&v| if v == 0 { 0 } else { 255 }).collect();
-    atomic_write(path, |out| {
-        PngEncoder::new_with_quality(out, compression.image_type(), FilterType::Adaptive)
-            .write_image(&bytes, mask.width, mask.height, ExtendedColorType::L8)
-            .map_err(|e| Error::encode(path, e.to_string()))
-    })
+    PngEncoder::new_with_quality(out, compression.image_type(), FilterType::Adaptive)
+        .write_image(&bytes, mask.width, mask.height, ExtendedColorType::L8)
+        .map_err(|e| Error::encode(path, e.to_string()))
 }
 
 /// Reads a PNG mask: a pixel is 1 when any of its colour samples is nonzero (alpha is
