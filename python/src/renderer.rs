@@ -218,7 +218,7 @@ impl Renderer {
         };
         if require_gpu {
             let info = renderer.gpu()?.info();
-            if crate::is_software(&info.renderer) {
+            if info.software {
                 return Err(errors::raise(
                     Kind::GpuUnavailable,
                     format!(
@@ -672,7 +672,7 @@ impl Renderer {
     /// Raises InvalidInputError for a bad argument or frame entry, FileError for an unreadable
     /// manifest or an unusable out_dir.
     #[allow(clippy::too_many_arguments)]
-    #[pyo3(signature = (frames, out_dir, *, scales = vec![0.5, 0.75, 1.0, 1.5, 2.0], size = None, principal = None,
+    #[pyo3(signature = (frames, out_dir, *, scales = viewsynth::refocus::manifest::DEFAULT_SCALES.to_vec(), size = None, principal = None,
                         outputs = None, tau_rel = 0.05, tau_abs = 0.2, method = "fullscreen", rgb_format = "png",
                         depth_format = None, depth_preview = false, png_compression = "fast",
                         exr_compression = "zip", depth_trunc = None, resume = true, jobs = None, shard = None))]

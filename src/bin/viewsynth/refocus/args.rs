@@ -56,7 +56,7 @@ pub(crate) struct RefocusArgs {
     #[arg(help_heading = TARGETS, long, value_delimiter = ',', conflicts_with = "zoom_range", value_parser = finite_value)]
     focal_list: Option<Vec<f64>>,
     /// Target focal scales s (fx' = s fx).
-    #[arg(help_heading = TARGETS, long, value_delimiter = ',', default_value = "0.5,0.75,1,1.5,2", value_parser = finite_value)]
+    #[arg(help_heading = TARGETS, long, value_delimiter = ',', default_value = viewsynth::refocus::manifest::DEFAULT_SCALES_TEXT, value_parser = finite_value)]
     zoom_range: Vec<f64>,
     /// Output width in pixels (default: the source's; with --height-out).
     #[arg(help_heading = TARGETS, long, requires = "height_out", value_parser = clap::value_parser!(u32).range(1..=i64::from(io::MAX_DIMENSION)))]
