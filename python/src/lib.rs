@@ -11,6 +11,7 @@ mod errors;
 mod ints;
 mod renderer;
 mod reproject;
+mod shared;
 mod stitch;
 
 use pyo3::prelude::*;
