@@ -1,4 +1,5 @@
-//! The output layer end to end, table-driven: every file-writing command with every
+//! The output layer end to end, table-driven: every file-writing command (refocus single frame
+//! and batch, reproject, cyclopean, stitch, scene) with every
 //! `--outputs` subset and every `--depth-format` combination it accepts writes exactly the
 //! files its `--help` names for them (each expected name, with the command's placeholder for
 //! the view, must appear in the help), and an option a command cannot honour is refused by
@@ -180,6 +181,31 @@ fn refocus_writes_exactly_the_files_its_help_names_for_every_output_and_format()
     base.extend(strs(&["--zoom-range", "1"]));
     let named = |f: &str| f.replacen("s1_", "s{s}_", 1);
     check("refocus", named, format_rows(&base, "s1", &["manifest.json"]), &d);
+    // The batch: the same files for every frame, in <out-dir>/<name>/.
+    let manifest = d.join("frames.csv");
+    let k = viewsynth::scene::demo_camera(W, H).k;
+    std::fs::write(
+        &manifest,
+        format!(
+            "rgb,depth,fx,fy,cx,cy,name\nsrc_rgb.png,src_depth.exr,{},{},{},{},f0\n",
+            k.fx, k.fy, k.cx, k.cy
+        ),
+    )
+    .unwrap();
+    for (i, row) in format_rows(&strs(&["--zoom-range", "1"]), "s1", &["manifest.json"])
+        .into_iter()
+        .enumerate()
+    {
+        let out = d.join(format!("batch-{i}"));
+        let mut args = strs(&["refocus", "--batch", &manifest.display().to_string()]);
+        args.extend(row.args);
+        args.extend(["--out-dir".to_string(), out.display().to_string()]);
+        let o = run(&args);
+        assert!(o.status.success(), "{}: {}", args.join(" "), text(&o));
+        let mut want = row.files;
+        want.sort();
+        assert_eq!(files_in(&out.join("f0")), want, "{}", args.join(" "));
+    }
     let out = d.join("refused").display().to_string();
     let mut args: Vec<&str> = vec!["refocus"];
     args.extend(base.iter().map(String::as_str));
