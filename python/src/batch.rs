@@ -168,28 +168,15 @@ fn depth_formats(obj: &Bound<'_, PyAny>) -> PyResult<DepthFormats> {
         obj.extract()
             .map_err(|_| errors::invalid("depth_format", "expected any of \"exr\", \"npy\", \"png16\""))?
     };
-    let mut f = DepthFormats {
-        exr: false,
-        npy: false,
-        png16: false,
-    };
-    for n in &names {
-        match n.as_str() {
-            "exr" => f.exr = true,
-            "npy" => f.npy = true,
-            "png16" => f.png16 = true,
-            other => {
-                return Err(errors::invalid(
-                    "depth_format",
-                    format!("'{other}': expected any of \"exr\", \"npy\", \"png16\""),
-                ))
-            }
-        }
-    }
     if names.is_empty() {
         return Err(errors::invalid("depth_format", "no format given"));
     }
-    Ok(f)
+    DepthFormats::parse(names.iter().map(String::as_str)).map_err(|bad| {
+        errors::invalid(
+            "depth_format",
+            format!("'{bad}': expected any of \"exr\", \"npy\", \"png16\""),
+        )
+    })
 }
 
 /// The arguments of one refocus_batch call, as Python gave them.

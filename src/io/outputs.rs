@@ -103,6 +103,31 @@ pub struct DepthFormats {
     pub png16: bool,
 }
 
+impl DepthFormats {
+    /// The formats named (any of exr, npy, png16; at least one): the one parser of the CLI's
+    /// `--depth-format` and Python's `depth_format=`. Err holds the first entry that is not a
+    /// format ("" when none is given).
+    pub fn parse<'a>(names: impl IntoIterator<Item = &'a str>) -> std::result::Result<Self, String> {
+        let mut f = DepthFormats {
+            exr: false,
+            npy: false,
+            png16: false,
+        };
+        for name in names {
+            match name.trim() {
+                "exr" => f.exr = true,
+                "npy" => f.npy = true,
+                "png16" => f.png16 = true,
+                other => return Err(other.to_string()),
+            }
+        }
+        if !(f.exr || f.npy || f.png16) {
+            return Err(String::new());
+        }
+        Ok(f)
+    }
+}
+
 impl Default for DepthFormats {
     fn default() -> Self {
         DepthFormats {
