@@ -15,7 +15,7 @@ use std::fmt::Write as _;
 use std::path::Path;
 
 /// The focal scales the demo refocuses at.
-pub const DEMO_SCALES: [f64; 5] = [0.5, 0.75, 1.0, 1.5, 2.0];
+pub const DEMO_SCALES: [f64; 5] = crate::refocus::manifest::DEFAULT_SCALES;
 
 /// Run the demo into `out_dir`; returns the report, its files and, last, refocus_check.md.
 pub fn run(gpu: &Gpu, out_dir: &Path) -> Result<WrittenReport> {

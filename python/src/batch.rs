@@ -4,7 +4,7 @@
 //! frames gets exactly the CLI batch's output folders. Scheduling frames is the caller's part.
 
 use crate::errors;
-use crate::renderer::SameThread;
+use crate::shared::SameThread;
 use pyo3::conversion::FromPyObjectOwned;
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyList, PyMapping, PyString};
@@ -12,8 +12,8 @@ use std::path::PathBuf;
 use viewsynth::convention::Conventions;
 use viewsynth::gpu::Gpu;
 use viewsynth::io::Encoding;
-use viewsynth::refocus::batch::{load_manifest as read_manifest, run_batch, BatchFrame, BatchOptions, Shard};
 use viewsynth::io::{DepthFormats, FileFormats, RgbFormat};
+use viewsynth::refocus::batch::{load_manifest as read_manifest, run_batch, BatchFrame, BatchOptions, Shard};
 use viewsynth::refocus::{BreakRule, Method};
 
 /// The keys a frame may have (a manifest's columns).
@@ -168,28 +168,15 @@ fn depth_formats(obj: &Bound<'_, PyAny>) -> PyResult<DepthFormats> {
         obj.extract()
             .map_err(|_| errors::invalid("depth_format", "expected any of \"exr\", \"npy\", \"png16\""))?
     };
-    let mut f = DepthFormats {
-        exr: false,
-        npy: false,
-        png16: false,
-    };
-    for n in &names {
-        match n.as_str() {
-            "exr" => f.exr = true,
-            "npy" => f.npy = true,
-            "png16" => f.png16 = true,
-            other => {
-                return Err(errors::invalid(
-                    "depth_format",
-                    format!("'{other}': expected any of \"exr\", \"npy\", \"png16\""),
-                ))
-            }
-        }
-    }
     if names.is_empty() {
         return Err(errors::invalid("depth_format", "no format given"));
     }
-    Ok(f)
+    DepthFormats::parse(names.iter().map(String::as_str)).map_err(|bad| {
+        errors::invalid(
+            "depth_format",
+            format!("'{bad}': expected any of \"exr\", \"npy\", \"png16\""),
+        )
+    })
 }
 
 /// The arguments of one refocus_batch call, as Python gave them.
@@ -215,7 +202,7 @@ pub struct BatchArgs<'a, 'py> {
 }
 
 fn options(a: &BatchArgs<'_, '_>) -> PyResult<BatchOptions> {
-    let outputs = crate::renderer::output_set(a.outputs)?;
+    let outputs = crate::shared::output_set(a.outputs)?;
     let rgb = match a.rgb_format {
         "png" => RgbFormat::Png,
         "jpeg" | "jpg" => RgbFormat::Jpeg,

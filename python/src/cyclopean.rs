@@ -7,7 +7,7 @@
 use crate::arrays;
 use crate::errors;
 use crate::errors::Kind;
-use crate::renderer::SameThread;
+use crate::shared::SameThread;
 use pyo3::prelude::*;
 use pyo3::types::{PyBool, PyDict, PyFloat, PyInt, PyList, PyString, PyTuple};
 use viewsynth::convention::Conventions;
@@ -364,7 +364,7 @@ pub fn cyclopean<'py>(py: Python<'py>, gpu: Gpu, a: CyclopeanArgs<'_, 'py>) -> P
         }
     };
     let outputs = match a.outputs {
-        Some(_) => crate::renderer::output_set(a.outputs)?,
+        Some(_) => crate::shared::output_set(a.outputs)?,
         None => OutputSet {
             rgb: true,
             depth: metric,

@@ -11,24 +11,17 @@ mod errors;
 mod ints;
 mod renderer;
 mod reproject;
+mod shared;
 mod stitch;
 
 use pyo3::prelude::*;
 use viewsynth::gpu::GpuInfo;
 
-/// Mesa's software rasterisers (no GPU behind them).
-pub(crate) fn is_software(renderer: &str) -> bool {
-    ["llvmpipe", "softpipe", "swrast", "lavapipe"]
-        .iter()
-        .any(|s| renderer.to_ascii_lowercase().contains(s))
-}
-
-/// GpuInfo as a plain dict (through its serde form, so new fields appear without a change here).
+/// GpuInfo as a plain dict (through its serde form, so new fields appear without a change here;
+/// "software" is the library's own `GpuInfo.software`, the only software check).
 pub(crate) fn info_dict<'py>(py: Python<'py>, info: &GpuInfo) -> PyResult<Bound<'py, PyAny>> {
     let text = serde_json::to_string(info).map_err(|e| pyo3::exceptions::PyRuntimeError::new_err(e.to_string()))?;
-    let dict = py.import("json")?.call_method1("loads", (text,))?;
-    dict.set_item("software", is_software(&info.renderer))?;
-    Ok(dict)
+    py.import("json")?.call_method1("loads", (text,))
 }
 
 /// Describe the EGL/OpenGL context viewsynth renders with (opening one, or reusing this thread's):

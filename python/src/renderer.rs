@@ -5,6 +5,7 @@
 use crate::arrays;
 use crate::context;
 use crate::errors::{self, Kind};
+use crate::shared::{output_set, SameThread};
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyList, PyString};
 use viewsynth::camera::PinholeCamera;
@@ -12,14 +13,6 @@ use viewsynth::convention::Conventions;
 use viewsynth::gpu::Gpu;
 use viewsynth::refocus::manifest::TargetSpec;
 use viewsynth::refocus::{BreakRule, Method, OutputSet, RefocusOutput, RefocusSource, Refocuser};
-
-/// Moves a value into `Python::detach`, whose closure runs synchronously on the calling thread.
-/// The `Gpu` inside is an `Rc`: it is sound here because nothing else can reach it while the GIL
-/// is released (the Renderer's handle is `ThreadBound`, refused to every other thread, and the
-/// call holds a mutable borrow of the Renderer until detach returns).
-pub(crate) struct SameThread<T>(pub(crate) T);
-// SAFETY: see above; the value never leaves the thread that made it.
-unsafe impl<T> Send for SameThread<T> {}
 
 /// A refocus call's inputs, validated while the GIL is held.
 struct RefocusJob {
@@ -58,19 +51,6 @@ fn coverage(out: &RefocusOutput) -> Option<f64> {
     out.depth
         .as_ref()
         .map(|d| d.data.iter().filter(|z| **z > 0.0).count() as f64 / d.data.len() as f64)
-}
-
-pub(crate) fn output_set(obj: Option<&Bound<'_, PyAny>>) -> PyResult<OutputSet> {
-    let Some(obj) = obj else {
-        return Ok(OutputSet::default());
-    };
-    let list: Vec<String> = if let Ok(s) = obj.cast::<PyString>() {
-        vec![s.to_string()]
-    } else {
-        obj.extract()
-            .map_err(|_| errors::invalid("outputs", "expected a sequence of \"rgb\", \"depth\", \"mask\""))?
-    };
-    OutputSet::parse(&list.join(",")).map_err(errors::from_library)
 }
 
 /// A value usable only on the thread that made it: every access checks the thread and fails
@@ -218,7 +198,7 @@ impl Renderer {
         };
         if require_gpu {
             let info = renderer.gpu()?.info();
-            if crate::is_software(&info.renderer) {
+            if info.software {
                 return Err(errors::raise(
                     Kind::GpuUnavailable,
                     format!(
@@ -672,7 +652,7 @@ impl Renderer {
     /// Raises InvalidInputError for a bad argument or frame entry, FileError for an unreadable
     /// manifest or an unusable out_dir.
     #[allow(clippy::too_many_arguments)]
-    #[pyo3(signature = (frames, out_dir, *, scales = vec![0.5, 0.75, 1.0, 1.5, 2.0], size = None, principal = None,
+    #[pyo3(signature = (frames, out_dir, *, scales = viewsynth::refocus::manifest::DEFAULT_SCALES.to_vec(), size = None, principal = None,
                         outputs = None, tau_rel = 0.05, tau_abs = 0.2, method = "fullscreen", rgb_format = "png",
                         depth_format = None, depth_preview = false, png_compression = "fast",
                         exr_compression = "zip", depth_trunc = None, resume = true, jobs = None, shard = None))]

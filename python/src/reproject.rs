@@ -3,7 +3,7 @@
 
 use crate::arrays;
 use crate::errors;
-use crate::renderer::SameThread;
+use crate::shared::SameThread;
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 use viewsynth::camera::stereo::{Eye, StereoParams};
@@ -166,7 +166,7 @@ pub fn reproject<'py>(py: Python<'py>, gpu: Gpu, a: ReprojectArgs<'_, 'py>) -> P
         tau_rel: a.tau_rel,
     };
     params.validate().map_err(errors::from_library)?;
-    let outputs = crate::renderer::output_set(a.outputs)?;
+    let outputs = crate::shared::output_set(a.outputs)?;
     let params = ReprojectParams {
         outputs: ReprojectOutputs {
             color: outputs.rgb,

@@ -4,7 +4,7 @@
 
 use crate::arrays;
 use crate::errors;
-use crate::renderer::SameThread;
+use crate::shared::SameThread;
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 use viewsynth::convention::{Conventions, DepthPlanes, NdcDepthRange};

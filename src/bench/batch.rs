@@ -207,7 +207,7 @@ pub fn batch_bench(
     let frames: Vec<BatchFrame> = load_manifest(&manifest)?;
     let first = &frames[0];
     let (w, h) = io::load_rgb(&first.rgb).map(|i| (i.width, i.height))?;
-    let scales = vec![0.5, 0.75, 1.0, 1.5, 2.0];
+    let scales = crate::refocus::manifest::DEFAULT_SCALES.to_vec();
     let opts = |jobs: usize| BatchOptions {
         scales: scales.clone(),
         size: None,

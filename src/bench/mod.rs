@@ -47,7 +47,7 @@ impl BenchCase {
     }
 }
 
-const SCALES: [f64; 5] = [0.5, 0.75, 1.0, 1.5, 2.0];
+const SCALES: [f64; 5] = crate::refocus::manifest::DEFAULT_SCALES;
 
 /// Times both refocus paths at each size over the five focal scales (`repeats` runs, medians);
 /// returns a Markdown table and appends each case to `cases`.

@@ -16,7 +16,7 @@ use crate::vulkan::{Vk, VkExecutor};
 use std::fmt::Write as _;
 use std::time::Instant;
 
-const SCALES: [f64; 5] = [0.5, 0.75, 1.0, 1.5, 2.0];
+const SCALES: [f64; 5] = crate::refocus::manifest::DEFAULT_SCALES;
 
 /// One Markdown table; every case also goes to `cases` (as `vulkan-fullscreen`, `vulkan-mesh`).
 pub fn refocus_bench(vk: &Vk, sizes: &[(u32, u32)], repeats: usize, cases: &mut Vec<BenchCase>) -> Result<String> {

@@ -136,16 +136,35 @@ pub fn save_depth_exr(path: &Path, depth: &DepthMap) -> Result<()> {
 /// [`save_depth_exr`] with a chosen compression.
 pub fn save_depth_exr_with(path: &Path, depth: &DepthMap, compression: super::ExrCompression) -> Result<()> {
     encode_dims(path, depth.width, depth.height, 1, depth.data.len())?;
-    atomic_write(path, |out| {
-        let channels = vec![("Z", depth.data.clone())];
-        write_f32_channels(path, out, depth.width, depth.height, channels, compression)
-    })
+    atomic_write(path, |out| encode_depth_exr(path, out, depth, compression))
+}
+
+/// Encodes [`save_depth_exr_with`]'s file into `out`; errors name `path`.
+pub(crate) fn encode_depth_exr(
+    path: &Path,
+    out: &mut std::io::BufWriter<std::fs::File>,
+    depth: &DepthMap,
+    compression: super::ExrCompression,
+) -> Result<()> {
+    encode_dims(path, depth.width, depth.height, 1, depth.data.len())?;
+    let channels = vec![("Z", depth.data.clone())];
+    write_f32_channels(path, out, depth.width, depth.height, channels, compression)
 }
 
 /// Writes `<f4`, shape (height, width), C order, NPY 1.0.
 pub fn save_depth_npy(path: &Path, depth: &DepthMap) -> Result<()> {
     encode_dims(path, depth.width, depth.height, 1, depth.data.len())?;
     save_npy_f32(path, &[depth.height as usize, depth.width as usize], &depth.data)
+}
+
+/// Encodes [`save_depth_npy`]'s file into `out`; errors name `path`.
+pub(crate) fn encode_depth_npy(
+    path: &Path,
+    out: &mut std::io::BufWriter<std::fs::File>,
+    depth: &DepthMap,
+) -> Result<()> {
+    encode_dims(path, depth.width, depth.height, 1, depth.data.len())?;
+    super::npy::encode_npy_f32(path, out, &[depth.height as usize, depth.width as usize], &depth.data)
 }
 
 fn read_png(path: &Path) -> Result<RawDepth> {

@@ -19,6 +19,23 @@ pub const PNG16_UNITS_PER_METRE: f64 = 1000.0;
 /// because they round above 65535 mm (65.535 m), the format's largest value.
 pub fn save_depth_png16(path: &Path, depth: &DepthMap, compression: PngCompression) -> Result<u64> {
     encode_dims(path, depth.width, depth.height, 1, depth.data.len())?;
+    let mut clipped = 0;
+    atomic_write(path, |out| {
+        clipped = encode_depth_png16(path, out, depth, compression)?;
+        Ok(())
+    })?;
+    Ok(clipped)
+}
+
+/// Encodes [`save_depth_png16`]'s file into `out` and returns the clipped count; errors name
+/// `path`.
+pub(crate) fn encode_depth_png16(
+    path: &Path,
+    out: &mut std::io::BufWriter<std::fs::File>,
+    depth: &DepthMap,
+    compression: PngCompression,
+) -> Result<u64> {
+    encode_dims(path, depth.width, depth.height, 1, depth.data.len())?;
     let mut clipped = 0u64;
     let mm: Vec<u16> = depth
         .data
@@ -37,17 +54,15 @@ pub fn save_depth_png16(path: &Path, depth: &DepthMap, compression: PngCompressi
             }
         })
         .collect();
-    atomic_write(path, |out| {
-        // The encoder takes native-endian samples and writes them big-endian, as PNG requires.
-        PngEncoder::new_with_quality(out, compression.image_type(), FilterType::Adaptive)
-            .write_image(
-                bytemuck::cast_slice(&mm),
-                depth.width,
-                depth.height,
-                ExtendedColorType::L16,
-            )
-            .map_err(|e| Error::encode(path, e.to_string()))
-    })?;
+    // The encoder takes native-endian samples and writes them big-endian, as PNG requires.
+    PngEncoder::new_with_quality(out, compression.image_type(), FilterType::Adaptive)
+        .write_image(
+            bytemuck::cast_slice(&mm),
+            depth.width,
+            depth.height,
+            ExtendedColorType::L16,
+        )
+        .map_err(|e| Error::encode(path, e.to_string()))?;
     Ok(clipped)
 }
 

@@ -10,7 +10,7 @@ use super::decode::{decode_image, Decoded, Samples};
 use super::image_types::{encode_dims, Mask};
 use crate::error::{Error, Result};
 
-/// Writes 8-bit gray: 0 -> 0, any nonzero value -> 255.
+/// Writes 8-bit gray: 0 -> 0, [`MASK_FILLED`] -> itself, any other nonzero value -> 255.
 pub fn save_mask_png(path: &Path, mask: &Mask) -> Result<()> {
     save_mask_png_with(path, mask, super::PngCompression::default())
 }
@@ -21,6 +21,16 @@ pub const MASK_FILLED: u8 = 128;
 
 /// [`save_mask_png`] with a chosen compression.
 pub fn save_mask_png_with(path: &Path, mask: &Mask, compression: super::PngCompression) -> Result<()> {
+    atomic_write(path, |out| encode_mask_png(path, out, mask, compression))
+}
+
+/// Encodes [`save_mask_png_with`]'s file into `out`; errors name `path`.
+pub(crate) fn encode_mask_png(
+    path: &Path,
+    out: &mut std::io::BufWriter<std::fs::File>,
+    mask: &Mask,
+    compression: super::PngCompression,
+) -> Result<()> {
     encode_dims(path, mask.width, mask.height, 1, mask.data.len())?;
     let bytes: Vec<u8> = mask
         .data
@@ -31,11 +41,9 @@ pub fn save_mask_png_with(path: &Path, mask: &Mask, compression: super::PngCompr
             _ => 255,
         })
         .collect();
-    atomic_write(path, |out| {
-        PngEncoder::new_with_quality(out, compression.image_type(), FilterType::Adaptive)
-            .write_image(&bytes, mask.width, mask.height, ExtendedColorType::L8)
-            .map_err(|e| Error::encode(path, e.to_string()))
-    })
+    PngEncoder::new_with_quality(out, compression.image_type(), FilterType::Adaptive)
+        .write_image(&bytes, mask.width, mask.height, ExtendedColorType::L8)
+        .map_err(|e| Error::encode(path, e.to_string()))
 }
 
 /// Reads a PNG mask: a pixel is 1 when any of its colour samples is nonzero (alpha is

@@ -262,6 +262,11 @@ fn header_extent(start: &[u8]) -> std::result::Result<(usize, usize), String> {
 
 /// Writes `data` as `<f4` in C order with the given shape, NPY format 1.0.
 pub fn save_npy_f32(path: &Path, shape: &[usize], data: &[f32]) -> Result<()> {
+    check_shape(path, shape, data)?;
+    atomic_write(path, |out| encode_npy_f32(path, out, shape, data))
+}
+
+fn check_shape(path: &Path, shape: &[usize], data: &[f32]) -> Result<()> {
     let count = shape.iter().try_fold(1usize, |acc, &d| acc.checked_mul(d));
     if count != Some(data.len()) {
         return Err(Error::SizeMismatch {
@@ -272,15 +277,24 @@ pub fn save_npy_f32(path: &Path, shape: &[usize], data: &[f32]) -> Result<()> {
             ),
         });
     }
+    Ok(())
+}
+
+/// Encodes [`save_npy_f32`]'s file into `out`; errors name `path`.
+pub(crate) fn encode_npy_f32(
+    path: &Path,
+    out: &mut std::io::BufWriter<std::fs::File>,
+    shape: &[usize],
+    data: &[f32],
+) -> Result<()> {
+    check_shape(path, shape, data)?;
     let header =
         format_header("<f4", shape).ok_or_else(|| Error::encode(path, "NPY header longer than 65535 bytes"))?;
-    atomic_write(path, |out| {
-        out.write_all(&header).map_err(|e| Error::io(path, e))?;
-        for v in data {
-            out.write_all(&v.to_le_bytes()).map_err(|e| Error::io(path, e))?;
-        }
-        Ok(())
-    })
+    out.write_all(&header).map_err(|e| Error::io(path, e))?;
+    for v in data {
+        out.write_all(&v.to_le_bytes()).map_err(|e| Error::io(path, e))?;
+    }
+    Ok(())
 }
 
 /// Magic, version, length and dict text padded so the payload starts 64-byte aligned.

@@ -13,6 +13,8 @@ use super::{Encoding, FileSet, PreviewRange};
 use crate::error::{Error, Result};
 use crate::view::ViewOutput;
 use serde::{Deserialize, Serialize};
+use std::fs::File;
+use std::io::BufWriter;
 use std::path::Path;
 
 /// Which outputs to produce; nothing is allocated, read back or written for the others.
@@ -99,6 +101,31 @@ pub struct DepthFormats {
     /// when off, so batches made before it resume.
     #[serde(skip_serializing_if = "std::ops::Not::not")]
     pub png16: bool,
+}
+
+impl DepthFormats {
+    /// The formats named (any of exr, npy, png16; at least one): the one parser of the CLI's
+    /// `--depth-format` and Python's `depth_format=`. Err holds the first entry that is not a
+    /// format ("" when none is given).
+    pub fn parse<'a>(names: impl IntoIterator<Item = &'a str>) -> std::result::Result<Self, String> {
+        let mut f = DepthFormats {
+            exr: false,
+            npy: false,
+            png16: false,
+        };
+        for name in names {
+            match name.trim() {
+                "exr" => f.exr = true,
+                "npy" => f.npy = true,
+                "png16" => f.png16 = true,
+                other => return Err(other.to_string()),
+            }
+        }
+        if !(f.exr || f.npy || f.png16) {
+            return Err(String::new());
+        }
+        Ok(f)
+    }
 }
 
 impl Default for DepthFormats {
@@ -309,7 +336,7 @@ pub fn file_records<'a>(dir: &Path, names: impl IntoIterator<Item = &'a String>)
 /// returns the entry naming them. An output asked for that the view does not hold is an
 /// error naming it (never a file silently left out); errors name the final paths.
 pub fn write_view(set: &mut FileSet, names: &ViewNames, view: &ViewOutput, formats: &FileFormats) -> Result<ViewFiles> {
-    write_view_in(set.staging(), names, view, formats).map_err(|e| set.final_error(e))
+    write_view_in(set, names, view, formats)
 }
 
 fn missing(what: &str) -> Error {
@@ -319,50 +346,61 @@ fn missing(what: &str) -> Error {
     )
 }
 
-fn write_view_in(dir: &Path, names: &ViewNames, view: &ViewOutput, formats: &FileFormats) -> Result<ViewFiles> {
+fn write_view_in(set: &mut FileSet, names: &ViewNames, view: &ViewOutput, formats: &FileFormats) -> Result<ViewFiles> {
     formats.validate()?;
     let (outputs, enc) = (formats.outputs, formats.encoding);
     let mut entry = ViewFiles::default();
-    let file = |stem: &str, suffix: &str| -> (std::path::PathBuf, String) {
-        let name = format!("{stem}{suffix}");
-        (dir.join(&name), name)
+    // Each file straight into the set (synced with the others at commit); errors name the
+    // final path.
+    let mut put = |name: String, encode: &mut dyn FnMut(&Path, &mut BufWriter<File>) -> Result<()>| {
+        let shown = set.final_path(&name);
+        set.write(&name, |out| encode(&shown, out))?;
+        Ok::<String, Error>(name)
     };
     if outputs.rgb {
         let rgb = view.color.as_ref().ok_or_else(|| missing("rgb"))?;
-        let (path, name) = file(&names.rgb, &format!(".{}", formats.rgb.extension()));
-        super::save_rgb_with(&path, rgb, &enc)?;
-        entry.rgb = Some(name);
+        let ext = formats.rgb.extension();
+        let name = format!("{}.{ext}", names.rgb);
+        entry.rgb = Some(put(name, &mut |p, out| super::rgb::encode_rgb(p, out, rgb, ext, &enc))?);
     }
     if outputs.depth {
         let depth = view.depth.as_ref().ok_or_else(|| missing("depth"))?;
         if formats.depth.exr {
-            let (path, name) = file(&names.depth, ".exr");
-            super::save_depth_exr_with(&path, depth, enc.exr)?;
-            entry.depth_exr = Some(name);
+            let name = format!("{}.exr", names.depth);
+            entry.depth_exr = Some(put(name, &mut |p, out| {
+                super::depth::encode_depth_exr(p, out, depth, enc.exr)
+            })?);
         }
         if formats.depth.npy {
-            let (path, name) = file(&names.depth, ".npy");
-            super::save_depth_npy(&path, depth)?;
-            entry.depth_npy = Some(name);
+            let name = format!("{}.npy", names.depth);
+            entry.depth_npy = Some(put(name, &mut |p, out| super::depth::encode_depth_npy(p, out, depth))?);
         }
         if formats.depth.png16 {
-            let (path, name) = file(&names.depth, ".png");
-            entry.depth_png16_clipped = Some(super::save_depth_png16(&path, depth, enc.png)?);
-            entry.depth_png16 = Some(name);
+            let (name, mut clipped) = (format!("{}.png", names.depth), 0);
+            entry.depth_png16 = Some(put(name, &mut |p, out| {
+                clipped = super::depth_png16::encode_depth_png16(p, out, depth, enc.png)?;
+                Ok(())
+            })?);
+            entry.depth_png16_clipped = Some(clipped);
         }
         if formats.depth_preview {
-            let (path, name) = file(&names.depth, "_preview.png");
-            entry.depth_preview_range_m = super::save_depth_preview(&path, depth, &enc)?;
-            entry.depth_preview = Some(name);
+            let range = super::depth_preview_range(depth);
+            let image = super::depth_preview(depth, range);
+            let name = format!("{}_preview.png", names.depth);
+            entry.depth_preview = Some(put(name, &mut |p, out| {
+                super::rgb::encode_rgb(p, out, &image, "png", &enc)
+            })?);
+            entry.depth_preview_range_m = range;
         }
         let valid = depth.data.iter().filter(|z| **z > 0.0).count();
         entry.coverage = Some(valid as f64 / depth.data.len().max(1) as f64);
     }
     if outputs.mask {
         let mask = view.mask.as_ref().ok_or_else(|| missing("mask"))?;
-        let (path, name) = file(&names.mask, ".png");
-        super::save_mask_png_with(&path, mask, enc.png)?;
-        entry.mask = Some(name);
+        let name = format!("{}.png", names.mask);
+        entry.mask = Some(put(name, &mut |p, out| {
+            super::mask::encode_mask_png(p, out, mask, enc.png)
+        })?);
         let valid = mask.data.iter().filter(|m| **m != 0).count();
         entry.coverage = Some(valid as f64 / mask.data.len().max(1) as f64);
     }

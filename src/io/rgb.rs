@@ -1,5 +1,7 @@
 //! 8-bit RGB loading and saving.
 
+use std::fs::File;
+use std::io::BufWriter;
 use std::path::Path;
 
 use image::codecs::jpeg::JpegEncoder;
@@ -43,19 +45,33 @@ pub fn save_rgb(path: &Path, img: &RgbImage) -> Result<()> {
 /// [`save_rgb`] with chosen PNG/EXR compression.
 pub fn save_rgb_with(path: &Path, img: &RgbImage, encoding: &super::Encoding) -> Result<()> {
     let ext = lowercase_extension(path);
+    if !matches!(ext.as_str(), "png" | "jpg" | "jpeg" | "exr") {
+        return Err(Error::encode(
+            path,
+            "unknown RGB output format: expected .png .jpg .jpeg .exr",
+        ));
+    }
+    encode_dims(path, img.width, img.height, 3, img.data.len())?;
+    atomic_write(path, |out| encode_rgb(path, out, img, &ext, encoding))
+}
+
+/// Encodes `img` into `out` as `ext` says (png, jpg/jpeg or exr); errors name `path`.
+pub(crate) fn encode_rgb(
+    path: &Path,
+    out: &mut BufWriter<File>,
+    img: &RgbImage,
+    ext: &str,
+    encoding: &super::Encoding,
+) -> Result<()> {
     encode_dims(path, img.width, img.height, 3, img.data.len())?;
     let (w, h) = (img.width, img.height);
-    match ext.as_str() {
-        "png" => atomic_write(path, |out| {
-            PngEncoder::new_with_quality(out, encoding.png.image_type(), FilterType::Adaptive)
-                .write_image(&img.data, w, h, ExtendedColorType::Rgb8)
-                .map_err(|e| Error::encode(path, e.to_string()))
-        }),
-        "jpg" | "jpeg" => atomic_write(path, |out| {
-            JpegEncoder::new_with_quality(out, JPEG_QUALITY)
-                .write_image(&img.data, w, h, ExtendedColorType::Rgb8)
-                .map_err(|e| Error::encode(path, e.to_string()))
-        }),
+    match ext {
+        "png" => PngEncoder::new_with_quality(out, encoding.png.image_type(), FilterType::Adaptive)
+            .write_image(&img.data, w, h, ExtendedColorType::Rgb8)
+            .map_err(|e| Error::encode(path, e.to_string())),
+        "jpg" | "jpeg" => JpegEncoder::new_with_quality(out, JPEG_QUALITY)
+            .write_image(&img.data, w, h, ExtendedColorType::Rgb8)
+            .map_err(|e| Error::encode(path, e.to_string())),
         "exr" => {
             let plane = |c: usize| -> Vec<f32> {
                 img.data
@@ -66,7 +82,7 @@ pub fn save_rgb_with(path: &Path, img: &RgbImage, encoding: &super::Encoding) ->
                     .collect()
             };
             let channels = vec![("R", plane(0)), ("G", plane(1)), ("B", plane(2))];
-            atomic_write(path, |out| write_f32_channels(path, out, w, h, channels, encoding.exr))
+            write_f32_channels(path, out, w, h, channels, encoding.exr)
         }
         _ => Err(Error::encode(
             path,

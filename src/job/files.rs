@@ -45,20 +45,7 @@ pub fn file_formats(o: &FileOptions<'_>) -> Result<FileFormats, ArgError> {
 
 /// `--depth-format`: a comma-separated list of exr, npy, png16.
 pub fn depth_formats(list: &str) -> Result<DepthFormats, ArgError> {
-    let mut f = DepthFormats {
-        exr: false,
-        npy: false,
-        png16: false,
-    };
-    for item in list.split(',').map(str::trim) {
-        match item {
-            "exr" => f.exr = true,
-            "npy" => f.npy = true,
-            "png16" => f.png16 = true,
-            _ => return Err(ArgError::DepthFormat(item.to_string())),
-        }
-    }
-    Ok(f)
+    DepthFormats::parse(list.split(',')).map_err(ArgError::DepthFormat)
 }
 
 #[cfg(test)]

@@ -10,6 +10,13 @@ use crate::view::ViewOutput;
 use serde::Serialize;
 use std::path::{Path, PathBuf};
 
+/// The default focal scales of refocus (CLI `--zoom-range`, Python `scales=`, the demo and the
+/// benchmarks): the one list every default refers to.
+pub const DEFAULT_SCALES: [f64; 5] = [0.5, 0.75, 1.0, 1.5, 2.0];
+
+/// [`DEFAULT_SCALES`] as the CLI's `--zoom-range` default text (a test checks they agree).
+pub const DEFAULT_SCALES_TEXT: &str = "0.5,0.75,1,1.5,2";
+
 /// How target cameras are derived from the source.
 #[derive(Debug, Clone, PartialEq)]
 pub struct TargetSpec {
@@ -278,6 +285,12 @@ mod tests {
         assert!(e.contains("0.5000001") && e.contains("s0.5"), "{e}");
         assert_eq!(scale_tag(1.0), "s1");
         assert_eq!(TargetSpec::scales_from_focal_list(&src.k, &[250.0]), vec![0.5]);
+    }
+
+    #[test]
+    fn the_default_scales_text_is_the_default_scales() {
+        let parsed: Vec<f64> = DEFAULT_SCALES_TEXT.split(',').map(|v| v.parse().unwrap()).collect();
+        assert_eq!(parsed, DEFAULT_SCALES);
     }
 
     #[test]

@@ -8,6 +8,7 @@ mod cli_compare;
 mod cli_depth_out;
 mod cli_formats;
 mod cli_output;
+mod cli_outputs_table;
 mod cli_reproject_stitch;
 mod common;
 mod compare;

@@ -56,7 +56,7 @@ pub(crate) struct RefocusArgs {
     #[arg(help_heading = TARGETS, long, value_delimiter = ',', conflicts_with = "zoom_range", value_parser = finite_value)]
     focal_list: Option<Vec<f64>>,
     /// Target focal scales s (fx' = s fx).
-    #[arg(help_heading = TARGETS, long, value_delimiter = ',', default_value = "0.5,0.75,1,1.5,2", value_parser = finite_value)]
+    #[arg(help_heading = TARGETS, long, value_delimiter = ',', default_value = viewsynth::refocus::manifest::DEFAULT_SCALES_TEXT, value_parser = finite_value)]
     zoom_range: Vec<f64>,
     /// Output width in pixels (default: the source's; with --height-out).
     #[arg(help_heading = TARGETS, long, requires = "height_out", value_parser = clap::value_parser!(u32).range(1..=i64::from(io::MAX_DIMENSION)))]
@@ -81,9 +81,10 @@ pub(crate) struct RefocusArgs {
     /// default) or mesh (the triangles rasterised); both give the same output.
     #[arg(help_heading = METHOD, long, value_enum, default_value = "fullscreen")]
     method: MethodArg,
-    /// Output folder (created if missing): per zoom scale s, s{s}_rgb.png, s{s}_depth.exr,
-    /// s{s}_mask.png (those in --outputs; f{fx'}_rgb.png etc. with --focal-list), and
-    /// manifest.json.
+    /// Output folder (created if missing): per zoom scale s, s{s}_rgb.png (s{s}_rgb.jpg, s{s}_rgb.exr
+    /// with --rgb-format), s{s}_depth.exr, s{s}_depth.npy, s{s}_depth.png (those in --depth-format),
+    /// s{s}_depth_preview.png (--depth-preview), s{s}_mask.png (those in --outputs; f{fx'}_rgb.png
+    /// etc. with --focal-list), and manifest.json.
     #[arg(help_heading = OUTPUTS, long)]
     out_dir: PathBuf,
     #[command(flatten)]

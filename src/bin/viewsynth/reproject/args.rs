@@ -124,8 +124,10 @@ pub(crate) struct ReprojectArgs {
     tau_rel: f64,
     #[command(flatten)]
     files: FileOutputArgs,
-    /// Output folder (created if missing): <target>_rgb.png, <target>_depth.exr,
-    /// <target>_mask.png (target = left, right; those in --outputs).
+    /// Output folder (created if missing): per target (left, right), <target>_rgb.png
+    /// (<target>_rgb.jpg, <target>_rgb.exr with --rgb-format), <target>_depth.exr,
+    /// <target>_depth.npy, <target>_depth.png (those in --depth-format),
+    /// <target>_depth_preview.png (--depth-preview), <target>_mask.png (those in --outputs).
     #[arg(help_heading = OUTPUTS, long)]
     out_dir: PathBuf,
     #[command(flatten)]

@@ -28,7 +28,8 @@ pub(crate) struct SceneArgs {
     /// Interocular distance in metres.
     #[arg(help_heading = TARGETS, long, default_value_t = 0.064, value_parser = finite_value)]
     ipd: f64,
-    /// Output folder (created if missing).
+    /// Output folder (created if missing): {left,right,middle}_rgb.png, {left,right,middle}_view_z.exr,
+    /// {left,right,middle}_device_depth.exr and cameras.json.
     #[arg(help_heading = OUTPUTS, long, default_value = "out/scene")]
     out_dir: PathBuf,
     /// Also write each eye's six cube faces, N x N pixels, as `viewsynth stitch --faces` reads

@@ -1,0 +1,29 @@
+//! Helpers every binding uses (the renderer's methods and the modules they call alike), kept
+//! apart from `renderer` so that no binding imports back from the module that calls it.
+
+use crate::errors;
+use pyo3::prelude::*;
+use pyo3::types::PyString;
+use viewsynth::refocus::OutputSet;
+
+/// Moves a value into `Python::detach`, whose closure runs synchronously on the calling thread.
+/// The `Gpu` inside is an `Rc`: it is sound here because nothing else can reach it while the GIL
+/// is released (the Renderer's handle is `ThreadBound`, refused to every other thread, and the
+/// call holds a mutable borrow of the Renderer until detach returns).
+pub(crate) struct SameThread<T>(pub(crate) T);
+// SAFETY: see above; the value never leaves the thread that made it.
+unsafe impl<T> Send for SameThread<T> {}
+
+/// `outputs=`: a name or a sequence of "rgb", "depth", "mask" (None: all three).
+pub(crate) fn output_set(obj: Option<&Bound<'_, PyAny>>) -> PyResult<OutputSet> {
+    let Some(obj) = obj else {
+        return Ok(OutputSet::default());
+    };
+    let list: Vec<String> = if let Ok(s) = obj.cast::<PyString>() {
+        vec![s.to_string()]
+    } else {
+        obj.extract()
+            .map_err(|_| errors::invalid("outputs", "expected a sequence of \"rgb\", \"depth\", \"mask\""))?
+    };
+    OutputSet::parse(&list.join(",")).map_err(errors::from_library)
+}
