@@ -7,6 +7,7 @@ mod cli_batch;
 mod cli_cameras_cv;
 mod cli_compare;
 mod cli_depth_out;
+mod cli_end_to_end;
 mod cli_formats;
 mod cli_output;
 mod cli_reproject_stitch;
