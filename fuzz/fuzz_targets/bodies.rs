@@ -96,8 +96,11 @@ pub fn npz_target(data: &[u8]) {
     }
 }
 
+/// A target's body.
+pub type Body = fn(&[u8]);
+
 /// Every target by name (the corpus folders' names).
-pub const TARGETS: [(&str, fn(&[u8])); 5] = [
+pub const TARGETS: [(&str, Body); 5] = [
     ("load_depth", load_depth_target),
     ("load_rgb", load_rgb_target),
     ("json_inputs", json_inputs_target),

@@ -8,8 +8,11 @@ use std::collections::BTreeSet;
 use std::path::Path;
 use viewsynth::io;
 
-/// report.csv: its rows as (capability, scene, method, setting, psnr, coverage).
-fn report_rows(path: &Path) -> Vec<(String, String, String, String, Option<f64>, Option<f64>)> {
+/// A report.csv row: (capability, scene, method, setting, psnr, coverage).
+type Row = (String, String, String, String, Option<f64>, Option<f64>);
+
+/// report.csv: its rows.
+fn report_rows(path: &Path) -> Vec<Row> {
     let mut r = csv::Reader::from_path(path).unwrap();
     let headers = r.headers().unwrap().clone();
     let col = |name: &str| {
@@ -44,7 +47,7 @@ fn report_rows(path: &Path) -> Vec<(String, String, String, String, Option<f64>,
 
 /// report.{md,csv,svg} are there, whole, and agree on the row count; every built-in capability
 /// has rows for all its methods with a finite PSNR and coverage in (0, 1]. Returns the rows.
-fn check_report(dir: &Path) -> Vec<(String, String, String, String, Option<f64>, Option<f64>)> {
+fn check_report(dir: &Path) -> Vec<Row> {
     let rows = report_rows(&dir.join("report.csv"));
     let md = std::fs::read_to_string(dir.join("report.md")).unwrap();
     let svg = std::fs::read_to_string(dir.join("report.svg")).unwrap();
