@@ -1,17 +1,7 @@
 #![no_main]
-//! Batch manifests, CSV and JSON.
+//! Batch manifests, CSV and JSON. Body: bodies.rs (shared with the stable driver tests/fuzz_stable.rs).
 use libfuzzer_sys::fuzz_target;
-use viewsynth::refocus::batch::load_manifest;
 
-mod common;
+mod bodies;
 
-fuzz_target!(|data: &[u8]| {
-    if data.is_empty() {
-        return;
-    }
-    let ext = if data[0] & 1 == 0 { "csv" } else { "json" };
-    let p = common::scratch(ext, &data[1..]);
-    if let Ok(frames) = load_manifest(&p) {
-        assert!(!frames.is_empty());
-    }
-});
+fuzz_target!(|data: &[u8]| bodies::batch_manifest_target(data));

@@ -1,14 +1,7 @@
 #![no_main]
-//! Colour loader (format sniffed from content) and the mask reader.
+//! Colour loader (format sniffed from content) and the mask reader. Body: bodies.rs (shared with the stable driver tests/fuzz_stable.rs).
 use libfuzzer_sys::fuzz_target;
-use viewsynth::io::{load_mask_png, load_rgb};
 
-mod common;
+mod bodies;
 
-fuzz_target!(|data: &[u8]| {
-    let p = common::scratch("png", data);
-    if let Ok(img) = load_rgb(&p) {
-        assert_eq!(img.data.len(), img.width as usize * img.height as usize * 3);
-    }
-    let _ = load_mask_png(&p);
-});
+fuzz_target!(|data: &[u8]| bodies::load_rgb_target(data));

@@ -3,9 +3,11 @@
 
 mod batch;
 mod cli;
+mod cli_batch;
 mod cli_cameras_cv;
 mod cli_compare;
 mod cli_depth_out;
+mod cli_end_to_end;
 mod cli_formats;
 mod cli_output;
 mod cli_outputs_table;

@@ -155,4 +155,33 @@ fn only_requested_outputs_are_produced() {
         }
     }
     assert!(OutputSet::parse("").is_err() && OutputSet::parse("rgb,normals").is_err());
+    // Last (each new context becomes current on this thread, so `g` is not used after):
+    // counted on a fresh context per choice, renderer alive after one render, every output
+    // left out costs exactly one render-target texture and one readback (pixel-pack buffer)
+    // less than all three (colour also its source upload). An attachment, upload or read made
+    // and thrown away shows here.
+    let census = |set: OutputSet, method: Method| {
+        let g = gpu();
+        let mut r = Refocuser::new(&g, &src, &BreakRule::default(), method, set, Conventions::default()).unwrap();
+        r.render(&cam).unwrap();
+        (g.live_objects(), g.readback_buffers_created())
+    };
+    for method in [Method::Fullscreen, Method::Mesh] {
+        let (all, all_reads) = census(OutputSet::parse("rgb,depth,mask").unwrap(), method);
+        for list in ["rgb", "depth", "mask", "rgb,depth", "rgb,mask", "depth,mask"] {
+            let set = OutputSet::parse(list).unwrap();
+            let (live, reads) = census(set, method);
+            let left_out = usize::from(!set.rgb) + usize::from(!set.depth) + usize::from(!set.mask);
+            // Without colour the source colour is not uploaded either: one texture more.
+            let textures_saved = left_out + usize::from(!set.rgb);
+            let tag = format!("{method:?} {list}: {live:?}, {reads} readbacks; all {all:?}, {all_reads}");
+            assert_eq!(live.textures + textures_saved, all.textures, "{tag}");
+            assert_eq!(reads + left_out, all_reads, "{tag}");
+            assert_eq!(
+                (live.framebuffers, live.programs, live.vertex_arrays),
+                (all.framebuffers, all.programs, all.vertex_arrays),
+                "{tag}"
+            );
+        }
+    }
 }

@@ -1,0 +1,292 @@
+//! `refocus --batch` from the command line, for the README's promises that no other test holds
+//! through the binary: each resume invalidation rule (inputs' size and mtime, conventions,
+//! outputs, formats), `--shard K/N` taking the frames with i % N == K over several K, resume per
+//! shard, and kill -9 mid-batch then resume.
+
+use crate::cli::{bin, files_in, scratch};
+use image::ImageEncoder;
+use std::collections::BTreeMap;
+use std::path::{Path, PathBuf};
+use std::process::{Output, Stdio};
+use viewsynth::io::{self, DepthMap, RgbImage};
+
+/// Two input pairs (`rgb{0,1}.png`, `depth{0,1}.npy`, 32 x 24) and a manifest of `n` frames
+/// `f0..` alternating between them (frame i uses pair i % 2).
+fn setup(name: &str, n: usize) -> (PathBuf, PathBuf) {
+    let dir = scratch(name);
+    for p in 0..2u32 {
+        let (w, h) = (32u32, 24u32);
+        let rgb: Vec<u8> = (0..w * h * 3).map(|i| ((i * (7 + p)) % 251) as u8).collect();
+        let depth: Vec<f32> = (0..w * h)
+            .map(|i| 1.0 + 0.01 * (i % w) as f32 + 0.1 * p as f32)
+            .collect();
+        io::save_rgb(&dir.join(format!("rgb{p}.png")), &RgbImage::new(w, h, rgb).unwrap()).unwrap();
+        io::save_depth_npy(&dir.join(format!("depth{p}.npy")), &DepthMap::new(w, h, depth).unwrap()).unwrap();
+    }
+    let mut csv = String::from("rgb,depth,fx,fy,cx,cy,name\n");
+    for f in 0..n {
+        csv += &format!("rgb{p}.png,depth{p}.npy,40,40,15.5,11.5,f{f}\n", p = f % 2);
+    }
+    let manifest = dir.join("frames.csv");
+    std::fs::write(&manifest, csv).unwrap();
+    (dir, manifest)
+}
+
+fn batch(manifest: &Path, out: &Path, extra: &[&str]) -> Output {
+    bin()
+        .args(["refocus", "--zoom-range", "0.5,1.5", "--jobs", "1", "--batch"])
+        .arg(manifest)
+        .arg("--out-dir")
+        .arg(out)
+        .args(extra)
+        .output()
+        .unwrap()
+}
+
+/// (rendered, already done) from the summary line "N frames ...: R rendered, S already done".
+fn counts(o: &Output) -> (usize, usize) {
+    let text = format!(
+        "{}{}",
+        String::from_utf8_lossy(&o.stdout),
+        String::from_utf8_lossy(&o.stderr)
+    );
+    assert!(o.status.success(), "{text}");
+    let num_before = |word: &str| -> usize {
+        let at = text.find(word).unwrap_or_else(|| panic!("no '{word}' in: {text}"));
+        let head = text[..at].trim_end();
+        head[head.rfind(|c: char| !c.is_ascii_digit()).map_or(0, |i| i + 1)..]
+            .parse()
+            .unwrap_or_else(|_| panic!("no count before '{word}' in: {text}"))
+    };
+    (num_before(" rendered"), num_before(" already done"))
+}
+
+/// Each frame folder's manifest bytes (they hold timings: rewritten means redone).
+fn manifests(out: &Path) -> BTreeMap<String, Vec<u8>> {
+    files_in(out)
+        .into_iter()
+        .filter(|f| !f.starts_with(".viewsynth-"))
+        .filter_map(|f| std::fs::read(out.join(&f).join("manifest.json")).ok().map(|m| (f, m)))
+        .collect()
+}
+
+/// The frames whose manifest changed between `before` and `after`.
+fn redone(before: &BTreeMap<String, Vec<u8>>, after: &BTreeMap<String, Vec<u8>>) -> Vec<String> {
+    after
+        .iter()
+        .filter(|(k, v)| before.get(*k) != Some(*v))
+        .map(|(k, _)| k.clone())
+        .collect()
+}
+
+fn names(v: &[&str]) -> Vec<String> {
+    v.iter().map(|s| s.to_string()).collect()
+}
+
+/// Every file a frame's manifest lists is there with its CRC-32.
+fn frame_complete(dir: &Path) -> bool {
+    let Ok(bytes) = std::fs::read(dir.join("manifest.json")) else {
+        return false;
+    };
+    let m: serde_json::Value = serde_json::from_slice(&bytes).expect("a whole manifest");
+    let files = m["files"].as_array().expect("files");
+    !files.is_empty()
+        && files.iter().all(|f| {
+            std::fs::read(dir.join(f["name"].as_str().unwrap())).is_ok_and(|b| {
+                let mut c = flate2::Crc::new();
+                c.update(&b);
+                Some(u64::from(c.sum())) == f["crc32"].as_u64()
+            })
+        })
+}
+
+#[test]
+fn resume_redoes_a_frame_for_each_recorded_setting_that_changed() {
+    let (dir, manifest) = setup("batch-resume-rules", 4);
+    let out = dir.join("out");
+    assert_eq!(counts(&batch(&manifest, &out, &[])), (4, 0));
+    let mut before = manifests(&out);
+    assert_eq!(
+        counts(&batch(&manifest, &out, &[])),
+        (0, 4),
+        "nothing changed: all resumed"
+    );
+    assert_eq!(redone(&before, &manifests(&out)), Vec::<String>::new());
+
+    // An input's mtime only (same bytes): the frames reading it (f0, f2) are redone.
+    let rgb0 = dir.join("rgb0.png");
+    let f = std::fs::File::options().write(true).open(&rgb0).unwrap();
+    let t = f.metadata().unwrap().modified().unwrap();
+    f.set_modified(t - std::time::Duration::from_secs(3600)).unwrap();
+    drop(f);
+    assert_eq!(counts(&batch(&manifest, &out, &[])), (2, 2), "mtime of rgb0.png");
+    let after = manifests(&out);
+    assert_eq!(redone(&before, &after), names(&["f0", "f2"]));
+    before = after;
+
+    // An input's size only: rgb1.png rewritten with other PNG settings (same pixels, another
+    // size) and its mtime put back. f1 and f3 are redone.
+    let rgb1 = dir.join("rgb1.png");
+    let t = std::fs::metadata(&rgb1).unwrap().modified().unwrap();
+    let img = io::load_rgb(&rgb1).unwrap();
+    let len = std::fs::metadata(&rgb1).unwrap().len();
+    // The first encoder setting that gives another size.
+    use image::codecs::png::{CompressionType, FilterType, PngEncoder};
+    let png = [FilterType::NoFilter, FilterType::Sub, FilterType::Paeth]
+        .into_iter()
+        .flat_map(|f| [CompressionType::Fast, CompressionType::Best].map(|c| (c, f)))
+        .map(|(c, f)| {
+            let mut png = Vec::new();
+            PngEncoder::new_with_quality(&mut png, c, f)
+                .write_image(&img.data, img.width, img.height, image::ExtendedColorType::Rgb8)
+                .unwrap();
+            png
+        })
+        .find(|png| png.len() as u64 != len)
+        .expect("an encoding of another size");
+    assert_ne!(png.len() as u64, len, "the rewrite must change the size");
+    std::fs::write(&rgb1, &png).unwrap();
+    std::fs::File::options()
+        .write(true)
+        .open(&rgb1)
+        .unwrap()
+        .set_modified(t)
+        .unwrap();
+    assert_eq!(std::fs::metadata(&rgb1).unwrap().modified().unwrap(), t);
+    assert_eq!(counts(&batch(&manifest, &out, &[])), (2, 2), "size of rgb1.png");
+    let after = manifests(&out);
+    assert_eq!(redone(&before, &after), names(&["f1", "f3"]));
+    before = after;
+
+    // Conventions, outputs, formats: each redoes every frame, and back again too.
+    for (what, extra) in [
+        ("conventions (--ndc vulkan)", vec!["--ndc", "vulkan"]),
+        ("conventions (--rows top-down)", vec!["--rows", "top-down"]),
+        ("conventions (--reversed-z)", vec!["--reversed-z"]),
+        ("outputs", vec!["--outputs", "rgb,mask"]),
+        ("depth formats", vec!["--depth-format", "exr,npy"]),
+        ("colour format", vec!["--rgb-format", "jpeg"]),
+        ("the defaults again", vec![]),
+    ] {
+        assert_eq!(counts(&batch(&manifest, &out, &extra)), (4, 0), "{what}");
+        let after = manifests(&out);
+        assert_eq!(redone(&before, &after), names(&["f0", "f1", "f2", "f3"]), "{what}");
+        // And the same settings once more: all resumed.
+        assert_eq!(counts(&batch(&manifest, &out, &extra)), (0, 4), "{what}, again");
+        before = after;
+    }
+    for f in ["f0", "f1", "f2", "f3"] {
+        assert!(frame_complete(&out.join(f)), "{f}");
+    }
+}
+
+#[test]
+fn shard_k_of_n_from_the_cli_takes_the_frames_with_i_mod_n_equal_k_and_resumes_per_shard() {
+    let (dir, manifest) = setup("batch-shard", 7);
+    for n in [2usize, 3] {
+        let shared = dir.join(format!("shared-{n}"));
+        for k in 0..n {
+            // Alone in a folder: exactly its frames.
+            let own = dir.join(format!("own-{k}-{n}"));
+            let o = batch(&manifest, &own, &["--shard", &format!("{k}/{n}")]);
+            let want: Vec<String> = (0..7).filter(|i| i % n == k).map(|i| format!("f{i}")).collect();
+            assert_eq!(counts(&o), (want.len(), 0), "shard {k}/{n}");
+            let text = String::from_utf8_lossy(&o.stdout).into_owned() + &String::from_utf8_lossy(&o.stderr);
+            assert!(
+                text.contains(&format!(
+                    "shard {k}/{n}: {} frames belong to other shards",
+                    7 - want.len()
+                )),
+                "{text}"
+            );
+            assert_eq!(files_in(&own), want, "shard {k}/{n}");
+            // Into a folder the earlier shards wrote: only its own frames are rendered, the
+            // others' untouched; run again, all of its frames resume.
+            let before = manifests(&shared);
+            assert_eq!(
+                counts(&batch(&manifest, &shared, &["--shard", &format!("{k}/{n}")])),
+                (want.len(), 0)
+            );
+            let after = manifests(&shared);
+            assert_eq!(redone(&before, &after), want, "shard {k}/{n} in the shared folder");
+            assert_eq!(
+                counts(&batch(&manifest, &shared, &["--shard", &format!("{k}/{n}")])),
+                (0, want.len()),
+                "shard {k}/{n} resumed"
+            );
+            assert_eq!(manifests(&shared), after);
+        }
+        // Together the shards made every frame once; unsharded, all resume.
+        assert_eq!(files_in(&shared).len(), 7);
+        assert_eq!(counts(&batch(&manifest, &shared, &[])), (0, 7));
+    }
+}
+
+#[test]
+fn kill_9_mid_batch_then_resume_renders_only_the_unfinished_frames() {
+    use std::os::unix::process::ExitStatusExt;
+    let (dir, manifest) = setup("batch-kill", 16);
+    let out = dir.join("out");
+    // Large outputs so each frame takes tens of ms: the kill lands between frames 3 and 16.
+    let heavy = ["--width-out", "800", "--height-out", "600"];
+    let mut child = bin()
+        .args(["refocus", "--zoom-range", "0.5,1.5", "--jobs", "1", "--batch"])
+        .arg(&manifest)
+        .arg("--out-dir")
+        .arg(&out)
+        .args(heavy)
+        .stdout(Stdio::null())
+        .stderr(Stdio::null())
+        .spawn()
+        .unwrap();
+    let t0 = std::time::Instant::now();
+    while manifests(&out).len() < 3 {
+        assert!(t0.elapsed().as_secs() < 120, "no frame finished in 120 s");
+        if child.try_wait().unwrap().is_some() {
+            break;
+        }
+        std::thread::sleep(std::time::Duration::from_micros(500));
+    }
+    child.kill().unwrap();
+    let status = child.wait().unwrap();
+    assert_eq!(status.signal(), Some(9), "the batch ended before the kill ({status:?})");
+    // Every frame with a manifest is complete; the others hold no final file (at most a
+    // staging folder).
+    let done: Vec<String> = manifests(&out).into_keys().collect();
+    assert!(done.len() >= 3 && done.len() < 16, "{done:?}");
+    for f in files_in(&out).into_iter().filter(|f| !f.starts_with(".viewsynth-")) {
+        let frame = out.join(&f);
+        if done.contains(&f) {
+            assert!(frame_complete(&frame), "{f}: manifest without its files");
+        } else {
+            let finals: Vec<String> = files_in(&frame)
+                .into_iter()
+                .filter(|n| !n.starts_with(".viewsynth-"))
+                .collect();
+            assert!(finals.is_empty(), "{f}: unfinished frame with final files {finals:?}");
+        }
+    }
+    // Resume: only the unfinished frames are rendered; the finished ones are untouched.
+    let before = manifests(&out);
+    let o = batch(&manifest, &out, &heavy);
+    assert_eq!(counts(&o), (16 - done.len(), done.len()));
+    let after = manifests(&out);
+    assert_eq!(after.len(), 16);
+    for f in &done {
+        assert_eq!(before[f], after[f], "{f} was redone");
+    }
+    for f in after.keys() {
+        let frame = out.join(f);
+        assert!(frame_complete(&frame), "{f}");
+        assert!(
+            files_in(&frame).iter().all(|n| !n.starts_with(".viewsynth-")),
+            "{f}: temporaries left: {:?}",
+            files_in(&frame)
+        );
+    }
+    assert!(
+        files_in(&out).iter().all(|n| !n.starts_with(".viewsynth-")),
+        "{:?}",
+        files_in(&out)
+    );
+}
