@@ -3,6 +3,7 @@
 //! files, so a Ray Data (or any other) pipeline that hands each worker a share of a manifest's
 //! frames gets exactly the CLI batch's output folders. Scheduling frames is the caller's part.
 
+use crate::backend::Backend;
 use crate::errors;
 use crate::shared::SameThread;
 use pyo3::conversion::FromPyObjectOwned;
@@ -10,7 +11,6 @@ use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyList, PyMapping, PyString};
 use std::path::PathBuf;
 use viewsynth::convention::Conventions;
-use viewsynth::gpu::Gpu;
 use viewsynth::io::Encoding;
 use viewsynth::io::{DepthFormats, FileFormats, RgbFormat};
 use viewsynth::refocus::batch::{load_manifest as read_manifest, run_batch, BatchFrame, BatchOptions, Shard};
@@ -259,7 +259,7 @@ fn options(a: &BatchArgs<'_, '_>) -> PyResult<BatchOptions> {
 }
 
 /// Validates `a`, runs the batch with the GIL released, and returns its summary as a dict.
-pub fn refocus_batch<'py>(py: Python<'py>, gpu: Gpu, a: BatchArgs<'_, 'py>) -> PyResult<Bound<'py, PyAny>> {
+pub fn refocus_batch<'py>(py: Python<'py>, gpu: Backend, a: BatchArgs<'_, 'py>) -> PyResult<Bound<'py, PyAny>> {
     let opts = options(&a)?;
     let frames = frames(a.frames)?;
     let out_dir = a.out_dir;

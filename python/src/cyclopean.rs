@@ -5,6 +5,7 @@
 //! converted to GL matrices exactly as for the CLI); see `camera_json` for the dict.
 
 use crate::arrays;
+use crate::backend::Backend;
 use crate::errors;
 use crate::errors::Kind;
 use crate::shared::SameThread;
@@ -13,13 +14,14 @@ use pyo3::types::{PyBool, PyDict, PyFloat, PyInt, PyList, PyString, PyTuple};
 use viewsynth::convention::Conventions;
 use viewsynth::cyclopean::camera_file::{CameraFile, EyeCameras};
 use viewsynth::cyclopean::disparity_frame::{disparity_frame, DisparityRig};
+use viewsynth::cyclopean::fill::FILLED;
 use viewsynth::cyclopean::forward::ForwardWarp;
 use viewsynth::cyclopean::render::CyclopeanRenderer;
 use viewsynth::cyclopean::splat::{SplatParams, SplatRenderer};
 use viewsynth::cyclopean::{
     CyclopeanOutput, CyclopeanOutputs, CyclopeanParams, EyeInput, Method as GatherMethod, MiddleCamera, StereoFrame,
 };
-use viewsynth::gpu::{Gpu, Timing};
+use viewsynth::gpu::Timing;
 use viewsynth::io::{DepthMap, RgbImage};
 use viewsynth::refocus::{BreakRule, OutputSet};
 
@@ -64,6 +66,7 @@ pub struct CyclopeanArgs<'a, 'py> {
     pub baseline: Option<f64>,
     pub doffs: f64,
     pub outputs: Option<&'a Bound<'py, PyAny>>,
+    pub fill: bool,
 }
 
 /// A call's inputs, validated while the GIL is held.
@@ -74,10 +77,12 @@ struct Job {
     /// Seed/refine start from it: the median depth the left eye saw (as the CLI).
     fixation: f64,
     wanted: CyclopeanOutputs,
+    /// Holes filled from the background side after the method (the CLI's --fill).
+    fill: bool,
 }
 
 /// The same renderer the CLI picks for `method`, with its defaults.
-fn render(gpu: &Gpu, job: &Job) -> viewsynth::Result<(f64, CyclopeanOutput, Timing)> {
+fn render(gpu: &Backend, job: &Job) -> viewsynth::Result<(f64, CyclopeanOutput, Timing)> {
     let t0 = std::time::Instant::now();
     let (frame, mid, wanted) = (&job.frame, &job.mid, job.wanted);
     let (out, timing) = match job.method {
@@ -93,6 +98,10 @@ fn render(gpu: &Gpu, job: &Job) -> viewsynth::Result<(f64, CyclopeanOutput, Timi
         }
         Method::Forward => ForwardWarp::new(gpu, frame, &BreakRule::default())?.render(mid)?,
         Method::SplatGather => SplatRenderer::new(gpu, frame, SplatParams::default(), wanted)?.render(mid)?,
+    };
+    let out = match job.fill {
+        true => viewsynth::cyclopean::fill::Filler::new(gpu)?.fill(&out, mid.width, mid.height)?,
+        false => out,
     };
     // Everything before the render itself: uploads, meshes, programs.
     let setup_ms = (t0.elapsed().as_secs_f64() * 1e3 - timing.wall_ms).max(0.0);
@@ -135,7 +144,7 @@ fn eyes(
 /// A rectified pair with disparities (the CLI's --left-disparity mode): the frame, the view,
 /// the fixation of seed/refine (the median depth the left eye saw) and whether depth is metric.
 fn disparity_job(
-    gpu: &Gpu,
+    gpu: &Backend,
     a: &CyclopeanArgs<'_, '_>,
     left_disparity: &Bound<'_, PyAny>,
     right_disparity: &Bound<'_, PyAny>,
@@ -279,7 +288,7 @@ fn check_eye_size(cam: &EyeCameras, side: &str, (rgb, _): &(RgbImage, DepthMap))
 /// Depth per eye placed by a camera file (the CLI's --left-depth ... --cameras mode): the frame,
 /// the view and the fixation the file gives (fixation_distance or the gaze rays' vergence).
 fn camera_job(
-    gpu: &Gpu,
+    gpu: &Backend,
     a: &CyclopeanArgs<'_, '_>,
     left_depth: &Bound<'_, PyAny>,
     right_depth: &Bound<'_, PyAny>,
@@ -324,7 +333,7 @@ fn camera_job(
 }
 
 /// Validates `a`, renders the view with the GIL released, and returns the result dict.
-pub fn cyclopean<'py>(py: Python<'py>, gpu: Gpu, a: CyclopeanArgs<'_, 'py>) -> PyResult<Bound<'py, PyDict>> {
+pub fn cyclopean<'py>(py: Python<'py>, gpu: Backend, a: CyclopeanArgs<'_, 'py>) -> PyResult<Bound<'py, PyDict>> {
     let method = Method::parse(a.method)?;
     let disparity = a.left_disparity.is_some() || a.right_disparity.is_some();
     let depth = a.left_depth.is_some() || a.right_depth.is_some() || a.cameras.is_some();
@@ -384,10 +393,12 @@ pub fn cyclopean<'py>(py: Python<'py>, gpu: Gpu, a: CyclopeanArgs<'_, 'py>) -> P
         mid,
         method,
         fixation,
+        // The fill reads both planes whatever is returned.
         wanted: CyclopeanOutputs {
-            color: outputs.rgb,
-            depth: outputs.depth,
+            color: outputs.rgb || a.fill,
+            depth: outputs.depth || a.fill,
         },
+        fill: a.fill,
     };
 
     // The inputs were copied out of numpy above; see SameThread for why the move is sound.
@@ -400,7 +411,8 @@ pub fn cyclopean<'py>(py: Python<'py>, gpu: Gpu, a: CyclopeanArgs<'_, 'py>) -> P
     let (setup_ms, out, timing) = result.0.map_err(errors::from_library)?;
 
     let d = PyDict::new(py);
-    let valid = out.sources.iter().filter(|s| **s != 0).count();
+    let rendered = |s: &u8| *s != 0 && *s != FILLED;
+    let valid = out.sources.iter().filter(|s| rendered(s)).count();
     d.set_item("coverage", valid as f64 / out.sources.len() as f64)?;
     let timings = PyDict::new(py);
     timings.set_item("setup_ms", setup_ms)?;
@@ -415,9 +427,14 @@ pub fn cyclopean<'py>(py: Python<'py>, gpu: Gpu, a: CyclopeanArgs<'_, 'py>) -> P
         d.set_item("depth", arrays::depth_array(py, z))?;
     }
     if outputs.mask {
-        let mask = viewsynth::io::Mask::new(w, h, out.sources.iter().map(|s| (*s != 0) as u8).collect())
+        let mask = viewsynth::io::Mask::new(w, h, out.sources.iter().map(|s| rendered(s) as u8).collect())
             .map_err(errors::from_library)?;
         d.set_item("mask", arrays::mask_array(py, mask))?;
+    }
+    if a.fill {
+        let filled = viewsynth::io::Mask::new(w, h, out.sources.iter().map(|s| (*s == FILLED) as u8).collect())
+            .map_err(errors::from_library)?;
+        d.set_item("filled", arrays::mask_array(py, filled))?;
     }
     Ok(d)
 }

@@ -4,6 +4,7 @@
 //! batch's writers): `batch`.
 
 mod arrays;
+mod backend;
 mod batch;
 mod context;
 mod cyclopean;

@@ -3,6 +3,7 @@
 //! `reproject`, `stitch`, `batch`).
 
 use crate::arrays;
+use crate::backend::Backend;
 use crate::context;
 use crate::errors::{self, Kind};
 use crate::shared::{output_set, SameThread};
@@ -10,7 +11,6 @@ use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyList, PyString};
 use viewsynth::camera::PinholeCamera;
 use viewsynth::convention::Conventions;
-use viewsynth::gpu::Gpu;
 use viewsynth::refocus::manifest::TargetSpec;
 use viewsynth::refocus::{BreakRule, Method, OutputSet, RefocusOutput, RefocusSource, Refocuser};
 
@@ -24,7 +24,7 @@ struct RefocusJob {
 }
 
 /// The GPU work of one call: upload the source once, render every target.
-fn render_all(gpu: &Gpu, job: &RefocusJob) -> viewsynth::Result<(f64, Vec<RefocusOutput>)> {
+fn render_all(gpu: &Backend, job: &RefocusJob) -> viewsynth::Result<(f64, Vec<RefocusOutput>)> {
     let t0 = std::time::Instant::now();
     let mut refocuser = Refocuser::new(
         gpu,
@@ -112,7 +112,8 @@ impl<T> Drop for ThreadBound<T> {
     }
 }
 
-/// An OpenGL 4.5 context over EGL (a GPU, or Mesa's llvmpipe on the CPU) for refocusing numpy
+/// An OpenGL 4.5 context over EGL (a GPU, or Mesa's llvmpipe on the CPU), or a Vulkan 1.3
+/// device running the same shaders (backend="vulkan"), for refocusing numpy
 /// RGB-D frames (refocus), synthesising in-between views of stereo pairs (cyclopean),
 /// reprojecting a view of a stereo rig to the other eye (reproject), stitching an ODS 360 from
 /// cube faces (stitch), and refocusing frames from files into files as the CLI's batch
@@ -120,7 +121,11 @@ impl<T> Drop for ThreadBound<T> {
 ///
 /// device: "auto" (the CUDA_VISIBLE_DEVICES GPU, else EGL device 0, else Mesa surfaceless),
 /// "surfaceless", or an EGL device index as a string ("0", "1", ...).
-/// require_gpu: raise GpuUnavailableError when EGL only offers a software renderer.
+/// require_gpu: raise GpuUnavailableError when EGL only offers a software renderer (with
+/// backend="vulkan": refuse a CPU Vulkan device such as lavapipe, as the CLI's --require-gpu).
+/// backend: "gl" (default) or "vulkan", as the CLI's --backend: every call renders on it, with
+/// the same outputs within the GL-vs-Vulkan agreement rule (device then is "auto" or an index of
+/// `viewsynth info --backend vulkan`). gl_objects() is for GL only.
 ///
 /// Threads: a Renderer belongs to the thread that created it; using it on another thread raises
 /// WrongThreadError. Open one per thread (threading.local()); Renderers opened on the same
@@ -136,14 +141,14 @@ impl<T> Drop for ThreadBound<T> {
 /// Release the context with close() or a with-block; garbage collection also releases it.
 #[pyclass(module = "viewsynth")]
 pub struct Renderer {
-    gpu: ThreadBound<Option<Gpu>>,
+    gpu: ThreadBound<Option<Backend>>,
     /// Process that opened the context: a forked child must not use (or free) it.
     pid: u32,
     device: String,
 }
 
 impl Renderer {
-    fn gpu(&self) -> PyResult<&Gpu> {
+    fn gpu(&self) -> PyResult<&Backend> {
         if self.pid != std::process::id() {
             return Err(errors::raise(
                 Kind::Forked,
@@ -165,12 +170,12 @@ impl Renderer {
 
     fn close_inner(&mut self) -> PyResult<()> {
         let forked = self.pid != std::process::id();
-        if let Some(gpu) = self.gpu.get_mut()?.take() {
-            if forked {
-                // The parent's context: never to be freed (or used) in the child.
-                std::mem::forget(gpu);
-            } else {
-                context::release(gpu);
+        if let Some(backend) = self.gpu.get_mut()?.take() {
+            match (backend, forked) {
+                // The parent's context or device: never to be freed (or used) in the child.
+                (backend, true) => std::mem::forget(backend),
+                (Backend::Gl(gpu), false) => context::release(gpu),
+                (Backend::Vulkan(..), false) => {}
             }
         }
         Ok(())
@@ -187,17 +192,39 @@ impl Drop for Renderer {
 #[pymethods]
 impl Renderer {
     #[new]
-    #[pyo3(signature = (device = "auto", require_gpu = false))]
-    fn new(device: &str, require_gpu: bool) -> PyResult<Self> {
+    #[pyo3(signature = (device = "auto", require_gpu = false, backend = "gl"))]
+    fn new(device: &str, require_gpu: bool, backend: &str) -> PyResult<Self> {
         let choice = context::parse_device(device)?;
-        let gpu = context::acquire(choice)?;
+        let gpu = match backend {
+            "gl" => Backend::Gl(context::acquire(choice)?),
+            "vulkan" => {
+                // The CLI's --backend vulkan: the same device choice and software policy.
+                let request = viewsynth::job::GpuRequest {
+                    device: choice,
+                    policy: viewsynth::gpu::GpuPolicy {
+                        require_hardware: require_gpu,
+                    }
+                    .with_env()
+                    .map_err(errors::from_library)?,
+                };
+                let vk = request.open_vulkan().map_err(errors::from_library)?;
+                let device = viewsynth::vulkan::VkExecutor::device(&vk).map_err(errors::from_library)?;
+                Backend::Vulkan(device, vk.info().clone())
+            }
+            other => {
+                return Err(errors::invalid(
+                    "backend",
+                    format!("'{other}': expected \"gl\" or \"vulkan\""),
+                ))
+            }
+        };
         let renderer = Renderer {
             gpu: ThreadBound::new(Some(gpu)),
             pid: std::process::id(),
             device: device.to_string(),
         };
-        if require_gpu {
-            let info = renderer.gpu()?.info();
+        if let (true, Backend::Gl(gpu)) = (require_gpu, renderer.gpu()?) {
+            let info = gpu.info();
             if info.software {
                 return Err(errors::raise(
                     Kind::GpuUnavailable,
@@ -213,10 +240,26 @@ impl Renderer {
         Ok(renderer)
     }
 
+    /// "gl" or "vulkan".
+    #[getter]
+    fn backend(&self) -> PyResult<&'static str> {
+        Ok(match self.gpu()? {
+            Backend::Gl(_) => "gl",
+            Backend::Vulkan(..) => "vulkan",
+        })
+    }
+
     /// What the context runs on (vendor, renderer, GL version, EGL platform and device, limits).
     #[getter]
     fn info<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
-        crate::info_dict(py, self.gpu()?.info())
+        match self.gpu()? {
+            Backend::Gl(gpu) => crate::info_dict(py, gpu.info()),
+            Backend::Vulkan(_, info) => {
+                let text = serde_json::to_string(info)
+                    .map_err(|e| pyo3::exceptions::PyRuntimeError::new_err(e.to_string()))?;
+                py.import("json")?.call_method1("loads", (text,))
+            }
+        }
     }
 
     /// The GL objects this Renderer's context holds now, by kind: {"textures", "framebuffers",
@@ -225,7 +268,13 @@ impl Renderer {
     /// same-sized calls leaves the counts unchanged; growth is a leak. Renderers on one thread
     /// share a context, hence these counts.
     fn gl_objects<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
-        let counts = self.gpu()?.live_objects();
+        let Backend::Gl(gpu) = self.gpu()? else {
+            return Err(errors::invalid(
+                "backend",
+                "gl_objects() counts GL objects; this Renderer runs on Vulkan",
+            ));
+        };
+        let counts = gpu.live_objects();
         let text =
             serde_json::to_string(&counts).map_err(|e| pyo3::exceptions::PyRuntimeError::new_err(e.to_string()))?;
         py.import("json")?.call_method1("loads", (text,))
@@ -265,7 +314,15 @@ impl Renderer {
             return format!("Renderer(device={:?}, owned by another thread)", self.device);
         }
         match (&*self.gpu.value, self.pid == std::process::id()) {
-            (Some(gpu), true) => format!("Renderer(device={:?}, renderer={:?})", self.device, gpu.info().renderer),
+            (Some(Backend::Gl(gpu)), true) => {
+                format!("Renderer(device={:?}, renderer={:?})", self.device, gpu.info().renderer)
+            }
+            (Some(Backend::Vulkan(_, info)), true) => {
+                format!(
+                    "Renderer(device={:?}, backend=\"vulkan\", renderer={:?})",
+                    self.device, info.name
+                )
+            }
             (Some(_), false) => format!("Renderer(device={:?}, inherited through fork: unusable)", self.device),
             (None, _) => format!("Renderer(device={:?}, closed)", self.device),
         }
@@ -428,6 +485,9 @@ impl Renderer {
     /// "forward", as the CLI's --method with its defaults.
     /// outputs: any of "rgb", "depth", "mask" (default rgb and mask, plus depth with focal or
     /// with depth input).
+    /// fill: the CLI's --fill: holes (pixels no eye saw) take the nearest rendered pixel on their
+    /// background side along the row (both sides one surface: their mix by distance; an empty
+    /// row: the column), so the frame is complete; "filled" bool[H, W] says where.
     ///
     /// Returns a dict: "coverage" (fraction of pixels some eye saw), "timings" (setup_ms:
     /// uploads and set-up; render_ms; gpu_ms, None where GPU timers are not meaningful), and the
@@ -440,7 +500,7 @@ impl Renderer {
     #[allow(clippy::too_many_arguments)]
     #[pyo3(signature = (left_rgb, right_rgb, left_disparity = None, right_disparity = None, position = None, *,
                         left_depth = None, right_depth = None, cameras = None, method = "splat-gather",
-                        focal = None, baseline = None, doffs = 0.0, outputs = None))]
+                        focal = None, baseline = None, doffs = 0.0, outputs = None, fill = false))]
     fn cyclopean<'py>(
         &mut self,
         py: Python<'py>,
@@ -457,6 +517,7 @@ impl Renderer {
         baseline: Option<f64>,
         doffs: f64,
         outputs: Option<&Bound<'py, PyAny>>,
+        fill: bool,
     ) -> PyResult<Bound<'py, PyDict>> {
         let gpu = self.gpu()?.clone();
         crate::cyclopean::cyclopean(
@@ -476,6 +537,7 @@ impl Renderer {
                 baseline,
                 doffs,
                 outputs,
+                fill,
             },
         )
     }

@@ -2,6 +2,7 @@
 //! (`viewsynth reproject --fx ... --baseline ...`), numpy in and out.
 
 use crate::arrays;
+use crate::backend::Backend;
 use crate::errors;
 use crate::shared::SameThread;
 use pyo3::prelude::*;
@@ -10,7 +11,7 @@ use viewsynth::camera::stereo::{Eye, StereoParams};
 use viewsynth::camera::PinholeCamera;
 use viewsynth::convention::{Conventions, DepthPlanes};
 use viewsynth::depth::DepthEncoding;
-use viewsynth::gpu::{Gpu, Timing};
+use viewsynth::gpu::Timing;
 use viewsynth::reproject::render::Reprojector;
 use viewsynth::reproject::{
     Geometry, Method, ReprojectOutput, ReprojectOutputs, ReprojectParams, ReprojectSource, ShiftModel,
@@ -142,7 +143,7 @@ fn depth_input(a: &ReprojectArgs<'_, '_>, focal: f64) -> PyResult<DepthEncoding>
 type Rendered = Vec<(Eye, f64, ReprojectOutput, Timing)>;
 
 fn render(
-    gpu: &Gpu,
+    gpu: &Backend,
     src: &ReprojectSource,
     targets: &[(Eye, Geometry)],
     params: ReprojectParams,
@@ -159,7 +160,7 @@ fn render(
 }
 
 /// Validates `a`, renders every target with the GIL released, and returns {eye name: dict}.
-pub fn reproject<'py>(py: Python<'py>, gpu: Gpu, a: ReprojectArgs<'_, 'py>) -> PyResult<Bound<'py, PyDict>> {
+pub fn reproject<'py>(py: Python<'py>, gpu: Backend, a: ReprojectArgs<'_, 'py>) -> PyResult<Bound<'py, PyDict>> {
     let params = ReprojectParams {
         method: method(a.method, a.steps)?,
         outputs: ReprojectOutputs::default(),

@@ -3,13 +3,14 @@
 //! defaults and checks, the faces given as stacked arrays instead of a folder.
 
 use crate::arrays;
+use crate::backend::Backend;
 use crate::errors;
 use crate::shared::SameThread;
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 use viewsynth::convention::{Conventions, DepthPlanes, NdcDepthRange};
 use viewsynth::depth::DepthEncoding;
-use viewsynth::gpu::{Gpu, Timing};
+use viewsynth::gpu::Timing;
 use viewsynth::io::{DepthMap, RgbImage};
 use viewsynth::stitch::faces::{faces_from_images, view_z_of};
 use viewsynth::stitch::render::StitchRenderer;
@@ -149,7 +150,7 @@ fn eye_faces(rgb: &Bound<'_, PyAny>, depth: &Bound<'_, PyAny>, eye: &str) -> PyR
 }
 
 fn render(
-    gpu: &Gpu,
+    gpu: &Backend,
     left: &FaceSet,
     right: &FaceSet,
     params: &StitchParams,
@@ -162,7 +163,7 @@ fn render(
 }
 
 /// Validates `a`, stitches both eyes with the GIL released, and returns the result dict.
-pub fn stitch<'py>(py: Python<'py>, gpu: Gpu, a: StitchArgs<'_, 'py>) -> PyResult<Bound<'py, PyDict>> {
+pub fn stitch<'py>(py: Python<'py>, gpu: Backend, a: StitchArgs<'_, 'py>) -> PyResult<Bound<'py, PyDict>> {
     let (fov, overlap) = fov_and_overlap(a.fov, a.overlap)?;
     // The faces' own frame: the circle centre only translates the face eyes and the ODS rays
     // together (as the CLI's --faces).

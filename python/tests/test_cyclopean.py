@@ -178,3 +178,46 @@ def test_bad_inputs(renderer, pair):
     check(renderer, pair, "outputs", [], outputs=("rgb", "normals"))
     # Nothing was left broken: a good call still works.
     assert renderer.cyclopean(*pair)["coverage"] > 0.5
+
+
+def test_fill_equals_cli_fill(renderer, cli, pair, tmp_path):
+    """fill=True is the CLI's --fill: the same colour, rendered pixels where the CLI's mask is
+    255 and filled ones where it is 128, and every pixel of the crop one or the other."""
+    view = renderer.cyclopean(*pair, fill=True)
+    plain = renderer.cyclopean(*pair)
+    out = run_cli(cli, tmp_path, pair, ["--fill"])
+    cli_rgb = np.asarray(Image.open(out / "middle_rgb.png").convert("RGB"))
+    cli_mask = np.asarray(Image.open(out / "middle_mask.png"))
+    assert np.array_equal(view["rgb"], cli_rgb)
+    assert np.array_equal(view["mask"], cli_mask == 255)
+    assert np.array_equal(view["filled"], cli_mask == 128)
+    assert np.array_equal(view["mask"], plain["mask"]), "the fill leaves rendered pixels alone"
+    assert np.array_equal(view["filled"], ~plain["mask"]), "every hole of the crop is filled"
+    assert np.array_equal(view["rgb"][plain["mask"]], plain["rgb"][plain["mask"]])
+    assert "filled" not in plain
+
+
+def test_vulkan_renderer_matches_gl(renderer, pair):
+    """Renderer(backend="vulkan") runs the same passes on the Vulkan device (lavapipe here): the
+    same coverage, and colour within the GL-vs-Vulkan agreement rule (one level on at least
+    99.5 % of the pixels both render); a refocus likewise."""
+    with vs.Renderer(backend="vulkan") as vk:
+        assert vk.backend == "vulkan" and renderer.backend == "gl"
+        assert vk.info["name"]
+        a, b = renderer.cyclopean(*pair), vk.cyclopean(*pair)
+        both = a["mask"] & b["mask"]
+        assert (a["mask"] != b["mask"]).mean() <= 0.005
+        diff = np.abs(a["rgb"].astype(int) - b["rgb"].astype(int)).max(axis=2)[both]
+        assert (diff <= 1).mean() >= 0.995, np.bincount(diff)
+        from conftest import make_frame
+
+        rgb, depth, K = make_frame()
+        for ra, rb in zip(renderer.refocus(rgb, depth, K, scales=[0.5, 1.5]), vk.refocus(rgb, depth, K, scales=[0.5, 1.5])):
+            # The refocus bound of tests/integration/vulkan_refocus.rs: masks identical, colour
+            # within one level.
+            assert np.array_equal(ra["mask"], rb["mask"])
+            assert np.abs(ra["rgb"].astype(int) - rb["rgb"].astype(int)).max() <= 1
+        with pytest.raises(vs.InvalidInputError, match="backend"):
+            vk.gl_objects()
+    with pytest.raises(vs.InvalidInputError, match="backend"):
+        vs.Renderer(backend="metal")

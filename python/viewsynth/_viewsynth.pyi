@@ -37,13 +37,15 @@ class CyclopeanTimings(TypedDict):
     gpu_ms: Optional[float]
 
 class CyclopeanView(TypedDict, total=False):
-    """Renderer.cyclopean's result. "rgb", "depth", "mask" are present when requested."""
+    """Renderer.cyclopean's result. "rgb", "depth", "mask" are present when requested,
+    "filled" with fill=True."""
 
     coverage: float
     timings: CyclopeanTimings
     rgb: npt.NDArray[np.uint8]
     depth: npt.NDArray[np.float32]
     mask: npt.NDArray[np.bool_]
+    filled: npt.NDArray[np.bool_]
 
 class CameraDict(TypedDict, total=False):
     """One camera of a cameras.json: K (3x3, pixels), R (3x3) and t (3) world -> camera with
@@ -133,7 +135,7 @@ class ManifestFrame(TypedDict):
     sun_bit_rotate: bool
 
 class Renderer:
-    """An OpenGL 4.5 context over EGL for refocusing numpy RGB-D frames, synthesising
+    """An OpenGL 4.5 context over EGL (or a Vulkan device, backend="vulkan") for refocusing numpy RGB-D frames, synthesising
     in-between views of rectified stereo pairs and reprojecting a view to the other eye.
 
     Thread-affine (WrongThreadError on another thread; open one per thread) and process-affine
@@ -141,7 +143,11 @@ class Renderer:
     else RendererForkedError). See help(viewsynth.Renderer).
     """
 
-    def __init__(self, device: str = "auto", require_gpu: bool = False) -> None: ...
+    def __init__(
+        self, device: str = "auto", require_gpu: bool = False, backend: Literal["gl", "vulkan"] = "gl"
+    ) -> None: ...
+    @property
+    def backend(self) -> Literal["gl", "vulkan"]: ...
     @property
     def info(self) -> Dict[str, Any]: ...
     @property
@@ -189,6 +195,7 @@ class Renderer:
         baseline: Optional[float] = None,
         doffs: float = 0.0,
         outputs: Optional[Union[OutputName, Sequence[OutputName]]] = None,
+        fill: bool = False,
     ) -> CyclopeanView:
         """Synthesise an in-between view of a stereo pair (rgb uint8[H, W, 3] per eye), as
         `viewsynth cyclopean`, from either
