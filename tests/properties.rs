@@ -112,7 +112,8 @@ proptest! {
     }
 
     /// The mask PNG writer and loader, at every compression: 0 stays 0, any other byte is
-    /// valid (255 on disk, 1 in memory).
+    /// valid (1 in memory; 255 on disk, or 128 for MASK_FILLED, the filled pixels of
+    /// cyclopean --fill).
     #[test]
     fn mask_png_loads_what_was_saved((w, h, data) in image_bytes(1), best in any::<bool>()) {
         let d = scratch();
@@ -124,7 +125,14 @@ proptest! {
         let want: Vec<u8> = data.iter().map(|v| u8::from(*v != 0)).collect();
         prop_assert_eq!(back.data, want);
         let disk = image::open(&p).unwrap().into_luma8();
-        let on_disk: Vec<u8> = data.iter().map(|v| if *v == 0 { 0 } else { 255 }).collect();
+        let on_disk: Vec<u8> = data
+            .iter()
+            .map(|v| match *v {
+                0 => 0,
+                io::MASK_FILLED => io::MASK_FILLED,
+                _ => 255,
+            })
+            .collect();
         prop_assert_eq!(disk.as_raw(), &on_disk);
     }
 

@@ -10,7 +10,6 @@ use super::splat::{SplatParams, SplatRenderer};
 use super::splat_reference::splat_reference;
 use super::{CyclopeanOutputs, CyclopeanParams, MiddleCamera, StereoFrame};
 use crate::error::Result;
-use crate::gpu::Gpu;
 use crate::view::ViewOutput;
 
 /// Which middle-view pass, with its parameters.
@@ -36,7 +35,7 @@ pub struct CyclopeanInput<'a> {
 }
 
 /// The GPU middle view of `input`, with its times (one renderer, one middle camera).
-pub fn gpu(gpu: &Gpu, input: &CyclopeanInput) -> Result<ViewOutput> {
+pub fn gpu(gpu: impl crate::pass::ToDevice, input: &CyclopeanInput) -> Result<ViewOutput> {
     let (out, timing) = match input.pass {
         CyclopeanPass::Gather(params) => {
             CyclopeanRenderer::with_outputs(gpu, input.frame, params, input.outputs)?.render(input.mid)?

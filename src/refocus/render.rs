@@ -63,8 +63,9 @@ pub struct RefocusOutput {
 struct Source {
     camera: PinholeCamera,
     planes: DepthPlanes,
-    /// Colour, or a 1 x 1 stand-in when colour is not asked for (the programs then never read it).
-    rgb: Image,
+    /// Colour; None when colour is not asked for (the programs then never read it, and the depth
+    /// image is bound in its slot: no upload, no texture).
+    rgb: Option<Image>,
     depth: Image,
     geometry: Geometry,
 }
@@ -196,11 +197,7 @@ impl Refocuser {
             .is_some_and(|s| (s.camera.width, s.camera.height) == (w, h));
         let previous = if same_size { self.source.take() } else { None };
         self.source = None; // free a differently sized source before allocating
-        let rgba: Vec<u8> = match self.outputs.rgb {
-            true => crate::gpu::pixels::rgb_to_rgba(&src.rgb.data),
-            false => vec![0; 4],
-        };
-        let (rw, rh) = if self.outputs.rgb { (w, h) } else { (1, 1) };
+        let rgba: Option<Vec<u8>> = self.outputs.rgb.then(|| crate::gpu::pixels::rgb_to_rgba(&src.rgb.data));
         let depth_bytes: &[u8] = bytemuck::cast_slice(&src.depth.data);
         let (cx, cy) = (grid.cells_x() as u32, grid.cells_y() as u32);
         let d = &self.device;
@@ -216,8 +213,8 @@ impl Refocuser {
         let flags = |method| (method == Method::Fullscreen).then(|| grid.coverage_flags(&keep));
         let (rgb, depth, geometry) = match previous {
             Some(p) => {
-                if self.outputs.rgb {
-                    d.write_image(&p.rgb, &rgba)?;
+                if let (Some(image), Some(texels)) = (&p.rgb, &rgba) {
+                    d.write_image(image, texels)?;
                 }
                 d.write_image(&p.depth, depth_bytes)?;
                 let geometry = match (p.geometry, flags(self.method)) {
@@ -233,7 +230,10 @@ impl Refocuser {
                 (p.rgb, p.depth, geometry)
             }
             None => {
-                let rgb = upload(rw, rh, Format::Rgba8, &rgba, "refocus source rgb")?;
+                let rgb = match &rgba {
+                    Some(texels) => Some(upload(w, h, Format::Rgba8, texels, "refocus source rgb")?),
+                    None => None,
+                };
                 let depth = upload(w, h, Format::R32F, depth_bytes, "refocus source depth")?;
                 let geometry = match flags(self.method) {
                     Some(f) => Geometry::Fullscreen {
@@ -339,7 +339,8 @@ impl Refocuser {
         let params = bytemuck::bytes_of(&params);
         let want_rgb = self.outputs.rgb;
         let program = |kind| ShaderProgram::new(conv, kind);
-        let shared = [source.rgb.id(), source.depth.id(), cols_id, rows_id];
+        let rgb = source.rgb.as_ref().unwrap_or(&source.depth);
+        let shared = [rgb.id(), source.depth.id(), cols_id, rows_id];
         let with = |extra| [shared[0], shared[1], shared[2], shared[3], extra];
         let viewport = [0, 0, target.width, target.height];
         let draw = |kind, images, triangles, indices| {

@@ -113,6 +113,7 @@ fn demo_writes_every_output_of_the_built_in_scene() {
         [
             "cyclopean",
             "fullscreen",
+            "gl_vs_vulkan.md",
             "mesh",
             "refocus_check.md",
             "report.csv",
@@ -247,7 +248,21 @@ fn report_with_a_case_measures_it_beside_the_built_in_rows() {
         .unwrap();
     let err = String::from_utf8_lossy(&o.stderr);
     assert!(o.status.success(), "{err}");
-    assert_eq!(files_in(&out), ["report.csv", "report.md", "report.svg"]);
+    assert_eq!(
+        files_in(&out),
+        ["gl_vs_vulkan.md", "report.csv", "report.md", "report.svg"]
+    );
+    // GL against Vulkan: refocus under 2 methods x 8 conventions, then every other pass, each
+    // row within the agreement rule ("yes"), none left out.
+    let vk = std::fs::read_to_string(out.join("gl_vs_vulkan.md")).unwrap();
+    assert!(!vk.contains("Vulkan not run"), "{vk}");
+    let refocus_rows = vk
+        .lines()
+        .filter(|l| l.starts_with("| Fullscreen") || l.starts_with("| Mesh"))
+        .count();
+    assert_eq!(refocus_rows, 16, "{vk}");
+    assert!(!vk.contains("| no |"), "a pass disagrees: {vk}");
+    assert!(vk.matches("| yes |").count() >= 11, "every pass agrees: {vk}");
     let rows = check_report(&out);
     // The case's rows: the 5 cyclopean methods on it, named after its folder, each close to the
     // case's own middle view (measured 27.8-39.9 dB on this 64 x 48 case, edge pixels weighing

@@ -73,7 +73,19 @@ fn disagreement(out: &ViewOutput, r: &ViewOutput) -> (usize, usize, f64) {
 /// Through the pass/twin contract: [`pass::gpu`] against [`pass::reference`].
 #[test]
 fn gpu_matches_the_f64_reference_under_every_convention_and_depth_kind() {
-    let g = gpu();
+    gather_matches_the_twin(&viewsynth::pass::Device::gl(&gpu()).unwrap());
+}
+
+/// The same on the Vulkan executor (lavapipe in CI), with the GL bounds: the same GLSL on the
+/// same f32 inputs, so the derivation above holds for either compiler.
+#[cfg(feature = "vulkan")]
+#[test]
+fn vulkan_gather_matches_the_f64_reference_under_every_convention_and_depth_kind() {
+    let v = crate::vulkan_refocus::vulkan();
+    gather_matches_the_twin(&viewsynth::vulkan::VkExecutor::device(&v).unwrap());
+}
+
+fn gather_matches_the_twin(g: &viewsynth::pass::Device) {
     let mut rig = StereoRig::demo(160, 120);
     rig.ipd = 0.2;
     for conv in Conventions::all() {
@@ -87,7 +99,7 @@ fn gpu_matches_the_f64_reference_under_every_convention_and_depth_kind() {
                     outputs: CyclopeanOutputs::default(),
                 };
                 let reference = pass::reference(&input).unwrap();
-                let out = pass::gpu(&g, &input).unwrap();
+                let out = pass::gpu(g, &input).unwrap();
                 let (src, col, z) = disagreement(&out, &reference);
                 let n = (mid.width * mid.height) as usize;
                 let tag = format!("{} {kind:?} {name}", conv.label());
