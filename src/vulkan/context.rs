@@ -344,29 +344,10 @@ impl VulkanContext {
         if let Some(s) = self.submit.get() {
             return Ok(s);
         }
-        let d = &self.device;
-        // SAFETY: plain allocation from the context's pool; on the fence's failure the command
-        // buffer is freed here. Both are owned by the context from then on (freed in Drop).
-        unsafe {
-            let alloc = vk::CommandBufferAllocateInfo::default()
-                .command_pool(self.pool)
-                .level(vk::CommandBufferLevel::PRIMARY)
-                .command_buffer_count(1);
-            let cb = d
-                .allocate_command_buffers(&alloc)
-                .map_err(vk_err("vkAllocateCommandBuffers"))?[0];
-            let fence = match d.create_fence(&vk::FenceCreateInfo::default(), None) {
-                Ok(f) => f,
-                Err(r) => {
-                    d.free_command_buffers(self.pool, &[cb]);
-                    return Err(vk_err("vkCreateFence")(r));
-                }
-            };
-            self.count(Created::SubmitObject);
-            self.count(Created::SubmitObject);
-            self.submit.set(Some((cb, fence)));
-            Ok((cb, fence))
-        }
+        // Owned by the context from then on (freed in Drop).
+        let slot = self.new_submit_slot()?;
+        self.submit.set(Some(slot));
+        Ok(slot)
     }
 
     /// A command buffer and fence of a caller's own (an in-flight submission's), freed with
