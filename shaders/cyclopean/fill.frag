@@ -2,7 +2,7 @@
 // rule): a pixel no eye saw takes the colour and depth of the nearest valid pixel to its left or
 // right along the row, whichever is farther (a disocclusion uncovers background, so the nearer
 // foreground edge must not bleed into it), or, where both lie on one surface (depths within
-// u_same_surface relative), their mix by distance. With neither within reach along the row, the
+// u_same_surface relative), their mix by distance. With neither found along the row, the
 // column is searched the same way.
 // Rendered pixels pass through unchanged; filled ones carry only u_filled.
 
@@ -10,10 +10,11 @@ layout(location = 0) out vec4 o_color;
 layout(location = 1) out float o_depth;
 layout(location = 2) out float o_sources;  // R8 normalised: bits / 255 stores the bits
 
-// Steps to the nearest valid pixel from p along d within reach (its position in q), 0: none.
+// Steps to the nearest valid pixel from p along d (its position in q), 0: none before the
+// image's edge.
 int nearest_valid(ivec2 p, ivec2 d, out ivec2 q) {
     q = p;
-    for (int k = 1; k <= u_reach; ++k) {
+    for (int k = 1; k <= max(u_size.x, u_size.y); ++k) {
         ivec2 c = p + k * d;
         if (any(lessThan(c, ivec2(0))) || any(greaterThanEqual(c, u_size))) {
             return 0;

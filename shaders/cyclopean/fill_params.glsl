@@ -3,7 +3,6 @@
 // (bindings 1..3), rows in memory order.
 layout(std140, binding = 0) uniform FillParams {
     ivec2 u_size;     // W, H of the middle view
-    int u_reach;      // pixels searched each way along the row (then the column)
     uint u_filled;    // the source bit filled pixels carry (fill.rs FILLED)
     float u_same_surface;  // relative depth difference below which both sides are one surface
 };

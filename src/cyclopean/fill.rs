@@ -26,7 +26,6 @@ crate::param_block! {
     /// shaders/cyclopean/fill_params.glsl, member for member.
     pub struct FillParams("FillParams") {
         u_size: [i32; 2],
-        u_reach: i32,
         u_filled: u32,
         u_same_surface: f32,
     }
@@ -105,7 +104,6 @@ impl Filler {
         let i = self.inputs.as_ref().expect("uploaded above");
         let params = FillParams {
             u_size: [w as i32, h as i32],
-            u_reach: w.max(h) as i32,
             u_filled: FILLED.into(),
             u_same_surface: SAME_SURFACE,
         };
@@ -134,12 +132,11 @@ impl Filler {
 pub fn fill_reference(out: &CyclopeanOutput, width: u32, height: u32) -> Result<CyclopeanOutput> {
     let (color, depth) = planes(out)?;
     let (w, h) = (width as i64, height as i64);
-    let reach = w.max(h);
     let valid = |x: i64, y: i64| out.sources[(y * w + x) as usize] != 0;
     let z = |(x, y): (i64, i64)| depth.data[(y * w + x) as usize];
-    // Steps to the nearest valid pixel from (x, y) along (dx, dy) within reach, and where.
+    // Steps to the nearest valid pixel from (x, y) along (dx, dy) before the edge, and where.
     let nearest = |x: i64, y: i64, dx: i64, dy: i64| -> Option<(i64, (i64, i64))> {
-        (1..=reach)
+        (1..=w.max(h))
             .map(|k| (k, (x + k * dx, y + k * dy)))
             .take_while(|&(_, (cx, cy))| cx >= 0 && cy >= 0 && cx < w && cy < h)
             .find(|&(_, (cx, cy))| valid(cx, cy))

@@ -575,7 +575,13 @@ impl Executor for VkExecutor {
             .get(id.0)
             .ok_or_else(|| Error::Vulkan(format!("write_image: image {} was freed", id.0)))?;
         let need = stored.image.width as usize * stored.image.height as usize * stored.format.texel_bytes();
-        if bytes.len() != need || stored.layout != vk::ImageLayout::SHADER_READ_ONLY_OPTIMAL {
+        if stored.layout != vk::ImageLayout::SHADER_READ_ONLY_OPTIMAL {
+            return Err(Error::Vulkan(format!(
+                "write_image: image {} was created for storage, not uploaded",
+                id.0
+            )));
+        }
+        if bytes.len() != need {
             return Err(Error::Vulkan(format!(
                 "write_image: {} bytes for an uploaded image of {need}",
                 bytes.len()
