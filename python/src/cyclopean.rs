@@ -11,45 +11,12 @@ use crate::errors::Kind;
 use crate::shared::SameThread;
 use pyo3::prelude::*;
 use pyo3::types::{PyBool, PyDict, PyFloat, PyInt, PyList, PyString, PyTuple};
-use viewsynth::convention::Conventions;
-use viewsynth::cyclopean::camera_file::{CameraFile, EyeCameras};
-use viewsynth::cyclopean::disparity_frame::{disparity_frame, DisparityRig};
-use viewsynth::cyclopean::fill::FILLED;
-use viewsynth::cyclopean::forward::ForwardWarp;
-use viewsynth::cyclopean::render::CyclopeanRenderer;
-use viewsynth::cyclopean::splat::{SplatParams, SplatRenderer};
-use viewsynth::cyclopean::{
-    CyclopeanOutput, CyclopeanOutputs, CyclopeanParams, EyeInput, Method as GatherMethod, MiddleCamera, StereoFrame,
+use viewsynth::cyclopean::camera_file::CameraFile;
+use viewsynth::io::{DepthMap, RgbImage, MASK_FILLED};
+use viewsynth::job::cyclopean::{
+    CyclopeanPlan, CyclopeanRequest, InputName, StereoGiven, StereoInput, StereoKind, Synthesised,
 };
-use viewsynth::gpu::Timing;
-use viewsynth::io::{DepthMap, RgbImage};
-use viewsynth::refocus::{BreakRule, OutputSet};
-
-/// The methods of `viewsynth cyclopean --method`.
-#[derive(Clone, Copy, PartialEq, Eq)]
-pub enum Method {
-    SplatGather,
-    Seed,
-    Refine,
-    Forward,
-}
-
-impl Method {
-    fn parse(name: &str) -> PyResult<Self> {
-        Ok(match name {
-            "splat-gather" => Method::SplatGather,
-            "seed" => Method::Seed,
-            "refine" => Method::Refine,
-            "forward" => Method::Forward,
-            _ => {
-                return Err(errors::invalid(
-                    "method",
-                    format!("'{name}': expected \"splat-gather\", \"seed\", \"refine\" or \"forward\""),
-                ))
-            }
-        })
-    }
-}
+use viewsynth::pass::ToDevice;
 
 /// The arguments of one call, as Python gave them.
 pub struct CyclopeanArgs<'a, 'py> {
@@ -57,55 +24,61 @@ pub struct CyclopeanArgs<'a, 'py> {
     pub right_rgb: &'a Bound<'py, PyAny>,
     pub left_disparity: Option<&'a Bound<'py, PyAny>>,
     pub right_disparity: Option<&'a Bound<'py, PyAny>>,
-    pub position: Option<f64>,
     pub left_depth: Option<&'a Bound<'py, PyAny>>,
     pub right_depth: Option<&'a Bound<'py, PyAny>>,
     pub cameras: Option<&'a Bound<'py, PyAny>>,
-    pub method: &'a str,
-    pub focal: Option<f64>,
-    pub baseline: Option<f64>,
-    pub doffs: f64,
-    pub outputs: Option<&'a Bound<'py, PyAny>>,
-    pub fill: bool,
+    /// Every other keyword argument, named as the library's request names it.
+    pub request: CyclopeanRequest,
 }
 
-/// A call's inputs, validated while the GIL is held.
-struct Job {
-    frame: StereoFrame,
-    mid: MiddleCamera,
-    method: Method,
-    /// Seed/refine start from it: the median depth the left eye saw (as the CLI).
-    fixation: f64,
-    wanted: CyclopeanOutputs,
-    /// Holes filled from the background side after the method (the CLI's --fill).
+/// The keyword arguments that are settings, as the library's request (choices parsed by the
+/// library's names for them).
+#[allow(clippy::too_many_arguments)]
+pub fn request(
+    method: Option<&str>,
+    refine_steps: Option<u32>,
+    blend: Option<&str>,
+    z_threshold: Option<f64>,
+    dominant: Option<String>,
+    position: Option<f64>,
+    focal: Option<f64>,
+    baseline: Option<f64>,
+    doffs: f64,
+    outputs: Option<&Bound<'_, PyAny>>,
     fill: bool,
+) -> PyResult<CyclopeanRequest> {
+    use viewsynth::job::choice;
+    Ok(CyclopeanRequest {
+        method: method
+            .map(|m| choice("--method", m))
+            .transpose()
+            .map_err(errors::from_request)?,
+        refine_steps,
+        blend: blend
+            .map(|b| choice("--blend", b))
+            .transpose()
+            .map_err(errors::from_request)?,
+        z_threshold,
+        dominant,
+        position,
+        focal,
+        baseline,
+        doffs,
+        outputs: outputs.map(|_| crate::shared::output_set(outputs)).transpose()?,
+        fill,
+    })
 }
 
-/// The same renderer the CLI picks for `method`, with its defaults.
-fn render(gpu: &Backend, job: &Job) -> viewsynth::Result<(f64, CyclopeanOutput, Timing)> {
-    let t0 = std::time::Instant::now();
-    let (frame, mid, wanted) = (&job.frame, &job.mid, job.wanted);
-    let (out, timing) = match job.method {
-        Method::Seed | Method::Refine => {
-            let mut params = CyclopeanParams::seed(job.fixation);
-            if job.method == Method::Refine {
-                // The CLI's default --refine-steps.
-                params.method = GatherMethod::Refine { steps: 3 };
-            }
-            params.validate()?;
-            let mut r = CyclopeanRenderer::with_outputs(gpu, frame, params, wanted)?;
-            r.render(mid)?
-        }
-        Method::Forward => ForwardWarp::new(gpu, frame, &BreakRule::default())?.render(mid)?,
-        Method::SplatGather => SplatRenderer::new(gpu, frame, SplatParams::default(), wanted)?.render(mid)?,
-    };
-    let out = match job.fill {
-        true => viewsynth::cyclopean::fill::Filler::new(gpu)?.fill(&out, mid.width, mid.height)?,
-        false => out,
-    };
-    // Everything before the render itself: uploads, meshes, programs.
-    let setup_ms = (t0.elapsed().as_secs_f64() * 1e3 - timing.wall_ms).max(0.0);
-    Ok((setup_ms, out, timing))
+/// The work of one call once validated: render with the GIL released.
+fn render(gpu: &Backend, plan: &CyclopeanPlan, input: StereoInput) -> viewsynth::Result<Synthesised> {
+    let names = match plan.kind() {
+        StereoKind::Disparity => ["left_rgb", "right_rgb", "left_disparity", "cameras"],
+        StereoKind::Cameras => ["left_rgb", "right_rgb", "left_depth", "cameras"],
+    }
+    .map(InputName::Argument);
+    let (frame, mid, fixation) = plan.frame(input, names)?;
+    gpu.check_image_size("the view (cameras[\"middle\"] width/height)", mid.width, mid.height)?;
+    plan.synthesise(&gpu.to_device()?, &frame, &mid, fixation)
 }
 
 fn eye(
@@ -139,46 +112,6 @@ fn eyes(
         }
     }
     Ok((left, right))
-}
-
-/// A rectified pair with disparities (the CLI's --left-disparity mode): the frame, the view,
-/// the fixation of seed/refine (the median depth the left eye saw) and whether depth is metric.
-fn disparity_job(
-    gpu: &Backend,
-    a: &CyclopeanArgs<'_, '_>,
-    left_disparity: &Bound<'_, PyAny>,
-    right_disparity: &Bound<'_, PyAny>,
-) -> PyResult<(StereoFrame, MiddleCamera, f64, bool)> {
-    let metric = match (a.focal, a.baseline) {
-        (Some(_), Some(_)) => true,
-        (None, None) => false,
-        (Some(_), None) => return Err(errors::invalid("baseline", "focal needs baseline (metres) too")),
-        (None, Some(_)) => return Err(errors::invalid("focal", "baseline needs focal (pixels) too")),
-    };
-    let (left, right) = eyes(
-        a,
-        [(left_disparity, "left_disparity"), (right_disparity, "right_disparity")],
-    )?;
-    let (w, h) = (left.0.width, left.0.height);
-    gpu.check_image_size("left_rgb", w, h).map_err(errors::from_library)?;
-    // Without a calibration only f B matters for the view; any nominal values do (as the CLI).
-    let rig = DisparityRig {
-        focal_px: a.focal.unwrap_or(w as f64),
-        baseline: a.baseline.unwrap_or(0.1),
-        doffs: a.doffs,
-        position: a.position.unwrap_or(0.5),
-    };
-    let (frame, mid) = disparity_frame(left, right, &rig, Conventions::default()).map_err(errors::from_library)?;
-    let mut z: Vec<f32> = frame.left.depth.data.iter().copied().filter(|z| *z > 0.0).collect();
-    if z.is_empty() {
-        return Err(errors::invalid(
-            "left_disparity",
-            "no known disparity (all 0, negative or non-finite)",
-        ));
-    }
-    let half = z.len() / 2;
-    let fixation = *z.select_nth_unstable_by(half, f32::total_cmp).1 as f64;
-    Ok((frame, mid, fixation, metric))
 }
 
 /// A camera-file problem as InvalidInputError naming `cameras`; the message names the field
@@ -271,170 +204,82 @@ fn camera_file(obj: &Bound<'_, PyAny>) -> PyResult<CameraFile> {
     serde_json::from_value(value).map_err(camera_error)
 }
 
-/// The size the camera gives its eye must be the image's (the CLI's check, argument named).
-fn check_eye_size(cam: &EyeCameras, side: &str, (rgb, _): &(RgbImage, DepthMap)) -> PyResult<()> {
-    match cam.size {
-        Some([w, h]) if (w, h) != (rgb.width, rgb.height) => Err(errors::invalid(
-            &format!("{side}_rgb"),
-            format!(
-                "{}x{} (W x H) but cameras[\"{side}\"] gives width x height {w}x{h}",
-                rgb.width, rgb.height
-            ),
-        )),
-        _ => Ok(()),
-    }
-}
-
-/// Depth per eye placed by a camera file (the CLI's --left-depth ... --cameras mode): the frame,
-/// the view and the fixation the file gives (fixation_distance or the gaze rays' vergence).
-fn camera_job(
-    gpu: &Backend,
-    a: &CyclopeanArgs<'_, '_>,
-    left_depth: &Bound<'_, PyAny>,
-    right_depth: &Bound<'_, PyAny>,
-    cameras: &Bound<'_, PyAny>,
-) -> PyResult<(StereoFrame, MiddleCamera, f64)> {
-    // The rig options of the disparity mode: the camera file already places both eyes.
-    for (name, given) in [
-        ("position", a.position.is_some()),
-        ("focal", a.focal.is_some()),
-        ("baseline", a.baseline.is_some()),
-        ("doffs", a.doffs != 0.0),
-    ] {
-        if given {
-            return Err(errors::invalid(
-                name,
-                "applies to disparity input only; with cameras the camera file places the eyes and the view",
-            ));
-        }
-    }
-    let cams = camera_file(cameras)?;
-    let (left, right) = eyes(a, [(left_depth, "left_depth"), (right_depth, "right_depth")])?;
-    check_eye_size(&cams.left, "left", &left)?;
-    check_eye_size(&cams.right, "right", &right)?;
-    gpu.check_image_size("left_rgb", left.0.width, left.0.height)
-        .map_err(errors::from_library)?;
-    let (mid, fixation) = cams.middle_and_fixation().map_err(camera_error)?;
-    gpu.check_image_size("cameras[\"middle\"] width/height", mid.width, mid.height)
-        .map_err(errors::from_library)?;
-    let eye_input = |(color, depth): (RgbImage, DepthMap), cam: &EyeCameras| EyeInput {
-        color,
-        depth,
-        view: cam.view,
-        proj: cam.proj,
-    };
-    let frame = StereoFrame {
-        left: eye_input(left, &cams.left),
-        right: eye_input(right, &cams.right),
-        depth_kind: cams.depth_kind,
-        conv: cams.conventions,
-    };
-    Ok((frame, mid, fixation))
-}
-
 /// Validates `a`, renders the view with the GIL released, and returns the result dict.
 pub fn cyclopean<'py>(py: Python<'py>, gpu: Backend, a: CyclopeanArgs<'_, 'py>) -> PyResult<Bound<'py, PyDict>> {
-    let method = Method::parse(a.method)?;
-    let disparity = a.left_disparity.is_some() || a.right_disparity.is_some();
-    let depth = a.left_depth.is_some() || a.right_depth.is_some() || a.cameras.is_some();
-    let (frame, mid, fixation, metric) = match (disparity, depth) {
-        (true, false) => {
-            let missing = |name: &str, other: &str| errors::invalid(name, format!("missing ({other} is given)"));
-            let ld = a
-                .left_disparity
-                .ok_or_else(|| missing("left_disparity", "right_disparity"))?;
-            let rd = a
-                .right_disparity
-                .ok_or_else(|| missing("right_disparity", "left_disparity"))?;
-            disparity_job(&gpu, &a, ld, rd)?
-        }
-        (false, true) => {
-            let missing =
-                |name: &str| errors::invalid(name, "missing: depth input needs left_depth, right_depth and cameras");
-            let ld = a.left_depth.ok_or_else(|| missing("left_depth"))?;
-            let rd = a.right_depth.ok_or_else(|| missing("right_depth"))?;
-            let cams = a.cameras.ok_or_else(|| missing("cameras"))?;
-            let (frame, mid, fixation) = camera_job(&gpu, &a, ld, rd, cams)?;
-            (frame, mid, fixation, true)
-        }
-        (true, true) => {
-            return Err(errors::invalid(
-                "cameras",
-                "give disparities (left_disparity, right_disparity) or depth (left_depth, right_depth, \
-                 cameras), not both",
-            ))
-        }
-        (false, false) => {
-            return Err(errors::invalid(
-                "left_disparity",
-                "no stereo input: give left_disparity and right_disparity, or left_depth, right_depth and \
-                 cameras",
-            ))
-        }
-    };
-    let outputs = match a.outputs {
-        Some(_) => crate::shared::output_set(a.outputs)?,
-        None => OutputSet {
-            rgb: true,
-            depth: metric,
-            mask: true,
-        },
-    };
-    if outputs.depth && !metric {
-        return Err(errors::invalid(
-            "outputs",
-            "\"depth\" needs focal and baseline (the depth is metric)",
-        ));
+    let kind = StereoGiven {
+        left_disparity: a.left_disparity.is_some(),
+        right_disparity: a.right_disparity.is_some(),
+        left_depth: a.left_depth.is_some(),
+        right_depth: a.right_depth.is_some(),
+        cameras: a.cameras.is_some(),
     }
-    frame.validate().map_err(errors::from_library)?;
-    let (w, h) = (mid.width, mid.height);
-    let job = Job {
-        frame,
-        mid,
-        method,
-        fixation,
-        // The fill reads both planes whatever is returned.
-        wanted: CyclopeanOutputs {
-            color: outputs.rgb || a.fill,
-            depth: outputs.depth || a.fill,
-        },
-        fill: a.fill,
+    .kind()
+    .map_err(errors::from_request)?;
+    let plan = a.request.plan(kind).map_err(errors::from_request)?;
+    let input = match kind {
+        StereoKind::Disparity => {
+            let maps = [
+                (some(a.left_disparity), "left_disparity"),
+                (some(a.right_disparity), "right_disparity"),
+            ];
+            let (left, right) = eyes(&a, maps)?;
+            StereoInput::Disparity { left, right }
+        }
+        StereoKind::Cameras => {
+            let cameras = Box::new(camera_file(some(a.cameras))?);
+            let maps = [(some(a.left_depth), "left_depth"), (some(a.right_depth), "right_depth")];
+            let (left, right) = eyes(&a, maps)?;
+            StereoInput::Cameras { left, right, cameras }
+        }
     };
+    gpu.check_image_size("left_rgb", input_width(&input).0, input_width(&input).1)
+        .map_err(errors::from_library)?;
 
     // The inputs were copied out of numpy above; see SameThread for why the move is sound.
-    let work = SameThread((gpu, job));
+    let work = SameThread((gpu, plan.clone(), input));
     let result = py.detach(move || {
         let work = work;
-        let (gpu, job) = work.0;
-        SameThread(render(&gpu, &job))
+        let (gpu, plan, input) = work.0;
+        SameThread(render(&gpu, &plan, input))
     });
-    let (setup_ms, out, timing) = result.0.map_err(errors::from_library)?;
+    let done = result.0.map_err(errors::from_library)?;
 
     let d = PyDict::new(py);
-    let rendered = |s: &u8| *s != 0 && *s != FILLED;
-    let valid = out.sources.iter().filter(|s| rendered(s)).count();
-    d.set_item("coverage", valid as f64 / out.sources.len() as f64)?;
+    d.set_item("coverage", done.coverage)?;
+    let timing = done.view.timing.unwrap_or_default();
     let timings = PyDict::new(py);
-    timings.set_item("setup_ms", setup_ms)?;
+    timings.set_item("setup_ms", done.setup_ms)?;
     timings.set_item("render_ms", timing.wall_ms)?;
     timings.set_item("gpu_ms", timing.gpu_ms)?;
     d.set_item("timings", timings)?;
-    // The forward method renders colour and depth whatever was asked: keep only what was.
-    if let Some(img) = out.color.filter(|_| outputs.rgb) {
+    let (w, h) = (done.view.width, done.view.height);
+    if let Some(img) = done.view.color {
         d.set_item("rgb", arrays::rgb_array(py, img))?;
     }
-    if let Some(z) = out.depth.filter(|_| outputs.depth) {
+    if let Some(z) = done.view.depth {
         d.set_item("depth", arrays::depth_array(py, z))?;
     }
-    if outputs.mask {
-        let mask = viewsynth::io::Mask::new(w, h, out.sources.iter().map(|s| rendered(s) as u8).collect())
-            .map_err(errors::from_library)?;
-        d.set_item("mask", arrays::mask_array(py, mask))?;
+    let sources = done.view.mask.map(|m| m.data).unwrap_or_default();
+    let plane = |f: &dyn Fn(u8) -> bool| {
+        viewsynth::io::Mask::new(w, h, sources.iter().map(|s| f(*s) as u8).collect()).map_err(errors::from_library)
+    };
+    if plan.outputs().mask {
+        d.set_item("mask", arrays::mask_array(py, plane(&|s| s == 1)?))?;
     }
-    if a.fill {
-        let filled = viewsynth::io::Mask::new(w, h, out.sources.iter().map(|s| (*s == FILLED) as u8).collect())
-            .map_err(errors::from_library)?;
-        d.set_item("filled", arrays::mask_array(py, filled))?;
+    if a.request.fill {
+        d.set_item("filled", arrays::mask_array(py, plane(&|s| s == MASK_FILLED)?))?;
     }
     Ok(d)
+}
+
+/// An input `StereoGiven::kind` found given.
+fn some<'a, 'py>(x: Option<&'a Bound<'py, PyAny>>) -> &'a Bound<'py, PyAny> {
+    x.expect("StereoGiven::kind checked it is given")
+}
+
+/// The left eye's size (every input was checked to share it).
+fn input_width(input: &StereoInput) -> (u32, u32) {
+    match input {
+        StereoInput::Disparity { left, .. } | StereoInput::Cameras { left, .. } => (left.0.width, left.0.height),
+    }
 }

@@ -80,3 +80,74 @@ pub fn from_library(e: Error) -> PyErr {
         Error::Io { .. } | Error::Decode { .. } | Error::Encode { .. } => raise(Kind::File, message, None),
     }
 }
+
+/// A command-line option as the keyword argument that gives the same request field:
+/// `--tau-rel` -> `tau_rel`; `--from`/`--to` -> `source`/`target` (`from` is a Python keyword).
+pub fn keyword(option: &str) -> String {
+    match option.trim_start_matches('-') {
+        "from" => "source".to_string(),
+        "to" => "target".to_string(),
+        name => name.replace('-', "_"),
+    }
+}
+
+/// `text` with each `--option` written as its keyword argument.
+fn keywords_in(text: &str) -> (String, Option<String>) {
+    let mut out = String::with_capacity(text.len());
+    let mut first = None;
+    let mut rest = text;
+    while let Some(at) = rest.find("--") {
+        out.push_str(&rest[..at]);
+        let tail = &rest[at + 2..];
+        let len = tail
+            .find(|c: char| !(c.is_ascii_lowercase() || c.is_ascii_digit() || c == '-'))
+            .unwrap_or(tail.len());
+        match len {
+            0 => out.push_str("--"),
+            _ => {
+                let kw = keyword(&tail[..len]);
+                first.get_or_insert_with(|| kw.clone());
+                out.push_str(&kw);
+            }
+        }
+        rest = &tail[len..];
+    }
+    out.push_str(rest);
+    (out, first)
+}
+
+/// A request the library refused (the CLI's usage errors), worded for Python: options become
+/// keyword arguments, and `parameter` is the field the library named, else the first option
+/// in the message.
+pub fn from_request(e: viewsynth::job::ArgError) -> PyErr {
+    use std::error::Error as _;
+    // A file or GPU failure found while checking is no bad argument: its own class.
+    let e = match e {
+        viewsynth::job::ArgError::Invalid(lib) if !matches!(lib, Error::InvalidParameter { .. }) => {
+            return from_library(lib)
+        }
+        e => e,
+    };
+    let mut chain = e.to_string();
+    let mut named = None;
+    let mut source = e.source();
+    while let Some(s) = source {
+        chain.push_str(&format!(": {s}"));
+        if let Some(Error::InvalidParameter { name, .. }) = s.downcast_ref::<Error>() {
+            named = Some(name.clone());
+        }
+        source = s.source();
+    }
+    if let viewsynth::job::ArgError::Invalid(Error::InvalidParameter { name, .. }) = &e {
+        named = Some(name.clone());
+    }
+    let (message, first) = keywords_in(&chain);
+    let parameter = named
+        .map(|n| keywords_in(&n).0.split('/').next().unwrap_or_default().to_string())
+        .or(first);
+    let message = match message.starts_with("invalid ") {
+        true => message,
+        false => format!("invalid {}: {message}", parameter.as_deref().unwrap_or("argument")),
+    };
+    raise(Kind::InvalidInput, message, parameter.as_deref())
+}

@@ -1,4 +1,4 @@
-//! Integer keyword arguments (`size`, `jobs`, `steps`, `width`, `height`), extracted here rather
+//! Integer keyword arguments (`size`, `jobs`, `steps`, `refine_steps`, `width`, `height`), extracted here rather
 //! than by pyo3, whose conversion of -1 or 2**40 to an unsigned type raises a bare
 //! OverflowError naming no argument. Every one goes through [`int`]: anything that is not an
 //! integer (operator.index refuses it; bool too) is a TypeError, and an integer outside the
@@ -95,4 +95,12 @@ pub fn width(obj: &Bound<'_, PyAny>) -> PyResult<u32> {
 /// `height=`.
 pub fn height(obj: &Bound<'_, PyAny>) -> PyResult<u32> {
     u32_of(obj, "height")
+}
+
+/// `refine_steps=` or None.
+pub fn refine_steps(obj: &Bound<'_, PyAny>) -> PyResult<Option<u32>> {
+    match obj.is_none() {
+        true => Ok(None),
+        false => u32_of(obj, "refine_steps").map(Some),
+    }
 }

@@ -39,11 +39,20 @@ fn info<'py>(py: Python<'py>, device: &str) -> PyResult<Bound<'py, PyAny>> {
     Ok(dict)
 }
 
+/// The library's request for `command` at its defaults, as JSON text (None for a command with
+/// none): what tests/test_front_ends.py holds each keyword argument's default to.
+#[pyfunction]
+fn _request_defaults(command: &str) -> Option<String> {
+    viewsynth::job::request_defaults(command).map(|v| v.to_string())
+}
+
 #[pymodule]
 fn _viewsynth(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<renderer::Renderer>()?;
     m.add_function(wrap_pyfunction!(info, m)?)?;
     m.add_function(wrap_pyfunction!(batch::load_manifest, m)?)?;
+    m.add_function(wrap_pyfunction!(_request_defaults, m)?)?;
+    m.add("_REQUEST_COMMANDS", viewsynth::job::REQUEST_COMMANDS.to_vec())?;
     m.add(
         "FACE_ORDER",
         pyo3::types::PyTuple::new(m.py(), viewsynth::stitch::faces::FACE_TAGS)?,

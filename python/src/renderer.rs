@@ -481,8 +481,11 @@ impl Renderer {
     ///   {"origin", "direction"}}); optionally "conventions", "head_rotation", "fixation_range".
     ///   Values may be numbers, lists, tuples or numpy arrays. The view is the middle camera's
     ///   (its size); position, focal, baseline and doffs do not apply.
-    /// method: "splat-gather" (default, the best on real stereo), "seed", "refine" (3 steps) or
-    /// "forward", as the CLI's --method with its defaults.
+    /// method: "splat-gather" (the default, the best on real stereo), "seed", "refine" or
+    /// "forward"; refine_steps (0..=16; alone it picks seed for 0, else refine; default 3),
+    /// blend ("hard" or "soft"), z_threshold (metres) and dominant ("left:W" or "right:W") tune
+    /// seed and refine only. All as the CLI's options of the same names, decided by the same
+    /// library request (viewsynth.job.cyclopean.CyclopeanRequest).
     /// outputs: any of "rgb", "depth", "mask" (default rgb and mask, plus depth with focal or
     /// with depth input).
     /// fill: the CLI's --fill: holes (pixels no eye saw) take the nearest rendered pixel on their
@@ -499,7 +502,8 @@ impl Renderer {
     /// unreadable cameras file; GpuError if the GPU fails.
     #[allow(clippy::too_many_arguments)]
     #[pyo3(signature = (left_rgb, right_rgb, left_disparity = None, right_disparity = None, position = None, *,
-                        left_depth = None, right_depth = None, cameras = None, method = "splat-gather",
+                        left_depth = None, right_depth = None, cameras = None, method = None,
+                        refine_steps = None, blend = None, z_threshold = None, dominant = None,
                         focal = None, baseline = None, doffs = 0.0, outputs = None, fill = false))]
     fn cyclopean<'py>(
         &mut self,
@@ -512,7 +516,11 @@ impl Renderer {
         left_depth: Option<&Bound<'py, PyAny>>,
         right_depth: Option<&Bound<'py, PyAny>>,
         cameras: Option<&Bound<'py, PyAny>>,
-        method: &str,
+        method: Option<&str>,
+        #[pyo3(from_py_with = crate::ints::refine_steps)] refine_steps: Option<u32>,
+        blend: Option<&str>,
+        z_threshold: Option<f64>,
+        dominant: Option<String>,
         focal: Option<f64>,
         baseline: Option<f64>,
         doffs: f64,
@@ -520,6 +528,19 @@ impl Renderer {
         fill: bool,
     ) -> PyResult<Bound<'py, PyDict>> {
         let gpu = self.gpu()?.clone();
+        let request = crate::cyclopean::request(
+            method,
+            refine_steps,
+            blend,
+            z_threshold,
+            dominant,
+            position,
+            focal,
+            baseline,
+            doffs,
+            outputs,
+            fill,
+        )?;
         crate::cyclopean::cyclopean(
             py,
             gpu,
@@ -528,16 +549,10 @@ impl Renderer {
                 right_rgb,
                 left_disparity,
                 right_disparity,
-                position,
                 left_depth,
                 right_depth,
                 cameras,
-                method,
-                focal,
-                baseline,
-                doffs,
-                outputs,
-                fill,
+                request,
             },
         )
     }
@@ -556,7 +571,8 @@ impl Renderer {
     /// source: "left", "centre" or "right"; target: "left", "right" or "both" (from the centre).
     /// method: "shift-scan" (exact, default), "shift" or "gather3d" (both with steps, 1..=16).
     /// tau_rel: a row segment breaks where |Za - Zb| > tau_rel * min(Za, Zb).
-    /// outputs: any of "rgb", "depth", "mask" (default all three).
+    /// outputs: any of "rgb", "depth", "mask" (a sequence, or one comma-separated string; default
+    /// all three).
     ///
     /// Returns {"left": view, "right": view} for the targets rendered, each view a dict:
     /// "coverage", "timings" (setup_ms, render_ms, gpu_ms) and the requested arrays "rgb"

@@ -8,13 +8,15 @@ use crate::errors;
 use crate::shared::SameThread;
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
-use viewsynth::convention::{Conventions, DepthPlanes, NdcDepthRange};
+use viewsynth::convention::{Conventions, RowOrder};
 use viewsynth::depth::DepthEncoding;
 use viewsynth::gpu::Timing;
 use viewsynth::io::{DepthMap, RgbImage};
+use viewsynth::job::choice;
+use viewsynth::job::stitch::{StitchPlan, StitchRequest};
 use viewsynth::stitch::faces::{faces_from_images, view_z_of};
 use viewsynth::stitch::render::StitchRenderer;
-use viewsynth::stitch::{FaceSet, Method, OdsRig, Side, StitchParams};
+use viewsynth::stitch::{FaceSet, OdsRig, Side, StitchParams};
 
 /// The arguments of one call, as Python gave them.
 pub struct StitchArgs<'a, 'py> {
@@ -36,86 +38,24 @@ pub struct StitchArgs<'a, 'py> {
     pub reversed_z: bool,
 }
 
-fn method(name: &str) -> PyResult<Method> {
-    Method::ALL.into_iter().find(|m| m.label() == name).ok_or_else(|| {
-        errors::invalid(
-            "method",
-            format!("'{name}': expected \"reproject\", \"blend\" or \"border-weight\""),
-        )
-    })
-}
-
-/// Face FOV and seam half-width (degrees) from what was given, as the CLI's --fov/--overlap.
-fn fov_and_overlap(fov: Option<f64>, overlap: Option<f64>) -> PyResult<(f64, f64)> {
-    if let (None, Some(o)) = (fov, overlap) {
-        if !(o > 0.0 && o < 44.0) {
-            return Err(errors::invalid(
-                "overlap",
-                format!("{o}: must be in (0, 44) degrees (faces of 90 + 2 x overlap; or give fov)"),
-            ));
-        }
+impl StitchArgs<'_, '_> {
+    /// The settings as the library's request (choices parsed by the library's names).
+    fn request(&self) -> PyResult<StitchRequest> {
+        Ok(StitchRequest {
+            fov: self.fov,
+            overlap: self.overlap,
+            method: choice("--method", self.method).map_err(errors::from_request)?,
+            width: self.width,
+            height: self.height,
+            ipd: self.ipd,
+            pole_fade: self.pole_fade,
+            depth_kind: choice("--depth-kind", self.depth_kind).map_err(errors::from_request)?,
+            near: self.near,
+            far: self.far,
+            ndc: choice("--ndc", self.ndc).map_err(errors::from_request)?,
+            reversed_z: self.reversed_z,
+        })
     }
-    let (fov, overlap) = match (fov, overlap) {
-        (None, None) => (110.0, 10.0),
-        (Some(f), None) => (f, 0.5 * (f - 90.0)),
-        (None, Some(o)) => (90.0 + 2.0 * o, o),
-        (Some(f), Some(o)) => (f, o),
-    };
-    if !(fov > 90.0 && fov < 178.0) {
-        return Err(errors::invalid(
-            "fov",
-            format!("{fov}: the face field of view must be in (90, 178) degrees"),
-        ));
-    }
-    Ok((fov, overlap))
-}
-
-/// What the face depth arrays hold, with the conventions device depth was written under.
-fn depth_input(a: &StitchArgs<'_, '_>) -> PyResult<(DepthEncoding, Conventions)> {
-    let ndc_depth = match a.ndc {
-        "gl" => NdcDepthRange::MinusOneToOne,
-        "vulkan" => NdcDepthRange::ZeroToOne,
-        other => {
-            return Err(errors::invalid(
-                "ndc",
-                format!("'{other}': expected \"gl\" or \"vulkan\""),
-            ))
-        }
-    };
-    let conv = Conventions {
-        ndc_depth,
-        reversed_z: a.reversed_z,
-        ..Conventions::default()
-    };
-    let kind = match (a.depth_kind, a.near, a.far) {
-        ("view-z", None, None) => DepthEncoding::ViewZ,
-        ("view-z", _, _) => {
-            return Err(errors::invalid("near", "near/far apply to depth_kind=\"device\" only"));
-        }
-        ("device", Some(near), Some(far)) => DepthEncoding::Device {
-            planes: DepthPlanes { near, far },
-        },
-        ("device", _, _) => {
-            return Err(errors::invalid(
-                "near",
-                "depth_kind=\"device\" needs near and far (the planes the faces' depth was written with)",
-            ))
-        }
-        (other, _, _) => {
-            return Err(errors::invalid(
-                "depth_kind",
-                format!("'{other}': expected \"view-z\" or \"device\""),
-            ))
-        }
-    };
-    kind.validate().map_err(errors::from_library)?;
-    if a.depth_kind == "view-z" && (a.ndc != "gl" || a.reversed_z) {
-        return Err(errors::invalid(
-            "ndc",
-            "ndc and reversed_z describe device depth: they apply to depth_kind=\"device\" only",
-        ));
-    }
-    Ok((kind, conv))
 }
 
 /// One eye's six faces as the library's face set (device depth converted to view Z).
@@ -154,9 +94,10 @@ fn render(
     left: &FaceSet,
     right: &FaceSet,
     params: &StitchParams,
+    conv: &Conventions,
 ) -> viewsynth::Result<(f64, RgbImage, Timing)> {
     let t0 = std::time::Instant::now();
-    let mut renderer = StitchRenderer::new(gpu, left, right)?;
+    let mut renderer = StitchRenderer::with_conventions(gpu, left, right, *conv)?;
     let setup_ms = t0.elapsed().as_secs_f64() * 1e3;
     let (img, timing) = renderer.render(params)?;
     Ok((setup_ms, img, timing))
@@ -164,31 +105,24 @@ fn render(
 
 /// Validates `a`, stitches both eyes with the GIL released, and returns the result dict.
 pub fn stitch<'py>(py: Python<'py>, gpu: Backend, a: StitchArgs<'_, 'py>) -> PyResult<Bound<'py, PyDict>> {
-    let (fov, overlap) = fov_and_overlap(a.fov, a.overlap)?;
     // The faces' own frame: the circle centre only translates the face eyes and the ODS rays
-    // together (as the CLI's --faces).
-    let rig = OdsRig {
+    // together (as the CLI's --faces); arrays are top-down, as the CLI's files.
+    let base = OdsRig {
         centre: [0.0; 3],
-        ipd: a.ipd,
-        pole_fade_start_deg: a.pole_fade,
+        ..OdsRig::demo()
     };
-    rig.validate().map_err(errors::from_library)?;
-    let params = StitchParams {
-        method: method(a.method)?,
-        overlap_deg: overlap,
-        width: a.width,
-        height: a.height,
-    };
-    let template = FaceSet {
+    let plan = a
+        .request()?
+        .plan(base, RowOrder::default())
+        .map_err(errors::from_request)?;
+    let StitchPlan {
+        fov,
         rig,
-        side: Side::Left,
-        fov_deg: fov,
-        faces: Vec::new(),
-    };
-    params.validate(&template).map_err(errors::from_library)?;
-    viewsynth::io::check_output_pixels("width/height (top-bottom)", a.width, a.height.saturating_mul(2))
-        .map_err(errors::from_library)?;
-    let (kind, conv) = depth_input(&a)?;
+        params,
+        depth_kind: kind,
+        conventions: conv,
+    } = plan;
+    let overlap = params.overlap_deg;
     let left = eye_faces(a.left_rgb, a.left_depth, "left")?;
     let right = eye_faces(a.right_rgb, a.right_depth, "right")?;
     let (n, m) = (left.0[0].width, right.0[0].width);
@@ -202,11 +136,11 @@ pub fn stitch<'py>(py: Python<'py>, gpu: Backend, a: StitchArgs<'_, 'py>) -> PyR
     let right = face_set(&rig, Side::Right, fov, right, &kind, &conv)?;
 
     // The inputs were copied out of numpy above; see SameThread for why the move is sound.
-    let work = SameThread((gpu, left, right, params));
+    let work = SameThread((gpu, left, right, params, conv));
     let result = py.detach(move || {
         let work = work;
-        let (gpu, left, right, params) = work.0;
-        SameThread(render(&gpu, &left, &right, &params))
+        let (gpu, left, right, params, conv) = work.0;
+        SameThread(render(&gpu, &left, &right, &params, &conv))
     });
     let (setup_ms, img, timing) = result.0.map_err(errors::from_library)?;
 

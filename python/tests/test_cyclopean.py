@@ -172,7 +172,7 @@ def test_bad_inputs(renderer, pair):
     check(renderer, pair, "method", ["'mesh'", "splat-gather"], method="mesh")
     check(renderer, pair, "baseline", ["focal needs baseline"], focal=700.0)
     check(renderer, pair, "focal", ["baseline needs focal"], baseline=0.1)
-    check(renderer, pair, "focal/baseline", ["finite and > 0"], focal=-1.0, baseline=0.1)
+    check(renderer, pair, "focal", ["-1 must be in [1e-3, 1e6]"], focal=-1.0, baseline=0.1)
     check(renderer, pair, "doffs", ["finite"], doffs=float("inf"))
     check(renderer, pair, "outputs", ["needs focal and baseline"], outputs=("rgb", "depth"))
     check(renderer, pair, "outputs", [], outputs=("rgb", "normals"))

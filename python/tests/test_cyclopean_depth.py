@@ -177,17 +177,17 @@ def test_bad_inputs(renderer, pair):
     check(renderer, pair, "cameras", ["bogus"], cams)
     check(renderer, pair, "cameras", ["set"], dict(cameras(h, w), fixation_distance={1.0}))
     check(renderer, pair, "cameras", ["expected a dict"], cameras=[1, 2])
-    check(renderer, pair, "left_rgb", ["gives width x height 64x96"], with_camera("left", "width", 64))
-    check(renderer, pair, "position", ["disparity input only"], position=0.3)
-    check(renderer, pair, "baseline", ["disparity input only"], baseline=0.1)
+    check(renderer, pair, "left_rgb", ["left_rgb is 128x96, its camera in the camera file 64x96"], with_camera("left", "width", 64))
+    check(renderer, pair, "position", ["the camera file places the view"], position=0.3)
+    check(renderer, pair, "baseline", ["the camera file places the view"], baseline=0.1)
     check(renderer, pair, "cameras", ["missing"], cameras=None)
-    check(renderer, pair, "cameras", ["not both"], left_disparity=left_z)
+    check(renderer, pair, "left_disparity", ["not both"], left_disparity=left_z)
     with pytest.raises(vs.InvalidInputError) as err:
         renderer.cyclopean(left_rgb, right_rgb, right_depth=right_z, cameras=cameras(h, w))
     assert err.value.parameter == "left_depth"
     with pytest.raises(vs.InvalidInputError) as err:
         renderer.cyclopean(left_rgb, right_rgb)
-    assert err.value.parameter == "left_disparity" and "no stereo input" in str(err.value)
+    assert err.value.parameter == "left_disparity" and "give left_disparity and right_disparity" in str(err.value)
     with pytest.raises(vs.FileError):
         renderer.cyclopean(left_rgb, right_rgb, left_depth=left_z, right_depth=right_z, cameras="/nonexistent/cams.json")
     # Nothing was left broken: a good call still works.

@@ -177,7 +177,12 @@ def test_stitch_bad_inputs(renderer, faces):
     stitch_error(renderer, faces, "near", ["needs near and far"], depth_kind="device", near=0.1)
     stitch_error(renderer, faces, "depth_kind", ["'disparity'"], depth_kind="disparity")
     stitch_error(renderer, faces, "ndc", ["'dx'"], depth_kind="device", near=0.1, far=10.0, ndc="dx")
-    stitch_error(renderer, faces, "ndc", ["device"], reversed_z=True)
+    # With view-Z faces the conventions only switch the pass's own (as the CLI's --ndc,
+    # --reversed-z): the image must not depend on them.
+    plain = renderer.stitch(*faces["left"], *faces["right"], width=32, height=16)["rgb"]
+    for conv in (dict(reversed_z=True), dict(ndc="vulkan"), dict(ndc="vulkan", reversed_z=True)):
+        switched = renderer.stitch(*faces["left"], *faces["right"], width=32, height=16, **conv)["rgb"]
+        assert np.array_equal(switched, plain), conv
     with pytest.raises(TypeError):
         renderer.stitch(rgb, depth, width=32, height=16)  # the right eye is missing
     # Still usable after the errors.

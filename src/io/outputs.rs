@@ -39,6 +39,16 @@ impl Default for OutputSet {
 }
 
 impl OutputSet {
+    /// The set as `--outputs` names it, e.g. "rgb,mask".
+    pub fn names(&self) -> String {
+        [(self.rgb, "rgb"), (self.depth, "depth"), (self.mask, "mask")]
+            .iter()
+            .filter(|(on, _)| *on)
+            .map(|(_, name)| *name)
+            .collect::<Vec<_>>()
+            .join(",")
+    }
+
     /// Parse "rgb,depth,mask" (any subset, at least one; "color"/"colour" name rgb).
     pub fn parse(list: &str) -> Result<Self> {
         let mut out = OutputSet {

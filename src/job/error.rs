@@ -89,15 +89,26 @@ pub enum ArgError {
     /// A cyclopean disparity pair with one eye missing.
     #[error("--left-disparity needs --right-disparity (a file of zeros if the right eye has none)")]
     RightDisparityMissing,
+    /// A cyclopean disparity pair given by its right eye only.
+    #[error("--right-disparity needs --left-disparity")]
+    LeftDisparityMissing,
+    /// Cyclopean disparities and depth input both given.
+    #[error(
+        "give disparities (--left-disparity, --right-disparity) or depth (--left-depth, --right-depth, --cameras), not both"
+    )]
+    DisparityAndDepth,
+    /// Cyclopean depth input without one of its three parts.
+    #[error("{0} is missing: depth input needs --left-depth, --right-depth and --cameras")]
+    DepthInputMissing(&'static str),
+    /// A disparity-rig value without its partner.
+    #[error("{0} needs {1} too (both or neither: together they make depth metric)")]
+    RigPartner(&'static str, &'static str),
     /// `--depth-scale` with disparity inputs.
     #[error("--depth-scale is for --left-depth/--right-depth; use --disparity-scale with disparities")]
     DepthScaleWithDisparity,
     /// A disparity-rig option given with a camera file.
     #[error("{0} is for --left-disparity/--right-disparity; the camera file places the view")]
     RigOptionWithCameraFile(&'static str),
-    /// A camera file without both eyes' depth.
-    #[error("--cameras needs --left-depth and --right-depth")]
-    CameraFileWithoutDepth,
     /// `--dominant` without the `eye:weight` form.
     #[error("--dominant '{0}': expected left:W or right:W")]
     DominantForm(String),

@@ -76,6 +76,48 @@ pub(crate) fn check_npz_key(key: Option<&str>, depths: &[&std::path::Path]) -> R
     }
 }
 
+/// A request's outputs as the text `--outputs` takes ("rgb,depth,mask"), or none: one value
+/// for each front end's default to be compared with.
+pub(crate) fn outputs_text<S: serde::Serializer>(
+    outputs: &Option<crate::io::OutputSet>,
+    s: S,
+) -> Result<S::Ok, S::Error> {
+    match outputs {
+        Some(o) => s.serialize_some(&o.names()),
+        None => s.serialize_none(),
+    }
+}
+
+/// The commands whose settings both front ends give through one request type.
+pub const REQUEST_COMMANDS: &[&str] = &["cyclopean", "reproject", "stitch"];
+
+/// The request of `command` (one of [`REQUEST_COMMANDS`]) at its defaults, as JSON: what the
+/// front-end mapping tests hold the CLI's and Python's defaults to.
+pub fn request_defaults(command: &str) -> Option<serde_json::Value> {
+    let value = match command {
+        "cyclopean" => serde_json::to_value(cyclopean::CyclopeanRequest::default()),
+        "reproject" => serde_json::to_value(reproject::ReprojectRequest::default()),
+        "stitch" => serde_json::to_value(stitch::StitchRequest::default()),
+        _ => return None,
+    };
+    value.ok()
+}
+
+/// A named choice (`--method`'s "shift-scan", `--depth-kind`'s "view-z", ...) by the names
+/// the request's serialisation gives it, so that each front end parses choices the same way;
+/// a refusal names `option` and the choices.
+pub fn choice<T: serde::de::DeserializeOwned>(option: &str, text: &str) -> Result<T, ArgError> {
+    serde_json::from_value(serde_json::Value::String(text.to_string())).map_err(|e| {
+        // serde's words: "unknown variant `x`, expected one of `a`, `b`"; the position is noise.
+        let why = e.to_string();
+        let why = why.split(" at line").next().unwrap_or(&why).to_string();
+        ArgError::Invalid(crate::Error::param(
+            option,
+            format!("'{}': {why}", crate::error::excerpt(text)),
+        ))
+    })
+}
+
 /// As [`finite_value`], or `inf` where infinity has a meaning (a far plane, a disabled limit).
 pub fn finite_or_inf(text: &str) -> Result<f64, String> {
     match text.trim().parse::<f64>() {

@@ -18,6 +18,8 @@ use clap::{Parser, Subcommand};
 use std::process::ExitCode;
 use viewsynth::io;
 
+#[cfg(test)]
+mod front_ends;
 mod host;
 mod options;
 mod progress;

@@ -7,7 +7,8 @@ use crate::options::{GPU, INPUTS, INTRINSICS, METHOD, OUTPUTS, TARGETS};
 use clap::{Args, ValueEnum};
 use std::path::PathBuf;
 use viewsynth::cyclopean::Blend;
-use viewsynth::job::cyclopean::{CyclopeanJob, CyclopeanMethod, CyclopeanOptions};
+use viewsynth::io::OutputSet;
+use viewsynth::job::cyclopean::{CyclopeanJob, CyclopeanMethod, CyclopeanOptions, CyclopeanRequest};
 use viewsynth::job::{finite_value, ArgError};
 
 #[derive(Clone, Copy, ValueEnum)]
@@ -126,39 +127,49 @@ pub(crate) struct CyclopeanArgs {
     backend: BackendArg,
 }
 
+impl CyclopeanArgs {
+    /// The settings the Python binding gives too, as the library's request.
+    pub(crate) fn request(&self) -> Result<CyclopeanRequest, ArgError> {
+        Ok(CyclopeanRequest {
+            method: self.method.map(|m| match m {
+                MethodArg::SplatGather => CyclopeanMethod::SplatGather,
+                MethodArg::Seed => CyclopeanMethod::Seed,
+                MethodArg::Refine => CyclopeanMethod::Refine,
+                MethodArg::Forward => CyclopeanMethod::Forward,
+            }),
+            refine_steps: self.refine_steps,
+            blend: self.blend.map(|b| match b {
+                BlendArg::Hard => Blend::Hard,
+                BlendArg::Soft => Blend::Soft,
+            }),
+            z_threshold: self.z_threshold,
+            dominant: self.dominant.clone(),
+            position: self.position,
+            focal: self.focal,
+            baseline: self.baseline,
+            doffs: self.doffs,
+            outputs: self.outputs.as_deref().map(OutputSet::parse).transpose()?,
+            fill: self.fill,
+        })
+    }
+}
+
 impl TryFrom<CyclopeanArgs> for CyclopeanJob {
     type Error = ArgError;
     fn try_from(a: CyclopeanArgs) -> Result<Self, ArgError> {
+        let request = a.request()?;
         CyclopeanJob::new(CyclopeanOptions {
             left_rgb: a.left_rgb,
             right_rgb: a.right_rgb,
             left_disparity: a.left_disparity,
             right_disparity: a.right_disparity,
             disparity_scale: a.disparity_scale,
-            doffs: a.doffs,
-            focal: a.focal,
-            baseline: a.baseline,
-            position: a.position,
             left_depth: a.left_depth,
             right_depth: a.right_depth,
             cameras: a.cameras,
             depth_scale: a.depth_scale,
             npz_key: a.npz_key,
-            method: a.method.map(|m| match m {
-                MethodArg::SplatGather => CyclopeanMethod::SplatGather,
-                MethodArg::Seed => CyclopeanMethod::Seed,
-                MethodArg::Refine => CyclopeanMethod::Refine,
-                MethodArg::Forward => CyclopeanMethod::Forward,
-            }),
-            refine_steps: a.refine_steps,
-            blend: a.blend.map(|b| match b {
-                BlendArg::Hard => Blend::Hard,
-                BlendArg::Soft => Blend::Soft,
-            }),
-            z_threshold: a.z_threshold,
-            dominant: a.dominant,
-            outputs: a.outputs,
-            fill: a.fill,
+            request,
             out_dir: a.out_dir,
             gpu: a.gpu.try_into()?,
             backend: a.backend.into(),

@@ -18,6 +18,17 @@ pub(crate) struct ConventionArgs {
     rows: RowsArg,
 }
 
+impl ConventionArgs {
+    /// The switches a request names (`--ndc`, `--reversed-z`) and the pass's row order.
+    pub(crate) fn parts(&self) -> (viewsynth::job::stitch::Ndc, bool, RowOrder) {
+        let ndc = match self.ndc {
+            NdcArg::Gl => viewsynth::job::stitch::Ndc::Gl,
+            NdcArg::Vulkan => viewsynth::job::stitch::Ndc::Vulkan,
+        };
+        (ndc, self.reversed_z, Conventions::from(*self).row_order)
+    }
+}
+
 impl From<ConventionArgs> for Conventions {
     fn from(a: ConventionArgs) -> Self {
         conventions(a.ndc, a.reversed_z, a.rows)

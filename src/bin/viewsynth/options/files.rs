@@ -14,9 +14,9 @@ enum RgbFormatArg {
 #[derive(Args, Clone)]
 #[command(next_help_heading = super::OUTPUTS)]
 pub(crate) struct FileOutputArgs {
-    /// Outputs to produce: any of rgb (or color), depth, mask.
-    #[arg(long, default_value = "rgb,depth,mask")]
-    outputs: String,
+    /// Outputs to produce: any of rgb (or color), depth, mask [default: rgb,depth,mask].
+    #[arg(long)]
+    outputs: Option<String>,
     /// Colour file format: png (8-bit RGB), jpeg or exr.
     #[arg(long, value_enum, default_value = "png")]
     rgb_format: RgbFormatArg,
@@ -37,11 +37,19 @@ pub(crate) struct FileOutputArgs {
     exr_compression: String,
 }
 
+/// `--outputs` when it is not given.
+const ALL_OUTPUTS: &str = "rgb,depth,mask";
+
 impl FileOutputArgs {
+    /// `--outputs` as given (None: the request's default, all three).
+    pub(crate) fn outputs_given(&self) -> Result<Option<viewsynth::io::OutputSet>, viewsynth::Error> {
+        self.outputs.as_deref().map(viewsynth::io::OutputSet::parse).transpose()
+    }
+
     /// The options as the library checks them.
     pub(crate) fn options(&self) -> FileOptions<'_> {
         FileOptions {
-            outputs: &self.outputs,
+            outputs: self.outputs.as_deref().unwrap_or(ALL_OUTPUTS),
             rgb: match self.rgb_format {
                 RgbFormatArg::Png => RgbFormat::Png,
                 RgbFormatArg::Jpeg => RgbFormat::Jpeg,

@@ -4,8 +4,9 @@ use crate::options::{BackendArg, ConventionArgs, FileOutputArgs, GpuArgs, Intrin
 use crate::options::{GPU, INPUTS, INTRINSICS, METHOD, OUTPUTS, TARGETS};
 use clap::{Args, ValueEnum};
 use std::path::PathBuf;
-use viewsynth::camera::stereo::Eye;
-use viewsynth::job::reproject::{MethodChoice, ReprojectJob, ReprojectOptions, SourceDepth, Target};
+use viewsynth::job::reproject::{
+    MethodChoice, ReprojectJob, ReprojectOptions, ReprojectRequest, SourceDepth, SourceView, Target,
+};
 use viewsynth::job::{file_formats, finite_or_inf, finite_value, ArgError};
 
 #[derive(Clone, Copy, ValueEnum, PartialEq)]
@@ -140,47 +141,59 @@ pub(crate) struct ReprojectArgs {
     backend: BackendArg,
 }
 
-impl TryFrom<ReprojectArgs> for ReprojectJob {
-    type Error = ArgError;
-    fn try_from(a: ReprojectArgs) -> Result<Self, ArgError> {
-        let files = file_formats(&a.files.options())?;
-        ReprojectJob::new(ReprojectOptions {
-            color: a.color,
-            depth: a.depth,
-            depth_kind: match a.depth_kind {
+impl ReprojectArgs {
+    /// The settings the Python binding gives too, as the library's request.
+    pub(crate) fn request(&self) -> Result<ReprojectRequest, ArgError> {
+        let outputs = self.files.outputs_given()?;
+        Ok(ReprojectRequest {
+            depth_kind: match self.depth_kind {
                 ReprojectDepthArg::ViewZ => SourceDepth::ViewZ,
                 ReprojectDepthArg::Device => SourceDepth::Device,
                 ReprojectDepthArg::Disparity => SourceDepth::Disparity,
             },
-            depth_scale: a.depth_scale,
-            npz_key: a.npz_key,
-            near: a.near,
-            far: a.far,
-            intrinsics_file: a.intrinsics.intrinsics.clone(),
-            intrinsics: a.intrinsics.values(),
-            cameras: a.cameras,
-            baseline: a.baseline,
-            focal: a.focal,
-            doffs: a.doffs,
-            separation: a.separation,
-            convergence: a.convergence,
-            from: match a.from {
-                FromArg::Left => Some(Eye::Left),
-                FromArg::Centre => None,
-                FromArg::Right => Some(Eye::Right),
+            near: self.near,
+            far: self.far,
+            baseline: self.baseline,
+            focal: self.focal,
+            doffs: self.doffs,
+            separation: self.separation,
+            convergence: self.convergence,
+            from: match self.from {
+                FromArg::Left => SourceView::Left,
+                FromArg::Centre => SourceView::Centre,
+                FromArg::Right => SourceView::Right,
             },
-            to: match a.to {
+            to: match self.to {
                 ToArg::Left => Target::Left,
                 ToArg::Right => Target::Right,
                 ToArg::Both => Target::Both,
             },
-            method: match a.method {
+            method: match self.method {
                 ReprojectMethodArg::Shift => MethodChoice::Shift,
                 ReprojectMethodArg::ShiftScan => MethodChoice::ShiftScan,
                 ReprojectMethodArg::Gather3d => MethodChoice::Gather3d,
             },
-            steps: a.steps,
-            tau_rel: a.tau_rel,
+            steps: self.steps,
+            tau_rel: self.tau_rel,
+            outputs,
+        })
+    }
+}
+
+impl TryFrom<ReprojectArgs> for ReprojectJob {
+    type Error = ArgError;
+    fn try_from(a: ReprojectArgs) -> Result<Self, ArgError> {
+        let files = file_formats(&a.files.options())?;
+        let request = a.request()?;
+        ReprojectJob::new(ReprojectOptions {
+            color: a.color,
+            depth: a.depth,
+            depth_scale: a.depth_scale,
+            npz_key: a.npz_key,
+            intrinsics_file: a.intrinsics.intrinsics.clone(),
+            intrinsics: a.intrinsics.values(),
+            cameras: a.cameras,
+            request,
             files,
             out_dir: a.out_dir,
             conventions: a.conv.into(),

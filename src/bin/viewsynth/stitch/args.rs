@@ -6,7 +6,7 @@ use crate::options::{GPU, INPUTS, METHOD, OUTPUTS, TARGETS};
 use clap::{Args, ValueEnum};
 use std::path::PathBuf;
 use viewsynth::io;
-use viewsynth::job::stitch::{FaceDepth, StitchJob, StitchOptions};
+use viewsynth::job::stitch::{FaceDepth, StitchJob, StitchOptions, StitchRequest};
 use viewsynth::job::{finite_or_inf, finite_value, ArgError};
 use viewsynth::stitch::Method;
 
@@ -115,33 +115,46 @@ pub(crate) struct StitchArgs {
     backend: BackendArg,
 }
 
-impl TryFrom<StitchArgs> for StitchJob {
-    type Error = ArgError;
-    fn try_from(a: StitchArgs) -> Result<Self, ArgError> {
-        StitchJob::new(StitchOptions {
-            scene: a.scene,
-            faces: a.faces,
-            fov: a.fov,
-            overlap: a.overlap,
-            method: match a.method {
+impl StitchArgs {
+    /// The settings the Python binding gives too, as the library's request.
+    pub(crate) fn request(&self) -> Result<StitchRequest, ArgError> {
+        let (ndc, reversed_z, _) = self.conv.parts();
+        Ok(StitchRequest {
+            fov: self.fov,
+            overlap: self.overlap,
+            method: match self.method {
                 StitchMethodArg::Blend => Method::Blend,
                 StitchMethodArg::BorderWeight => Method::BorderWeight,
                 StitchMethodArg::Reproject => Method::Reproject,
             },
-            width: a.width,
-            height: a.height,
-            face_size: a.face_size,
-            ipd: a.ipd,
-            pole_fade: a.pole_fade,
-            depth_scale: a.depth_scale,
-            npz_key: a.npz_key,
-            depth_kind: match a.depth_kind {
+            width: self.width,
+            height: self.height,
+            ipd: self.ipd,
+            pole_fade: self.pole_fade,
+            depth_kind: match self.depth_kind {
                 FaceDepthArg::ViewZ => FaceDepth::ViewZ,
                 FaceDepthArg::Device => FaceDepth::Device,
             },
-            near: a.near,
-            far: a.far,
-            conventions: a.conv.into(),
+            near: self.near,
+            far: self.far,
+            ndc,
+            reversed_z,
+        })
+    }
+}
+
+impl TryFrom<StitchArgs> for StitchJob {
+    type Error = ArgError;
+    fn try_from(a: StitchArgs) -> Result<Self, ArgError> {
+        let request = a.request()?;
+        StitchJob::new(StitchOptions {
+            scene: a.scene,
+            faces: a.faces,
+            face_size: a.face_size,
+            depth_scale: a.depth_scale,
+            npz_key: a.npz_key,
+            request,
+            rows: a.conv.parts().2,
             per_eye: a.per_eye,
             truth: a.truth,
             out_dir: a.out_dir,

@@ -2,10 +2,13 @@
 //! eye(s), on a parallel rig from intrinsics or from full eye matrices (`--cameras`). The
 //! options become a [`ReprojectJob`]; running it writes each target's files all-or-none.
 
+mod request;
+
+pub use request::{RenderedTarget, ReprojectRequest, RigPlan, SourceView};
+
 use super::error::{InContext, OptionsContext};
 use super::{ArgError, Backend, Event, GpuRequest, Host, JobError, SourceIntrinsics};
-use crate::camera::stereo::{Eye, StereoParams};
-use crate::camera::PinholeCamera;
+use crate::camera::stereo::Eye;
 use crate::convention::{Conventions, DepthPlanes};
 use crate::cyclopean::camera_file::CameraFile;
 use crate::cyclopean::{FrameDepth, MiddleCamera};
@@ -13,19 +16,18 @@ use crate::depth::DepthEncoding;
 use crate::gpu::Timing;
 use crate::io::FileFormats;
 use crate::io::{self, DepthDecode, DepthSummary};
-use crate::reproject::render::Reprojector;
-use crate::reproject::{
-    Geometry, Method, ReprojectOutput, ReprojectOutputs, ReprojectParams, ReprojectSource, ShiftModel,
-};
+use crate::reproject::{Geometry, ReprojectParams, ReprojectSource};
 use crate::view::ViewOutput;
+use serde::{Deserialize, Serialize};
 use std::path::{Path, PathBuf};
-use std::time::Instant;
 
 /// What the source depth file holds.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
+#[serde(rename_all = "kebab-case")]
 pub enum SourceDepth {
     /// View-space Z in metres.
     #[default]
+    #[serde(alias = "metric")]
     ViewZ,
     /// Window depth written with `--near/--far` under the conventions.
     Device,
@@ -45,7 +47,8 @@ impl SourceDepth {
 }
 
 /// The target view(s).
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
+#[serde(rename_all = "kebab-case")]
 pub enum Target {
     /// The left eye.
     Left,
@@ -57,7 +60,8 @@ pub enum Target {
 }
 
 /// The reprojection method as chosen.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
+#[serde(rename_all = "kebab-case")]
 pub enum MethodChoice {
     /// Fixed-point walk along the row.
     Shift,
@@ -68,50 +72,26 @@ pub enum MethodChoice {
     Gather3d,
 }
 
-/// The reproject options as given.
+/// The reproject options as given: the files, the source camera and the request.
 #[derive(Debug, Clone, Default)]
 pub struct ReprojectOptions {
     /// Source colour.
     pub color: PathBuf,
     /// Source depth.
     pub depth: PathBuf,
-    /// What the depth holds.
-    pub depth_kind: SourceDepth,
     /// Raw units per unit of the depth file.
     pub depth_scale: Option<f64>,
     /// The `.npz` array to read.
     pub npz_key: Option<String>,
-    /// Near plane of device depth.
-    pub near: Option<f64>,
-    /// Far plane of device depth.
-    pub far: Option<f64>,
     /// `--intrinsics FILE`.
     pub intrinsics_file: Option<PathBuf>,
     /// `--fx --fy --cx --cy`.
     pub intrinsics: [Option<f64>; 4],
     /// Full eye matrices instead of a rig.
     pub cameras: Option<PathBuf>,
-    /// Rectified rig's baseline, metres.
-    pub baseline: Option<f64>,
-    /// Rectified rig's focal length, pixels (default fx).
-    pub focal: Option<f64>,
-    /// cx_right - cx_left, pixels.
-    pub doffs: f64,
-    /// Game-engine rig's separation.
-    pub separation: Option<f64>,
-    /// Game-engine rig's convergence distance.
-    pub convergence: Option<f64>,
-    /// The source view: an eye, or None for the centre.
-    pub from: Option<Eye>,
-    /// The target view(s).
-    pub to: Target,
-    /// The method.
-    pub method: MethodChoice,
-    /// Steps of the walk / gather.
-    pub steps: u32,
-    /// Segment break threshold.
-    pub tau_rel: f64,
-    /// Outputs and formats ([`super::file_formats`]).
+    /// Every setting the Python binding gives too (its outputs are the files' outputs).
+    pub request: ReprojectRequest,
+    /// The file formats ([`super::file_formats`]).
     pub files: FileFormats,
     /// Output folder.
     pub out_dir: PathBuf,
@@ -134,17 +114,11 @@ enum Views {
     Cameras { path: PathBuf, from: Eye, to: Eye },
 }
 
-/// [`Views::Rig`]: the source eye, its intrinsics and depth, the target eyes and their shifts.
+/// [`Views::Rig`]: the checked rig, the source intrinsics and the conventions.
 #[derive(Debug, Clone)]
 struct RigViews {
-    from: Option<Eye>,
+    plan: RigPlan,
     intrinsics: SourceIntrinsics,
-    targets: Vec<Eye>,
-    depth_kind: DepthEncoding,
-    /// Game-engine stereo, or None for the rectified rig below.
-    seed: Option<StereoParams>,
-    /// The rectified rig's shift per target (when no `seed`).
-    rectified: Vec<ShiftModel>,
     conventions: Conventions,
 }
 
@@ -217,23 +191,11 @@ pub(crate) fn device_depth(near: Option<f64>, far: Option<f64>, what: &'static s
 
 impl ReprojectJob {
     /// Checks the options against each other and the library's rules.
-    pub fn new(o: ReprojectOptions) -> Result<Self, ArgError> {
+    pub fn new(mut o: ReprojectOptions) -> Result<Self, ArgError> {
         super::check_npz_key(o.npz_key.as_deref(), &[&o.depth])?;
-        let method = match o.method {
-            MethodChoice::Shift => Method::Shift { steps: o.steps },
-            MethodChoice::ShiftScan => Method::ShiftScan,
-            MethodChoice::Gather3d => Method::Gather3d { steps: o.steps },
-        };
+        o.files.outputs = o.request.outputs();
         // The mask is always rendered: the coverage reported is measured on it.
-        let params = ReprojectParams {
-            method,
-            outputs: ReprojectOutputs {
-                color: o.files.outputs.rgb,
-                depth: o.files.outputs.depth,
-            },
-            tau_rel: o.tau_rel,
-        };
-        params.validate().for_options("--steps/--tau-rel")?;
+        let params = o.request.params()?;
         let views = match &o.cameras {
             Some(path) => camera_file_views(&o, path)?,
             None => rig_views(&o)?,
@@ -247,7 +209,7 @@ impl ReprojectJob {
             color: o.color,
             depth: o.depth,
             npz_key: o.npz_key,
-            depth_option: o.depth_kind,
+            depth_option: o.request.depth_kind,
             views,
             params,
             files: o.files,
@@ -264,26 +226,32 @@ impl ReprojectJob {
 
     /// Reads the source, renders every target and writes the files all-or-none.
     pub fn run(&self, host: &dyn Host) -> Result<ReprojectReport, JobError> {
-        let (src, from, targets) = match &self.views {
-            Views::Rig(rig) => self.rig_setup(host, rig)?,
-            Views::Cameras { path, from, to } => self.camera_file_setup(host, path, *from, *to)?,
+        // Read and check the source before the folder or the GPU is touched.
+        let (src, from, geometries) = match &self.views {
+            Views::Rig(rig) => (self.rig_source(host, rig)?, rig.plan.from(), None),
+            Views::Cameras { path, from, to } => {
+                let (src, targets) = self.camera_file_setup(host, path, *from, *to)?;
+                (src, Some(*from), Some(targets))
+            }
+        };
+        let out_dir = io::OutDir::prepare(&self.out_dir)?;
+        let gpu = host.open_device(&self.gpu, self.backend)?;
+        let results = match (&self.views, geometries) {
+            (_, Some(targets)) => request::render_targets(&gpu, &src, &targets, self.params)?,
+            (Views::Rig(rig), None) => rig.plan.render(&gpu, &src, rig.intrinsics.k)?,
+            (Views::Cameras { .. }, None) => unreachable!("the camera file's set-up gives its targets"),
         };
         let (width, height) = (src.color.width, src.color.height);
-        let out_dir = io::OutDir::prepare(&self.out_dir)?;
-
-        let gpu = host.open_device(&self.gpu, self.backend)?;
-        let mut results: Vec<(Eye, ReprojectOutput, Timing, f64)> = Vec::new();
-        for (to, geometry) in &targets {
-            let t0 = Instant::now();
-            let mut r = Reprojector::new(&gpu, &src, geometry, self.params)?;
-            let setup_ms = t0.elapsed().as_secs_f64() * 1e3;
-            let (out, timing) = r.render()?;
-            results.push((*to, out, timing, setup_ms));
-        }
         // Every target's files through the output layer, all or none.
         let mut set = out_dir.file_set()?;
         let mut reports = Vec::with_capacity(results.len());
-        for (to, out, timing, setup_ms) in results {
+        for RenderedTarget {
+            to,
+            out,
+            timing,
+            setup_ms,
+        } in results
+        {
             let coverage = out.coverage();
             let view = ViewOutput {
                 width,
@@ -348,45 +316,15 @@ impl ReprojectJob {
         Ok(src)
     }
 
-    /// The source and its targets on the parallel rig.
-    #[allow(clippy::type_complexity)]
-    fn rig_setup(
-        &self,
-        host: &dyn Host,
-        rig: &RigViews,
-    ) -> Result<(ReprojectSource, Option<Eye>, Vec<(Eye, Geometry)>), JobError> {
-        let RigViews {
-            from,
-            intrinsics,
-            targets,
-            depth_kind,
-            seed,
-            rectified,
-            conventions,
-        } = rig;
+    /// The source on the parallel rig, its size checked against an intrinsics file.
+    fn rig_source(&self, host: &dyn Host, rig: &RigViews) -> Result<ReprojectSource, JobError> {
         let what = format!(
             "--depth-kind {} (check --depth-kind, --depth-scale, --near/--far, conventions)",
             self.depth_option.option_value()
         );
-        let src = self.load_source(host, *depth_kind, *conventions, &what)?;
-        intrinsics.check_size(src.color.width, src.color.height)?;
-        let camera = PinholeCamera {
-            k: intrinsics.k,
-            width: src.color.width,
-            height: src.color.height,
-        };
-        camera.validate("source intrinsics")?;
-        let from = *from;
-        let mut geometries = Vec::new();
-        for (i, &to) in targets.iter().enumerate() {
-            let shift = match seed {
-                Some(p) => ShiftModel::seed(p, camera.width, from, Some(to)),
-                None => rectified[i],
-            };
-            shift.validate()?;
-            geometries.push((to, Geometry::Rig { camera, shift }));
-        }
-        Ok((src, from, geometries))
+        let src = self.load_source(host, rig.plan.depth_kind(), rig.conventions, &what)?;
+        rig.intrinsics.check_size(src.color.width, src.color.height)?;
+        Ok(src)
     }
 
     /// The source eye and the other eye from full GL matrices (3-D gather only).
@@ -397,7 +335,7 @@ impl ReprojectJob {
         path: &Path,
         from: Eye,
         to: Eye,
-    ) -> Result<(ReprojectSource, Option<Eye>, Vec<(Eye, Geometry)>), JobError> {
+    ) -> Result<(ReprojectSource, Vec<(Eye, Geometry)>), JobError> {
         let file = CameraFile::load(path)?;
         let (source, target) = match from {
             Eye::Left => (&file.left, &file.right),
@@ -432,89 +370,39 @@ impl ReprojectJob {
                 height: src.color.height,
             },
         };
-        Ok((src, Some(from), vec![(to, geometry)]))
+        Ok((src, vec![(to, geometry)]))
     }
 }
 
-/// The rig's checks, in the order earlier releases made them.
+/// The rig: the source intrinsics, then the request's checks ([`ReprojectRequest::rig`]).
 fn rig_views(o: &ReprojectOptions) -> Result<Views, ArgError> {
     if o.intrinsics_file.is_none() && o.intrinsics.iter().all(Option::is_none) {
         return Err(ArgError::MissingIntrinsicsOrCameras);
     }
     let intrinsics = SourceIntrinsics::resolve(o.intrinsics_file.as_deref(), o.intrinsics)?;
-    let targets = match (o.from, o.to) {
-        (None, Target::Both) => vec![Eye::Left, Eye::Right],
-        (_, Target::Both) => return Err(ArgError::BothFromEye),
-        (Some(Eye::Left), Target::Left) | (Some(Eye::Right), Target::Right) => return Err(ArgError::TargetIsSource),
-        (_, Target::Left) => vec![Eye::Left],
-        (_, Target::Right) => vec![Eye::Right],
-    };
-    let focal = o.focal.unwrap_or(intrinsics.k.fx);
-    let depth_kind = match o.depth_kind {
-        SourceDepth::ViewZ => DepthEncoding::ViewZ,
-        SourceDepth::Device => device_depth(o.near, o.far, "the depth buffer")?,
-        SourceDepth::Disparity => {
-            let Some(baseline) = o.baseline else {
-                return Err(ArgError::DisparityWithoutBaseline);
-            };
-            let kind = DepthEncoding::Disparity {
-                focal_px: focal,
-                baseline,
-                doffs: o.doffs,
-            };
-            kind.validate()
-                .for_options("--depth-kind disparity: --focal/--baseline/--doffs")?;
-            kind
-        }
-    };
-    if o.depth_kind != SourceDepth::Device && (o.near.is_some() || o.far.is_some()) {
-        return Err(ArgError::PlanesWithoutDevice);
-    }
-    let seed = match (o.separation, o.convergence) {
-        (Some(s), Some(c)) => Some(StereoParams::new(s, c).for_options("--separation/--convergence")?),
-        _ => None,
-    };
-    // --baseline places a rectified rig; with a game-engine rig it would be ignored, unless it
-    // makes disparity depth metric.
-    if seed.is_some() && o.baseline.is_some() && o.depth_kind != SourceDepth::Disparity {
-        return Err(ArgError::RigConflict);
-    }
-    let rectified = match (seed, o.baseline) {
-        (Some(_), _) => Vec::new(),
-        (None, Some(b)) => targets
-            .iter()
-            .map(|&to| {
-                ShiftModel::rectified(focal, b, o.doffs, o.from, Some(to)).for_options("--focal/--baseline/--doffs")
-            })
-            .collect::<Result<_, _>>()?,
-        (None, None) => return Err(ArgError::NoRig),
-    };
     Ok(Views::Rig(RigViews {
-        from: o.from,
+        plan: o.request.rig(intrinsics.k.fx)?,
         intrinsics,
-        targets,
-        depth_kind,
-        seed,
-        rectified,
         conventions: o.conventions,
     }))
 }
 
 /// The camera file's checks: an eye to the other, 3-D gather, the file's own conventions.
 fn camera_file_views(o: &ReprojectOptions, path: &Path) -> Result<Views, ArgError> {
-    let (from, to) = match o.from {
+    let r = &o.request;
+    let (from, to) = match r.from.eye() {
         Some(Eye::Left) => (Eye::Left, Eye::Right),
         Some(Eye::Right) => (Eye::Right, Eye::Left),
         None => return Err(ArgError::CameraFileFromCentre),
     };
-    if !matches!((o.to, to), (Target::Left, Eye::Left) | (Target::Right, Eye::Right)) {
+    if !matches!((r.to, to), (Target::Left, Eye::Left) | (Target::Right, Eye::Right)) {
         return Err(ArgError::CameraFileTarget(view_name(Some(to))));
     }
-    if o.method != MethodChoice::Gather3d {
+    if r.method != MethodChoice::Gather3d {
         return Err(ArgError::CameraFileNeedsGather);
     }
     // The file carries both; a flag that differs from its default would be silently overridden.
-    if o.depth_kind != SourceDepth::ViewZ || o.conventions != Conventions::default() {
+    if r.depth_kind != SourceDepth::ViewZ || o.conventions != Conventions::default() {
         return Err(ArgError::CameraFileOverridden);
     }
     Ok(Views::Cameras {
@@ -526,19 +414,28 @@ fn camera_file_views(o: &ReprojectOptions, path: &Path) -> Result<Views, ArgErro
 
 #[cfg(test)]
 mod tests {
-    use super::{ArgError, Eye, MethodChoice, ReprojectJob, ReprojectOptions, SourceDepth, Target};
+    use super::{
+        ArgError, MethodChoice, ReprojectJob, ReprojectOptions, ReprojectRequest, SourceDepth, SourceView, Target,
+    };
 
     fn rig_options() -> ReprojectOptions {
         ReprojectOptions {
             color: "c.png".into(),
             depth: "d.exr".into(),
             intrinsics: [Some(500.0), Some(500.0), Some(320.0), Some(240.0)],
-            baseline: Some(0.1),
-            from: Some(Eye::Left),
-            steps: 3,
-            tau_rel: 0.05,
+            request: ReprojectRequest {
+                baseline: Some(0.1),
+                ..Default::default()
+            },
             ..Default::default()
         }
+    }
+
+    /// The rig options with the request changed by `change`.
+    fn with(change: impl FnOnce(&mut ReprojectRequest)) -> ReprojectOptions {
+        let mut o = rig_options();
+        change(&mut o.request);
+        o
     }
 
     #[test]
@@ -552,68 +449,39 @@ mod tests {
             ReprojectJob::new(no_k),
             Err(ArgError::MissingIntrinsicsOrCameras)
         ));
-        let no_rig = ReprojectOptions {
-            baseline: None,
-            ..rig_options()
-        };
+        let no_rig = with(|r| r.baseline = None);
         assert!(matches!(ReprojectJob::new(no_rig), Err(ArgError::NoRig)));
-        let itself = ReprojectOptions {
-            to: Target::Left,
-            ..rig_options()
-        };
+        let itself = with(|r| r.to = Target::Left);
         assert!(matches!(ReprojectJob::new(itself), Err(ArgError::TargetIsSource)));
-        let both = ReprojectOptions {
-            to: Target::Both,
-            ..rig_options()
-        };
+        let both = with(|r| r.to = Target::Both);
         assert!(matches!(ReprojectJob::new(both), Err(ArgError::BothFromEye)));
     }
 
     #[test]
     fn planes_go_with_device_depth_only() {
-        let planes = ReprojectOptions {
-            near: Some(0.1),
-            far: Some(10.0),
-            ..rig_options()
-        };
+        let planes = with(|r| (r.near, r.far) = (Some(0.1), Some(10.0)));
         assert!(matches!(ReprojectJob::new(planes), Err(ArgError::PlanesWithoutDevice)));
-        let device = ReprojectOptions {
-            depth_kind: SourceDepth::Device,
-            ..rig_options()
-        };
+        let device = with(|r| r.depth_kind = SourceDepth::Device);
         assert!(matches!(
             ReprojectJob::new(device),
             Err(ArgError::DevicePlanesMissing(_))
         ));
-        let reversed = ReprojectOptions {
-            depth_kind: SourceDepth::Device,
-            near: Some(10.0),
-            far: Some(1.0),
-            ..rig_options()
-        };
+        let reversed = with(|r| (r.depth_kind, r.near, r.far) = (SourceDepth::Device, Some(10.0), Some(1.0)));
         let e = ReprojectJob::new(reversed).unwrap_err();
         assert!(e.to_string().starts_with("--near/--far"), "{e}");
     }
 
     #[test]
     fn a_camera_file_takes_an_eye_to_the_other_by_3d_gather_under_its_own_conventions() {
-        let cams = ReprojectOptions {
-            cameras: Some("cameras.json".into()),
-            intrinsics: [None; 4],
-            baseline: None,
-            method: MethodChoice::Gather3d,
-            ..rig_options()
-        };
+        let mut cams = with(|r| (r.baseline, r.method) = (None, MethodChoice::Gather3d));
+        cams.cameras = Some("cameras.json".into());
+        cams.intrinsics = [None; 4];
         assert!(ReprojectJob::new(cams.clone()).is_ok());
-        let shift = ReprojectOptions {
-            method: MethodChoice::ShiftScan,
-            ..cams.clone()
-        };
+        let mut shift = cams.clone();
+        shift.request.method = MethodChoice::ShiftScan;
         assert!(matches!(ReprojectJob::new(shift), Err(ArgError::CameraFileNeedsGather)));
-        let centre = ReprojectOptions {
-            from: None,
-            ..cams.clone()
-        };
+        let mut centre = cams.clone();
+        centre.request.from = SourceView::Centre;
         assert!(matches!(ReprojectJob::new(centre), Err(ArgError::CameraFileFromCentre)));
         let mut conv = cams;
         conv.conventions.reversed_z = true;

@@ -3,8 +3,11 @@
 //! running it writes the image(s) all-or-none and, with the built-in scene, scores them
 //! against the ray-traced ODS truth.
 
-use super::error::{InContext, OptionsContext};
-use super::reproject::device_depth;
+mod request;
+
+pub use request::{Ndc, StitchPlan, StitchRequest};
+
+use super::error::InContext;
 use super::{ArgError, Backend, Event, GpuRequest, Host, JobError};
 use crate::convention::Conventions;
 use crate::depth::DepthEncoding;
@@ -14,7 +17,7 @@ use crate::io::{self, DepthDecode, DepthMap, DepthSummary, RgbImage};
 use crate::stitch::faces::{load_face_dir, scene_faces, FaceDepthFiles, FACE_TAGS};
 use crate::stitch::render::StitchRenderer;
 use crate::stitch::truth::ods_truth;
-use crate::stitch::{seam_band_mask, FaceSet, Method, OdsRig, Side, StitchParams};
+use crate::stitch::{seam_band_mask, FaceSet, OdsRig, Side, StitchParams};
 use crate::view::ViewOutput;
 use std::path::PathBuf;
 use std::time::Instant;
@@ -36,7 +39,8 @@ fn stacked_depth(set: &FaceSet) -> DepthMap {
 }
 
 /// What face depth files hold.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, serde::Serialize, serde::Deserialize)]
+#[serde(rename_all = "kebab-case")]
 pub enum FaceDepth {
     /// View-space Z in metres.
     #[default]
@@ -45,41 +49,23 @@ pub enum FaceDepth {
     Device,
 }
 
-/// The stitch options as given.
+/// The stitch options as given: where the faces come from, how to decode them, the request.
 #[derive(Debug, Clone)]
 pub struct StitchOptions {
     /// A built-in scene to ray-trace the faces of (only `demo`).
     pub scene: Option<String>,
     /// A folder with the 12 faces.
     pub faces: Option<PathBuf>,
-    /// Face field of view, degrees.
-    pub fov: Option<f64>,
-    /// Seam band half-width, degrees.
-    pub overlap: Option<f64>,
-    /// Stitch method.
-    pub method: Method,
-    /// Equirect width per eye.
-    pub width: u32,
-    /// Equirect height per eye.
-    pub height: u32,
     /// Face side with the scene.
     pub face_size: u32,
-    /// Interpupillary distance, metres.
-    pub ipd: f64,
-    /// Latitude where the eye radius starts fading, degrees.
-    pub pole_fade: f64,
     /// Raw units per metre for integer face depth.
     pub depth_scale: Option<f64>,
     /// The array of `.npz` face depth files to read (default: the only, else the first float one).
     pub npz_key: Option<String>,
-    /// What face depth holds.
-    pub depth_kind: FaceDepth,
-    /// Near plane of device-depth faces.
-    pub near: Option<f64>,
-    /// Far plane of device-depth faces.
-    pub far: Option<f64>,
-    /// Conventions of device-depth faces and of the pass's memory order.
-    pub conventions: Conventions,
+    /// Every setting the Python binding gives too.
+    pub request: StitchRequest,
+    /// Memory row order of the pass.
+    pub rows: crate::convention::RowOrder,
     /// Also write each eye's equirect.
     pub per_eye: bool,
     /// Score against the ray-traced ODS truth.
@@ -157,69 +143,26 @@ impl StitchJob {
                 "applies to --faces depth files only (the built-in scene has none)",
             )));
         }
-        if let (None, Some(overlap)) = (o.fov, o.overlap) {
-            if !(overlap > 0.0 && overlap < 44.0) {
-                return Err(ArgError::Overlap(overlap));
-            }
-        }
-        let (fov, overlap) = match (o.fov, o.overlap) {
-            (None, None) => (110.0, 10.0),
-            (Some(f), None) => (f, 0.5 * (f - 90.0)),
-            (None, Some(v)) => (90.0 + 2.0 * v, v),
-            (Some(f), Some(v)) => (f, v),
-        };
-        if !(fov > 90.0 && fov < 178.0) {
-            return Err(ArgError::FaceFov(fov));
-        }
-        let rig = match &o.scene {
-            Some(name) if name == "demo" => OdsRig {
-                ipd: o.ipd,
-                pole_fade_start_deg: o.pole_fade,
-                ..OdsRig::demo()
-            },
+        let base = match &o.scene {
+            Some(name) if name == "demo" => OdsRig::demo(),
             Some(name) => return Err(ArgError::StitchScene(name.clone())),
             // The circle centre only translates the face eyes and the ODS rays together.
             None => OdsRig {
                 centre: [0.0; 3],
-                ipd: o.ipd,
-                pole_fade_start_deg: o.pole_fade,
+                ..OdsRig::demo()
             },
         };
-        rig.validate().for_options("--ipd/--pole-fade")?;
+        let StitchPlan {
+            fov,
+            rig,
+            params,
+            depth_kind,
+            conventions,
+        } = o.request.plan(base, o.rows)?;
         if o.truth && o.scene.is_none() {
             return Err(ArgError::TruthWithoutScene);
         }
-        let params = StitchParams {
-            method: o.method,
-            overlap_deg: overlap,
-            width: o.width,
-            height: o.height,
-        };
-        let template = FaceSet {
-            rig,
-            side: Side::Left,
-            fov_deg: fov,
-            faces: Vec::new(),
-        };
-        params
-            .validate(&template)
-            .for_options("--overlap/--fov/--width/--height")?;
-        // The GPU's limit is checked when rendering; the image files' bound is known now.
-        let max = io::MAX_DIMENSION;
-        if o.width > max || 2 * o.height as u64 > max as u64 {
-            return Err(ArgError::TopBottomTooTall {
-                width: o.width,
-                height: o.height,
-                max,
-            });
-        }
-        io::check_output_pixels("--width/--height (top-bottom)", o.width, o.height.saturating_mul(2))?;
-        let depth_kind = match (o.depth_kind, o.near, o.far) {
-            (FaceDepth::ViewZ, None, None) => DepthEncoding::ViewZ,
-            (FaceDepth::ViewZ, _, _) => return Err(ArgError::PlanesWithoutDevice),
-            (FaceDepth::Device, near, far) => device_depth(near, far, "the faces' depth")?,
-        };
-        if o.faces.is_none() && o.depth_kind != FaceDepth::ViewZ {
+        if o.faces.is_none() && o.request.depth_kind != FaceDepth::ViewZ {
             return Err(ArgError::FaceDepthKindWithoutFaces);
         }
         super::cyclopean::check_scale("--depth-scale", o.depth_scale)?;
@@ -235,7 +178,7 @@ impl StitchJob {
             },
             npz_key: o.npz_key,
             depth_kind,
-            conventions: o.conventions,
+            conventions,
             per_eye: o.per_eye,
             truth: o.truth,
             out_dir: o.out_dir,
@@ -361,26 +304,21 @@ impl StitchJob {
 
 #[cfg(test)]
 mod tests {
-    use super::{ArgError, Conventions, FaceDepth, GpuRequest, Method, StitchJob, StitchOptions};
+    use super::{ArgError, FaceDepth, GpuRequest, StitchJob, StitchOptions, StitchRequest};
 
     fn demo() -> StitchOptions {
         StitchOptions {
             scene: Some("demo".into()),
             faces: None,
-            fov: None,
-            overlap: None,
-            method: Method::Reproject,
-            width: 256,
-            height: 128,
             face_size: 64,
-            ipd: 0.064,
-            pole_fade: 45.0,
             depth_scale: None,
             npz_key: None,
-            depth_kind: FaceDepth::ViewZ,
-            near: None,
-            far: None,
-            conventions: Conventions::default(),
+            request: StitchRequest {
+                width: 256,
+                height: 128,
+                ..Default::default()
+            },
+            rows: Default::default(),
             per_eye: false,
             truth: false,
             out_dir: "out".into(),
@@ -389,31 +327,24 @@ mod tests {
         }
     }
 
+    /// The demo options with the request changed by `change`.
+    fn with(change: impl FnOnce(&mut StitchRequest)) -> StitchOptions {
+        let mut o = demo();
+        change(&mut o.request);
+        o
+    }
+
     #[test]
     fn fov_and_overlap_derive_each_other() {
         let job = StitchJob::new(demo()).unwrap();
         assert_eq!((job.fov, job.params.overlap_deg), (110.0, 10.0));
-        let job = StitchJob::new(StitchOptions {
-            fov: Some(120.0),
-            ..demo()
-        })
-        .unwrap();
+        let job = StitchJob::new(with(|r| r.fov = Some(120.0))).unwrap();
         assert_eq!(job.params.overlap_deg, 15.0);
-        let job = StitchJob::new(StitchOptions {
-            overlap: Some(5.0),
-            ..demo()
-        })
-        .unwrap();
+        let job = StitchJob::new(with(|r| r.overlap = Some(5.0))).unwrap();
         assert_eq!(job.fov, 100.0);
-        let e = StitchJob::new(StitchOptions {
-            overlap: Some(50.0),
-            ..demo()
-        });
+        let e = StitchJob::new(with(|r| r.overlap = Some(50.0)));
         assert!(matches!(e, Err(ArgError::Overlap(_))));
-        let e = StitchJob::new(StitchOptions {
-            fov: Some(200.0),
-            ..demo()
-        });
+        let e = StitchJob::new(with(|r| r.fov = Some(200.0)));
         assert!(matches!(e, Err(ArgError::FaceFov(_))));
     }
 
@@ -429,18 +360,11 @@ mod tests {
             ..faces.clone()
         });
         assert!(matches!(e, Err(ArgError::TruthWithoutScene)));
-        let e = StitchJob::new(StitchOptions {
-            depth_kind: FaceDepth::Device,
-            near: Some(0.1),
-            far: Some(100.0),
-            ..demo()
-        });
+        let e = StitchJob::new(with(|r| {
+            (r.depth_kind, r.near, r.far) = (FaceDepth::Device, Some(0.1), Some(100.0));
+        }));
         assert!(matches!(e, Err(ArgError::FaceDepthKindWithoutFaces)));
-        let e = StitchJob::new(StitchOptions {
-            height: crate::io::MAX_DIMENSION,
-            width: 16,
-            ..demo()
-        });
+        let e = StitchJob::new(with(|r| (r.height, r.width) = (crate::io::MAX_DIMENSION, 16)));
         assert!(matches!(e, Err(ArgError::TopBottomTooTall { .. })));
     }
 }

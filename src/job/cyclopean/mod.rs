@@ -1,0 +1,352 @@
+//! `cyclopean`: the middle (spectator) view of a stereo pair, from a rectified pair with
+//! disparities or from any pair with depth and a camera file. The options become a
+//! [`CyclopeanJob`]; running it writes `middle_{rgb,depth,mask}` all-or-none.
+
+use super::{ArgError, Backend, Event, GpuRequest, Host, JobError};
+use crate::convention::{Conventions, DepthPlanes};
+use crate::cyclopean::camera_file::CameraFile;
+use crate::cyclopean::{EyeInput, FrameDepth};
+use crate::depth::DepthEncoding;
+use crate::io::{self, DepthDecode, DepthMap, DepthSummary, RgbImage};
+use serde::Serialize;
+use std::path::{Path, PathBuf};
+
+mod request;
+
+pub use request::{CyclopeanPlan, CyclopeanRequest, InputName, StereoGiven, StereoInput, StereoKind, Synthesised};
+
+/// How the middle view is synthesised.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, serde::Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum CyclopeanMethod {
+    /// Splat each eye's surfaces, refine each pixel on the surface it sees, merge the eyes.
+    SplatGather,
+    /// Seed 000: one reconstruction step from the fixation depth.
+    Seed,
+    /// The seed's step, `--refine-steps` refinement steps and a projection check.
+    Refine,
+    /// Each eye's depth mesh rendered into the view, the nearest surface wins.
+    Forward,
+}
+
+impl CyclopeanMethod {
+    /// The name `--method` takes.
+    pub fn name(self) -> &'static str {
+        match self {
+            CyclopeanMethod::SplatGather => "splat-gather",
+            CyclopeanMethod::Seed => "seed",
+            CyclopeanMethod::Refine => "refine",
+            CyclopeanMethod::Forward => "forward",
+        }
+    }
+}
+
+/// The cyclopean options as given: the files, how to decode them, and the request.
+#[derive(Debug, Clone, Default)]
+pub struct CyclopeanOptions {
+    /// Left eye colour.
+    pub left_rgb: PathBuf,
+    /// Right eye colour.
+    pub right_rgb: PathBuf,
+    /// Left disparity (rectified pair).
+    pub left_disparity: Option<PathBuf>,
+    /// Right disparity.
+    pub right_disparity: Option<PathBuf>,
+    /// Raw disparity units per pixel.
+    pub disparity_scale: Option<f64>,
+    /// Left depth (with a camera file).
+    pub left_depth: Option<PathBuf>,
+    /// Right depth.
+    pub right_depth: Option<PathBuf>,
+    /// The camera file.
+    pub cameras: Option<PathBuf>,
+    /// Raw units per unit of depth for integer depth files.
+    pub depth_scale: Option<f64>,
+    /// The `.npz` array to read.
+    pub npz_key: Option<String>,
+    /// Every setting the Python binding gives too.
+    pub request: CyclopeanRequest,
+    /// Output folder.
+    pub out_dir: PathBuf,
+    /// The GPU to render on.
+    pub gpu: GpuRequest,
+    /// GL, or Vulkan (every method).
+    pub backend: Backend,
+}
+
+/// A checked cyclopean run.
+#[derive(Debug, Clone)]
+pub struct CyclopeanJob {
+    left_rgb: PathBuf,
+    right_rgb: PathBuf,
+    /// Left and right disparity or depth files.
+    maps: (PathBuf, PathBuf),
+    cameras: Option<PathBuf>,
+    decode: DepthDecode,
+    npz_key: Option<String>,
+    plan: CyclopeanPlan,
+    out_dir: PathBuf,
+    gpu: GpuRequest,
+    backend: Backend,
+}
+
+/// What a cyclopean run wrote.
+#[derive(Debug)]
+pub struct CyclopeanReport {
+    /// View width.
+    pub width: u32,
+    /// View height.
+    pub height: u32,
+    /// Fraction of pixels some eye saw.
+    pub valid_fraction: f64,
+    /// Render wall time.
+    pub render_ms: f64,
+    /// The files written.
+    pub written: Vec<PathBuf>,
+}
+
+impl CyclopeanJob {
+    /// Checks the options: one input set-up, the files' decoding options for it, and the
+    /// request ([`CyclopeanRequest::plan`]).
+    pub fn new(o: CyclopeanOptions) -> Result<Self, ArgError> {
+        let kind = StereoGiven {
+            left_disparity: o.left_disparity.is_some(),
+            right_disparity: o.right_disparity.is_some(),
+            left_depth: o.left_depth.is_some(),
+            right_depth: o.right_depth.is_some(),
+            cameras: o.cameras.is_some(),
+        }
+        .kind()?;
+        let (maps, scale) = match kind {
+            StereoKind::Disparity => {
+                if o.depth_scale.is_some() {
+                    return Err(ArgError::DepthScaleWithDisparity);
+                }
+                check_scale("--disparity-scale", o.disparity_scale)?;
+                let maps = (o.left_disparity.clone(), o.right_disparity.clone());
+                (maps, Some(o.disparity_scale.unwrap_or(1.0)))
+            }
+            StereoKind::Cameras => {
+                if o.disparity_scale.is_some() {
+                    return Err(ArgError::RigOptionWithCameraFile("--disparity-scale"));
+                }
+                check_scale("--depth-scale", o.depth_scale)?;
+                ((o.left_depth.clone(), o.right_depth.clone()), o.depth_scale)
+            }
+        };
+        let (Some(left), Some(right)) = maps else {
+            unreachable!("StereoGiven::kind checked both maps")
+        };
+        super::check_npz_key(o.npz_key.as_deref(), &[&left, &right])?;
+        let plan = o.request.plan(kind)?;
+        Ok(CyclopeanJob {
+            left_rgb: o.left_rgb,
+            right_rgb: o.right_rgb,
+            maps: (left, right),
+            cameras: o.cameras,
+            decode: DepthDecode {
+                scale,
+                ..Default::default()
+            },
+            npz_key: o.npz_key,
+            plan,
+            out_dir: o.out_dir,
+            gpu: o.gpu,
+            backend: o.backend,
+        })
+    }
+
+    /// `--out-dir`.
+    pub fn out_dir(&self) -> &Path {
+        &self.out_dir
+    }
+
+    /// Reads the pair, renders the view and writes the requested files all-or-none.
+    pub fn run(&self, host: &dyn Host) -> Result<CyclopeanReport, JobError> {
+        let names = [
+            InputName::File(&self.left_rgb),
+            InputName::File(&self.right_rgb),
+            InputName::File(&self.maps.0),
+            InputName::File(self.cameras.as_deref().unwrap_or(&self.maps.1)),
+        ];
+        let eye = |rgb: &Path, map: &Path| -> crate::Result<(RgbImage, DepthMap)> {
+            // Sizes and the pixel budget from the headers before either file is decoded.
+            io::check_rgbd_sizes(rgb, map)?;
+            Ok((
+                io::load_rgb(rgb)?,
+                io::load_depth_with_key(map, self.npz_key.as_deref(), &self.decode)?,
+            ))
+        };
+        let left = eye(&self.left_rgb, &self.maps.0)?;
+        let right = eye(&self.right_rgb, &self.maps.1)?;
+        let input = match &self.cameras {
+            None => StereoInput::Disparity { left, right },
+            Some(path) => StereoInput::Cameras {
+                left,
+                right,
+                cameras: Box::new(CameraFile::load(path)?),
+            },
+        };
+        let (frame, mid, fixation) = self.plan.frame(input, names)?;
+        if let Some(cameras) = &self.cameras {
+            for (path, eye) in [(&self.maps.0, &frame.left), (&self.maps.1, &frame.right)] {
+                let hint = format!(
+                    "read as {:?} depth (check depth_kind and the projections in {}, and --depth-scale)",
+                    frame.depth_kind,
+                    cameras.display()
+                );
+                host.event(Event::InputDepth {
+                    path,
+                    summary: &DepthSummary::of(&view_z_in_metres(eye, frame.depth_kind, &frame.conv)?),
+                    hint: &hint,
+                });
+            }
+        }
+        let out_dir = io::OutDir::prepare(&self.out_dir)?;
+        let device = host.open_device(&self.gpu, self.backend)?;
+        let done = self.plan.synthesise(&device, &frame, &mid, fixation)?;
+        let formats = io::FileFormats {
+            outputs: self.plan.outputs(),
+            ..Default::default()
+        };
+        let mut set = out_dir.file_set()?;
+        io::write_view(&mut set, &io::ViewNames::tagged("middle"), &done.view, &formats)?;
+        let written = set.commit()?;
+        Ok(CyclopeanReport {
+            width: mid.width,
+            height: mid.height,
+            valid_fraction: done.coverage,
+            render_ms: done.view.timing.map_or(0.0, |t| t.wall_ms),
+            written,
+        })
+    }
+}
+
+/// An eye's depth as view Z in metres (0 where invalid), for the input summary.
+fn view_z_in_metres(eye: &EyeInput, kind: FrameDepth, conv: &Conventions) -> crate::Result<DepthMap> {
+    let input = match kind {
+        FrameDepth::ViewZ => DepthEncoding::ViewZ,
+        FrameDepth::Device => DepthEncoding::Device {
+            planes: DepthPlanes::from_gl_projection(&eye.proj, conv)?,
+        },
+    };
+    Ok(input.view_z_map(conv, &eye.depth))
+}
+
+/// A scale option, when given, must be finite and > 0 (refused by its own name, before any
+/// input is read).
+pub(crate) fn check_scale(option: &'static str, value: Option<f64>) -> Result<(), ArgError> {
+    match value {
+        Some(v) if !(v.is_finite() && v > 0.0) => Err(ArgError::Scale { option, value: v }),
+        _ => Ok(()),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::request::dominant;
+    use super::{ArgError, CyclopeanJob, CyclopeanMethod, CyclopeanOptions, CyclopeanRequest};
+    use crate::cyclopean::{Blend, Eye};
+
+    fn disparity_options(request: CyclopeanRequest) -> CyclopeanOptions {
+        CyclopeanOptions {
+            left_rgb: "l.png".into(),
+            right_rgb: "r.png".into(),
+            left_disparity: Some("ld.pgm".into()),
+            right_disparity: Some("rd.pgm".into()),
+            request,
+            ..Default::default()
+        }
+    }
+
+    #[test]
+    fn method_options_need_their_method() {
+        let o = disparity_options(CyclopeanRequest {
+            blend: Some(Blend::Soft),
+            ..Default::default()
+        });
+        assert!(matches!(
+            CyclopeanJob::new(o),
+            Err(ArgError::GatherOptionOnly("--blend"))
+        ));
+        // A lone --refine-steps picks the method, so its options are accepted.
+        let o = disparity_options(CyclopeanRequest {
+            refine_steps: Some(0),
+            blend: Some(Blend::Soft),
+            ..Default::default()
+        });
+        assert_eq!(CyclopeanJob::new(o).unwrap().plan.method(), CyclopeanMethod::Seed);
+    }
+
+    #[test]
+    fn vulkan_backend_takes_every_method() {
+        use super::Backend;
+        for method in [
+            None,
+            Some(CyclopeanMethod::SplatGather),
+            Some(CyclopeanMethod::Seed),
+            Some(CyclopeanMethod::Refine),
+            Some(CyclopeanMethod::Forward),
+        ] {
+            let o = CyclopeanOptions {
+                backend: Backend::Vulkan,
+                ..disparity_options(CyclopeanRequest {
+                    method,
+                    ..Default::default()
+                })
+            };
+            assert_eq!(CyclopeanJob::new(o).unwrap().backend, Backend::Vulkan);
+        }
+    }
+
+    #[test]
+    fn dominant_eye_is_parsed_once_and_named_on_error() {
+        assert_eq!(dominant("right:0.7").unwrap(), (Eye::Right, 0.7));
+        assert!(matches!(dominant("0.7"), Err(ArgError::DominantForm(_))));
+        assert!(matches!(dominant("centre:0.7"), Err(ArgError::DominantEye(_))));
+        let e = dominant("left:heavy").unwrap_err();
+        assert!(matches!(e, ArgError::DominantWeight { .. }), "{e}");
+    }
+
+    #[test]
+    fn uncalibrated_disparity_gives_no_metric_depth() {
+        let job = CyclopeanJob::new(disparity_options(CyclopeanRequest::default())).unwrap();
+        assert!(!job.plan.outputs().depth && job.plan.outputs().rgb);
+        let o = disparity_options(CyclopeanRequest {
+            outputs: Some(crate::io::OutputSet::parse("depth").unwrap()),
+            ..Default::default()
+        });
+        assert!(matches!(CyclopeanJob::new(o), Err(ArgError::DepthOutputNotMetric)));
+    }
+
+    #[test]
+    fn focal_and_baseline_come_together() {
+        let o = disparity_options(CyclopeanRequest {
+            focal: Some(700.0),
+            ..Default::default()
+        });
+        assert!(matches!(
+            CyclopeanJob::new(o),
+            Err(ArgError::RigPartner("--focal", "--baseline"))
+        ));
+    }
+
+    #[test]
+    fn one_input_set_up_at_a_time() {
+        let both = CyclopeanOptions {
+            cameras: Some("c.json".into()),
+            left_depth: Some("l.exr".into()),
+            right_depth: Some("r.exr".into()),
+            ..disparity_options(CyclopeanRequest::default())
+        };
+        assert!(matches!(CyclopeanJob::new(both), Err(ArgError::DisparityAndDepth)));
+        let no_right = CyclopeanOptions {
+            right_disparity: None,
+            ..disparity_options(CyclopeanRequest::default())
+        };
+        assert!(matches!(
+            CyclopeanJob::new(no_right),
+            Err(ArgError::RightDisparityMissing)
+        ));
+    }
+}

@@ -1,0 +1,465 @@
+//! The cyclopean request: every setting both front ends give (the CLI's flags, Python's keyword
+//! arguments), with one default and one set of checks for both, and the synthesis from decoded
+//! images that both run.
+//!
+//! Why here: the CLI and the Python binding used to decide the method, the seed's fixation, the
+//! rig's nominal values and the default outputs each on their own, and drifted. Now a front end
+//! only names fields ([`CyclopeanRequest`]) and loads its inputs (files, or numpy arrays) into a
+//! [`StereoInput`]; [`CyclopeanRequest::plan`] checks the settings against the input set-up and
+//! [`CyclopeanPlan::frame`] / [`CyclopeanPlan::synthesise`] do the rest.
+
+use super::CyclopeanMethod;
+use crate::convention::Conventions;
+use crate::cyclopean::camera_file::{CameraFile, EyeCameras};
+use crate::cyclopean::disparity_frame::{disparity_frame, median_fixation, DisparityRig};
+use crate::cyclopean::fill::{Filler, FILLED};
+use crate::cyclopean::forward::ForwardWarp;
+use crate::cyclopean::render::CyclopeanRenderer;
+use crate::cyclopean::splat::{SplatParams, SplatRenderer};
+use crate::cyclopean::{Blend, CyclopeanOutputs, CyclopeanParams, Eye, EyeInput, MiddleCamera, StereoFrame};
+use crate::io::{self, DepthMap, OutputSet, RgbImage};
+use crate::job::ArgError;
+use crate::pass::Device;
+use crate::refocus::BreakRule;
+use crate::view::ViewOutput;
+use serde::Serialize;
+use std::path::Path;
+
+/// Every cyclopean setting a front end gives. `None` (and `false`) leave the choice to
+/// [`CyclopeanRequest::plan`], the one place that makes it.
+#[derive(Debug, Clone, Default, Serialize)]
+pub struct CyclopeanRequest {
+    /// The method; none: splat-gather, or seed/refine when only `refine_steps` is given.
+    pub method: Option<CyclopeanMethod>,
+    /// Seed/refine: reconstruction steps after the seed's (0 = seed; default 3).
+    pub refine_steps: Option<u32>,
+    /// Seed/refine: how the eyes are blended (default hard).
+    pub blend: Option<Blend>,
+    /// Seed/refine: depth disagreement treated as different surfaces.
+    pub z_threshold: Option<f64>,
+    /// Seed/refine: `left:W` or `right:W`.
+    pub dominant: Option<String>,
+    /// Disparity input: where the view sits between the eyes (0 left, 1 right; default 0.5).
+    pub position: Option<f64>,
+    /// Disparity input: focal length, pixels (with `baseline`: metric depth).
+    pub focal: Option<f64>,
+    /// Disparity input: baseline, metres (with `focal`).
+    pub baseline: Option<f64>,
+    /// Disparity input: right principal point minus left, pixels.
+    pub doffs: f64,
+    /// The outputs; none: colour and mask, plus depth where it is metric.
+    #[serde(serialize_with = "super::super::outputs_text")]
+    pub outputs: Option<OutputSet>,
+    /// Holes filled from the background side (mask 128 there); off, holes stay.
+    pub fill: bool,
+}
+
+/// The two input set-ups.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum StereoKind {
+    /// A rectified pair with disparities.
+    Disparity,
+    /// Depth per eye placed by a camera file.
+    Cameras,
+}
+
+/// Which stereo inputs a call gives (whatever the front end calls them).
+#[derive(Debug, Clone, Copy, Default)]
+pub struct StereoGiven {
+    /// Left disparity.
+    pub left_disparity: bool,
+    /// Right disparity.
+    pub right_disparity: bool,
+    /// Left depth.
+    pub left_depth: bool,
+    /// Right depth.
+    pub right_depth: bool,
+    /// The camera file.
+    pub cameras: bool,
+}
+
+impl StereoGiven {
+    /// The set-up the inputs make, or the input that is missing or in excess.
+    pub fn kind(self) -> Result<StereoKind, ArgError> {
+        let disparity = self.left_disparity || self.right_disparity;
+        let depth = self.left_depth || self.right_depth || self.cameras;
+        match (disparity, depth) {
+            (true, true) => Err(ArgError::DisparityAndDepth),
+            (false, false) => Err(ArgError::NoStereoInput),
+            (true, false) => match (self.left_disparity, self.right_disparity) {
+                (true, true) => Ok(StereoKind::Disparity),
+                (true, false) => Err(ArgError::RightDisparityMissing),
+                _ => Err(ArgError::LeftDisparityMissing),
+            },
+            (false, true) => {
+                for (flag, given) in [
+                    ("--left-depth", self.left_depth),
+                    ("--right-depth", self.right_depth),
+                    ("--cameras", self.cameras),
+                ] {
+                    if !given {
+                        return Err(ArgError::DepthInputMissing(flag));
+                    }
+                }
+                Ok(StereoKind::Cameras)
+            }
+        }
+    }
+}
+
+/// The seed/refine settings, all but the fixation (known once the inputs are read).
+#[derive(Debug, Clone, Copy)]
+struct GatherSettings {
+    refine: bool,
+    steps: u32,
+    blend: Blend,
+    z_threshold: Option<f64>,
+    dominant: Option<(Eye, f64)>,
+}
+
+impl GatherSettings {
+    fn params(&self, fixation: f64) -> crate::Result<CyclopeanParams> {
+        let mut params = CyclopeanParams::seed(fixation);
+        if self.refine && self.steps > 0 {
+            params.method = crate::cyclopean::Method::Refine { steps: self.steps };
+        }
+        params.blend = self.blend;
+        if let Some(t) = self.z_threshold {
+            params.z_threshold = t;
+        }
+        params.dominant = self.dominant;
+        params.validate()?;
+        Ok(params)
+    }
+}
+
+/// A checked request for one input set-up.
+#[derive(Debug, Clone)]
+pub struct CyclopeanPlan {
+    kind: StereoKind,
+    method: CyclopeanMethod,
+    gather: Option<GatherSettings>,
+    /// The disparity rig: focal and baseline (nominal without a calibration), doffs, position.
+    rig: (Option<f64>, Option<f64>, f64, f64),
+    outputs: OutputSet,
+    fill: bool,
+}
+
+/// `--dominant`'s `eye:weight`.
+pub(super) fn dominant(d: &str) -> Result<(Eye, f64), ArgError> {
+    let (eye, w) = d.split_once(':').ok_or_else(|| ArgError::DominantForm(d.into()))?;
+    let eye = match eye {
+        "left" => Eye::Left,
+        "right" => Eye::Right,
+        _ => return Err(ArgError::DominantEye(d.into())),
+    };
+    let w = w.parse().map_err(|source| ArgError::DominantWeight {
+        value: d.into(),
+        source,
+    })?;
+    Ok((eye, w))
+}
+
+impl CyclopeanRequest {
+    /// Checks the settings against each other and the input set-up: method options with
+    /// their method, rig options with disparities, outputs the input can give.
+    pub fn plan(&self, kind: StereoKind) -> Result<CyclopeanPlan, ArgError> {
+        let method = match (self.method, self.refine_steps) {
+            (Some(m), _) => m,
+            (None, Some(0)) => CyclopeanMethod::Seed,
+            (None, Some(_)) => CyclopeanMethod::Refine,
+            (None, None) => CyclopeanMethod::SplatGather,
+        };
+        let gathers = matches!(method, CyclopeanMethod::Seed | CyclopeanMethod::Refine);
+        if !gathers {
+            for (flag, given) in [
+                ("--refine-steps", self.refine_steps.is_some()),
+                ("--blend", self.blend.is_some()),
+                ("--z-threshold", self.z_threshold.is_some()),
+                ("--dominant", self.dominant.is_some()),
+            ] {
+                if given {
+                    return Err(ArgError::GatherOptionOnly(flag));
+                }
+            }
+        }
+        if let Some(steps) = self.refine_steps.filter(|s| *s > 16) {
+            return Err(ArgError::Invalid(crate::Error::param(
+                "--refine-steps",
+                format!("{steps} outside 0..=16"),
+            )));
+        }
+        let metric = match kind {
+            StereoKind::Disparity => {
+                self.check_rig()?;
+                self.focal.is_some()
+            }
+            StereoKind::Cameras => {
+                for (flag, given) in [
+                    ("--position", self.position.is_some()),
+                    ("--focal", self.focal.is_some()),
+                    ("--baseline", self.baseline.is_some()),
+                    ("--doffs", self.doffs != 0.0),
+                ] {
+                    if given {
+                        return Err(ArgError::RigOptionWithCameraFile(flag));
+                    }
+                }
+                true
+            }
+        };
+        let outputs = self.outputs.unwrap_or(OutputSet {
+            rgb: true,
+            depth: metric,
+            mask: true,
+        });
+        if outputs.depth && !metric {
+            return Err(ArgError::DepthOutputNotMetric);
+        }
+        let gather = match gathers {
+            true => Some(GatherSettings {
+                refine: method == CyclopeanMethod::Refine,
+                steps: self.refine_steps.unwrap_or(3),
+                blend: self.blend.unwrap_or(Blend::Hard),
+                z_threshold: self.z_threshold,
+                dominant: self.dominant.as_deref().map(dominant).transpose()?,
+            }),
+            false => None,
+        };
+        Ok(CyclopeanPlan {
+            kind,
+            method,
+            gather,
+            rig: (self.focal, self.baseline, self.doffs, self.position.unwrap_or(0.5)),
+            outputs,
+            fill: self.fill,
+        })
+    }
+
+    /// The disparity rig's values: finite, focal and baseline together and in range.
+    fn check_rig(&self) -> Result<(), ArgError> {
+        match (self.focal, self.baseline) {
+            (Some(_), None) => return Err(ArgError::RigPartner("--focal", "--baseline")),
+            (None, Some(_)) => return Err(ArgError::RigPartner("--baseline", "--focal")),
+            _ => {}
+        }
+        if !self.doffs.is_finite() {
+            return Err(ArgError::Invalid(crate::Error::param(
+                "--doffs",
+                format!("{} must be finite", self.doffs),
+            )));
+        }
+        // The bounds of focal lengths everywhere (intrinsics, flags, files); a baseline is a
+        // length, held to the options' magnitude.
+        use crate::camera::{MAX_INTRINSIC, MIN_FOCAL_PX};
+        let min_baseline = f64::from(crate::depth::MIN_DEPTH_VALUE);
+        for (flag, v, lo) in [
+            ("--focal", self.focal, MIN_FOCAL_PX),
+            ("--baseline", self.baseline, min_baseline),
+        ] {
+            if let Some(v) = v.filter(|v| !(v.is_finite() && (lo..=MAX_INTRINSIC).contains(v))) {
+                return Err(ArgError::Invalid(crate::Error::param(
+                    flag,
+                    format!("{v} must be in [{lo:e}, {MAX_INTRINSIC:e}]"),
+                )));
+            }
+        }
+        if let Some(p) = self.position.filter(|p| !(0.0..=1.0).contains(p)) {
+            return Err(ArgError::Invalid(crate::Error::param(
+                "--position",
+                format!("{p} outside [0, 1] (0 = left eye, 1 = right eye)"),
+            )));
+        }
+        Ok(())
+    }
+}
+
+/// The decoded inputs of one view, each eye's colour with its disparity or depth.
+pub enum StereoInput {
+    /// A rectified pair: disparities in pixels (0 = unknown).
+    Disparity {
+        /// Left colour and disparity.
+        left: (RgbImage, DepthMap),
+        /// Right colour and disparity.
+        right: (RgbImage, DepthMap),
+    },
+    /// Depth per eye as the camera file says, and the file.
+    Cameras {
+        /// Left colour and depth.
+        left: (RgbImage, DepthMap),
+        /// Right colour and depth.
+        right: (RgbImage, DepthMap),
+        /// The eyes' and the view's cameras.
+        cameras: Box<CameraFile>,
+    },
+}
+
+/// How messages name an input: by its file (a decode error, exit 1) or by the argument that
+/// holds it (a bad argument).
+#[derive(Debug, Clone, Copy)]
+pub enum InputName<'a> {
+    /// A file read by the CLI.
+    File(&'a Path),
+    /// A front end's argument, e.g. Python's `left_disparity`.
+    Argument(&'a str),
+}
+
+impl InputName<'_> {
+    fn error(self, message: impl Into<String>) -> crate::Error {
+        match self {
+            InputName::File(p) => crate::Error::decode(p, message),
+            InputName::Argument(a) => crate::Error::param(a, message),
+        }
+    }
+
+    fn check_size(self, cam: &EyeCameras, width: u32, height: u32) -> crate::Result<()> {
+        match self {
+            InputName::File(p) => cam.check_size(&p.display().to_string(), width, height),
+            InputName::Argument(a) => cam
+                .check_size(a, width, height)
+                .map_err(|e| crate::Error::param(a, e.to_string())),
+        }
+    }
+}
+
+/// The view synthesised: its planes and mask (1 rendered, [`io::MASK_FILLED`] filled, 0 hole).
+pub struct Synthesised {
+    /// Colour, depth (those asked for) and the mask.
+    pub view: ViewOutput,
+    /// Fraction of pixels some eye saw (filled pixels not counted).
+    pub coverage: f64,
+    /// Milliseconds before the render itself: uploads, meshes, programs.
+    pub setup_ms: f64,
+}
+
+impl CyclopeanPlan {
+    /// The set-up this plan was checked for.
+    pub fn kind(&self) -> StereoKind {
+        self.kind
+    }
+
+    /// The outputs to return or write.
+    pub fn outputs(&self) -> OutputSet {
+        self.outputs
+    }
+
+    /// The method.
+    pub fn method(&self) -> CyclopeanMethod {
+        self.method
+    }
+
+    /// The frame, the view and the fixation the seed/refine methods start from: the median
+    /// depth the left eye saw (disparities), or the camera file's fixation. `names` name the
+    /// left and right colour, the left disparity or depth and the cameras in messages.
+    pub fn frame(&self, input: StereoInput, names: [InputName; 4]) -> crate::Result<(StereoFrame, MiddleCamera, f64)> {
+        let [left_rgb, right_rgb, left_map, cameras_name] = names;
+        match input {
+            StereoInput::Disparity { left, right } => {
+                let (focal, baseline, doffs, position) = self.rig;
+                // Without a calibration only f B matters for the view; any nominal values do.
+                let rig = DisparityRig {
+                    focal_px: focal.unwrap_or(left.0.width as f64),
+                    baseline: baseline.unwrap_or(0.1),
+                    doffs,
+                    position,
+                };
+                let known = left.1.data.iter().any(|&d| d.is_finite() && d > 0.0);
+                let (frame, mid) = disparity_frame(left, right, &rig, Conventions::default())?;
+                // f B / d outside the usable depths makes holes (the one depth rule); all of
+                // them is the rig's fault, said by name rather than a silent 0 % valid view.
+                if known && !frame.left.depth.data.iter().any(|z| z.is_finite() && *z > 0.0) {
+                    return Err(crate::Error::param(
+                        "--focal/--baseline",
+                        format!(
+                            "f B / disparity = {:e} m / px puts every known disparity outside the usable depths [{:e}, {:e}] m",
+                            rig.focal_px * rig.baseline,
+                            crate::depth::MIN_DEPTH_VALUE,
+                            crate::depth::MAX_DEPTH_VALUE
+                        ),
+                    ));
+                }
+                let fixation = median_fixation(&frame)
+                    .ok_or_else(|| left_map.error("no known disparity (all 0 or non-finite)"))?;
+                Ok((frame, mid, fixation))
+            }
+            StereoInput::Cameras { left, right, cameras } => {
+                left_rgb.check_size(&cameras.left, left.0.width, left.0.height)?;
+                right_rgb.check_size(&cameras.right, right.0.width, right.0.height)?;
+                let (mid, fixation) = cameras
+                    .middle_and_fixation()
+                    .map_err(|e| cameras_name.error(e.to_string()))?;
+                let eye = |(color, depth): (RgbImage, DepthMap), cam: &EyeCameras| EyeInput {
+                    color,
+                    depth,
+                    view: cam.view,
+                    proj: cam.proj,
+                };
+                let frame = StereoFrame {
+                    left: eye(left, &cameras.left),
+                    right: eye(right, &cameras.right),
+                    depth_kind: cameras.depth_kind,
+                    conv: cameras.conventions,
+                };
+                Ok((frame, mid, fixation))
+            }
+        }
+    }
+
+    /// Renders the view with the plan's method (and fill) on `device`.
+    pub fn synthesise(
+        &self,
+        device: &Device,
+        frame: &StereoFrame,
+        mid: &MiddleCamera,
+        fixation: f64,
+    ) -> crate::Result<Synthesised> {
+        let t0 = std::time::Instant::now();
+        frame.validate()?;
+        let params = self.gather.map(|g| g.params(fixation)).transpose()?;
+        // The fill reads both planes whatever is returned.
+        let wanted = CyclopeanOutputs {
+            color: self.outputs.rgb || self.fill,
+            depth: self.outputs.depth || self.fill,
+        };
+        let (mut out, timing) = match (self.method, params) {
+            (CyclopeanMethod::Seed | CyclopeanMethod::Refine, Some(p)) => {
+                CyclopeanRenderer::with_outputs(device, frame, p, wanted)?.render(mid)?
+            }
+            (CyclopeanMethod::Forward, _) => ForwardWarp::new(device, frame, &BreakRule::default())?.render(mid)?,
+            _ => SplatRenderer::new(device, frame, SplatParams::default(), wanted)?.render(mid)?,
+        };
+        if self.fill {
+            out = Filler::new(device)?.fill(&out, mid.width, mid.height)?;
+        }
+        let setup_ms = (t0.elapsed().as_secs_f64() * 1e3 - timing.wall_ms).max(0.0);
+        // The mask: 1 where an eye (or the history) gave the pixel, MASK_FILLED where filled.
+        let mask = io::Mask::new(
+            mid.width,
+            mid.height,
+            out.sources
+                .iter()
+                .map(|&s| match s {
+                    0 => 0,
+                    FILLED => io::MASK_FILLED,
+                    _ => 1,
+                })
+                .collect(),
+        )?;
+        let rendered = out.sources.iter().filter(|s| **s != 0 && **s != FILLED).count();
+        // Some methods render planes that were not asked for: keep only those that were.
+        let view = ViewOutput {
+            width: mid.width,
+            height: mid.height,
+            color: out.color.filter(|_| self.outputs.rgb),
+            depth: out.depth.filter(|_| self.outputs.depth),
+            mask: Some(mask),
+            timing: Some(timing),
+            exact: None,
+        };
+        Ok(Synthesised {
+            view,
+            coverage: rendered as f64 / out.sources.len().max(1) as f64,
+            setup_ms,
+        })
+    }
+}
