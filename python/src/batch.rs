@@ -11,10 +11,9 @@ use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyList, PyMapping, PyString};
 use std::path::PathBuf;
 use viewsynth::convention::Conventions;
-use viewsynth::io::Encoding;
-use viewsynth::io::{DepthFormats, FileFormats, RgbFormat};
-use viewsynth::refocus::batch::{load_manifest as read_manifest, run_batch, BatchFrame, BatchOptions, Shard};
-use viewsynth::refocus::{BreakRule, Method};
+use viewsynth::job::choice;
+use viewsynth::job::refocus::RefocusRequest;
+use viewsynth::refocus::batch::{load_manifest as read_manifest, run_batch, BatchFrame, BatchOptions};
 
 /// The keys a frame may have (a manifest's columns).
 const FRAME_KEYS: [&str; 9] = [
@@ -161,29 +160,22 @@ fn frames(obj: &Bound<'_, PyAny>) -> PyResult<Vec<BatchFrame>> {
 }
 
 /// Depth file formats: any of "exr", "npy", "png16" (a comma-separated string or a sequence).
-fn depth_formats(obj: &Bound<'_, PyAny>) -> PyResult<DepthFormats> {
-    let names: Vec<String> = if let Ok(s) = obj.cast::<PyString>() {
-        s.to_string().split(',').map(|p| p.trim().to_string()).collect()
-    } else {
-        obj.extract()
-            .map_err(|_| errors::invalid("depth_format", "expected any of \"exr\", \"npy\", \"png16\""))?
-    };
-    if names.is_empty() {
-        return Err(errors::invalid("depth_format", "no format given"));
+/// `depth_format=`: a name, a comma-separated list or a sequence of names, as the CLI's text.
+fn depth_format_text(obj: &Bound<'_, PyAny>) -> PyResult<String> {
+    if let Ok(s) = obj.cast::<PyString>() {
+        return Ok(s.to_string());
     }
-    DepthFormats::parse(names.iter().map(String::as_str)).map_err(|bad| {
-        errors::invalid(
-            "depth_format",
-            format!("'{bad}': expected any of \"exr\", \"npy\", \"png16\""),
-        )
-    })
+    let names: Vec<String> = obj
+        .extract()
+        .map_err(|_| errors::invalid("depth_format", "expected any of \"exr\", \"npy\", \"png16\""))?;
+    Ok(names.join(","))
 }
 
-/// The arguments of one refocus_batch call, as Python gave them.
+/// The arguments of one call, as Python gave them.
 pub struct BatchArgs<'a, 'py> {
     pub frames: &'a Bound<'py, PyAny>,
     pub out_dir: PathBuf,
-    pub scales: Vec<f64>,
+    pub scales: Option<Vec<f64>>,
     pub size: Option<(u32, u32)>,
     pub principal: Option<(f64, f64)>,
     pub outputs: Option<&'a Bound<'py, PyAny>>,
@@ -191,7 +183,7 @@ pub struct BatchArgs<'a, 'py> {
     pub tau_abs: f64,
     pub method: &'a str,
     pub rgb_format: &'a str,
-    pub depth_format: &'a Bound<'py, PyAny>,
+    pub depth_format: Option<&'a Bound<'py, PyAny>>,
     pub depth_preview: bool,
     pub png_compression: &'a str,
     pub exr_compression: &'a str,
@@ -201,61 +193,28 @@ pub struct BatchArgs<'a, 'py> {
     pub shard: Option<&'a str>,
 }
 
+/// The settings as the library's request, checked by it as the CLI's `refocus --batch`.
 fn options(a: &BatchArgs<'_, '_>) -> PyResult<BatchOptions> {
-    let outputs = crate::shared::output_set(a.outputs)?;
-    let rgb = match a.rgb_format {
-        "png" => RgbFormat::Png,
-        "jpeg" | "jpg" => RgbFormat::Jpeg,
-        "exr" => RgbFormat::Exr,
-        other => {
-            return Err(errors::invalid(
-                "rgb_format",
-                format!("'{other}': expected \"png\", \"jpeg\" or \"exr\""),
-            ))
-        }
-    };
-    if a.depth_preview && !outputs.depth {
-        return Err(errors::invalid(
-            "depth_preview",
-            "colours the depth output: add \"depth\" to outputs",
-        ));
-    }
-    let encoding = Encoding {
-        png: a.png_compression.parse().map_err(errors::from_library)?,
-        exr: a.exr_compression.parse().map_err(errors::from_library)?,
-    };
-    let rule = BreakRule {
-        tau_rel: a.tau_rel,
-        tau_abs: a.tau_abs,
-    };
-    rule.validate().map_err(errors::from_library)?;
-    let shard = a
-        .shard
-        .map(str::parse::<Shard>)
-        .transpose()
-        .map_err(errors::from_library)?;
-    Ok(BatchOptions {
+    let request = RefocusRequest {
         scales: a.scales.clone(),
+        focal_list: None,
         size: a.size,
         principal: a.principal,
-        rule,
-        method: a.method.parse::<Method>().map_err(errors::from_library)?,
-        conv: Conventions::default(),
-        files: FileFormats {
-            outputs,
-            rgb,
-            depth: depth_formats(a.depth_format)?,
-            encoding,
-            depth_preview: a.depth_preview,
-        },
+        tau_rel: a.tau_rel,
+        tau_abs: a.tau_abs,
+        method: choice("--method", a.method).map_err(errors::from_request)?,
+        outputs: a.outputs.map(|_| crate::shared::output_set(a.outputs)).transpose()?,
+        rgb_format: choice("--rgb-format", a.rgb_format).map_err(errors::from_request)?,
+        depth_format: a.depth_format.map(depth_format_text).transpose()?,
+        depth_preview: a.depth_preview,
+        png_compression: a.png_compression.to_string(),
+        exr_compression: a.exr_compression.to_string(),
         depth_trunc: a.depth_trunc,
         resume: a.resume,
-        // As the CLI: one decode and one encode thread per core unless told.
-        jobs: a
-            .jobs
-            .unwrap_or_else(|| std::thread::available_parallelism().map_or(2, |n| n.get())),
-        shard,
-    })
+        jobs: a.jobs,
+        shard: a.shard.map(str::to_string),
+    };
+    request.batch(Conventions::default()).map_err(errors::from_request)
 }
 
 /// Validates `a`, runs the batch with the GIL released, and returns its summary as a dict.

@@ -81,12 +81,18 @@ pub fn from_library(e: Error) -> PyErr {
     }
 }
 
-/// A command-line option as the keyword argument that gives the same request field:
-/// `--tau-rel` -> `tau_rel`; `--from`/`--to` -> `source`/`target` (`from` is a Python keyword).
+/// A command-line option as the keyword argument that gives the same request field
+/// (tests/data/front_ends.json maps them all): `--tau-rel` -> `tau_rel`; `--from`/`--to` ->
+/// `source`/`target` (`from` is a Python keyword); refocus's target options -> `scales`,
+/// `size`, `principal`; `--force` -> `resume`.
 pub fn keyword(option: &str) -> String {
     match option.trim_start_matches('-') {
         "from" => "source".to_string(),
         "to" => "target".to_string(),
+        "zoom-range" => "scales".to_string(),
+        "width-out" | "height-out" => "size".to_string(),
+        "cx-out" | "cy-out" => "principal".to_string(),
+        "force" => "resume".to_string(),
         name => name.replace('-', "_"),
     }
 }

@@ -46,12 +46,19 @@ fn _request_defaults(command: &str) -> Option<String> {
     viewsynth::job::request_defaults(command).map(|v| v.to_string())
 }
 
+/// The keyword argument error messages name for a CLI option (`--tau-rel` -> "tau_rel").
+#[pyfunction]
+fn _keyword(option: &str) -> String {
+    errors::keyword(option)
+}
+
 #[pymodule]
 fn _viewsynth(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<renderer::Renderer>()?;
     m.add_function(wrap_pyfunction!(info, m)?)?;
     m.add_function(wrap_pyfunction!(batch::load_manifest, m)?)?;
     m.add_function(wrap_pyfunction!(_request_defaults, m)?)?;
+    m.add_function(wrap_pyfunction!(_keyword, m)?)?;
     m.add("_REQUEST_COMMANDS", viewsynth::job::REQUEST_COMMANDS.to_vec())?;
     m.add(
         "FACE_ORDER",

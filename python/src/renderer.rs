@@ -8,10 +8,11 @@ use crate::context;
 use crate::errors::{self, Kind};
 use crate::shared::{output_set, SameThread};
 use pyo3::prelude::*;
-use pyo3::types::{PyDict, PyList, PyString};
+use pyo3::types::{PyDict, PyList};
 use viewsynth::camera::PinholeCamera;
 use viewsynth::convention::Conventions;
-use viewsynth::refocus::manifest::TargetSpec;
+use viewsynth::job::choice;
+use viewsynth::job::refocus::RefocusRequest;
 use viewsynth::refocus::{BreakRule, Method, OutputSet, RefocusOutput, RefocusSource, Refocuser};
 
 /// A refocus call's inputs, validated while the GIL is held.
@@ -334,7 +335,8 @@ impl Renderer {
     /// rgb: uint8[H, W, 3], C-contiguous. depth: float32[H, W], C-contiguous, view-space Z in
     /// metres (0, NaN, inf or negative = no depth). K: 3x3 pinhole [[fx, 0, cx], [0, fy, cy],
     /// [0, 0, 1]] (any numeric dtype or nested lists; no skew), OpenCV pixel centres.
-    /// Targets, one of: scales=[s, ...] (fx' = s fx, fy' = s fy) or K_out=[K', ...] (3x3 each).
+    /// Targets, one of: scales=[s, ...] (fx' = s fx, fy' = s fy) or K_out=[K', ...] (3x3 each);
+    /// neither: the CLI's default scales (0.5, 0.75, 1, 1.5, 2).
     /// size: (width, height) of the outputs (default: the source's). principal: (cx', cy') with
     /// scales (default: the source's offset from the image centre).
     /// outputs: any of "rgb", "depth", "mask" (default all three); only those are rendered.
@@ -373,20 +375,24 @@ impl Renderer {
         let k = arrays::intrinsics(K, "K")?;
         let source = RefocusSource::new(arrays::rgb_image(rgb, "rgb")?, arrays::float_map(depth, "depth")?, k)
             .map_err(errors::from_library)?;
-        let rule = BreakRule { tau_rel, tau_abs };
-        rule.validate().map_err(errors::from_library)?;
-        let method: Method = method.parse().map_err(errors::from_library)?;
-        let outputs = output_set(outputs)?;
+        if scales.is_some() && K_out.is_some() {
+            return Err(errors::invalid("scales", "give scales or K_out, not both"));
+        }
+        let request = RefocusRequest {
+            scales,
+            size,
+            principal,
+            outputs: outputs.map(|_| output_set(outputs)).transpose()?,
+            tau_rel,
+            tau_abs,
+            method: choice("--method", method).map_err(errors::from_request)?,
+            ..Default::default()
+        };
+        let plan = request.frame().map_err(errors::from_request)?;
         let camera = source.camera();
-        let targets = match (scales, K_out) {
-            (Some(scales), None) => TargetSpec {
-                scales,
-                size,
-                principal,
-            }
-            .targets(&camera)
-            .map_err(errors::from_library)?,
-            (None, Some(k_out)) => {
+        let targets = match K_out {
+            None => plan.targets(&camera).map_err(errors::from_library)?.1,
+            Some(k_out) => {
                 if principal.is_some() {
                     return Err(errors::invalid("principal", "K_out already gives each target's cx, cy"));
                 }
@@ -408,9 +414,8 @@ impl Renderer {
                 }
                 targets
             }
-            (Some(_), Some(_)) => return Err(errors::invalid("scales", "give scales or K_out, not both")),
-            (None, None) => return Err(errors::invalid("scales", "give scales=[...] or K_out=[...]")),
         };
+        let (rule, method, outputs) = (plan.rule, plan.method, plan.files.outputs);
         let job = RefocusJob {
             source,
             rule,
@@ -730,7 +735,7 @@ impl Renderer {
     /// Raises InvalidInputError for a bad argument or frame entry, FileError for an unreadable
     /// manifest or an unusable out_dir.
     #[allow(clippy::too_many_arguments)]
-    #[pyo3(signature = (frames, out_dir, *, scales = viewsynth::refocus::manifest::DEFAULT_SCALES.to_vec(), size = None, principal = None,
+    #[pyo3(signature = (frames, out_dir, *, scales = None, size = None, principal = None,
                         outputs = None, tau_rel = 0.05, tau_abs = 0.2, method = "fullscreen", rgb_format = "png",
                         depth_format = None, depth_preview = false, png_compression = "fast",
                         exr_compression = "zip", depth_trunc = None, resume = true, jobs = None, shard = None))]
@@ -739,7 +744,7 @@ impl Renderer {
         py: Python<'py>,
         frames: &Bound<'py, PyAny>,
         out_dir: std::path::PathBuf,
-        scales: Vec<f64>,
+        scales: Option<Vec<f64>>,
         #[pyo3(from_py_with = crate::ints::size)] size: Option<(u32, u32)>,
         principal: Option<(f64, f64)>,
         outputs: Option<&Bound<'py, PyAny>>,
@@ -757,7 +762,6 @@ impl Renderer {
         shard: Option<&str>,
     ) -> PyResult<Bound<'py, PyAny>> {
         let gpu = self.gpu()?.clone();
-        let exr = PyString::new(py, "exr").into_any();
         crate::batch::refocus_batch(
             py,
             gpu,
@@ -772,7 +776,7 @@ impl Renderer {
                 tau_abs,
                 method,
                 rgb_format,
-                depth_format: depth_format.unwrap_or(&exr),
+                depth_format,
                 depth_preview,
                 png_compression,
                 exr_compression,

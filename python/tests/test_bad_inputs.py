@@ -69,10 +69,11 @@ def test_bad_intrinsics(renderer, frame):
 
 def test_bad_targets_and_options(renderer, frame):
     rgb, depth, K = frame
-    check(renderer, frame, "focal scale", ["must be finite and > 0"], scales=[1.0, -2.0])
-    check(renderer, frame, "focal scale", ["NaN"], scales=[math.nan])
-    check(renderer, frame, "scales", ["no focal scale"], scales=[])
-    check(renderer, frame, "scales", ["give scales=[...] or K_out=[...]"], scales=None)
+    check(renderer, frame, "scales", ["-2: must be finite and > 0"], scales=[1.0, -2.0])
+    check(renderer, frame, "scales", ["NaN"], scales=[math.nan])
+    check(renderer, frame, "scales", ["no target given"], scales=[])
+    # Neither scales nor K_out: the CLI's default scales (one request default for both).
+    assert [t["scale"] for t in renderer.refocus(rgb, depth, K, outputs="mask")] == [0.5, 0.75, 1.0, 1.5, 2.0]
     check(renderer, frame, "scales", ["not both"], K_out=[K])
     check(renderer, frame, "K_out", ["no target"], scales=None, K_out=[])
     check(renderer, frame, "principal", ["K_out"], scales=None, K_out=[K], principal=(1.0, 2.0))

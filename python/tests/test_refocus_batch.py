@@ -85,6 +85,6 @@ def test_refocus_batch_bad_inputs(renderer, tmp_path):
     batch_error(renderer, tmp_path, [frame], "png-compression", ["'huge'"], png_compression="huge")
     batch_error(renderer, tmp_path, [frame], "shard", ["'3/2'"], shard="3/2")
     batch_error(renderer, tmp_path, [frame], "depth_preview", ["outputs"], depth_preview=True, outputs=["rgb"])
-    batch_error(renderer, tmp_path, [frame], "scales", ["no focal scale"], scales=[])
+    batch_error(renderer, tmp_path, [frame], "scales", ["no target given"], scales=[])
     batch_error(renderer, tmp_path, [frame], "tau", [], tau_rel=-1.0)
     assert not (tmp_path / "out").exists()  # nothing written for a refused call

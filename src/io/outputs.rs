@@ -77,13 +77,14 @@ impl OutputSet {
 }
 
 /// File format of the colour output.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Default)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, Default)]
 #[serde(rename_all = "lowercase")]
 pub enum RgbFormat {
     /// 8-bit PNG (the default).
     #[default]
     Png,
     /// JPEG at quality 95 (lossy).
+    #[serde(alias = "jpg")]
     Jpeg,
     /// OpenEXR, float32 R, G, B in [0, 1] (level / 255).
     Exr,

@@ -30,7 +30,7 @@ pub enum ArgError {
         source: std::num::ParseIntError,
     },
     /// An entry of `--depth-format` names no depth file format.
-    #[error("invalid depth-format '{0}': expected exr, npy, png16 or a list such as exr,png16")]
+    #[error("--depth-format '{0}': expected exr, npy, png16 or a list such as exr,png16")]
     DepthFormat(String),
     /// `--depth-preview` without a depth output to colour.
     #[error("--depth-preview colours the depth output: add depth to --outputs")]

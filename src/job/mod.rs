@@ -89,7 +89,7 @@ pub(crate) fn outputs_text<S: serde::Serializer>(
 }
 
 /// The commands whose settings both front ends give through one request type.
-pub const REQUEST_COMMANDS: &[&str] = &["cyclopean", "reproject", "stitch"];
+pub const REQUEST_COMMANDS: &[&str] = &["cyclopean", "refocus", "reproject", "stitch"];
 
 /// The request of `command` (one of [`REQUEST_COMMANDS`]) at its defaults, as JSON: what the
 /// front-end mapping tests hold the CLI's and Python's defaults to.
@@ -98,6 +98,7 @@ pub fn request_defaults(command: &str) -> Option<serde_json::Value> {
         "cyclopean" => serde_json::to_value(cyclopean::CyclopeanRequest::default()),
         "reproject" => serde_json::to_value(reproject::ReprojectRequest::default()),
         "stitch" => serde_json::to_value(stitch::StitchRequest::default()),
+        "refocus" => serde_json::to_value(refocus::RefocusRequest::default()),
         _ => return None,
     };
     value.ok()

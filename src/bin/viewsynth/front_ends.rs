@@ -15,6 +15,7 @@ fn required(command: &str) -> &'static [&'static str] {
         "cyclopean" => &["--left-rgb", "l.png", "--right-rgb", "r.png", "--out-dir", "o"],
         "reproject" => &["--color", "c.png", "--depth", "d.exr", "--out-dir", "o"],
         "stitch" => &["--faces", "faces", "--out-dir", "o"],
+        "refocus" => &["--rgb", "c.png", "--depth", "d.exr", "--out-dir", "o"],
         _ => panic!("{command}: no required options listed"),
     }
 }
@@ -30,6 +31,7 @@ fn request_of(command: &str, extra: &[&str]) -> Value {
         Command::Cyclopean(a) => a.request().map(|r| serde_json::to_value(r).unwrap()),
         Command::Reproject(a) => a.request().map(|r| serde_json::to_value(r).unwrap()),
         Command::Stitch(a) => a.request().map(|r| serde_json::to_value(r).unwrap()),
+        Command::Refocus(a) => a.request().map(|r| serde_json::to_value(r).unwrap()),
         _ => panic!("{command}: no request conversion"),
     };
     request.unwrap_or_else(|e| panic!("{command} {extra:?}: {e}"))
@@ -99,7 +101,14 @@ fn cli_options_map_to_request_fields_with_the_library_defaults() {
         // Every option of the command is a field's or listed CLI-only with a reason.
         let cmd = Cli::command();
         let sub = cmd.find_subcommand(command).unwrap();
-        let field_options: Vec<&str> = fields.values().filter_map(|s| s["cli"][0].as_str()).collect();
+        // Every option a field's arguments name (a field may take two, e.g. --width-out/--height-out).
+        let field_options: Vec<&str> = fields
+            .values()
+            .filter_map(|s| s["cli"].as_array())
+            .flatten()
+            .filter_map(Value::as_str)
+            .filter(|a| a.starts_with("--"))
+            .collect();
         let mut options: Vec<String> = sub
             .get_arguments()
             .filter_map(|a| a.get_long().map(|l| format!("--{l}")))

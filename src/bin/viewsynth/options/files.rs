@@ -21,9 +21,10 @@ pub(crate) struct FileOutputArgs {
     #[arg(long, value_enum, default_value = "png")]
     rgb_format: RgbFormatArg,
     /// Depth file formats, any of: exr (float32 metres), npy (float32 metres), png16 (uint16
-    /// millimetres, 0 = invalid; beyond 65.535 m written as 0 and counted in the manifest).
-    #[arg(long, default_value = "exr")]
-    depth_format: String,
+    /// millimetres, 0 = invalid; beyond 65.535 m written as 0 and counted in the manifest)
+    /// [default: exr].
+    #[arg(long)]
+    depth_format: Option<String>,
     /// Also write s{tag}_depth_preview.png: the depth output colour-mapped (turbo: near red, far
     /// blue, invalid black) over its 2nd-98th percentile, the range recorded in the manifest.
     #[arg(long)]
@@ -46,6 +47,17 @@ impl FileOutputArgs {
         self.outputs.as_deref().map(viewsynth::io::OutputSet::parse).transpose()
     }
 
+    /// Sets the file settings of a refocus request.
+    pub(crate) fn fill_refocus(&self, r: &mut viewsynth::job::refocus::RefocusRequest) -> Result<(), viewsynth::Error> {
+        r.outputs = self.outputs_given()?;
+        r.rgb_format = self.options().rgb;
+        r.depth_format = self.depth_format.clone();
+        r.depth_preview = self.depth_preview;
+        r.png_compression = self.png_compression.clone();
+        r.exr_compression = self.exr_compression.clone();
+        Ok(())
+    }
+
     /// The options as the library checks them.
     pub(crate) fn options(&self) -> FileOptions<'_> {
         FileOptions {
@@ -55,7 +67,10 @@ impl FileOutputArgs {
                 RgbFormatArg::Jpeg => RgbFormat::Jpeg,
                 RgbFormatArg::Exr => RgbFormat::Exr,
             },
-            depth: &self.depth_format,
+            depth: self
+                .depth_format
+                .as_deref()
+                .unwrap_or(viewsynth::job::refocus::DEFAULT_DEPTH_FORMAT),
             depth_preview: self.depth_preview,
             png_compression: &self.png_compression,
             exr_compression: &self.exr_compression,

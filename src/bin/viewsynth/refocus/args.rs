@@ -5,8 +5,8 @@ use crate::options::{BATCH, GPU, INPUTS, METHOD, OUTPUTS, TARGETS};
 use clap::{Args, ValueEnum};
 use std::path::PathBuf;
 use viewsynth::io::{self, DepthDecode};
-use viewsynth::job::refocus::{Focals, RefocusCommand, RefocusOptions};
-use viewsynth::job::{file_formats, finite_or_inf, finite_value, shard_value, ArgError};
+use viewsynth::job::refocus::{RefocusCommand, RefocusOptions, RefocusRequest};
+use viewsynth::job::{finite_or_inf, finite_value, shard_value, ArgError};
 use viewsynth::refocus::{BreakRule, Method};
 
 #[derive(Clone, Copy, ValueEnum)]
@@ -55,9 +55,9 @@ pub(crate) struct RefocusArgs {
     /// them, e.g. f571.4_rgb.png.
     #[arg(help_heading = TARGETS, long, value_delimiter = ',', conflicts_with = "zoom_range", value_parser = finite_value)]
     focal_list: Option<Vec<f64>>,
-    /// Target focal scales s (fx' = s fx).
-    #[arg(help_heading = TARGETS, long, value_delimiter = ',', default_value = viewsynth::refocus::manifest::DEFAULT_SCALES_TEXT, value_parser = finite_value)]
-    zoom_range: Vec<f64>,
+    /// Target focal scales s (fx' = s fx) [default: 0.5,0.75,1,1.5,2].
+    #[arg(help_heading = TARGETS, long, value_delimiter = ',', value_parser = finite_value)]
+    zoom_range: Option<Vec<f64>>,
     /// Output width in pixels (default: the source's; with --height-out).
     #[arg(help_heading = TARGETS, long, requires = "height_out", value_parser = clap::value_parser!(u32).range(1..=i64::from(io::MAX_DIMENSION)))]
     width_out: Option<u32>,
@@ -116,42 +116,49 @@ pub(crate) struct RefocusArgs {
     backend: BackendArg,
 }
 
+impl RefocusArgs {
+    /// The settings the Python binding gives too, as the library's request.
+    pub(crate) fn request(&self) -> Result<RefocusRequest, ArgError> {
+        let mut r = RefocusRequest {
+            scales: self.zoom_range.clone(),
+            focal_list: self.focal_list.clone(),
+            size: self.width_out.zip(self.height_out),
+            principal: self.cx_out.zip(self.cy_out),
+            tau_rel: self.tau_rel,
+            tau_abs: self.tau_abs,
+            method: match self.method {
+                MethodArg::Mesh => Method::Mesh,
+                MethodArg::Fullscreen => Method::Fullscreen,
+            },
+            depth_trunc: self.depth_trunc,
+            resume: !self.force,
+            jobs: self.jobs,
+            shard: self.shard.clone(),
+            ..Default::default()
+        };
+        self.files.fill_refocus(&mut r)?;
+        Ok(r)
+    }
+}
+
 impl TryFrom<RefocusArgs> for RefocusCommand {
     type Error = ArgError;
     fn try_from(a: RefocusArgs) -> Result<Self, ArgError> {
-        let files = file_formats(&a.files.options())?;
+        let request = a.request()?;
         RefocusCommand::new(RefocusOptions {
             rgb: a.rgb,
             depth: a.depth,
             manifest: a.batch,
-            force: a.force,
-            jobs: a.jobs,
-            shard: a.shard,
             decode: DepthDecode {
                 scale: a.depth_scale,
                 sun_rgbd_bit_rotate: a.sun_bit_rotate,
                 ..Default::default()
             },
             npz_key: a.npz_key,
-            depth_trunc: a.depth_trunc,
             intrinsics_file: a.intrinsics.intrinsics.clone(),
             intrinsics: a.intrinsics.values(),
-            focals: match a.focal_list {
-                Some(list) => Focals::List(list),
-                None => Focals::Scales(a.zoom_range),
-            },
-            size: a.width_out.zip(a.height_out),
-            principal: a.cx_out.zip(a.cy_out),
-            rule: BreakRule {
-                tau_rel: a.tau_rel,
-                tau_abs: a.tau_abs,
-            },
-            method: match a.method {
-                MethodArg::Mesh => Method::Mesh,
-                MethodArg::Fullscreen => Method::Fullscreen,
-            },
+            request,
             conventions: a.conv.into(),
-            files,
             out_dir: a.out_dir,
             gpu: a.gpu.try_into()?,
             backend: a.backend.into(),

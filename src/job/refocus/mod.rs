@@ -2,30 +2,25 @@
 //! a manifest (`--batch`). The options become a [`RefocusJob`] or [`RefocusBatchJob`], checked
 //! whole before a file is read; running one writes every target and the manifest, or nothing.
 
+mod request;
+
+pub use request::{FramePlan, RefocusRequest, DEFAULT_DEPTH_FORMAT};
+
 use super::error::InContext;
 use super::{ArgError, Backend, Event, GpuRequest, Host, JobError, PerFrameOption, SourceIntrinsics};
 use crate::convention::Conventions;
-use crate::io::FileFormats;
 use crate::io::{self, DepthDecode, DepthSummary};
 use crate::refocus::batch::{load_manifest, run_batch, BatchOptions, BatchSummary, Shard};
-use crate::refocus::manifest::{self as job, Manifest, ManifestEntry, TargetSpec};
-use crate::refocus::{BreakRule, Method, RefocusSource, Refocuser};
+use crate::refocus::manifest::{self as job, Manifest, ManifestEntry};
+use crate::refocus::{RefocusSource, Refocuser};
 use std::path::PathBuf;
 
 /// What to check when a refocus input's depth summary looks wrong.
 const DEPTH_HINT: &str = "check --depth-scale (raw units per metre: 5000 TUM, 1000 SUN RGB-D with --sun-bit-rotate) \
      and that the file holds metric depth, not disparity";
 
-/// How the target focal lengths are given.
-#[derive(Debug, Clone, PartialEq)]
-pub enum Focals {
-    /// Focal scales s, fx' = s fx (`--zoom-range`); files named `s{s}_...`.
-    Scales(Vec<f64>),
-    /// Absolute fx' in pixels, fy' keeping fy/fx (`--focal-list`); files named `f{fx'}_...`.
-    List(Vec<f64>),
-}
-
-/// The refocus options as given (one frame, or a batch with `manifest`).
+/// The refocus options as given (one frame, or a batch with `manifest`): the files, how to
+/// decode them, the source intrinsics and the request.
 #[derive(Debug, Clone)]
 pub struct RefocusOptions {
     /// Source colour (one frame).
@@ -34,36 +29,18 @@ pub struct RefocusOptions {
     pub depth: Option<PathBuf>,
     /// A CSV/JSON manifest of frames instead of one frame.
     pub manifest: Option<PathBuf>,
-    /// Batch: render finished frames again.
-    pub force: bool,
-    /// Batch: threads per CPU pool (None: the number of cores).
-    pub jobs: Option<usize>,
-    /// Batch: `K/N`.
-    pub shard: Option<String>,
     /// How integer (and, when given, float) depth is decoded.
     pub decode: DepthDecode,
     /// The `.npz` array to read.
     pub npz_key: Option<String>,
-    /// Depth beyond this many metres is a hole.
-    pub depth_trunc: Option<f64>,
     /// `--intrinsics FILE`.
     pub intrinsics_file: Option<PathBuf>,
     /// `--fx --fy --cx --cy`.
     pub intrinsics: [Option<f64>; 4],
-    /// Target focal lengths.
-    pub focals: Focals,
-    /// Output size.
-    pub size: Option<(u32, u32)>,
-    /// Output principal point.
-    pub principal: Option<(f64, f64)>,
-    /// Edge breaking.
-    pub rule: BreakRule,
-    /// GPU path.
-    pub method: Method,
+    /// Every setting the Python binding gives too.
+    pub request: RefocusRequest,
     /// NDC range, reversed-Z, row order.
     pub conventions: Conventions,
-    /// What to write, how (already checked: [`super::file_formats`]).
-    pub files: FileFormats,
     /// Output folder.
     pub out_dir: PathBuf,
     /// The GPU to render on.
@@ -88,17 +65,9 @@ pub struct RefocusJob {
     depth: PathBuf,
     decode: DepthDecode,
     npz_key: Option<String>,
-    depth_trunc: Option<f64>,
     intrinsics: SourceIntrinsics,
-    focals: Focals,
-    /// File-name tag of each target, in order.
-    tags: Vec<String>,
-    size: Option<(u32, u32)>,
-    principal: Option<(f64, f64)>,
-    rule: BreakRule,
-    method: Method,
+    plan: FramePlan,
     conventions: Conventions,
-    files: FileFormats,
     out_dir: PathBuf,
     gpu: GpuRequest,
     backend: Backend,
@@ -118,56 +87,24 @@ impl RefocusCommand {
     /// Checks the options against each other and the library's rules.
     pub fn new(o: RefocusOptions) -> Result<Self, ArgError> {
         super::cyclopean::check_scale("--depth-scale", o.decode.scale)?;
-        let (option, values) = match &o.focals {
-            Focals::List(list) => ("--focal-list", list),
-            Focals::Scales(scales) => ("--zoom-range", scales),
-        };
-        for &v in values {
-            super::cyclopean::check_scale(option, Some(v))?;
-        }
         if let Some(manifest) = o.manifest.clone() {
             return RefocusBatchJob::new(manifest, o).map(RefocusCommand::Batch);
         }
-        // Batch-only options are refused by name rather than ignored.
-        if o.shard.is_some() {
-            return Err(ArgError::Invalid(crate::Error::param(
-                "--shard",
-                "applies with --batch only (it picks the manifest rows a run takes)",
-            )));
-        }
+        let plan = o.request.frame()?;
         // clap requires both without --batch.
         let (Some(rgb), Some(depth)) = (o.rgb.clone(), o.depth.clone()) else {
             return Err(ArgError::PerFrameInput);
         };
         super::check_npz_key(o.npz_key.as_deref(), &[&depth])?;
         let intrinsics = SourceIntrinsics::resolve(o.intrinsics_file.as_deref(), o.intrinsics)?;
-        o.rule.validate()?;
-        if let Some((w, h)) = o.size {
-            io::check_output_pixels("--width-out/--height-out", w, h)?;
-        }
-        if let Some(m) = o.depth_trunc {
-            io::check_depth_trunc(m)?;
-        }
-        // Files are named by the focal given with --focal-list, else by the zoom scale.
-        let tags = match &o.focals {
-            Focals::List(list) => TargetSpec::focal_tags(list)?,
-            Focals::Scales(scales) => scales.iter().map(|&s| job::scale_tag(s)).collect(),
-        };
         Ok(RefocusCommand::Frame(RefocusJob {
             rgb,
             depth,
             decode: o.decode,
             npz_key: o.npz_key,
-            depth_trunc: o.depth_trunc,
             intrinsics,
-            focals: o.focals,
-            tags,
-            size: o.size,
-            principal: o.principal,
-            rule: o.rule,
-            method: o.method,
+            plan,
             conventions: o.conventions,
-            files: o.files,
             out_dir: o.out_dir,
             gpu: o.gpu,
             backend: o.backend,
@@ -198,28 +135,20 @@ impl RefocusJob {
             summary: &DepthSummary::of(&depth),
             hint: DEPTH_HINT,
         });
-        if let Some(limit_m) = self.depth_trunc {
+        if let Some(limit_m) = self.plan.depth_trunc {
             let pixels = io::truncate_depth(&mut depth, limit_m)?;
             host.event(Event::DepthTruncated { limit_m, pixels });
         }
         let k = self.intrinsics.k;
         let src = RefocusSource::new(rgb, depth, k)
             .within(|| format!("{} and {}", self.rgb.display(), self.depth.display()))?;
-        let scales = match &self.focals {
-            Focals::List(list) => TargetSpec::scales_from_focal_list(&k, list),
-            Focals::Scales(scales) => scales.clone(),
-        };
-        let spec = TargetSpec {
-            scales: scales.clone(),
-            size: self.size,
-            principal: self.principal,
-        };
-        let targets = spec.targets(&src.camera())?;
+        let (scales, targets) = self.plan.targets(&src.camera())?;
         let out_dir = io::OutDir::prepare(&self.out_dir)?;
 
-        let (files, conv) = (&self.files, self.conventions);
+        let (plan, conv) = (&self.plan, self.conventions);
+        let files = &plan.files;
         let device = host.open_device(&self.gpu, self.backend)?;
-        let mut refocuser = Refocuser::new(&device, &src, &self.rule, self.method, files.outputs, conv)?;
+        let mut refocuser = Refocuser::new(&device, &src, &plan.rule, plan.method, files.outputs, conv)?;
         host.event(Event::Started {
             what: "refocus targets",
             total: targets.len() as u64,
@@ -227,7 +156,7 @@ impl RefocusJob {
         let mut entries: Vec<ManifestEntry> = Vec::new();
         // All targets and the manifest, or (on any failure) none: earlier runs' files stay.
         let mut set = out_dir.file_set()?;
-        for ((scale, target), tag) in scales.iter().zip(&targets).zip(&self.tags) {
+        for ((scale, target), tag) in scales.iter().zip(&targets).zip(&plan.tags) {
             let out = refocuser.render(target)?;
             entries.push(job::write_target(&mut set, tag, *scale, out, files)?);
             host.event(Event::Advanced);
@@ -236,8 +165,8 @@ impl RefocusJob {
         let manifest = Manifest {
             tool: format!("viewsynth {}", env!("CARGO_PKG_VERSION")),
             source: src.camera(),
-            method: self.method,
-            break_rule: self.rule,
+            method: plan.method,
+            break_rule: plan.rule,
             conventions: conv,
             renderer: refocuser.renderer(),
             notes: job::MANIFEST_NOTES.to_string(),
@@ -283,27 +212,9 @@ impl RefocusBatchJob {
         if o.intrinsics_file.is_some() || o.intrinsics.iter().any(Option::is_some) {
             return Err(ArgError::PerFrameInBatch(PerFrameOption::Intrinsics));
         }
-        let Focals::Scales(scales) = o.focals else {
-            return Err(ArgError::PerFrameInBatch(PerFrameOption::FocalList));
-        };
-        let jobs = super::pool_threads(o.jobs)?;
-        let shard: Option<Shard> = o.shard.as_deref().map(str::parse).transpose()?;
-        o.rule.validate()?;
         Ok(RefocusBatchJob {
             manifest,
-            options: BatchOptions {
-                scales,
-                size: o.size,
-                principal: o.principal,
-                rule: o.rule,
-                method: o.method,
-                conv: o.conventions,
-                files: o.files,
-                depth_trunc: o.depth_trunc,
-                resume: !o.force,
-                jobs,
-                shard,
-            },
+            options: o.request.batch(o.conventions)?,
             out_dir: o.out_dir,
             gpu: o.gpu,
             backend: o.backend,
@@ -334,7 +245,7 @@ impl RefocusBatchJob {
 
 #[cfg(test)]
 mod tests {
-    use super::{ArgError, BreakRule, Focals, Method, RefocusCommand, RefocusOptions};
+    use super::{ArgError, RefocusCommand, RefocusOptions, RefocusRequest};
     use crate::job::PerFrameOption;
 
     fn frame() -> RefocusOptions {
@@ -342,45 +253,37 @@ mod tests {
             rgb: Some("c.png".into()),
             depth: Some("d.exr".into()),
             manifest: None,
-            force: false,
-            jobs: None,
-            shard: None,
             decode: Default::default(),
             npz_key: None,
-            depth_trunc: None,
             intrinsics_file: None,
             intrinsics: [Some(525.0), Some(525.0), Some(319.5), Some(239.5)],
-            focals: Focals::Scales(vec![0.5, 2.0]),
-            size: None,
-            principal: None,
-            rule: BreakRule::default(),
-            method: Method::Fullscreen,
+            request: RefocusRequest {
+                scales: Some(vec![0.5, 2.0]),
+                ..Default::default()
+            },
             conventions: Default::default(),
-            files: Default::default(),
             out_dir: "out".into(),
             gpu: Default::default(),
             backend: Default::default(),
         }
     }
 
+    /// `base` with its request changed by `change`.
+    fn with(base: RefocusOptions, change: impl FnOnce(&mut RefocusRequest)) -> RefocusOptions {
+        let mut o = base;
+        change(&mut o.request);
+        o
+    }
+
     #[test]
     fn one_frame_is_checked_whole_before_any_file_is_read() {
         assert!(matches!(RefocusCommand::new(frame()), Ok(RefocusCommand::Frame(_))));
-        let e = RefocusCommand::new(RefocusOptions {
-            rule: BreakRule {
-                tau_rel: -1.0,
-                ..BreakRule::default()
-            },
-            ..frame()
-        })
-        .unwrap_err();
+        let e = RefocusCommand::new(with(frame(), |r| r.tau_rel = -1.0)).unwrap_err();
         assert!(e.to_string().contains("tau"), "{e}");
-        let e = RefocusCommand::new(RefocusOptions {
-            depth_trunc: Some(0.0),
-            ..frame()
-        })
-        .unwrap_err();
+        let e = RefocusCommand::new(with(frame(), |r| r.depth_trunc = Some(0.0))).unwrap_err();
         assert!(e.to_string().contains("depth-trunc"), "{e}");
+        let e = RefocusCommand::new(with(frame(), |r| r.shard = Some("1/2".into()))).unwrap_err();
+        assert!(e.to_string().contains("--shard"), "{e}");
     }
 
     #[test]
@@ -404,18 +307,12 @@ mod tests {
             RefocusCommand::new(with_k),
             Err(ArgError::PerFrameInBatch(PerFrameOption::Intrinsics))
         ));
-        let focal_list = RefocusOptions {
-            focals: Focals::List(vec![500.0]),
-            ..batch.clone()
-        };
+        let focal_list = with(batch.clone(), |r| (r.scales, r.focal_list) = (None, Some(vec![500.0])));
         assert!(matches!(
             RefocusCommand::new(focal_list),
             Err(ArgError::PerFrameInBatch(PerFrameOption::FocalList))
         ));
-        let threads = RefocusOptions {
-            jobs: Some(crate::refocus::batch::MAX_JOBS + 1),
-            ..batch
-        };
+        let threads = with(batch, |r| r.jobs = Some(crate::refocus::batch::MAX_JOBS + 1));
         assert!(matches!(
             RefocusCommand::new(threads),
             Err(ArgError::TooManyJobs { .. })

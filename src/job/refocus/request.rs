@@ -1,0 +1,232 @@
+//! The refocus request: every refocus setting both front ends give (the CLI's flags; Python's
+//! keyword arguments of `refocus` and `refocus_batch`), with one default and one set of checks.
+//!
+//! Why here: the Python binding used to parse the file formats, default the thread count and
+//! check the break rule and the targets on its own (and had drifted: no thread limit); now
+//! both fill a [`RefocusRequest`] and [`RefocusRequest::frame`] / [`RefocusRequest::batch`]
+//! decide once.
+
+use crate::camera::PinholeCamera;
+use crate::convention::Conventions;
+use crate::io::{self, FileFormats, OutputSet, RgbFormat};
+use crate::job::{ArgError, FileOptions, PerFrameOption};
+use crate::refocus::batch::{BatchOptions, Shard};
+use crate::refocus::manifest::{self, TargetSpec, DEFAULT_SCALES};
+use crate::refocus::{BreakRule, Method};
+use serde::Serialize;
+
+/// The depth file format when none is asked for.
+pub const DEFAULT_DEPTH_FORMAT: &str = "exr";
+
+/// Every refocus setting a front end gives; [`Default`] holds the defaults of both.
+#[derive(Debug, Clone, Serialize)]
+pub struct RefocusRequest {
+    /// Focal scales s, fx' = s fx (none: the default list, unless `focal_list`).
+    pub scales: Option<Vec<f64>>,
+    /// Absolute target fx' in pixels, fy' keeping fy/fx (one frame only).
+    pub focal_list: Option<Vec<f64>>,
+    /// Output (width, height); none: the source's.
+    pub size: Option<(u32, u32)>,
+    /// Output principal point; none: the source's offset from the image centre.
+    pub principal: Option<(f64, f64)>,
+    /// Relative depth-edge break threshold.
+    pub tau_rel: f64,
+    /// Absolute depth-edge break threshold, metres (inf disables).
+    pub tau_abs: f64,
+    /// GPU path.
+    pub method: Method,
+    /// The outputs; none: all three.
+    #[serde(serialize_with = "crate::job::outputs_text")]
+    pub outputs: Option<OutputSet>,
+    /// Colour file format.
+    pub rgb_format: RgbFormat,
+    /// Depth file formats, comma-separated; none: [`DEFAULT_DEPTH_FORMAT`].
+    pub depth_format: Option<String>,
+    /// Also write the depth preview.
+    pub depth_preview: bool,
+    /// PNG compression.
+    pub png_compression: String,
+    /// EXR compression.
+    pub exr_compression: String,
+    /// Depth beyond this many metres is a hole.
+    pub depth_trunc: Option<f64>,
+    /// Batch: skip frames finished with the same settings.
+    pub resume: bool,
+    /// Batch: threads per CPU pool (none: the number of cores).
+    pub jobs: Option<usize>,
+    /// Batch: `K/N`.
+    pub shard: Option<String>,
+}
+
+impl Default for RefocusRequest {
+    fn default() -> Self {
+        RefocusRequest {
+            scales: None,
+            focal_list: None,
+            size: None,
+            principal: None,
+            tau_rel: BreakRule::default().tau_rel,
+            tau_abs: BreakRule::default().tau_abs,
+            method: Method::Fullscreen,
+            outputs: None,
+            rgb_format: RgbFormat::Png,
+            depth_format: None,
+            depth_preview: false,
+            png_compression: "fast".into(),
+            exr_compression: "zip".into(),
+            depth_trunc: None,
+            resume: true,
+            jobs: None,
+            shard: None,
+        }
+    }
+}
+
+/// One frame's checked settings: its targets wait for the source camera.
+#[derive(Debug, Clone)]
+pub struct FramePlan {
+    /// Focal scales, or the absolute focal list.
+    focals: Focals,
+    /// File-name tag of each target, in order.
+    pub tags: Vec<String>,
+    size: Option<(u32, u32)>,
+    principal: Option<(f64, f64)>,
+    /// The edge-break rule.
+    pub rule: BreakRule,
+    /// The GPU path.
+    pub method: Method,
+    /// Outputs and file formats.
+    pub files: FileFormats,
+    /// Depth truncation, metres.
+    pub depth_trunc: Option<f64>,
+}
+
+/// How the target focal lengths are given.
+#[derive(Debug, Clone, PartialEq)]
+enum Focals {
+    /// Focal scales s, fx' = s fx; files named `s{s}_...`.
+    Scales(Vec<f64>),
+    /// Absolute fx' in pixels, fy' keeping fy/fx; files named `f{fx'}_...`.
+    List(Vec<f64>),
+}
+
+impl RefocusRequest {
+    /// The scales or the focal list, each value finite and > 0.
+    fn focals(&self) -> Result<Focals, ArgError> {
+        let focals = match (&self.focal_list, &self.scales) {
+            (Some(_), Some(_)) => {
+                return Err(ArgError::Invalid(crate::Error::param(
+                    "--focal-list",
+                    "give target focal lengths or scales (--zoom-range), not both",
+                )))
+            }
+            (Some(list), None) => Focals::List(list.clone()),
+            (None, scales) => Focals::Scales(scales.clone().unwrap_or_else(|| DEFAULT_SCALES.to_vec())),
+        };
+        let (option, values) = match &focals {
+            Focals::List(list) => ("--focal-list", list),
+            Focals::Scales(scales) => ("--zoom-range", scales),
+        };
+        if values.is_empty() {
+            return Err(ArgError::Invalid(crate::Error::param(option, "no target given")));
+        }
+        for &v in values {
+            crate::job::cyclopean::check_scale(option, Some(v))?;
+        }
+        Ok(focals)
+    }
+
+    /// The break rule, checked.
+    fn rule(&self) -> Result<BreakRule, ArgError> {
+        let rule = BreakRule {
+            tau_rel: self.tau_rel,
+            tau_abs: self.tau_abs,
+        };
+        rule.validate()?;
+        Ok(rule)
+    }
+
+    /// Outputs and file formats, checked.
+    pub fn files(&self) -> Result<FileFormats, ArgError> {
+        let outputs = self.outputs.unwrap_or_default().names();
+        crate::job::file_formats(&FileOptions {
+            outputs: &outputs,
+            rgb: self.rgb_format,
+            depth: self.depth_format.as_deref().unwrap_or(DEFAULT_DEPTH_FORMAT),
+            depth_preview: self.depth_preview,
+            png_compression: &self.png_compression,
+            exr_compression: &self.exr_compression,
+        })
+    }
+
+    /// The settings of one frame, checked; batch-only settings given are refused by name.
+    pub fn frame(&self) -> Result<FramePlan, ArgError> {
+        let focals = self.focals()?;
+        if self.shard.is_some() {
+            return Err(ArgError::Invalid(crate::Error::param(
+                "--shard",
+                "applies with --batch only (it picks the manifest rows a run takes)",
+            )));
+        }
+        let rule = self.rule()?;
+        if let Some((w, h)) = self.size {
+            io::check_output_pixels("--width-out/--height-out", w, h)?;
+        }
+        if let Some(m) = self.depth_trunc {
+            io::check_depth_trunc(m)?;
+        }
+        // Files are named by the focal given with --focal-list, else by the zoom scale.
+        let tags = match &focals {
+            Focals::List(list) => TargetSpec::focal_tags(list)?,
+            Focals::Scales(scales) => scales.iter().map(|&s| manifest::scale_tag(s)).collect(),
+        };
+        Ok(FramePlan {
+            focals,
+            tags,
+            size: self.size,
+            principal: self.principal,
+            rule,
+            method: self.method,
+            files: self.files()?,
+            depth_trunc: self.depth_trunc,
+        })
+    }
+
+    /// The settings of a batch, checked: per-frame settings given are refused by name.
+    pub fn batch(&self, conv: Conventions) -> Result<BatchOptions, ArgError> {
+        let Focals::Scales(scales) = self.focals()? else {
+            return Err(ArgError::PerFrameInBatch(PerFrameOption::FocalList));
+        };
+        let jobs = crate::job::pool_threads(self.jobs)?;
+        let shard: Option<Shard> = self.shard.as_deref().map(str::parse).transpose()?;
+        Ok(BatchOptions {
+            scales,
+            size: self.size,
+            principal: self.principal,
+            rule: self.rule()?,
+            method: self.method,
+            conv,
+            files: self.files()?,
+            depth_trunc: self.depth_trunc,
+            resume: self.resume,
+            jobs,
+            shard,
+        })
+    }
+}
+
+impl FramePlan {
+    /// Each target's focal scale and camera, for a source seen by `camera`.
+    pub fn targets(&self, camera: &PinholeCamera) -> crate::Result<(Vec<f64>, Vec<PinholeCamera>)> {
+        let scales = match &self.focals {
+            Focals::List(list) => TargetSpec::scales_from_focal_list(&camera.k, list),
+            Focals::Scales(scales) => scales.clone(),
+        };
+        let spec = TargetSpec {
+            scales: scales.clone(),
+            size: self.size,
+            principal: self.principal,
+        };
+        Ok((scales, spec.targets(camera)?))
+    }
+}
