@@ -5,13 +5,13 @@
 
 use crate::backend::Backend;
 use crate::errors;
+use crate::shared::choice;
 use crate::shared::SameThread;
 use pyo3::conversion::FromPyObjectOwned;
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyList, PyMapping, PyString};
 use std::path::PathBuf;
 use viewsynth::convention::Conventions;
-use viewsynth::job::choice;
 use viewsynth::job::refocus::RefocusRequest;
 use viewsynth::refocus::batch::{load_manifest as read_manifest, run_batch, BatchFrame, BatchOptions};
 
@@ -202,9 +202,9 @@ fn options(a: &BatchArgs<'_, '_>) -> PyResult<BatchOptions> {
         principal: a.principal,
         tau_rel: a.tau_rel,
         tau_abs: a.tau_abs,
-        method: choice("--method", a.method).map_err(errors::from_request)?,
-        outputs: a.outputs.map(|_| crate::shared::output_set(a.outputs)).transpose()?,
-        rgb_format: choice("--rgb-format", a.rgb_format).map_err(errors::from_request)?,
+        method: choice("--method", a.method)?,
+        outputs: crate::shared::outputs_given(a.outputs)?,
+        rgb_format: choice("--rgb-format", a.rgb_format)?,
         depth_format: a.depth_format.map(depth_format_text).transpose()?,
         depth_preview: a.depth_preview,
         png_compression: a.png_compression.to_string(),

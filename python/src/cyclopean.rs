@@ -31,44 +31,6 @@ pub struct CyclopeanArgs<'a, 'py> {
     pub request: CyclopeanRequest,
 }
 
-/// The keyword arguments that are settings, as the library's request (choices parsed by the
-/// library's names for them).
-#[allow(clippy::too_many_arguments)]
-pub fn request(
-    method: Option<&str>,
-    refine_steps: Option<u32>,
-    blend: Option<&str>,
-    z_threshold: Option<f64>,
-    dominant: Option<String>,
-    position: Option<f64>,
-    focal: Option<f64>,
-    baseline: Option<f64>,
-    doffs: f64,
-    outputs: Option<&Bound<'_, PyAny>>,
-    fill: bool,
-) -> PyResult<CyclopeanRequest> {
-    use viewsynth::job::choice;
-    Ok(CyclopeanRequest {
-        method: method
-            .map(|m| choice("--method", m))
-            .transpose()
-            .map_err(errors::from_request)?,
-        refine_steps,
-        blend: blend
-            .map(|b| choice("--blend", b))
-            .transpose()
-            .map_err(errors::from_request)?,
-        z_threshold,
-        dominant,
-        position,
-        focal,
-        baseline,
-        doffs,
-        outputs: outputs.map(|_| crate::shared::output_set(outputs)).transpose()?,
-        fill,
-    })
-}
-
 /// The work of one call once validated: render with the GIL released.
 fn render(gpu: &Backend, plan: &CyclopeanPlan, input: StereoInput) -> viewsynth::Result<Synthesised> {
     let names = match plan.kind() {

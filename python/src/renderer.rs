@@ -6,13 +6,14 @@ use crate::arrays;
 use crate::backend::Backend;
 use crate::context;
 use crate::errors::{self, Kind};
-use crate::shared::{output_set, SameThread};
+use crate::shared::{choice, outputs_given, SameThread};
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyList};
 use viewsynth::camera::PinholeCamera;
 use viewsynth::convention::Conventions;
-use viewsynth::job::choice;
+use viewsynth::job::cyclopean::CyclopeanRequest;
 use viewsynth::job::refocus::RefocusRequest;
+use viewsynth::job::reproject::ReprojectRequest;
 use viewsynth::refocus::{BreakRule, Method, OutputSet, RefocusOutput, RefocusSource, Refocuser};
 
 /// A refocus call's inputs, validated while the GIL is held.
@@ -382,10 +383,10 @@ impl Renderer {
             scales,
             size,
             principal,
-            outputs: outputs.map(|_| output_set(outputs)).transpose()?,
+            outputs: outputs_given(outputs)?,
             tau_rel,
             tau_abs,
-            method: choice("--method", method).map_err(errors::from_request)?,
+            method: choice("--method", method)?,
             ..Default::default()
         };
         let plan = request.frame().map_err(errors::from_request)?;
@@ -533,19 +534,20 @@ impl Renderer {
         fill: bool,
     ) -> PyResult<Bound<'py, PyDict>> {
         let gpu = self.gpu()?.clone();
-        let request = crate::cyclopean::request(
-            method,
+        // The settings as the library's request: it alone decides and checks them.
+        let request = CyclopeanRequest {
+            method: method.map(|m| choice("--method", m)).transpose()?,
             refine_steps,
-            blend,
+            blend: blend.map(|b| choice("--blend", b)).transpose()?,
             z_threshold,
             dominant,
             position,
             focal,
             baseline,
             doffs,
-            outputs,
+            outputs: outputs_given(outputs)?,
             fill,
-        )?;
+        };
         crate::cyclopean::cyclopean(
             py,
             gpu,
@@ -612,6 +614,23 @@ impl Renderer {
         outputs: Option<&Bound<'py, PyAny>>,
     ) -> PyResult<Bound<'py, PyDict>> {
         let gpu = self.gpu()?.clone();
+        // The settings as the library's request: it alone decides and checks them.
+        let request = ReprojectRequest {
+            depth_kind: choice("--depth-kind", depth_kind)?,
+            near,
+            far,
+            baseline,
+            focal,
+            doffs,
+            separation,
+            convergence,
+            from: choice("--from", source)?,
+            to: choice("--to", target)?,
+            method: choice("--method", method)?,
+            steps,
+            tau_rel,
+            outputs: outputs_given(outputs)?,
+        };
         crate::reproject::reproject(
             py,
             gpu,
@@ -619,20 +638,7 @@ impl Renderer {
                 rgb,
                 depth,
                 k: K,
-                depth_kind,
-                baseline,
-                focal,
-                doffs,
-                separation,
-                convergence,
-                near,
-                far,
-                source,
-                target,
-                method,
-                steps,
-                tau_rel,
-                outputs,
+                request,
             },
         )
     }

@@ -10,54 +10,15 @@ use pyo3::prelude::*;
 use pyo3::types::PyDict;
 use viewsynth::camera::stereo::Eye;
 use viewsynth::convention::Conventions;
-use viewsynth::job::choice;
 use viewsynth::job::reproject::{RenderedTarget, ReprojectRequest};
 use viewsynth::pass::ToDevice;
 
-/// The arguments of one call, as Python gave them.
+/// The arguments of one call: the arrays, and the settings as the library's request.
 pub struct ReprojectArgs<'a, 'py> {
     pub rgb: &'a Bound<'py, PyAny>,
     pub depth: &'a Bound<'py, PyAny>,
     pub k: &'a Bound<'py, PyAny>,
-    pub depth_kind: &'a str,
-    pub baseline: Option<f64>,
-    pub focal: Option<f64>,
-    pub doffs: f64,
-    pub separation: Option<f64>,
-    pub convergence: Option<f64>,
-    pub near: Option<f64>,
-    pub far: Option<f64>,
-    pub source: &'a str,
-    pub target: &'a str,
-    pub method: &'a str,
-    pub steps: u32,
-    pub tau_rel: f64,
-    pub outputs: Option<&'a Bound<'py, PyAny>>,
-}
-
-impl ReprojectArgs<'_, '_> {
-    /// The settings as the library's request (choices parsed by the library's names).
-    fn request(&self) -> PyResult<ReprojectRequest> {
-        Ok(ReprojectRequest {
-            depth_kind: choice("--depth-kind", self.depth_kind).map_err(errors::from_request)?,
-            near: self.near,
-            far: self.far,
-            baseline: self.baseline,
-            focal: self.focal,
-            doffs: self.doffs,
-            separation: self.separation,
-            convergence: self.convergence,
-            from: choice("--from", self.source).map_err(errors::from_request)?,
-            to: choice("--to", self.target).map_err(errors::from_request)?,
-            method: choice("--method", self.method).map_err(errors::from_request)?,
-            steps: self.steps,
-            tau_rel: self.tau_rel,
-            outputs: self
-                .outputs
-                .map(|_| crate::shared::output_set(self.outputs))
-                .transpose()?,
-        })
-    }
+    pub request: ReprojectRequest,
 }
 
 fn eye_name(eye: Eye) -> &'static str {
@@ -69,7 +30,7 @@ fn eye_name(eye: Eye) -> &'static str {
 
 /// Validates `a`, renders every target with the GIL released, and returns {eye name: dict}.
 pub fn reproject<'py>(py: Python<'py>, gpu: Backend, a: ReprojectArgs<'_, 'py>) -> PyResult<Bound<'py, PyDict>> {
-    let request = a.request()?;
+    let request = a.request;
     let k = arrays::intrinsics(a.k, "K")?;
     let plan = request.rig(k.fx).map_err(errors::from_request)?;
     let src = plan.source(
@@ -92,7 +53,10 @@ pub fn reproject<'py>(py: Python<'py>, gpu: Backend, a: ReprojectArgs<'_, 'py>) 
     if src.inverse_depth_range().is_none() {
         return Err(errors::invalid(
             "depth",
-            format!("no pixel holds valid depth as depth_kind=\"{}\"", a.depth_kind),
+            format!(
+                "no pixel holds valid depth as depth_kind=\"{}\"",
+                request.depth_kind.option_value()
+            ),
         ));
     }
 

@@ -14,6 +14,17 @@ pub(crate) struct SameThread<T>(pub(crate) T);
 // SAFETY: see above; the value never leaves the thread that made it.
 unsafe impl<T> Send for SameThread<T> {}
 
+/// A named choice keyword argument (`method="seed"`), parsed by the library's names for it;
+/// `option` is the CLI option it matches (errors name the keyword argument).
+pub(crate) fn choice<T: serde::de::DeserializeOwned>(option: &str, text: &str) -> PyResult<T> {
+    viewsynth::job::choice(option, text).map_err(errors::from_request)
+}
+
+/// `outputs=` where None leaves the choice to the library's request.
+pub(crate) fn outputs_given(obj: Option<&Bound<'_, PyAny>>) -> PyResult<Option<OutputSet>> {
+    obj.map(|_| output_set(obj)).transpose()
+}
+
 /// `outputs=`: a name or a sequence of "rgb", "depth", "mask" (None: all three).
 pub(crate) fn output_set(obj: Option<&Bound<'_, PyAny>>) -> PyResult<OutputSet> {
     let Some(obj) = obj else {

@@ -5,6 +5,7 @@
 use crate::arrays;
 use crate::backend::Backend;
 use crate::errors;
+use crate::shared::choice;
 use crate::shared::SameThread;
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
@@ -12,7 +13,6 @@ use viewsynth::convention::{Conventions, RowOrder};
 use viewsynth::depth::DepthEncoding;
 use viewsynth::gpu::Timing;
 use viewsynth::io::{DepthMap, RgbImage};
-use viewsynth::job::choice;
 use viewsynth::job::stitch::{StitchPlan, StitchRequest};
 use viewsynth::stitch::faces::{faces_from_images, view_z_of};
 use viewsynth::stitch::render::StitchRenderer;
@@ -44,15 +44,15 @@ impl StitchArgs<'_, '_> {
         Ok(StitchRequest {
             fov: self.fov,
             overlap: self.overlap,
-            method: choice("--method", self.method).map_err(errors::from_request)?,
+            method: choice("--method", self.method)?,
             width: self.width,
             height: self.height,
             ipd: self.ipd,
             pole_fade: self.pole_fade,
-            depth_kind: choice("--depth-kind", self.depth_kind).map_err(errors::from_request)?,
+            depth_kind: choice("--depth-kind", self.depth_kind)?,
             near: self.near,
             far: self.far,
-            ndc: choice("--ndc", self.ndc).map_err(errors::from_request)?,
+            ndc: choice("--ndc", self.ndc)?,
             reversed_z: self.reversed_z,
         })
     }
