@@ -35,6 +35,7 @@ pub struct CyclopeanArgs<'a, 'py> {
 fn render(gpu: &Backend, plan: &CyclopeanPlan, input: StereoInput) -> viewsynth::Result<Synthesised> {
     let names = match plan.kind() {
         StereoKind::Disparity => ["left_rgb", "right_rgb", "left_disparity", "cameras"],
+        StereoKind::Images => ["left_rgb", "right_rgb", "left_rgb", "left_rgb"],
         StereoKind::Cameras => ["left_rgb", "right_rgb", "left_depth", "cameras"],
     }
     .map(InputName::Argument);
@@ -187,6 +188,20 @@ pub fn cyclopean<'py>(py: Python<'py>, gpu: Backend, a: CyclopeanArgs<'_, 'py>) 
             let (left, right) = eyes(&a, maps)?;
             StereoInput::Disparity { left, right }
         }
+        StereoKind::Images => {
+            let left = arrays::rgb_image(a.left_rgb, "left_rgb")?;
+            let right = arrays::rgb_image(a.right_rgb, "right_rgb")?;
+            if (right.width, right.height) != (left.width, left.height) {
+                return Err(errors::invalid(
+                    "right_rgb",
+                    format!(
+                        "{}x{} (W x H) differs from left_rgb's {}x{}",
+                        right.width, right.height, left.width, left.height
+                    ),
+                ));
+            }
+            StereoInput::Images { left, right }
+        }
         StereoKind::Cameras => {
             let cameras = Box::new(camera_file(some(a.cameras))?);
             let maps = [(some(a.left_depth), "left_depth"), (some(a.right_depth), "right_depth")];
@@ -243,5 +258,6 @@ fn some<'a, 'py>(x: Option<&'a Bound<'py, PyAny>>) -> &'a Bound<'py, PyAny> {
 fn input_width(input: &StereoInput) -> (u32, u32) {
     match input {
         StereoInput::Disparity { left, .. } | StereoInput::Cameras { left, .. } => (left.0.width, left.0.height),
+        StereoInput::Images { left, .. } => (left.width, left.height),
     }
 }

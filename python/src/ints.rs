@@ -104,3 +104,11 @@ pub fn refine_steps(obj: &Bound<'_, PyAny>) -> PyResult<Option<u32>> {
         false => u32_of(obj, "refine_steps").map(Some),
     }
 }
+
+/// `max_disparity=` or None.
+pub fn max_disparity(obj: &Bound<'_, PyAny>) -> PyResult<Option<u32>> {
+    match obj.is_none() {
+        true => Ok(None),
+        false => u32_of(obj, "max_disparity").map(Some),
+    }
+}

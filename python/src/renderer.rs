@@ -462,8 +462,10 @@ impl Renderer {
     }
 
     /// Synthesise an in-between view of a stereo pair: the library calls of `viewsynth
-    /// cyclopean`, from disparities of a rectified pair (its --left-disparity mode) or from each
-    /// eye's depth placed by cameras (its --left-depth ... --cameras mode).
+    /// cyclopean`, from disparities of a rectified pair (its --left-disparity mode), from each
+    /// eye's depth placed by cameras (its --left-depth ... --cameras mode), or from a rectified
+    /// pair alone (the disparities estimated by the census matcher over 0..=max_disparity px;
+    /// default a sixth of the width, rounded up to 16, in 16..=256).
     ///
     /// left_rgb, right_rgb: uint8[H, W, 3], C-contiguous. Then one of:
     /// - left_disparity, right_disparity: float32[H, W], pixels, x_right = x_left - d (left) and
@@ -510,7 +512,8 @@ impl Renderer {
     #[pyo3(signature = (left_rgb, right_rgb, left_disparity = None, right_disparity = None, position = None, *,
                         left_depth = None, right_depth = None, cameras = None, method = None,
                         refine_steps = None, blend = None, z_threshold = None, dominant = None,
-                        focal = None, baseline = None, doffs = 0.0, outputs = None, fill = false))]
+                        focal = None, baseline = None, doffs = 0.0, outputs = None, fill = false,
+                        max_disparity = None))]
     fn cyclopean<'py>(
         &mut self,
         py: Python<'py>,
@@ -532,6 +535,7 @@ impl Renderer {
         doffs: f64,
         outputs: Option<&Bound<'py, PyAny>>,
         fill: bool,
+        #[pyo3(from_py_with = crate::ints::max_disparity)] max_disparity: Option<u32>,
     ) -> PyResult<Bound<'py, PyDict>> {
         let gpu = self.gpu()?.clone();
         // The settings as the library's request: it alone decides and checks them.
@@ -547,6 +551,7 @@ impl Renderer {
             doffs,
             outputs: outputs_given(outputs)?,
             fill,
+            max_disparity,
         };
         crate::cyclopean::cyclopean(
             py,

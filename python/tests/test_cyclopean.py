@@ -221,3 +221,22 @@ def test_vulkan_renderer_matches_gl(renderer, pair):
             vk.gl_objects()
     with pytest.raises(vs.InvalidInputError, match="backend"):
         vs.Renderer(backend="metal")
+
+
+def test_two_images_alone_equal_cli(renderer, cli, pair, tmp_path):
+    """Two images alone: the disparities are estimated by the census matcher (as the CLI with
+    --left-rgb/--right-rgb only), the same view and mask as the CLI's."""
+    view = renderer.cyclopean(pair[0], pair[1], max_disparity=32)
+    paths = [tmp_path / "l.png", tmp_path / "r.png"]
+    Image.fromarray(pair[0]).save(paths[0])
+    Image.fromarray(pair[1]).save(paths[1])
+    out = tmp_path / "out"
+    done = subprocess.run([str(cli), "cyclopean", "--left-rgb", str(paths[0]), "--right-rgb", str(paths[1]),
+                           "--max-disparity", "32", "--out-dir", str(out)], capture_output=True, text=True)
+    assert done.returncode == 0, done.stderr
+    assert np.array_equal(view["rgb"], np.asarray(Image.open(out / "middle_rgb.png").convert("RGB")))
+    assert np.array_equal(view["mask"], np.asarray(Image.open(out / "middle_mask.png")) == 255)
+    assert view["coverage"] > 0.5
+    with pytest.raises(vs.InvalidInputError) as err:
+        renderer.cyclopean(pair[0], pair[1], max_disparity=10_000)
+    assert err.value.parameter == "left_rgb" and "less than the width" in str(err.value)

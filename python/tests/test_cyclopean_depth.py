@@ -186,8 +186,9 @@ def test_bad_inputs(renderer, pair):
         renderer.cyclopean(left_rgb, right_rgb, right_depth=right_z, cameras=cameras(h, w))
     assert err.value.parameter == "left_depth"
     with pytest.raises(vs.InvalidInputError) as err:
-        renderer.cyclopean(left_rgb, right_rgb)
-    assert err.value.parameter == "left_disparity" and "give left_disparity and right_disparity" in str(err.value)
+        renderer.cyclopean(left_rgb, right_rgb, left_depth=left_z, right_depth=right_z, cameras=cameras(h, w),
+                           max_disparity=16)
+    assert err.value.parameter == "max_disparity", str(err.value)
     with pytest.raises(vs.FileError):
         renderer.cyclopean(left_rgb, right_rgb, left_depth=left_z, right_depth=right_z, cameras="/nonexistent/cams.json")
     # Nothing was left broken: a good call still works.

@@ -200,6 +200,7 @@ class Renderer:
         doffs: float = 0.0,
         outputs: Optional[Union[OutputName, Sequence[OutputName]]] = None,
         fill: bool = False,
+        max_disparity: Optional[int] = None,
     ) -> CyclopeanView:
         """Synthesise an in-between view of a stereo pair (rgb uint8[H, W, 3] per eye), as
         `viewsynth cyclopean`, from either

@@ -127,11 +127,12 @@ pub enum ArgError {
     /// A seed/refine option with another cyclopean method.
     #[error("{0} applies to --method seed or refine only")]
     GatherOptionOnly(&'static str),
-    /// Cyclopean inputs of neither set-up.
-    #[error(
-        "give --left-disparity and --right-disparity (rectified pair), or --left-depth, --right-depth and --cameras"
-    )]
-    NoStereoInput,
+    /// A decoding option for disparity or depth files with two images alone.
+    #[error("{0} decodes disparity or depth files; with two images alone the disparities are estimated")]
+    DecodeWithoutMaps(&'static str),
+    /// The matcher's range with disparities or depth given.
+    #[error("--max-disparity applies to two images alone (the disparities are then estimated)")]
+    MaxDisparityWithMaps,
     /// A metric depth output asked of disparities without a calibration.
     #[error("--outputs depth needs --focal and --baseline (the depth is metric)")]
     DepthOutputNotMetric,

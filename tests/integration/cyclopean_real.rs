@@ -748,3 +748,75 @@ fn edge_pass_mixes_more_edge_pixels_than_the_work_group_limit() {
         0.001,
     );
 }
+
+/// Two images alone: the CLI estimates the disparities with the census matcher and renders as
+/// if they had been given. Oracle: the matcher's own disparities written to files and given
+/// with --left-disparity/--right-disparity must give the same files, byte for byte. Options
+/// that decode disparity files, and a search range with disparities given, are usage errors.
+#[test]
+fn cli_two_images_alone_render_the_matchers_disparities() {
+    let dir = data_dir().join("middlebury2003_cones");
+    let out = out_dir("cyclopean-two-images");
+    let (l, r) = (dir.join("im2.png"), dir.join("im6.png"));
+    let (dl, dr) =
+        viewsynth::eval::block_match::estimate_disparities(&io::load_rgb(&l).unwrap(), &io::load_rgb(&r).unwrap(), 64)
+            .unwrap();
+    let (dl_file, dr_file) = (out.join("dl.npy"), out.join("dr.npy"));
+    io::save_depth_npy(&dl_file, &dl).unwrap();
+    io::save_depth_npy(&dr_file, &dr).unwrap();
+    let (alone, given) = (out.join("alone"), out.join("given"));
+    let o = viewsynth(
+        &["--max-disparity", "64"],
+        &[("--left-rgb", &l), ("--right-rgb", &r), ("--out-dir", &alone)],
+    );
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let o = viewsynth(
+        &[],
+        &[
+            ("--left-rgb", &l),
+            ("--right-rgb", &r),
+            ("--left-disparity", &dl_file),
+            ("--right-disparity", &dr_file),
+            ("--out-dir", &given),
+        ],
+    );
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    for name in ["middle_rgb.png", "middle_mask.png"] {
+        let (a, b) = (
+            std::fs::read(alone.join(name)).unwrap(),
+            std::fs::read(given.join(name)).unwrap(),
+        );
+        assert!(
+            a == b,
+            "{name}: two images alone differ from the matcher's disparities given as files"
+        );
+    }
+    let usage = |args: &[&str], paths: &[(&str, &Path)]| {
+        let o = viewsynth(args, paths);
+        assert_eq!(
+            o.status.code(),
+            Some(2),
+            "{args:?}: {}",
+            String::from_utf8_lossy(&o.stderr)
+        );
+        String::from_utf8_lossy(&o.stderr).into_owned()
+    };
+    let bad = out.join("bad");
+    let e = usage(
+        &["--max-disparity", "64"],
+        &[
+            ("--left-rgb", &l),
+            ("--right-rgb", &r),
+            ("--left-disparity", &dl_file),
+            ("--right-disparity", &dr_file),
+            ("--out-dir", &bad),
+        ],
+    );
+    assert!(e.contains("--max-disparity applies to two images alone"), "{e}");
+    let e = usage(
+        &["--disparity-scale", "4"],
+        &[("--left-rgb", &l), ("--right-rgb", &r), ("--out-dir", &bad)],
+    );
+    assert!(e.contains("--disparity-scale decodes disparity or depth files"), "{e}");
+    assert!(!bad.exists(), "a refused run writes nothing");
+}

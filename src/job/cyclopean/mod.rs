@@ -79,8 +79,8 @@ pub struct CyclopeanOptions {
 pub struct CyclopeanJob {
     left_rgb: PathBuf,
     right_rgb: PathBuf,
-    /// Left and right disparity or depth files.
-    maps: (PathBuf, PathBuf),
+    /// Left and right disparity or depth files (none: two images alone).
+    maps: Option<(PathBuf, PathBuf)>,
     cameras: Option<PathBuf>,
     decode: DepthDecode,
     npz_key: Option<String>,
@@ -118,6 +118,18 @@ impl CyclopeanJob {
         }
         .kind()?;
         let (maps, scale) = match kind {
+            StereoKind::Images => {
+                for (flag, given) in [
+                    ("--disparity-scale", o.disparity_scale.is_some()),
+                    ("--depth-scale", o.depth_scale.is_some()),
+                    ("--npz-key", o.npz_key.is_some()),
+                ] {
+                    if given {
+                        return Err(ArgError::DecodeWithoutMaps(flag));
+                    }
+                }
+                ((None, None), None)
+            }
             StereoKind::Disparity => {
                 if o.depth_scale.is_some() {
                     return Err(ArgError::DepthScaleWithDisparity);
@@ -134,15 +146,15 @@ impl CyclopeanJob {
                 ((o.left_depth.clone(), o.right_depth.clone()), o.depth_scale)
             }
         };
-        let (Some(left), Some(right)) = maps else {
-            unreachable!("StereoGiven::kind checked both maps")
-        };
-        super::check_npz_key(o.npz_key.as_deref(), &[&left, &right])?;
+        let maps = maps.0.zip(maps.1);
+        if let Some((left, right)) = &maps {
+            super::check_npz_key(o.npz_key.as_deref(), &[left, right])?;
+        }
         let plan = o.request.plan(kind)?;
         Ok(CyclopeanJob {
             left_rgb: o.left_rgb,
             right_rgb: o.right_rgb,
-            maps: (left, right),
+            maps,
             cameras: o.cameras,
             decode: DepthDecode {
                 scale,
@@ -163,33 +175,63 @@ impl CyclopeanJob {
 
     /// Reads the pair, renders the view and writes the requested files all-or-none.
     pub fn run(&self, host: &dyn Host) -> Result<CyclopeanReport, JobError> {
+        let input = match &self.maps {
+            None => {
+                // Sizes and the pixel budget from the headers before either file is decoded.
+                let (l, r) = (
+                    io::rgb_dimensions(&self.left_rgb)?,
+                    io::rgb_dimensions(&self.right_rgb)?,
+                );
+                if l != r {
+                    return Err(crate::Error::SizeMismatch {
+                        message: format!(
+                            "left {} is {}x{} but right {} is {}x{} (from their headers; nothing decoded)",
+                            self.left_rgb.display(),
+                            l.0,
+                            l.1,
+                            self.right_rgb.display(),
+                            r.0,
+                            r.1
+                        ),
+                    }
+                    .into());
+                }
+                StereoInput::Images {
+                    left: io::load_rgb(&self.left_rgb)?,
+                    right: io::load_rgb(&self.right_rgb)?,
+                }
+            }
+            Some((left_map, right_map)) => {
+                let eye = |rgb: &Path, map: &Path| -> crate::Result<(RgbImage, DepthMap)> {
+                    // Sizes and the pixel budget from the headers before either file is decoded.
+                    io::check_rgbd_sizes(rgb, map)?;
+                    Ok((
+                        io::load_rgb(rgb)?,
+                        io::load_depth_with_key(map, self.npz_key.as_deref(), &self.decode)?,
+                    ))
+                };
+                let left = eye(&self.left_rgb, left_map)?;
+                let right = eye(&self.right_rgb, right_map)?;
+                match &self.cameras {
+                    None => StereoInput::Disparity { left, right },
+                    Some(path) => StereoInput::Cameras {
+                        left,
+                        right,
+                        cameras: Box::new(CameraFile::load(path)?),
+                    },
+                }
+            }
+        };
+        let left_map = self.maps.as_ref().map_or(self.left_rgb.as_path(), |m| m.0.as_path());
         let names = [
             InputName::File(&self.left_rgb),
             InputName::File(&self.right_rgb),
-            InputName::File(&self.maps.0),
-            InputName::File(self.cameras.as_deref().unwrap_or(&self.maps.1)),
+            InputName::File(left_map),
+            InputName::File(self.cameras.as_deref().unwrap_or(left_map)),
         ];
-        let eye = |rgb: &Path, map: &Path| -> crate::Result<(RgbImage, DepthMap)> {
-            // Sizes and the pixel budget from the headers before either file is decoded.
-            io::check_rgbd_sizes(rgb, map)?;
-            Ok((
-                io::load_rgb(rgb)?,
-                io::load_depth_with_key(map, self.npz_key.as_deref(), &self.decode)?,
-            ))
-        };
-        let left = eye(&self.left_rgb, &self.maps.0)?;
-        let right = eye(&self.right_rgb, &self.maps.1)?;
-        let input = match &self.cameras {
-            None => StereoInput::Disparity { left, right },
-            Some(path) => StereoInput::Cameras {
-                left,
-                right,
-                cameras: Box::new(CameraFile::load(path)?),
-            },
-        };
         let (frame, mid, fixation) = self.plan.frame(input, names)?;
-        if let Some(cameras) = &self.cameras {
-            for (path, eye) in [(&self.maps.0, &frame.left), (&self.maps.1, &frame.right)] {
+        if let (Some(cameras), Some((left_map, right_map))) = (&self.cameras, &self.maps) {
+            for (path, eye) in [(left_map, &frame.left), (right_map, &frame.right)] {
                 let hint = format!(
                     "read as {:?} depth (check depth_kind and the projections in {}, and --depth-scale)",
                     frame.depth_kind,

@@ -17,6 +17,7 @@ use crate::cyclopean::forward::ForwardWarp;
 use crate::cyclopean::render::CyclopeanRenderer;
 use crate::cyclopean::splat::{SplatParams, SplatRenderer};
 use crate::cyclopean::{Blend, CyclopeanOutputs, CyclopeanParams, Eye, EyeInput, MiddleCamera, StereoFrame};
+use crate::eval::block_match::estimate_disparities;
 use crate::io::{self, DepthMap, OutputSet, RgbImage};
 use crate::job::ArgError;
 use crate::pass::Device;
@@ -52,6 +53,14 @@ pub struct CyclopeanRequest {
     pub outputs: Option<OutputSet>,
     /// Holes filled from the background side (mask 128 there); off, holes stay.
     pub fill: bool,
+    /// Two images alone: the matcher's search range, pixels (none: [`default_max_disparity`]).
+    pub max_disparity: Option<u32>,
+}
+
+/// The matcher's search range for two images alone when none is given: a sixth of the width
+/// (Middlebury's quarter-size pairs need about a seventh), rounded up to 16 px, in 16..=256.
+pub fn default_max_disparity(width: u32) -> u32 {
+    (width.div_ceil(6).div_ceil(16) * 16).clamp(16, 256)
 }
 
 /// The two input set-ups.
@@ -61,6 +70,8 @@ pub enum StereoKind {
     Disparity,
     /// Depth per eye placed by a camera file.
     Cameras,
+    /// A rectified pair alone: disparities estimated by the census matcher.
+    Images,
 }
 
 /// Which stereo inputs a call gives (whatever the front end calls them).
@@ -85,7 +96,7 @@ impl StereoGiven {
         let depth = self.left_depth || self.right_depth || self.cameras;
         match (disparity, depth) {
             (true, true) => Err(ArgError::DisparityAndDepth),
-            (false, false) => Err(ArgError::NoStereoInput),
+            (false, false) => Ok(StereoKind::Images),
             (true, false) => match (self.left_disparity, self.right_disparity) {
                 (true, true) => Ok(StereoKind::Disparity),
                 (true, false) => Err(ArgError::RightDisparityMissing),
@@ -143,6 +154,7 @@ pub struct CyclopeanPlan {
     rig: (Option<f64>, Option<f64>, f64, f64),
     outputs: OutputSet,
     fill: bool,
+    max_disparity: Option<u32>,
 }
 
 /// `--dominant`'s `eye:weight`.
@@ -189,8 +201,17 @@ impl CyclopeanRequest {
                 format!("{steps} outside 0..=16"),
             )));
         }
+        if self.max_disparity.is_some() && kind != StereoKind::Images {
+            return Err(ArgError::MaxDisparityWithMaps);
+        }
+        if self.max_disparity == Some(0) {
+            return Err(ArgError::Invalid(crate::Error::param(
+                "--max-disparity",
+                "0 px searches nothing: give at least 1",
+            )));
+        }
         let metric = match kind {
-            StereoKind::Disparity => {
+            StereoKind::Disparity | StereoKind::Images => {
                 self.check_rig()?;
                 self.focal.is_some()
             }
@@ -233,6 +254,7 @@ impl CyclopeanRequest {
             rig: (self.focal, self.baseline, self.doffs, self.position.unwrap_or(0.5)),
             outputs,
             fill: self.fill,
+            max_disparity: self.max_disparity,
         })
     }
 
@@ -291,6 +313,13 @@ pub enum StereoInput {
         right: (RgbImage, DepthMap),
         /// The eyes' and the view's cameras.
         cameras: Box<CameraFile>,
+    },
+    /// A rectified pair alone: the disparities are estimated.
+    Images {
+        /// Left colour.
+        left: RgbImage,
+        /// Right colour.
+        right: RgbImage,
     },
 }
 
@@ -353,6 +382,23 @@ impl CyclopeanPlan {
     /// left and right colour, the left disparity or depth and the cameras in messages.
     pub fn frame(&self, input: StereoInput, names: [InputName; 4]) -> crate::Result<(StereoFrame, MiddleCamera, f64)> {
         let [left_rgb, right_rgb, left_map, cameras_name] = names;
+        let input = match input {
+            StereoInput::Images { left, right } => {
+                let max = self.max_disparity.unwrap_or(default_max_disparity(left.width));
+                if max >= left.width {
+                    return Err(left_rgb.error(format!(
+                        "{} px wide: the search range (--max-disparity {max}) must be less than the width",
+                        left.width
+                    )));
+                }
+                let (dl, dr) = estimate_disparities(&left, &right, max)?;
+                StereoInput::Disparity {
+                    left: (left, dl),
+                    right: (right, dr),
+                }
+            }
+            input => input,
+        };
         match input {
             StereoInput::Disparity { left, right } => {
                 let (focal, baseline, doffs, position) = self.rig;
@@ -402,6 +448,7 @@ impl CyclopeanPlan {
                 };
                 Ok((frame, mid, fixation))
             }
+            StereoInput::Images { .. } => unreachable!("estimated above"),
         }
     }
 

@@ -1,6 +1,7 @@
-//! `viewsynth cyclopean` options and their conversion into a checked library job. Two set-ups:
-//! a rectified pair with disparities (`--left-disparity/--right-disparity`), or any pair with
-//! depth and a camera file (`--left-depth/--right-depth --cameras`).
+//! `viewsynth cyclopean` options and their conversion into a checked library job. Three set-ups:
+//! a rectified pair with disparities (`--left-disparity/--right-disparity`), any pair with
+//! depth and a camera file (`--left-depth/--right-depth --cameras`), or a rectified pair alone
+//! (disparities estimated by the census matcher, `--max-disparity`).
 
 use crate::options::{BackendArg, GpuArgs};
 use crate::options::{GPU, INPUTS, INTRINSICS, METHOD, OUTPUTS, TARGETS};
@@ -116,6 +117,11 @@ pub(crate) struct CyclopeanArgs {
     /// stay 0.
     #[arg(help_heading = OUTPUTS, long)]
     fill: bool,
+    /// Two images alone (no disparities, no depth): the disparities are estimated by the census
+    /// matcher over 0..=N px (a rectified pair; default a sixth of the width, rounded up to 16,
+    /// in 16..=256).
+    #[arg(help_heading = INPUTS, long, value_name = "N", value_parser = clap::value_parser!(u32).range(1..=i64::from(viewsynth::io::MAX_DIMENSION)))]
+    max_disparity: Option<u32>,
     /// Writes middle_rgb.png, middle_depth.exr, middle_mask.png (those in --outputs).
     #[arg(help_heading = OUTPUTS, long)]
     out_dir: PathBuf,
@@ -150,6 +156,7 @@ impl CyclopeanArgs {
             doffs: self.doffs,
             outputs: self.outputs.as_deref().map(OutputSet::parse).transpose()?,
             fill: self.fill,
+            max_disparity: self.max_disparity,
         })
     }
 }
