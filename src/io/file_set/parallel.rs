@@ -1,6 +1,6 @@
 //! [`FileSet::write_all`]: several files of a set encoded side by side on the rayon pool (a
 //! view's colour PNG, depth EXR and mask PNG, the EXR's blocks themselves split into tasks), then
-//! synced on a background thread while the caller goes on to the next view.
+//! synced on background threads, one a file, while the caller goes on to the next view.
 //!
 //! The commit protocol is unchanged: [`FileSet::commit`] waits for those syncs, and fails on
 //! any of them, before its journal names the files (step 2 of the module notes); what moves is
@@ -18,8 +18,8 @@ use crate::error::{Error, Result};
 pub type FileWriter<'a> = Box<dyn FnOnce(&mut BufWriter<File>) -> Result<()> + Send + 'a>;
 
 /// Background sync threads a set keeps before it waits for the oldest (bounds the threads and
-/// open files of a set that writes many batches).
-const MAX_SYNCING: usize = 8;
+/// open files of a set that writes many files).
+const MAX_SYNCING: usize = 32;
 
 impl FileSet {
     /// Stages every `(name, writer)` of `files` at once: the names are checked and the files
@@ -75,24 +75,26 @@ impl FileSet {
         first_error.map_or(synced.map(|()| done), Err)
     }
 
-    /// Syncs `files` on a thread of their own, joined at commit (inline where no thread can be
-    /// started).
+    /// Syncs each of `files` on a thread of its own, joined at commit (inline where no thread
+    /// can be started): the device's flushes of a view's files overlap one another and the
+    /// encoding of the next view.
     fn sync_in_background(&mut self, files: Vec<(PathBuf, File)>) -> Result<()> {
-        if files.is_empty() {
-            return Ok(());
-        }
-        // The files go to the thread once it runs, so they are still here to sync if it cannot.
-        let (tx, rx) = std::sync::mpsc::channel::<Vec<(PathBuf, File)>>();
-        let spawned = std::thread::Builder::new()
-            .name("viewsynth-sync".into())
-            .spawn(move || rx.recv().map_or(Ok(()), |files| sync_files(&files)));
-        match spawned {
-            Ok(handle) => {
-                self.syncing.push(handle);
-                tx.send(files).or_else(|unsent| sync_files(&unsent.0))
+        for (shown, file) in files {
+            // The file goes to the thread once it runs, so it is still here to sync if it cannot.
+            let (tx, rx) = std::sync::mpsc::channel::<File>();
+            let path = shown.clone();
+            let spawned = std::thread::Builder::new()
+                .name("viewsynth-sync".into())
+                .spawn(move || rx.recv().map_or(Ok(()), |f| sync_file(&f, &path)));
+            match spawned {
+                Ok(handle) => {
+                    self.syncing.push(handle);
+                    tx.send(file).or_else(|unsent| sync_file(&unsent.0, &shown))?;
+                }
+                Err(_) => sync_file(&file, &shown)?,
             }
-            Err(_) => sync_files(&files),
         }
+        Ok(())
     }
 
     /// Waits for the oldest background syncs while more than [`MAX_SYNCING`] are running.
@@ -107,10 +109,8 @@ impl FileSet {
     }
 }
 
-fn sync_files(files: &[(PathBuf, File)]) -> Result<()> {
-    files
-        .iter()
-        .try_for_each(|(shown, file)| file.sync_all().map_err(|e| Error::io(shown, e)))
+fn sync_file(file: &File, shown: &std::path::Path) -> Result<()> {
+    file.sync_all().map_err(|e| Error::io(shown, e))
 }
 
 #[cfg(test)]
@@ -177,10 +177,10 @@ mod tests {
             assert!(set.write_all(bad).is_err());
         }
         assert_eq!(list_dir(set.staging()), [".viewsynth-lock", "a.txt"]);
-        for i in 0..3 * MAX_SYNCING {
+        for i in 0..2 * MAX_SYNCING {
             set.write_all(vec![(format!("f{i}"), text("x"))]).unwrap();
             assert!(set.syncing.len() <= MAX_SYNCING);
         }
-        assert_eq!(set.commit().unwrap().len(), 1 + 3 * MAX_SYNCING);
+        assert_eq!(set.commit().unwrap().len(), 1 + 2 * MAX_SYNCING);
     }
 }
