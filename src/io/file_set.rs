@@ -12,7 +12,9 @@
 //! The commit protocol survives a kill at any instruction:
 //! 1. the staging folder is owned by an exclusive `flock` on `.viewsynth-lock` inside it,
 //!    held until the set is done (a killed owner's lock is released by the kernel);
-//! 2. every file is written and synced in the staging folder;
+//! 2. every file is written and synced in the staging folder ([`FileSet::write_all`] encodes
+//!    several side by side and syncs them on background threads; commit waits for every one of
+//!    those syncs before step 3);
 //! 3. a journal `.viewsynth-commit` listing the names in rename order (the manifest last) is
 //!    written and synced: from here on the set is the new one;
 //! 4. the files are renamed into place in that order, the manifest last, then the folder is
