@@ -214,9 +214,9 @@ fn choose_channel(names: &[String]) -> Option<usize> {
 ///
 /// ZIP (the default) is compressed here, block by block, with libdeflate at its fastest level
 /// (the `exr` crate's own ZIP runs miniz_oxide at level 4: about 2.5x the CPU for files ~5 %
-/// smaller), in tasks on the rayon pool ([`zip_blocks`]); the blocks, header and offset table are the
-/// `exr` crate's, and any OpenEXR reader decodes the file. Other compressions go through the
-/// `exr` crate as they are.
+/// smaller), in tasks on the rayon pool ([`zip_blocks`]); the blocks, header and offset table
+/// are the `exr` crate's, and any OpenEXR reader decodes the file. Other compressions go
+/// through the `exr` crate as they are.
 pub(crate) fn write_f32_channels(
     path: &Path,
     out: &mut BufWriter<File>,
@@ -314,8 +314,8 @@ struct ZipImage<'a> {
 const KEEP_SCRATCH_BYTES: usize = 1 << 20;
 
 thread_local! {
-    /// Each pool thread's compressor and buffers, kept between blocks and files (libdeflate's
-    /// compressor is ~0.5 MB to set up).
+    /// Each pool thread's compressor and buffers, kept between blocks and files (a new
+    /// libdeflate compressor allocates its hash tables each time).
     static ZIP_SCRATCH: std::cell::RefCell<Option<ZipScratch>> = const { std::cell::RefCell::new(None) };
 }
 
