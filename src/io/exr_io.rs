@@ -214,9 +214,9 @@ fn choose_channel(names: &[String]) -> Option<usize> {
 ///
 /// ZIP (the default) is compressed here, block by block, with libdeflate at its fastest level
 /// (the `exr` crate's own ZIP runs miniz_oxide at level 4: about 2.5x the CPU for files ~5 %
-/// smaller), on up to [`zip_threads`] threads; the blocks, header and offset table are the
-/// `exr` crate's, and any OpenEXR reader decodes the file. Other compressions go through the
-/// `exr` crate as they are.
+/// smaller), in tasks on the rayon pool ([`zip_blocks`]); the blocks, header and offset table
+/// are the `exr` crate's, and any OpenEXR reader decodes the file. Other compressions go
+/// through the `exr` crate as they are.
 pub(crate) fn write_f32_channels(
     path: &Path,
     out: &mut BufWriter<File>,
@@ -279,62 +279,109 @@ pub(crate) fn write_f32_channels(
     })
 }
 
-/// Threads one EXR's ZIP blocks are compressed on: the cores, at most 4 (a batch already runs
-/// one encoder per core; this only shortens a single file's wall time, at no extra CPU).
-fn zip_threads() -> usize {
-    std::thread::available_parallelism().map_or(1, |n| n.get()).min(4)
-}
+/// Blocks of 16 lines one task of [`zip_blocks`] compresses in turn (4: ~160 KB of f32 VGA
+/// rows, ~0.5 ms here): small enough to spread a VGA image's 30 blocks over the cores and over
+/// the other files being encoded beside it, large enough that splitting costs nothing.
+const BLOCKS_PER_TASK: usize = 4;
 
 /// The ZIP chunks of a scan-line image: per block of `lines` rows, each row's channels in
 /// turn (little-endian f32), byte-split into even and odd bytes, delta-coded and deflated
 /// (zlib) -- OpenEXR's ZIP -- or the raw bytes where deflate would not make them smaller.
+/// Tasks of [`BLOCKS_PER_TASK`] blocks run on the rayon pool, beside whatever else it runs
+/// (a view's PNGs: see `FileSet::write_all`).
 fn zip_blocks(planes: &[&[f32]], width: usize, height: usize, lines: usize) -> Vec<Vec<u8>> {
-    let count = height.div_ceil(lines);
-    let compress_range = |range: std::ops::Range<usize>| -> Vec<Vec<u8>> {
-        // Level 1: libdeflate's fastest that compresses (0 only stores).
-        let level = libdeflater::CompressionLvl::new(1).expect("libdeflate has level 1");
-        let mut deflater = libdeflater::Compressor::new(level);
-        let (mut raw, mut predicted) = (Vec::new(), Vec::new());
-        range
-            .map(|b| {
-                let rows = b * lines..((b + 1) * lines).min(height);
-                raw.clear();
-                for y in rows {
-                    for plane in planes {
-                        for v in &plane[y * width..(y + 1) * width] {
-                            raw.extend_from_slice(&v.to_le_bytes());
-                        }
-                    }
-                }
-                zip_predict(&raw, &mut predicted);
-                let mut out = vec![0u8; deflater.zlib_compress_bound(predicted.len())];
-                match deflater.zlib_compress(&predicted, &mut out) {
-                    Ok(n) if n < raw.len() => {
-                        out.truncate(n);
-                        out
-                    }
-                    _ => raw.clone(),
-                }
-            })
-            .collect()
+    let mut blocks = vec![Vec::new(); height.div_ceil(lines)];
+    let image = ZipImage {
+        planes,
+        width,
+        height,
+        lines,
     };
-    let threads = zip_threads().min(count.div_ceil(8)).max(1);
-    if threads == 1 {
-        return compress_range(0..count);
+    image.compress(&mut blocks, 0);
+    blocks
+}
+
+/// What every task of [`zip_blocks`] reads.
+#[derive(Clone, Copy)]
+struct ZipImage<'a> {
+    planes: &'a [&'a [f32]],
+    width: usize,
+    height: usize,
+    lines: usize,
+}
+
+/// Largest block buffers a pool thread keeps between files (a block of 16 rows of 16,384 f32).
+const KEEP_SCRATCH_BYTES: usize = 1 << 20;
+
+thread_local! {
+    /// Each pool thread's compressor and buffers, kept between blocks and files (a new
+    /// libdeflate compressor allocates its hash tables each time).
+    static ZIP_SCRATCH: std::cell::RefCell<Option<ZipScratch>> = const { std::cell::RefCell::new(None) };
+}
+
+struct ZipScratch {
+    deflater: libdeflater::Compressor,
+    raw: Vec<u8>,
+    predicted: Vec<u8>,
+    deflated: Vec<u8>,
+}
+
+impl ZipImage<'_> {
+    /// Compresses blocks `first..first + out.len()` into `out`, splitting in halves on the pool.
+    fn compress(self, out: &mut [Vec<u8>], first: usize) {
+        if out.len() > BLOCKS_PER_TASK {
+            let half = out.len() / 2;
+            let (a, b) = out.split_at_mut(half);
+            rayon_core::join(|| self.compress(a, first), || self.compress(b, first + half));
+            return;
+        }
+        ZIP_SCRATCH.with(|cell| {
+            let mut cell = cell.borrow_mut();
+            let scratch = cell.get_or_insert_with(|| ZipScratch {
+                // Level 1: libdeflate's fastest that compresses (0 only stores).
+                deflater: libdeflater::Compressor::new(
+                    libdeflater::CompressionLvl::new(1).expect("libdeflate has level 1"),
+                ),
+                raw: Vec::new(),
+                predicted: Vec::new(),
+                deflated: Vec::new(),
+            });
+            for (i, block) in out.iter_mut().enumerate() {
+                *block = self.block(first + i, scratch);
+            }
+            // Kept for the next file unless a huge image grew them (a long-lived process).
+            if scratch.raw.capacity() > KEEP_SCRATCH_BYTES {
+                *cell = None;
+            }
+        });
     }
-    let per = count.div_ceil(threads);
-    std::thread::scope(|scope| {
-        let handles: Vec<_> = (0..threads)
-            .map(|t| {
-                let range = (t * per).min(count)..((t + 1) * per).min(count);
-                scope.spawn(move || compress_range(range))
-            })
-            .collect();
-        handles
-            .into_iter()
-            .flat_map(|h| h.join().expect("a ZIP thread panicked"))
-            .collect()
-    })
+
+    fn block(&self, b: usize, s: &mut ZipScratch) -> Vec<u8> {
+        let rows = b * self.lines..((b + 1) * self.lines).min(self.height);
+        s.raw.clear();
+        for y in rows {
+            for plane in self.planes {
+                extend_le(&mut s.raw, &plane[y * self.width..(y + 1) * self.width]);
+            }
+        }
+        zip_predict(&s.raw, &mut s.predicted);
+        s.deflated.resize(s.deflater.zlib_compress_bound(s.predicted.len()), 0);
+        match s.deflater.zlib_compress(&s.predicted, &mut s.deflated) {
+            Ok(n) if n < s.raw.len() => s.deflated[..n].to_vec(),
+            _ => s.raw.clone(),
+        }
+    }
+}
+
+/// Appends `v` as little-endian f32 bytes: one copy on a little-endian machine.
+fn extend_le(out: &mut Vec<u8>, v: &[f32]) {
+    if cfg!(target_endian = "little") {
+        out.extend_from_slice(bytemuck::cast_slice(v));
+    } else {
+        for x in v {
+            out.extend_from_slice(&x.to_le_bytes());
+        }
+    }
 }
 
 /// OpenEXR's ZIP predictor: the even bytes then the odd bytes, each byte stored as its

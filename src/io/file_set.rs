@@ -12,7 +12,9 @@
 //! The commit protocol survives a kill at any instruction:
 //! 1. the staging folder is owned by an exclusive `flock` on `.viewsynth-lock` inside it,
 //!    held until the set is done (a killed owner's lock is released by the kernel);
-//! 2. every file is written and synced in the staging folder;
+//! 2. every file is written and synced in the staging folder ([`FileSet::write_all`] encodes
+//!    several side by side and syncs them on background threads; commit waits for every one of
+//!    those syncs before step 3);
 //! 3. a journal `.viewsynth-commit` listing the names in rename order (the manifest last) is
 //!    written and synced: from here on the set is the new one;
 //! 4. the files are renamed into place in that order, the manifest last, then the folder is
@@ -38,6 +40,9 @@
 use std::fs::{self, File};
 use std::io::{self, BufWriter, Write};
 use std::path::{Component, Path, PathBuf};
+
+mod parallel;
+pub use parallel::FileWriter;
 
 use super::atomic::{
     check_replaceable, fault_point, older_than, open_for_lock, own_prefix, probe_writable, remove_orphan_temporaries,
@@ -187,8 +192,12 @@ pub struct FileSet {
     staging: tempfile::TempDir,
     /// The staging folder's lock, held while this set lives.
     _lock: File,
-    /// Names written through [`FileSet::write`], in order.
+    /// Names written through [`FileSet::write`] and [`FileSet::write_all`], in order.
     written: Vec<String>,
+    /// Names of [`FileSet::write`] not synced yet (synced at commit, all at once).
+    unsynced: Vec<String>,
+    /// The background syncs of [`FileSet::write_all`]'s files, joined at commit.
+    syncing: Vec<std::thread::JoinHandle<Result<()>>>,
 }
 
 impl FileSet {
@@ -215,6 +224,8 @@ impl FileSet {
             staging,
             _lock: lock,
             written: Vec::new(),
+            unsynced: Vec::new(),
+            syncing: Vec::new(),
         })
     }
 
@@ -262,21 +273,22 @@ impl FileSet {
     /// Stages `name` (one plain file name) with the bytes `write` produces. Errors name the
     /// final path. Returns the final path.
     pub fn write(&mut self, name: &str, write: impl FnOnce(&mut BufWriter<File>) -> Result<()>) -> Result<PathBuf> {
+        let shown = self.check_new_name(name)?;
+        let file = File::create_new(self.staging.path().join(name)).map_err(|e| Error::io(&shown, e))?;
+        // Synced at commit, with the set's other files at once (see `sync_written`).
+        write_file(file, &shown, write)?;
+        self.written.push(name.to_string());
+        self.unsynced.push(name.to_string());
+        Ok(shown)
+    }
+
+    /// The final path of `name`, refused unless it is a plain name not yet written in this set.
+    fn check_new_name(&self, name: &str) -> Result<PathBuf> {
         check_plain_name(name, &self.shown)?;
         let shown = self.final_path(name);
         if self.written.iter().any(|n| n == name) {
-            return Err(Error::param(
-                "output name",
-                format!("{} is written twice in one set", shown.display()),
-            ));
+            return Err(twice(&shown));
         }
-        let file = File::create_new(self.staging.path().join(name)).map_err(|e| Error::io(&shown, e))?;
-        let mut writer = BufWriter::with_capacity(super::atomic::WRITE_BUFFER, file);
-        write(&mut writer)?;
-        writer.flush().map_err(|e| Error::io(&shown, e))?;
-        // Synced at commit, with the set's other files at once (see `sync_written`).
-        writer.into_inner().map_err(|e| Error::io(&shown, e.into_error()))?;
-        self.written.push(name.to_string());
         Ok(shown)
     }
 
@@ -288,7 +300,7 @@ impl FileSet {
     /// the module notes). Nothing is renamed if the staging folder holds anything but regular
     /// files. A rename that fails leaves the journalled staging folder for the next run to
     /// roll forward.
-    pub fn commit(self) -> Result<Vec<PathBuf>> {
+    pub fn commit(mut self) -> Result<Vec<PathBuf>> {
         let mut direct = Vec::new();
         let entries = fs::read_dir(self.staging.path()).map_err(|e| Error::io(&self.shown, e))?;
         for e in entries {
@@ -364,26 +376,30 @@ impl FileSet {
         result
     }
 
-    /// Makes the files of [`FileSet::write`] durable before the journal names them: all at once,
-    /// on up to 16 threads, so the device's flushes overlap (16 files of a VGA frame: ~8 ms here
-    /// against ~50 one after another) at no extra CPU.
-    fn sync_written(&self) -> Result<()> {
+    /// Makes every written file durable before the journal names them: waits for the
+    /// background syncs of [`FileSet::write_all`], and syncs the files of [`FileSet::write`]
+    /// all at once, on up to 16 threads, so the device's flushes overlap (16 files of a VGA
+    /// frame: ~8 ms here against ~50 one after another) at no extra CPU.
+    fn sync_written(&mut self) -> Result<()> {
+        for handle in self.syncing.drain(..) {
+            handle.join().unwrap_or_else(|_| Err(sync_panicked(&self.shown)))?;
+        }
         let sync = |name: &String| -> Result<()> {
             let path = self.staging.path().join(name);
             File::open(&path)
                 .and_then(|f| f.sync_all())
                 .map_err(|e| Error::io(self.final_path(name), e))
         };
-        let per = self.written.len().div_ceil(16).max(1);
+        let per = self.unsynced.len().div_ceil(16).max(1);
         std::thread::scope(|scope| {
             let handles: Vec<_> = self
-                .written
+                .unsynced
                 .chunks(per)
                 .map(|names| scope.spawn(move || names.iter().try_for_each(sync)))
                 .collect();
             handles
                 .into_iter()
-                .try_for_each(|h| h.join().expect("an fsync thread panicked"))
+                .try_for_each(|h| h.join().unwrap_or_else(|_| Err(sync_panicked(&self.shown))))
         })
     }
 
@@ -393,6 +409,26 @@ impl FileSet {
             other => other,
         }
     }
+}
+
+/// Writes `file` through a [`super::atomic::WRITE_BUFFER`]-sized buffer with `write`, flushed;
+/// errors name `shown`. Returns the file, not yet synced.
+fn write_file(file: File, shown: &Path, write: impl FnOnce(&mut BufWriter<File>) -> Result<()>) -> Result<File> {
+    let mut writer = BufWriter::with_capacity(super::atomic::WRITE_BUFFER, file);
+    write(&mut writer)?;
+    writer.flush().map_err(|e| Error::io(shown, e))?;
+    writer.into_inner().map_err(|e| Error::io(shown, e.into_error()))
+}
+
+fn twice(shown: &Path) -> Error {
+    Error::param(
+        "output name",
+        format!("{} is written twice in one set", shown.display()),
+    )
+}
+
+fn sync_panicked(dir: &Path) -> Error {
+    Error::io(dir, io::Error::other("a thread syncing the set's files panicked"))
 }
 
 fn sync_dir(dir: &Path) {

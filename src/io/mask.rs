@@ -2,7 +2,7 @@
 
 use std::path::Path;
 
-use image::codecs::png::{FilterType, PngEncoder};
+use image::codecs::png::PngEncoder;
 use image::{ExtendedColorType, ImageEncoder, ImageFormat};
 
 use super::atomic::atomic_write;
@@ -41,7 +41,7 @@ pub(crate) fn encode_mask_png(
             _ => 255,
         })
         .collect();
-    PngEncoder::new_with_quality(out, compression.image_type(), FilterType::Adaptive)
+    PngEncoder::new_with_quality(out, compression.image_type(), compression.mask_filter())
         .write_image(&bytes, mask.width, mask.height, ExtendedColorType::L8)
         .map_err(|e| Error::encode(path, e.to_string()))
 }

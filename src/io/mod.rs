@@ -45,7 +45,7 @@ pub use depth_preview::{depth_preview, depth_preview_range, save_depth_preview, 
 pub use depth_summary::{DepthSummary, DepthWarning, PLAUSIBLE_MEDIAN_M};
 pub use depth_trunc::{check_depth_trunc, truncate_depth};
 pub use encoding::{Encoding, ExrCompression, PngCompression};
-pub use file_set::{write_paths_all_or_none, FileSet, OutDir, PathWriter, MANIFEST_NAME};
+pub use file_set::{write_paths_all_or_none, FileSet, FileWriter, OutDir, PathWriter, MANIFEST_NAME};
 pub use image_types::{DepthMap, Mask, RgbImage, MAX_DIMENSION};
 pub(crate) use input::{check_file_len, open_regular};
 pub use input::{check_output_pixels, max_pixels, set_max_pixels, DEFAULT_MAX_PIXELS};

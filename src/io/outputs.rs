@@ -9,7 +9,7 @@
 //! [`ViewNames`] lets a command keep other names it has always written (stitch's
 //! `ods_left.png`, scene's `left_view_z.exr`).
 
-use super::{Encoding, FileSet, PreviewRange};
+use super::{Encoding, FileSet, FileWriter, PreviewRange};
 use crate::error::{Error, Result};
 use crate::view::ViewOutput;
 use serde::{Deserialize, Serialize};
@@ -361,46 +361,52 @@ fn write_view_in(set: &mut FileSet, names: &ViewNames, view: &ViewOutput, format
     formats.validate()?;
     let (outputs, enc) = (formats.outputs, formats.encoding);
     let mut entry = ViewFiles::default();
-    // Each file straight into the set (synced with the others at commit); errors name the
-    // final path.
-    let mut put = |name: String, encode: &mut dyn FnMut(&Path, &mut BufWriter<File>) -> Result<()>| {
-        let shown = set.final_path(&name);
-        set.write(&name, |out| encode(&shown, out))?;
-        Ok::<String, Error>(name)
-    };
+    // Filled by the jobs, so declared before them.
+    let (mut clipped, mut preview) = (None, None);
+    // The view's files are encoded side by side, straight into the set (FileSet::write_all).
+    let mut jobs: Vec<(String, FileWriter)> = Vec::new();
     if outputs.rgb {
         let rgb = view.color.as_ref().ok_or_else(|| missing("rgb"))?;
         let ext = formats.rgb.extension();
         let name = format!("{}.{ext}", names.rgb);
-        entry.rgb = Some(put(name, &mut |p, out| super::rgb::encode_rgb(p, out, rgb, ext, &enc))?);
+        jobs.push(job(set, &name, move |p, out| {
+            super::rgb::encode_rgb(p, out, rgb, ext, &enc)
+        }));
+        entry.rgb = Some(name);
     }
     if outputs.depth {
         let depth = view.depth.as_ref().ok_or_else(|| missing("depth"))?;
         if formats.depth.exr {
             let name = format!("{}.exr", names.depth);
-            entry.depth_exr = Some(put(name, &mut |p, out| {
+            jobs.push(job(set, &name, move |p, out| {
                 super::depth::encode_depth_exr(p, out, depth, enc.exr)
-            })?);
+            }));
+            entry.depth_exr = Some(name);
         }
         if formats.depth.npy {
             let name = format!("{}.npy", names.depth);
-            entry.depth_npy = Some(put(name, &mut |p, out| super::depth::encode_depth_npy(p, out, depth))?);
+            jobs.push(job(set, &name, move |p, out| {
+                super::depth::encode_depth_npy(p, out, depth)
+            }));
+            entry.depth_npy = Some(name);
         }
         if formats.depth.png16 {
-            let (name, mut clipped) = (format!("{}.png", names.depth), 0);
-            entry.depth_png16 = Some(put(name, &mut |p, out| {
-                clipped = super::depth_png16::encode_depth_png16(p, out, depth, enc.png)?;
+            let name = format!("{}.png", names.depth);
+            let count = &mut clipped;
+            jobs.push(job(set, &name, move |p, out| {
+                *count = Some(super::depth_png16::encode_depth_png16(p, out, depth, enc.png)?);
                 Ok(())
-            })?);
-            entry.depth_png16_clipped = Some(clipped);
+            }));
+            entry.depth_png16 = Some(name);
         }
         if formats.depth_preview {
             let range = super::depth_preview_range(depth);
-            let image = super::depth_preview(depth, range);
+            let image = preview.insert(super::depth_preview(depth, range));
             let name = format!("{}_preview.png", names.depth);
-            entry.depth_preview = Some(put(name, &mut |p, out| {
-                super::rgb::encode_rgb(p, out, &image, "png", &enc)
-            })?);
+            jobs.push(job(set, &name, move |p, out| {
+                super::rgb::encode_rgb(p, out, image, "png", &enc)
+            }));
+            entry.depth_preview = Some(name);
             entry.depth_preview_range_m = range;
         }
         let valid = depth.data.iter().filter(|z| **z > 0.0).count();
@@ -409,13 +415,26 @@ fn write_view_in(set: &mut FileSet, names: &ViewNames, view: &ViewOutput, format
     if outputs.mask {
         let mask = view.mask.as_ref().ok_or_else(|| missing("mask"))?;
         let name = format!("{}.png", names.mask);
-        entry.mask = Some(put(name, &mut |p, out| {
+        jobs.push(job(set, &name, move |p, out| {
             super::mask::encode_mask_png(p, out, mask, enc.png)
-        })?);
+        }));
+        entry.mask = Some(name);
         let valid = mask.data.iter().filter(|m| **m != 0).count();
         entry.coverage = Some(valid as f64 / mask.data.len().max(1) as f64);
     }
+    set.write_all(jobs)?;
+    entry.depth_png16_clipped = clipped;
     Ok(entry)
+}
+
+/// A job of [`FileSet::write_all`]: `name` and its encoder, handed the final path for errors.
+fn job<'a>(
+    set: &FileSet,
+    name: &str,
+    encode: impl FnOnce(&Path, &mut BufWriter<File>) -> Result<()> + Send + 'a,
+) -> (String, FileWriter<'a>) {
+    let shown = set.final_path(name);
+    (name.to_string(), Box::new(move |out| encode(&shown, out)))
 }
 
 #[cfg(test)]

@@ -5,7 +5,7 @@ use std::io::BufWriter;
 use std::path::Path;
 
 use image::codecs::jpeg::JpegEncoder;
-use image::codecs::png::{FilterType, PngEncoder};
+use image::codecs::png::PngEncoder;
 use image::{ExtendedColorType, ImageEncoder};
 
 use super::atomic::atomic_write;
@@ -66,7 +66,7 @@ pub(crate) fn encode_rgb(
     encode_dims(path, img.width, img.height, 3, img.data.len())?;
     let (w, h) = (img.width, img.height);
     match ext {
-        "png" => PngEncoder::new_with_quality(out, encoding.png.image_type(), FilterType::Adaptive)
+        "png" => PngEncoder::new_with_quality(out, encoding.png.image_type(), encoding.png.colour_filter())
             .write_image(&img.data, w, h, ExtendedColorType::Rgb8)
             .map_err(|e| Error::encode(path, e.to_string())),
         "jpg" | "jpeg" => JpegEncoder::new_with_quality(out, JPEG_QUALITY)
