@@ -29,8 +29,9 @@ pub(crate) struct FileOutputArgs {
     /// blue, invalid black) over its 2nd-98th percentile, the range recorded in the manifest.
     #[arg(long)]
     depth_preview: bool,
-    /// PNG compression of colour and mask files: fast (the default, as earlier releases wrote),
-    /// default (deflate's default level: smaller files, several times the CPU) or best.
+    /// PNG compression of colour and mask files: fast (the default: the fastest deflate level
+    /// and a fixed row filter), default (deflate's default level: smaller files, several times
+    /// the CPU) or best.
     #[arg(long, default_value = "fast")]
     png_compression: String,
     /// EXR compression of depth (and EXR colour): none, rle, zip (default) or piz; all lossless.
