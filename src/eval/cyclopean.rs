@@ -1,6 +1,6 @@
 //! Cyclopean report rows: every method on the built-in scene under the depth conventions (exact
 //! ray-traced middle view), on Middlebury 2003 (real data, ground-truth disparities), on real
-//! pairs with disparities estimated by [`super::block_match`] and on user cases, with run times.
+//! pairs with disparities estimated by [`crate::cyclopean::matcher`] and on user cases, with run times.
 
 use super::{score, timed};
 use crate::convention::{Conventions, NdcDepthRange, RowOrder};
@@ -361,7 +361,7 @@ pub const TSUKUBA_MAX_DISPARITY_PER_STEP: u32 = 16;
 /// 7.2 to 59.9 px.
 pub const MOTORCYCLE_MAX_DISPARITY: u32 = 64;
 
-/// A real pair scored with disparities estimated by [`super::block_match`] between its two
+/// A real pair scored with disparities estimated by [`crate::cyclopean::matcher`] between its two
 /// images (no ground truth used), against a real view at `position`.
 pub struct EstimatedCase {
     /// Report scene name.
@@ -473,7 +473,7 @@ pub type Eye = (RgbImage, DepthMap);
 /// rig, on the nominal Middlebury focal length and baseline: disparities are estimated between
 /// these very images, so there is no principal-point offset (doffs 0) and only t d matters.
 pub fn estimated_eyes(case: &EstimatedCase) -> Result<(Eye, Eye, DisparityRig)> {
-    let (dl, mut dr) = super::block_match::estimate_disparities(&case.left, &case.right, case.max_disparity)?;
+    let (dl, mut dr) = crate::cyclopean::matcher::estimate_disparities(&case.left, &case.right, case.max_disparity)?;
     if case.left_eye_only {
         dr.data.iter_mut().for_each(|d| *d = 0.0);
     }
@@ -492,7 +492,7 @@ pub fn cyclopean_estimated_rows(gpu: &Gpu, data_dir: &Path, repeats: usize) -> R
     let (cases, mut notes) = estimated_cases(data_dir)?;
     let mut rows = Vec::new();
     notes.push(format!(
-        "Estimated disparities: a census stereo matcher (src/eval/block_match.rs: 7x5 census on r+g+b, Hamming cost, \
+        "Estimated disparities: a census stereo matcher (src/cyclopean/matcher/: 7x5 census on r+g+b, Hamming cost, \
          9x9 box mean, winner takes all with a parabolic sub-pixel step, left-right check within 1 px, 3x3 median of \
          the known values; integer costs, deterministic), run on each pair as given with the same settings everywhere; \
          only the search range comes from each set's documented disparity range ({MIDDLEBURY_2003_MAX_DISPARITY} px \

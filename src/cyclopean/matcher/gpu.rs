@@ -1,0 +1,186 @@
+//! The census matcher's GPU pass (see [`super`] for the rule and the stages): one run of compute
+//! dispatches on a [`Device`], the two disparity maps read back as the run's outputs. A
+//! [`Matcher`] is made for one image size and search range; its buffers are created once and
+//! its input images rewritten for each pair, so a stream of pairs creates nothing.
+
+use super::{check_pair, check_range};
+use crate::convention::RowOrder;
+use crate::error::{Error, Result};
+use crate::gpu::shaders::MatcherStage;
+use crate::gpu::{ProgramKind, ShaderProgram};
+use crate::io::{DepthMap, RgbImage};
+use crate::pass::{Buffer, Device, Dispatch, Format, Groups, Image, ImageData, Step, StorageImage, Target, ToDevice};
+
+crate::param_block! {
+    /// Every matcher stage's parameters: shaders/cyclopean/matcher_params.glsl, member for member.
+    pub struct MatcherParams("MatcherParams") {
+        u_size: [i32; 2],
+        u_max_disparity: i32,
+        u_first_d: i32,
+        u_pairs: i32,
+    }
+}
+
+/// Words a chunk buffer holds at most (64 MiB): under GL's guaranteed-in-practice storage-block
+/// size (llvmpipe: 128 MiB) and Vulkan's storage-buffer range on the devices we run.
+const CHUNK_WORDS: usize = 1 << 24;
+
+/// The pair's images on the device, rewritten for each pair.
+struct Inputs {
+    left: Image,
+    right: Image,
+}
+
+/// Estimates both eyes' disparities of rectified pairs of one size on a device.
+pub struct Matcher {
+    device: Device,
+    width: u32,
+    height: u32,
+    max_disparity: u32,
+    /// Disparity pairs (16-bit lanes of one word) per chunk.
+    chunk_pairs: u32,
+    inputs: Option<Inputs>,
+    /// Census codes, 4 words a pixel.
+    codes: Buffer,
+    /// A chunk's costs, then its means.
+    costs: Buffer,
+    /// A chunk's row sums.
+    rows: Buffer,
+    /// Each eye's winner so far, 3 words a pixel.
+    winners: [Buffer; 2],
+    /// Sub-pixel disparities, then the checked ones, both eyes (f32 bits).
+    raw: Buffer,
+    checked: Buffer,
+}
+
+impl Matcher {
+    /// A matcher for `width` x `height` pairs searching 0..=`max_disparity` px, on `device` (a
+    /// [`Device`], or a GL context). Fails as [`super::estimate_disparities`] does on the range,
+    /// and on a size the device cannot hold.
+    pub fn new(device: impl ToDevice, width: u32, height: u32, max_disparity: u32) -> Result<Self> {
+        check_range(width, max_disparity)?;
+        let device = device.to_device()?;
+        device.check_image_size("stereo pair", width, height)?;
+        let n = width as usize * height as usize;
+        let pairs = (max_disparity as usize + 1).div_ceil(2);
+        let chunk_pairs = pairs.min((CHUNK_WORDS / n).max(1));
+        let buffer = |words: usize, label: &str| device.create_buffer(words, label);
+        Ok(Matcher {
+            codes: buffer(4 * n, "matcher census codes")?,
+            costs: buffer(chunk_pairs * n, "matcher costs")?,
+            rows: buffer(chunk_pairs * n, "matcher row sums")?,
+            winners: [
+                buffer(3 * n, "matcher left winners")?,
+                buffer(3 * n, "matcher right winners")?,
+            ],
+            raw: buffer(2 * n, "matcher sub-pixel disparities")?,
+            checked: buffer(2 * n, "matcher checked disparities")?,
+            chunk_pairs: chunk_pairs as u32,
+            device,
+            width,
+            height,
+            max_disparity,
+            inputs: None,
+        })
+    }
+
+    /// Disparities of the left and right eye of `left` and `right` (the matcher's size), as
+    /// [`super::estimate_disparities`] gives them, bit for bit.
+    pub fn estimate(&mut self, left: &RgbImage, right: &RgbImage) -> Result<(DepthMap, DepthMap)> {
+        check_pair(left, right)?;
+        let (w, h) = (self.width, self.height);
+        if (left.width, left.height) != (w, h) {
+            return Err(Error::SizeMismatch {
+                message: format!(
+                    "stereo matching: a {}x{} pair given to a matcher made for {w}x{h}",
+                    left.width, left.height
+                ),
+            });
+        }
+        self.set_inputs(left, right)?;
+        let inputs = self.inputs.as_ref().expect("set above");
+        let params = |first_d: u32, pairs: u32| MatcherParams {
+            u_size: [w as i32, h as i32],
+            u_max_disparity: self.max_disparity as i32,
+            u_first_d: first_d as i32,
+            u_pairs: pairs as i32,
+        };
+        let pairs = (self.max_disparity + 1).div_ceil(2);
+        let chunks: Vec<MatcherParams> = (0..pairs.div_ceil(self.chunk_pairs))
+            .map(|c| {
+                let first = c * self.chunk_pairs;
+                params(2 * first, self.chunk_pairs.min(pairs - first))
+            })
+            .collect();
+        let whole = params(0, 0);
+        let ids = |b: &[&Buffer]| b.iter().map(|b| b.id()).collect::<Vec<_>>();
+        let census_buffers = ids(&[&self.codes]);
+        let cost_buffers = ids(&[&self.codes, &self.costs]);
+        let rows_buffers = ids(&[&self.costs, &self.rows]);
+        let columns_buffers = ids(&[&self.rows, &self.costs]);
+        let winner_buffers = ids(&[&self.costs, &self.winners[0], &self.winners[1]]);
+        let subpixel_buffers = ids(&[&self.winners[0], &self.winners[1], &self.raw]);
+        let check_buffers = ids(&[&self.raw, &self.checked]);
+        let median_buffers = ids(&[&self.checked]);
+        let images = [inputs.left.id(), inputs.right.id()];
+        let outputs = [StorageImage::Output(0), StorageImage::Output(1)];
+        let groups = Groups::Fixed([w.div_ceil(8), h.div_ceil(8)]);
+        let dispatch = |stage, block, buffers, images, storage_images| {
+            Step::Dispatch(Dispatch {
+                program: ShaderProgram::new(Default::default(), ProgramKind::CyclopeanMatcher(stage)),
+                params: bytemuck::bytes_of(block),
+                images,
+                storage_images,
+                buffers,
+                groups,
+            })
+        };
+        let mut steps = vec![dispatch(MatcherStage::Census, &whole, &census_buffers, &images, &[])];
+        for chunk in &chunks {
+            steps.push(dispatch(MatcherStage::Cost, chunk, &cost_buffers, &[], &[]));
+            steps.push(dispatch(MatcherStage::Rows, chunk, &rows_buffers, &[], &[]));
+            steps.push(dispatch(MatcherStage::Columns, chunk, &columns_buffers, &[], &[]));
+            steps.push(dispatch(MatcherStage::Winner, chunk, &winner_buffers, &[], &[]));
+        }
+        steps.push(dispatch(MatcherStage::Subpixel, &whole, &subpixel_buffers, &[], &[]));
+        steps.push(dispatch(MatcherStage::LrCheck, &whole, &check_buffers, &[], &[]));
+        steps.push(dispatch(MatcherStage::Median, &whole, &median_buffers, &[], &outputs));
+        // Memory rows are the images' top-down rows (the rule is symmetric in y): no flip.
+        let target = Target {
+            width: w,
+            height: h,
+            outputs: vec![Some(Format::R32F), Some(Format::R32F)],
+            rows: RowOrder::TopDown,
+            depth_test: None,
+        };
+        let mut out = self.device.run(Some(&target), &steps)?;
+        let missing = || Error::Gl("stereo matcher: a disparity output was not read back".into());
+        Ok((out.depth(0)?.ok_or_else(missing)?, out.depth(1)?.ok_or_else(missing)?))
+    }
+
+    /// Upload the pair (first time) or rewrite the images in place.
+    fn set_inputs(&mut self, left: &RgbImage, right: &RgbImage) -> Result<()> {
+        let (l, r) = (
+            crate::gpu::pixels::rgb_to_rgba(&left.data),
+            crate::gpu::pixels::rgb_to_rgba(&right.data),
+        );
+        if let Some(i) = &self.inputs {
+            self.device.write_image(&i.left, &l)?;
+            return self.device.write_image(&i.right, &r);
+        }
+        let upload = |bytes: &[u8], label| {
+            self.device.upload(&ImageData {
+                width: self.width,
+                height: self.height,
+                format: Format::Rgba8,
+                bytes,
+                label,
+            })
+        };
+        self.inputs = Some(Inputs {
+            left: upload(&l, "matcher left image")?,
+            right: upload(&r, "matcher right image")?,
+        });
+        Ok(())
+    }
+}
