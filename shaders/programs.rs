@@ -204,12 +204,6 @@ pub const PROGRAMS: &[ProgramEntry] = &[
         vulkan: Some(&[]),
     },
     ProgramEntry {
-        name: "cyclopean/matcher_cost",
-        stages: &[("comp", &[MATCHER_COMMON[0], MATCHER_COMMON[1], "cyclopean/matcher_cost.comp"])],
-        switches: &[],
-        vulkan: Some(&[]),
-    },
-    ProgramEntry {
         name: "cyclopean/matcher_rows",
         stages: &[("comp", &[MATCHER_COMMON[0], MATCHER_COMMON[1], "cyclopean/matcher_rows.comp"])],
         switches: &[],

@@ -106,9 +106,7 @@ pub enum StitchBlend {
 pub enum MatcherStage {
     /// Census codes of both eyes.
     Census,
-    /// Hamming costs of a chunk of disparities.
-    Cost,
-    /// The box's horizontal sums.
+    /// Hamming costs of a chunk of disparities and the box's horizontal sums.
     Rows,
     /// The box's vertical sums and the fixed-point means.
     Columns,
@@ -124,9 +122,8 @@ pub enum MatcherStage {
 
 impl MatcherStage {
     /// Every stage, in dispatch order.
-    pub const ALL: [MatcherStage; 8] = [
+    pub const ALL: [MatcherStage; 7] = [
         MatcherStage::Census,
-        MatcherStage::Cost,
         MatcherStage::Rows,
         MatcherStage::Columns,
         MatcherStage::Winner,
@@ -138,7 +135,6 @@ impl MatcherStage {
     fn program_name(self) -> &'static str {
         match self {
             MatcherStage::Census => "cyclopean/matcher_census",
-            MatcherStage::Cost => "cyclopean/matcher_cost",
             MatcherStage::Rows => "cyclopean/matcher_rows",
             MatcherStage::Columns => "cyclopean/matcher_columns",
             MatcherStage::Winner => "cyclopean/matcher_winner",

@@ -115,8 +115,7 @@ impl Matcher {
         let whole = params(0, 0);
         let ids = |b: &[&Buffer]| b.iter().map(|b| b.id()).collect::<Vec<_>>();
         let census_buffers = ids(&[&self.codes]);
-        let cost_buffers = ids(&[&self.codes, &self.costs]);
-        let rows_buffers = ids(&[&self.costs, &self.rows]);
+        let rows_buffers = ids(&[&self.codes, &self.rows]);
         let columns_buffers = ids(&[&self.rows, &self.costs]);
         let winner_buffers = ids(&[&self.costs, &self.winners[0], &self.winners[1]]);
         let subpixel_buffers = ids(&[&self.winners[0], &self.winners[1], &self.raw]);
@@ -124,27 +123,57 @@ impl Matcher {
         let median_buffers = ids(&[&self.checked]);
         let images = [inputs.left.id(), inputs.right.id()];
         let outputs = [StorageImage::Output(0), StorageImage::Output(1)];
-        let groups = Groups::Fixed([w.div_ceil(8), h.div_ceil(8)]);
-        let dispatch = |stage, block, buffers, images, storage_images| {
-            Step::Dispatch(Dispatch {
-                program: ShaderProgram::new(Default::default(), ProgramKind::CyclopeanMatcher(stage)),
-                params: bytemuck::bytes_of(block),
-                images,
-                storage_images,
-                buffers,
-                groups,
-            })
+        let pixels = Groups::Fixed([w.div_ceil(8), h.div_ceil(8)]);
+        let dispatch = |stage, block, buffers, groups| Dispatch {
+            program: ShaderProgram::new(Default::default(), ProgramKind::CyclopeanMatcher(stage)),
+            params: bytemuck::bytes_of(block),
+            images: &[],
+            storage_images: &[],
+            buffers,
+            groups,
         };
-        let mut steps = vec![dispatch(MatcherStage::Census, &whole, &census_buffers, &images, &[])];
+        let mut steps = vec![Step::Dispatch(Dispatch {
+            images: &images,
+            ..dispatch(MatcherStage::Census, &whole, &census_buffers, pixels)
+        })];
         for chunk in &chunks {
-            steps.push(dispatch(MatcherStage::Cost, chunk, &cost_buffers, &[], &[]));
-            steps.push(dispatch(MatcherStage::Rows, chunk, &rows_buffers, &[], &[]));
-            steps.push(dispatch(MatcherStage::Columns, chunk, &columns_buffers, &[], &[]));
-            steps.push(dispatch(MatcherStage::Winner, chunk, &winner_buffers, &[], &[]));
+            // Rows and columns: one invocation per row (column) and disparity pair.
+            let lines = |n: u32| Groups::Fixed([n.div_ceil(8), (chunk.u_pairs as u32).div_ceil(8)]);
+            steps.push(Step::Dispatch(dispatch(
+                MatcherStage::Rows,
+                chunk,
+                &rows_buffers,
+                lines(h),
+            )));
+            steps.push(Step::Dispatch(dispatch(
+                MatcherStage::Columns,
+                chunk,
+                &columns_buffers,
+                lines(w),
+            )));
+            steps.push(Step::Dispatch(dispatch(
+                MatcherStage::Winner,
+                chunk,
+                &winner_buffers,
+                pixels,
+            )));
         }
-        steps.push(dispatch(MatcherStage::Subpixel, &whole, &subpixel_buffers, &[], &[]));
-        steps.push(dispatch(MatcherStage::LrCheck, &whole, &check_buffers, &[], &[]));
-        steps.push(dispatch(MatcherStage::Median, &whole, &median_buffers, &[], &outputs));
+        steps.push(Step::Dispatch(dispatch(
+            MatcherStage::Subpixel,
+            &whole,
+            &subpixel_buffers,
+            pixels,
+        )));
+        steps.push(Step::Dispatch(dispatch(
+            MatcherStage::LrCheck,
+            &whole,
+            &check_buffers,
+            pixels,
+        )));
+        steps.push(Step::Dispatch(Dispatch {
+            storage_images: &outputs,
+            ..dispatch(MatcherStage::Median, &whole, &median_buffers, pixels)
+        }));
         // Memory rows are the images' top-down rows (the rule is symmetric in y): no flip.
         let target = Target {
             width: w,
