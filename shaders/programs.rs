@@ -198,6 +198,12 @@ pub const PROGRAMS: &[ProgramEntry] = &[
         vulkan: Some(&[]),
     },
     ProgramEntry {
+        name: "cyclopean/matcher_grey",
+        stages: &[("comp", &[MATCHER_COMMON[0], MATCHER_COMMON[1], "cyclopean/matcher_grey.comp"])],
+        switches: &[],
+        vulkan: Some(&[]),
+    },
+    ProgramEntry {
         name: "cyclopean/matcher_census",
         stages: &[("comp", &[MATCHER_COMMON[0], MATCHER_COMMON[1], "cyclopean/matcher_census.comp"])],
         switches: &[],

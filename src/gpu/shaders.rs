@@ -104,6 +104,8 @@ pub enum StitchBlend {
 /// in the order a run dispatches them.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum MatcherStage {
+    /// Grey levels of both eyes.
+    Grey,
     /// Census codes of both eyes.
     Census,
     /// Hamming costs of a chunk of disparities and the box's horizontal sums.
@@ -122,7 +124,8 @@ pub enum MatcherStage {
 
 impl MatcherStage {
     /// Every stage, in dispatch order.
-    pub const ALL: [MatcherStage; 7] = [
+    pub const ALL: [MatcherStage; 8] = [
+        MatcherStage::Grey,
         MatcherStage::Census,
         MatcherStage::Rows,
         MatcherStage::Columns,
@@ -134,6 +137,7 @@ impl MatcherStage {
 
     fn program_name(self) -> &'static str {
         match self {
+            MatcherStage::Grey => "cyclopean/matcher_grey",
             MatcherStage::Census => "cyclopean/matcher_census",
             MatcherStage::Rows => "cyclopean/matcher_rows",
             MatcherStage::Columns => "cyclopean/matcher_columns",

@@ -40,10 +40,12 @@ pub struct Matcher {
     /// Disparity pairs (16-bit lanes of one word) per chunk.
     chunk_pairs: u32,
     inputs: Option<Inputs>,
+    /// Both eyes' grey levels, one word a pixel.
+    greys: Buffer,
     /// Census codes, 4 words a pixel.
     codes: Buffer,
-    /// A chunk's costs, then its means.
-    costs: Buffer,
+    /// A chunk's fixed-point means.
+    means: Buffer,
     /// A chunk's row sums.
     rows: Buffer,
     /// Each eye's winner so far, 3 words a pixel.
@@ -66,8 +68,9 @@ impl Matcher {
         let chunk_pairs = pairs.min((CHUNK_WORDS / n).max(1));
         let buffer = |words: usize, label: &str| device.create_buffer(words, label);
         Ok(Matcher {
+            greys: buffer(n, "matcher grey levels")?,
             codes: buffer(4 * n, "matcher census codes")?,
-            costs: buffer(chunk_pairs * n, "matcher costs")?,
+            means: buffer(chunk_pairs * n, "matcher means")?,
             rows: buffer(chunk_pairs * n, "matcher row sums")?,
             winners: [
                 buffer(3 * n, "matcher left winners")?,
@@ -114,10 +117,11 @@ impl Matcher {
             .collect();
         let whole = params(0, 0);
         let ids = |b: &[&Buffer]| b.iter().map(|b| b.id()).collect::<Vec<_>>();
-        let census_buffers = ids(&[&self.codes]);
+        let grey_buffers = ids(&[&self.greys]);
+        let census_buffers = ids(&[&self.greys, &self.codes]);
         let rows_buffers = ids(&[&self.codes, &self.rows]);
-        let columns_buffers = ids(&[&self.rows, &self.costs]);
-        let winner_buffers = ids(&[&self.costs, &self.winners[0], &self.winners[1]]);
+        let columns_buffers = ids(&[&self.rows, &self.means]);
+        let winner_buffers = ids(&[&self.means, &self.winners[0], &self.winners[1]]);
         let subpixel_buffers = ids(&[&self.winners[0], &self.winners[1], &self.raw]);
         let check_buffers = ids(&[&self.raw, &self.checked]);
         let median_buffers = ids(&[&self.checked]);
@@ -132,10 +136,13 @@ impl Matcher {
             buffers,
             groups,
         };
-        let mut steps = vec![Step::Dispatch(Dispatch {
-            images: &images,
-            ..dispatch(MatcherStage::Census, &whole, &census_buffers, pixels)
-        })];
+        let mut steps = vec![
+            Step::Dispatch(Dispatch {
+                images: &images,
+                ..dispatch(MatcherStage::Grey, &whole, &grey_buffers, pixels)
+            }),
+            Step::Dispatch(dispatch(MatcherStage::Census, &whole, &census_buffers, pixels)),
+        ];
         for chunk in &chunks {
             // Rows and columns: one invocation per row (column) and disparity pair.
             let lines = |n: u32| Groups::Fixed([n.div_ceil(8), (chunk.u_pairs as u32).div_ceil(8)]);
@@ -174,6 +181,13 @@ impl Matcher {
             storage_images: &outputs,
             ..dispatch(MatcherStage::Median, &whole, &median_buffers, pixels)
         }));
+        if let Ok(v) = std::env::var("TMP_MATCHER_SKIP") {
+            let skip: Vec<String> = v.split(',').map(String::from).collect();
+            steps.retain(|s| match s {
+                Step::Dispatch(d) => !skip.iter().any(|k| d.program.kind.name().ends_with(k.as_str())),
+                _ => true,
+            });
+        }
         // Memory rows are the images' top-down rows (the rule is symmetric in y): no flip.
         let target = Target {
             width: w,

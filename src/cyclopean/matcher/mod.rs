@@ -22,14 +22,15 @@
 //! - [`reference`]: the CPU twin, one slice of the cost volume at a time by prefix sums (memory
 //!   O(w h); Cones 450 x 375 with 65 disparities in a fraction of a second).
 //! - [`Matcher`] ([`gpu`]): the GPU pass on either executor, one compute dispatch per stage
-//!   (shaders/cyclopean/matcher_*.comp): census codes; per chunk of disparities (so the buffers
-//!   stay within every API's storage-buffer limit at any size) the Hamming costs two disparities
-//!   a word in 16-bit lanes, the box's row sums, its column sums and fixed-point means, and the
-//!   winners of both eyes carried from chunk to chunk; then the sub-pixel step, the left-right
-//!   check and the median, written to the two output images. At 720p and above it dominates a
-//!   frame's time on the CPU, hence the pass.
+//!   (shaders/cyclopean/matcher_*.comp): grey levels, census codes; per chunk of disparities (so the buffers
+//!   stay within every API's storage-buffer limit at any size) the Hamming costs summed along
+//!   each row by a sliding window, two disparities a word in 16-bit lanes, then down each
+//!   column into the fixed-point means, and the winners of both eyes carried from chunk to
+//!   chunk; then the sub-pixel step, the left-right check and the median, stored into the run's
+//!   two outputs. At 720p and above the CPU twin dominates a frame's time, hence the pass.
 //!
-//! Every stage is exact on the GPU: the costs, sums and means are integers; the parabola's
+//! Every stage is exact on the GPU: the costs, sums and means are integers (a mean's division
+//! is a float quotient corrected by integer tests); the parabola's
 //! quotient is rebuilt from integers correctly rounded (GLSL's own division may be 2.5 ulp off);
 //! the rest are single f32 additions, subtractions, comparisons and moves, which GLSL rounds as
 //! the CPU does. So the GPU's disparities are the twin's bit for bit
