@@ -181,13 +181,6 @@ impl Matcher {
             storage_images: &outputs,
             ..dispatch(MatcherStage::Median, &whole, &median_buffers, pixels)
         }));
-        if let Ok(v) = std::env::var("TMP_MATCHER_SKIP") {
-            let skip: Vec<String> = v.split(',').map(String::from).collect();
-            steps.retain(|s| match s {
-                Step::Dispatch(d) => !skip.iter().any(|k| d.program.kind.name().ends_with(k.as_str())),
-                _ => true,
-            });
-        }
         // Memory rows are the images' top-down rows (the rule is symmetric in y): no flip.
         let target = Target {
             width: w,
