@@ -246,6 +246,12 @@ pub const PROGRAMS: &[ProgramEntry] = &[
         vulkan: Some(&[]),
     },
     ProgramEntry {
+        name: "cyclopean/matcher_confidence",
+        stages: &[("comp", &[MATCHER_COMMON[0], MATCHER_COMMON[1], "cyclopean/matcher_confidence.comp"])],
+        switches: &[],
+        vulkan: Some(&[]),
+    },
+    ProgramEntry {
         name: "reproject/shift",
         stages: &[
             ("vert", FULLSCREEN_VERT),

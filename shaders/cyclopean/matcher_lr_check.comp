@@ -1,5 +1,5 @@
 // Left-right consistency (the twin's `left_right_check`): an eye's disparity is kept where the
-// other eye's, read at the pixel it points to (rounded half away from zero, as Rust's `round`),
+// other eye's, read at the pixel it points to (round_half_away, matcher_params.glsl),
 // is known and within LR_TOLERANCE_PX; 0 elsewhere. The sums and differences are single f32
 // operations, correctly rounded in GLSL as on the CPU, so the decisions are the twin's.
 layout(std430, STORAGE_BUFFER(0)) readonly buffer Raw {
@@ -8,14 +8,6 @@ layout(std430, STORAGE_BUFFER(0)) readonly buffer Raw {
 layout(std430, STORAGE_BUFFER(1)) writeonly buffer Checked {
     float checked[];
 };
-
-// Rust's f32::round: to the nearest integer, halves away from zero (GLSL's round leaves the
-// halves to the implementation). r + 0.5 is exact below 2^22, so the comparisons are exact.
-float round_half_away(float v) {
-    float r = floor(v);
-    float half_up = r + 0.5;
-    return (v > half_up || (v == half_up && v >= 0.0)) ? r + 1.0 : r;
-}
 
 // Eye `own` (0 left, 1 right) at pixel p: its disparity points to x + sign d in the other eye.
 float checked_disparity(int own, ivec2 p, float sign) {

@@ -5,6 +5,9 @@
 layout(std430, STORAGE_BUFFER(0)) readonly buffer Checked {
     float checked[];  // left eye, then right eye
 };
+layout(std430, STORAGE_BUFFER(1)) writeonly buffer Final {
+    float final_disparity[];  // the outputs again, for the confidence stage
+};
 layout(r32f, STORAGE_IMAGE(0)) writeonly uniform image2D u_left_disparity;
 layout(r32f, STORAGE_IMAGE(1)) writeonly uniform image2D u_right_disparity;
 
@@ -40,6 +43,11 @@ void main() {
     if (p.x < 0) {
         return;
     }
-    imageStore(u_left_disparity, p, vec4(median_of_known(0, p), 0.0, 0.0, 0.0));
-    imageStore(u_right_disparity, p, vec4(median_of_known(pixels(), p), 0.0, 0.0, 0.0));
+    float l = median_of_known(0, p);
+    float r = median_of_known(pixels(), p);
+    int i = p.y * u_size.x + p.x;
+    final_disparity[i] = l;
+    final_disparity[pixels() + i] = r;
+    imageStore(u_left_disparity, p, vec4(l, 0.0, 0.0, 0.0));
+    imageStore(u_right_disparity, p, vec4(r, 0.0, 0.0, 0.0));
 }

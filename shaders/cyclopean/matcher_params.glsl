@@ -28,3 +28,11 @@ ivec2 this_pixel() {
     ivec2 p = ivec2(gl_GlobalInvocationID.xy);
     return any(greaterThanEqual(p, u_size)) ? ivec2(-1) : p;
 }
+
+// Rust's f32::round: to the nearest integer, halves away from zero (GLSL's round leaves the
+// halves to the implementation). r + 0.5 is exact below 2^22, so the comparisons are exact.
+float round_half_away(float v) {
+    float r = floor(v);
+    float half_up = r + 0.5;
+    return (v > half_up || (v == half_up && v >= 0.0)) ? r + 1.0 : r;
+}

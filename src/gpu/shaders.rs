@@ -120,11 +120,13 @@ pub enum MatcherStage {
     LrCheck,
     /// The 3 x 3 median of the known values.
     Median,
+    /// Each eye's confidence in its final disparity (where asked for).
+    Confidence,
 }
 
 impl MatcherStage {
     /// Every stage, in dispatch order.
-    pub const ALL: [MatcherStage; 8] = [
+    pub const ALL: [MatcherStage; 9] = [
         MatcherStage::Grey,
         MatcherStage::Census,
         MatcherStage::Rows,
@@ -133,6 +135,7 @@ impl MatcherStage {
         MatcherStage::Subpixel,
         MatcherStage::LrCheck,
         MatcherStage::Median,
+        MatcherStage::Confidence,
     ];
 
     fn program_name(self) -> &'static str {
@@ -145,6 +148,7 @@ impl MatcherStage {
             MatcherStage::Subpixel => "cyclopean/matcher_subpixel",
             MatcherStage::LrCheck => "cyclopean/matcher_lr_check",
             MatcherStage::Median => "cyclopean/matcher_median",
+            MatcherStage::Confidence => "cyclopean/matcher_confidence",
         }
     }
 }

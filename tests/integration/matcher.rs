@@ -1,6 +1,7 @@
 //! The census stereo matcher (src/cyclopean/matcher/): the GPU pass against its CPU twin on real
 //! pairs (Tsukuba, Cones) and on a 720p synthetic pair whose cost volume takes two chunks, on GL
-//! and, with the `vulkan` feature, on Vulkan.
+//! and, with the `vulkan` feature, on Vulkan; and its confidence stage against its twin (bound
+//! beside `CONFIDENCE_BOUND`).
 //!
 //! Bound, from the numerics: none; the GPU's disparities are the twin's bit for bit. Census
 //! codes, Hamming costs, box sums and the fixed-point means are integers (exact); the winner is
@@ -15,7 +16,7 @@
 //! both disparity maps and their difference are written (eval::image_check).
 
 use crate::common::{data_dir, gpu};
-use viewsynth::cyclopean::matcher::{estimate_disparities, Matcher};
+use viewsynth::cyclopean::matcher::{confidence_reference, estimate_disparities, Matcher};
 use viewsynth::eval::image_check::{ensure, Plane};
 use viewsynth::io::{load_rgb, DepthMap, RgbImage};
 use viewsynth::pass::Device;
@@ -75,7 +76,49 @@ fn real_pairs(device: &Device, api: &str) {
     let (left, right) = pair("middlebury2003_cones", "im2.png", "im6.png");
     let twin = estimate_disparities(&left, &right, 64).unwrap();
     let mut matcher = Matcher::new(device, left.width, left.height, 64).unwrap();
-    check(&format!("{api} Cones"), matcher.estimate(&left, &right).unwrap(), &twin);
+    let [l, r] = matcher.estimate_with_confidence(&left, &right).unwrap();
+    check(&format!("{api} Cones"), (l.disparity, r.disparity), &twin);
+    check_confidence(&format!("{api} Cones"), (&l.confidence, &r.confidence), &twin);
+}
+
+/// Bound on |confidence_gpu - confidence_twin|, from the numerics: the GPU's decisions (which
+/// pixel is read, whether the eyes agree within 1 px) are f32 operations the twin repeats in f32,
+/// so the same pixels are 0. The value `(1 - |d - e|) / (1 + variance)` over at most 9 known
+/// disparities below 2^7 px: the f32 mean is off by at most ~9 x 2^7 x 2^-24 < 7e-5 px (plus
+/// GLSL's 2.5 ulp division), so each squared deviation by 2 |v - m| 7e-5 and the variance by
+/// about 1.4e-4 sqrt(variance) plus its own rounding (a few 2^-24 relative); divided by
+/// (1 + variance)^2 that moves the confidence by at most 1.4e-4 x max sqrt(v) / (1 + v)^2
+/// (0.33 at v = 1/3) < 5e-5, and the agreement's f32 difference by 2^-24. So 1e-4.
+const CONFIDENCE_BOUND: f32 = 1e-4;
+
+fn check_confidence(what: &str, gpu: (&DepthMap, &DepthMap), twin_maps: &(DepthMap, DepthMap)) {
+    let twin = confidence_reference(&twin_maps.0, &twin_maps.1).unwrap();
+    for (eye, g, t) in [("left", gpu.0, &twin.0), ("right", gpu.1, &twin.1)] {
+        let zero = g
+            .data
+            .iter()
+            .zip(&t.data)
+            .filter(|(a, b)| (**a == 0.0) != (**b == 0.0))
+            .count();
+        let worst = g
+            .data
+            .iter()
+            .zip(&t.data)
+            .map(|(a, b)| (a - b).abs())
+            .fold(0.0f32, f32::max);
+        let trusted = t.data.iter().filter(|c| **c > 0.5).count();
+        let name = format!("matcher confidence {what} {eye}");
+        ensure(
+            zero == 0 && worst <= CONFIDENCE_BOUND,
+            &name,
+            t.width,
+            t.height,
+            &[("confidence", Plane::Depth(&g.data), Plane::Depth(&t.data))],
+            format!("{name}: zero on {zero} pixels of one side only, values off by up to {worst:e} (bound {CONFIDENCE_BOUND:e})"),
+        );
+        assert!(trusted * 2 > t.data.len(), "{name}: only {trusted} pixels above 0.5");
+        println!("{name}: {trusted} pixels above 0.5, worst difference {worst:e}");
+    }
 }
 
 #[test]

@@ -9,7 +9,9 @@ use crate::error::{Error, Result};
 use crate::gpu::shaders::MatcherStage;
 use crate::gpu::{ProgramKind, ShaderProgram};
 use crate::io::{DepthMap, RgbImage};
-use crate::pass::{Buffer, Device, Dispatch, Format, Groups, Image, ImageData, Step, StorageImage, Target, ToDevice};
+use crate::pass::{
+    Buffer, Device, Dispatch, Format, Groups, Image, ImageData, Rendered, Step, StorageImage, Target, ToDevice,
+};
 
 crate::param_block! {
     /// Every matcher stage's parameters: shaders/cyclopean/matcher_params.glsl, member for member.
@@ -24,6 +26,21 @@ crate::param_block! {
 /// Words a chunk buffer holds at most (64 MiB): under GL's guaranteed-in-practice storage-block
 /// size (llvmpipe: 128 MiB) and Vulkan's storage-buffer range on the devices we run.
 const CHUNK_WORDS: usize = 1 << 24;
+
+/// One eye of [`Matcher::estimate_with_confidence`].
+#[derive(Debug, Clone)]
+pub struct EyeEstimate {
+    /// Disparity in pixels, 0 = unknown (as [`Matcher::estimate`] gives it).
+    pub disparity: DepthMap,
+    /// Confidence in it, in [0, 1]; 0 where it is unknown.
+    pub confidence: DepthMap,
+}
+
+/// Output `k` of a run, read back as a map.
+fn disparity(out: &mut Rendered, k: usize) -> Result<DepthMap> {
+    out.depth(k)?
+        .ok_or_else(|| Error::Gl(format!("stereo matcher: output {k} was not read back")))
+}
 
 /// The pair's images on the device, rewritten for each pair.
 struct Inputs {
@@ -90,6 +107,26 @@ impl Matcher {
     /// Disparities of the left and right eye of `left` and `right` (the matcher's size), as
     /// [`super::estimate_disparities`] gives them, bit for bit.
     pub fn estimate(&mut self, left: &RgbImage, right: &RgbImage) -> Result<(DepthMap, DepthMap)> {
+        let mut out = self.run(left, right, false)?;
+        Ok((disparity(&mut out, 0)?, disparity(&mut out, 1)?))
+    }
+
+    /// [`Matcher::estimate`] with each eye's confidence in its disparities (in [0, 1], 0 where
+    /// unknown; [`super::confidence`] holds the rule and the twin).
+    pub fn estimate_with_confidence(&mut self, left: &RgbImage, right: &RgbImage) -> Result<[EyeEstimate; 2]> {
+        let mut out = self.run(left, right, true)?;
+        let mut eye = |k: usize| -> Result<EyeEstimate> {
+            Ok(EyeEstimate {
+                disparity: disparity(&mut out, k)?,
+                confidence: disparity(&mut out, 2 + k)?,
+            })
+        };
+        Ok([eye(0)?, eye(1)?])
+    }
+
+    /// One run of every stage (and the confidence where asked for): outputs 0 and 1 the
+    /// disparities, 2 and 3 the confidences.
+    fn run(&mut self, left: &RgbImage, right: &RgbImage, confidence: bool) -> Result<Rendered> {
         check_pair(left, right)?;
         let (w, h) = (self.width, self.height);
         if (left.width, left.height) != (w, h) {
@@ -124,9 +161,12 @@ impl Matcher {
         let winner_buffers = ids(&[&self.means, &self.winners[0], &self.winners[1]]);
         let subpixel_buffers = ids(&[&self.winners[0], &self.winners[1], &self.raw]);
         let check_buffers = ids(&[&self.raw, &self.checked]);
-        let median_buffers = ids(&[&self.checked]);
+        // The median stores the final disparities into `raw` too (free after the check).
+        let median_buffers = ids(&[&self.checked, &self.raw]);
+        let confidence_buffers = ids(&[&self.raw]);
         let images = [inputs.left.id(), inputs.right.id()];
         let outputs = [StorageImage::Output(0), StorageImage::Output(1)];
+        let confidence_outputs = [StorageImage::Output(2), StorageImage::Output(3)];
         let pixels = Groups::Fixed([w.div_ceil(8), h.div_ceil(8)]);
         let dispatch = |stage, block, buffers, groups| Dispatch {
             program: ShaderProgram::new(Default::default(), ProgramKind::CyclopeanMatcher(stage)),
@@ -181,17 +221,21 @@ impl Matcher {
             storage_images: &outputs,
             ..dispatch(MatcherStage::Median, &whole, &median_buffers, pixels)
         }));
+        if confidence {
+            steps.push(Step::Dispatch(Dispatch {
+                storage_images: &confidence_outputs,
+                ..dispatch(MatcherStage::Confidence, &whole, &confidence_buffers, pixels)
+            }));
+        }
         // Memory rows are the images' top-down rows (the rule is symmetric in y): no flip.
         let target = Target {
             width: w,
             height: h,
-            outputs: vec![Some(Format::R32F), Some(Format::R32F)],
+            outputs: vec![Some(Format::R32F); if confidence { 4 } else { 2 }],
             rows: RowOrder::TopDown,
             depth_test: None,
         };
-        let mut out = self.device.run(Some(&target), &steps)?;
-        let missing = || Error::Gl("stereo matcher: a disparity output was not read back".into());
-        Ok((out.depth(0)?.ok_or_else(missing)?, out.depth(1)?.ok_or_else(missing)?))
+        self.device.run(Some(&target), &steps)
     }
 
     /// Upload the pair (first time) or rewrite the images in place.

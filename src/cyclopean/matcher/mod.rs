@@ -36,14 +36,19 @@
 //! the CPU does. So the GPU's disparities are the twin's bit for bit
 //! (tests/integration/matcher.rs).
 //!
+//! [`confidence`]: per pixel, how far to trust each eye's disparity (the eyes' agreement and the
+//! local spread), a further stage ([`Matcher::estimate_with_confidence`]) with its twin.
+//!
 //! Conventions as [`crate::cyclopean::disparity_frame`]: the left disparity maps x_left to
 //! x_right = x_left - d, the right one x_right to x_left = x_right + d; 0 = unknown. Images and
 //! disparities have top-down rows.
 
+pub mod confidence;
 pub mod gpu;
 pub mod reference;
 
-pub use gpu::Matcher;
+pub use confidence::confidence_reference;
+pub use gpu::{EyeEstimate, Matcher};
 pub use reference::estimate_disparities;
 
 use crate::error::{Error, Result};
