@@ -19,7 +19,7 @@
 //! - A 3 x 3 median over the known values of each known pixel (unknown pixels stay unknown).
 //!
 //! Two implementations of that one rule:
-//! - [`reference`]: the CPU twin, one slice of the cost volume at a time by prefix sums (memory
+//! - [`reference`](mod@reference): the CPU twin, one slice of the cost volume at a time by prefix sums (memory
 //!   O(w h); Cones 450 x 375 with 65 disparities in a fraction of a second).
 //! - [`Matcher`] ([`gpu`]): the GPU pass on either executor, one compute dispatch per stage
 //!   (shaders/cyclopean/matcher_*.comp): grey levels, census codes; per chunk of disparities (so the buffers
