@@ -172,6 +172,10 @@ fn matcher_refuses_a_pair_of_another_size_and_a_bad_range() {
         Matcher::new(&g, 64, 32, 64),
         Err(viewsynth::Error::InvalidParameter { .. })
     ));
+    assert!(matches!(
+        Matcher::new(&g, 4096, 4096, 64),
+        Err(viewsynth::Error::InvalidParameter { .. })
+    ));
     let mut m = Matcher::new(&g, 64, 32, 8).unwrap();
     let img = |w: u32| RgbImage::new(w, 32, vec![7; 3 * w as usize * 32]).unwrap();
     assert!(matches!(

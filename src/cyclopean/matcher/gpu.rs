@@ -42,6 +42,10 @@ fn disparity(out: &mut Rendered, k: usize) -> Result<DepthMap> {
         .ok_or_else(|| Error::Gl(format!("stereo matcher: output {k} was not read back")))
 }
 
+/// Largest pair the pass takes (8 Mpx, 4K UHD fits): its census codes (4 words a pixel) then
+/// fill 128 MiB, llvmpipe's storage-block limit and the smallest we run on.
+pub const MAX_PIXELS: usize = 1 << 23;
+
 /// The pair's images on the device, rewritten for each pair.
 struct Inputs {
     left: Image,
@@ -75,12 +79,18 @@ pub struct Matcher {
 impl Matcher {
     /// A matcher for `width` x `height` pairs searching 0..=`max_disparity` px, on `device` (a
     /// [`Device`], or a GL context). Fails as [`super::estimate_disparities`] does on the range,
-    /// and on a size the device cannot hold.
+    /// and on a size the device cannot hold or above [`MAX_PIXELS`].
     pub fn new(device: impl ToDevice, width: u32, height: u32, max_disparity: u32) -> Result<Self> {
         check_range(width, max_disparity)?;
         let device = device.to_device()?;
         device.check_image_size("stereo pair", width, height)?;
         let n = width as usize * height as usize;
+        if n > MAX_PIXELS {
+            return Err(Error::param(
+                "stereo pair",
+                format!("{width}x{height}: the GPU matcher takes at most {MAX_PIXELS} pixels"),
+            ));
+        }
         let pairs = (max_disparity as usize + 1).div_ceil(2);
         let chunk_pairs = pairs.min((CHUNK_WORDS / n).max(1));
         let buffer = |words: usize, label: &str| device.create_buffer(words, label);
