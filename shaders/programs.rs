@@ -40,6 +40,8 @@ const SPLAT_GATHER_COMMON: [&str; 5] = [
     "cyclopean/edge_list.glsl",
     "cyclopean/splat_gather.glsl",
 ];
+/// Every stage of the census matcher: storage bindings, then the shared block and constants.
+const MATCHER_COMMON: [&str; 2] = ["common/bindings.glsl", "cyclopean/matcher_params.glsl"];
 
 pub const PROGRAMS: &[ProgramEntry] = &[
     ProgramEntry {
@@ -192,6 +194,60 @@ pub const PROGRAMS: &[ProgramEntry] = &[
     ProgramEntry {
         name: "cyclopean/edge_snap",
         stages: &[("comp", &["common/bindings.glsl", "cyclopean/edge_snap.comp"])],
+        switches: &[],
+        vulkan: Some(&[]),
+    },
+    ProgramEntry {
+        name: "cyclopean/matcher_grey",
+        stages: &[("comp", &[MATCHER_COMMON[0], MATCHER_COMMON[1], "cyclopean/matcher_grey.comp"])],
+        switches: &[],
+        vulkan: Some(&[]),
+    },
+    ProgramEntry {
+        name: "cyclopean/matcher_census",
+        stages: &[("comp", &[MATCHER_COMMON[0], MATCHER_COMMON[1], "cyclopean/matcher_census.comp"])],
+        switches: &[],
+        vulkan: Some(&[]),
+    },
+    ProgramEntry {
+        name: "cyclopean/matcher_rows",
+        stages: &[("comp", &[MATCHER_COMMON[0], MATCHER_COMMON[1], "cyclopean/matcher_rows.comp"])],
+        switches: &[],
+        vulkan: Some(&[]),
+    },
+    ProgramEntry {
+        name: "cyclopean/matcher_columns",
+        stages: &[("comp", &[MATCHER_COMMON[0], MATCHER_COMMON[1], "cyclopean/matcher_columns.comp"])],
+        switches: &[],
+        vulkan: Some(&[]),
+    },
+    ProgramEntry {
+        name: "cyclopean/matcher_winner",
+        stages: &[("comp", &[MATCHER_COMMON[0], MATCHER_COMMON[1], "cyclopean/matcher_winner.comp"])],
+        switches: &[],
+        vulkan: Some(&[]),
+    },
+    ProgramEntry {
+        name: "cyclopean/matcher_subpixel",
+        stages: &[("comp", &[MATCHER_COMMON[0], MATCHER_COMMON[1], "cyclopean/matcher_subpixel.comp"])],
+        switches: &[],
+        vulkan: Some(&[]),
+    },
+    ProgramEntry {
+        name: "cyclopean/matcher_lr_check",
+        stages: &[("comp", &[MATCHER_COMMON[0], MATCHER_COMMON[1], "cyclopean/matcher_lr_check.comp"])],
+        switches: &[],
+        vulkan: Some(&[]),
+    },
+    ProgramEntry {
+        name: "cyclopean/matcher_median",
+        stages: &[("comp", &[MATCHER_COMMON[0], MATCHER_COMMON[1], "cyclopean/matcher_median.comp"])],
+        switches: &[],
+        vulkan: Some(&[]),
+    },
+    ProgramEntry {
+        name: "cyclopean/matcher_confidence",
+        stages: &[("comp", &[MATCHER_COMMON[0], MATCHER_COMMON[1], "cyclopean/matcher_confidence.comp"])],
         switches: &[],
         vulkan: Some(&[]),
     },

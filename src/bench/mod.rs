@@ -4,6 +4,7 @@
 //! whole job with file writing. Printed as a Markdown table; nothing here asserts a time.
 
 pub mod batch;
+pub mod matcher;
 pub mod vulkan;
 
 use crate::convention::Conventions;
@@ -209,8 +210,34 @@ pub fn cyclopean_bench(
         |r| r.render(&mid),
     )?;
     record(crate::eval::cyclopean::SPLAT_NAME, splat);
+    // The census matcher on a pair of this size: what a user without disparities pays before
+    // any of the methods above (GPU pass, then its CPU twin as the baseline).
+    let (left, right, _) = matcher::synthetic_pair(width, height)?;
+    let max_d = MATCHER_BENCH_MAX_DISPARITY;
+    let on_gpu = setup_and_median(
+        repeats,
+        || crate::cyclopean::matcher::Matcher::new(gpu, width, height, max_d),
+        |m| m.estimate(&left, &right),
+    )?;
+    record(
+        &format!("census matcher, GPU pass (both eyes, search 0-{max_d} px)"),
+        on_gpu,
+    );
+    let on_cpu = setup_and_median(
+        repeats.min(3),
+        || Ok(()),
+        |_| crate::cyclopean::matcher::estimate_disparities(&left, &right, max_d),
+    )?;
+    record(
+        &format!("census matcher, CPU twin (1 thread, both eyes, search 0-{max_d} px)"),
+        on_cpu,
+    );
     Ok(t)
 }
+
+/// The matcher rows' search range at 720p: a tenth of the row (the report searches 64 px of the
+/// 450 px Middlebury rows); the synthetic pair's disparities (20 and 60 px) lie inside.
+pub const MATCHER_BENCH_MAX_DISPARITY: u32 = 128;
 
 /// The stitch table's heading, naming the number of timed runs its medians are of.
 fn stitch_table_head(renderer: &str, trace_ms: f64, setup_ms: f64, repeats: usize) -> String {

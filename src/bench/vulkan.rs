@@ -98,8 +98,9 @@ fn both<'a>(
 
 /// Every pass on both APIs from one run, same inputs, render + readback, medians of `repeats`
 /// after a warm-up (pipelines, targets): refocus (5 focal scales a frame), cyclopean seed,
-/// refine, splat-gather and forward warp, reproject shift, shift-scan and 3-D gather, stitch's three methods
-/// (one stereo equirect) and the scene ray tracer, at `width` x `height`. One Markdown table;
+/// refine, splat-gather and forward warp, the census stereo matcher (both eyes), reproject
+/// shift, shift-scan and 3-D gather, stitch's three methods (one stereo equirect) and the scene
+/// ray tracer, at `width` x `height`. One Markdown table;
 /// every case also goes to `cases` (`gl-<pass>`, `vulkan-<pass>`).
 pub fn passes_bench(
     gpu: &crate::gpu::Gpu,
@@ -209,6 +210,14 @@ pub fn passes_bench(
         Ok(Box::new(move || r.render(mid).map(drop)) as Frame)
     })?;
     row("cyclopean forward", ms, cases);
+    // The stereo matcher a user without disparities runs first (both eyes, search 0-64 px).
+    let (pair_l, pair_r, _) = crate::bench::matcher::synthetic_pair(width, height)?;
+    let ms = both(&devices, repeats, |d| {
+        let mut m = crate::cyclopean::matcher::Matcher::new(d, width, height, 64)?;
+        let (l, r) = (&pair_l, &pair_r);
+        Ok(Box::new(move || m.estimate(l, r).map(drop)) as Frame)
+    })?;
+    row("census stereo matcher (0-64 px)", ms, cases);
     for params in crate::eval::reproject::methods() {
         let ms = both(&devices, repeats, |d| {
             let mut r = Reprojector::new(d, &reproject_case.source, &reproject_case.geometry, params)?;

@@ -12,6 +12,8 @@
 //! - [`reference`](mod@reference): the f64 CPU twin; [`render`]: the GPU pass (shaders/cyclopean/gather.frag).
 //! - [`pass`]: the pass/twin contract, [`pass::gpu`] and [`pass::reference`] over one
 //!   [`CyclopeanInput`] (gather or splat), both returning a [`crate::view::ViewOutput`].
+//! - [`matcher`]: the census stereo matcher (GPU pass and CPU twin), for pairs without
+//!   ground-truth disparities.
 //! - [`scene_frame`]: a stereo frame of the built-in scene under any conventions, for tests,
 //!   the demo and the report.
 
@@ -23,6 +25,7 @@ pub mod edge_snap;
 pub mod fill;
 pub mod forward;
 pub mod frame_depth;
+pub mod matcher;
 pub mod pass;
 pub mod reference;
 pub mod render;

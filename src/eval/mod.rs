@@ -4,14 +4,11 @@
 //! - [`refocus`], [`cyclopean`], [`reproject`], [`stitch`]: each capability's report rows (and the
 //!   data set-ups its tests share), scored on the built-in scene (exact ray-traced truth) and on
 //!   real data.
-//! - [`block_match`]: a small deterministic census stereo matcher, so the cyclopean rows can
-//!   also run on estimated (not ground-truth) disparities.
 //! - [`image_check`]: compares a GPU image with its f64 twin and, on failure, writes both and
 //!   their difference as PNG under `target/` for a person to look at.
 //! - [`run_report`]: all rows into report.{md,csv,svg}.
 
 pub mod backends;
-pub mod block_match;
 pub mod cyclopean;
 pub mod image_check;
 pub mod refocus;

@@ -100,6 +100,59 @@ pub enum StitchBlend {
     Reproject,
 }
 
+/// The stages of the census stereo matcher (src/cyclopean/matcher/), one compute program each,
+/// in the order a run dispatches them.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum MatcherStage {
+    /// Grey levels of both eyes.
+    Grey,
+    /// Census codes of both eyes.
+    Census,
+    /// Hamming costs of a chunk of disparities and the box's horizontal sums.
+    Rows,
+    /// The box's vertical sums and the fixed-point means.
+    Columns,
+    /// Winner takes all over a chunk, both eyes.
+    Winner,
+    /// The parabola's sub-pixel step.
+    Subpixel,
+    /// The left-right consistency check.
+    LrCheck,
+    /// The 3 x 3 median of the known values.
+    Median,
+    /// Each eye's confidence in its final disparity (where asked for).
+    Confidence,
+}
+
+impl MatcherStage {
+    /// Every stage, in dispatch order.
+    pub const ALL: [MatcherStage; 9] = [
+        MatcherStage::Grey,
+        MatcherStage::Census,
+        MatcherStage::Rows,
+        MatcherStage::Columns,
+        MatcherStage::Winner,
+        MatcherStage::Subpixel,
+        MatcherStage::LrCheck,
+        MatcherStage::Median,
+        MatcherStage::Confidence,
+    ];
+
+    fn program_name(self) -> &'static str {
+        match self {
+            MatcherStage::Grey => "cyclopean/matcher_grey",
+            MatcherStage::Census => "cyclopean/matcher_census",
+            MatcherStage::Rows => "cyclopean/matcher_rows",
+            MatcherStage::Columns => "cyclopean/matcher_columns",
+            MatcherStage::Winner => "cyclopean/matcher_winner",
+            MatcherStage::Subpixel => "cyclopean/matcher_subpixel",
+            MatcherStage::LrCheck => "cyclopean/matcher_lr_check",
+            MatcherStage::Median => "cyclopean/matcher_median",
+            MatcherStage::Confidence => "cyclopean/matcher_confidence",
+        }
+    }
+}
+
 /// Every program of the crate with its compile-time switches.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum ProgramKind {
@@ -140,6 +193,8 @@ pub enum ProgramKind {
     CyclopeanEdgeSnap,
     /// cyclopean/fill.frag: holes filled from the background side (`--fill`).
     CyclopeanFill,
+    /// cyclopean/matcher_*.comp: one stage of the census stereo matcher (compute).
+    CyclopeanMatcher(MatcherStage),
     /// reproject/shift.frag: the row shift as a gather (walk, or the exact scan).
     ReprojectShift {
         /// How the stored source depth is read.
@@ -233,6 +288,7 @@ impl ProgramKind {
             ProgramKind::CyclopeanSplatEdges => "cyclopean/splat_edges",
             ProgramKind::CyclopeanEdgeSnap => "cyclopean/edge_snap",
             ProgramKind::CyclopeanFill => "cyclopean/fill",
+            ProgramKind::CyclopeanMatcher(stage) => stage.program_name(),
             ProgramKind::ReprojectShift { .. } => "reproject/shift",
             ProgramKind::SceneRaytrace => "scene/raytrace",
             ProgramKind::Stitch { .. } => "stitch/stitch",
@@ -262,6 +318,7 @@ impl ProgramKind {
             | ProgramKind::CyclopeanSplatEdges
             | ProgramKind::CyclopeanEdgeSnap
             | ProgramKind::CyclopeanFill
+            | ProgramKind::CyclopeanMatcher(_)
             | ProgramKind::SceneRaytrace => vec![],
             ProgramKind::ReprojectShift {
                 depth,
@@ -354,6 +411,7 @@ impl ShaderProgram {
             ProgramKind::CyclopeanFill,
             ProgramKind::SceneRaytrace,
         ]);
+        kinds.extend(MatcherStage::ALL.map(ProgramKind::CyclopeanMatcher));
         for depth in [ShiftDepth::ViewZ, ShiftDepth::Device, ShiftDepth::Disparity] {
             for scan in [false, true] {
                 for &scan_margin in switch_values("reproject/shift", "SCAN_MARGIN") {

@@ -240,7 +240,12 @@ impl Executor for GlExecutor {
         let fb = fb.map(|i| &self.targets[i].1);
         let mut timer = DeferredTimer::begin(&self.gpu);
         let mut pass = None;
-        let mut drawn = false;
+        if let (Some(fb), false) = (fb, steps.iter().any(|s| matches!(s, Step::Draw(_)))) {
+            // No draws (no kept triangles, or compute steps storing to the outputs): the target
+            // is still cleared, before the steps so that what they store survives.
+            drop(fb.begin_pass(DrawState::default(), 1.0));
+            self.gpu.memory_barrier(Barrier::All);
+        }
         for (k, step) in steps.iter().enumerate() {
             if k > 0 && !matches!((&steps[k - 1], step), (Step::Draw(_), Step::Draw(_))) {
                 // What earlier steps wrote, before this one reads it.
@@ -260,7 +265,6 @@ impl Executor for GlExecutor {
                             None => (DrawState::default(), 1.0),
                         };
                         pass = Some(fb.begin_pass(state, clear));
-                        drawn = true;
                     }
                     let p = &self.programs[programs[k].expect("built above")].1;
                     self.bind(p, (offsets[k], d.params.len()), d.images, d.buffers)?;
@@ -300,10 +304,6 @@ impl Executor for GlExecutor {
             }
         }
         drop(pass);
-        if let (Some(fb), false) = (fb, drawn) {
-            // No draws (e.g. no kept triangles): the target is still cleared before its readback.
-            drop(fb.begin_pass(DrawState::default(), 1.0));
-        }
         timer.end();
         self.gpu.check("pass steps")?;
         let reads = match (target, fb) {

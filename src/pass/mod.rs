@@ -98,7 +98,8 @@ pub enum StorageImage {
     /// A created image ([`Device::create_image`]).
     Image(ImageId),
     /// Output location `k` of the run's target, after its draws (e.g. a compute pass rewriting
-    /// some texels of the colour the draws wrote).
+    /// some texels of the colour the draws wrote), or, in a run without draws, after the clear
+    /// (a compute pass writing the outputs: the stereo matcher).
     Output(usize),
 }
 
@@ -290,7 +291,8 @@ pub trait Executor {
     /// [`Executor::free_buffer`].
     fn upload_indices(&mut self, indices: &[u32], label: &str) -> Result<BufferId>;
     /// Queue `steps` in order; the draws (at most one contiguous group) render into `target`,
-    /// whose attachments are cleared to 0 first, and its outputs are copied out asynchronously.
+    /// whose attachments are cleared to 0 first (without draws: before the first step, so
+    /// compute steps can store the outputs), and its outputs are copied out asynchronously.
     /// Returns without waiting; several runs may be in flight.
     fn submit(&mut self, target: Option<&Target>, steps: &[Step]) -> Result<Ticket>;
     /// Whether a submitted run has finished (never blocks).

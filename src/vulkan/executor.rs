@@ -769,7 +769,12 @@ impl VkExecutor {
                 }
             }
             let mut rendering = false;
-            let mut drawn = false;
+            if let (Some(targets), false) = (targets, steps.iter().any(|s| matches!(s, Step::Draw(_)))) {
+                // No draws (no kept triangles, or compute steps storing to the outputs): the
+                // target is still cleared, before the steps so that what they store survives.
+                targets.record_begin(cb, None);
+                targets.record_end_to_general(cb);
+            }
             for (k, step) in steps.iter().enumerate() {
                 let draw = matches!(step, Step::Draw(_));
                 if rendering && !draw {
@@ -810,7 +815,6 @@ impl VkExecutor {
                                     depth_image.map(|dpt| super::targets::depth_attachment(cb, dpt, clear_depth));
                                 targets.record_begin(cb, attachment.as_ref());
                                 rendering = true;
-                                drawn = true;
                             }
                             let (p, l) = chosen[k].expect("chosen above");
                             let [x, y, w, h] = draw.viewport;
@@ -873,11 +877,6 @@ impl VkExecutor {
             }
             if let Some(targets) = targets {
                 if rendering {
-                    targets.record_end_to_general(cb);
-                }
-                if !drawn {
-                    // No draws (e.g. no kept triangles): the target is still cleared.
-                    targets.record_begin(cb, None);
                     targets.record_end_to_general(cb);
                 }
                 full_barrier(d, cb);

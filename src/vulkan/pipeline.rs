@@ -208,7 +208,7 @@ mod tests {
         }
         // Under each of 8 conventions: refocus 3 x 2, gather 8, shift 6, stitch 3, ray tracer 1,
         // splat-gather's draw 1, forward warp 1 and fill 1 programs of 2 stages; splat, edge
-        // snap and edge pass 1 stage.
-        assert_eq!(found, ((6 + 8 + 6 + 3 + 1 + 1 + 1 + 1) * 2 + 3) * 8);
+        // snap, edge pass and the matcher's 9 stages 1 stage.
+        assert_eq!(found, ((6 + 8 + 6 + 3 + 1 + 1 + 1 + 1) * 2 + 3 + 9) * 8);
     }
 }

@@ -646,7 +646,7 @@ fn estimated_versus_splats(scene_prefix: &str) -> [Versus; 2] {
 }
 
 /// Issue 13's "generalises": the default's settings, unchanged, on real pairs whose disparities
-/// the census matcher (`viewsynth::eval::block_match`) estimated from the two images alone, the
+/// the census matcher (`viewsynth::cyclopean::matcher`) estimated from the two images alone, the
 /// cases and search ranges of the report's estimated rows; against both forward splats on the
 /// same disparities, on the pixels both cover, and covering at least as many pixels.
 ///

@@ -23,6 +23,7 @@ mod gpu_context;
 mod hostile;
 mod hostile_round3;
 mod limits;
+mod matcher;
 mod pass_contract;
 mod readback;
 mod refocus_accuracy;

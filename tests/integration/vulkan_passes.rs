@@ -90,6 +90,9 @@ fn every_parameter_block_has_the_layout_the_gl_compiler_reports() {
     check_block::<ForwardParams>(ProgramKind::CyclopeanForward);
     check_block::<RefocusParams>(ProgramKind::RefocusFullscreen { want_rgb: true });
     check_block::<viewsynth::cyclopean::fill::FillParams>(ProgramKind::CyclopeanFill);
+    for stage in viewsynth::gpu::shaders::MatcherStage::ALL {
+        check_block::<viewsynth::cyclopean::matcher::gpu::MatcherParams>(ProgramKind::CyclopeanMatcher(stage));
+    }
     check_block::<RefocusParams>(ProgramKind::RefocusMeshBoundary { want_rgb: true });
 }
 
@@ -279,6 +282,9 @@ fn a_steady_state_frame_creates_nothing_on_either_api() {
             viewsynth::reproject::render::Reprojector::new(d, &case.source, &case.geometry, methods()[0]).unwrap();
         let mut stitch = viewsynth::stitch::render::StitchRenderer::new(d, &left, &right).unwrap();
         let mut tracer = SceneRenderer::new(d, &scene).unwrap();
+        let mut matcher = viewsynth::cyclopean::matcher::Matcher::new(d, 64, 48, 8).unwrap();
+        // The first pair uploads the matcher's images; the frames below rewrite them.
+        drop(matcher.estimate(&frame.left.color, &frame.right.color).unwrap());
         let source = crate::common::synthetic(64, 48);
         let targets = viewsynth::refocus::manifest::TargetSpec {
             scales: vec![0.5, 1.0, 2.0],
@@ -308,6 +314,10 @@ fn a_steady_state_frame_creates_nothing_on_either_api() {
             ("reproject shift", Box::new(|| drop(shift.render().unwrap()))),
             ("stitch", Box::new(|| drop(stitch.render(&stitch_params).unwrap()))),
             ("ray tracer", Box::new(|| drop(tracer.render(&cam).unwrap()))),
+            (
+                "stereo matcher",
+                Box::new(|| drop(matcher.estimate(&frame.left.color, &frame.right.color).unwrap())),
+            ),
             (
                 // The batch's frame: a new source of the same size, every target in flight at once.
                 "refocus batch frame",
@@ -668,28 +678,44 @@ fn every_vulkan_pass_runs_clean_under_the_validation_layer() {
     filled[2] = "splat-gather".into();
     filled.push("--fill".into());
     runs.push(filled);
-    for (k, args) in runs.iter().enumerate() {
-        let out = dir.join(format!("run{k}"));
-        let o = bin()
-            .args(args)
-            .args(["--backend", "vulkan", "--out-dir"])
-            .arg(&out)
+    let under_layer = |command: &mut std::process::Command| {
+        command
             .env("VK_INSTANCE_LAYERS", "VK_LAYER_KHRONOS_validation")
             .env("VK_LOADER_DEBUG", "layer")
             .output()
-            .unwrap();
+            .unwrap()
+    };
+    let assert_clean = |what: &dyn std::fmt::Debug, o: std::process::Output| {
         let text = format!(
             "{}{}",
             String::from_utf8_lossy(&o.stdout),
             String::from_utf8_lossy(&o.stderr)
         );
-        assert!(o.status.success(), "{args:?}: {text}");
+        assert!(o.status.success(), "{what:?}: {text}");
         assert!(
             text.contains("Insert instance layer \"VK_LAYER_KHRONOS_validation\""),
-            "{args:?}: the validation layer was not loaded (install vulkan-validationlayers):\n{text}"
+            "{what:?}: the validation layer was not loaded (install vulkan-validationlayers):\n{text}"
         );
         for bad in ["Validation Error", "VUID-", "Validation Warning"] {
-            assert!(!text.contains(bad), "{args:?}: {bad}:\n{text}");
+            assert!(!text.contains(bad), "{what:?}: {bad}:\n{text}");
         }
+        text
+    };
+    for (k, args) in runs.iter().enumerate() {
+        let out = dir.join(format!("run{k}"));
+        let o = under_layer(bin().args(args).args(["--backend", "vulkan", "--out-dir"]).arg(&out));
+        assert_clean(args, o);
     }
+    // The stereo matcher has no command of its own: its Vulkan test (real pairs, one matcher
+    // reused across two pairs) runs again in a child of this test binary, under the layer.
+    let test = "matcher::matcher_gpu_pass_is_its_twin_on_real_pairs_on_vulkan";
+    let o = under_layer(std::process::Command::new(std::env::current_exe().unwrap()).args([
+        test,
+        "--exact",
+        "--nocapture",
+        "--test-threads",
+        "1",
+    ]));
+    let text = assert_clean(&test, o);
+    assert!(text.contains("1 passed"), "{test} did not run:\n{text}");
 }

@@ -1,39 +1,12 @@
-//! A small dense stereo matcher for rectified pairs, so that the report can score the middle-view
-//! methods on *estimated* disparities (issue 13: the default must beat the splat baseline on real
-//! pairs without ground truth too), the way a user without a structured-light scan would run them.
-//!
-//! Design: deliberately plain and deterministic (integer costs, fixed tie rule, no tuning per
-//! scene), so that what the report measures is the view-synthesis methods, not a clever matcher.
-//! - Census transform over a 7 x 5 window of grey = r + g + b (34 bits: neighbour darker than the
-//!   centre), borders replicated: robust to the exposure differences between real views.
-//! - Cost: Hamming distance of the census codes, left pixel x against right pixel x - d.
-//! - Aggregation: mean over a 9 x 9 box clipped to the image and to the pixels where the
-//!   disparity can exist (x >= d), by prefix sums: one slice of the cost volume at a time, so
-//!   memory stays O(w h) and a 450 x 375 pair with 65 disparities takes a fraction of a second.
-//!   The mean is kept in fixed point (x 256) so that clipped boxes compare fairly.
-//! - Winner takes all, ties to the smaller disparity, for both eyes from the same slices (the
-//!   right eye's cost at (x, d) is the left eye's at (x + d, d)); sub-pixel by the parabola
-//!   through the winner's cost and its two neighbours' (offset clamped to half a pixel).
-//! - Left-right consistency: a disparity is kept only if the other eye's, read at the pixel it
-//!   points to, is within 1 px; occlusions and most mismatches become 0 (unknown).
-//! - A 3 x 3 median over the known values of each known pixel (unknown pixels stay unknown).
-//!
-//! Conventions as [`crate::cyclopean::disparity_frame`]: the left disparity maps x_left to
-//! x_right = x_left - d, the right one x_right to x_left = x_right + d; 0 = unknown.
+//! The census matcher's CPU twin: the algorithm of [`super`] (see its design comment), one
+//! slice of the cost volume at a time. Moved here from `eval::block_match` unchanged, so the
+//! report's estimated-disparity rows keep their numbers; the GPU pass ([`super::Matcher`]) must
+//! reproduce it bit for bit.
 
-use crate::error::{Error, Result};
+use super::{BOX_RADIUS, CENSUS_HALF_H, CENSUS_HALF_W, LR_TOLERANCE_PX, MEAN_SHIFT};
+use crate::error::Result;
 use crate::io::{DepthMap, RgbImage};
 
-/// Census window half-width (7 columns).
-const CENSUS_HALF_W: usize = 3;
-/// Census window half-height (5 rows).
-const CENSUS_HALF_H: usize = 2;
-/// Aggregation box half-size (9 x 9).
-const BOX_RADIUS: usize = 4;
-/// Largest disagreement (px) between the eyes the left-right check accepts.
-const LR_TOLERANCE_PX: f32 = 1.0;
-/// Aggregated costs are means in fixed point with this many fractional bits.
-const MEAN_SHIFT: u32 = 8;
 /// No cost: the disparity cannot exist at this pixel (it would look outside the other image).
 const NO_COST: u32 = u32::MAX;
 
@@ -41,23 +14,8 @@ const NO_COST: u32 = u32::MAX;
 /// returned as unknown, as are occluded and inconsistent pixels). Fails on images of different
 /// sizes and on a `max_disparity` of 0 or at least the width.
 pub fn estimate_disparities(left: &RgbImage, right: &RgbImage, max_disparity: u32) -> Result<(DepthMap, DepthMap)> {
-    if (left.width, left.height) != (right.width, right.height) {
-        return Err(Error::SizeMismatch {
-            message: format!(
-                "stereo matching: left image {}x{} vs right image {}x{}",
-                left.width, left.height, right.width, right.height
-            ),
-        });
-    }
-    if max_disparity == 0 || max_disparity >= left.width {
-        return Err(Error::param(
-            "max_disparity",
-            format!(
-                "{max_disparity} px: must be at least 1 and less than the image width ({} px)",
-                left.width
-            ),
-        ));
-    }
+    super::check_pair(left, right)?;
+    super::check_range(left.width, max_disparity)?;
     let (w, h) = (left.width as usize, left.height as usize);
     let (cl, cr) = (census(&grey(left), w, h), census(&grey(right), w, h));
     let n = w * h;
@@ -282,6 +240,7 @@ fn median_of_known(d: &[f32], w: usize, h: usize) -> Vec<f32> {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::error::Error;
     use crate::test_rng::Rng;
 
     /// Margin (px) from the image edges where census windows and boxes see replicated borders.
