@@ -39,9 +39,10 @@ fn render(gpu: &Backend, plan: &CyclopeanPlan, input: StereoInput) -> viewsynth:
         StereoKind::Cameras => ["left_rgb", "right_rgb", "left_depth", "cameras"],
     }
     .map(InputName::Argument);
-    let (frame, mid, fixation) = plan.frame(input, names)?;
+    let device = gpu.to_device()?;
+    let (frame, mid, fixation) = plan.frame(&device, input, names)?;
     gpu.check_image_size("the view (cameras[\"middle\"] width/height)", mid.width, mid.height)?;
-    plan.synthesise(&gpu.to_device()?, &frame, &mid, fixation)
+    plan.synthesise(&device, &frame, &mid, fixation)
 }
 
 fn eye(

@@ -749,8 +749,9 @@ fn edge_pass_mixes_more_edge_pixels_than_the_work_group_limit() {
     );
 }
 
-/// Two images alone: the CLI estimates the disparities with the census matcher and renders as
-/// if they had been given. Oracle: the matcher's own disparities written to files and given
+/// Two images alone: the CLI estimates the disparities with the census matcher (its GPU pass)
+/// and renders as if they had been given. Oracle: the matcher's twin's disparities (the GPU
+/// pass is bit-exact with it, tests/integration/matcher.rs) written to files and given
 /// with --left-disparity/--right-disparity must give the same files, byte for byte. Options
 /// that decode disparity files, and a search range with disparities given, are usage errors.
 #[test]
@@ -759,7 +760,7 @@ fn cli_two_images_alone_render_the_matchers_disparities() {
     let out = out_dir("cyclopean-two-images");
     let (l, r) = (dir.join("im2.png"), dir.join("im6.png"));
     let (dl, dr) =
-        viewsynth::eval::block_match::estimate_disparities(&io::load_rgb(&l).unwrap(), &io::load_rgb(&r).unwrap(), 64)
+        viewsynth::cyclopean::matcher::estimate_disparities(&io::load_rgb(&l).unwrap(), &io::load_rgb(&r).unwrap(), 64)
             .unwrap();
     let (dl_file, dr_file) = (out.join("dl.npy"), out.join("dr.npy"));
     io::save_depth_npy(&dl_file, &dl).unwrap();

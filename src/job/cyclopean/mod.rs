@@ -229,7 +229,10 @@ impl CyclopeanJob {
             InputName::File(left_map),
             InputName::File(self.cameras.as_deref().unwrap_or(left_map)),
         ];
-        let (frame, mid, fixation) = self.plan.frame(input, names)?;
+        // The GPU before the folder: two images alone are matched on it, and a refused input
+        // leaves no folder behind.
+        let device = host.open_device(&self.gpu, self.backend)?;
+        let (frame, mid, fixation) = self.plan.frame(&device, input, names)?;
         if let (Some(cameras), Some((left_map, right_map))) = (&self.cameras, &self.maps) {
             for (path, eye) in [(left_map, &frame.left), (right_map, &frame.right)] {
                 let hint = format!(
@@ -245,7 +248,6 @@ impl CyclopeanJob {
             }
         }
         let out_dir = io::OutDir::prepare(&self.out_dir)?;
-        let device = host.open_device(&self.gpu, self.backend)?;
         let done = self.plan.synthesise(&device, &frame, &mid, fixation)?;
         let formats = io::FileFormats {
             outputs: self.plan.outputs(),

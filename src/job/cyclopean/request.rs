@@ -14,10 +14,10 @@ use crate::cyclopean::camera_file::{CameraFile, EyeCameras};
 use crate::cyclopean::disparity_frame::{disparity_frame, median_fixation, DisparityRig};
 use crate::cyclopean::fill::{Filler, FILLED};
 use crate::cyclopean::forward::ForwardWarp;
+use crate::cyclopean::matcher::Matcher;
 use crate::cyclopean::render::CyclopeanRenderer;
 use crate::cyclopean::splat::{SplatParams, SplatRenderer};
 use crate::cyclopean::{Blend, CyclopeanOutputs, CyclopeanParams, Eye, EyeInput, MiddleCamera, StereoFrame};
-use crate::eval::block_match::estimate_disparities;
 use crate::io::{self, DepthMap, OutputSet, RgbImage};
 use crate::job::ArgError;
 use crate::pass::Device;
@@ -379,8 +379,15 @@ impl CyclopeanPlan {
 
     /// The frame, the view and the fixation the seed/refine methods start from: the median
     /// depth the left eye saw (disparities), or the camera file's fixation. `names` name the
-    /// left and right colour, the left disparity or depth and the cameras in messages.
-    pub fn frame(&self, input: StereoInput, names: [InputName; 4]) -> crate::Result<(StereoFrame, MiddleCamera, f64)> {
+    /// left and right colour, the left disparity or depth and the cameras in messages. Two
+    /// images alone are matched on `device` (the census matcher's GPU pass, bit-exact with its
+    /// twin).
+    pub fn frame(
+        &self,
+        device: &Device,
+        input: StereoInput,
+        names: [InputName; 4],
+    ) -> crate::Result<(StereoFrame, MiddleCamera, f64)> {
         let [left_rgb, right_rgb, left_map, cameras_name] = names;
         let input = match input {
             StereoInput::Images { left, right } => {
@@ -391,7 +398,7 @@ impl CyclopeanPlan {
                         left.width
                     )));
                 }
-                let (dl, dr) = estimate_disparities(&left, &right, max)?;
+                let (dl, dr) = Matcher::new(device, left.width, left.height, max)?.estimate(&left, &right)?;
                 StereoInput::Disparity {
                     left: (left, dl),
                     right: (right, dr),
