@@ -92,18 +92,20 @@ impl Flight {
         Ok(self.params.as_ref().expect("allocated above"))
     }
 
-    /// Host buffers for `outputs` at `width` x `height` (kept when they already fit).
+    /// Host buffers for `outputs` at `width` x `height` (kept when they already fit). A buffer
+    /// of an output this run does not ask for is kept too (the run's target has no attachment
+    /// there, so nothing is copied into it): runs that alternate output sets on one flight (the
+    /// stereo matcher with and without its confidence) then allocate nothing.
     pub fn readback(&mut self, width: u32, height: u32, outputs: &[Option<Format>]) -> Result<()> {
-        self.readback.resize_with(outputs.len(), || None);
+        if self.readback.len() < outputs.len() {
+            self.readback.resize_with(outputs.len(), || None);
+        }
         for (slot, f) in self.readback.iter_mut().zip(outputs) {
-            let need = f.map(|f| width as usize * height as usize * f.texel_bytes());
-            match (need, slot.as_ref()) {
-                (None, _) => *slot = None,
-                (Some(n), Some(b)) if b.size >= n => {}
-                (Some(n), _) => {
-                    *slot = None;
-                    *slot = Some(Buffer::new(&self.vk, n, vk::BufferUsageFlags::TRANSFER_DST)?);
-                }
+            let Some(f) = f else { continue };
+            let need = width as usize * height as usize * f.texel_bytes();
+            if slot.as_ref().is_none_or(|b| b.size < need) {
+                *slot = None;
+                *slot = Some(Buffer::new(&self.vk, need, vk::BufferUsageFlags::TRANSFER_DST)?);
             }
         }
         self.outputs = outputs.to_vec();

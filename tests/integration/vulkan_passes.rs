@@ -315,8 +315,16 @@ fn a_steady_state_frame_creates_nothing_on_either_api() {
             ("stitch", Box::new(|| drop(stitch.render(&stitch_params).unwrap()))),
             ("ray tracer", Box::new(|| drop(tracer.render(&cam).unwrap()))),
             (
-                "stereo matcher",
-                Box::new(|| drop(matcher.estimate(&frame.left.color, &frame.right.color).unwrap())),
+                // With and without the confidence: two output sets on the same flights.
+                "stereo matcher and its confidence",
+                Box::new(|| {
+                    drop(matcher.estimate(&frame.left.color, &frame.right.color).unwrap());
+                    drop(
+                        matcher
+                            .estimate_with_confidence(&frame.left.color, &frame.right.color)
+                            .unwrap(),
+                    );
+                }),
             ),
             (
                 // The batch's frame: a new source of the same size, every target in flight at once.
