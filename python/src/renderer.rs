@@ -465,7 +465,8 @@ impl Renderer {
     /// cyclopean`, from disparities of a rectified pair (its --left-disparity mode), from each
     /// eye's depth placed by cameras (its --left-depth ... --cameras mode), or from a rectified
     /// pair alone (the disparities estimated by the census matcher over 0..=max_disparity px;
-    /// default a sixth of the width, rounded up to 16, in 16..=256).
+    /// default a sixth of the width, rounded up to 16, in 16..=256; min_confidence in [0, 1]
+    /// drops the estimates the matcher trusts less, trading coverage for precision).
     ///
     /// left_rgb, right_rgb: uint8[H, W, 3], C-contiguous. Then one of:
     /// - left_disparity, right_disparity: float32[H, W], pixels, x_right = x_left - d (left) and
@@ -513,7 +514,7 @@ impl Renderer {
                         left_depth = None, right_depth = None, cameras = None, method = None,
                         refine_steps = None, blend = None, z_threshold = None, dominant = None,
                         focal = None, baseline = None, doffs = 0.0, outputs = None, fill = false,
-                        max_disparity = None))]
+                        max_disparity = None, min_confidence = None))]
     fn cyclopean<'py>(
         &mut self,
         py: Python<'py>,
@@ -536,6 +537,7 @@ impl Renderer {
         outputs: Option<&Bound<'py, PyAny>>,
         fill: bool,
         #[pyo3(from_py_with = crate::ints::max_disparity)] max_disparity: Option<u32>,
+        min_confidence: Option<f64>,
     ) -> PyResult<Bound<'py, PyDict>> {
         let gpu = self.gpu()?.clone();
         // The settings as the library's request: it alone decides and checks them.
@@ -552,6 +554,7 @@ impl Renderer {
             outputs: outputs_given(outputs)?,
             fill,
             max_disparity,
+            min_confidence,
         };
         crate::cyclopean::cyclopean(
             py,

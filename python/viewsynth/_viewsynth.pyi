@@ -201,6 +201,7 @@ class Renderer:
         outputs: Optional[Union[OutputName, Sequence[OutputName]]] = None,
         fill: bool = False,
         max_disparity: Optional[int] = None,
+        min_confidence: Optional[float] = None,
     ) -> CyclopeanView:
         """Synthesise an in-between view of a stereo pair (rgb uint8[H, W, 3] per eye), as
         `viewsynth cyclopean`, from either

@@ -130,9 +130,9 @@ pub enum ArgError {
     /// A decoding option for disparity or depth files with two images alone.
     #[error("{0} decodes disparity or depth files; with two images alone the disparities are estimated")]
     DecodeWithoutMaps(&'static str),
-    /// The matcher's range with disparities or depth given.
-    #[error("--max-disparity applies to two images alone (the disparities are then estimated)")]
-    MaxDisparityWithMaps,
+    /// A matcher option with disparities or depth given.
+    #[error("{0} applies to two images alone (the disparities are then estimated)")]
+    MatcherOptionWithMaps(&'static str),
     /// A metric depth output asked of disparities without a calibration.
     #[error("--outputs depth needs --focal and --baseline (the depth is metric)")]
     DepthOutputNotMetric,

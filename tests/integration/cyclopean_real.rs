@@ -814,6 +814,46 @@ fn cli_two_images_alone_render_the_matchers_disparities() {
         ],
     );
     assert!(e.contains("--max-disparity applies to two images alone"), "{e}");
+
+    // --min-confidence trades coverage for precision: fewer pixels, and those kept are the
+    // ones the matcher trusts, so the view's error against im4 on them is no worse.
+    let truth = io::load_rgb(&dir.join("im4.png")).unwrap();
+    let mut prev: Option<(f64, f64)> = None;
+    for c in ["0", "0.5", "0.9"] {
+        let o_dir = out.join(format!("conf{c}"));
+        let o = viewsynth(
+            &["--max-disparity", "64", "--min-confidence", c],
+            &[("--left-rgb", &l), ("--right-rgb", &r), ("--out-dir", &o_dir)],
+        );
+        assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+        let mask = io::load_mask_png(&o_dir.join("middle_mask.png")).unwrap();
+        let seen: Vec<bool> = mask.data.iter().map(|m| *m != 0).collect();
+        let rgb = io::load_rgb(&o_dir.join("middle_rgb.png")).unwrap();
+        let (cover, db) = (count(&seen) as f64 / seen.len() as f64, psnr(&rgb, &truth, &seen));
+        if c == "0" {
+            // Confidence 0 drops only what is already unknown: the plain estimate's view.
+            let plain = std::fs::read(alone.join("middle_rgb.png")).unwrap();
+            assert!(
+                std::fs::read(o_dir.join("middle_rgb.png")).unwrap() == plain,
+                "--min-confidence 0"
+            );
+        }
+        if let Some((c0, db0)) = prev {
+            assert!(
+                cover < c0,
+                "--min-confidence {c}: coverage {cover:.4} not below {c0:.4}"
+            );
+            // The kept pixels are those seen by surfaces the matcher trusts: allow 0.1 dB of
+            // the metric's own noise (fewer pixels averaged), no real loss.
+            assert!(db > db0 - 0.1, "--min-confidence {c}: {db:.2} dB against {db0:.2}");
+        }
+        prev = Some((cover, db));
+    }
+    let e = usage(
+        &["--min-confidence", "1.5"],
+        &[("--left-rgb", &l), ("--right-rgb", &r), ("--out-dir", &bad)],
+    );
+    assert!(e.contains("outside [0, 1]"), "{e}");
     let e = usage(
         &["--disparity-scale", "4"],
         &[("--left-rgb", &l), ("--right-rgb", &r), ("--out-dir", &bad)],

@@ -14,7 +14,7 @@ use crate::cyclopean::camera_file::{CameraFile, EyeCameras};
 use crate::cyclopean::disparity_frame::{disparity_frame, median_fixation, DisparityRig};
 use crate::cyclopean::fill::{Filler, FILLED};
 use crate::cyclopean::forward::ForwardWarp;
-use crate::cyclopean::matcher::Matcher;
+use crate::cyclopean::matcher::{EyeEstimate, Matcher};
 use crate::cyclopean::render::CyclopeanRenderer;
 use crate::cyclopean::splat::{SplatParams, SplatRenderer};
 use crate::cyclopean::{Blend, CyclopeanOutputs, CyclopeanParams, Eye, EyeInput, MiddleCamera, StereoFrame};
@@ -55,6 +55,10 @@ pub struct CyclopeanRequest {
     pub fill: bool,
     /// Two images alone: the matcher's search range, pixels (none: [`default_max_disparity`]).
     pub max_disparity: Option<u32>,
+    /// Two images alone: estimated disparities whose confidence (the matcher's, in [0, 1]:
+    /// the eyes' agreement and the local spread) is below this are dropped, trading coverage
+    /// for precision; none keeps every disparity the left-right check kept.
+    pub min_confidence: Option<f64>,
 }
 
 /// The matcher's search range for two images alone when none is given: a sixth of the width
@@ -155,6 +159,7 @@ pub struct CyclopeanPlan {
     outputs: OutputSet,
     fill: bool,
     max_disparity: Option<u32>,
+    min_confidence: Option<f64>,
 }
 
 /// `--dominant`'s `eye:weight`.
@@ -201,8 +206,19 @@ impl CyclopeanRequest {
                 format!("{steps} outside 0..=16"),
             )));
         }
-        if self.max_disparity.is_some() && kind != StereoKind::Images {
-            return Err(ArgError::MaxDisparityWithMaps);
+        for (flag, given) in [
+            ("--max-disparity", self.max_disparity.is_some()),
+            ("--min-confidence", self.min_confidence.is_some()),
+        ] {
+            if given && kind != StereoKind::Images {
+                return Err(ArgError::MatcherOptionWithMaps(flag));
+            }
+        }
+        if let Some(c) = self.min_confidence.filter(|c| !(0.0..=1.0).contains(c)) {
+            return Err(ArgError::Invalid(crate::Error::param(
+                "--min-confidence",
+                format!("{c} outside [0, 1] (the matcher's confidence)"),
+            )));
         }
         if self.max_disparity == Some(0) {
             return Err(ArgError::Invalid(crate::Error::param(
@@ -255,6 +271,7 @@ impl CyclopeanRequest {
             outputs,
             fill: self.fill,
             max_disparity: self.max_disparity,
+            min_confidence: self.min_confidence,
         })
     }
 
@@ -294,6 +311,17 @@ impl CyclopeanRequest {
         }
         Ok(())
     }
+}
+
+/// An eye's estimated disparities with those below `min` confidence made unknown (0).
+fn confident(eye: EyeEstimate, min: f64) -> DepthMap {
+    let mut d = eye.disparity;
+    for (v, c) in d.data.iter_mut().zip(&eye.confidence.data) {
+        if f64::from(*c) < min {
+            *v = 0.0;
+        }
+    }
+    d
 }
 
 /// The decoded inputs of one view, each eye's colour with its disparity or depth.
@@ -398,7 +426,14 @@ impl CyclopeanPlan {
                         left.width
                     )));
                 }
-                let (dl, dr) = Matcher::new(device, left.width, left.height, max)?.estimate(&left, &right)?;
+                let mut matcher = Matcher::new(device, left.width, left.height, max)?;
+                let (dl, dr) = match self.min_confidence {
+                    None => matcher.estimate(&left, &right)?,
+                    Some(min) => {
+                        let [l, r] = matcher.estimate_with_confidence(&left, &right)?;
+                        (confident(l, min), confident(r, min))
+                    }
+                };
                 StereoInput::Disparity {
                     left: (left, dl),
                     right: (right, dr),

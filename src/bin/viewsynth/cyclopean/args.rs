@@ -122,6 +122,11 @@ pub(crate) struct CyclopeanArgs {
     /// in 16..=256).
     #[arg(help_heading = INPUTS, long, value_name = "N", value_parser = clap::value_parser!(u32).range(1..=i64::from(viewsynth::io::MAX_DIMENSION)))]
     max_disparity: Option<u32>,
+    /// Two images alone: drop estimated disparities whose confidence is below C, in [0, 1]
+    /// (the eyes' agreement times 1 / (1 + the local disparity variance)): fewer pixels, more
+    /// of them right.
+    #[arg(help_heading = INPUTS, long, value_name = "C", value_parser = finite_value)]
+    min_confidence: Option<f64>,
     /// Writes middle_rgb.png, middle_depth.exr, middle_mask.png (those in --outputs).
     #[arg(help_heading = OUTPUTS, long)]
     out_dir: PathBuf,
@@ -157,6 +162,7 @@ impl CyclopeanArgs {
             outputs: self.outputs.as_deref().map(OutputSet::parse).transpose()?,
             fill: self.fill,
             max_disparity: self.max_disparity,
+            min_confidence: self.min_confidence,
         })
     }
 }
