@@ -81,7 +81,7 @@ pub(crate) struct CyclopeanArgs {
     #[arg(help_heading = INPUTS, long, value_name = "NAME")]
     npz_key: Option<String>,
     /// Right principal point minus left, pixels (Middlebury 2014 `doffs`): depth = f B / (d + doffs).
-    #[arg(help_heading = INTRINSICS, long, default_value_t = 0.0)]
+    #[arg(help_heading = INTRINSICS, long, default_value_t = CyclopeanRequest::default().doffs)]
     doffs: f64,
     /// Focal length, pixels; with --baseline the view's metric depth is written.
     #[arg(help_heading = INTRINSICS, long, requires = "baseline")]

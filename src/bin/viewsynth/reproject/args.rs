@@ -94,7 +94,7 @@ pub(crate) struct ReprojectArgs {
     #[arg(help_heading = INTRINSICS, long, value_parser = finite_value)]
     focal: Option<f64>,
     /// cx_right - cx_left in pixels (Middlebury's doffs) of the rectified rig and of disparity.
-    #[arg(help_heading = INTRINSICS, long, default_value_t = 0.0, value_parser = finite_value)]
+    #[arg(help_heading = INTRINSICS, long, default_value_t = ReprojectRequest::default().doffs, value_parser = finite_value)]
     doffs: f64,
     /// Rectified rig: distance between the eyes in metres (x_right = x_left + doffs - f B / Z).
     /// Also the baseline of --depth-kind disparity.
@@ -118,10 +118,10 @@ pub(crate) struct ReprojectArgs {
     #[arg(help_heading = METHOD, long, value_enum, default_value = "shift-scan")]
     method: ReprojectMethodArg,
     /// Steps of the shift walk / 3-D gather (1..=16).
-    #[arg(help_heading = METHOD, long, default_value_t = 3, value_parser = clap::value_parser!(u32).range(1..=16))]
+    #[arg(help_heading = METHOD, long, default_value_t = ReprojectRequest::default().steps, value_parser = clap::value_parser!(u32).range(1..=16))]
     steps: u32,
     /// A row segment breaks (an unseen surface) where |Z_a - Z_b| > tau_rel * min(Z_a, Z_b).
-    #[arg(help_heading = METHOD, long, default_value_t = 0.05, value_parser = finite_value)]
+    #[arg(help_heading = METHOD, long, default_value_t = ReprojectRequest::default().tau_rel, value_parser = finite_value)]
     tau_rel: f64,
     #[command(flatten)]
     files: FileOutputArgs,

@@ -74,13 +74,13 @@ pub(crate) struct StitchArgs {
     #[arg(help_heading = INPUTS, long, value_parser = finite_or_inf)]
     far: Option<f64>,
     /// Equirect width per eye.
-    #[arg(help_heading = TARGETS, long, default_value_t = 2048, value_parser = clap::value_parser!(u32).range(1..=i64::from(io::MAX_DIMENSION)))]
+    #[arg(help_heading = TARGETS, long, default_value_t = StitchRequest::default().width, value_parser = clap::value_parser!(u32).range(1..=i64::from(io::MAX_DIMENSION)))]
     width: u32,
     /// Equirect height per eye (the top-bottom image is twice as high).
-    #[arg(help_heading = TARGETS, long, default_value_t = 1024, value_parser = clap::value_parser!(u32).range(1..=i64::from(io::MAX_DIMENSION)))]
+    #[arg(help_heading = TARGETS, long, default_value_t = StitchRequest::default().height, value_parser = clap::value_parser!(u32).range(1..=i64::from(io::MAX_DIMENSION)))]
     height: u32,
     /// Interpupillary distance (metres, the faces' units).
-    #[arg(help_heading = TARGETS, long, default_value_t = 0.064, value_parser = finite_value)]
+    #[arg(help_heading = TARGETS, long, default_value_t = StitchRequest::default().ipd, value_parser = finite_value)]
     ipd: f64,
     /// Seam band half-width in degrees, in (0, (fov - 90) / 2] (default (fov - 90) / 2 with
     /// --fov, else 10).
@@ -91,7 +91,7 @@ pub(crate) struct StitchArgs {
     #[arg(help_heading = METHOD, long, value_enum, default_value = "reproject")]
     method: StitchMethodArg,
     /// Latitude (deg) above which the eye radius fades to 0 at the poles.
-    #[arg(help_heading = METHOD, long, default_value_t = 45.0, value_parser = finite_value)]
+    #[arg(help_heading = METHOD, long, default_value_t = StitchRequest::default().pole_fade, value_parser = finite_value)]
     pole_fade: f64,
     /// Also write each eye's equirect (ods_left.png, ods_right.png).
     #[arg(help_heading = OUTPUTS, long)]
