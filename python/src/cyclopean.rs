@@ -180,16 +180,19 @@ pub fn cyclopean<'py>(py: Python<'py>, gpu: Backend, a: CyclopeanArgs<'_, 'py>) 
     .kind()
     .map_err(errors::from_request)?;
     let plan = a.request.plan(kind).map_err(errors::from_request)?;
-    let input = match kind {
-        StereoKind::Disparity => {
-            let maps = [
-                (some(a.left_disparity), "left_disparity"),
-                (some(a.right_disparity), "right_disparity"),
-            ];
-            let (left, right) = eyes(&a, maps)?;
+    let input = match (
+        kind,
+        a.left_disparity,
+        a.right_disparity,
+        a.left_depth,
+        a.right_depth,
+        a.cameras,
+    ) {
+        (StereoKind::Disparity, Some(ld), Some(rd), ..) => {
+            let (left, right) = eyes(&a, [(ld, "left_disparity"), (rd, "right_disparity")])?;
             StereoInput::Disparity { left, right }
         }
-        StereoKind::Images => {
+        (StereoKind::Images, ..) => {
             let left = arrays::rgb_image(a.left_rgb, "left_rgb")?;
             let right = arrays::rgb_image(a.right_rgb, "right_rgb")?;
             if (right.width, right.height) != (left.width, left.height) {
@@ -203,18 +206,20 @@ pub fn cyclopean<'py>(py: Python<'py>, gpu: Backend, a: CyclopeanArgs<'_, 'py>) 
             }
             StereoInput::Images { left, right }
         }
-        StereoKind::Cameras => {
-            let cameras = Box::new(camera_file(some(a.cameras))?);
-            let maps = [(some(a.left_depth), "left_depth"), (some(a.right_depth), "right_depth")];
-            let (left, right) = eyes(&a, maps)?;
+        (StereoKind::Cameras, _, _, Some(ld), Some(rd), Some(cams)) => {
+            let cameras = Box::new(camera_file(cams)?);
+            let (left, right) = eyes(&a, [(ld, "left_depth"), (rd, "right_depth")])?;
             StereoInput::Cameras { left, right, cameras }
         }
+        // StereoGiven::kind only names a set-up whose inputs are all given.
+        _ => return Err(errors::invalid("left_rgb", "the stereo inputs make no set-up")),
     };
-    gpu.check_image_size("left_rgb", input_width(&input).0, input_width(&input).1)
-        .map_err(errors::from_library)?;
+    let (w, h) = input_size(&input);
+    gpu.check_image_size("left_rgb", w, h).map_err(errors::from_library)?;
 
+    let outputs = plan.outputs();
     // The inputs were copied out of numpy above; see SameThread for why the move is sound.
-    let work = SameThread((gpu, plan.clone(), input));
+    let work = SameThread((gpu, plan, input));
     let result = py.detach(move || {
         let work = work;
         let (gpu, plan, input) = work.0;
@@ -241,7 +246,7 @@ pub fn cyclopean<'py>(py: Python<'py>, gpu: Backend, a: CyclopeanArgs<'_, 'py>) 
     let plane = |f: &dyn Fn(u8) -> bool| {
         viewsynth::io::Mask::new(w, h, sources.iter().map(|s| f(*s) as u8).collect()).map_err(errors::from_library)
     };
-    if plan.outputs().mask {
+    if outputs.mask {
         d.set_item("mask", arrays::mask_array(py, plane(&|s| s == 1)?))?;
     }
     if a.request.fill {
@@ -250,13 +255,8 @@ pub fn cyclopean<'py>(py: Python<'py>, gpu: Backend, a: CyclopeanArgs<'_, 'py>) 
     Ok(d)
 }
 
-/// An input `StereoGiven::kind` found given.
-fn some<'a, 'py>(x: Option<&'a Bound<'py, PyAny>>) -> &'a Bound<'py, PyAny> {
-    x.expect("StereoGiven::kind checked it is given")
-}
-
 /// The left eye's size (every input was checked to share it).
-fn input_width(input: &StereoInput) -> (u32, u32) {
+fn input_size(input: &StereoInput) -> (u32, u32) {
     match input {
         StereoInput::Disparity { left, .. } | StereoInput::Cameras { left, .. } => (left.0.width, left.0.height),
         StereoInput::Images { left, .. } => (left.width, left.height),

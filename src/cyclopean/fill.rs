@@ -76,14 +76,17 @@ impl Filler {
         let rgba = crate::gpu::pixels::rgb_to_rgba(&color.data);
         let depth_bytes: &[u8] = bytemuck::cast_slice(&depth.data);
         let d = &self.device;
-        match &self.inputs {
+        // Rewritten in place when the size is the last call's, else made anew (the old ones
+        // freed first); a failed write leaves none, so the next call uploads.
+        let inputs = match self.inputs.take() {
             Some(i) if i.size == (w, h) => {
                 d.write_image(&i.color, &rgba)?;
                 d.write_image(&i.depth, depth_bytes)?;
                 d.write_image(&i.sources, &out.sources)?;
+                i
             }
-            _ => {
-                self.inputs = None;
+            old => {
+                drop(old);
                 let image = |format, bytes, label| {
                     d.upload(&ImageData {
                         width: w,
@@ -93,15 +96,16 @@ impl Filler {
                         label,
                     })
                 };
-                self.inputs = Some(Inputs {
+                Inputs {
                     size: (w, h),
                     color: image(Format::Rgba8, &rgba, "fill colour")?,
                     depth: image(Format::R32F, depth_bytes, "fill depth")?,
                     sources: image(Format::R8Ui, &out.sources, "fill sources")?,
-                });
+                }
             }
-        }
-        let i = self.inputs.as_ref().expect("uploaded above");
+        };
+        let images = [inputs.color.id(), inputs.depth.id(), inputs.sources.id()];
+        self.inputs = Some(inputs);
         let params = FillParams {
             u_size: [w as i32, h as i32],
             u_filled: FILLED.into(),
@@ -109,7 +113,6 @@ impl Filler {
         };
         // Memory rows are the top-down rows: the rule is symmetric, nothing to flip.
         let target = Target::view(w, h, true, true, crate::convention::RowOrder::TopDown);
-        let images = [i.color.id(), i.depth.id(), i.sources.id()];
         let draw = Draw {
             program: ShaderProgram::new(Default::default(), ProgramKind::CyclopeanFill),
             params: bytemuck::bytes_of(&params),

@@ -10,7 +10,7 @@ use crate::gpu::shaders::MatcherStage;
 use crate::gpu::{ProgramKind, ShaderProgram};
 use crate::io::{DepthMap, RgbImage};
 use crate::pass::{
-    Buffer, Device, Dispatch, Format, Groups, Image, ImageData, Rendered, Step, StorageImage, Target, ToDevice,
+    Buffer, Device, Dispatch, Format, Groups, Image, ImageData, ImageId, Rendered, Step, StorageImage, Target, ToDevice,
 };
 
 crate::param_block! {
@@ -147,8 +147,7 @@ impl Matcher {
                 ),
             });
         }
-        self.set_inputs(left, right)?;
-        let inputs = self.inputs.as_ref().expect("set above");
+        let images = self.set_inputs(left, right)?;
         let params = |first_d: u32, pairs: u32| MatcherParams {
             u_size: [w as i32, h as i32],
             u_max_disparity: self.max_disparity as i32,
@@ -174,7 +173,6 @@ impl Matcher {
         // The median stores the final disparities into `raw` too (free after the check).
         let median_buffers = ids(&[&self.checked, &self.raw]);
         let confidence_buffers = ids(&[&self.raw]);
-        let images = [inputs.left.id(), inputs.right.id()];
         let outputs = [StorageImage::Output(0), StorageImage::Output(1)];
         let confidence_outputs = [StorageImage::Output(2), StorageImage::Output(3)];
         let pixels = Groups::Fixed([w.div_ceil(8), h.div_ceil(8)]);
@@ -249,14 +247,18 @@ impl Matcher {
     }
 
     /// Upload the pair (first time) or rewrite the images in place.
-    fn set_inputs(&mut self, left: &RgbImage, right: &RgbImage) -> Result<()> {
+    fn set_inputs(&mut self, left: &RgbImage, right: &RgbImage) -> Result<[ImageId; 2]> {
         let (l, r) = (
             crate::gpu::pixels::rgb_to_rgba(&left.data),
             crate::gpu::pixels::rgb_to_rgba(&right.data),
         );
-        if let Some(i) = &self.inputs {
+        // A failed rewrite drops the images: the next pair uploads them anew.
+        if let Some(i) = self.inputs.take() {
             self.device.write_image(&i.left, &l)?;
-            return self.device.write_image(&i.right, &r);
+            self.device.write_image(&i.right, &r)?;
+            let ids = [i.left.id(), i.right.id()];
+            self.inputs = Some(i);
+            return Ok(ids);
         }
         let upload = |bytes: &[u8], label| {
             self.device.upload(&ImageData {
@@ -267,10 +269,12 @@ impl Matcher {
                 label,
             })
         };
-        self.inputs = Some(Inputs {
+        let i = Inputs {
             left: upload(&l, "matcher left image")?,
             right: upload(&r, "matcher right image")?,
-        });
-        Ok(())
+        };
+        let ids = [i.left.id(), i.right.id()];
+        self.inputs = Some(i);
+        Ok(ids)
     }
 }

@@ -417,58 +417,11 @@ impl CyclopeanPlan {
         names: [InputName; 4],
     ) -> crate::Result<(StereoFrame, MiddleCamera, f64)> {
         let [left_rgb, right_rgb, left_map, cameras_name] = names;
-        let input = match input {
-            StereoInput::Images { left, right } => {
-                let max = self.max_disparity.unwrap_or(default_max_disparity(left.width));
-                if max >= left.width {
-                    return Err(left_rgb.error(format!(
-                        "{} px wide: the search range (--max-disparity {max}) must be less than the width",
-                        left.width
-                    )));
-                }
-                let mut matcher = Matcher::new(device, left.width, left.height, max)?;
-                let (dl, dr) = match self.min_confidence {
-                    None => matcher.estimate(&left, &right)?,
-                    Some(min) => {
-                        let [l, r] = matcher.estimate_with_confidence(&left, &right)?;
-                        (confident(l, min), confident(r, min))
-                    }
-                };
-                StereoInput::Disparity {
-                    left: (left, dl),
-                    right: (right, dr),
-                }
-            }
-            input => input,
-        };
         match input {
-            StereoInput::Disparity { left, right } => {
-                let (focal, baseline, doffs, position) = self.rig;
-                // Without a calibration only f B matters for the view; any nominal values do.
-                let rig = DisparityRig {
-                    focal_px: focal.unwrap_or(left.0.width as f64),
-                    baseline: baseline.unwrap_or(0.1),
-                    doffs,
-                    position,
-                };
-                let known = left.1.data.iter().any(|&d| d.is_finite() && d > 0.0);
-                let (frame, mid) = disparity_frame(left, right, &rig, Conventions::default())?;
-                // f B / d outside the usable depths makes holes (the one depth rule); all of
-                // them is the rig's fault, said by name rather than a silent 0 % valid view.
-                if known && !frame.left.depth.data.iter().any(|z| z.is_finite() && *z > 0.0) {
-                    return Err(crate::Error::param(
-                        "--focal/--baseline",
-                        format!(
-                            "f B / disparity = {:e} m / px puts every known disparity outside the usable depths [{:e}, {:e}] m",
-                            rig.focal_px * rig.baseline,
-                            crate::depth::MIN_DEPTH_VALUE,
-                            crate::depth::MAX_DEPTH_VALUE
-                        ),
-                    ));
-                }
-                let fixation = median_fixation(&frame)
-                    .ok_or_else(|| left_map.error("no known disparity (all 0 or non-finite)"))?;
-                Ok((frame, mid, fixation))
+            StereoInput::Disparity { left, right } => self.disparity_frame(left, right, left_map),
+            StereoInput::Images { left, right } => {
+                let (dl, dr) = self.estimate(device, &left, &right, left_rgb)?;
+                self.disparity_frame((left, dl), (right, dr), left_map)
             }
             StereoInput::Cameras { left, right, cameras } => {
                 left_rgb.check_size(&cameras.left, left.0.width, left.0.height)?;
@@ -490,8 +443,69 @@ impl CyclopeanPlan {
                 };
                 Ok((frame, mid, fixation))
             }
-            StereoInput::Images { .. } => unreachable!("estimated above"),
         }
+    }
+
+    /// Both eyes' disparities of a pair alone, by the census matcher on `device` (those below
+    /// the minimum confidence made unknown).
+    fn estimate(
+        &self,
+        device: &Device,
+        left: &RgbImage,
+        right: &RgbImage,
+        left_rgb: InputName,
+    ) -> crate::Result<(DepthMap, DepthMap)> {
+        let max = self.max_disparity.unwrap_or(default_max_disparity(left.width));
+        if max >= left.width {
+            return Err(left_rgb.error(format!(
+                "{} px wide: the search range (--max-disparity {max}) must be less than the width",
+                left.width
+            )));
+        }
+        let mut matcher = Matcher::new(device, left.width, left.height, max)?;
+        Ok(match self.min_confidence {
+            None => matcher.estimate(left, right)?,
+            Some(min) => {
+                let [l, r] = matcher.estimate_with_confidence(left, right)?;
+                (confident(l, min), confident(r, min))
+            }
+        })
+    }
+
+    /// A rectified pair with disparities: the frame, the view and the seed's fixation (the
+    /// median depth the left eye saw).
+    fn disparity_frame(
+        &self,
+        left: (RgbImage, DepthMap),
+        right: (RgbImage, DepthMap),
+        left_map: InputName,
+    ) -> crate::Result<(StereoFrame, MiddleCamera, f64)> {
+        let (focal, baseline, doffs, position) = self.rig;
+        // Without a calibration only f B matters for the view; any nominal values do.
+        let rig = DisparityRig {
+            focal_px: focal.unwrap_or(left.0.width as f64),
+            baseline: baseline.unwrap_or(0.1),
+            doffs,
+            position,
+        };
+        let known = left.1.data.iter().any(|&d| d.is_finite() && d > 0.0);
+        let (frame, mid) = disparity_frame(left, right, &rig, Conventions::default())?;
+        // f B / d outside the usable depths makes holes (the one depth rule); all of them is
+        // the rig's fault, said by name rather than a silent 0 % valid view.
+        if known && !frame.left.depth.data.iter().any(|z| z.is_finite() && *z > 0.0) {
+            return Err(crate::Error::param(
+                "--focal/--baseline",
+                format!(
+                    "f B / disparity = {:e} m / px puts every known disparity outside the usable depths [{:e}, {:e}] m",
+                    rig.focal_px * rig.baseline,
+                    crate::depth::MIN_DEPTH_VALUE,
+                    crate::depth::MAX_DEPTH_VALUE
+                ),
+            ));
+        }
+        let fixation =
+            median_fixation(&frame).ok_or_else(|| left_map.error("no known disparity (all 0 or non-finite)"))?;
+        Ok((frame, mid, fixation))
     }
 
     /// Renders the view with the plan's method (and fill) on `device`.

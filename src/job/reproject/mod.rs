@@ -226,21 +226,24 @@ impl ReprojectJob {
 
     /// Reads the source, renders every target and writes the files all-or-none.
     pub fn run(&self, host: &dyn Host) -> Result<ReprojectReport, JobError> {
-        // Read and check the source before the folder or the GPU is touched.
-        let (src, from, geometries) = match &self.views {
-            Views::Rig(rig) => (self.rig_source(host, rig)?, rig.plan.from(), None),
+        // Read and check the source and place the targets before the folder or the GPU is
+        // touched.
+        let (src, from, targets) = match &self.views {
+            Views::Rig(rig) => {
+                let src = self.rig_source(host, rig)?;
+                let targets = rig
+                    .plan
+                    .geometries(rig.intrinsics.k, src.color.width, src.color.height)?;
+                (src, rig.plan.from(), targets)
+            }
             Views::Cameras { path, from, to } => {
                 let (src, targets) = self.camera_file_setup(host, path, *from, *to)?;
-                (src, Some(*from), Some(targets))
+                (src, Some(*from), targets)
             }
         };
         let out_dir = io::OutDir::prepare(&self.out_dir)?;
         let gpu = host.open_device(&self.gpu, self.backend)?;
-        let results = match (&self.views, geometries) {
-            (_, Some(targets)) => request::render_targets(&gpu, &src, &targets, self.params)?,
-            (Views::Rig(rig), None) => rig.plan.render(&gpu, &src, rig.intrinsics.k)?,
-            (Views::Cameras { .. }, None) => unreachable!("the camera file's set-up gives its targets"),
-        };
+        let results = request::render_targets(&gpu, &src, &targets, self.params)?;
         let (width, height) = (src.color.width, src.color.height);
         // Every target's files through the output layer, all or none.
         let mut set = out_dir.file_set()?;

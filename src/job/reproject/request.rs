@@ -255,11 +255,17 @@ impl RigPlan {
     /// Renders every target of the rig from `src` (validated by the caller), the source
     /// camera `k` at the source's size.
     pub fn render(&self, device: &Device, src: &ReprojectSource, k: Intrinsics) -> crate::Result<Vec<RenderedTarget>> {
-        let camera = PinholeCamera {
-            k,
-            width: src.color.width,
-            height: src.color.height,
-        };
+        render_targets(
+            device,
+            src,
+            &self.geometries(k, src.color.width, src.color.height)?,
+            self.params,
+        )
+    }
+
+    /// Each target eye's geometry for a source camera `k` of `width` x `height`.
+    pub(super) fn geometries(&self, k: Intrinsics, width: u32, height: u32) -> crate::Result<Vec<(Eye, Geometry)>> {
+        let camera = PinholeCamera { k, width, height };
         camera.validate("source intrinsics")?;
         let mut geometries = Vec::new();
         for (i, &to) in self.targets.iter().enumerate() {
@@ -270,7 +276,7 @@ impl RigPlan {
             shift.validate()?;
             geometries.push((to, Geometry::Rig { camera, shift }));
         }
-        render_targets(device, src, &geometries, self.params)
+        Ok(geometries)
     }
 }
 
