@@ -14,7 +14,7 @@ use pyo3::types::{PyBool, PyDict, PyFloat, PyInt, PyList, PyString, PyTuple};
 use viewsynth::cyclopean::camera_file::CameraFile;
 use viewsynth::io::{DepthMap, RgbImage, MASK_FILLED};
 use viewsynth::job::cyclopean::{
-    CyclopeanPlan, CyclopeanRequest, InputName, StereoGiven, StereoInput, StereoKind, Synthesised,
+    CyclopeanPlan, CyclopeanRequest, Framed, InputName, StereoGiven, StereoInput, StereoKind, Synthesised,
 };
 use viewsynth::pass::ToDevice;
 
@@ -32,7 +32,11 @@ pub struct CyclopeanArgs<'a, 'py> {
 }
 
 /// The work of one call once validated: render with the GIL released.
-fn render(gpu: &Backend, plan: &CyclopeanPlan, input: StereoInput) -> viewsynth::Result<Synthesised> {
+fn render(
+    gpu: &Backend,
+    plan: &CyclopeanPlan,
+    input: StereoInput,
+) -> viewsynth::Result<(Synthesised, Option<[DepthMap; 2]>)> {
     let names = match plan.kind() {
         StereoKind::Disparity => ["left_rgb", "right_rgb", "left_disparity", "cameras"],
         StereoKind::Images => ["left_rgb", "right_rgb", "left_rgb", "left_rgb"],
@@ -40,9 +44,14 @@ fn render(gpu: &Backend, plan: &CyclopeanPlan, input: StereoInput) -> viewsynth:
     }
     .map(InputName::Argument);
     let device = gpu.to_device()?;
-    let (frame, mid, fixation) = plan.frame(&device, input, names)?;
+    let Framed {
+        frame,
+        mid,
+        fixation,
+        confidence,
+    } = plan.frame(&device, input, names)?;
     gpu.check_image_size("the view (cameras[\"middle\"] width/height)", mid.width, mid.height)?;
-    plan.synthesise(&device, &frame, &mid, fixation)
+    Ok((plan.synthesise(&device, &frame, &mid, fixation)?, confidence))
 }
 
 fn eye(
@@ -225,7 +234,7 @@ pub fn cyclopean<'py>(py: Python<'py>, gpu: Backend, a: CyclopeanArgs<'_, 'py>) 
         let (gpu, plan, input) = work.0;
         SameThread(render(&gpu, &plan, input))
     });
-    let done = result.0.map_err(errors::from_library)?;
+    let (done, confidence) = result.0.map_err(errors::from_library)?;
 
     let d = PyDict::new(py);
     d.set_item("coverage", done.coverage)?;
@@ -251,6 +260,10 @@ pub fn cyclopean<'py>(py: Python<'py>, gpu: Backend, a: CyclopeanArgs<'_, 'py>) 
     }
     if a.request.fill {
         d.set_item("filled", arrays::mask_array(py, plane(&|s| s == MASK_FILLED)?))?;
+    }
+    if let Some([left, right]) = confidence {
+        d.set_item("left_confidence", arrays::depth_array(py, left))?;
+        d.set_item("right_confidence", arrays::depth_array(py, right))?;
     }
     Ok(d)
 }

@@ -466,7 +466,9 @@ impl Renderer {
     /// eye's depth placed by cameras (its --left-depth ... --cameras mode), or from a rectified
     /// pair alone (the disparities estimated by the census matcher over 0..=max_disparity px;
     /// default a sixth of the width, rounded up to 16, in 16..=256; min_confidence in [0, 1]
-    /// drops the estimates the matcher trusts less, trading coverage for precision).
+    /// drops the estimates the matcher trusts less, trading coverage for precision; confidence=True
+    /// also returns each eye's confidence as "left_confidence" and "right_confidence",
+    /// float32[H, W] in [0, 1], 0 where the disparity is unknown: the CLI's --confidence).
     ///
     /// left_rgb, right_rgb: uint8[H, W, 3], C-contiguous. Then one of:
     /// - left_disparity, right_disparity: float32[H, W], pixels, x_right = x_left - d (left) and
@@ -514,7 +516,7 @@ impl Renderer {
                         left_depth = None, right_depth = None, cameras = None, method = None,
                         refine_steps = None, blend = None, z_threshold = None, dominant = None,
                         focal = None, baseline = None, doffs = 0.0, outputs = None, fill = false,
-                        max_disparity = None, min_confidence = None))]
+                        max_disparity = None, min_confidence = None, confidence = false))]
     fn cyclopean<'py>(
         &mut self,
         py: Python<'py>,
@@ -538,6 +540,7 @@ impl Renderer {
         fill: bool,
         #[pyo3(from_py_with = crate::ints::max_disparity)] max_disparity: Option<u32>,
         min_confidence: Option<f64>,
+        confidence: bool,
     ) -> PyResult<Bound<'py, PyDict>> {
         let gpu = self.gpu()?.clone();
         // The settings as the library's request: it alone decides and checks them.
@@ -555,6 +558,7 @@ impl Renderer {
             fill,
             max_disparity,
             min_confidence,
+            confidence,
         };
         crate::cyclopean::cyclopean(
             py,

@@ -226,15 +226,27 @@ def test_vulkan_renderer_matches_gl(renderer, pair):
 def test_two_images_alone_equal_cli(renderer, cli, pair, tmp_path):
     """Two images alone: the disparities are estimated by the census matcher (as the CLI with
     --left-rgb/--right-rgb only), the same view and mask as the CLI's."""
-    view = renderer.cyclopean(pair[0], pair[1], max_disparity=32)
+    view = renderer.cyclopean(pair[0], pair[1], max_disparity=32, confidence=True)
     paths = [tmp_path / "l.png", tmp_path / "r.png"]
     Image.fromarray(pair[0]).save(paths[0])
     Image.fromarray(pair[1]).save(paths[1])
     out = tmp_path / "out"
     done = subprocess.run([str(cli), "cyclopean", "--left-rgb", str(paths[0]), "--right-rgb", str(paths[1]),
-                           "--max-disparity", "32", "--out-dir", str(out)], capture_output=True, text=True)
+                           "--max-disparity", "32", "--confidence", "--out-dir", str(out)],
+                          capture_output=True, text=True)
     assert done.returncode == 0, done.stderr
     assert np.array_equal(view["rgb"], np.asarray(Image.open(out / "middle_rgb.png").convert("RGB")))
+    # confidence=True: each eye's matcher confidence, the CLI's --confidence files exactly.
+    for eye in ("left", "right"):
+        c = view[f"{eye}_confidence"]
+        assert c.dtype == np.float32 and c.shape == pair[0].shape[:2]
+        assert 0.0 <= c.min() and c.max() <= 1.0 and c.max() > 0.5
+        assert depth_difference(cli, out / f"{eye}_confidence.exr", c, tmp_path) == (0.0, 0)
+    plain = renderer.cyclopean(pair[0], pair[1], max_disparity=32)
+    assert "left_confidence" not in plain and np.array_equal(plain["rgb"], view["rgb"])
+    with pytest.raises(vs.InvalidInputError) as err:
+        renderer.cyclopean(*pair, confidence=True)
+    assert err.value.parameter == "confidence" and "two images alone" in str(err.value)
     assert np.array_equal(view["mask"], np.asarray(Image.open(out / "middle_mask.png")) == 255)
     assert view["coverage"] > 0.5
     with pytest.raises(vs.InvalidInputError) as err:

@@ -210,6 +210,20 @@ pub fn cyclopean_bench(
         |r| r.render(&mid),
     )?;
     record(crate::eval::cyclopean::SPLAT_NAME, splat);
+    // --fill on the default method's view: what a complete spectator frame adds to it.
+    let (view, _) = crate::cyclopean::splat::SplatRenderer::new(
+        gpu,
+        &frame,
+        crate::cyclopean::splat::SplatParams::default(),
+        crate::cyclopean::CyclopeanOutputs::default(),
+    )?
+    .render(&mid)?;
+    let fill = setup_and_median(
+        repeats,
+        || crate::cyclopean::fill::Filler::new(gpu),
+        |f| f.fill(&view, mid.width, mid.height),
+    )?;
+    record("--fill alone (on the splat-gather view; add to its row)", fill);
     // The census matcher on a pair of this size: what a user without disparities pays before
     // any of the methods above (GPU pass, then its CPU twin as the baseline).
     let (left, right, _) = matcher::synthetic_pair(width, height)?;
@@ -222,6 +236,15 @@ pub fn cyclopean_bench(
     record(
         &format!("census matcher, GPU pass (both eyes, search 0-{max_d} px)"),
         on_gpu,
+    );
+    let with_confidence = setup_and_median(
+        repeats,
+        || crate::cyclopean::matcher::Matcher::new(gpu, width, height, max_d),
+        |m| m.estimate_with_confidence(&left, &right),
+    )?;
+    record(
+        &format!("census matcher + confidence stage, GPU pass (both eyes, search 0-{max_d} px)"),
+        with_confidence,
     );
     let on_cpu = setup_and_median(
         repeats.min(3),

@@ -350,6 +350,22 @@ pub fn write_view(set: &mut FileSet, names: &ViewNames, view: &ViewOutput, forma
     write_view_in(set, names, view, formats)
 }
 
+/// A per-pixel float map that is not a depth (the matcher's confidence, say) as `name` in `set`:
+/// one channel "Y" (OpenEXR's name for a single grey channel), f32, ZIP, rows top-down.
+pub fn write_float_exr(set: &mut FileSet, name: &str, map: &crate::io::DepthMap) -> Result<std::path::PathBuf> {
+    let shown = set.final_path(name);
+    set.write(name, |out| {
+        super::exr_io::write_f32_channels(
+            &shown,
+            out,
+            map.width,
+            map.height,
+            vec![("Y", map.data.clone())],
+            super::ExrCompression::Zip,
+        )
+    })
+}
+
 fn missing(what: &str) -> Error {
     Error::param(
         "outputs",

@@ -314,8 +314,32 @@ fn cyclopean_stitch_and_scene_write_exactly_the_files_their_help_names() {
                 files: view_files("middle", &outputs, &["exr"], "png", false),
             }
         })
-        .collect();
+        .collect::<Vec<_>>();
+    // Two images alone (the matcher's disparities: no metric depth) with each eye's confidence.
+    let mut rows = rows;
+    for outputs in [vec!["rgb"], vec!["mask"], vec!["rgb", "mask"]] {
+        let mut files = view_files("middle", &outputs, &["exr"], "png", false);
+        files.extend(strs(&viewsynth::job::cyclopean::CONFIDENCE_FILES));
+        rows.push(Row {
+            args: strs(&[
+                "--left-rgb",
+                &s("left_rgb.png"),
+                "--right-rgb",
+                &s("right_rgb.png"),
+                "--outputs",
+                &outputs.join(","),
+                "--confidence",
+            ]),
+            files,
+        });
+    }
     check("cyclopean", str::to_string, rows, &d);
+    // Depth input has no matcher, so no confidence to write.
+    let out = d.join("refused").display().to_string();
+    let mut args: Vec<&str> = base.iter().map(String::as_str).collect();
+    args.extend(["--confidence", "--out-dir", &out]);
+    args.insert(0, "cyclopean");
+    refused(&args, "--confidence");
     let base = strs(&[
         "--scene",
         "demo",

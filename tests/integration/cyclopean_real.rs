@@ -766,11 +766,42 @@ fn cli_two_images_alone_render_the_matchers_disparities() {
     io::save_depth_npy(&dl_file, &dl).unwrap();
     io::save_depth_npy(&dr_file, &dr).unwrap();
     let (alone, given) = (out.join("alone"), out.join("given"));
+    // With --confidence: the view must not change (compared with the given disparities below).
     let o = viewsynth(
-        &["--max-disparity", "64"],
+        &["--max-disparity", "64", "--confidence"],
         &[("--left-rgb", &l), ("--right-rgb", &r), ("--out-dir", &alone)],
     );
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    // Each eye's confidence file holds the matcher's confidence stage: its twin on the twin's
+    // disparities, within the stage's GPU-vs-twin bound (1e-4, derived beside CONFIDENCE_BOUND
+    // in tests/integration/matcher.rs), and exactly 0 where the disparity is unknown.
+    let twin = viewsynth::cyclopean::matcher::confidence_reference(&dl, &dr).unwrap();
+    for (name, want, d) in [
+        ("left_confidence.exr", &twin.0, &dl),
+        ("right_confidence.exr", &twin.1, &dr),
+    ] {
+        let got = io::load_depth(&alone.join(name), &io::DepthDecode::default()).unwrap();
+        assert_eq!((got.width, got.height), (want.width, want.height), "{name}");
+        let worst = got
+            .data
+            .iter()
+            .zip(&want.data)
+            .map(|(a, b)| (a - b).abs())
+            .fold(0.0f32, f32::max);
+        assert!(worst <= 1e-4, "{name}: off the twin by up to {worst:e}");
+        let unknown_nonzero = got
+            .data
+            .iter()
+            .zip(&d.data)
+            .filter(|(c, d)| **d <= 0.0 && **c != 0.0)
+            .count();
+        assert_eq!(unknown_nonzero, 0, "{name}: confidence where the disparity is unknown");
+        assert!(
+            got.data.iter().all(|c| (0.0..=1.0).contains(c)),
+            "{name}: outside [0, 1]"
+        );
+        assert!(got.data.iter().any(|c| *c > 0.5), "{name}: no confident pixel");
+    }
     let o = viewsynth(
         &[],
         &[
@@ -814,6 +845,17 @@ fn cli_two_images_alone_render_the_matchers_disparities() {
         ],
     );
     assert!(e.contains("--max-disparity applies to two images alone"), "{e}");
+    let e = usage(
+        &["--confidence"],
+        &[
+            ("--left-rgb", &l),
+            ("--right-rgb", &r),
+            ("--left-disparity", &dl_file),
+            ("--right-disparity", &dr_file),
+            ("--out-dir", &bad),
+        ],
+    );
+    assert!(e.contains("--confidence applies to two images alone"), "{e}");
 
     // --min-confidence trades coverage for precision: fewer pixels, and those kept are the
     // ones the matcher trusts, so the view's error against im4 on them is no worse.

@@ -1,6 +1,7 @@
 //! `cyclopean`: the middle (spectator) view of a stereo pair, from a rectified pair with
 //! disparities or from any pair with depth and a camera file. The options become a
-//! [`CyclopeanJob`]; running it writes `middle_{rgb,depth,mask}` all-or-none.
+//! [`CyclopeanJob`]; running it writes `middle_{rgb,depth,mask}` (and, two images alone,
+//! `{left,right}_confidence.exr`) all-or-none.
 
 use super::{ArgError, Backend, Event, GpuRequest, Host, JobError};
 use crate::convention::{Conventions, DepthPlanes};
@@ -13,7 +14,12 @@ use std::path::{Path, PathBuf};
 
 mod request;
 
-pub use request::{CyclopeanPlan, CyclopeanRequest, InputName, StereoGiven, StereoInput, StereoKind, Synthesised};
+pub use request::{
+    CyclopeanPlan, CyclopeanRequest, Framed, InputName, StereoGiven, StereoInput, StereoKind, Synthesised,
+};
+
+/// The files of each eye's matcher confidence (`--confidence`), left then right.
+pub const CONFIDENCE_FILES: [&str; 2] = ["left_confidence.exr", "right_confidence.exr"];
 
 /// How the middle view is synthesised.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, serde::Deserialize)]
@@ -232,7 +238,12 @@ impl CyclopeanJob {
         // The GPU before the folder: two images alone are matched on it, and a refused input
         // leaves no folder behind.
         let device = host.open_device(&self.gpu, self.backend)?;
-        let (frame, mid, fixation) = self.plan.frame(&device, input, names)?;
+        let Framed {
+            frame,
+            mid,
+            fixation,
+            confidence,
+        } = self.plan.frame(&device, input, names)?;
         if let (Some(cameras), Some((left_map, right_map))) = (&self.cameras, &self.maps) {
             for (path, eye) in [(left_map, &frame.left), (right_map, &frame.right)] {
                 let hint = format!(
@@ -255,6 +266,9 @@ impl CyclopeanJob {
         };
         let mut set = out_dir.file_set()?;
         io::write_view(&mut set, &io::ViewNames::tagged("middle"), &done.view, &formats)?;
+        for (name, map) in CONFIDENCE_FILES.iter().zip(confidence.iter().flatten()) {
+            io::write_float_exr(&mut set, name, map)?;
+        }
         let written = set.commit()?;
         Ok(CyclopeanReport {
             width: mid.width,

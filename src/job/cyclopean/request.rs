@@ -59,6 +59,9 @@ pub struct CyclopeanRequest {
     /// the eyes' agreement and the local spread) is below this are dropped, trading coverage
     /// for precision; none keeps every disparity the left-right check kept.
     pub min_confidence: Option<f64>,
+    /// Two images alone: also give each eye's matcher confidence (a float map in [0, 1], 0 where
+    /// the disparity is unknown), the same values `min_confidence` is held against.
+    pub confidence: bool,
 }
 
 /// The matcher's search range for two images alone when none is given: a sixth of the width
@@ -160,6 +163,7 @@ pub struct CyclopeanPlan {
     fill: bool,
     max_disparity: Option<u32>,
     min_confidence: Option<f64>,
+    confidence: bool,
 }
 
 /// `--dominant`'s `eye:weight`.
@@ -209,6 +213,7 @@ impl CyclopeanRequest {
         for (flag, given) in [
             ("--max-disparity", self.max_disparity.is_some()),
             ("--min-confidence", self.min_confidence.is_some()),
+            ("--confidence", self.confidence),
         ] {
             if given && kind != StereoKind::Images {
                 return Err(ArgError::MatcherOptionWithMaps(flag));
@@ -272,6 +277,7 @@ impl CyclopeanRequest {
             fill: self.fill,
             max_disparity: self.max_disparity,
             min_confidence: self.min_confidence,
+            confidence: self.confidence,
         })
     }
 
@@ -313,15 +319,28 @@ impl CyclopeanRequest {
     }
 }
 
-/// An eye's estimated disparities with those below `min` confidence made unknown (0).
-fn confident(eye: EyeEstimate, min: f64) -> DepthMap {
-    let mut d = eye.disparity;
-    for (v, c) in d.data.iter_mut().zip(&eye.confidence.data) {
+/// An eye's estimated disparities with those below `min` confidence (if any) made unknown (0).
+fn confident(eye: &mut EyeEstimate, min: Option<f64>) {
+    let Some(min) = min else { return };
+    for (v, c) in eye.disparity.data.iter_mut().zip(&eye.confidence.data) {
         if f64::from(*c) < min {
             *v = 0.0;
         }
     }
-    d
+}
+
+/// A frame ready to render.
+pub struct Framed {
+    /// Both eyes, placed.
+    pub frame: StereoFrame,
+    /// The view's camera.
+    pub mid: MiddleCamera,
+    /// Where the seed/refine methods start: the median depth the left eye saw, or the camera
+    /// file's fixation.
+    pub fixation: f64,
+    /// Two images alone with `confidence` asked for: the matcher's confidence of the left and
+    /// the right eye (rows top-down, in [0, 1], 0 where the disparity is unknown).
+    pub confidence: Option<[DepthMap; 2]>,
 }
 
 /// The decoded inputs of one view, each eye's colour with its disparity or depth.
@@ -409,19 +428,23 @@ impl CyclopeanPlan {
     /// depth the left eye saw (disparities), or the camera file's fixation. `names` name the
     /// left and right colour, the left disparity or depth and the cameras in messages. Two
     /// images alone are matched on `device` (the census matcher's GPU pass, bit-exact with its
-    /// twin).
-    pub fn frame(
-        &self,
-        device: &Device,
-        input: StereoInput,
-        names: [InputName; 4],
-    ) -> crate::Result<(StereoFrame, MiddleCamera, f64)> {
+    /// twin), with each eye's confidence when the request asked for it.
+    pub fn frame(&self, device: &Device, input: StereoInput, names: [InputName; 4]) -> crate::Result<Framed> {
         let [left_rgb, right_rgb, left_map, cameras_name] = names;
+        let framed = |(frame, mid, fixation), confidence| Framed {
+            frame,
+            mid,
+            fixation,
+            confidence,
+        };
         match input {
-            StereoInput::Disparity { left, right } => self.disparity_frame(left, right, left_map),
+            StereoInput::Disparity { left, right } => Ok(framed(self.disparity_frame(left, right, left_map)?, None)),
             StereoInput::Images { left, right } => {
-                let (dl, dr) = self.estimate(device, &left, &right, left_rgb)?;
-                self.disparity_frame((left, dl), (right, dr), left_map)
+                let (dl, dr, confidence) = self.estimate(device, &left, &right, left_rgb)?;
+                Ok(framed(
+                    self.disparity_frame((left, dl), (right, dr), left_map)?,
+                    confidence,
+                ))
             }
             StereoInput::Cameras { left, right, cameras } => {
                 left_rgb.check_size(&cameras.left, left.0.width, left.0.height)?;
@@ -441,20 +464,20 @@ impl CyclopeanPlan {
                     depth_kind: cameras.depth_kind,
                     conv: cameras.conventions,
                 };
-                Ok((frame, mid, fixation))
+                Ok(framed((frame, mid, fixation), None))
             }
         }
     }
 
     /// Both eyes' disparities of a pair alone, by the census matcher on `device` (those below
-    /// the minimum confidence made unknown).
+    /// the minimum confidence made unknown), and their confidence when asked for.
     fn estimate(
         &self,
         device: &Device,
         left: &RgbImage,
         right: &RgbImage,
         left_rgb: InputName,
-    ) -> crate::Result<(DepthMap, DepthMap)> {
+    ) -> crate::Result<(DepthMap, DepthMap, Option<[DepthMap; 2]>)> {
         let max = self.max_disparity.unwrap_or(default_max_disparity(left.width));
         if max >= left.width {
             return Err(left_rgb.error(format!(
@@ -463,13 +486,16 @@ impl CyclopeanPlan {
             )));
         }
         let mut matcher = Matcher::new(device, left.width, left.height, max)?;
-        Ok(match self.min_confidence {
-            None => matcher.estimate(left, right)?,
-            Some(min) => {
-                let [l, r] = matcher.estimate_with_confidence(left, right)?;
-                (confident(l, min), confident(r, min))
-            }
-        })
+        // The confidence stage runs only when something reads it.
+        if self.min_confidence.is_none() && !self.confidence {
+            let (l, r) = matcher.estimate(left, right)?;
+            return Ok((l, r, None));
+        }
+        let [mut l, mut r] = matcher.estimate_with_confidence(left, right)?;
+        confident(&mut l, self.min_confidence);
+        confident(&mut r, self.min_confidence);
+        let confidence = self.confidence.then(|| [l.confidence, r.confidence]);
+        Ok((l.disparity, r.disparity, confidence))
     }
 
     /// A rectified pair with disparities: the frame, the view and the seed's fixation (the

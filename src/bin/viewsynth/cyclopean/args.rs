@@ -127,7 +127,13 @@ pub(crate) struct CyclopeanArgs {
     /// of them right.
     #[arg(help_heading = INPUTS, long, value_name = "C", value_parser = finite_value)]
     min_confidence: Option<f64>,
-    /// Writes middle_rgb.png, middle_depth.exr, middle_mask.png (those in --outputs).
+    /// Two images alone: also write each eye's matcher confidence, left_confidence.exr and
+    /// right_confidence.exr (float32 in [0, 1]; 0 where the disparity is unknown), the values
+    /// --min-confidence is held against.
+    #[arg(help_heading = OUTPUTS, long)]
+    confidence: bool,
+    /// Writes middle_rgb.png, middle_depth.exr, middle_mask.png (those in --outputs), and
+    /// left_confidence.exr, right_confidence.exr with --confidence.
     #[arg(help_heading = OUTPUTS, long)]
     out_dir: PathBuf,
     #[command(flatten)]
@@ -163,6 +169,7 @@ impl CyclopeanArgs {
             fill: self.fill,
             max_disparity: self.max_disparity,
             min_confidence: self.min_confidence,
+            confidence: self.confidence,
         })
     }
 }
