@@ -494,7 +494,7 @@ impl CyclopeanPlan {
         let [mut l, mut r] = matcher.estimate_with_confidence(left, right)?;
         confident(&mut l, self.min_confidence);
         confident(&mut r, self.min_confidence);
-        let confidence = self.confidence.then(|| [l.confidence, r.confidence]);
+        let confidence = self.confidence.then_some([l.confidence, r.confidence]);
         Ok((l.disparity, r.disparity, confidence))
     }
 
