@@ -35,18 +35,11 @@ crate::param_block! {
 /// surface, and the hole is interpolated between them instead of copied from the farther.
 pub const SAME_SURFACE: f32 = 0.05;
 
-/// The inputs of one size, rewritten for each view.
-struct Inputs {
-    size: (u32, u32),
-    color: Image,
-    depth: Image,
-    sources: Image,
-}
-
 /// Fills middle views on one device.
 pub struct Filler {
     device: Device,
-    inputs: Option<Inputs>,
+    /// Colour, depth and sources of the last view, rewritten in place for the next of its size.
+    inputs: [Option<Image>; 3],
 }
 
 /// Colour and depth of `out`, both needed: depth chooses the side, colour is what is filled.
@@ -65,7 +58,7 @@ impl Filler {
     pub fn new(device: impl ToDevice) -> Result<Self> {
         Ok(Filler {
             device: device.to_device()?,
-            inputs: None,
+            inputs: [None, None, None],
         })
     }
 
@@ -75,37 +68,20 @@ impl Filler {
         let (w, h) = (width, height);
         let rgba = crate::gpu::pixels::rgb_to_rgba(&color.data);
         let depth_bytes: &[u8] = bytemuck::cast_slice(&depth.data);
-        let d = &self.device;
-        // Rewritten in place when the size is the last call's, else made anew (the old ones
-        // freed first); a failed write leaves none, so the next call uploads.
-        let inputs = match self.inputs.take() {
-            Some(i) if i.size == (w, h) => {
-                d.write_image(&i.color, &rgba)?;
-                d.write_image(&i.depth, depth_bytes)?;
-                d.write_image(&i.sources, &out.sources)?;
-                i
-            }
-            old => {
-                drop(old);
-                let image = |format, bytes, label| {
-                    d.upload(&ImageData {
-                        width: w,
-                        height: h,
-                        format,
-                        bytes,
-                        label,
-                    })
-                };
-                Inputs {
-                    size: (w, h),
-                    color: image(Format::Rgba8, &rgba, "fill colour")?,
-                    depth: image(Format::R32F, depth_bytes, "fill depth")?,
-                    sources: image(Format::R8Ui, &out.sources, "fill sources")?,
-                }
-            }
+        let image = |format, bytes, label| ImageData {
+            width: w,
+            height: h,
+            format,
+            bytes,
+            label,
         };
-        let images = [inputs.color.id(), inputs.depth.id(), inputs.sources.id()];
-        self.inputs = Some(inputs);
+        let [color_slot, depth_slot, sources_slot] = &mut self.inputs;
+        let d = &self.device;
+        let images = [
+            d.put_image(color_slot, &image(Format::Rgba8, &rgba, "fill colour"))?,
+            d.put_image(depth_slot, &image(Format::R32F, depth_bytes, "fill depth"))?,
+            d.put_image(sources_slot, &image(Format::R8Ui, &out.sources, "fill sources"))?,
+        ];
         let params = FillParams {
             u_size: [w as i32, h as i32],
             u_filled: FILLED.into(),

@@ -373,7 +373,27 @@ impl Device {
         Ok(Image {
             device: self.clone(),
             id,
+            shape: (image.width, image.height, image.format),
         })
+    }
+
+    /// `image` into the one `slot` holds: its texels rewritten in place when it has `image`'s
+    /// size and format (a steady-state frame allocates nothing), else the old image freed
+    /// before the new one is uploaded (peak memory holds one). A failed write or upload leaves
+    /// the slot empty, so the next call uploads anew. Returns the id of the image now held.
+    pub fn put_image(&self, slot: &mut Option<Image>, image: &ImageData) -> Result<ImageId> {
+        let shape = (image.width, image.height, image.format);
+        let held = match slot.take() {
+            Some(old) if old.shape == shape => {
+                self.write_image(&old, image.bytes)?;
+                old
+            }
+            old => {
+                drop(old);
+                self.upload(image)?
+            }
+        };
+        Ok(slot.insert(held).id)
     }
 
     /// Run one pass: `draws` into `target`, outputs read back top-down.
@@ -431,6 +451,7 @@ impl Device {
         Ok(Image {
             device: self.clone(),
             id,
+            shape: (width, height, format),
         })
     }
 
@@ -501,6 +522,8 @@ impl Drop for Buffer {
 pub struct Image {
     device: Device,
     id: ImageId,
+    /// Width, height and texel format, as made.
+    shape: (u32, u32, Format),
 }
 
 impl Image {

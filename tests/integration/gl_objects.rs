@@ -144,3 +144,35 @@ fn a_second_identical_cyclopean_frame_allocates_no_gl_objects() {
         assert_eq!(g.live_objects(), warm);
     }
 }
+
+/// `Device::put_image`: an image of the held one's size and format is rewritten in place (same
+/// id, no texture made); another shape frees the old before uploading (one texture held); a
+/// refused upload leaves the slot empty, so the next call uploads anew.
+#[test]
+fn put_image_rewrites_in_place_and_replaces_on_a_new_shape() {
+    use viewsynth::pass::{Device, Format, ImageData};
+    let g = gpu();
+    let d = Device::gl(&g).unwrap();
+    let data = |width, height, format, bytes| ImageData {
+        width,
+        height,
+        format,
+        bytes,
+        label: "put_image test",
+    };
+    let before = g.live_objects().textures;
+    let mut slot = None;
+    let a = d.put_image(&mut slot, &data(4, 2, Format::R32F, &[0u8; 32])).unwrap();
+    assert_eq!(g.live_objects().textures, before + 1);
+    let b = d.put_image(&mut slot, &data(4, 2, Format::R32F, &[7u8; 32])).unwrap();
+    assert_eq!((a, g.live_objects().textures), (b, before + 1), "same shape: rewritten");
+    d.put_image(&mut slot, &data(2, 2, Format::R32F, &[0u8; 16])).unwrap();
+    assert_eq!(g.live_objects().textures, before + 1, "new size: the old one freed");
+    d.put_image(&mut slot, &data(2, 2, Format::Rgba8, &[0u8; 16])).unwrap();
+    assert_eq!(g.live_objects().textures, before + 1, "new format: the old one freed");
+    assert!(d.put_image(&mut slot, &data(2, 2, Format::Rgba8, &[0u8; 3])).is_err());
+    assert!(slot.is_none(), "a failed write empties the slot");
+    assert_eq!(g.live_objects().textures, before);
+    d.put_image(&mut slot, &data(2, 2, Format::Rgba8, &[0u8; 16])).unwrap();
+    assert_eq!(g.live_objects().textures, before + 1);
+}

@@ -301,6 +301,11 @@ fn a_steady_state_frame_creates_nothing_on_either_api() {
             refocuser(viewsynth::refocus::Method::Fullscreen),
             refocuser(viewsynth::refocus::Method::Mesh),
         );
+        // The fill's input: a splat-gather view. Its first fill uploads the images; the frames
+        // below rewrite them (the first rewrite sizes the flight's staging arena).
+        let view = splat.render(&mid).unwrap().0;
+        let mut filler = viewsynth::cyclopean::fill::Filler::new(d).unwrap();
+        drop(filler.fill(&view, mid.width, mid.height).unwrap());
         let stitch_params = StitchParams {
             method: StitchMethod::Reproject,
             overlap_deg: 10.0,
@@ -311,6 +316,10 @@ fn a_steady_state_frame_creates_nothing_on_either_api() {
             ("gather", Box::new(|| drop(gather.render(&mid).unwrap()))),
             ("splat-gather", Box::new(|| drop(splat.render(&mid).unwrap()))),
             ("forward", Box::new(|| drop(forward.render(&mid).unwrap()))),
+            (
+                "fill",
+                Box::new(|| drop(filler.fill(&view, mid.width, mid.height).unwrap())),
+            ),
             ("reproject shift", Box::new(|| drop(shift.render().unwrap()))),
             ("stitch", Box::new(|| drop(stitch.render(&stitch_params).unwrap()))),
             ("ray tracer", Box::new(|| drop(tracer.render(&cam).unwrap()))),

@@ -46,12 +46,6 @@ fn disparity(out: &mut Rendered, k: usize) -> Result<DepthMap> {
 /// fill 128 MiB, llvmpipe's storage-block limit and the smallest we run on.
 pub const MAX_PIXELS: usize = 1 << 23;
 
-/// The pair's images on the device, rewritten for each pair.
-struct Inputs {
-    left: Image,
-    right: Image,
-}
-
 /// Estimates both eyes' disparities of rectified pairs of one size on a device.
 pub struct Matcher {
     device: Device,
@@ -60,7 +54,7 @@ pub struct Matcher {
     max_disparity: u32,
     /// Disparity pairs (16-bit lanes of one word) per chunk.
     chunk_pairs: u32,
-    inputs: Option<Inputs>,
+    inputs: [Option<Image>; 2],
     /// Both eyes' grey levels, one word a pixel.
     greys: Buffer,
     /// Census codes, 4 words a pixel.
@@ -110,7 +104,7 @@ impl Matcher {
             width,
             height,
             max_disparity,
-            inputs: None,
+            inputs: [None, None],
         })
     }
 
@@ -246,35 +240,23 @@ impl Matcher {
         self.device.run(Some(&target), &steps)
     }
 
-    /// Upload the pair (first time) or rewrite the images in place.
+    /// The pair on the device: uploaded the first time, rewritten in place after.
     fn set_inputs(&mut self, left: &RgbImage, right: &RgbImage) -> Result<[ImageId; 2]> {
+        let image = |bytes, label| ImageData {
+            width: self.width,
+            height: self.height,
+            format: Format::Rgba8,
+            bytes,
+            label,
+        };
         let (l, r) = (
             crate::gpu::pixels::rgb_to_rgba(&left.data),
             crate::gpu::pixels::rgb_to_rgba(&right.data),
         );
-        // A failed rewrite drops the images: the next pair uploads them anew.
-        if let Some(i) = self.inputs.take() {
-            self.device.write_image(&i.left, &l)?;
-            self.device.write_image(&i.right, &r)?;
-            let ids = [i.left.id(), i.right.id()];
-            self.inputs = Some(i);
-            return Ok(ids);
-        }
-        let upload = |bytes: &[u8], label| {
-            self.device.upload(&ImageData {
-                width: self.width,
-                height: self.height,
-                format: Format::Rgba8,
-                bytes,
-                label,
-            })
-        };
-        let i = Inputs {
-            left: upload(&l, "matcher left image")?,
-            right: upload(&r, "matcher right image")?,
-        };
-        let ids = [i.left.id(), i.right.id()];
-        self.inputs = Some(i);
-        Ok(ids)
+        let [left_slot, right_slot] = &mut self.inputs;
+        Ok([
+            self.device.put_image(left_slot, &image(&l, "matcher left image"))?,
+            self.device.put_image(right_slot, &image(&r, "matcher right image"))?,
+        ])
     }
 }
