@@ -228,24 +228,20 @@ pub fn cyclopean_bench(
     // any of the methods above (GPU pass, then its CPU twin as the baseline).
     let (left, right, _) = matcher::synthetic_pair(width, height)?;
     let max_d = MATCHER_BENCH_MAX_DISPARITY;
-    let on_gpu = setup_and_median(
-        repeats,
-        || crate::cyclopean::matcher::Matcher::new(gpu, width, height, max_d),
-        |m| m.estimate(&left, &right),
-    )?;
-    record(
-        &format!("census matcher, GPU pass (both eyes, search 0-{max_d} px)"),
-        on_gpu,
-    );
-    let with_confidence = setup_and_median(
-        repeats,
-        || crate::cyclopean::matcher::Matcher::new(gpu, width, height, max_d),
-        |m| m.estimate_with_confidence(&left, &right),
-    )?;
-    record(
-        &format!("census matcher + confidence stage, GPU pass (both eyes, search 0-{max_d} px)"),
-        with_confidence,
-    );
+    for (stages, confidence) in [(", GPU pass", false), (" + confidence stage, GPU pass", true)] {
+        let timing = setup_and_median(
+            repeats,
+            || crate::cyclopean::matcher::Matcher::new(gpu, width, height, max_d),
+            |m| match confidence {
+                false => m.estimate(&left, &right).map(drop),
+                true => m.estimate_with_confidence(&left, &right).map(drop),
+            },
+        )?;
+        record(
+            &format!("census matcher{stages} (both eyes, search 0-{max_d} px)"),
+            timing,
+        );
+    }
     let on_cpu = setup_and_median(
         repeats.min(3),
         || Ok(()),
