@@ -21,7 +21,7 @@ use crate::convention::{Conventions, DepthPlanes};
 use crate::error::{Error, Result};
 use crate::gpu::{ProgramKind, ShaderProgram, Timing};
 use crate::io::{DepthMap, Mask, RgbImage};
-use crate::pass::{mat4_std140, Device, Draw, Format, Image, ImageData, Pending, Step, Target, ToDevice};
+use crate::pass::{mat4_std140, Device, Draw, Format, Image, ImageData, ImageId, Pending, Step, Target, ToDevice};
 use std::time::Instant;
 
 /// Output sizes whose lookup images are kept (a batch uses one; a sweep over sizes a few).
@@ -59,21 +59,31 @@ pub struct RefocusOutput {
     pub readback_ms: f64,
 }
 
-/// The uploaded source.
+/// The uploaded source: its camera and the images that hold it (in [`SourceImages`]).
 struct Source {
     camera: PinholeCamera,
     planes: DepthPlanes,
-    /// Colour; None when colour is not asked for (the programs then never read it, and the depth
-    /// image is bound in its slot: no upload, no texture).
-    rgb: Option<Image>,
-    depth: Image,
+    /// Colour; the depth image when colour is not asked for (the programs then never read it:
+    /// no upload, no texture).
+    rgb: ImageId,
+    depth: ImageId,
     geometry: Geometry,
 }
 
 /// Per method: the full-screen pass's coverage flags, or the mesh pass's triangles.
 enum Geometry {
-    Fullscreen { keep: Image },
+    Fullscreen { keep: ImageId },
     Mesh(MeshGeometry),
+}
+
+/// The images sources are written into, kept from source to source: rewritten in place while
+/// the size stays (a batch frame makes none), all freed before a source of another size.
+#[derive(Default)]
+struct SourceImages {
+    rgb: Option<Image>,
+    depth: Option<Image>,
+    /// The full-screen method's coverage flags.
+    keep: Option<Image>,
 }
 
 /// The lookup images of one output size.
@@ -92,6 +102,7 @@ pub struct Refocuser {
     rule: BreakRule,
     method: Method,
     source: Option<Source>,
+    images: SourceImages,
     /// Most recently used last.
     lookups: Vec<Lookups>,
 }
@@ -167,6 +178,7 @@ impl Refocuser {
             rule: *rule,
             method,
             source: None,
+            images: SourceImages::default(),
             lookups: Vec::new(),
         })
     }
@@ -191,58 +203,45 @@ impl Refocuser {
         crate::gpu::check_image_size("source size", w.into(), h.into(), max_side.saturating_sub(1))?;
         let grid = Grid { width: w, height: h };
         let keep = grid.keep_mask(&src.depth.data, &self.rule);
-        let same_size = self
+        if self
             .source
             .as_ref()
-            .is_some_and(|s| (s.camera.width, s.camera.height) == (w, h));
-        let previous = if same_size { self.source.take() } else { None };
-        self.source = None; // free a differently sized source before allocating
+            .is_some_and(|s| (s.camera.width, s.camera.height) != (w, h))
+        {
+            self.images = SourceImages::default(); // free a differently sized source before allocating
+        }
+        self.source = None; // and the previous triangles before uploading new ones
         let rgba: Option<Vec<u8>> = self.outputs.rgb.then(|| crate::gpu::pixels::rgb_to_rgba(&src.rgb.data));
         let depth_bytes: &[u8] = bytemuck::cast_slice(&src.depth.data);
         let (cx, cy) = (grid.cells_x() as u32, grid.cells_y() as u32);
-        let d = &self.device;
-        let upload = |width, height, format, bytes: &[u8], label| {
-            d.upload(&ImageData {
-                width,
-                height,
-                format,
-                bytes,
-                label,
-            })
+        let data = |width, height, format, bytes, label| ImageData {
+            width,
+            height,
+            format,
+            bytes,
+            label,
         };
-        let flags = |method| (method == Method::Fullscreen).then(|| grid.coverage_flags(&keep));
-        let (rgb, depth, geometry) = match previous {
-            Some(p) => {
-                if let (Some(image), Some(texels)) = (&p.rgb, &rgba) {
-                    d.write_image(image, texels)?;
+        let (d, images) = (&self.device, &mut self.images);
+        let rgb = match &rgba {
+            Some(texels) => Some(d.put_image(
+                &mut images.rgb,
+                &data(w, h, Format::Rgba8, texels, "refocus source rgb"),
+            )?),
+            None => None,
+        };
+        let depth = d.put_image(
+            &mut images.depth,
+            &data(w, h, Format::R32F, depth_bytes, "refocus source depth"),
+        )?;
+        let geometry = match self.method {
+            Method::Fullscreen => {
+                let flags = grid.coverage_flags(&keep);
+                let data = data(cx, cy, Format::R8Ui, &flags, "refocus coverage flags");
+                Geometry::Fullscreen {
+                    keep: d.put_image(&mut images.keep, &data)?,
                 }
-                d.write_image(&p.depth, depth_bytes)?;
-                let geometry = match (p.geometry, flags(self.method)) {
-                    (Geometry::Fullscreen { keep }, Some(f)) => {
-                        d.write_image(&keep, &f)?;
-                        Geometry::Fullscreen { keep }
-                    }
-                    (old, _) => {
-                        drop(old); // free the previous triangles before uploading the new ones
-                        Geometry::Mesh(MeshGeometry::new(d, &grid, &keep, max_side)?)
-                    }
-                };
-                (p.rgb, p.depth, geometry)
             }
-            None => {
-                let rgb = match &rgba {
-                    Some(texels) => Some(upload(w, h, Format::Rgba8, texels, "refocus source rgb")?),
-                    None => None,
-                };
-                let depth = upload(w, h, Format::R32F, depth_bytes, "refocus source depth")?;
-                let geometry = match flags(self.method) {
-                    Some(f) => Geometry::Fullscreen {
-                        keep: upload(cx, cy, Format::R8Ui, &f, "refocus coverage flags")?,
-                    },
-                    None => Geometry::Mesh(MeshGeometry::new(d, &grid, &keep, max_side)?),
-                };
-                (rgb, depth, geometry)
-            }
+            Method::Mesh => Geometry::Mesh(MeshGeometry::new(d, &grid, &keep, max_side)?),
         };
         // Every kept vertex lies in [min, max] of the valid depths; the factor 2 leaves room for
         // the expanded border of each triangle (which the vertex shader keeps within it).
@@ -256,7 +255,7 @@ impl Refocuser {
         self.source = Some(Source {
             camera: src.camera(),
             planes,
-            rgb,
+            rgb: rgb.unwrap_or(depth),
             depth,
             geometry,
         });
@@ -339,8 +338,7 @@ impl Refocuser {
         let params = bytemuck::bytes_of(&params);
         let want_rgb = self.outputs.rgb;
         let program = |kind| ShaderProgram::new(conv, kind);
-        let rgb = source.rgb.as_ref().unwrap_or(&source.depth);
-        let shared = [rgb.id(), source.depth.id(), cols_id, rows_id];
+        let shared = [source.rgb, source.depth, cols_id, rows_id];
         let with = |extra| [shared[0], shared[1], shared[2], shared[3], extra];
         let viewport = [0, 0, target.width, target.height];
         let draw = |kind, images, triangles, indices| {
@@ -358,7 +356,7 @@ impl Refocuser {
         let mut steps = Vec::with_capacity(2);
         match &source.geometry {
             Geometry::Fullscreen { keep } => {
-                keep_images = with(keep.id());
+                keep_images = with(*keep);
                 steps.push(draw(
                     ProgramKind::RefocusFullscreen { want_rgb },
                     &keep_images[..],
