@@ -61,6 +61,52 @@ def test_stubs_name_what_the_module_has():
     assert "manifest" in vs.load_manifest.__doc__
 
 
+def test_stub_signatures_are_the_modules():
+    """Every function and Renderer method of the stubs takes the module's parameters: the same
+    names in the same order, the same positional/keyword-only split and the same defaults (a
+    keyword argument added to the binding but not to the stubs fails here)."""
+    import inspect
+    from viewsynth import _viewsynth
+
+    tree = ast.parse((PACKAGE / "_viewsynth.pyi").read_text())
+
+    def stub_params(fn):
+        a = fn.args
+        positional = [p.arg for p in a.posonlyargs + a.args if p.arg != "self"]
+        pos_defaults = [None] * (len(a.posonlyargs + a.args) - len(a.defaults)) + list(a.defaults)
+        pos_defaults = pos_defaults[len(a.posonlyargs + a.args) - len(positional):]
+        rows = [(n, "positional", d) for n, d in zip(positional, pos_defaults)]
+        rows += [(p.arg, "keyword", d) for p, d in zip(a.kwonlyargs, a.kw_defaults)]
+        return [(n, kind, None if d is None else ast.literal_eval(d)) for n, kind, d in rows]
+
+    def runtime_params(obj):
+        rows = []
+        for p in inspect.signature(obj).parameters.values():
+            if p.name == "self":
+                continue
+            kind = "keyword" if p.kind == p.KEYWORD_ONLY else "positional"
+            rows.append((p.name, kind, None if p.default is p.empty else p.default))
+        return rows
+
+    checked = 0
+    for node in tree.body:
+        if isinstance(node, ast.FunctionDef) and hasattr(_viewsynth, node.name):
+            assert stub_params(node) == runtime_params(getattr(_viewsynth, node.name)), node.name
+            checked += 1
+        if isinstance(node, ast.ClassDef) and node.name == "Renderer":
+            for fn in node.body:
+                # Protocol methods (__enter__, __exit__, ...) are typed by the protocol's names.
+                if not isinstance(fn, ast.FunctionDef) or (fn.name.startswith("__") and fn.name != "__init__"):
+                    continue
+                # The constructor's signature is the class's own (pyo3's #[new]).
+                runtime = vs.Renderer if fn.name == "__init__" else getattr(vs.Renderer, fn.name, None)
+                if runtime is None or not getattr(runtime, "__text_signature__", None):
+                    continue
+                assert stub_params(fn) == runtime_params(runtime), f"Renderer.{fn.name}"
+                checked += 1
+    assert checked >= 7, checked
+
+
 def test_augment_example_draws_seeded_zooms():
     sys.path.insert(0, str(EXAMPLES))
     try:

@@ -38,7 +38,8 @@ class CyclopeanTimings(TypedDict):
 
 class CyclopeanView(TypedDict, total=False):
     """Renderer.cyclopean's result. "rgb", "depth", "mask" are present when requested,
-    "filled" with fill=True."""
+    "filled" with fill=True, "left_confidence" and "right_confidence" (each eye's matcher
+    confidence in [0, 1], 0 where the disparity is unknown) with confidence=True."""
 
     coverage: float
     timings: CyclopeanTimings
@@ -46,6 +47,8 @@ class CyclopeanView(TypedDict, total=False):
     depth: npt.NDArray[np.float32]
     mask: npt.NDArray[np.bool_]
     filled: npt.NDArray[np.bool_]
+    left_confidence: npt.NDArray[np.float32]
+    right_confidence: npt.NDArray[np.float32]
 
 class CameraDict(TypedDict, total=False):
     """One camera of a cameras.json: K (3x3, pixels), R (3x3) and t (3) world -> camera with
@@ -202,6 +205,7 @@ class Renderer:
         fill: bool = False,
         max_disparity: Optional[int] = None,
         min_confidence: Optional[float] = None,
+        confidence: bool = False,
     ) -> CyclopeanView:
         """Synthesise an in-between view of a stereo pair (rgb uint8[H, W, 3] per eye), as
         `viewsynth cyclopean`, from either
@@ -211,7 +215,10 @@ class Renderer:
         - depth: left_depth, right_depth float32[H, W] (view-z metres or device depth, as
           cameras["depth_kind"]) with cameras: a cameras.json path or a dict with its keys
           (eyes and view as K, R, t, width, height, near, far, or GL view/proj; fixation_distance
-          or gaze). The view is the middle camera's.
+          or gaze). The view is the middle camera's; or
+        - the two images alone: the disparities are estimated by the census matcher over
+          0..=max_disparity px; min_confidence drops the estimates it trusts less, and
+          confidence=True returns each eye's confidence ("left_confidence", "right_confidence").
         See help(viewsynth.Renderer.cyclopean)."""
         ...
     def gl_objects(self) -> GlObjectCounts:
@@ -272,7 +279,7 @@ class Renderer:
         frames: Union[str, "os.PathLike[str]", Sequence[Mapping[str, Any]]],
         out_dir: Union[str, "os.PathLike[str]"],
         *,
-        scales: Sequence[float] = (0.5, 0.75, 1.0, 1.5, 2.0),
+        scales: Optional[Sequence[float]] = None,
         size: Optional[Tuple[int, int]] = None,
         principal: Optional[Tuple[float, float]] = None,
         outputs: Optional[Union[OutputName, Sequence[OutputName]]] = None,
