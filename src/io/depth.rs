@@ -146,9 +146,26 @@ pub(crate) fn encode_depth_exr(
     depth: &DepthMap,
     compression: super::ExrCompression,
 ) -> Result<()> {
-    encode_dims(path, depth.width, depth.height, 1, depth.data.len())?;
-    let channels = vec![("Z", depth.data.clone())];
-    write_f32_channels(path, out, depth.width, depth.height, channels, compression)
+    encode_map_exr(path, out, depth, "Z", compression)
+}
+
+/// One f32 channel named `channel` holding `map`, rows top-down, into `out`; errors name `path`.
+pub(crate) fn encode_map_exr(
+    path: &Path,
+    out: &mut std::io::BufWriter<std::fs::File>,
+    map: &DepthMap,
+    channel: &str,
+    compression: super::ExrCompression,
+) -> Result<()> {
+    encode_dims(path, map.width, map.height, 1, map.data.len())?;
+    write_f32_channels(
+        path,
+        out,
+        map.width,
+        map.height,
+        vec![(channel, map.data.clone())],
+        compression,
+    )
 }
 
 /// Writes `<f4`, shape (height, width), C order, NPY 1.0.

@@ -355,14 +355,7 @@ pub fn write_view(set: &mut FileSet, names: &ViewNames, view: &ViewOutput, forma
 pub fn write_float_exr(set: &mut FileSet, name: &str, map: &crate::io::DepthMap) -> Result<std::path::PathBuf> {
     let shown = set.final_path(name);
     set.write(name, |out| {
-        super::exr_io::write_f32_channels(
-            &shown,
-            out,
-            map.width,
-            map.height,
-            vec![("Y", map.data.clone())],
-            super::ExrCompression::Zip,
-        )
+        super::depth::encode_map_exr(&shown, out, map, "Y", super::ExrCompression::Zip)
     })
 }
 

@@ -190,3 +190,8 @@ pub fn cyclopean_cli(
         .output()
         .unwrap()
 }
+
+/// Largest |a - b| over two maps of one length (0 for none).
+pub fn max_abs_difference(a: &[f32], b: &[f32]) -> f32 {
+    a.iter().zip(b).map(|(x, y)| (x - y).abs()).fold(0.0f32, f32::max)
+}

@@ -773,8 +773,8 @@ fn cli_two_images_alone_render_the_matchers_disparities() {
     );
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
     // Each eye's confidence file holds the matcher's confidence stage: its twin on the twin's
-    // disparities, within the stage's GPU-vs-twin bound (1e-4, derived beside CONFIDENCE_BOUND
-    // in tests/integration/matcher.rs), and exactly 0 where the disparity is unknown.
+    // disparities, within the stage's GPU-vs-twin bound (CONFIDENCE_BOUND, derived beside it in
+    // tests/integration/matcher.rs), and exactly 0 where the disparity is unknown.
     let twin = viewsynth::cyclopean::matcher::confidence_reference(&dl, &dr).unwrap();
     for (name, want, d) in [
         ("left_confidence.exr", &twin.0, &dl),
@@ -782,13 +782,19 @@ fn cli_two_images_alone_render_the_matchers_disparities() {
     ] {
         let got = io::load_depth(&alone.join(name), &io::DepthDecode::default()).unwrap();
         assert_eq!((got.width, got.height), (want.width, want.height), "{name}");
-        let worst = got
-            .data
-            .iter()
-            .zip(&want.data)
-            .map(|(a, b)| (a - b).abs())
-            .fold(0.0f32, f32::max);
-        assert!(worst <= 1e-4, "{name}: off the twin by up to {worst:e}");
+        let worst = crate::common::max_abs_difference(&got.data, &want.data);
+        viewsynth::eval::image_check::ensure(
+            worst <= crate::matcher::CONFIDENCE_BOUND,
+            &format!("cli confidence {name}"),
+            want.width,
+            want.height,
+            &[(
+                "confidence",
+                viewsynth::eval::image_check::Plane::Depth(&got.data),
+                viewsynth::eval::image_check::Plane::Depth(&want.data),
+            )],
+            format!("{name}: off the twin by up to {worst:e}"),
+        );
         let unknown_nonzero = got
             .data
             .iter()

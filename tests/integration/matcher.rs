@@ -15,7 +15,7 @@
 //! rounded sum. So validity must agree everywhere and |d_gpu - d_twin| must be 0; on failure
 //! both disparity maps and their difference are written (eval::image_check).
 
-use crate::common::{data_dir, gpu};
+use crate::common::{data_dir, gpu, max_abs_difference};
 use viewsynth::cyclopean::matcher::{confidence_reference, estimate_disparities, Matcher};
 use viewsynth::eval::image_check::{ensure, Plane};
 use viewsynth::io::{load_rgb, DepthMap, RgbImage};
@@ -31,12 +31,7 @@ fn check(what: &str, gpu: (DepthMap, DepthMap), twin: &(DepthMap, DepthMap)) {
             .zip(&t.data)
             .filter(|(a, b)| (**a > 0.0) != (**b > 0.0))
             .count();
-        let worst = g
-            .data
-            .iter()
-            .zip(&t.data)
-            .map(|(a, b)| (a - b).abs())
-            .fold(0.0f32, f32::max);
+        let worst = max_abs_difference(&g.data, &t.data);
         let name = format!("matcher {what} {eye}");
         ensure(
             validity == 0 && worst == 0.0,
@@ -89,7 +84,7 @@ fn real_pairs(device: &Device, api: &str) {
 /// about 1.4e-4 sqrt(variance) plus its own rounding (a few 2^-24 relative); divided by
 /// (1 + variance)^2 that moves the confidence by at most 1.4e-4 x max sqrt(v) / (1 + v)^2
 /// (0.33 at v = 1/3) < 5e-5, and the agreement's f32 difference by 2^-24. So 1e-4.
-const CONFIDENCE_BOUND: f32 = 1e-4;
+pub(crate) const CONFIDENCE_BOUND: f32 = 1e-4;
 
 fn check_confidence(what: &str, gpu: (&DepthMap, &DepthMap), twin_maps: &(DepthMap, DepthMap)) {
     let twin = confidence_reference(&twin_maps.0, &twin_maps.1).unwrap();
@@ -100,12 +95,7 @@ fn check_confidence(what: &str, gpu: (&DepthMap, &DepthMap), twin_maps: &(DepthM
             .zip(&t.data)
             .filter(|(a, b)| (**a == 0.0) != (**b == 0.0))
             .count();
-        let worst = g
-            .data
-            .iter()
-            .zip(&t.data)
-            .map(|(a, b)| (a - b).abs())
-            .fold(0.0f32, f32::max);
+        let worst = max_abs_difference(&g.data, &t.data);
         let trusted = t.data.iter().filter(|c| **c > 0.5).count();
         let name = format!("matcher confidence {what} {eye}");
         ensure(

@@ -431,20 +431,14 @@ impl CyclopeanPlan {
     /// twin), with each eye's confidence when the request asked for it.
     pub fn frame(&self, device: &Device, input: StereoInput, names: [InputName; 4]) -> crate::Result<Framed> {
         let [left_rgb, right_rgb, left_map, cameras_name] = names;
-        let framed = |(frame, mid, fixation), confidence| Framed {
-            frame,
-            mid,
-            fixation,
-            confidence,
-        };
         match input {
-            StereoInput::Disparity { left, right } => Ok(framed(self.disparity_frame(left, right, left_map)?, None)),
+            StereoInput::Disparity { left, right } => self.disparity_frame(left, right, left_map),
             StereoInput::Images { left, right } => {
                 let (dl, dr, confidence) = self.estimate(device, &left, &right, left_rgb)?;
-                Ok(framed(
-                    self.disparity_frame((left, dl), (right, dr), left_map)?,
+                Ok(Framed {
                     confidence,
-                ))
+                    ..self.disparity_frame((left, dl), (right, dr), left_map)?
+                })
             }
             StereoInput::Cameras { left, right, cameras } => {
                 left_rgb.check_size(&cameras.left, left.0.width, left.0.height)?;
@@ -464,7 +458,12 @@ impl CyclopeanPlan {
                     depth_kind: cameras.depth_kind,
                     conv: cameras.conventions,
                 };
-                Ok(framed((frame, mid, fixation), None))
+                Ok(Framed {
+                    frame,
+                    mid,
+                    fixation,
+                    confidence: None,
+                })
             }
         }
     }
@@ -505,7 +504,7 @@ impl CyclopeanPlan {
         left: (RgbImage, DepthMap),
         right: (RgbImage, DepthMap),
         left_map: InputName,
-    ) -> crate::Result<(StereoFrame, MiddleCamera, f64)> {
+    ) -> crate::Result<Framed> {
         let (focal, baseline, doffs, position) = self.rig;
         // Without a calibration only f B matters for the view; any nominal values do.
         let rig = DisparityRig {
@@ -531,7 +530,12 @@ impl CyclopeanPlan {
         }
         let fixation =
             median_fixation(&frame).ok_or_else(|| left_map.error("no known disparity (all 0 or non-finite)"))?;
-        Ok((frame, mid, fixation))
+        Ok(Framed {
+            frame,
+            mid,
+            fixation,
+            confidence: None,
+        })
     }
 
     /// Renders the view with the plan's method (and fill) on `device`.
