@@ -304,7 +304,7 @@ fn cyclopean_stitch_and_scene_write_exactly_the_files_their_help_names() {
         "--cameras",
         &s("cameras.json"),
     ]);
-    let rows = subsets(&OUTPUTS)
+    let mut rows: Vec<Row> = subsets(&OUTPUTS)
         .into_iter()
         .map(|outputs| {
             let mut args = base.clone();
@@ -314,9 +314,8 @@ fn cyclopean_stitch_and_scene_write_exactly_the_files_their_help_names() {
                 files: view_files("middle", &outputs, &["exr"], "png", false),
             }
         })
-        .collect::<Vec<_>>();
+        .collect();
     // Two images alone (the matcher's disparities: no metric depth) with each eye's confidence.
-    let mut rows = rows;
     for outputs in [vec!["rgb"], vec!["mask"], vec!["rgb", "mask"]] {
         let mut files = view_files("middle", &outputs, &["exr"], "png", false);
         files.extend(strs(&viewsynth::job::cyclopean::CONFIDENCE_FILES));
