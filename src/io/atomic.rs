@@ -7,21 +7,25 @@
 //! lock file inside it), so [`remove_orphan_temporaries`] tells a killed run's leftovers from a
 //! live run's by trying the lock: unlike a pid, a lock means the same in every PID namespace
 //! and container sharing the volume, and it is released by the kernel when its holder dies.
+//!
+//! A temporary is unlocked for the microseconds between its creation and its lock, when a
+//! cleaner may take it. The maker then checks, once locked, that the name is still its file
+//! ([`is_same_file`]) and otherwise makes another, so a cleaner can remove any unlocked
+//! temporary at once, however young: a kill leaves nothing that outlives the next run's start.
 
 use std::fs::{self, File};
 use std::io::{self, BufWriter, Write};
 use std::os::unix::fs::{FileTypeExt, OpenOptionsExt};
 use std::path::Path;
-use std::time::{Duration, SystemTime};
 
 use crate::error::{Error, Result};
 
 /// Prefix of every temporary file or folder this crate creates beside its outputs.
 pub const TEMP_PREFIX: &str = ".viewsynth-";
 
-/// A temporary that holds no lock is only removed once this old: its creator takes the lock
-/// microseconds after creating it, so a younger one may be a live run's, not yet locked.
-const UNLOCKED_GRACE: Duration = Duration::from_secs(2);
+/// How many temporaries [`temp_file_in`] makes before giving up, when a cleaner of another run
+/// takes each one between its creation and its lock.
+const TEMP_TRIES: usize = 16;
 
 /// Takes `file`'s exclusive lock without waiting: Ok(true) when taken, Ok(false) when another
 /// open file holds it.
@@ -31,6 +35,16 @@ pub(crate) fn try_lock(file: &File) -> io::Result<bool> {
         Ok(()) => Ok(true),
         Err(e) if e == rustix::io::Errno::WOULDBLOCK => Ok(false),
         Err(e) => Err(e.into()),
+    }
+}
+
+/// Whether `file` is still the file at `path` (not followed): false once `path` was removed
+/// or replaced.
+pub(crate) fn is_same_file(file: &File, path: &Path) -> bool {
+    use std::os::unix::fs::MetadataExt;
+    match (file.metadata(), fs::symlink_metadata(path)) {
+        (Ok(a), Ok(b)) => a.dev() == b.dev() && a.ino() == b.ino(),
+        _ => false,
     }
 }
 
@@ -74,7 +88,8 @@ pub(crate) fn check_replaceable(path: &Path) -> Result<()> {
 /// The fault-injection hook of the file layer, for tests of the commit protocol:
 /// `VIEWSYNTH_FAULT_AFTER=<k>` ends the process at once with status 137 (as SIGKILL would) right after the
 /// k-th step (1-based) of the process's commits, `<k>:fail` returns an error there instead.
-/// Steps: a set's journal written, each rename, the staging folder removed. Unset: no effect.
+/// Steps: a set's journal written, each rename, then its staging folder's journal, lock file and
+/// folder removed. Unset: no effect.
 pub(crate) fn fault_point(what: &str) -> Result<()> {
     use std::sync::atomic::{AtomicU64, Ordering};
     use std::sync::OnceLock;
@@ -127,15 +142,25 @@ pub(crate) fn parent_dir(path: &Path) -> &Path {
 /// Held under its lock (see the module notes) until closed.
 pub(crate) fn temp_file_in(dir: &Path, shown: &Path) -> Result<tempfile::NamedTempFile> {
     use std::os::unix::fs::PermissionsExt;
-    let temp = tempfile::Builder::new()
-        .prefix(&own_prefix())
-        .suffix(".tmp")
-        // What a plain create gives (the umask applies), not tempfile's private 0600.
-        .permissions(fs::Permissions::from_mode(0o666))
-        .tempfile_in(dir)
-        .map_err(|e| Error::io(shown, e))?;
-    try_lock(temp.as_file()).map_err(|e| Error::io(shown, e))?;
-    Ok(temp)
+    for _ in 0..TEMP_TRIES {
+        let temp = tempfile::Builder::new()
+            .prefix(&own_prefix())
+            .suffix(".tmp")
+            // What a plain create gives (the umask applies), not tempfile's private 0600.
+            .permissions(fs::Permissions::from_mode(0o666))
+            .tempfile_in(dir)
+            .map_err(|e| Error::io(shown, e))?;
+        // Taken by a cleaner before the lock (see the module notes): make another.
+        if try_lock(temp.as_file()).map_err(|e| Error::io(shown, e))? && is_same_file(temp.as_file(), temp.path()) {
+            return Ok(temp);
+        }
+    }
+    Err(Error::io(
+        shown,
+        io::Error::other(format!(
+            "another process removed each of {TEMP_TRIES} temporaries as soon as it was made"
+        )),
+    ))
 }
 
 /// Writes `path` atomically: `write` fills a fresh temporary in the same folder (so the final
@@ -177,7 +202,8 @@ pub fn probe_writable(dir: &Path) -> Result<()> {
 /// Removes the temporaries (files or staging folders named `.viewsynth-…`) that a run killed
 /// before it could clean up left in `dir`; returns how many were removed. A temporary whose
 /// lock another process holds is a live run's and is never touched, whatever its pid says (a
-/// pid is meaningless across PID namespaces). A staging folder killed after its journal was
+/// pid is meaningless across PID namespaces); an unlocked one goes at once, however young
+/// (its maker, if alive, makes another: see the module notes). A staging folder killed after its journal was
 /// written is first rolled forward (its remaining files renamed into `dir`, the manifest
 /// last), so a set is always either the old one or the new one, complete.
 pub fn remove_orphan_temporaries(dir: &Path) -> usize {
@@ -192,8 +218,9 @@ pub fn remove_orphan_temporaries(dir: &Path) -> usize {
         let ok = match e.file_type() {
             Ok(t) if t.is_dir() => super::file_set::recover_staging(dir, &e.path()),
             Ok(t) if t.is_file() => match open_for_lock(&e.path()) {
+                // Removed while locked, so its maker's late lock finds the name gone.
                 Ok(f) => match try_lock(&f) {
-                    Ok(true) if older_than(&e.path(), UNLOCKED_GRACE) => fs::remove_file(e.path()).is_ok(),
+                    Ok(true) if is_same_file(&f, &e.path()) => fs::remove_file(e.path()).is_ok(),
                     _ => false,
                 },
                 Err(_) => false,
@@ -204,13 +231,6 @@ pub fn remove_orphan_temporaries(dir: &Path) -> usize {
         removed += usize::from(ok);
     }
     removed
-}
-
-/// Whether `path` (not followed) was last modified longer than `age` ago.
-pub(crate) fn older_than(path: &Path, age: Duration) -> bool {
-    fs::symlink_metadata(path)
-        .and_then(|m| m.modified())
-        .is_ok_and(|t| SystemTime::now().duration_since(t).is_ok_and(|d| d > age))
 }
 
 #[cfg(test)]
@@ -337,30 +357,62 @@ mod tests {
     #[test]
     fn orphan_clean_up_spares_locked_temporaries_whatever_their_pid() {
         let dir = scratch_dir("atomic-orphans");
-        let old = SystemTime::now() - Duration::from_secs(3600);
         // pid 1 is alive here, u32::MAX - 1 is no pid: neither decides any more, the lock does.
         let unlocked = format!("{TEMP_PREFIX}1-abc.tmp");
         let locked = format!("{TEMP_PREFIX}{}-abc.tmp", u32::MAX - 1);
         for n in [&unlocked, &locked, &"keep.png".to_string()] {
             fs::write(dir.join(n), b"x").unwrap();
-            File::options()
-                .write(true)
-                .open(dir.join(n))
-                .unwrap()
-                .set_modified(old)
-                .unwrap();
         }
         let holder = File::open(dir.join(&locked)).unwrap();
         assert!(try_lock(&holder).unwrap());
-        // A young unlocked temporary may be a live run's that has not locked it yet.
-        let young = format!("{TEMP_PREFIX}2-young.tmp");
-        fs::write(dir.join(&young), b"x").unwrap();
+        // Unlocked goes at once, however young (its maker, if alive, makes another).
         assert_eq!(remove_orphan_temporaries(&dir), 1);
-        let mut want = vec![locked.clone(), young, "keep.png".to_string()];
+        let mut want = vec![locked.clone(), "keep.png".to_string()];
         want.sort();
         assert_eq!(list_dir(&dir), want);
         drop(holder);
         assert_eq!(remove_orphan_temporaries(&dir), 1);
+        assert_eq!(list_dir(&dir), ["keep.png"]);
+    }
+
+    /// Writers racing a cleaner that runs without pause: every write lands (a temporary taken
+    /// before its lock is made again), and nothing is left behind.
+    #[test]
+    fn writes_survive_a_cleaner_racing_them() {
+        use std::sync::atomic::{AtomicBool, Ordering};
+        let dir = scratch_dir("atomic-race");
+        let stop = AtomicBool::new(false);
+        let removed = std::thread::scope(|scope| {
+            let cleaner = scope.spawn(|| {
+                let mut n = 0;
+                while !stop.load(Ordering::Relaxed) {
+                    n += remove_orphan_temporaries(&dir);
+                }
+                n
+            });
+            let writers: Vec<_> = (0..4)
+                .map(|t| {
+                    let dir = &dir;
+                    scope.spawn(move || {
+                        for i in 0..200 {
+                            let path = dir.join(format!("w{t}.bin"));
+                            atomic_write(&path, |w| w.write_all(&[i as u8; 64]).map_err(|e| Error::io("w", e)))
+                                .unwrap();
+                            assert_eq!(fs::read(&path).unwrap(), [i as u8; 64]);
+                        }
+                    })
+                })
+                .collect();
+            let results: Vec<_> = writers.into_iter().map(|w| w.join()).collect();
+            // Stopped before any panic below, or the scope would wait on the cleaner forever.
+            stop.store(true, Ordering::Relaxed);
+            let removed = cleaner.join().unwrap();
+            assert!(results.iter().all(|r| r.is_ok()), "a writer failed");
+            removed
+        });
+        assert_eq!(list_dir(&dir), ["w0.bin", "w1.bin", "w2.bin", "w3.bin"]);
+        // A cleaner taking a temporary before its lock is rare (a window of microseconds).
+        eprintln!("temporaries the cleaner took: {removed}");
     }
 
     #[test]

@@ -20,11 +20,17 @@
 //! 4. the files are renamed into place in that order, the manifest last, then the folder is
 //!    removed.
 //!
+//! 5. the folder is emptied in an order that keeps it recognisable: the journal, then the lock
+//!    file, then the folder itself.
+//!
 //! A later run that finds an unlocked staging folder ([`remove_orphan_temporaries`]) removes
 //! it when it has no journal (killed before step 3: the old set is untouched) and otherwise
-//! finishes step 4 (rolls forward to the new set). So after any kill and the next run's
-//! start, a folder holds the old set or the new set, complete. `VIEWSYNTH_FAULT_AFTER` injects
-//! a kill or a failure after any step (see [`super::atomic`]).
+//! finishes step 4 (rolls forward to the new set). A folder with no lock file at all (killed
+//! while it was being made or removed) is claimed by making its lock file, then treated the
+//! same, at once: its maker, if alive, finds its lock file taken or gone and starts again in a
+//! new folder (see [`claim_lock`]), so no age threshold is needed. So after any kill and the
+//! next run's start, a folder holds the old set or the new set, complete, and no temporary.
+//! `VIEWSYNTH_FAULT_AFTER` injects a kill or a failure after any step (see [`super::atomic`]).
 //!
 //! ```no_run
 //! # fn main() -> viewsynth::Result<()> {
@@ -45,7 +51,7 @@ mod parallel;
 pub use parallel::FileWriter;
 
 use super::atomic::{
-    check_replaceable, fault_point, older_than, open_for_lock, own_prefix, probe_writable, remove_orphan_temporaries,
+    check_replaceable, fault_point, is_same_file, open_for_lock, own_prefix, probe_writable, remove_orphan_temporaries,
     try_lock, TEMP_PREFIX,
 };
 
@@ -55,9 +61,9 @@ const LOCK_NAME: &str = ".viewsynth-lock";
 const JOURNAL_NAME: &str = ".viewsynth-commit";
 /// The name renamed last in every set: its presence marks the set complete.
 pub const MANIFEST_NAME: &str = "manifest.json";
-/// A staging folder without its lock file is only taken as orphaned once this old (its creator
-/// makes the lock file right after the folder).
-const UNLOCKED_FOLDER_GRACE: std::time::Duration = std::time::Duration::from_secs(60);
+/// How many staging folders [`FileSet::new`] makes before giving up, when a cleaner of
+/// another run takes each one between its creation and its lock (a race of microseconds).
+const STAGING_TRIES: usize = 16;
 use crate::error::{Error, Result};
 
 /// An output folder that exists, accepts files, and bounds where outputs may go.
@@ -204,20 +210,7 @@ impl FileSet {
     /// A set whose files go into `dir` (an existing folder) on commit. The staging folder is
     /// created inside `dir` (same file system, so the renames are atomic).
     pub fn new(dir: &Path) -> Result<Self> {
-        let staging = tempfile::Builder::new()
-            .prefix(&own_prefix())
-            .tempdir_in(dir)
-            .map_err(|e| Error::io(dir, e))?;
-        // Locked under a temporary name, then renamed to the lock's name: a cleaner that can
-        // open the lock file finds it already locked.
-        let lock = tempfile::Builder::new()
-            .prefix(TEMP_PREFIX)
-            .tempfile_in(staging.path())
-            .map_err(|e| Error::io(dir, e))?;
-        try_lock(lock.as_file()).map_err(|e| Error::io(dir, e))?;
-        let lock = lock
-            .persist(staging.path().join(LOCK_NAME))
-            .map_err(|e| Error::io(dir, e.error))?;
+        let (staging, lock) = make_staging(dir)?;
         Ok(Self {
             dir: dir.to_path_buf(),
             shown: dir.to_path_buf(),
@@ -364,8 +357,7 @@ impl FileSet {
             }
             // Make the renames durable; failure to sync the folder is not worth failing the run.
             sync_dir(&dir);
-            fs::remove_dir_all(&staging).map_err(|e| Error::io(&shown, e))?;
-            fault_point("staging removed")?;
+            remove_staging(&staging).map_err(|e| Error::io(&shown, e))?;
             Ok(done)
         })();
         if result.is_err() {
@@ -463,20 +455,91 @@ fn roll_forward(dir: &Path, staging: &Path) -> bool {
     fs::remove_dir_all(staging).is_ok()
 }
 
-/// What a later run does with a staging folder `staging` in `dir` (see the module notes):
-/// nothing while its lock is held; else rolled forward when journalled, removed otherwise.
-/// True when the folder is gone.
-pub(crate) fn recover_staging(dir: &Path, staging: &Path) -> bool {
-    let lock = match open_for_lock(&staging.join(LOCK_NAME)) {
-        Ok(f) => f,
-        // No lock file: a folder being created (or one from before locks): only an old one.
-        Err(_) => {
-            return older_than(staging, UNLOCKED_FOLDER_GRACE) && fs::remove_dir_all(staging).is_ok();
+/// Makes a staging folder in `dir` and takes its lock. A cleaner of another run may take the
+/// folder between its creation and its lock (it looks orphaned then): this maker notices (see
+/// [`claim_lock`]) and makes another.
+fn make_staging(dir: &Path) -> Result<(tempfile::TempDir, File)> {
+    for _ in 0..STAGING_TRIES {
+        let staging = tempfile::Builder::new()
+            .prefix(&own_prefix())
+            .tempdir_in(dir)
+            .map_err(|e| Error::io(dir, e))?;
+        match claim_lock(staging.path()) {
+            Ok(Some(lock)) => return Ok((staging, lock)),
+            // Taken by a cleaner: dropping `staging` removes what it left, if anything.
+            Ok(None) => continue,
+            Err(e) => return Err(Error::io(dir, e)),
         }
-    };
-    if !try_lock(&lock).unwrap_or(false) {
-        return false;
     }
+    Err(Error::io(
+        dir,
+        io::Error::other(format!(
+            "another process removed each of {STAGING_TRIES} staging folders as soon as it was made"
+        )),
+    ))
+}
+
+/// Creates the lock file of the staging folder `staging` and takes its lock: `Some` when this
+/// call now owns the folder, `None` when another process got there first (made the lock file,
+/// holds its lock, or removed it or the folder meanwhile). The maker of a folder and a cleaner
+/// of a lockless one both claim it this way, so exactly one of them wins.
+fn claim_lock(staging: &Path) -> io::Result<Option<File>> {
+    let path = staging.join(LOCK_NAME);
+    let file = match File::options().write(true).create_new(true).open(&path) {
+        Ok(f) => f,
+        Err(e) if matches!(e.kind(), io::ErrorKind::AlreadyExists | io::ErrorKind::NotFound) => return Ok(None),
+        Err(e) => return Err(e),
+    };
+    if !try_lock(&file)? {
+        return Ok(None);
+    }
+    // Between the create and the lock a cleaner may have taken the file and removed it.
+    Ok(is_same_file(&file, &path).then_some(file))
+}
+
+/// Empties and removes this run's own staging folder after its commit: the journal first (a
+/// kill now leaves a locked-file folder with nothing to roll forward), then anything else, then
+/// the lock file (a kill now leaves an empty folder), then the folder. Every state a kill can
+/// leave is one [`recover_staging`] removes at once.
+fn remove_staging(staging: &Path) -> io::Result<()> {
+    let gone = |r: io::Result<()>| match r {
+        Err(e) if e.kind() == io::ErrorKind::NotFound => Ok(()),
+        other => other,
+    };
+    gone(fs::remove_file(staging.join(JOURNAL_NAME)))?;
+    fault_point("journal removed").map_err(io::Error::other)?;
+    for e in fs::read_dir(staging)?.flatten() {
+        if e.file_name() != LOCK_NAME {
+            gone(fs::remove_file(e.path()))?;
+        }
+    }
+    gone(fs::remove_file(staging.join(LOCK_NAME)))?;
+    fault_point("lock file removed").map_err(io::Error::other)?;
+    match fs::remove_dir(staging) {
+        // A cleaner claimed the lockless folder meanwhile (its new lock file is inside): the
+        // folder holds nothing of this set any more, and that cleaner removes it.
+        Err(e) if e.kind() == io::ErrorKind::DirectoryNotEmpty => {}
+        r => gone(r)?,
+    }
+    fault_point("staging removed").map_err(io::Error::other)
+}
+
+/// What a later run does with a staging folder `staging` in `dir` (see the module notes):
+/// nothing while its lock is held; else rolled forward when journalled, removed otherwise. A
+/// folder without a lock file is claimed first (see [`claim_lock`]). True when the folder is
+/// gone.
+pub(crate) fn recover_staging(dir: &Path, staging: &Path) -> bool {
+    let path = staging.join(LOCK_NAME);
+    let _lock = match open_for_lock(&path) {
+        // Held only if it is still the folder's lock file once locked.
+        Ok(f) if try_lock(&f).unwrap_or(false) && is_same_file(&f, &path) => f,
+        Ok(_) => return false,
+        Err(e) if e.kind() == io::ErrorKind::NotFound => match claim_lock(staging) {
+            Ok(Some(f)) => f,
+            _ => return false,
+        },
+        Err(_) => return false,
+    };
     if staging.join(JOURNAL_NAME).exists() {
         roll_forward(dir, staging)
     } else {
@@ -574,6 +637,66 @@ mod tests {
         let err = set.commit().unwrap_err().to_string();
         assert!(err.contains("b.txt") && err.contains("folder"), "{err}");
         assert_eq!(list_dir(&dir), ["b.txt"]);
+    }
+
+    /// Folders a kill left without a lock file (while being made or removed) go at the next
+    /// start, however young: empty, with staged files (the old set stays), or journalled
+    /// (rolled forward to the new set).
+    #[test]
+    fn lockless_staging_folders_are_recovered_at_once() {
+        let dir = scratch_dir("set-lockless");
+        fs::write(dir.join("x.txt"), "old x").unwrap();
+        let empty = dir.join(".viewsynth-1-empty");
+        fs::create_dir(&empty).unwrap();
+        let staged = dir.join(".viewsynth-1-staged");
+        fs::create_dir(&staged).unwrap();
+        fs::write(staged.join("y.txt"), "partial").unwrap();
+        let journalled = dir.join(".viewsynth-1-journalled");
+        fs::create_dir(&journalled).unwrap();
+        fs::write(journalled.join("x.txt"), "new x").unwrap();
+        fs::write(journalled.join(JOURNAL_NAME), "x.txt").unwrap();
+        assert_eq!(remove_orphan_temporaries(&dir), 3);
+        assert_eq!(list_dir(&dir), ["x.txt"]);
+        assert_eq!(fs::read_to_string(dir.join("x.txt")).unwrap(), "new x");
+    }
+
+    /// Sets made and committed while a cleaner runs without pause: each is made again if the
+    /// cleaner takes its folder before the lock, so every commit succeeds and nothing is left.
+    #[test]
+    fn sets_survive_a_cleaner_racing_them() {
+        use std::sync::atomic::{AtomicBool, Ordering};
+        let dir = scratch_dir("set-race");
+        let stop = AtomicBool::new(false);
+        std::thread::scope(|scope| {
+            let cleaner = scope.spawn(|| {
+                while !stop.load(Ordering::Relaxed) {
+                    remove_orphan_temporaries(&dir);
+                }
+            });
+            let makers: Vec<_> = (0..4)
+                .map(|t| {
+                    let dir = &dir;
+                    scope.spawn(move || {
+                        for i in 0..100 {
+                            let mut set = FileSet::new(dir).unwrap();
+                            let body = format!("{t}:{i}");
+                            set.write(&format!("t{t}.txt"), |w| {
+                                w.write_all(body.as_bytes()).map_err(|e| Error::io("x", e))
+                            })
+                            .unwrap();
+                            set.commit().unwrap();
+                            assert_eq!(fs::read_to_string(dir.join(format!("t{t}.txt"))).unwrap(), body);
+                        }
+                    })
+                })
+                .collect();
+            let results: Vec<_> = makers.into_iter().map(|m| m.join()).collect();
+            // Stopped before any panic below, or the scope would wait on the cleaner forever.
+            stop.store(true, Ordering::Relaxed);
+            cleaner.join().unwrap();
+            assert!(results.iter().all(|r| r.is_ok()), "a maker failed");
+        });
+        assert_eq!(list_dir(&dir), ["t0.txt", "t1.txt", "t2.txt", "t3.txt"]);
     }
 
     #[test]

@@ -1107,7 +1107,7 @@ fn kill_9_mid_run_then_rerun_leaves_the_old_or_the_new_set_complete() {
         check(&format!("{label}, recovered"), Some(false));
         assert!(temporaries(out).is_empty(), "{label}: {:?}", temporaries(out));
     }
-    // After the journal (step 1) and mid-renames (step 20 of 38: journal, 36 renames, cleanup):
+    // After the journal (step 1) and mid-renames (step 20 of 40: journal, 36 renames, 3 cleanup):
     // recovery rolls forward to the new set.
     for k in ["1", "20"] {
         let o = job(Some(k)).output().unwrap();

@@ -609,8 +609,9 @@ fn round3_commit_survives_a_kill_or_a_failure_after_every_step() {
     assert!(refocus(&old, "fullscreen", None).status.success());
     let (old_complete, old_method) = manifest_state(&old);
     assert!(old_complete);
-    // Steps: the journal, 2 scales x 3 files + the manifest renamed, the staging removed.
-    let steps = 1 + 7 + 1;
+    // Steps: the journal, 2 scales x 3 files + the manifest renamed, then the staging
+    // folder's journal, lock file and folder removed.
+    let steps = 1 + 7 + 3;
     let mut failures = Vec::new();
     let mut cases = 0;
     let mut new_method = String::new();
