@@ -105,6 +105,16 @@ pub fn excerpt(text: &str) -> String {
 }
 
 impl Error {
+    /// An [`Error::InvalidParameter`] renamed `name` (how a front end spells the parameter, e.g.
+    /// the option `--png-compression` for the library's `png-compression`); any other error as
+    /// it is.
+    pub fn renamed(self, name: &str) -> Self {
+        match self {
+            Error::InvalidParameter { message, .. } => Error::param(name, message),
+            other => other,
+        }
+    }
+
     /// An [`Error::Io`] on `path`.
     pub fn io(path: impl Into<PathBuf>, source: std::io::Error) -> Self {
         Error::Io {

@@ -82,7 +82,7 @@ def test_refocus_batch_bad_inputs(renderer, tmp_path):
     batch_error(renderer, tmp_path, [42], "frames[0]", ["expected a dict"])
     batch_error(renderer, tmp_path, [frame], "depth_format", ["'tiff'"], depth_format="tiff")
     batch_error(renderer, tmp_path, [frame], "rgb_format", ["'bmp'"], rgb_format="bmp")
-    batch_error(renderer, tmp_path, [frame], "png-compression", ["'huge'"], png_compression="huge")
+    batch_error(renderer, tmp_path, [frame], "invalid png_compression", ["'huge'"], png_compression="huge")
     batch_error(renderer, tmp_path, [frame], "shard", ["'3/2'"], shard="3/2")
     batch_error(renderer, tmp_path, [frame], "depth_preview", ["outputs"], depth_preview=True, outputs=["rgb"])
     batch_error(renderer, tmp_path, [frame], "scales", ["no target given"], scales=[])

@@ -88,7 +88,7 @@ impl BenchJob {
                 let jobs = super::pool_threads(o.jobs)?;
                 let files = FileFormats {
                     encoding: io::Encoding {
-                        png: o.png_compression.parse()?,
+                        png: super::files::png_compression(&o.png_compression)?,
                         ..Default::default()
                     },
                     ..Default::default()

@@ -9,8 +9,8 @@ use crate::io::{DepthFormats, FileFormats, OutputSet, RgbFormat};
 /// The file options as given.
 #[derive(Debug, Clone, Copy)]
 pub struct FileOptions<'a> {
-    /// `--outputs`: any of rgb (or color), depth, mask.
-    pub outputs: &'a str,
+    /// `--outputs`, parsed once by the front end.
+    pub outputs: OutputSet,
     /// `--rgb-format`.
     pub rgb: RgbFormat,
     /// `--depth-format`: any of exr, npy, png16.
@@ -27,12 +27,15 @@ pub struct FileOptions<'a> {
 /// colours); the output layer ([`crate::io::write_view`]) writes every one of them.
 pub fn file_formats(o: &FileOptions<'_>) -> Result<FileFormats, ArgError> {
     let formats = FileFormats {
-        outputs: OutputSet::parse(o.outputs)?,
+        outputs: o.outputs,
         rgb: o.rgb,
         depth: depth_formats(o.depth)?,
         encoding: io::Encoding {
-            png: o.png_compression.parse()?,
-            exr: o.exr_compression.parse()?,
+            png: png_compression(o.png_compression)?,
+            exr: o
+                .exr_compression
+                .parse()
+                .map_err(|e: crate::Error| e.renamed("--exr-compression"))?,
         },
         depth_preview: o.depth_preview,
     };
@@ -43,6 +46,11 @@ pub fn file_formats(o: &FileOptions<'_>) -> Result<FileFormats, ArgError> {
     Ok(formats)
 }
 
+/// `--png-compression`: fast, default or best (refocus, reproject and bench read it alike).
+pub fn png_compression(text: &str) -> Result<io::PngCompression, ArgError> {
+    Ok(text.parse().map_err(|e: crate::Error| e.renamed("--png-compression"))?)
+}
+
 /// `--depth-format`: a comma-separated list of exr, npy, png16.
 pub fn depth_formats(list: &str) -> Result<DepthFormats, ArgError> {
     DepthFormats::parse(list.split(',')).map_err(ArgError::DepthFormat)
@@ -50,11 +58,11 @@ pub fn depth_formats(list: &str) -> Result<DepthFormats, ArgError> {
 
 #[cfg(test)]
 mod tests {
-    use super::{depth_formats, file_formats, ArgError, FileOptions, RgbFormat};
+    use super::{depth_formats, file_formats, ArgError, FileOptions, OutputSet, RgbFormat};
 
-    fn options<'a>(outputs: &'a str, depth: &'a str, preview: bool) -> FileOptions<'a> {
+    fn options<'a>(outputs: &str, depth: &'a str, preview: bool) -> FileOptions<'a> {
         FileOptions {
-            outputs,
+            outputs: OutputSet::parse(outputs).unwrap(),
             rgb: RgbFormat::Png,
             depth,
             depth_preview: preview,
@@ -76,5 +84,19 @@ mod tests {
         assert!(file_formats(&options("rgb,depth", "exr", true)).unwrap().depth_preview);
         let e = file_formats(&options("rgb,mask", "exr", true)).unwrap_err();
         assert!(matches!(e, ArgError::PreviewWithoutDepth), "{e}");
+    }
+
+    #[test]
+    fn an_encoding_refusal_names_the_option() {
+        for (png, exr, want) in [
+            ("max", "zip", "invalid --png-compression: 'max'"),
+            ("fast", "lzw", "invalid --exr-compression: 'lzw'"),
+        ] {
+            let mut o = options("rgb", "exr", false);
+            o.png_compression = png;
+            o.exr_compression = exr;
+            let e = file_formats(&o).unwrap_err().to_string();
+            assert!(e.starts_with(want), "{e}");
+        }
     }
 }

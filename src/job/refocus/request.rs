@@ -148,9 +148,8 @@ impl RefocusRequest {
 
     /// Outputs and file formats, checked.
     pub fn files(&self) -> Result<FileFormats, ArgError> {
-        let outputs = self.outputs.unwrap_or_default().names();
         crate::job::file_formats(&FileOptions {
-            outputs: &outputs,
+            outputs: self.outputs.unwrap_or_default(),
             rgb: self.rgb_format,
             depth: self.depth_format.as_deref().unwrap_or(DEFAULT_DEPTH_FORMAT),
             depth_preview: self.depth_preview,

@@ -8,7 +8,6 @@ use crate::options::{GPU, INPUTS, INTRINSICS, METHOD, OUTPUTS, TARGETS};
 use clap::{Args, ValueEnum};
 use std::path::PathBuf;
 use viewsynth::cyclopean::Blend;
-use viewsynth::io::OutputSet;
 use viewsynth::job::cyclopean::{CyclopeanJob, CyclopeanMethod, CyclopeanOptions, CyclopeanRequest};
 use viewsynth::job::{finite_value, ArgError};
 
@@ -165,7 +164,7 @@ impl CyclopeanArgs {
             focal: self.focal,
             baseline: self.baseline,
             doffs: self.doffs,
-            outputs: self.outputs.as_deref().map(OutputSet::parse).transpose()?,
+            outputs: crate::options::parse_outputs(self.outputs.as_deref())?,
             fill: self.fill,
             max_disparity: self.max_disparity,
             min_confidence: self.min_confidence,

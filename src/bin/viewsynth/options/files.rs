@@ -39,19 +39,22 @@ pub(crate) struct FileOutputArgs {
     exr_compression: String,
 }
 
-/// `--outputs` when it is not given.
-const ALL_OUTPUTS: &str = "rgb,depth,mask";
+/// `--outputs` parsed, its errors naming the option as given.
+pub(crate) fn parse_outputs(list: Option<&str>) -> Result<Option<viewsynth::io::OutputSet>, viewsynth::Error> {
+    list.map(|l| viewsynth::io::OutputSet::parse(l).map_err(|e| e.renamed("--outputs")))
+        .transpose()
+}
 
 impl FileOutputArgs {
     /// `--outputs` as given (None: the request's default, all three).
     pub(crate) fn outputs_given(&self) -> Result<Option<viewsynth::io::OutputSet>, viewsynth::Error> {
-        self.outputs.as_deref().map(viewsynth::io::OutputSet::parse).transpose()
+        parse_outputs(self.outputs.as_deref())
     }
 
     /// Sets the file settings of a refocus request.
     pub(crate) fn fill_refocus(&self, r: &mut viewsynth::job::refocus::RefocusRequest) -> Result<(), viewsynth::Error> {
         r.outputs = self.outputs_given()?;
-        r.rgb_format = self.options().rgb;
+        r.rgb_format = self.rgb_format();
         r.depth_format = self.depth_format.clone();
         r.depth_preview = self.depth_preview;
         r.png_compression = self.png_compression.clone();
@@ -59,15 +62,20 @@ impl FileOutputArgs {
         Ok(())
     }
 
-    /// The options as the library checks them.
-    pub(crate) fn options(&self) -> FileOptions<'_> {
+    /// `--rgb-format`.
+    fn rgb_format(&self) -> RgbFormat {
+        match self.rgb_format {
+            RgbFormatArg::Png => RgbFormat::Png,
+            RgbFormatArg::Jpeg => RgbFormat::Jpeg,
+            RgbFormatArg::Exr => RgbFormat::Exr,
+        }
+    }
+
+    /// The options as the library checks them, with `outputs` parsed once (the request's).
+    pub(crate) fn options(&self, outputs: viewsynth::io::OutputSet) -> FileOptions<'_> {
         FileOptions {
-            outputs: self.outputs.as_deref().unwrap_or(ALL_OUTPUTS),
-            rgb: match self.rgb_format {
-                RgbFormatArg::Png => RgbFormat::Png,
-                RgbFormatArg::Jpeg => RgbFormat::Jpeg,
-                RgbFormatArg::Exr => RgbFormat::Exr,
-            },
+            outputs,
+            rgb: self.rgb_format(),
             depth: self
                 .depth_format
                 .as_deref()

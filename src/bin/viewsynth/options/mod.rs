@@ -8,7 +8,7 @@ mod intrinsics;
 
 pub(crate) use backend::BackendArg;
 pub(crate) use conventions::{conventions, ConventionArgs, NdcArg, RowsArg};
-pub(crate) use files::FileOutputArgs;
+pub(crate) use files::{parse_outputs, FileOutputArgs};
 pub(crate) use gpu::GpuArgs;
 pub(crate) use intrinsics::IntrinsicsArgs;
 

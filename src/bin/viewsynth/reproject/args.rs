@@ -183,8 +183,8 @@ impl ReprojectArgs {
 impl TryFrom<ReprojectArgs> for ReprojectJob {
     type Error = ArgError;
     fn try_from(a: ReprojectArgs) -> Result<Self, ArgError> {
-        let files = file_formats(&a.files.options())?;
         let request = a.request()?;
+        let files = file_formats(&a.files.options(request.outputs()))?;
         ReprojectJob::new(ReprojectOptions {
             color: a.color,
             depth: a.depth,
