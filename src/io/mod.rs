@@ -54,7 +54,7 @@ pub use mask::{load_mask_png, save_mask_png, save_mask_png_with, MASK_FILLED};
 pub use npy::{load_npy, save_npy_f32, NpyArray, NpyDtype};
 pub use npz::load_npz_array;
 pub use outputs::{
-    file_crc32, file_records, write_float_exr, write_view, DepthFormats, FileFormats, FileRecord, OutputSet, RgbFormat,
-    ViewFiles, ViewNames,
+    file_crc32, file_records, write_float_exrs, write_view, DepthFormats, FileFormats, FileRecord, OutputSet,
+    RgbFormat, ViewFiles, ViewNames,
 };
 pub use rgb::{load_rgb, save_rgb, save_rgb_with};

@@ -350,13 +350,20 @@ pub fn write_view(set: &mut FileSet, names: &ViewNames, view: &ViewOutput, forma
     write_view_in(set, names, view, formats)
 }
 
-/// A per-pixel float map that is not a depth (the matcher's confidence, say) as `name` in `set`:
-/// one channel "Y" (OpenEXR's name for a single grey channel), f32, ZIP, rows top-down.
-pub fn write_float_exr(set: &mut FileSet, name: &str, map: &crate::io::DepthMap) -> Result<std::path::PathBuf> {
-    let shown = set.final_path(name);
-    set.write(name, |out| {
-        super::depth::encode_map_exr(&shown, out, map, "Y", super::ExrCompression::Zip)
-    })
+/// Per-pixel float maps that are not depths (the matcher's confidence, say), each `(name, map)`
+/// as one file of `set`: one channel "Y" (OpenEXR's name for a single grey channel), f32, ZIP,
+/// rows top-down. Encoded side by side, as a view's files are ([`FileSet::write_all`]).
+pub fn write_float_exrs(set: &mut FileSet, maps: &[(&str, &crate::io::DepthMap)]) -> Result<Vec<std::path::PathBuf>> {
+    let jobs = maps
+        .iter()
+        .map(|&(name, map)| {
+            let shown = set.final_path(name);
+            let write: FileWriter =
+                Box::new(move |out| super::depth::encode_map_exr(&shown, out, map, "Y", super::ExrCompression::Zip));
+            (name.to_string(), write)
+        })
+        .collect();
+    set.write_all(jobs)
 }
 
 fn missing(what: &str) -> Error {

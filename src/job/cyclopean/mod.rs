@@ -266,9 +266,8 @@ impl CyclopeanJob {
         };
         let mut set = out_dir.file_set()?;
         io::write_view(&mut set, &io::ViewNames::tagged("middle"), &done.view, &formats)?;
-        for (name, map) in CONFIDENCE_FILES.iter().zip(confidence.iter().flatten()) {
-            io::write_float_exr(&mut set, name, map)?;
-        }
+        let maps: Vec<_> = CONFIDENCE_FILES.into_iter().zip(confidence.iter().flatten()).collect();
+        io::write_float_exrs(&mut set, &maps)?;
         let written = set.commit()?;
         Ok(CyclopeanReport {
             width: mid.width,
