@@ -203,9 +203,9 @@ pub fn probe_writable(dir: &Path) -> Result<()> {
 /// before it could clean up left in `dir`; returns how many were removed. A temporary whose
 /// lock another process holds is a live run's and is never touched, whatever its pid says (a
 /// pid is meaningless across PID namespaces); an unlocked one goes at once, however young
-/// (its maker, if alive, makes another: see the module notes). A staging folder killed after its journal was
-/// written is first rolled forward (its remaining files renamed into `dir`, the manifest
-/// last), so a set is always either the old one or the new one, complete.
+/// (its maker, if alive, makes another: see the module notes). A staging folder killed after
+/// its journal was written is first rolled forward (its remaining files renamed into `dir`,
+/// the manifest last), so a set is always either the old one or the new one, complete.
 pub fn remove_orphan_temporaries(dir: &Path) -> usize {
     let Ok(entries) = fs::read_dir(dir) else { return 0 };
     let mut removed = 0;

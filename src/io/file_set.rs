@@ -17,9 +17,7 @@
 //!    those syncs before step 3);
 //! 3. a journal `.viewsynth-commit` listing the names in rename order (the manifest last) is
 //!    written and synced: from here on the set is the new one;
-//! 4. the files are renamed into place in that order, the manifest last, then the folder is
-//!    removed.
-//!
+//! 4. the files are renamed into place in that order, the manifest last;
 //! 5. the folder is emptied in an order that keeps it recognisable: the journal, then the lock
 //!    file, then the folder itself.
 //!
