@@ -1,7 +1,7 @@
 //! `refocus --batch` from the command line, for the README's promises that no other test holds
 //! through the binary: each resume invalidation rule (inputs' size and mtime, conventions,
 //! outputs, formats), `--shard K/N` taking the frames with i % N == K over several K, resume per
-//! shard, and kill -9 mid-batch then resume.
+//! shard, kill -9 mid-batch then resume, and a batch ended after each step of its file commits.
 
 use crate::cli::{bin, files_in, scratch};
 use image::ImageEncoder;
@@ -288,5 +288,89 @@ fn kill_9_mid_batch_then_resume_renders_only_the_unfinished_frames() {
         files_in(&out).iter().all(|n| !n.starts_with(".viewsynth-")),
         "{:?}",
         files_in(&out)
+    );
+}
+
+/// Every place a batch can die in its file commits, not only where a timed kill happens to
+/// land: the fault hook (`VIEWSYNTH_FAULT_AFTER`) ends the run (as SIGKILL, status 137) or fails
+/// the frame (exit 1) after each step of each frame's set (journal, 7 renames, journal, lock
+/// file and folder removed: 11 a frame). Before recovery a manifest only ever stands beside
+/// its complete files; the resume then renders only what is unfinished, leaves the finished
+/// frames untouched, and leaves every frame complete with no temporary anywhere.
+#[test]
+fn a_batch_ended_after_any_commit_step_resumes_to_every_frame_complete() {
+    let (dir, manifest) = setup("batch-faults", 3);
+    let steps = 3 * (1 + 7 + 3);
+    let run = |out: &Path, fault: &str| {
+        bin()
+            .args(["refocus", "--zoom-range", "0.5,1.5", "--jobs", "1", "--batch"])
+            .arg(&manifest)
+            .arg("--out-dir")
+            .arg(out)
+            .env("VIEWSYNTH_FAULT_AFTER", fault)
+            .output()
+            .unwrap()
+    };
+    let temporaries = |out: &Path| -> Vec<String> {
+        let mut found: Vec<String> = files_in(out)
+            .into_iter()
+            .filter(|f| f.starts_with(".viewsynth-"))
+            .collect();
+        for f in files_in(out) {
+            if out.join(&f).is_dir() {
+                found.extend(
+                    files_in(&out.join(&f))
+                        .into_iter()
+                        .filter(|n| n.starts_with(".viewsynth-")),
+                );
+            }
+        }
+        found
+    };
+    let mut failures = Vec::new();
+    for k in 1..=steps + 1 {
+        for mode in ["", ":fail"] {
+            let out = dir.join(format!("k{k}{mode}"));
+            let o = run(&out, &format!("{k}{mode}"));
+            let want = match (k > steps, mode) {
+                (true, _) => Some(0),
+                (false, "") => Some(137),
+                (false, _) => Some(1),
+            };
+            let label = format!("fault after step {k}{mode}");
+            if o.status.code() != want {
+                failures.push(format!("{label}: exit {:?}, expected {want:?}", o.status.code()));
+            }
+            let before = manifests(&out);
+            for f in before.keys() {
+                if !frame_complete(&out.join(f)) {
+                    failures.push(format!("{label}: {f} has a manifest without its files"));
+                }
+            }
+            // The resume: no fault this time.
+            let o = batch(&manifest, &out, &[]);
+            let (rendered, done) = counts(&o);
+            if rendered + done != 3 || done < before.len() {
+                failures.push(format!("{label}: resume rendered {rendered}, skipped {done}"));
+            }
+            let after = manifests(&out);
+            for (f, m) in &before {
+                if after.get(f) != Some(m) {
+                    failures.push(format!("{label}: {f} was finished yet redone"));
+                }
+            }
+            if after.len() != 3 || !after.keys().all(|f| frame_complete(&out.join(f))) {
+                failures.push(format!("{label}: not every frame complete after the resume"));
+            }
+            if !temporaries(&out).is_empty() {
+                failures.push(format!("{label}: temporaries left: {:?}", temporaries(&out)));
+            }
+        }
+    }
+    assert!(
+        failures.is_empty(),
+        "{} problems:\n{}",
+        failures.len(),
+        failures.join("\n")
     );
 }
