@@ -1,6 +1,7 @@
 //! Hostile input, round 3 (issue 23), one table per class: exit codes of every option,
 //! numerics over the f32/f64 range (valid => finite), inputs bounded before decoding, the
-//! commit protocol killed or failed after every step, and resume that verifies.
+//! commit protocol killed or failed after every step (for every command that writes files), and
+//! resume that verifies.
 
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
@@ -1510,6 +1511,189 @@ fn round3_class6_leftovers_are_refused_by_name() {
             &["bad.exr", "offset table"],
             &mut failures,
         );
+    }
+    report(failures, cases);
+}
+
+/// The files of a folder by name, for comparing whole sets: a refocus manifest (it holds
+/// timings, so never the same bytes twice) is left out once it is checked to list its files
+/// with their CRC-32s.
+fn file_set_snapshot(dir: &Path) -> Result<BTreeMap<String, Vec<u8>>, String> {
+    let mut files = BTreeMap::new();
+    for name in files_in(dir) {
+        if name.starts_with(".viewsynth-") {
+            return Err(format!("temporary left: {name}"));
+        }
+        if name == "manifest.json" {
+            if !manifest_state(dir).0 {
+                return Err("the manifest does not match its files".into());
+            }
+            continue;
+        }
+        files.insert(name.clone(), std::fs::read(dir.join(&name)).unwrap());
+    }
+    Ok(files)
+}
+
+/// Every command that writes files commits them all-or-none, whatever step it is ended after:
+/// each command runs once into a folder holding its output of other settings (the old set),
+/// with the fault hook (`VIEWSYNTH_FAULT_AFTER`, a kill or a failure) after step k = 1, 2, ...
+/// until a run gets past every step. After the next start's recovery the folder is the old set
+/// or the new one (as clean runs make them), every file alike, and no temporary is left.
+#[test]
+fn round3_every_writing_command_is_all_or_none_after_any_commit_step() {
+    let root = scratch("r3-commit-all");
+    let (rgb, depth) = inputs(&root);
+    let scene = root.join("scene");
+    let made = run(&s(&[
+        "scene",
+        "--width",
+        "64",
+        "--height",
+        "48",
+        "--out-dir",
+        &p(&scene),
+    ]));
+    assert!(made.status.success(), "{}", String::from_utf8_lossy(&made.stderr));
+    let (r, d) = (p(&rgb), p(&depth));
+    let eye = |e: &str, what: &str| p(&scene.join(format!("{e}_{what}")));
+    // Each command with the one setting that differs between its old and new set (same names,
+    // other contents).
+    type Variant = (&'static str, Vec<String>, [Vec<String>; 2]);
+    let commands: Vec<Variant> = vec![
+        (
+            "refocus",
+            s(&[
+                "refocus",
+                "--rgb",
+                &r,
+                "--depth",
+                &d,
+                "--fx",
+                "40",
+                "--fy",
+                "40",
+                "--cx",
+                "15.5",
+                "--cy",
+                "11.5",
+                "--zoom-range",
+                "0.5,1.5",
+            ]),
+            [
+                s(&["--cx-out", "15.5", "--cy-out", "11.5"]),
+                s(&["--cx-out", "13.5", "--cy-out", "11.5"]),
+            ],
+        ),
+        (
+            "cyclopean",
+            s(&[
+                "cyclopean",
+                "--left-rgb",
+                &eye("left", "rgb.png"),
+                "--right-rgb",
+                &eye("right", "rgb.png"),
+                "--left-depth",
+                &eye("left", "device_depth.exr"),
+                "--right-depth",
+                &eye("right", "device_depth.exr"),
+                "--cameras",
+                &p(&scene.join("cameras.json")),
+            ]),
+            [s(&["--method", "seed"]), s(&["--method", "splat-gather"])],
+        ),
+        (
+            "reproject",
+            s(&[
+                "reproject",
+                "--color",
+                &r,
+                "--depth",
+                &d,
+                "--fx",
+                "40",
+                "--fy",
+                "40",
+                "--cx",
+                "15.5",
+                "--cy",
+                "11.5",
+            ]),
+            [s(&["--baseline", "0.1"]), s(&["--baseline", "0.2"])],
+        ),
+        (
+            "stitch",
+            s(&["stitch", "--scene", "demo", "--width", "64", "--height", "32"]),
+            [s(&["--ipd", "0.064"]), s(&["--ipd", "0.07"])],
+        ),
+        (
+            "scene",
+            s(&["scene", "--width", "64", "--height", "48"]),
+            [s(&["--ipd", "0.064"]), s(&["--ipd", "0.07"])],
+        ),
+    ];
+    let mut failures = Vec::new();
+    let mut cases = 0;
+    for (name, base, [old_args, new_args]) in &commands {
+        let args = |settings: &[String], out: &Path| -> Vec<String> {
+            let mut a = base.clone();
+            a.extend(settings.iter().cloned());
+            a.extend(s(&["--out-dir", &p(out)]));
+            a
+        };
+        let clean = |settings: &[String], tag: &str| {
+            let out = root.join(format!("{name}-{tag}"));
+            let o = run(&args(settings, &out));
+            assert!(
+                o.status.success(),
+                "{name} {tag}: {}",
+                String::from_utf8_lossy(&o.stderr)
+            );
+            (out.clone(), file_set_snapshot(&out).unwrap())
+        };
+        let (old_dir, old) = clean(old_args, "old");
+        let (_, new) = clean(new_args, "new");
+        assert_eq!(
+            old.keys().collect::<Vec<_>>(),
+            new.keys().collect::<Vec<_>>(),
+            "{name}: the two settings must write the same names"
+        );
+        assert_ne!(old, new, "{name}: the two settings must write other contents");
+        let mut steps = None;
+        for k in 1..=100 {
+            for mode in ["", ":fail"] {
+                cases += 1;
+                let label = format!("{name} after step {k}{mode}");
+                let out = root.join(format!("{name}-k{k}{mode}"));
+                copy_dir(&old_dir, &out);
+                let mut c = Command::new(env!("CARGO_BIN_EXE_viewsynth"));
+                c.args(args(new_args, &out))
+                    .env("VIEWSYNTH_FAULT_AFTER", format!("{k}{mode}"))
+                    .stdout(Stdio::null())
+                    .stderr(Stdio::null());
+                let code = c.status().unwrap().code();
+                match (code, mode) {
+                    (Some(0), _) => steps = Some(k - 1),
+                    (Some(137), "") | (Some(1), ":fail") => {}
+                    _ => failures.push(format!("{label}: exit {code:?}")),
+                }
+                io::OutDir::prepare(&out).unwrap();
+                match file_set_snapshot(&out) {
+                    Ok(now) if now == old || now == new => {}
+                    Ok(now) => {
+                        let mixed: Vec<_> = now.keys().filter(|f| now.get(*f) != new.get(*f)).collect();
+                        failures.push(format!("{label}: neither the old nor the new set (not new: {mixed:?})"));
+                    }
+                    Err(e) => failures.push(format!("{label}: {e}")),
+                }
+            }
+            if steps.is_some() {
+                break;
+            }
+        }
+        // A journal, one rename a file, and the three removals of the staging folder.
+        let files = old.len() + usize::from(*name == "refocus");
+        assert_eq!(steps, Some(1 + files + 3), "{name}: steps of one commit");
     }
     report(failures, cases);
 }
