@@ -1560,26 +1560,15 @@ fn round3_every_writing_command_is_all_or_none_after_any_commit_step() {
     // Each command with the one setting that differs between its old and new set (same names,
     // other contents).
     type Variant = (&'static str, Vec<String>, [Vec<String>; 2]);
+    let intrinsics = s(&["--fx", "40", "--fy", "40", "--cx", "15.5", "--cy", "11.5"]);
     let commands: Vec<Variant> = vec![
         (
             "refocus",
-            s(&[
-                "refocus",
-                "--rgb",
-                &r,
-                "--depth",
-                &d,
-                "--fx",
-                "40",
-                "--fy",
-                "40",
-                "--cx",
-                "15.5",
-                "--cy",
-                "11.5",
-                "--zoom-range",
-                "0.5,1.5",
-            ]),
+            [
+                s(&["refocus", "--rgb", &r, "--depth", &d, "--zoom-range", "0.5,1.5"]),
+                intrinsics.clone(),
+            ]
+            .concat(),
             [
                 s(&["--cx-out", "15.5", "--cy-out", "11.5"]),
                 s(&["--cx-out", "13.5", "--cy-out", "11.5"]),
@@ -1587,38 +1576,24 @@ fn round3_every_writing_command_is_all_or_none_after_any_commit_step() {
         ),
         (
             "cyclopean",
-            s(&[
-                "cyclopean",
-                "--left-rgb",
-                &eye("left", "rgb.png"),
-                "--right-rgb",
-                &eye("right", "rgb.png"),
-                "--left-depth",
-                &eye("left", "device_depth.exr"),
-                "--right-depth",
-                &eye("right", "device_depth.exr"),
-                "--cameras",
-                &p(&scene.join("cameras.json")),
-            ]),
+            [
+                s(&[
+                    "cyclopean",
+                    "--left-rgb",
+                    &eye("left", "rgb.png"),
+                    "--right-rgb",
+                    &eye("right", "rgb.png"),
+                ]),
+                s(&["--left-depth", &eye("left", "device_depth.exr")]),
+                s(&["--right-depth", &eye("right", "device_depth.exr")]),
+                s(&["--cameras", &p(&scene.join("cameras.json"))]),
+            ]
+            .concat(),
             [s(&["--method", "seed"]), s(&["--method", "splat-gather"])],
         ),
         (
             "reproject",
-            s(&[
-                "reproject",
-                "--color",
-                &r,
-                "--depth",
-                &d,
-                "--fx",
-                "40",
-                "--fy",
-                "40",
-                "--cx",
-                "15.5",
-                "--cy",
-                "11.5",
-            ]),
+            [s(&["reproject", "--color", &r, "--depth", &d]), intrinsics.clone()].concat(),
             [s(&["--baseline", "0.1"]), s(&["--baseline", "0.2"])],
         ),
         (
