@@ -41,6 +41,14 @@ fn refocus(rgb: &Path, depth: &Path, out: &Path, extra: &[&str]) -> Output {
     c.output().expect("run viewsynth")
 }
 
+/// The temporaries (`.viewsynth-…` files and staging folders) directly in `dir`.
+pub(crate) fn temporaries(dir: &Path) -> Vec<String> {
+    files_in(dir)
+        .into_iter()
+        .filter(|f| f.starts_with(viewsynth::io::TEMP_PREFIX))
+        .collect()
+}
+
 pub(crate) fn files_in(dir: &Path) -> Vec<String> {
     let mut v: Vec<String> = std::fs::read_dir(dir)
         .map(|r| {

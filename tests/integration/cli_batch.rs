@@ -3,7 +3,7 @@
 //! outputs, formats), `--shard K/N` taking the frames with i % N == K over several K, resume per
 //! shard, kill -9 mid-batch then resume, and a batch ended after each step of its file commits.
 
-use crate::cli::{bin, files_in, scratch};
+use crate::cli::{bin, files_in, scratch, temporaries};
 use image::ImageEncoder;
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
@@ -279,16 +279,12 @@ fn kill_9_mid_batch_then_resume_renders_only_the_unfinished_frames() {
         let frame = out.join(f);
         assert!(frame_complete(&frame), "{f}");
         assert!(
-            files_in(&frame).iter().all(|n| !n.starts_with(".viewsynth-")),
+            temporaries(&frame).is_empty(),
             "{f}: temporaries left: {:?}",
             files_in(&frame)
         );
     }
-    assert!(
-        files_in(&out).iter().all(|n| !n.starts_with(".viewsynth-")),
-        "{:?}",
-        files_in(&out)
-    );
+    assert!(temporaries(&out).is_empty(), "{:?}", files_in(&out));
 }
 
 /// Every place a batch can die in its file commits, not only where a timed kill happens to
@@ -311,21 +307,13 @@ fn a_batch_ended_after_any_commit_step_resumes_to_every_frame_complete() {
             .output()
             .unwrap()
     };
-    let temporaries = |out: &Path| -> Vec<String> {
-        let mut found: Vec<String> = files_in(out)
+    // In the out-dir and in each frame's folder.
+    let all_temporaries = |out: &Path| -> Vec<String> {
+        let frames = files_in(out).into_iter().filter(|f| out.join(f).is_dir());
+        temporaries(out)
             .into_iter()
-            .filter(|f| f.starts_with(".viewsynth-"))
-            .collect();
-        for f in files_in(out) {
-            if out.join(&f).is_dir() {
-                found.extend(
-                    files_in(&out.join(&f))
-                        .into_iter()
-                        .filter(|n| n.starts_with(".viewsynth-")),
-                );
-            }
-        }
-        found
+            .chain(frames.flat_map(|f| temporaries(&out.join(f))))
+            .collect()
     };
     let mut failures = Vec::new();
     for k in 1..=steps + 1 {
@@ -362,8 +350,9 @@ fn a_batch_ended_after_any_commit_step_resumes_to_every_frame_complete() {
             if after.len() != 3 || !after.keys().all(|f| frame_complete(&out.join(f))) {
                 failures.push(format!("{label}: not every frame complete after the resume"));
             }
-            if !temporaries(&out).is_empty() {
-                failures.push(format!("{label}: temporaries left: {:?}", temporaries(&out)));
+            let left = all_temporaries(&out);
+            if !left.is_empty() {
+                failures.push(format!("{label}: temporaries left: {left:?}"));
             }
         }
     }

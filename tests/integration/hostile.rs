@@ -15,7 +15,7 @@ use std::process::{Command, Output, Stdio};
 
 use viewsynth::io::{self, DepthMap, RgbImage};
 
-use super::cli::{bin, files_in, scratch};
+use super::cli::{bin, files_in, scratch, temporaries};
 
 /// Address-space limit (KiB) for runs that must fail before reading pixels: a 16383 x 16383
 /// image would need over 800 MB for its colour alone.
@@ -825,13 +825,6 @@ fn refocus_ok(rgb: &Path, depth: &Path, out: &Path, extra: &[&str]) -> Output {
         .arg(out)
         .args(extra);
     c.output().unwrap()
-}
-
-fn temporaries(dir: &Path) -> Vec<String> {
-    files_in(dir)
-        .into_iter()
-        .filter(|f| f.starts_with(".viewsynth-"))
-        .collect()
 }
 
 fn contents(dir: &Path) -> BTreeMap<PathBuf, Entry> {

@@ -9,7 +9,7 @@ use std::process::{Command, Output, Stdio};
 
 use viewsynth::io::{self, DepthMap, RgbImage};
 
-use super::cli::{bin, files_in, scratch};
+use super::cli::{bin, files_in, scratch, temporaries};
 
 const W: u32 = 32;
 const H: u32 = 24;
@@ -545,10 +545,7 @@ fn round3_outputs_never_replace_what_is_not_ours_and_compare_is_all_or_none() {
         {
             problems.push("/dev/null was replaced".into());
         }
-        let temps: Vec<String> = files_in(&root)
-            .into_iter()
-            .filter(|f| f.starts_with(".viewsynth-"))
-            .collect();
+        let temps = temporaries(&root);
         if !temps.is_empty() {
             problems.push(format!("temporaries left: {temps:?}"));
         }
@@ -652,10 +649,7 @@ fn round3_commit_survives_a_kill_or_a_failure_after_every_step() {
             if method == old_method {
                 problems.push("after recovery the old set is back although the journal was written".into());
             }
-            let temps: Vec<String> = files_in(&out)
-                .into_iter()
-                .filter(|f| f.starts_with(".viewsynth-"))
-                .collect();
+            let temps = temporaries(&out);
             if !temps.is_empty() {
                 problems.push(format!("temporaries left: {temps:?}"));
             }
