@@ -29,7 +29,7 @@ const TEMP_TRIES: usize = 16;
 
 /// Takes `file`'s exclusive lock without waiting: Ok(true) when taken, Ok(false) when another
 /// open file holds it.
-pub(crate) fn try_lock(file: &File) -> io::Result<bool> {
+fn try_lock(file: &File) -> io::Result<bool> {
     use rustix::fs::{flock, FlockOperation};
     match flock(file, FlockOperation::NonBlockingLockExclusive) {
         Ok(()) => Ok(true),
@@ -38,9 +38,16 @@ pub(crate) fn try_lock(file: &File) -> io::Result<bool> {
     }
 }
 
+/// Takes `file`'s lock (as [`try_lock`]) and tells whether this process now owns the
+/// temporary at `path`: locked, and `path` still names `file` (a cleaner may have taken and
+/// removed it before the lock; see the module notes).
+pub(crate) fn lock_if_current(file: &File, path: &Path) -> io::Result<bool> {
+    Ok(try_lock(file)? && is_same_file(file, path))
+}
+
 /// Whether `file` is still the file at `path` (not followed): false once `path` was removed
 /// or replaced.
-pub(crate) fn is_same_file(file: &File, path: &Path) -> bool {
+fn is_same_file(file: &File, path: &Path) -> bool {
     use std::os::unix::fs::MetadataExt;
     match (file.metadata(), fs::symlink_metadata(path)) {
         (Ok(a), Ok(b)) => a.dev() == b.dev() && a.ino() == b.ino(),
@@ -151,7 +158,7 @@ pub(crate) fn temp_file_in(dir: &Path, shown: &Path) -> Result<tempfile::NamedTe
             .tempfile_in(dir)
             .map_err(|e| Error::io(shown, e))?;
         // Taken by a cleaner before the lock (see the module notes): make another.
-        if try_lock(temp.as_file()).map_err(|e| Error::io(shown, e))? && is_same_file(temp.as_file(), temp.path()) {
+        if lock_if_current(temp.as_file(), temp.path()).map_err(|e| Error::io(shown, e))? {
             return Ok(temp);
         }
     }
@@ -219,10 +226,7 @@ pub fn remove_orphan_temporaries(dir: &Path) -> usize {
             Ok(t) if t.is_dir() => super::file_set::recover_staging(dir, &e.path()),
             Ok(t) if t.is_file() => match open_for_lock(&e.path()) {
                 // Removed while locked, so its maker's late lock finds the name gone.
-                Ok(f) => match try_lock(&f) {
-                    Ok(true) if is_same_file(&f, &e.path()) => fs::remove_file(e.path()).is_ok(),
-                    _ => false,
-                },
+                Ok(f) => lock_if_current(&f, &e.path()).unwrap_or(false) && fs::remove_file(e.path()).is_ok(),
                 Err(_) => false,
             },
             // Never ours (we make none) and harmless: left alone.

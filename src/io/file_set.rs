@@ -49,8 +49,8 @@ mod parallel;
 pub use parallel::FileWriter;
 
 use super::atomic::{
-    check_replaceable, fault_point, is_same_file, open_for_lock, own_prefix, probe_writable, remove_orphan_temporaries,
-    try_lock, TEMP_PREFIX,
+    check_replaceable, fault_point, lock_if_current, open_for_lock, own_prefix, probe_writable,
+    remove_orphan_temporaries, TEMP_PREFIX,
 };
 
 /// The lock file inside a staging folder (see the module notes).
@@ -488,11 +488,8 @@ fn claim_lock(staging: &Path) -> io::Result<Option<File>> {
         Err(e) if matches!(e.kind(), io::ErrorKind::AlreadyExists | io::ErrorKind::NotFound) => return Ok(None),
         Err(e) => return Err(e),
     };
-    if !try_lock(&file)? {
-        return Ok(None);
-    }
     // Between the create and the lock a cleaner may have taken the file and removed it.
-    Ok(is_same_file(&file, &path).then_some(file))
+    Ok(lock_if_current(&file, &path)?.then_some(file))
 }
 
 /// Empties and removes this run's own staging folder after its commit: the journal first (a
@@ -530,7 +527,7 @@ pub(crate) fn recover_staging(dir: &Path, staging: &Path) -> bool {
     let path = staging.join(LOCK_NAME);
     let _lock = match open_for_lock(&path) {
         // Held only if it is still the folder's lock file once locked.
-        Ok(f) if try_lock(&f).unwrap_or(false) && is_same_file(&f, &path) => f,
+        Ok(f) if lock_if_current(&f, &path).unwrap_or(false) => f,
         Ok(_) => return false,
         Err(e) if e.kind() == io::ErrorKind::NotFound => match claim_lock(staging) {
             Ok(Some(f)) => f,
