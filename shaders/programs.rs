@@ -125,6 +125,24 @@ pub const PROGRAMS: &[ProgramEntry] = &[
         vulkan: Some(&[]),
     },
     ProgramEntry {
+        name: "cyclopean/temporal_reproject",
+        stages: &[(
+            "comp",
+            &["common/bindings.glsl", "common/camera.glsl", "cyclopean/temporal_params.glsl", "cyclopean/temporal_reproject.comp"],
+        )],
+        switches: &[],
+        vulkan: Some(&[]),
+    },
+    ProgramEntry {
+        name: "cyclopean/temporal_compose",
+        stages: &[
+            ("vert", FULLSCREEN_VERT),
+            ("frag", &["cyclopean/temporal_params.glsl", "cyclopean/temporal_compose.frag"]),
+        ],
+        switches: &[],
+        vulkan: Some(&[]),
+    },
+    ProgramEntry {
         name: "cyclopean/forward",
         stages: &[
             (

@@ -193,6 +193,11 @@ pub enum ProgramKind {
     CyclopeanEdgeSnap,
     /// cyclopean/fill.frag: holes filled from the background side (`--fill`).
     CyclopeanFill,
+    /// cyclopean/temporal_reproject.comp: the previous middle view moved into the current
+    /// camera, nearest first (compute).
+    CyclopeanTemporalReproject,
+    /// cyclopean/temporal_compose.frag: the current view accumulated with that history.
+    CyclopeanTemporalCompose,
     /// cyclopean/matcher_*.comp: one stage of the census stereo matcher (compute).
     CyclopeanMatcher(MatcherStage),
     /// reproject/shift.frag: the row shift as a gather (walk, or the exact scan).
@@ -288,6 +293,8 @@ impl ProgramKind {
             ProgramKind::CyclopeanSplatEdges => "cyclopean/splat_edges",
             ProgramKind::CyclopeanEdgeSnap => "cyclopean/edge_snap",
             ProgramKind::CyclopeanFill => "cyclopean/fill",
+            ProgramKind::CyclopeanTemporalReproject => "cyclopean/temporal_reproject",
+            ProgramKind::CyclopeanTemporalCompose => "cyclopean/temporal_compose",
             ProgramKind::CyclopeanMatcher(stage) => stage.program_name(),
             ProgramKind::ReprojectShift { .. } => "reproject/shift",
             ProgramKind::SceneRaytrace => "scene/raytrace",
@@ -318,6 +325,8 @@ impl ProgramKind {
             | ProgramKind::CyclopeanSplatEdges
             | ProgramKind::CyclopeanEdgeSnap
             | ProgramKind::CyclopeanFill
+            | ProgramKind::CyclopeanTemporalReproject
+            | ProgramKind::CyclopeanTemporalCompose
             | ProgramKind::CyclopeanMatcher(_)
             | ProgramKind::SceneRaytrace => vec![],
             ProgramKind::ReprojectShift {
@@ -409,6 +418,8 @@ impl ShaderProgram {
             ProgramKind::CyclopeanSplatEdges,
             ProgramKind::CyclopeanEdgeSnap,
             ProgramKind::CyclopeanFill,
+            ProgramKind::CyclopeanTemporalReproject,
+            ProgramKind::CyclopeanTemporalCompose,
             ProgramKind::SceneRaytrace,
         ]);
         kinds.extend(MatcherStage::ALL.map(ProgramKind::CyclopeanMatcher));

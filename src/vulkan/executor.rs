@@ -542,6 +542,10 @@ impl Executor for VkExecutor {
         if let Some(image) = self.images.take(id.0) {
             self.bury(Grave::Image(image));
         }
+        // Writes still queued for it must not land in the next image given its id.
+        for f in &mut self.flights {
+            f.writes.retain(|(w, _)| *w != id);
+        }
     }
 
     fn create_buffer(&mut self, words: usize, label: &str) -> Result<BufferId> {

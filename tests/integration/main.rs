@@ -17,6 +17,7 @@ mod compare;
 mod cyclopean;
 mod cyclopean_fill;
 mod cyclopean_real;
+mod cyclopean_temporal;
 mod device_choice;
 mod gl_objects;
 mod gpu_context;

@@ -90,6 +90,8 @@ fn every_parameter_block_has_the_layout_the_gl_compiler_reports() {
     check_block::<ForwardParams>(ProgramKind::CyclopeanForward);
     check_block::<RefocusParams>(ProgramKind::RefocusFullscreen { want_rgb: true });
     check_block::<viewsynth::cyclopean::fill::FillParams>(ProgramKind::CyclopeanFill);
+    check_block::<viewsynth::cyclopean::temporal::TemporalParams>(ProgramKind::CyclopeanTemporalReproject);
+    check_block::<viewsynth::cyclopean::temporal::TemporalParams>(ProgramKind::CyclopeanTemporalCompose);
     for stage in viewsynth::gpu::shaders::MatcherStage::ALL {
         check_block::<viewsynth::cyclopean::matcher::gpu::MatcherParams>(ProgramKind::CyclopeanMatcher(stage));
     }
@@ -735,4 +737,42 @@ fn every_vulkan_pass_runs_clean_under_the_validation_layer() {
     ]));
     let text = assert_clean(&test, o);
     assert!(text.contains("1 passed"), "{test} did not run:\n{text}");
+}
+
+/// A write queued for an image (Vulkan defers `write_image` to the next submission) must not
+/// land in another image after the first is freed and its id given to the next upload. It did:
+/// a temporal accumulator dropped after its last frame left its history rewrite queued, and the
+/// next accumulator's fresh history took the id and the stale texels. Here: a 2x1 colour image
+/// rewritten to red, freed unsubmitted, then the fill's own upload of a view must read as given.
+#[test]
+fn a_write_queued_for_a_freed_image_does_not_reach_the_next_image() {
+    use viewsynth::cyclopean::fill::Filler;
+    use viewsynth::cyclopean::CyclopeanOutput;
+    use viewsynth::io::{DepthMap, RgbImage};
+    use viewsynth::pass::{Format, ImageData};
+    let device = VkExecutor::device(&vulkan()).unwrap();
+    let rgba = |c: [u8; 4]| [c, c].concat();
+    let black = rgba([0, 0, 0, 255]);
+    let stale = device
+        .upload(&ImageData {
+            width: 2,
+            height: 1,
+            format: Format::Rgba8,
+            bytes: &black,
+            label: "probe",
+        })
+        .unwrap();
+    device.write_image(&stale, &rgba([255, 0, 0, 255])).unwrap();
+    drop(stale);
+    let view = CyclopeanOutput {
+        color: Some(RgbImage::new(2, 1, vec![10, 20, 30, 40, 50, 60]).unwrap()),
+        depth: Some(DepthMap::new(2, 1, vec![1.0, 1.0]).unwrap()),
+        sources: vec![1, 1],
+    };
+    let out = Filler::new(&device).unwrap().fill(&view, 2, 1).unwrap();
+    assert_eq!(
+        out.color.unwrap().data,
+        [10, 20, 30, 40, 50, 60],
+        "the rendered pixels pass through the fill as uploaded"
+    );
 }
