@@ -51,7 +51,7 @@ fn render(
         confidence,
     } = plan.frame(&device, input, names)?;
     gpu.check_image_size("the view (cameras[\"middle\"] width/height)", mid.width, mid.height)?;
-    Ok((plan.synthesise(&device, &frame, &mid, fixation)?, confidence))
+    Ok((plan.synthesise(&device, &frame, &mid, fixation, None)?, confidence))
 }
 
 fn eye(

@@ -4,9 +4,6 @@
 // a hole takes the history's colour and distance and the source bit FROM_HISTORY. Pixels no
 // history texel reached pass through unchanged.
 
-// temporal.rs FROM_HISTORY (the twin test compares the source bits exactly).
-const uint FROM_HISTORY = 4u;
-
 layout(location = 0) out vec4 o_color;
 layout(location = 1) out float o_depth;
 layout(location = 2) out float o_sources;  // R8 normalised: bits / 255 stores the bits

@@ -13,3 +13,7 @@ layout(std140, binding = 0) uniform TemporalParams {
     float u_alpha;           // weight of the current frame where both agree (1: no blending)
     float u_depth_tolerance; // relative distance difference above which the history is rejected
 };
+
+// temporal.rs FROM_HISTORY, the source bit of pixels the history filled (the twin test compares
+// the source bits exactly).
+const uint FROM_HISTORY = 4u;

@@ -1,5 +1,6 @@
 // History reprojection of the temporal accumulation (src/cyclopean/temporal.rs; f64 twin:
-// TemporalAccumulator): each valid texel of the previous middle view moves with its distance
+// TemporalAccumulator): each texel of the previous middle view an eye rendered (not one the
+// history filled: see temporal.rs on why a fill is carried one frame only) moves with its distance
 // into the current middle camera, to the pixel whose centre its one-pixel footprint covers (the
 // floor of its window position), as splat.comp moves an eye's texels.
 // Stage 0 keeps each pixel's nearest distance (atomic min on the float bits: positive floats
@@ -15,7 +16,11 @@ layout(r32ui, STORAGE_IMAGE(1)) uniform uimage2D u_winner;   // cleared to 0xFFF
 
 void main() {
     ivec2 t = ivec2(gl_GlobalInvocationID.xy);
-    if (any(greaterThanEqual(t, u_size_h)) || texelFetch(u_hist_sources, t, 0).r == 0u) {
+    if (any(greaterThanEqual(t, u_size_h))) {
+        return;
+    }
+    uint source = texelFetch(u_hist_sources, t, 0).r;
+    if (source == 0u || source == FROM_HISTORY) {
         return;
     }
     float z = texelFetch(u_hist_depth, t, 0).r;

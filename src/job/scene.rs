@@ -32,6 +32,15 @@ pub struct SceneOptions {
     pub cube_faces: Option<u32>,
     /// The cube faces' horizontal and vertical field of view, degrees (> 90: they overlap).
     pub face_fov: f64,
+    /// Frames: 1 writes one stereo frame; more write a sequence, the head moving `dolly`
+    /// metres to its right per frame, each frame's files prefixed `{k:05}_`, and
+    /// `sequence.json` for `cyclopean --sequence`.
+    pub frames: u32,
+    /// Metres the head moves to its right from one frame to the next.
+    pub dolly: f64,
+    /// Metres to the head's right of the middle (spectator) camera: 0 halfway between the
+    /// eyes; beyond half the IPD it sees past an eye (disocclusions neither eye saw).
+    pub spectator_offset: f64,
     /// Output folder.
     pub out_dir: PathBuf,
     /// The GPU to render on.
@@ -39,6 +48,9 @@ pub struct SceneOptions {
     /// `--backend`: the API the passes run on.
     pub backend: Backend,
 }
+
+/// Most frames of a scene sequence.
+pub const MAX_SCENE_FRAMES: u32 = 10_000;
 
 /// The scene to trace: built in (known now) or a file (read when the job runs).
 #[derive(Debug, Clone)]
@@ -55,6 +67,9 @@ pub struct SceneJob {
     conventions: Conventions,
     /// Cube faces to write: the ODS rig (stitch's defaults, at the same IPD), side and FOV.
     faces: Option<(OdsRig, u32, f64)>,
+    frames: u32,
+    dolly: f64,
+    spectator_offset: f64,
     out_dir: PathBuf,
     gpu: GpuRequest,
     backend: Backend,
@@ -86,6 +101,30 @@ impl SceneJob {
             return Err(ArgError::Ipd(o.ipd));
         }
         io::check_output_pixels("--width/--height", o.width, o.height)?;
+        if !(1..=MAX_SCENE_FRAMES).contains(&o.frames) {
+            return Err(ArgError::Invalid(crate::Error::param(
+                "--frames",
+                format!("{} outside 1..={MAX_SCENE_FRAMES}", o.frames),
+            )));
+        }
+        if !(o.dolly.is_finite() && o.dolly.abs() <= 1.0) {
+            return Err(ArgError::Invalid(crate::Error::param(
+                "--dolly",
+                format!("{} m per frame: give a finite step within 1 m", o.dolly),
+            )));
+        }
+        if !(o.spectator_offset.is_finite() && o.spectator_offset.abs() <= 10.0) {
+            return Err(ArgError::Invalid(crate::Error::param(
+                "--spectator-offset",
+                format!("{} m: give a finite offset within 10 m", o.spectator_offset),
+            )));
+        }
+        if o.frames > 1 && o.cube_faces.is_some() {
+            return Err(ArgError::Invalid(crate::Error::param(
+                "--cube-faces",
+                "is for one frame: not with --frames",
+            )));
+        }
         let mut rig = StereoRig::demo(o.width, o.height);
         rig.camera.validate("scene camera")?;
         rig.ipd = o.ipd;
@@ -112,6 +151,9 @@ impl SceneJob {
             rig,
             conventions: o.conventions,
             faces,
+            frames: o.frames,
+            dolly: o.dolly,
+            spectator_offset: o.spectator_offset,
             out_dir: o.out_dir,
             gpu: o.gpu,
             backend: o.backend,
@@ -140,48 +182,81 @@ impl SceneJob {
         let gpu = host.open_device(&self.gpu, self.backend)?;
         let mut renderer = SceneRenderer::new(&gpu, scene)?;
         let proj = gl_projection(&rig.camera, &rig.planes, &conv);
-        let mut cams = serde_json::Map::new();
         let mut eyes = Vec::new();
-        for (eye, side) in [("left", -1.0), ("right", 1.0), ("middle", 0.0)] {
-            let view = rig.eye_pose(side).gl_view();
-            let (img, timing) = renderer.render(&GlCamera {
-                view,
-                proj,
-                width,
-                height,
-                conv,
-            })?;
-            let (rgb_depth, depth_only) = (
-                io::FileFormats::of(io::OutputSet::RGB_DEPTH),
-                io::FileFormats::of(io::OutputSet::DEPTH),
-            );
-            let mut planes = ViewOutput::color_only(img.color, None);
-            planes.depth = Some(img.view_z);
-            let names = io::ViewNames::named(&format!("{eye}_rgb"), &format!("{eye}_view_z"));
-            io::write_view(&mut set, &names, &planes, &rgb_depth)?;
-            planes.depth = Some(img.device_depth);
-            let names = io::ViewNames::named("", &format!("{eye}_device_depth"));
-            io::write_view(&mut set, &names, &planes, &depth_only)?;
-            let entry = if eye == "middle" {
-                serde_json::json!({ "view": view, "proj": proj, "width": width, "height": height })
+        let mut sequence = Vec::new();
+        for k in 0..self.frames {
+            // One frame: no prefix, as before sequences; frame k of a sequence: `{k:05}_`.
+            let prefix = if self.frames == 1 {
+                String::new()
             } else {
-                serde_json::json!({ "view": view, "proj": proj })
+                format!("{k:05}_")
             };
-            cams.insert(eye.to_string(), entry);
-            eyes.push((eye, timing.wall_ms));
+            let mut frame_rig = rig.clone();
+            let r = &rig.head.rotation;
+            let o = self.dolly * f64::from(k);
+            for (axis, p) in frame_rig.head.position.iter_mut().enumerate() {
+                *p += o * r[axis][0];
+            }
+            let mut cams = serde_json::Map::new();
+            let spectator = match rig.ipd {
+                ipd if ipd > 0.0 => 2.0 * self.spectator_offset / ipd,
+                _ => 0.0,
+            };
+            for (eye, side) in [("left", -1.0), ("right", 1.0), ("middle", spectator)] {
+                let view = frame_rig.eye_pose(side).gl_view();
+                let (img, timing) = renderer.render(&GlCamera {
+                    view,
+                    proj,
+                    width,
+                    height,
+                    conv,
+                })?;
+                let (rgb_depth, depth_only) = (
+                    io::FileFormats::of(io::OutputSet::RGB_DEPTH),
+                    io::FileFormats::of(io::OutputSet::DEPTH),
+                );
+                let mut planes = ViewOutput::color_only(img.color, None);
+                planes.depth = Some(img.view_z);
+                let names = io::ViewNames::named(&format!("{prefix}{eye}_rgb"), &format!("{prefix}{eye}_view_z"));
+                io::write_view(&mut set, &names, &planes, &rgb_depth)?;
+                planes.depth = Some(img.device_depth);
+                let names = io::ViewNames::named("", &format!("{prefix}{eye}_device_depth"));
+                io::write_view(&mut set, &names, &planes, &depth_only)?;
+                let entry = if eye == "middle" {
+                    serde_json::json!({ "view": view, "proj": proj, "width": width, "height": height })
+                } else {
+                    serde_json::json!({ "view": view, "proj": proj })
+                };
+                cams.insert(eye.to_string(), entry);
+                if k == 0 {
+                    eyes.push((eye, timing.wall_ms));
+                }
+            }
+            let name = format!("{prefix}cameras.json");
+            let cameras_json = self.out_dir.join(&name);
+            let conv_json =
+                serde_json::to_value(conv).map_err(|e| crate::Error::encode(&cameras_json, e.to_string()))?;
+            cams.insert("conventions".into(), conv_json);
+            cams.insert("depth_kind".into(), "device".into());
+            cams.insert("fixation_distance".into(), 3.0.into());
+            write_json(&mut set, &name, &cameras_json, &serde_json::Value::Object(cams))?;
+            sequence.push(serde_json::json!({
+                "left_rgb": format!("{prefix}left_rgb.png"),
+                "left_depth": format!("{prefix}left_device_depth.exr"),
+                "right_rgb": format!("{prefix}right_rgb.png"),
+                "right_depth": format!("{prefix}right_device_depth.exr"),
+                "cameras": name,
+            }));
         }
-        let cameras_json = self.out_dir.join("cameras.json");
-        let conv_json = serde_json::to_value(conv).map_err(|e| crate::Error::encode(&cameras_json, e.to_string()))?;
-        cams.insert("conventions".into(), conv_json);
-        cams.insert("depth_kind".into(), "device".into());
-        cams.insert("fixation_distance".into(), 3.0.into());
-        let text =
-            serde_json::to_string_pretty(&cams).map_err(|e| crate::Error::encode(&cameras_json, e.to_string()))?;
-        set.write("cameras.json", |w| {
-            use std::io::Write;
-            w.write_all(text.as_bytes())
-                .map_err(|e| crate::Error::io(&cameras_json, e))
-        })?;
+        if self.frames > 1 {
+            let path = self.out_dir.join("sequence.json");
+            write_json(
+                &mut set,
+                "sequence.json",
+                &path,
+                &serde_json::json!({ "frames": sequence }),
+            )?;
+        }
         let faces = match self.faces {
             None => None,
             Some((ods, n, fov)) => {
@@ -208,6 +283,16 @@ impl SceneJob {
     }
 }
 
+/// `value` as pretty JSON into the set as `name` (`path` names it in errors).
+fn write_json(set: &mut io::FileSet, name: &str, path: &Path, value: &serde_json::Value) -> crate::Result<()> {
+    let text = serde_json::to_string_pretty(value).map_err(|e| crate::Error::encode(path, e.to_string()))?;
+    set.write(name, |w| {
+        use std::io::Write;
+        w.write_all(text.as_bytes()).map_err(|e| crate::Error::io(path, e))
+    })?;
+    Ok(())
+}
+
 #[cfg(test)]
 mod tests {
     use super::{ArgError, SceneJob, SceneOptions, SceneSource};
@@ -221,6 +306,9 @@ mod tests {
             conventions: Default::default(),
             cube_faces: None,
             face_fov: 110.0,
+            frames: 1,
+            dolly: 0.0,
+            spectator_offset: 0.0,
             out_dir: "out".into(),
             gpu: Default::default(),
             backend: Default::default(),

@@ -73,7 +73,7 @@ fn ambiguous(prev: &CyclopeanOutput, prev_mid: &MiddleCamera, mid: &MiddleCamera
         };
         for x in 0..pw {
             let d = depth[y * pw + x] as f64;
-            if prev.sources[y * pw + x] == 0 || !(d > 0.0 && d.is_finite()) {
+            if [0, FROM_HISTORY].contains(&prev.sources[y * pw + x]) || !(d > 0.0 && d.is_finite()) {
                 continue;
             }
             let ndc = [

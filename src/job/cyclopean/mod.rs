@@ -9,14 +9,18 @@ use crate::cyclopean::camera_file::CameraFile;
 use crate::cyclopean::{EyeInput, FrameDepth};
 use crate::depth::DepthEncoding;
 use crate::io::{self, DepthDecode, DepthMap, DepthSummary, RgbImage};
+use crate::pass::Device;
 use serde::Serialize;
 use std::path::{Path, PathBuf};
 
 mod request;
+mod sequence;
 
 pub use request::{
     CyclopeanPlan, CyclopeanRequest, Framed, InputName, StereoGiven, StereoInput, StereoKind, Synthesised,
 };
+use sequence::History;
+pub use sequence::{load_sequence, CyclopeanSequenceJob, SequenceFrame, MAX_SEQUENCE_FRAMES};
 
 /// The files of each eye's matcher confidence (`--confidence`), left then right.
 pub const CONFIDENCE_FILES: [&str; 2] = ["left_confidence.exr", "right_confidence.exr"];
@@ -103,9 +107,11 @@ pub struct CyclopeanReport {
     pub width: u32,
     /// View height.
     pub height: u32,
-    /// Fraction of pixels some eye saw.
+    /// Frames rendered (1 without a sequence).
+    pub frames: usize,
+    /// Fraction of pixels some eye saw (the mean over a sequence's frames).
     pub valid_fraction: f64,
-    /// Render wall time.
+    /// Render wall time (the sum over a sequence's frames).
     pub render_ms: f64,
     /// The files written.
     pub written: Vec<PathBuf>,
@@ -181,9 +187,46 @@ impl CyclopeanJob {
 
     /// Reads the pair, renders the view and writes the requested files all-or-none.
     pub fn run(&self, host: &dyn Host) -> Result<CyclopeanReport, JobError> {
-        let input = match &self.maps {
+        // The GPU before the folder: two images alone are matched on it, and a refused input
+        // leaves no folder behind.
+        let device = host.open_device(&self.gpu, self.backend)?;
+        let view = self.render(&device, host, None)?;
+        let out_dir = io::OutDir::prepare(&self.out_dir)?;
+        let mut set = out_dir.file_set()?;
+        io::write_view(
+            &mut set,
+            &io::ViewNames::tagged("middle"),
+            &view.done.view,
+            &self.formats(),
+        )?;
+        let maps: Vec<_> = CONFIDENCE_FILES
+            .into_iter()
+            .zip(view.confidence.iter().flatten())
+            .collect();
+        io::write_float_exrs(&mut set, &maps)?;
+        let written = set.commit()?;
+        Ok(CyclopeanReport {
+            width: view.size.0,
+            height: view.size.1,
+            frames: 1,
+            valid_fraction: view.done.coverage,
+            render_ms: view.done.view.timing.map_or(0.0, |t| t.wall_ms),
+            written,
+        })
+    }
+
+    /// The file formats of the plan's outputs.
+    pub(crate) fn formats(&self) -> io::FileFormats {
+        io::FileFormats {
+            outputs: self.plan.outputs(),
+            ..Default::default()
+        }
+    }
+
+    /// Reads the pair (sizes checked from the headers before anything is decoded).
+    fn input(&self) -> crate::Result<StereoInput> {
+        Ok(match &self.maps {
             None => {
-                // Sizes and the pixel budget from the headers before either file is decoded.
                 let (l, r) = (
                     io::rgb_dimensions(&self.left_rgb)?,
                     io::rgb_dimensions(&self.right_rgb)?,
@@ -199,8 +242,7 @@ impl CyclopeanJob {
                             r.0,
                             r.1
                         ),
-                    }
-                    .into());
+                    });
                 }
                 StereoInput::Images {
                     left: io::load_rgb(&self.left_rgb)?,
@@ -209,7 +251,6 @@ impl CyclopeanJob {
             }
             Some((left_map, right_map)) => {
                 let eye = |rgb: &Path, map: &Path| -> crate::Result<(RgbImage, DepthMap)> {
-                    // Sizes and the pixel budget from the headers before either file is decoded.
                     io::check_rgbd_sizes(rgb, map)?;
                     Ok((
                         io::load_rgb(rgb)?,
@@ -227,7 +268,17 @@ impl CyclopeanJob {
                     },
                 }
             }
-        };
+        })
+    }
+
+    /// Reads the pair and renders its view on `device` (the history, if any, with `--fill`).
+    pub(crate) fn render(
+        &self,
+        device: &Device,
+        host: &dyn Host,
+        history: Option<&mut History>,
+    ) -> crate::Result<RenderedView> {
+        let input = self.input()?;
         let left_map = self.maps.as_ref().map_or(self.left_rgb.as_path(), |m| m.0.as_path());
         let names = [
             InputName::File(&self.left_rgb),
@@ -235,15 +286,12 @@ impl CyclopeanJob {
             InputName::File(left_map),
             InputName::File(self.cameras.as_deref().unwrap_or(left_map)),
         ];
-        // The GPU before the folder: two images alone are matched on it, and a refused input
-        // leaves no folder behind.
-        let device = host.open_device(&self.gpu, self.backend)?;
         let Framed {
             frame,
             mid,
             fixation,
             confidence,
-        } = self.plan.frame(&device, input, names)?;
+        } = self.plan.frame(device, input, names)?;
         if let (Some(cameras), Some((left_map, right_map))) = (&self.cameras, &self.maps) {
             for (path, eye) in [(left_map, &frame.left), (right_map, &frame.right)] {
                 let hint = format!(
@@ -258,25 +306,24 @@ impl CyclopeanJob {
                 });
             }
         }
-        let out_dir = io::OutDir::prepare(&self.out_dir)?;
-        let done = self.plan.synthesise(&device, &frame, &mid, fixation)?;
-        let formats = io::FileFormats {
-            outputs: self.plan.outputs(),
-            ..Default::default()
+        let accumulator = match history {
+            Some(h) => Some(h.for_conventions(device, frame.conv)?),
+            None => None,
         };
-        let mut set = out_dir.file_set()?;
-        io::write_view(&mut set, &io::ViewNames::tagged("middle"), &done.view, &formats)?;
-        let maps: Vec<_> = CONFIDENCE_FILES.into_iter().zip(confidence.iter().flatten()).collect();
-        io::write_float_exrs(&mut set, &maps)?;
-        let written = set.commit()?;
-        Ok(CyclopeanReport {
-            width: mid.width,
-            height: mid.height,
-            valid_fraction: done.coverage,
-            render_ms: done.view.timing.map_or(0.0, |t| t.wall_ms),
-            written,
+        let done = self.plan.synthesise(device, &frame, &mid, fixation, accumulator)?;
+        Ok(RenderedView {
+            done,
+            confidence,
+            size: (mid.width, mid.height),
         })
     }
+}
+
+/// One view rendered, before it is written.
+pub(crate) struct RenderedView {
+    done: Synthesised,
+    confidence: Option<[DepthMap; 2]>,
+    size: (u32, u32),
 }
 
 /// An eye's depth as view Z in metres (0 where invalid), for the input summary.

@@ -17,6 +17,7 @@ use crate::cyclopean::forward::ForwardWarp;
 use crate::cyclopean::matcher::{EyeEstimate, Matcher};
 use crate::cyclopean::render::CyclopeanRenderer;
 use crate::cyclopean::splat::{SplatParams, SplatRenderer};
+use crate::cyclopean::temporal::{Accumulator, FROM_HISTORY};
 use crate::cyclopean::{Blend, CyclopeanOutputs, CyclopeanParams, Eye, EyeInput, MiddleCamera, StereoFrame};
 use crate::io::{self, DepthMap, OutputSet, RgbImage};
 use crate::job::ArgError;
@@ -402,7 +403,7 @@ impl InputName<'_> {
 pub struct Synthesised {
     /// Colour, depth (those asked for) and the mask.
     pub view: ViewOutput,
-    /// Fraction of pixels some eye saw (filled pixels not counted).
+    /// Fraction of pixels some eye saw in this frame (filled pixels not counted).
     pub coverage: f64,
     /// Milliseconds before the render itself: uploads, meshes, programs.
     pub setup_ms: f64,
@@ -539,17 +540,20 @@ impl CyclopeanPlan {
     }
 
     /// Renders the view with the plan's method (and fill) on `device`.
+    /// With `fill` and a `history` (a sequence's [`Accumulator`]), holes the earlier frames
+    /// saw take the history first and the fill fills the rest; both count as filled in the mask.
     pub fn synthesise(
         &self,
         device: &Device,
         frame: &StereoFrame,
         mid: &MiddleCamera,
         fixation: f64,
+        history: Option<&mut Accumulator>,
     ) -> crate::Result<Synthesised> {
         let t0 = std::time::Instant::now();
         frame.validate()?;
         let params = self.gather.map(|g| g.params(fixation)).transpose()?;
-        // The fill reads both planes whatever is returned.
+        // The fill (and the history) read both planes whatever is returned.
         let wanted = CyclopeanOutputs {
             color: self.outputs.rgb || self.fill,
             depth: self.outputs.depth || self.fill,
@@ -562,10 +566,14 @@ impl CyclopeanPlan {
             _ => SplatRenderer::new(device, frame, SplatParams::default(), wanted)?.render(mid)?,
         };
         if self.fill {
+            if let Some(history) = history {
+                out = history.push(&out, mid)?;
+            }
             out = Filler::new(device)?.fill(&out, mid.width, mid.height)?;
         }
         let setup_ms = (t0.elapsed().as_secs_f64() * 1e3 - timing.wall_ms).max(0.0);
-        // The mask: 1 where an eye (or the history) gave the pixel, MASK_FILLED where filled.
+        // The mask: 1 where an eye gave the pixel, MASK_FILLED where filled (from the history
+        // or from the background side).
         let mask = io::Mask::new(
             mid.width,
             mid.height,
@@ -573,12 +581,16 @@ impl CyclopeanPlan {
                 .iter()
                 .map(|&s| match s {
                     0 => 0,
-                    FILLED => io::MASK_FILLED,
+                    FILLED | FROM_HISTORY => io::MASK_FILLED,
                     _ => 1,
                 })
                 .collect(),
         )?;
-        let rendered = out.sources.iter().filter(|s| **s != 0 && **s != FILLED).count();
+        let rendered = out
+            .sources
+            .iter()
+            .filter(|s| ![0, FILLED, FROM_HISTORY].contains(*s))
+            .count();
         // Some methods render planes that were not asked for: keep only those that were.
         let view = ViewOutput {
             width: mid.width,

@@ -8,7 +8,9 @@ use crate::options::{GPU, INPUTS, INTRINSICS, METHOD, OUTPUTS, TARGETS};
 use clap::{Args, ValueEnum};
 use std::path::PathBuf;
 use viewsynth::cyclopean::Blend;
-use viewsynth::job::cyclopean::{CyclopeanJob, CyclopeanMethod, CyclopeanOptions, CyclopeanRequest};
+use viewsynth::job::cyclopean::{
+    CyclopeanJob, CyclopeanMethod, CyclopeanOptions, CyclopeanRequest, CyclopeanSequenceJob,
+};
 use viewsynth::job::{finite_value, ArgError};
 
 #[derive(Clone, Copy, ValueEnum)]
@@ -46,11 +48,24 @@ Examples:
 #[derive(Args)]
 pub(crate) struct CyclopeanArgs {
     /// Left eye colour (PNG, JPEG, PPM, EXR), rows top-down.
-    #[arg(help_heading = INPUTS, long)]
-    left_rgb: PathBuf,
+    #[arg(help_heading = INPUTS, long, required_unless_present = "sequence")]
+    left_rgb: Option<PathBuf>,
     /// Right eye colour.
-    #[arg(help_heading = INPUTS, long)]
-    right_rgb: PathBuf,
+    #[arg(help_heading = INPUTS, long, required_unless_present = "sequence")]
+    right_rgb: Option<PathBuf>,
+    /// A sequence of frames, rendered in order: JSON `{"frames": [{"left_rgb": ..., "right_rgb":
+    /// ..., "left_depth": ..., "right_depth": ..., "cameras": ...}, ...]}` (the keys of these
+    /// flags; disparities or neither as for one pair), paths relative to the file. Writes
+    /// middle_00000_rgb.png, ... for frame 0 and so on, all-or-none. With --fill, holes take
+    /// what earlier frames saw there (the last view moved into this frame's camera) before the
+    /// fill fills the rest.
+    #[arg(
+        help_heading = INPUTS,
+        long,
+        value_name = "FILE",
+        conflicts_with_all = ["left_rgb", "right_rgb", "left_disparity", "right_disparity", "left_depth", "right_depth", "cameras", "confidence"]
+    )]
+    sequence: Option<PathBuf>,
     /// Left disparity of a rectified pair, pixels (x_right = x_left - d); 0 or non-finite =
     /// unknown. PGM/PNG (8/16-bit), PFM, NPY or EXR.
     #[arg(help_heading = INPUTS, long, conflicts_with_all = ["left_depth", "cameras"])]
@@ -132,7 +147,8 @@ pub(crate) struct CyclopeanArgs {
     #[arg(help_heading = OUTPUTS, long)]
     confidence: bool,
     /// Writes middle_rgb.png, middle_depth.exr, middle_mask.png (those in --outputs), and
-    /// left_confidence.exr, right_confidence.exr with --confidence.
+    /// left_confidence.exr, right_confidence.exr with --confidence; with --sequence,
+    /// middle_00000_rgb.png, ... per frame.
     #[arg(help_heading = OUTPUTS, long)]
     out_dir: PathBuf,
     #[command(flatten)]
@@ -173,13 +189,19 @@ impl CyclopeanArgs {
     }
 }
 
-impl TryFrom<CyclopeanArgs> for CyclopeanJob {
+/// One pair, or a sequence of frames (`--sequence`).
+pub(crate) enum CyclopeanRun {
+    Pair(CyclopeanJob),
+    Sequence(CyclopeanSequenceJob),
+}
+
+impl TryFrom<CyclopeanArgs> for CyclopeanRun {
     type Error = ArgError;
     fn try_from(a: CyclopeanArgs) -> Result<Self, ArgError> {
         let request = a.request()?;
-        CyclopeanJob::new(CyclopeanOptions {
-            left_rgb: a.left_rgb,
-            right_rgb: a.right_rgb,
+        let options = CyclopeanOptions {
+            left_rgb: a.left_rgb.unwrap_or_default(),
+            right_rgb: a.right_rgb.unwrap_or_default(),
             left_disparity: a.left_disparity,
             right_disparity: a.right_disparity,
             disparity_scale: a.disparity_scale,
@@ -192,6 +214,10 @@ impl TryFrom<CyclopeanArgs> for CyclopeanJob {
             out_dir: a.out_dir,
             gpu: a.gpu.try_into()?,
             backend: a.backend.into(),
+        };
+        Ok(match a.sequence {
+            Some(file) => CyclopeanRun::Sequence(CyclopeanSequenceJob::new(file, options)?),
+            None => CyclopeanRun::Pair(CyclopeanJob::new(options)?),
         })
     }
 }

@@ -12,7 +12,8 @@ use viewsynth::job::{finite_value, ArgError};
 pub(crate) const EXAMPLES: &str = "\
 Examples:
   viewsynth scene --width 320 --height 240 --out-dir out/scene     # a stereo frame + cameras.json
-  viewsynth scene --cube-faces 128 --out-dir out/faces             # also 6 faces per eye for stitch --faces";
+  viewsynth scene --cube-faces 128 --out-dir out/faces             # also 6 faces per eye for stitch --faces
+  viewsynth scene --width 320 --height 240 --frames 8 --out-dir out/seq  # a sequence for cyclopean --sequence";
 
 #[derive(Args)]
 pub(crate) struct SceneArgs {
@@ -40,6 +41,18 @@ pub(crate) struct SceneArgs {
     /// Field of view of the cube faces, degrees, in (90, 178): give stitch the same --fov.
     #[arg(help_heading = OUTPUTS, long, default_value_t = 110.0, requires = "cube_faces", value_parser = finite_value)]
     face_fov: f64,
+    /// Frames of a sequence: the head moves --dolly metres to its right per frame; each
+    /// frame's files are prefixed 00000_, 00001_, ... and sequence.json lists them for
+    /// `viewsynth cyclopean --sequence`.
+    #[arg(help_heading = OUTPUTS, long, default_value_t = 1, value_parser = clap::value_parser!(u32).range(1..=i64::from(viewsynth::job::scene::MAX_SCENE_FRAMES)))]
+    frames: u32,
+    /// Metres the head moves to its right between frames (with --frames).
+    #[arg(help_heading = OUTPUTS, long, default_value_t = 0.02, value_parser = finite_value)]
+    dolly: f64,
+    /// Metres to the head's right of the middle (spectator) camera and its truth view: 0
+    /// halfway between the eyes; beyond half the IPD it looks past the right eye.
+    #[arg(help_heading = TARGETS, long, default_value_t = 0.0, value_parser = finite_value)]
+    spectator_offset: f64,
     #[command(flatten)]
     conv: ConventionArgs,
     #[command(flatten)]
@@ -58,6 +71,9 @@ impl TryFrom<SceneArgs> for SceneJob {
             width: a.width,
             height: a.height,
             cube_faces: a.cube_faces,
+            frames: a.frames,
+            dolly: a.dolly,
+            spectator_offset: a.spectator_offset,
             face_fov: a.face_fov,
             ipd: a.ipd,
             conventions: a.conv.into(),
