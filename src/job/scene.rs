@@ -191,7 +191,7 @@ impl SceneJob {
             } else {
                 format!("{k:05}_")
             };
-            let mut frame_rig = rig.clone();
+            let mut frame_rig = *rig;
             let r = &rig.head.rotation;
             let o = self.dolly * f64::from(k);
             for (axis, p) in frame_rig.head.position.iter_mut().enumerate() {
