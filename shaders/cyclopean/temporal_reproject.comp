@@ -14,18 +14,32 @@ layout(binding = 2) uniform usampler2D u_hist_sources;  // R8UI previous source 
 layout(r32ui, STORAGE_IMAGE(0)) uniform uimage2D u_nearest;  // cleared to 0xFFFFFFFF
 layout(r32ui, STORAGE_IMAGE(1)) uniform uimage2D u_winner;   // cleared to 0xFFFFFFFF
 
+// Texel t was rendered by an eye (not filled from the history) at a usable distance.
+bool rendered(ivec2 t) {
+    uint source = texelFetch(u_hist_sources, t, 0).r;
+    float z = texelFetch(u_hist_depth, t, 0).r;
+    return source != 0u && source != FROM_HISTORY && z > 0.0 && !isinf(z);
+}
+
 void main() {
     ivec2 t = ivec2(gl_GlobalInvocationID.xy);
     if (any(greaterThanEqual(t, u_size_h))) {
         return;
     }
-    uint source = texelFetch(u_hist_sources, t, 0).r;
-    if (source == 0u || source == FROM_HISTORY) {
+    if (!rendered(t)) {
         return;
     }
     float z = texelFetch(u_hist_depth, t, 0).r;
-    if (!(z > 0.0) || isinf(z)) {
-        return;
+    // Not an edge: every 4-neighbour in the image rendered and none farther than the tolerance
+    // (temporal.rs `carried`: an edge texel would fill the background a disocclusion uncovers).
+    float far = z * (1.0 + u_depth_tolerance);
+    const ivec2 steps[4] = ivec2[4](ivec2(-1, 0), ivec2(1, 0), ivec2(0, -1), ivec2(0, 1));
+    for (int k = 0; k < 4; ++k) {
+        ivec2 n = t + steps[k];
+        if (all(greaterThanEqual(n, ivec2(0))) && all(lessThan(n, u_size_h))
+            && (!rendered(n) || texelFetch(u_hist_depth, n, 0).r > far)) {
+            return;
+        }
     }
     vec3 ray = view_ray(u_inv_proj_h, ndc_of_pixel(vec2(t), vec2(u_size_h)));
     vec4 world = vec4(transform_point(u_inv_view_h, ray * z), 1.0);

@@ -5,11 +5,12 @@
 //! history fills it (source bit 4). With `alpha` 1 the history only fills holes: what a
 //! spectator stream wants when objects move (blending without motion vectors ghosts them).
 //!
-//! Only pixels an eye rendered are carried into the next frame; a pixel the history filled is
-//! not carried again. Each carry moves a texel to the nearest pixel centre (up to half a pixel
+//! Only pixels an eye rendered are carried into the next frame ([`carried`]: not at a depth
+//! break or beside a hole either); a pixel the history filled is not carried again. Each carry moves a texel to the nearest pixel centre (up to half a pixel
 //! off), so a fill carried frame after frame drifts: on the built-in scene's 8-frame dolly with
 //! the spectator 0.1 m right of the head (`viewsynth scene --frames 8 --dolly 0.03
-//! --spectator-offset 0.1`), carrying fills lost 4.7 dB by frame 5 against carrying them once.
+//! --spectator-offset 0.1`), carrying fills lost 4.7 dB by frame 5 against carrying them once
+//! (measured before edge texels were dropped too).
 //!
 //! Two passes on either executor ([`Accumulator`]): shaders/cyclopean/temporal_reproject.comp
 //! moves the history's texels (nearest distance, then that texel, as an atomic min each) and
@@ -239,6 +240,43 @@ impl Accumulator {
     }
 }
 
+/// Whether texel (x, top-down row y) of the last view is carried into the next frame: an eye
+/// rendered it (not the history) at a usable distance, and so did each of its 4-neighbours in
+/// the image, none of them farther than `tolerance` relative. Why the neighbours: a texel at a
+/// depth break or beside a hole is an edge, and an edge texel (moved to the nearest pixel
+/// centre, up to half a pixel past its surface; or an edge pixel mixing both surfaces) would
+/// fill the background a disocclusion uncovers with the foreground's colour. The comparison
+/// is f32, as the shader's, so both choose the same texels.
+pub fn carried(
+    view: &CyclopeanOutput,
+    depth: &crate::io::DepthMap,
+    x: usize,
+    y: usize,
+    w: usize,
+    h: usize,
+    tolerance: f64,
+) -> bool {
+    let rendered = |i: usize| {
+        let d = depth.data[i];
+        ![0, FROM_HISTORY].contains(&view.sources[i]) && d.is_finite() && d > 0.0
+    };
+    let i = y * w + x;
+    if !rendered(i) {
+        return false;
+    }
+    let far = depth.data[i] * (1.0 + tolerance as f32);
+    let neighbours = [
+        (x > 0).then(|| i - 1),
+        (x + 1 < w).then(|| i + 1),
+        (y > 0).then(|| i - w),
+        (y + 1 < h).then(|| i + w),
+    ];
+    neighbours
+        .into_iter()
+        .flatten()
+        .all(|n| rendered(n) && depth.data[n] <= far)
+}
+
 /// Exponential accumulation of successive middle views, holes filled from the reprojected history.
 pub struct TemporalAccumulator {
     /// Weight of the current frame where both are valid (1 = no accumulation).
@@ -356,7 +394,7 @@ impl TemporalAccumulator {
             for x in 0..pw {
                 let i = y * pw + x;
                 let d = prev_depth.data[i] as f64;
-                if prev.sources[i] == 0 || prev.sources[i] == FROM_HISTORY || !(d.is_finite() && d > 0.0) {
+                if !carried(prev, prev_depth, x, y, pw, ph, self.depth_tolerance) {
                     continue;
                 }
                 let ndc = pixel_ndc(x, y, pw, ph, &self.conv);

@@ -20,7 +20,7 @@ use viewsynth::camera::mat4;
 use viewsynth::convention::{Conventions, RowOrder};
 use viewsynth::cyclopean::render::CyclopeanRenderer;
 use viewsynth::cyclopean::scene_frame::{scene_frame, StereoRig};
-use viewsynth::cyclopean::temporal::{Accumulator, TemporalAccumulator, FROM_HISTORY};
+use viewsynth::cyclopean::temporal::{carried, Accumulator, TemporalAccumulator, FROM_HISTORY};
 use viewsynth::cyclopean::{CyclopeanOutput, CyclopeanParams, FrameDepth, Method, MiddleCamera};
 use viewsynth::eval::image_check::{self, Plane};
 use viewsynth::pass::Device;
@@ -73,7 +73,7 @@ fn ambiguous(prev: &CyclopeanOutput, prev_mid: &MiddleCamera, mid: &MiddleCamera
         };
         for x in 0..pw {
             let d = depth[y * pw + x] as f64;
-            if [0, FROM_HISTORY].contains(&prev.sources[y * pw + x]) || !(d > 0.0 && d.is_finite()) {
+            if !carried(prev, prev.depth.as_ref().unwrap(), x, y, pw, ph, 0.02) {
                 continue;
             }
             let ndc = [

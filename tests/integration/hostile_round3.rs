@@ -1549,6 +1549,21 @@ fn round3_every_writing_command_is_all_or_none_after_any_commit_step() {
         &p(&scene),
     ]));
     assert!(made.status.success(), "{}", String::from_utf8_lossy(&made.stderr));
+    let frames = root.join("frames");
+    let made = run(&s(&[
+        "scene",
+        "--width",
+        "64",
+        "--height",
+        "48",
+        "--frames",
+        "2",
+        "--spectator-offset",
+        "0.1",
+        "--out-dir",
+        &p(&frames),
+    ]));
+    assert!(made.status.success(), "{}", String::from_utf8_lossy(&made.stderr));
     let (r, d) = (p(&rgb), p(&depth));
     let eye = |e: &str, what: &str| p(&scene.join(format!("{e}_{what}")));
     // Each command with the one setting that differs between its old and new set (same names,
@@ -1583,6 +1598,11 @@ fn round3_every_writing_command_is_all_or_none_after_any_commit_step() {
                 s(&["--cameras", &p(&scene.join("cameras.json"))]),
             ]
             .concat(),
+            [s(&["--method", "seed"]), s(&["--method", "splat-gather"])],
+        ),
+        (
+            "cyclopean-sequence",
+            s(&["cyclopean", "--sequence", &p(&frames.join("sequence.json")), "--fill"]),
             [s(&["--method", "seed"]), s(&["--method", "splat-gather"])],
         ),
         (

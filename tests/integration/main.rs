@@ -12,6 +12,7 @@ mod cli_formats;
 mod cli_output;
 mod cli_outputs_table;
 mod cli_reproject_stitch;
+mod cli_sequence;
 mod common;
 mod compare;
 mod cyclopean;
