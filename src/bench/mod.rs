@@ -224,6 +224,48 @@ pub fn cyclopean_bench(
         |f| f.fill(&view, mid.width, mid.height),
     )?;
     record("--fill alone (on the splat-gather view; add to its row)", fill);
+    // --sequence --fill also reprojects the last frame's view into this one first (the head
+    // 3 cm away): the temporal accumulation's two passes and uploads, then its f64 twin.
+    let mut moved = rig;
+    moved.head.position[0] += 0.03;
+    let (last, last_mid, _) = scene_frame(&moved, Conventions::default(), FrameDepth::Device);
+    let (last, _) = crate::cyclopean::splat::SplatRenderer::new(
+        gpu,
+        &last,
+        crate::cyclopean::splat::SplatParams::default(),
+        crate::cyclopean::CyclopeanOutputs::default(),
+    )?
+    .render(&last_mid)?;
+    use crate::cyclopean::temporal::{Accumulator, TemporalAccumulator, DEPTH_TOLERANCE, FILL_ONLY};
+    let conv = Conventions::default();
+    // Each timed push reprojects the other frame's view: the two alternate.
+    let temporal = setup_and_median(
+        repeats,
+        || Ok((Accumulator::new(gpu, FILL_ONLY, DEPTH_TOLERANCE, conv)?, false)),
+        |(a, odd)| {
+            *odd = !*odd;
+            match odd {
+                true => a.push(&view, &mid),
+                false => a.push(&last, &last_mid),
+            }
+        },
+    )?;
+    record(
+        "--sequence --fill: temporal accumulation before the fill (add to --fill's row)",
+        temporal,
+    );
+    let twin = setup_and_median(
+        repeats.min(3),
+        || Ok((TemporalAccumulator::new(FILL_ONLY, DEPTH_TOLERANCE, conv)?, false)),
+        |(a, odd)| {
+            *odd = !*odd;
+            match odd {
+                true => a.push(&view, &mid),
+                false => a.push(&last, &last_mid),
+            }
+        },
+    )?;
+    record("temporal accumulation, f64 twin (CPU, 1 thread)", twin);
     // The census matcher on a pair of this size: what a user without disparities pays before
     // any of the methods above (GPU pass, then its CPU twin as the baseline).
     let (left, right, _) = matcher::synthetic_pair(width, height)?;

@@ -87,6 +87,8 @@ pub struct SceneReport {
     /// The cube faces written, if asked: side N, field of view in degrees, and the ray-tracing
     /// time in milliseconds (CPU, f64).
     pub faces: Option<(u32, f64, f64)>,
+    /// Frames written (more than 1: a sequence with `sequence.json`).
+    pub frames: u32,
 }
 
 impl SceneJob {
@@ -279,6 +281,7 @@ impl SceneJob {
             size: (width, height),
             eyes,
             faces,
+            frames: self.frames,
         })
     }
 }

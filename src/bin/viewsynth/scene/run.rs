@@ -16,6 +16,15 @@ pub(crate) fn scene(job: &SceneJob) -> Result<()> {
             job.out_dir().display()
         );
     }
+    if r.frames > 1 {
+        println!(
+            "scene '{}': {} frames written to {} (sequence.json feeds `viewsynth cyclopean --sequence`)",
+            r.name,
+            r.frames,
+            job.out_dir().display()
+        );
+        return Ok(());
+    }
     println!(
         "scene '{}' written to {} (cameras.json feeds `viewsynth cyclopean`)",
         r.name,
