@@ -191,11 +191,84 @@ impl SplatGeometry {
 }
 
 struct EyeGpu {
-    color: Image,
-    dist: Image,
+    color: Option<Image>,
+    /// The distances as uploaded.
+    raw: Option<Image>,
+    /// Edge-snapped distances (when the params snap): what the passes read instead.
+    snapped: Option<Image>,
     size: (u32, u32),
     view: Mat4,
     proj: Mat4,
+}
+
+impl EyeGpu {
+    /// No images: what a failed [`SplatRenderer::set_frame`] leaves (its next render fails).
+    fn empty() -> Self {
+        EyeGpu {
+            color: None,
+            raw: None,
+            snapped: None,
+            size: (0, 0),
+            view: [[0.0; 4]; 4],
+            proj: [[0.0; 4]; 4],
+        }
+    }
+
+    fn color(&self) -> crate::pass::ImageId {
+        self.color.as_ref().expect("uploaded").id()
+    }
+    /// The distances the passes read.
+    fn dist(&self) -> crate::pass::ImageId {
+        self.snapped.as_ref().or(self.raw.as_ref()).expect("uploaded").id()
+    }
+}
+
+/// Uploads one eye into `old`'s images where their shapes match (rewritten in place), new ones
+/// otherwise, and snaps its distances when `snap` says so.
+fn upload_eye(
+    device: &Device,
+    eye: &super::EyeInput,
+    dist: &[f32],
+    rows: RowOrder,
+    old: Option<EyeGpu>,
+    snap: Option<(ShaderProgram, &EdgeSnapBlock)>,
+) -> Result<EyeGpu> {
+    let (w, h) = (eye.color.width, eye.color.height);
+    device.check_image_size("eye size", w, h)?;
+    let rgba = crate::gpu::pixels::rgb_to_rgba(&eye.color.data);
+    let mut gpu = old.unwrap_or(EyeGpu {
+        color: None,
+        raw: None,
+        snapped: None,
+        size: (w, h),
+        view: eye.view,
+        proj: eye.proj,
+    });
+    let image = |format, bytes, label| ImageData {
+        width: w,
+        height: h,
+        format,
+        bytes,
+        label,
+    };
+    let resized = gpu.size != (w, h);
+    let color = rows.convert_rows(rgba, w as usize * 4);
+    device.put_image(&mut gpu.color, &image(Format::Rgba8, &color, "splat eye colour"))?;
+    let dist = image(Format::R32F, bytemuck::cast_slice(dist), "splat eye distance");
+    device.put_image(&mut gpu.raw, &dist)?;
+    (gpu.size, gpu.view, gpu.proj) = ((w, h), eye.view, eye.proj);
+    match snap {
+        None => gpu.snapped = None,
+        Some((program, block)) => {
+            if resized || gpu.snapped.is_none() {
+                gpu.snapped = None;
+                gpu.snapped = Some(device.create_image(w, h, Format::R32F, "edge-snapped distances")?);
+            }
+            let out = gpu.snapped.as_ref().expect("made above");
+            snap_edges(device, program, &gpu, block, out)?;
+        }
+    }
+    Ok(gpu)
 }
 
 fn inverse(m: &Mat4, what: &str) -> Result<[[f32; 4]; 4]> {
@@ -204,11 +277,11 @@ fn inverse(m: &Mat4, what: &str) -> Result<[[f32; 4]; 4]> {
         .ok_or_else(|| Error::param(what.to_string(), "singular"))
 }
 
-/// One eye's distances with its depth breaks snapped to its colour edges (edge_snap.comp).
-fn snap_edges(device: &Device, program: ShaderProgram, eye: &EyeGpu, block: &EdgeSnapBlock) -> Result<Image> {
+/// One eye's distances with its depth breaks snapped to its colour edges, into `out`
+/// (edge_snap.comp).
+fn snap_edges(device: &Device, program: ShaderProgram, eye: &EyeGpu, block: &EdgeSnapBlock, out: &Image) -> Result<()> {
     let (w, h) = eye.size;
-    let out = device.create_image(w, h, Format::R32F, "edge-snapped distances")?;
-    let images = [eye.dist.id(), eye.color.id()];
+    let images = [eye.raw.as_ref().expect("uploaded").id(), eye.color()];
     let storage = [StorageImage::Image(out.id())];
     device.run(
         None,
@@ -221,7 +294,7 @@ fn snap_edges(device: &Device, program: ShaderProgram, eye: &EyeGpu, block: &Edg
             groups: Groups::Fixed([w.div_ceil(8), h.div_ceil(8)]),
         })],
     )?;
-    Ok(out)
+    Ok(())
 }
 
 /// Per middle-view size: each eye's splat image and the edge-pixel list.
@@ -234,6 +307,8 @@ struct SizedTargets {
 /// A stereo frame on the GPU (GL or Vulkan), ready to render splat-gather views.
 pub struct SplatRenderer {
     device: Device,
+    /// The frame's conventions, which the programs were built for.
+    conv: crate::convention::Conventions,
     splat: ShaderProgram,
     gather: ShaderProgram,
     /// The edge pass over the pixels the gather listed (shaders/cyclopean/splat_edges.comp).
@@ -266,46 +341,33 @@ impl SplatRenderer {
             height: 1,
         };
         let geo = SplatGeometry::new(frame, &probe)?;
-        let upload = |eye: &super::EyeInput, dist: &[f32]| -> Result<EyeGpu> {
-            let (w, h) = (eye.color.width, eye.color.height);
-            device.check_image_size("eye size", w, h)?;
-            let rgba = crate::gpu::pixels::rgb_to_rgba(&eye.color.data);
-            Ok(EyeGpu {
-                color: device.upload(&ImageData {
-                    width: w,
-                    height: h,
-                    format: Format::Rgba8,
-                    bytes: &frame.conv.row_order.convert_rows(rgba, w as usize * 4),
-                    label: "splat eye colour",
-                })?,
-                dist: device.upload(&ImageData {
-                    width: w,
-                    height: h,
-                    format: Format::R32F,
-                    bytes: bytemuck::cast_slice(dist),
-                    label: "splat eye distance",
-                })?,
-                size: (w, h),
-                view: eye.view,
-                proj: eye.proj,
-            })
-        };
-        let mut eyes = [
-            upload(&frame.left, &geo.dist_mem[0])?,
-            upload(&frame.right, &geo.dist_mem[1])?,
+        let snap = ShaderProgram::new(frame.conv, ProgramKind::CyclopeanEdgeSnap);
+        let block = params.edge_snap_margin.map(|margin| EdgeSnapBlock {
+            u_parallax_px: geo.parallax_px as f32,
+            u_tolerance_px: params.surface_tolerance_px as f32,
+            u_margin: margin as i32,
+        });
+        let rows = frame.conv.row_order;
+        let eyes = [
+            upload_eye(
+                &device,
+                &frame.left,
+                &geo.dist_mem[0],
+                rows,
+                None,
+                block.as_ref().map(|b| (snap, b)),
+            )?,
+            upload_eye(
+                &device,
+                &frame.right,
+                &geo.dist_mem[1],
+                rows,
+                None,
+                block.as_ref().map(|b| (snap, b)),
+            )?,
         ];
-        if let Some(margin) = params.edge_snap_margin {
-            let snap = ShaderProgram::new(frame.conv, ProgramKind::CyclopeanEdgeSnap);
-            let block = EdgeSnapBlock {
-                u_parallax_px: geo.parallax_px as f32,
-                u_tolerance_px: params.surface_tolerance_px as f32,
-                u_margin: margin as i32,
-            };
-            for eye in &mut eyes {
-                eye.dist = snap_edges(&device, snap, eye, &block)?;
-            }
-        }
         Ok(SplatRenderer {
+            conv: frame.conv,
             splat: ShaderProgram::new(frame.conv, ProgramKind::CyclopeanSplat),
             gather: ShaderProgram::new(frame.conv, ProgramKind::CyclopeanSplatGather),
             edges: ShaderProgram::new(frame.conv, ProgramKind::CyclopeanSplatEdges),
@@ -318,6 +380,46 @@ impl SplatRenderer {
             parallax_px: geo.parallax_px,
             targets: None,
         })
+    }
+
+    /// The conventions the renderer was made for.
+    pub fn conventions(&self) -> crate::convention::Conventions {
+        self.conv
+    }
+
+    /// Replaces the eyes with `frame`'s, rewriting the images in place where the sizes match
+    /// (a sequence's next frame allocates nothing); `frame` must have the conventions this
+    /// renderer was made for.
+    pub fn set_frame(&mut self, frame: &StereoFrame) -> Result<()> {
+        if frame.conv != self.conv {
+            return Err(Error::param(
+                "splat-gather frame",
+                "has other conventions than the renderer was made for",
+            ));
+        }
+        let probe = MiddleCamera {
+            view: frame.left.view,
+            proj: frame.left.proj,
+            width: 1,
+            height: 1,
+        };
+        let geo = SplatGeometry::new(frame, &probe)?;
+        let snap = ShaderProgram::new(frame.conv, ProgramKind::CyclopeanEdgeSnap);
+        let block = self.params.edge_snap_margin.map(|margin| EdgeSnapBlock {
+            u_parallax_px: geo.parallax_px as f32,
+            u_tolerance_px: self.params.surface_tolerance_px as f32,
+            u_margin: margin as i32,
+        });
+        let rows = frame.conv.row_order;
+        let [old_l, old_r] = std::mem::replace(&mut self.eyes, [EyeGpu::empty(), EyeGpu::empty()]);
+        let snap = block.as_ref().map(|b| (snap, b));
+        self.eyes = [
+            upload_eye(&self.device, &frame.left, &geo.dist_mem[0], rows, Some(old_l), snap)?,
+            upload_eye(&self.device, &frame.right, &geo.dist_mem[1], rows, Some(old_r), snap)?,
+        ];
+        self.frame_views = [frame.left.view, frame.right.view];
+        self.parallax_px = geo.parallax_px;
+        Ok(())
     }
 
     /// Renders the middle view of camera `mid`, with its times.
@@ -369,17 +471,17 @@ impl SplatRenderer {
             u_tolerance_px: self.params.surface_tolerance_px as f32,
             u_w_left: w_left as f32,
         };
-        let splat_images = [[l.dist.id()], [r.dist.id()]];
+        let splat_images = [[l.dist()], [r.dist()]];
         let splat_targets = [
             [StorageImage::Image(t.splats[0].id())],
             [StorageImage::Image(t.splats[1].id())],
         ];
         let gather_images = [
-            l.color.id(),
-            l.dist.id(),
+            l.color(),
+            l.dist(),
             t.splats[0].id(),
-            r.color.id(),
-            r.dist.id(),
+            r.color(),
+            r.dist(),
             t.splats[1].id(),
         ];
         let edges = [t.edges.id()];

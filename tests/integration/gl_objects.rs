@@ -145,6 +145,39 @@ fn a_second_identical_cyclopean_frame_allocates_no_gl_objects() {
     }
 }
 
+/// A sequence's renderer takes the next frame's eyes in place (`SplatRenderer::set_frame`): the
+/// view is byte for byte a new renderer's of that frame, and no GL object is made or left.
+#[test]
+fn a_sequence_frame_rewrites_the_splat_renderer_in_place() {
+    let g = gpu();
+    let conv = Conventions::all()[6];
+    let frame_at = |x: f64| {
+        let mut rig = StereoRig::demo(40, 30);
+        rig.head.position[0] += x;
+        scene_frame(&rig, conv, FrameDepth::Device)
+    };
+    let (a, _, _) = frame_at(0.0);
+    let (b, mid_b, _) = frame_at(0.04);
+    let fresh = SplatRenderer::new(&g, &b, SplatParams::default(), CyclopeanOutputs::default())
+        .unwrap()
+        .render(&mid_b)
+        .unwrap()
+        .0;
+    let mut r = SplatRenderer::new(&g, &a, SplatParams::default(), CyclopeanOutputs::default()).unwrap();
+    drop(r.render(&mid_b).unwrap());
+    let warm = g.live_objects();
+    r.set_frame(&b).unwrap();
+    let next = r.render(&mid_b).unwrap().0;
+    assert_eq!(g.live_objects(), warm, "set_frame made GL objects");
+    assert_eq!(next.sources, fresh.sources);
+    assert_eq!(next.color, fresh.color);
+    assert_eq!(next.depth, fresh.depth);
+    // Another frame's conventions are refused by name: the programs were built for these.
+    let (other, _, _) = scene_frame(&StereoRig::demo(40, 30), Conventions::all()[1], FrameDepth::Device);
+    let err = r.set_frame(&other).unwrap_err().to_string();
+    assert!(err.contains("conventions"), "{err}");
+}
+
 /// `Device::put_image`: an image of the held one's size and format is rewritten in place (same
 /// id, no texture made); another shape frees the old before uploading (one texture held); a
 /// refused upload leaves the slot empty, so the next call uploads anew.

@@ -261,6 +261,9 @@ fn a_steady_state_frame_creates_nothing_on_either_api() {
     let devices = [Device::gl(&g).unwrap(), VkExecutor::device(&v).unwrap()];
     let conv = Conventions::all()[5];
     let (frame, mid, _) = scene_frame(&StereoRig::demo(64, 48), conv, FrameDepth::Device);
+    let mut moved = StereoRig::demo(64, 48);
+    moved.head.position[0] += 0.05;
+    let next_frame = scene_frame(&moved, conv, FrameDepth::Device).0;
     let case = scene_cases(64, 48, 0.2, conv, FrameDepth::Device).unwrap().remove(0);
     let rig = OdsRig::demo();
     let (left, right) = (
@@ -280,6 +283,8 @@ fn a_steady_state_frame_creates_nothing_on_either_api() {
         let mut gather = CyclopeanRenderer::new(d, &frame, CyclopeanParams::seed(3.0)).unwrap();
         let mut splat = SplatRenderer::new(d, &frame, SplatParams::default(), CyclopeanOutputs::default()).unwrap();
         let mut forward = ForwardWarp::new(d, &frame, &BreakRule::default()).unwrap();
+        let mut sequence_splat =
+            SplatRenderer::new(d, &frame, SplatParams::default(), CyclopeanOutputs::default()).unwrap();
         let mut shift =
             viewsynth::reproject::render::Reprojector::new(d, &case.source, &case.geometry, methods()[0]).unwrap();
         let mut stitch = viewsynth::stitch::render::StitchRenderer::new(d, &left, &right).unwrap();
@@ -325,6 +330,14 @@ fn a_steady_state_frame_creates_nothing_on_either_api() {
         let frames: Vec<(&str, Frame)> = vec![
             ("gather", Box::new(|| drop(gather.render(&mid).unwrap()))),
             ("splat-gather", Box::new(|| drop(splat.render(&mid).unwrap()))),
+            (
+                // A sequence's next frame: the eyes rewritten in place, then rendered.
+                "splat-gather, next frame of a sequence",
+                Box::new(|| {
+                    sequence_splat.set_frame(&next_frame).unwrap();
+                    drop(sequence_splat.render(&mid).unwrap());
+                }),
+            ),
             ("forward", Box::new(|| drop(forward.render(&mid).unwrap()))),
             (
                 "fill",

@@ -14,12 +14,13 @@ use serde::Serialize;
 use std::path::{Path, PathBuf};
 
 mod request;
+mod reuse;
 mod sequence;
 
 pub use request::{
     CyclopeanPlan, CyclopeanRequest, Framed, InputName, StereoGiven, StereoInput, StereoKind, Synthesised,
 };
-use sequence::History;
+pub use reuse::Reused;
 pub use sequence::{load_sequence, CyclopeanSequenceJob, SequenceFrame, MAX_SEQUENCE_FRAMES};
 
 /// The files of each eye's matcher confidence (`--confidence`), left then right.
@@ -271,12 +272,12 @@ impl CyclopeanJob {
         })
     }
 
-    /// Reads the pair and renders its view on `device` (the history, if any, with `--fill`).
+    /// Reads the pair and renders its view on `device` (with a sequence's renderers, if any).
     pub(crate) fn render(
         &self,
         device: &Device,
         host: &dyn Host,
-        history: Option<&mut History>,
+        reuse: Option<&mut Reused>,
     ) -> crate::Result<RenderedView> {
         let input = self.input()?;
         let left_map = self.maps.as_ref().map_or(self.left_rgb.as_path(), |m| m.0.as_path());
@@ -306,11 +307,7 @@ impl CyclopeanJob {
                 });
             }
         }
-        let accumulator = match history {
-            Some(h) => Some(h.for_conventions(device, frame.conv)?),
-            None => None,
-        };
-        let done = self.plan.synthesise(device, &frame, &mid, fixation, accumulator)?;
+        let done = self.plan.synthesise(device, &frame, &mid, fixation, reuse)?;
         Ok(RenderedView {
             done,
             confidence,

@@ -8,6 +8,7 @@
 //! [`StereoInput`]; [`CyclopeanRequest::plan`] checks the settings against the input set-up and
 //! [`CyclopeanPlan::frame`] / [`CyclopeanPlan::synthesise`] do the rest.
 
+use super::reuse::Reused;
 use super::CyclopeanMethod;
 use crate::convention::Conventions;
 use crate::cyclopean::camera_file::{CameraFile, EyeCameras};
@@ -17,7 +18,7 @@ use crate::cyclopean::forward::ForwardWarp;
 use crate::cyclopean::matcher::{EyeEstimate, Matcher};
 use crate::cyclopean::render::CyclopeanRenderer;
 use crate::cyclopean::splat::{SplatParams, SplatRenderer};
-use crate::cyclopean::temporal::{Accumulator, FROM_HISTORY};
+use crate::cyclopean::temporal::FROM_HISTORY;
 use crate::cyclopean::{Blend, CyclopeanOutputs, CyclopeanParams, Eye, EyeInput, MiddleCamera, StereoFrame};
 use crate::io::{self, DepthMap, OutputSet, RgbImage};
 use crate::job::ArgError;
@@ -540,16 +541,18 @@ impl CyclopeanPlan {
     }
 
     /// Renders the view with the plan's method (and fill) on `device`.
-    /// With `fill` and a `history` (a sequence's [`Accumulator`]), holes the earlier frames
-    /// saw take the history first and the fill fills the rest; both count as filled in the mask.
+    /// A sequence passes what it keeps between frames (`reuse`): the default method's renderer
+    /// and the fill are reused, and with `fill` the holes the last frame's eyes saw take the
+    /// temporal history first and the fill fills the rest (both count as filled in the mask).
     pub fn synthesise(
         &self,
         device: &Device,
         frame: &StereoFrame,
         mid: &MiddleCamera,
         fixation: f64,
-        history: Option<&mut Accumulator>,
+        reuse: Option<&mut Reused>,
     ) -> crate::Result<Synthesised> {
+        let mut reuse = reuse;
         let t0 = std::time::Instant::now();
         frame.validate()?;
         let params = self.gather.map(|g| g.params(fixation)).transpose()?;
@@ -563,13 +566,19 @@ impl CyclopeanPlan {
                 CyclopeanRenderer::with_outputs(device, frame, p, wanted)?.render(mid)?
             }
             (CyclopeanMethod::Forward, _) => ForwardWarp::new(device, frame, &BreakRule::default())?.render(mid)?,
-            _ => SplatRenderer::new(device, frame, SplatParams::default(), wanted)?.render(mid)?,
+            _ => match &mut reuse {
+                Some(r) => r.splat(device, frame, wanted)?.render(mid)?,
+                None => SplatRenderer::new(device, frame, SplatParams::default(), wanted)?.render(mid)?,
+            },
         };
         if self.fill {
-            if let Some(history) = history {
-                out = history.push(&out, mid)?;
-            }
-            out = Filler::new(device)?.fill(&out, mid.width, mid.height)?;
+            out = match reuse {
+                Some(r) => {
+                    out = r.history(device, frame.conv)?.push(&out, mid)?;
+                    r.filler(device)?.fill(&out, mid.width, mid.height)?
+                }
+                None => Filler::new(device)?.fill(&out, mid.width, mid.height)?,
+            };
         }
         let setup_ms = (t0.elapsed().as_secs_f64() * 1e3 - timing.wall_ms).max(0.0);
         // The mask: 1 where an eye gave the pixel, MASK_FILLED where filled (from the history

@@ -2,7 +2,8 @@
 //! spectator stream. With `--fill`, each frame's holes take first what the earlier frames saw
 //! there (the temporal accumulation: the last accumulated view moved into this frame's camera,
 //! [`crate::cyclopean::temporal::Accumulator`]), and the fill fills what no frame saw; without
-//! `--fill` every frame is rendered on its own, holes left.
+//! `--fill` every frame is rendered on its own, holes left. The renderers are made at the first
+//! frame and reused ([`Reused`]), so a frame of the same size creates no GPU object.
 //!
 //! The file is JSON, `{"frames": [{...}, ...]}`, each frame naming its files with the keys of the
 //! one-frame flags (`left_rgb`, `right_rgb`, and `left_disparity`/`right_disparity` or
@@ -15,13 +16,10 @@
 //! most [`MAX_SEQUENCE_FRAMES`] frames; each frame's images are decoded when it is rendered,
 //! written to the set's staging folder and dropped.
 
-use super::{CyclopeanJob, CyclopeanOptions, CyclopeanReport};
-use crate::convention::Conventions;
-use crate::cyclopean::temporal::{Accumulator, DEPTH_TOLERANCE, FILL_ONLY};
+use super::{CyclopeanJob, CyclopeanOptions, CyclopeanReport, Reused};
 use crate::error::{Error, Result};
 use crate::io;
 use crate::job::{ArgError, Event, Host, JobError};
-use crate::pass::Device;
 use serde::Deserialize;
 use std::path::{Path, PathBuf};
 
@@ -98,21 +96,6 @@ pub fn load_sequence(path: &Path) -> Result<Vec<SequenceFrame>> {
     Ok(frames)
 }
 
-/// The temporal history of a sequence: one accumulator, made again when a frame's conventions
-/// differ from the last (the rows and depth it reads follow them).
-#[derive(Default)]
-pub(crate) struct History(Option<(Conventions, Accumulator)>);
-
-impl History {
-    /// The accumulator for frames under `conv` on `device`.
-    pub(crate) fn for_conventions(&mut self, device: &Device, conv: Conventions) -> Result<&mut Accumulator> {
-        if self.0.as_ref().is_none_or(|(c, _)| *c != conv) {
-            self.0 = Some((conv, Accumulator::new(device, FILL_ONLY, DEPTH_TOLERANCE, conv)?));
-        }
-        Ok(&mut self.0.as_mut().expect("set above").1)
-    }
-}
-
 /// A checked `cyclopean --sequence` run.
 #[derive(Debug, Clone)]
 pub struct CyclopeanSequenceJob {
@@ -182,8 +165,7 @@ impl CyclopeanSequenceJob {
             .map(|(k, f)| self.frame_job(k, f))
             .collect::<Result<Vec<_>>>()?;
         let device = host.open_device(&self.template.gpu, self.template.backend)?;
-        let fill = self.template.request.fill;
-        let mut history = History::default();
+        let mut reused = Reused::default();
         let mut set = None;
         let (mut size, mut coverage, mut render_ms) = ((0, 0), 0.0, 0.0);
         host.event(Event::Started {
@@ -191,7 +173,7 @@ impl CyclopeanSequenceJob {
             total: jobs.len() as u64,
         });
         for (k, job) in jobs.iter().enumerate() {
-            let view = job.render(&device, host, fill.then_some(&mut history))?;
+            let view = job.render(&device, host, Some(&mut reused))?;
             // The folder once the first frame rendered: a refused first input leaves none.
             let set = match &mut set {
                 Some(set) => set,

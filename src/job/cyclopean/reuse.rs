@@ -1,0 +1,54 @@
+//! What a sequence keeps on its device from one frame to the next: the default method's
+//! renderer (its eye images rewritten in place), the fill, and the temporal history. So a
+//! sequence's next frame of the same size creates no GPU object, where one pair alone makes
+//! its renderers and drops them.
+
+use crate::convention::Conventions;
+use crate::cyclopean::fill::Filler;
+use crate::cyclopean::splat::{SplatParams, SplatRenderer};
+use crate::cyclopean::temporal::{Accumulator, DEPTH_TOLERANCE, FILL_ONLY};
+use crate::cyclopean::{CyclopeanOutputs, StereoFrame};
+use crate::error::Result;
+use crate::pass::Device;
+
+/// A sequence's renderers, made at its first frame and reused (see the module notes).
+#[derive(Default)]
+pub struct Reused {
+    splat: Option<SplatRenderer>,
+    filler: Option<Filler>,
+    history: Option<(Conventions, Accumulator)>,
+}
+
+impl Reused {
+    /// The splat-gather renderer holding `frame`'s eyes: the last one with the eyes replaced,
+    /// or a new one where there is none or the conventions changed.
+    pub(crate) fn splat(
+        &mut self,
+        device: &Device,
+        frame: &StereoFrame,
+        outputs: CyclopeanOutputs,
+    ) -> Result<&mut SplatRenderer> {
+        match &mut self.splat {
+            Some(r) if r.conventions() == frame.conv => r.set_frame(frame)?,
+            slot => *slot = Some(SplatRenderer::new(device, frame, SplatParams::default(), outputs)?),
+        }
+        Ok(self.splat.as_mut().expect("set above"))
+    }
+
+    /// The fill.
+    pub(crate) fn filler(&mut self, device: &Device) -> Result<&mut Filler> {
+        if self.filler.is_none() {
+            self.filler = Some(Filler::new(device)?);
+        }
+        Ok(self.filler.as_mut().expect("set above"))
+    }
+
+    /// The temporal history for frames under `conv`: made again when the conventions change
+    /// (the rows and depth it reads follow them).
+    pub(crate) fn history(&mut self, device: &Device, conv: Conventions) -> Result<&mut Accumulator> {
+        if self.history.as_ref().is_none_or(|(c, _)| *c != conv) {
+            self.history = Some((conv, Accumulator::new(device, FILL_ONLY, DEPTH_TOLERANCE, conv)?));
+        }
+        Ok(&mut self.history.as_mut().expect("set above").1)
+    }
+}
