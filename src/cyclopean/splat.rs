@@ -277,6 +277,38 @@ fn inverse(m: &Mat4, what: &str) -> Result<[[f32; 4]; 4]> {
         .ok_or_else(|| Error::param(what.to_string(), "singular"))
 }
 
+/// Both eyes of `frame` on `device` (into `old`'s images where they fit), edge-snapped when
+/// `params` say so, and the frame's parallax unit.
+fn upload_eyes(
+    device: &Device,
+    frame: &StereoFrame,
+    params: &SplatParams,
+    old: Option<[EyeGpu; 2]>,
+) -> Result<([EyeGpu; 2], f64)> {
+    // The middle camera does not change the eye data; any will do to derive it here.
+    let probe = MiddleCamera {
+        view: frame.left.view,
+        proj: frame.left.proj,
+        width: 1,
+        height: 1,
+    };
+    let geo = SplatGeometry::new(frame, &probe)?;
+    let program = ShaderProgram::new(frame.conv, ProgramKind::CyclopeanEdgeSnap);
+    let block = params.edge_snap_margin.map(|margin| EdgeSnapBlock {
+        u_parallax_px: geo.parallax_px as f32,
+        u_tolerance_px: params.surface_tolerance_px as f32,
+        u_margin: margin as i32,
+    });
+    let snap = block.as_ref().map(|b| (program, b));
+    let rows = frame.conv.row_order;
+    let [old_l, old_r] = old.map_or([None, None], |[l, r]| [Some(l), Some(r)]);
+    let eyes = [
+        upload_eye(device, &frame.left, &geo.dist_mem[0], rows, old_l, snap)?,
+        upload_eye(device, &frame.right, &geo.dist_mem[1], rows, old_r, snap)?,
+    ];
+    Ok((eyes, geo.parallax_px))
+}
+
 /// One eye's distances with its depth breaks snapped to its colour edges, into `out`
 /// (edge_snap.comp).
 fn snap_edges(device: &Device, program: ShaderProgram, eye: &EyeGpu, block: &EdgeSnapBlock, out: &Image) -> Result<()> {
@@ -333,39 +365,7 @@ impl SplatRenderer {
     ) -> Result<Self> {
         params.validate()?;
         let device = device.to_device()?;
-        // The middle camera does not change the eye data; any will do to derive it here.
-        let probe = MiddleCamera {
-            view: frame.left.view,
-            proj: frame.left.proj,
-            width: 1,
-            height: 1,
-        };
-        let geo = SplatGeometry::new(frame, &probe)?;
-        let snap = ShaderProgram::new(frame.conv, ProgramKind::CyclopeanEdgeSnap);
-        let block = params.edge_snap_margin.map(|margin| EdgeSnapBlock {
-            u_parallax_px: geo.parallax_px as f32,
-            u_tolerance_px: params.surface_tolerance_px as f32,
-            u_margin: margin as i32,
-        });
-        let rows = frame.conv.row_order;
-        let eyes = [
-            upload_eye(
-                &device,
-                &frame.left,
-                &geo.dist_mem[0],
-                rows,
-                None,
-                block.as_ref().map(|b| (snap, b)),
-            )?,
-            upload_eye(
-                &device,
-                &frame.right,
-                &geo.dist_mem[1],
-                rows,
-                None,
-                block.as_ref().map(|b| (snap, b)),
-            )?,
-        ];
+        let (eyes, parallax_px) = upload_eyes(&device, frame, &params, None)?;
         Ok(SplatRenderer {
             conv: frame.conv,
             splat: ShaderProgram::new(frame.conv, ProgramKind::CyclopeanSplat),
@@ -377,7 +377,7 @@ impl SplatRenderer {
             rows: frame.conv.row_order,
             eyes,
             frame_views: [frame.left.view, frame.right.view],
-            parallax_px: geo.parallax_px,
+            parallax_px,
             targets: None,
         })
     }
@@ -397,28 +397,9 @@ impl SplatRenderer {
                 "has other conventions than the renderer was made for",
             ));
         }
-        let probe = MiddleCamera {
-            view: frame.left.view,
-            proj: frame.left.proj,
-            width: 1,
-            height: 1,
-        };
-        let geo = SplatGeometry::new(frame, &probe)?;
-        let snap = ShaderProgram::new(frame.conv, ProgramKind::CyclopeanEdgeSnap);
-        let block = self.params.edge_snap_margin.map(|margin| EdgeSnapBlock {
-            u_parallax_px: geo.parallax_px as f32,
-            u_tolerance_px: self.params.surface_tolerance_px as f32,
-            u_margin: margin as i32,
-        });
-        let rows = frame.conv.row_order;
-        let [old_l, old_r] = std::mem::replace(&mut self.eyes, [EyeGpu::empty(), EyeGpu::empty()]);
-        let snap = block.as_ref().map(|b| (snap, b));
-        self.eyes = [
-            upload_eye(&self.device, &frame.left, &geo.dist_mem[0], rows, Some(old_l), snap)?,
-            upload_eye(&self.device, &frame.right, &geo.dist_mem[1], rows, Some(old_r), snap)?,
-        ];
+        let old = std::mem::replace(&mut self.eyes, [EyeGpu::empty(), EyeGpu::empty()]);
+        (self.eyes, self.parallax_px) = upload_eyes(&self.device, frame, &self.params, Some(old))?;
         self.frame_views = [frame.left.view, frame.right.view];
-        self.parallax_px = geo.parallax_px;
         Ok(())
     }
 

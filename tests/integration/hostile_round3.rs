@@ -1538,32 +1538,20 @@ fn file_set_snapshot(dir: &Path) -> Result<BTreeMap<String, Vec<u8>>, String> {
 fn round3_every_writing_command_is_all_or_none_after_any_commit_step() {
     let root = scratch("r3-commit-all");
     let (rgb, depth) = inputs(&root);
-    let scene = root.join("scene");
-    let made = run(&s(&[
-        "scene",
-        "--width",
-        "64",
-        "--height",
-        "48",
-        "--out-dir",
-        &p(&scene),
-    ]));
-    assert!(made.status.success(), "{}", String::from_utf8_lossy(&made.stderr));
-    let frames = root.join("frames");
-    let made = run(&s(&[
-        "scene",
-        "--width",
-        "64",
-        "--height",
-        "48",
-        "--frames",
-        "2",
-        "--spectator-offset",
-        "0.1",
-        "--out-dir",
-        &p(&frames),
-    ]));
-    assert!(made.status.success(), "{}", String::from_utf8_lossy(&made.stderr));
+    // One stereo frame, and a two-frame sequence for cyclopean --sequence.
+    let (scene, frames) = (root.join("scene"), root.join("frames"));
+    for (dir, extra) in [
+        (&scene, vec![]),
+        (&frames, s(&["--frames", "2", "--spectator-offset", "0.1"])),
+    ] {
+        let args = [
+            s(&["scene", "--width", "64", "--height", "48", "--out-dir", &p(dir)]),
+            extra,
+        ]
+        .concat();
+        let made = run(&args);
+        assert!(made.status.success(), "{}", String::from_utf8_lossy(&made.stderr));
+    }
     let (r, d) = (p(&rgb), p(&depth));
     let eye = |e: &str, what: &str| p(&scene.join(format!("{e}_{what}")));
     // Each command with the one setting that differs between its old and new set (same names,
