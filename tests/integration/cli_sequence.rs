@@ -209,6 +209,13 @@ fn sequence_refusals_name_the_file_or_flag_and_leave_the_folder_as_it_was() {
         std::fs::write(&p, text).unwrap();
         p.to_str().unwrap().to_string()
     };
+    // Bounded before reading: a sequence file past the JSON cap is refused by its length.
+    let huge = frames.join("huge.json");
+    std::fs::File::create(&huge)
+        .unwrap()
+        .set_len(viewsynth::io::MAX_JSON_BYTES + 1)
+        .unwrap();
+    check(&["cyclopean", "--sequence", huge.to_str().unwrap()], 1, &["huge.json"]);
     let bad = write("bad.json", r#"{"frames": [{"left_rgb": "00000_left_rgb.png"}]}"#);
     check(&["cyclopean", "--sequence", &bad], 1, &["bad.json", "right_rgb"]);
     let half = write(
