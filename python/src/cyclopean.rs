@@ -49,7 +49,7 @@ fn render(
         mid,
         fixation,
         confidence,
-    } = plan.frame(&device, input, names)?;
+    } = plan.frame(&device, input, names, None)?;
     gpu.check_image_size("the view (cameras[\"middle\"] width/height)", mid.width, mid.height)?;
     Ok((plan.synthesise(&device, &frame, &mid, fixation, None)?, confidence))
 }

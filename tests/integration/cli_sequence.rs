@@ -159,6 +159,51 @@ fn an_unfilled_sequence_is_each_pair_alone() {
     }
 }
 
+/// Two images alone in a sequence: the census matcher is made once and its inputs rewritten in
+/// place, and each frame is still byte for byte its pair alone.
+#[test]
+fn a_sequence_of_pairs_alone_matches_each_pair_alone() {
+    let dir = scratch("sequence-images");
+    let frames = sequence(&dir, 3, -0.03, 0.0);
+    let list: Vec<String> = (0..3)
+        .map(|k| format!(r#"{{"left_rgb": "{k:05}_left_rgb.png", "right_rgb": "{k:05}_right_rgb.png"}}"#))
+        .collect();
+    let file = frames.join("pairs.json");
+    std::fs::write(&file, format!(r#"{{"frames": [{}]}}"#, list.join(","))).unwrap();
+    let out = dir.join("middle");
+    ok(&[
+        "cyclopean",
+        "--sequence",
+        file.to_str().unwrap(),
+        "--max-disparity",
+        "32",
+        "--out-dir",
+        out.to_str().unwrap(),
+    ]);
+    for k in 0..3u32 {
+        let one = dir.join(format!("alone-{k}"));
+        let f = |what: &str| frames.join(format!("{k:05}_{what}")).to_str().unwrap().to_string();
+        ok(&[
+            "cyclopean",
+            "--left-rgb",
+            &f("left_rgb.png"),
+            "--right-rgb",
+            &f("right_rgb.png"),
+            "--max-disparity",
+            "32",
+            "--out-dir",
+            one.to_str().unwrap(),
+        ]);
+        for (seq, single) in [("rgb.png", "middle_rgb.png"), ("mask.png", "middle_mask.png")] {
+            assert_eq!(
+                std::fs::read(out.join(format!("middle_{k:05}_{seq}"))).unwrap(),
+                std::fs::read(one.join(single)).unwrap(),
+                "frame {k} {seq}"
+            );
+        }
+    }
+}
+
 /// Refusals: flags that name one pair's files (exit 2), a sequence file that is missing or
 /// malformed, a frame's set-up that one pair would refuse, a frame whose file is missing
 /// (exit 1, naming the file and the frame). The folder keeps what it held, with no temporary.

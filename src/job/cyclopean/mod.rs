@@ -277,7 +277,7 @@ impl CyclopeanJob {
         &self,
         device: &Device,
         host: &dyn Host,
-        reuse: Option<&mut Reused>,
+        mut reuse: Option<&mut Reused>,
     ) -> crate::Result<RenderedView> {
         let input = self.input()?;
         let left_map = self.maps.as_ref().map_or(self.left_rgb.as_path(), |m| m.0.as_path());
@@ -292,7 +292,7 @@ impl CyclopeanJob {
             mid,
             fixation,
             confidence,
-        } = self.plan.frame(device, input, names)?;
+        } = self.plan.frame(device, input, names, reuse.as_deref_mut())?;
         if let (Some(cameras), Some((left_map, right_map))) = (&self.cameras, &self.maps) {
             for (path, eye) in [(left_map, &frame.left), (right_map, &frame.right)] {
                 let hint = format!(

@@ -430,13 +430,20 @@ impl CyclopeanPlan {
     /// depth the left eye saw (disparities), or the camera file's fixation. `names` name the
     /// left and right colour, the left disparity or depth and the cameras in messages. Two
     /// images alone are matched on `device` (the census matcher's GPU pass, bit-exact with its
-    /// twin), with each eye's confidence when the request asked for it.
-    pub fn frame(&self, device: &Device, input: StereoInput, names: [InputName; 4]) -> crate::Result<Framed> {
+    /// twin), with each eye's confidence when the request asked for it; a sequence passes its
+    /// `reuse` so the matcher is made once.
+    pub fn frame(
+        &self,
+        device: &Device,
+        input: StereoInput,
+        names: [InputName; 4],
+        reuse: Option<&mut Reused>,
+    ) -> crate::Result<Framed> {
         let [left_rgb, right_rgb, left_map, cameras_name] = names;
         match input {
             StereoInput::Disparity { left, right } => self.disparity_frame(left, right, left_map),
             StereoInput::Images { left, right } => {
-                let (dl, dr, confidence) = self.estimate(device, &left, &right, left_rgb)?;
+                let (dl, dr, confidence) = self.estimate(device, &left, &right, left_rgb, reuse)?;
                 Ok(Framed {
                     confidence,
                     ..self.disparity_frame((left, dl), (right, dr), left_map)?
@@ -478,6 +485,7 @@ impl CyclopeanPlan {
         left: &RgbImage,
         right: &RgbImage,
         left_rgb: InputName,
+        reuse: Option<&mut Reused>,
     ) -> crate::Result<(DepthMap, DepthMap, Option<[DepthMap; 2]>)> {
         let max = self.max_disparity.unwrap_or(default_max_disparity(left.width));
         if max >= left.width {
@@ -486,7 +494,14 @@ impl CyclopeanPlan {
                 left.width
             )));
         }
-        let mut matcher = Matcher::new(device, left.width, left.height, max)?;
+        let mut own;
+        let matcher = match reuse {
+            Some(r) => r.matcher(device, left.width, left.height, max)?,
+            None => {
+                own = Matcher::new(device, left.width, left.height, max)?;
+                &mut own
+            }
+        };
         // The confidence stage runs only when something reads it.
         if self.min_confidence.is_none() && !self.confidence {
             let (l, r) = matcher.estimate(left, right)?;

@@ -1,10 +1,12 @@
-//! What a sequence keeps on its device from one frame to the next: the default method's
-//! renderer (its eye images rewritten in place), the fill, and the temporal history. So a
+//! What a sequence keeps on its device from one frame to the next: the census matcher (two
+//! images alone), the default method's renderer (its eye images rewritten in place), the fill,
+//! and the temporal history. So a
 //! sequence's next frame of the same size creates no GPU object, where one pair alone makes
 //! its renderers and drops them.
 
 use crate::convention::Conventions;
 use crate::cyclopean::fill::Filler;
+use crate::cyclopean::matcher::Matcher;
 use crate::cyclopean::splat::{SplatParams, SplatRenderer};
 use crate::cyclopean::temporal::{Accumulator, DEPTH_TOLERANCE, FILL_ONLY};
 use crate::cyclopean::{CyclopeanOutputs, StereoFrame};
@@ -14,6 +16,8 @@ use crate::pass::Device;
 /// A sequence's renderers, made at its first frame and reused (see the module notes).
 #[derive(Default)]
 pub struct Reused {
+    /// The matcher and the width, height and search range it was made for.
+    matcher: Option<((u32, u32, u32), Matcher)>,
     splat: Option<SplatRenderer>,
     filler: Option<Filler>,
     history: Option<(Conventions, Accumulator)>,
@@ -33,6 +37,23 @@ impl Reused {
             slot => *slot = Some(SplatRenderer::new(device, frame, SplatParams::default(), outputs)?),
         }
         Ok(self.splat.as_mut().expect("set above"))
+    }
+
+    /// The census matcher for `width` x `height` pairs searching 0..=`max_disparity` px: the
+    /// last one where those match (its inputs are rewritten in place), else a new one.
+    pub(crate) fn matcher(
+        &mut self,
+        device: &Device,
+        width: u32,
+        height: u32,
+        max_disparity: u32,
+    ) -> Result<&mut Matcher> {
+        let key = (width, height, max_disparity);
+        if self.matcher.as_ref().is_none_or(|(k, _)| *k != key) {
+            self.matcher = None;
+            self.matcher = Some((key, Matcher::new(device, width, height, max_disparity)?));
+        }
+        Ok(&mut self.matcher.as_mut().expect("set above").1)
     }
 
     /// The fill.
