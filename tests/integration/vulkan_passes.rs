@@ -722,6 +722,26 @@ fn every_vulkan_pass_runs_clean_under_the_validation_layer() {
     filled[2] = "splat-gather".into();
     filled.push("--fill".into());
     runs.push(filled);
+    // The temporal accumulation: a two-frame sequence with --fill (frame 1 takes the history).
+    let seq = dir.join("seq");
+    let made = bin()
+        .args([
+            "scene",
+            "--width",
+            "64",
+            "--height",
+            "48",
+            "--frames",
+            "2",
+            "--spectator-offset",
+            "0.1",
+            "--out-dir",
+        ])
+        .arg(&seq)
+        .output()
+        .unwrap();
+    assert!(made.status.success(), "{}", String::from_utf8_lossy(&made.stderr));
+    runs.push(s(&["cyclopean", "--sequence", &file("seq/sequence.json"), "--fill"]));
     let under_layer = |command: &mut std::process::Command| {
         command
             .env("VK_INSTANCE_LAYERS", "VK_LAYER_KHRONOS_validation")
