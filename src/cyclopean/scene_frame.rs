@@ -34,12 +34,16 @@ impl StereoRig {
 
     /// Pose of one eye: `side` -1 for the left, +1 for the right (offset `side` * ipd / 2 along the head's x).
     pub fn eye_pose(&self, side: f64) -> Pose {
+        self.right_of_head(0.5 * side * self.ipd)
+    }
+
+    /// The head's pose moved `metres` along its own x axis (to its right; negative: left).
+    pub fn right_of_head(&self, metres: f64) -> Pose {
         let r = &self.head.rotation;
-        let o = 0.5 * side * self.ipd;
         let p = self.head.position;
         Pose {
             rotation: *r,
-            position: [p[0] + o * r[0][0], p[1] + o * r[1][0], p[2] + o * r[2][0]],
+            position: [0, 1, 2].map(|axis| p[axis] + metres * r[axis][0]),
         }
     }
 }

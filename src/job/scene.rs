@@ -193,19 +193,19 @@ impl SceneJob {
             } else {
                 format!("{k:05}_")
             };
-            let mut frame_rig = *rig;
-            let r = &rig.head.rotation;
-            let o = self.dolly * f64::from(k);
-            for (axis, p) in frame_rig.head.position.iter_mut().enumerate() {
-                *p += o * r[axis][0];
-            }
-            let mut cams = serde_json::Map::new();
-            let spectator = match rig.ipd {
-                ipd if ipd > 0.0 => 2.0 * self.spectator_offset / ipd,
-                _ => 0.0,
+            let frame_rig = StereoRig {
+                head: rig.right_of_head(self.dolly * f64::from(k)),
+                ..*rig
             };
-            for (eye, side) in [("left", -1.0), ("right", 1.0), ("middle", spectator)] {
-                let view = frame_rig.eye_pose(side).gl_view();
+            // The spectator is placed in metres from the head, whatever the IPD (0 included).
+            let spectator = frame_rig.right_of_head(self.spectator_offset);
+            let mut cams = serde_json::Map::new();
+            for (eye, pose) in [
+                ("left", frame_rig.eye_pose(-1.0)),
+                ("right", frame_rig.eye_pose(1.0)),
+                ("middle", spectator),
+            ] {
+                let view = pose.gl_view();
                 let (img, timing) = renderer.render(&GlCamera {
                     view,
                     proj,

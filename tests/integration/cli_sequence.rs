@@ -293,3 +293,34 @@ fn sequence_refusals_name_the_file_or_flag_and_leave_the_folder_as_it_was() {
         assert!(err.contains(says), "{args:?}: {err}");
     }
 }
+
+/// `--spectator-offset` is metres from the head whatever the IPD: with the eyes together
+/// (`--ipd 0`) the middle camera still sits 0.1 m to the right (it once stayed at the head,
+/// the offset divided by the IPD).
+#[test]
+fn the_spectator_offset_is_metres_from_the_head_even_with_no_ipd() {
+    let dir = scratch("spectator-offset");
+    let out = dir.join("scene");
+    ok(&[
+        "scene",
+        "--width",
+        "32",
+        "--height",
+        "24",
+        "--ipd",
+        "0",
+        "--spectator-offset",
+        "0.1",
+        "--out-dir",
+        out.to_str().unwrap(),
+    ]);
+    let cams: serde_json::Value = serde_json::from_slice(&std::fs::read(out.join("cameras.json")).unwrap()).unwrap();
+    // GL view matrices, row-major: the translation's x is minus the camera's x.
+    let tx = |eye: &str| cams[eye]["view"][0][3].as_f64().unwrap();
+    assert!(
+        (tx("left") - tx("middle") - 0.1).abs() < 1e-12,
+        "left {} middle {}",
+        tx("left"),
+        tx("middle")
+    );
+}
