@@ -37,7 +37,8 @@ use crate::convention::RowOrder;
 use crate::error::{Error, Result};
 use crate::gpu::{ProgramKind, ShaderProgram, Timing};
 use crate::pass::{
-    mat4_std140, Buffer, Device, Dispatch, Draw, Format, Groups, Image, ImageData, Step, StorageImage, Target, ToDevice,
+    mat4_std140, Buffer, Device, Dispatch, Draw, Format, Groups, Image, ImageData, ImageId, Step, StorageImage, Target,
+    ToDevice,
 };
 
 crate::param_block! {
@@ -202,7 +203,8 @@ struct EyeGpu {
 }
 
 impl EyeGpu {
-    /// No images: what a failed [`SplatRenderer::set_frame`] leaves (its next render fails).
+    /// No images: a new eye before its first upload, and what a failed
+    /// [`SplatRenderer::set_frame`] leaves (its next render is refused).
     fn empty() -> Self {
         EyeGpu {
             color: None,
@@ -214,12 +216,16 @@ impl EyeGpu {
         }
     }
 
-    fn color(&self) -> crate::pass::ImageId {
-        self.color.as_ref().expect("uploaded").id()
-    }
-    /// The distances the passes read.
-    fn dist(&self) -> crate::pass::ImageId {
-        self.snapped.as_ref().or(self.raw.as_ref()).expect("uploaded").id()
+    /// The colour and the distances the passes read (snapped where the params snap), or an
+    /// error where a failed `set_frame` left no eye.
+    fn images(&self) -> Result<(ImageId, ImageId)> {
+        match (&self.color, self.snapped.as_ref().or(self.raw.as_ref())) {
+            (Some(color), Some(dist)) => Ok((color.id(), dist.id())),
+            _ => Err(Error::param(
+                "splat-gather renderer",
+                "holds no eyes: the last set_frame failed; give it a frame again",
+            )),
+        }
     }
 }
 
@@ -236,14 +242,7 @@ fn upload_eye(
     let (w, h) = (eye.color.width, eye.color.height);
     device.check_image_size("eye size", w, h)?;
     let rgba = crate::gpu::pixels::rgb_to_rgba(&eye.color.data);
-    let mut gpu = old.unwrap_or(EyeGpu {
-        color: None,
-        raw: None,
-        snapped: None,
-        size: (w, h),
-        view: eye.view,
-        proj: eye.proj,
-    });
+    let mut gpu = old.unwrap_or_else(EyeGpu::empty);
     let image = |format, bytes, label| ImageData {
         width: w,
         height: h,
@@ -253,21 +252,24 @@ fn upload_eye(
     };
     let resized = gpu.size != (w, h);
     let color = rows.convert_rows(rgba, w as usize * 4);
-    device.put_image(&mut gpu.color, &image(Format::Rgba8, &color, "splat eye colour"))?;
+    let color = device.put_image(&mut gpu.color, &image(Format::Rgba8, &color, "splat eye colour"))?;
     let dist = image(Format::R32F, bytemuck::cast_slice(dist), "splat eye distance");
-    device.put_image(&mut gpu.raw, &dist)?;
+    let raw = device.put_image(&mut gpu.raw, &dist)?;
     (gpu.size, gpu.view, gpu.proj) = ((w, h), eye.view, eye.proj);
-    match snap {
-        None => gpu.snapped = None,
-        Some((program, block)) => {
-            if resized || gpu.snapped.is_none() {
-                gpu.snapped = None;
-                gpu.snapped = Some(device.create_image(w, h, Format::R32F, "edge-snapped distances")?);
-            }
-            let out = gpu.snapped.as_ref().expect("made above");
-            snap_edges(device, program, &gpu, block, out)?;
+    gpu.snapped = match (snap, gpu.snapped.take()) {
+        (None, _) => None,
+        (Some((program, block)), old) => {
+            let out = match old {
+                Some(out) if !resized => out,
+                old => {
+                    drop(old);
+                    device.create_image(w, h, Format::R32F, "edge-snapped distances")?
+                }
+            };
+            snap_edges(device, program, (w, h), [raw, color], block, &out)?;
+            Some(out)
         }
-    }
+    };
     Ok(gpu)
 }
 
@@ -309,11 +311,16 @@ fn upload_eyes(
     Ok((eyes, geo.parallax_px))
 }
 
-/// One eye's distances with its depth breaks snapped to its colour edges, into `out`
-/// (edge_snap.comp).
-fn snap_edges(device: &Device, program: ShaderProgram, eye: &EyeGpu, block: &EdgeSnapBlock, out: &Image) -> Result<()> {
-    let (w, h) = eye.size;
-    let images = [eye.raw.as_ref().expect("uploaded").id(), eye.color()];
+/// One eye's distances (`images`: the uploaded distances, then the colour, both `size`) with
+/// its depth breaks snapped to its colour edges, into `out` (edge_snap.comp).
+fn snap_edges(
+    device: &Device,
+    program: ShaderProgram,
+    (w, h): (u32, u32),
+    images: [ImageId; 2],
+    block: &EdgeSnapBlock,
+    out: &Image,
+) -> Result<()> {
     let storage = [StorageImage::Image(out.id())];
     device.run(
         None,
@@ -405,6 +412,8 @@ impl SplatRenderer {
 
     /// Renders the middle view of camera `mid`, with its times.
     pub fn render(&mut self, mid: &MiddleCamera) -> Result<(CyclopeanOutput, Timing)> {
+        // Before the eyes' matrices are read: after a failed set_frame they are zero.
+        let [(lc, ld), (rc, rd)] = [self.eyes[0].images()?, self.eyes[1].images()?];
         let (w, h) = (mid.width, mid.height);
         self.device.check_image_size("middle size", w, h)?;
         let w_left = left_weight(&self.frame_views[0], &self.frame_views[1], &mid.view)?;
@@ -452,19 +461,12 @@ impl SplatRenderer {
             u_tolerance_px: self.params.surface_tolerance_px as f32,
             u_w_left: w_left as f32,
         };
-        let splat_images = [[l.dist()], [r.dist()]];
+        let splat_images = [[ld], [rd]];
         let splat_targets = [
             [StorageImage::Image(t.splats[0].id())],
             [StorageImage::Image(t.splats[1].id())],
         ];
-        let gather_images = [
-            l.color(),
-            l.dist(),
-            t.splats[0].id(),
-            r.color(),
-            r.dist(),
-            t.splats[1].id(),
-        ];
+        let gather_images = [lc, ld, t.splats[0].id(), rc, rd, t.splats[1].id()];
         let edges = [t.edges.id()];
         let color_out = [StorageImage::Output(0)];
         let mut steps = vec![

@@ -25,7 +25,8 @@ use crate::convention::{Conventions, RowOrder};
 use crate::error::{Error, Result};
 use crate::gpu::{ProgramKind, ShaderProgram};
 use crate::pass::{
-    mat4_std140, Device, Dispatch, Draw, Format, Groups, Image, ImageData, Step, StorageImage, Target, ToDevice,
+    mat4_std140, Device, Dispatch, Draw, Format, Groups, Image, ImageData, ImageId, Step, StorageImage, Target,
+    ToDevice,
 };
 
 /// Source bit of pixels filled from the history (temporal_compose.frag's FROM_HISTORY).
@@ -72,6 +73,8 @@ struct History {
     mid: MiddleCamera,
     /// Colour (RGBA8), distance (R32F) and source bits (R8UI), memory rows.
     images: [Option<Image>; 3],
+    /// Their ids, as uploaded.
+    ids: [ImageId; 3],
 }
 
 /// The temporal accumulation on one device (GL or Vulkan): [`TemporalAccumulator`]'s rule, run
@@ -116,25 +119,29 @@ impl Accumulator {
         mid: &MiddleCamera,
         conv: &Conventions,
         what: &str,
-    ) -> Result<()> {
+    ) -> Result<[ImageId; 3]> {
         let (color, depth) = color_and_depth(out)?;
         let (w, h) = (mid.width, mid.height);
         let rows = conv.row_order;
         let rgba = rows.convert_rows(crate::gpu::pixels::rgb_to_rgba(&color.data), w as usize * 4);
         let dist = rows.convert_rows(bytemuck::cast_slice(&depth.data).to_vec(), w as usize * 4);
         let sources = rows.convert_rows(out.sources.clone(), w as usize);
-        let planes = [(Format::Rgba8, rgba), (Format::R32F, dist), (Format::R8Ui, sources)];
-        for (slot, (format, bytes)) in slots.iter_mut().zip(planes) {
+        let [c, d, s] = slots;
+        let put = |slot, format, bytes: &[u8]| {
             let data = ImageData {
                 width: w,
                 height: h,
                 format,
-                bytes: &bytes,
+                bytes,
                 label: what,
             };
-            device.put_image(slot, &data)?;
-        }
-        Ok(())
+            device.put_image(slot, &data)
+        };
+        Ok([
+            put(c, Format::Rgba8, &rgba)?,
+            put(d, Format::R32F, &dist)?,
+            put(s, Format::R8Ui, &sources)?,
+        ])
     }
 
     /// Accumulates `current` (seen by `mid`, top-down rows) with the history; returns the
@@ -154,13 +161,16 @@ impl Accumulator {
         };
         let d = &self.device;
         d.check_image_size("middle size", w, h)?;
-        Self::put(d, &mut self.current, current, mid, &self.conv, "temporal current")?;
-        if self.scratch.as_ref().is_none_or(|(size, _)| *size != (w, h)) {
-            self.scratch = None;
-            let make = |label| d.create_image(w, h, Format::R32Ui, label);
-            self.scratch = Some(((w, h), [make("temporal nearest")?, make("temporal winner")?]));
-        }
-        let [nearest, winner] = &self.scratch.as_ref().expect("made above").1;
+        let [cc, cd, cs] = Self::put(d, &mut self.current, current, mid, &self.conv, "temporal current")?;
+        // Kept for the next frame of this size; another size frees them before making new ones.
+        let [nearest, winner] = match self.scratch.take() {
+            Some((size, images)) if size == (w, h) => images,
+            old => {
+                drop(old);
+                let make = |label| d.create_image(w, h, Format::R32Ui, label);
+                [make("temporal nearest")?, make("temporal winner")?]
+            }
+        };
         let singular = |what: &str| Error::param(what.to_string(), "singular");
         let inv = |m: &mat4::Mat4, what: &str| mat4::inverse(m).map(|m| mat4_std140(&m)).ok_or_else(|| singular(what));
         let stage = |u_stage| -> Result<TemporalParams> {
@@ -178,12 +188,10 @@ impl Accumulator {
             })
         };
         let blocks = [stage(0)?, stage(1)?];
-        let id = |slot: &Option<Image>| slot.as_ref().expect("uploaded").id();
-        let [hc, hd, hs] = &hist.images;
-        let [cc, cd, cs] = &self.current;
-        let reproject_images = [id(hd), id(hs)];
+        let [hc, hd, hs] = hist.ids;
+        let reproject_images = [hd, hs];
         let storage = [StorageImage::Image(nearest.id()), StorageImage::Image(winner.id())];
-        let compose_images = [id(cc), id(cd), id(cs), id(hc), nearest.id(), winner.id()];
+        let compose_images = [cc, cd, cs, hc, nearest.id(), winner.id()];
         let groups = Groups::Fixed([hist.mid.width.div_ceil(8), hist.mid.height.div_ceil(8)]);
         let reproject = |k: usize| {
             Step::Dispatch(Dispatch {
@@ -218,6 +226,7 @@ impl Accumulator {
         ];
         let target = Target::view(w, h, true, true, self.conv.row_order);
         let mut r = self.device.run(Some(&target), &steps)?;
+        self.scratch = Some(((w, h), [nearest, winner]));
         let out = CyclopeanOutput {
             color: r.color(0)?,
             depth: r.depth(1)?,
@@ -234,8 +243,8 @@ impl Accumulator {
             Some(h) => h.images,
             None => [None, None, None],
         };
-        Self::put(&self.device, &mut images, out, mid, &self.conv, "temporal history")?;
-        self.history = Some(History { mid: *mid, images });
+        let ids = Self::put(&self.device, &mut images, out, mid, &self.conv, "temporal history")?;
+        self.history = Some(History { mid: *mid, images, ids });
         Ok(())
     }
 }

@@ -176,6 +176,17 @@ fn a_sequence_frame_rewrites_the_splat_renderer_in_place() {
     let (other, _, _) = scene_frame(&StereoRig::demo(40, 30), Conventions::all()[1], FrameDepth::Device);
     let err = r.set_frame(&other).unwrap_err().to_string();
     assert!(err.contains("conventions"), "{err}");
+    // A frame the device cannot hold fails set_frame; the renderer then refuses to render
+    // (an error, not a panic, nor the last frame's eyes) until it is given a frame again.
+    let side = viewsynth::pass::Device::gl(&g).unwrap().max_image_side() + 1;
+    let (huge, _, _) = scene_frame(&StereoRig::demo(side, 1), conv, FrameDepth::Device);
+    assert!(r.set_frame(&huge).is_err());
+    let Err(err) = r.render(&mid_b) else {
+        panic!("a renderer without eyes rendered")
+    };
+    assert!(err.to_string().contains("set_frame"), "{err}");
+    r.set_frame(&b).unwrap();
+    assert_eq!(r.render(&mid_b).unwrap().0.color, fresh.color);
 }
 
 /// `Device::put_image`: an image of the held one's size and format is rewritten in place (same

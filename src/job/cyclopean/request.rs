@@ -565,9 +565,8 @@ impl CyclopeanPlan {
         frame: &StereoFrame,
         mid: &MiddleCamera,
         fixation: f64,
-        reuse: Option<&mut Reused>,
+        mut reuse: Option<&mut Reused>,
     ) -> crate::Result<Synthesised> {
-        let mut reuse = reuse;
         let t0 = std::time::Instant::now();
         frame.validate()?;
         let params = self.gather.map(|g| g.params(fixation)).transpose()?;

@@ -25,22 +25,30 @@ pub struct Reused {
 
 impl Reused {
     /// The splat-gather renderer holding `frame`'s eyes: the last one with the eyes replaced,
-    /// or a new one where there is none or the conventions changed.
+    /// or a new one where there is none or the conventions changed. A renderer whose eyes
+    /// could not be replaced is dropped, never kept half-written.
     pub(crate) fn splat(
         &mut self,
         device: &Device,
         frame: &StereoFrame,
         outputs: CyclopeanOutputs,
     ) -> Result<&mut SplatRenderer> {
-        match &mut self.splat {
-            Some(r) if r.conventions() == frame.conv => r.set_frame(frame)?,
-            slot => *slot = Some(SplatRenderer::new(device, frame, SplatParams::default(), outputs)?),
-        }
-        Ok(self.splat.as_mut().expect("set above"))
+        let renderer = match self.splat.take() {
+            Some(mut r) if r.conventions() == frame.conv => {
+                r.set_frame(frame)?;
+                r
+            }
+            old => {
+                drop(old);
+                SplatRenderer::new(device, frame, SplatParams::default(), outputs)?
+            }
+        };
+        Ok(self.splat.insert(renderer))
     }
 
     /// The census matcher for `width` x `height` pairs searching 0..=`max_disparity` px: the
-    /// last one where those match (its inputs are rewritten in place), else a new one.
+    /// last one where those match (its inputs are rewritten in place), else a new one (the old
+    /// one freed first).
     pub(crate) fn matcher(
         &mut self,
         device: &Device,
@@ -49,27 +57,32 @@ impl Reused {
         max_disparity: u32,
     ) -> Result<&mut Matcher> {
         let key = (width, height, max_disparity);
-        if self.matcher.as_ref().is_none_or(|(k, _)| *k != key) {
-            self.matcher = None;
-            self.matcher = Some((key, Matcher::new(device, width, height, max_disparity)?));
-        }
-        Ok(&mut self.matcher.as_mut().expect("set above").1)
+        let matcher = match self.matcher.take() {
+            Some((k, m)) if k == key => m,
+            old => {
+                drop(old);
+                Matcher::new(device, width, height, max_disparity)?
+            }
+        };
+        Ok(&mut self.matcher.insert((key, matcher)).1)
     }
 
     /// The fill.
     pub(crate) fn filler(&mut self, device: &Device) -> Result<&mut Filler> {
-        if self.filler.is_none() {
-            self.filler = Some(Filler::new(device)?);
-        }
-        Ok(self.filler.as_mut().expect("set above"))
+        let filler = match self.filler.take() {
+            Some(f) => f,
+            None => Filler::new(device)?,
+        };
+        Ok(self.filler.insert(filler))
     }
 
     /// The temporal history for frames under `conv`: made again when the conventions change
     /// (the rows and depth it reads follow them).
     pub(crate) fn history(&mut self, device: &Device, conv: Conventions) -> Result<&mut Accumulator> {
-        if self.history.as_ref().is_none_or(|(c, _)| *c != conv) {
-            self.history = Some((conv, Accumulator::new(device, FILL_ONLY, DEPTH_TOLERANCE, conv)?));
-        }
-        Ok(&mut self.history.as_mut().expect("set above").1)
+        let history = match self.history.take() {
+            Some((c, h)) if c == conv => h,
+            _ => Accumulator::new(device, FILL_ONLY, DEPTH_TOLERANCE, conv)?,
+        };
+        Ok(&mut self.history.insert((conv, history)).1)
     }
 }

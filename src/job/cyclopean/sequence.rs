@@ -186,7 +186,9 @@ impl CyclopeanSequenceJob {
             render_ms += view.done.view.timing.map_or(0.0, |t| t.wall_ms);
             host.event(Event::Advanced);
         }
-        let written = set.expect("at least one frame").commit()?;
+        // load_sequence refuses a file without frames, so the loop opened the set.
+        let set = set.ok_or_else(|| Error::decode(&self.file, "the sequence lists no frame"))?;
+        let written = set.commit()?;
         host.event(Event::Finished);
         Ok(CyclopeanReport {
             width: size.0,
