@@ -116,10 +116,19 @@ pub const PROGRAMS: &[ProgramEntry] = &[
         vulkan: Some(&[]),
     },
     ProgramEntry {
+        name: "cyclopean/densify",
+        stages: &[
+            ("vert", FULLSCREEN_VERT),
+            ("frag", &["cyclopean/densify_params.glsl", "cyclopean/directions.glsl", "cyclopean/densify.frag"]),
+        ],
+        switches: &[],
+        vulkan: Some(&[]),
+    },
+    ProgramEntry {
         name: "cyclopean/fill",
         stages: &[
             ("vert", FULLSCREEN_VERT),
-            ("frag", &["cyclopean/fill_params.glsl", "cyclopean/fill.frag"]),
+            ("frag", &["cyclopean/fill_params.glsl", "cyclopean/directions.glsl", "cyclopean/fill.frag"]),
         ],
         switches: &[],
         vulkan: Some(&[]),

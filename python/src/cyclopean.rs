@@ -49,9 +49,11 @@ fn render(
         mid,
         fixation,
         confidence,
+        dense,
+        ..
     } = plan.frame(&device, input, names, None)?;
     gpu.check_image_size("the view (cameras[\"middle\"] width/height)", mid.width, mid.height)?;
-    Ok((plan.synthesise(&device, &frame, &mid, fixation, None)?, confidence))
+    Ok((plan.synthesise(&device, &frame, &mid, fixation, dense.as_ref(), None)?, confidence))
 }
 
 fn eye(

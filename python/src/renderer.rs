@@ -556,7 +556,7 @@ impl Renderer {
             doffs,
             outputs: outputs_given(outputs)?,
             fill,
-            max_disparity,
+            max_disparity: max_disparity.map(|m| m.min(i32::MAX as u32) as i32),
             min_confidence,
             confidence,
         };

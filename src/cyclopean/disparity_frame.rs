@@ -5,6 +5,10 @@
 //! With `doffs` (the right principal point minus the left one, Middlebury 2014) the right eye's
 //! principal point is `cx + doffs` and the in-between camera's `cx + t doffs`: then every image
 //! shift is exactly `t d`, whatever f, B and doffs, and only the metric depth depends on them.
+//!
+//! With `offset` the stored values are d + offset (the signed matcher's maps, see
+//! [`crate::cyclopean::matcher::range`]): 0 stays unknown, the image shift is the stored value
+//! minus the offset and the depth f B / (stored - offset + doffs).
 
 use super::scene_frame::StereoRig;
 use super::{EyeInput, FrameDepth, MiddleCamera, StereoFrame};
@@ -25,6 +29,8 @@ pub struct DisparityRig {
     pub doffs: f64,
     /// Position of the synthesised view along the baseline: 0 = left eye, 1 = right eye.
     pub position: f64,
+    /// What the stored disparities hold above the image shift, pixels (0: they are the shift).
+    pub offset: f64,
 }
 
 impl DisparityRig {
@@ -35,6 +41,7 @@ impl DisparityRig {
             baseline,
             doffs: 0.0,
             position: 0.5,
+            offset: 0.0,
         }
     }
 
@@ -48,6 +55,12 @@ impl DisparityRig {
         }
         if !self.doffs.is_finite() {
             return Err(Error::param("doffs", format!("{} must be finite", self.doffs)));
+        }
+        if !(self.offset.is_finite() && self.offset >= 0.0) {
+            return Err(Error::param(
+                "disparity offset",
+                format!("{} must be finite and >= 0", self.offset),
+            ));
         }
         if !(0.0..=1.0).contains(&self.position) {
             return Err(Error::param(
@@ -99,8 +112,9 @@ pub fn disparity_frame(
     let to_depth = |d: &DepthMap| {
         let z = d.data.iter().map(|&v| {
             let v = v as f64;
-            if v.is_finite() && v > 0.0 && v + rig.doffs > 0.0 {
-                (fb / (v + rig.doffs)) as f32
+            let shift = v - rig.offset;
+            if v.is_finite() && v > 0.0 && shift + rig.doffs > 0.0 {
+                (fb / (shift + rig.doffs)) as f32
             } else {
                 0.0
             }

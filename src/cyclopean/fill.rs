@@ -1,18 +1,21 @@
 //! `--fill`: a complete middle view for spectators. Holes (pixels no eye saw: disocclusions,
-//! unknown disparity, the borders only one eye covers) take the colour and depth of the nearest
-//! rendered pixel on their background side: along the row, the farther of the nearest valid
-//! pixels to the left and to the right (a disocclusion uncovers what lies behind the occluder,
-//! so the foreground edge must not bleed into it).
-//! Where both sides lie on one surface (depths within [`SAME_SURFACE`] relative) the hole is in
-//! that surface, not a disocclusion, and is interpolated between them by distance. Without a
-//! valid pixel in the row, the column is searched the same way (up before down).
+//! unknown disparity, the borders only one eye covers) are filled in two dimensions from the
+//! background layer around them (issue 38; the first fill went along the row, and its large
+//! holes became visible horizontal streaks across slanted, textured surfaces):
+//! - from the hole, walk the 16 directions of [`super::walk`] to the first rendered pixel in each;
+//! - sort those candidates far to near; the background layer is the farthest and every next one
+//!   within [`SAME_SURFACE`] (relative) of the one before it: a chain, so a slanted surface stays
+//!   one layer while an occluder's edge, a jump in depth, starts another;
+//! - the hole takes that layer's colour and depth, weighted by 1 / distance^2.
+//! A disocclusion uncovers what lies behind the occluder, so the foreground does not bleed into
+//! it; a hole inside one surface is interpolated across it from every side.
 //! Filled pixels carry [`FILLED`] alone in their source bits, so the mask file tells them apart
 //! (value 128, [`crate::io::MASK_FILLED`]); rendered pixels pass through unchanged.
 //!
 //! One full-screen pass (shaders/cyclopean/fill.frag) on either executor, and [`fill_reference`],
-//! its twin: the choices (which side, one surface or two) compare the same f32 depths, so they
-//! agree exactly; copied texels are exact, interpolated ones are the same f32 arithmetic up to
-//! the GPU's rounding of the normalised colour (one level at a tie) and its mix (a few ulp).
+//! its twin: the choices (which candidates, which layer) compare the same f32 depths, so they
+//! agree exactly; the weighted means are the same f32 sums, up to the GPU's division (GLSL allows
+//! 2.5 ulp) and its rounding of the normalised colour: one level at most, 1e-5 relative in depth.
 
 use super::CyclopeanOutput;
 use crate::error::{Error, Result};
@@ -107,19 +110,11 @@ impl Filler {
     }
 }
 
-/// The twin of [`Filler::fill`]: the same rule on the CPU.
+/// The twin of [`Filler::fill`]: the same rule on the CPU, in the shader's f32 arithmetic.
 pub fn fill_reference(out: &CyclopeanOutput, width: u32, height: u32) -> Result<CyclopeanOutput> {
     let (color, depth) = planes(out)?;
     let (w, h) = (width as i64, height as i64);
     let valid = |x: i64, y: i64| out.sources[(y * w + x) as usize] != 0;
-    let z = |(x, y): (i64, i64)| depth.data[(y * w + x) as usize];
-    // Steps to the nearest valid pixel from (x, y) along (dx, dy) before the edge, and where.
-    let nearest = |x: i64, y: i64, dx: i64, dy: i64| -> Option<(i64, (i64, i64))> {
-        (1..=w.max(h))
-            .map(|k| (k, (x + k * dx, y + k * dy)))
-            .take_while(|&(_, (cx, cy))| cx >= 0 && cy >= 0 && cx < w && cy < h)
-            .find(|&(_, (cx, cy))| valid(cx, cy))
-    };
     let mut filled = out.clone();
     let (fc, fd) = (
         filled.color.as_mut().expect("checked above"),
@@ -131,42 +126,39 @@ pub fn fill_reference(out: &CyclopeanOutput, width: u32, height: u32) -> Result<
             if out.sources[i] != 0 {
                 continue;
             }
-            let mut sides = (nearest(x, y, -1, 0), nearest(x, y, 1, 0));
-            if sides == (None, None) {
-                sides = (nearest(x, y, 0, -1), nearest(x, y, 0, 1));
+            // (depth, distance, index) of the first rendered pixel along each direction.
+            let mut candidates: Vec<(f32, i64, usize)> = super::walk::DIRECTIONS
+                .iter()
+                .filter_map(|&d| super::walk::first_along((x, y), d, (w, h), w.max(h), valid))
+                .map(|((qx, qy), r)| {
+                    let j = (qy * w + qx) as usize;
+                    (depth.data[j], r, j)
+                })
+                .collect();
+            if candidates.is_empty() {
+                fc.data[3 * i..3 * i + 3].fill(0);
+                fd.data[i] = 0.0;
+                continue;
             }
-            let q = match sides {
-                (None, None) => {
-                    fc.data[3 * i..3 * i + 3].fill(0);
-                    fd.data[i] = 0.0;
-                    continue;
+            // Far to near, stable (the shader's insertion keeps direction order at equal depths).
+            candidates.sort_by(|a, b| b.0.total_cmp(&a.0));
+            let layer = 1 + candidates
+                .windows(2)
+                .take_while(|p| p[0].0 - p[1].0 <= SAME_SURFACE * p[0].0)
+                .count();
+            let (mut rgb, mut z, mut total) = ([0f32; 3], 0f32, 0f32);
+            for &(zq, r, j) in &candidates[..layer] {
+                let wq = 1.0 / (r * r) as f32;
+                for (c, acc) in rgb.iter_mut().enumerate() {
+                    *acc += wq * (color.data[3 * j + c] as f32 / 255.0);
                 }
-                (Some((_, a)), None) => a,
-                (None, Some((_, b))) => b,
-                (Some((da, a)), Some((db, b))) => {
-                    let (za, zb) = (z(a), z(b));
-                    if (za - zb).abs() <= SAME_SURFACE * za.max(zb) {
-                        // One surface on both sides: interpolated as the shader's mix does, in f32.
-                        let t = da as f32 / (da + db) as f32;
-                        let (ja, jb) = ((a.1 * w + a.0) as usize, (b.1 * w + b.0) as usize);
-                        for c in 0..3 {
-                            let (ca, cb) = (color.data[3 * ja + c] as f32, color.data[3 * jb + c] as f32);
-                            fc.data[3 * i + c] = (ca + (cb - ca) * t).round() as u8;
-                        }
-                        fd.data[i] = za + (zb - za) * t;
-                        filled.sources[i] = FILLED;
-                        continue;
-                    }
-                    if za > zb {
-                        a
-                    } else {
-                        b
-                    }
-                }
-            };
-            let j = (q.1 * w + q.0) as usize;
-            fc.data.copy_within(3 * j..3 * j + 3, 3 * i);
-            fd.data[i] = depth.data[j];
+                z += wq * zq;
+                total += wq;
+            }
+            for (c, acc) in rgb.iter().enumerate() {
+                fc.data[3 * i + c] = ((acc / total) * 255.0).round().clamp(0.0, 255.0) as u8;
+            }
+            fd.data[i] = z / total;
             filled.sources[i] = FILLED;
         }
     }
@@ -200,12 +192,12 @@ mod tests {
 
     #[test]
     fn one_surface_either_side_is_interpolated_and_an_empty_row_takes_the_column() {
-        // 2 m and 2.05 m: within SAME_SURFACE, so x = 1..3 mix the two ends by distance.
+        // 2 m and 2.05 m: within SAME_SURFACE, so x = 1..3 mix the two ends by 1 / distance^2.
         let v = view(5, 1, vec![2.0, 0.0, 0.0, 0.0, 2.05], vec![1, 0, 0, 0, 1]);
         let f = fill_reference(&v, 5, 1).unwrap();
         let c = &f.color.as_ref().unwrap().data;
-        // Red is the pixel index: 0 at the left end, 4 at the right.
-        assert_eq!((c[3], c[6], c[9]), (1, 2, 3));
+        // Red is the pixel index: 0 at the left end, 4 at the right; x = 1 weighs them 9 : 1.
+        assert_eq!((c[3], c[6], c[9]), (0, 2, 4));
         let z = &f.depth.as_ref().unwrap().data;
         assert!((z[2] - 2.025).abs() < 1e-6, "{z:?}");
         // A 1 x 3 column: the middle row is empty, so it takes the column; 4 m and 9 m are two
@@ -215,6 +207,51 @@ mod tests {
         assert_eq!(f.sources, [2, FILLED, 2]);
         assert_eq!(f.depth.as_ref().unwrap().data[1], 9.0);
         assert_eq!(f.color.as_ref().unwrap().data[3], 2);
+    }
+
+    /// A slanted, textured plane (depth growing along x, texture in both directions) with a
+    /// 24 x 24 hole: the filled region varies no more from row to row than from column to
+    /// column (the row-wise fill made every filled row one streak: row-to-row differences 3x the
+    /// column-to-column ones on this plane), and its depth stays on the plane.
+    #[test]
+    fn a_hole_in_a_slanted_textured_plane_is_filled_without_row_streaks() {
+        let (w, h) = (64u32, 64u32);
+        let hole = |x: u32, y: u32| (20..44).contains(&x) && (20..44).contains(&y);
+        let plane = |x: u32| 2.0 + 0.01 * x as f32;
+        let tex = |x: u32, y: u32| {
+            let (fx, fy) = (x as f32, y as f32);
+            (128.0 + 60.0 * (fx * 0.31).sin() + 50.0 * (fy * 0.27).cos()) as u8
+        };
+        let color: Vec<u8> = (0..h).flat_map(|y| (0..w).flat_map(move |x| [tex(x, y); 3])).collect();
+        let z: Vec<f32> = (0..h)
+            .flat_map(|y| (0..w).map(move |x| if hole(x, y) { 0.0 } else { plane(x) }))
+            .collect();
+        let sources: Vec<u8> = (0..h)
+            .flat_map(|y| (0..w).map(move |x| u8::from(!hole(x, y))))
+            .collect();
+        let v = CyclopeanOutput {
+            color: Some(RgbImage::new(w, h, color).unwrap()),
+            depth: Some(DepthMap::new(w, h, z).unwrap()),
+            sources,
+        };
+        let f = fill_reference(&v, w, h).unwrap();
+        let c = &f.color.as_ref().unwrap().data;
+        let at = |x: u32, y: u32| c[3 * (y * w + x) as usize] as f64;
+        let (mut along_rows, mut along_columns) = (0.0, 0.0);
+        for y in 21..43 {
+            for x in 21..43 {
+                along_columns += (at(x + 1, y) - at(x, y)).abs();
+                along_rows += (at(x, y + 1) - at(x, y)).abs();
+                let zf = f.depth.as_ref().unwrap().data[(y * w + x) as usize];
+                assert!((zf - plane(x)).abs() < 0.15, "({x}, {y}): {zf} m off the plane");
+            }
+        }
+        // Within a factor 1.5 either way: neither direction streaks.
+        assert!(
+            along_rows <= 1.5 * along_columns && along_columns <= 1.5 * along_rows,
+            "row-to-row {along_rows} vs column-to-column {along_columns}"
+        );
+        assert!(f.sources.iter().all(|s| *s != 0), "the hole is filled");
     }
 
     #[test]

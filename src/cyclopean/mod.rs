@@ -20,6 +20,7 @@
 pub mod baseline;
 pub mod camera_file;
 pub mod camera_spec;
+pub mod densify;
 pub mod disparity_frame;
 pub mod edge_snap;
 pub mod fill;
@@ -33,6 +34,7 @@ pub mod scene_frame;
 pub mod splat;
 pub mod splat_reference;
 pub mod temporal;
+pub mod walk;
 
 use crate::camera::mat4::{self, Mat4};
 use crate::convention::Conventions;

@@ -330,6 +330,7 @@ pub fn cyclopean_real_rows(gpu: &Gpu, data_dir: &Path, repeats: usize) -> Result
         baseline: C::BASELINE_M,
         doffs: C::DOFFS_PX,
         position: 1.0,
+        offset: 0.0,
     };
     let runs = real_runs(gpu, &(left, disparity), &(truth.clone(), unknown), &rig, 1.5, repeats)?;
     rows.extend(

@@ -191,6 +191,9 @@ pub enum ProgramKind {
     CyclopeanSplatEdges,
     /// cyclopean/edge_snap.comp: depth breaks moved onto colour edges before the splat (compute).
     CyclopeanEdgeSnap,
+    /// cyclopean/densify.frag: unknown disparities of one eye filled before rendering (`--fill`
+    /// on two images alone).
+    CyclopeanDensify,
     /// cyclopean/fill.frag: holes filled from the background side (`--fill`).
     CyclopeanFill,
     /// cyclopean/temporal_reproject.comp: the previous middle view moved into the current
@@ -292,6 +295,7 @@ impl ProgramKind {
             ProgramKind::CyclopeanSplatGather => "cyclopean/splat_gather",
             ProgramKind::CyclopeanSplatEdges => "cyclopean/splat_edges",
             ProgramKind::CyclopeanEdgeSnap => "cyclopean/edge_snap",
+            ProgramKind::CyclopeanDensify => "cyclopean/densify",
             ProgramKind::CyclopeanFill => "cyclopean/fill",
             ProgramKind::CyclopeanTemporalReproject => "cyclopean/temporal_reproject",
             ProgramKind::CyclopeanTemporalCompose => "cyclopean/temporal_compose",
@@ -324,6 +328,7 @@ impl ProgramKind {
             | ProgramKind::CyclopeanSplatGather
             | ProgramKind::CyclopeanSplatEdges
             | ProgramKind::CyclopeanEdgeSnap
+            | ProgramKind::CyclopeanDensify
             | ProgramKind::CyclopeanFill
             | ProgramKind::CyclopeanTemporalReproject
             | ProgramKind::CyclopeanTemporalCompose
@@ -417,6 +422,7 @@ impl ShaderProgram {
             ProgramKind::CyclopeanSplatGather,
             ProgramKind::CyclopeanSplatEdges,
             ProgramKind::CyclopeanEdgeSnap,
+            ProgramKind::CyclopeanDensify,
             ProgramKind::CyclopeanFill,
             ProgramKind::CyclopeanTemporalReproject,
             ProgramKind::CyclopeanTemporalCompose,

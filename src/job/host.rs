@@ -85,6 +85,15 @@ pub enum Event<'a> {
         /// Pixels beyond it.
         pixels: usize,
     },
+    /// Two images alone: the disparity range the matcher searched, pixels.
+    DisparityRange {
+        /// Smallest disparity searched (may be negative).
+        min: i32,
+        /// Largest.
+        max: i32,
+        /// Estimated from the images (else both ends were given).
+        estimated: bool,
+    },
     /// `--data-dir` exists but is empty: the real-data rows are skipped.
     EmptyDataDir(&'a Path),
     /// Work of `total` items (targets, frames) starts.

@@ -1,15 +1,13 @@
 //! `--fill` (src/cyclopean/fill.rs): the GPU pass against its twin on both executors, and the
 //! complete spectator frame on Middlebury Cones.
 //!
-//! Bounds, from the numerics: which side fills a hole, and whether both sides are one surface,
-//! are comparisons of the same f32 depths on both sides, so the source bits must be identical;
-//! a copied pixel is the same texel, so exact. An interpolated pixel is `mix` of two texels in
-//! f32 on the GPU and the same expression in f32 on the CPU: mixing two integer levels at
-//! t = k / n often lands exactly on a half level (t = 1/2 between levels an odd number apart),
-//! which the driver's UNORM conversion rounds by its own rule while the twin rounds half away
-//! from zero, and a value within ~1e-5 of a half level may go either way: one level (93 of 988
-//! filled pixels on llvmpipe and lavapipe when written). Depth differs by the mix's few ulp
-//! (bound 1e-6 relative).
+//! Bounds, from the numerics: which candidates a hole walks to and which form its background
+//! layer are comparisons of the same f32 depths on both sides, so the source bits must be
+//! identical, and rendered pixels pass through exact. A filled pixel is a 1 / r^2-weighted mean of
+//! its layer's texels in f32 on both sides; the GPU's division may be 2.5 ulp off (GLSL) and its
+//! UNORM conversion rounds a value within ~1e-5 of a half level by its own rule while the twin
+//! rounds half away from zero: one level at most. Depth: the same mean, a few ulp (bound 1e-5
+//! relative). A 40-level error in any filled pixel fails.
 
 use crate::common::{data_dir, gpu};
 use viewsynth::convention::Conventions;
@@ -76,7 +74,7 @@ fn check(input: (CyclopeanOutput, u32, u32), device: &Device, what: &str) {
         assert!(d <= 1, "{what}: filled pixel {i} colour differs by {d} levels");
         let rel = (gz[i] - tz[i]).abs() / tz[i].abs().max(f32::MIN_POSITIVE);
         assert!(
-            rel <= 1e-6 || gz[i] == tz[i],
+            rel <= 1e-5 || gz[i] == tz[i],
             "{what}: filled pixel {i} depth {} vs {}",
             gz[i],
             tz[i]
@@ -84,7 +82,7 @@ fn check(input: (CyclopeanOutput, u32, u32), device: &Device, what: &str) {
     }
     assert_eq!(
         filled, holes,
-        "{what}: every hole has a valid pixel in its row or column"
+        "{what}: every hole has a valid pixel along one of its 16 directions"
     );
     println!("{what}: {filled} pixels filled, {off_by_one} one level off the twin");
 }

@@ -16,6 +16,7 @@ mod cli_sequence;
 mod common;
 mod compare;
 mod cyclopean;
+mod cyclopean_dense;
 mod cyclopean_fill;
 mod cyclopean_real;
 mod cyclopean_temporal;

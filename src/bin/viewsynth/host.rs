@@ -45,6 +45,14 @@ impl Host for CliHost {
             Event::DepthTruncated { limit_m, pixels } => {
                 eprintln!("--depth-trunc {limit_m}: {pixels} pixels beyond {limit_m} m set invalid");
             }
+            Event::DisparityRange { min, max, estimated } => {
+                let how = if estimated {
+                    "estimated from the images"
+                } else {
+                    "as given"
+                };
+                eprintln!("disparity range {min}..{max} px ({how}; --min-disparity/--max-disparity override it)");
+            }
             Event::EmptyDataDir(d) => {
                 eprintln!(
                     "note: --data-dir {} is empty: the real-data rows are skipped",

@@ -45,6 +45,7 @@
 
 pub mod confidence;
 pub mod gpu;
+pub mod range;
 pub mod reference;
 
 pub use confidence::confidence_reference;

@@ -292,7 +292,16 @@ impl CyclopeanJob {
             mid,
             fixation,
             confidence,
+            range,
+            dense,
         } = self.plan.frame(device, input, names, reuse.as_deref_mut())?;
+        if let Some((range, estimated)) = range {
+            host.event(Event::DisparityRange {
+                min: range.min,
+                max: range.max,
+                estimated,
+            });
+        }
         if let (Some(cameras), Some((left_map, right_map))) = (&self.cameras, &self.maps) {
             for (path, eye) in [(left_map, &frame.left), (right_map, &frame.right)] {
                 let hint = format!(
@@ -307,7 +316,9 @@ impl CyclopeanJob {
                 });
             }
         }
-        let done = self.plan.synthesise(device, &frame, &mid, fixation, reuse)?;
+        let done = self
+            .plan
+            .synthesise(device, &frame, &mid, fixation, dense.as_ref(), reuse)?;
         Ok(RenderedView {
             done,
             confidence,

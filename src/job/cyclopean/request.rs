@@ -12,9 +12,11 @@ use super::reuse::Reused;
 use super::CyclopeanMethod;
 use crate::convention::Conventions;
 use crate::cyclopean::camera_file::{CameraFile, EyeCameras};
+use crate::cyclopean::densify::Densifier;
 use crate::cyclopean::disparity_frame::{disparity_frame, median_fixation, DisparityRig};
 use crate::cyclopean::fill::{Filler, FILLED};
 use crate::cyclopean::forward::ForwardWarp;
+use crate::cyclopean::matcher::range::{estimate_range, DisparityRange, SignedSearch};
 use crate::cyclopean::matcher::{EyeEstimate, Matcher};
 use crate::cyclopean::render::CyclopeanRenderer;
 use crate::cyclopean::splat::{SplatParams, SplatRenderer};
@@ -55,8 +57,12 @@ pub struct CyclopeanRequest {
     pub outputs: Option<OutputSet>,
     /// Holes filled from the background side (mask 128 there); off, holes stay.
     pub fill: bool,
-    /// Two images alone: the matcher's search range, pixels (none: [`default_max_disparity`]).
-    pub max_disparity: Option<u32>,
+    /// Two images alone: the largest disparity searched, pixels (none: estimated from the
+    /// images, see [`crate::cyclopean::matcher::range`]).
+    pub max_disparity: Option<i32>,
+    /// Two images alone: the smallest disparity searched, pixels, negative allowed (none:
+    /// estimated from the images).
+    pub min_disparity: Option<i32>,
     /// Two images alone: estimated disparities whose confidence (the matcher's, in [0, 1]:
     /// the eyes' agreement and the local spread) is below this are dropped, trading coverage
     /// for precision; none keeps every disparity the left-right check kept.
@@ -66,7 +72,8 @@ pub struct CyclopeanRequest {
     pub confidence: bool,
 }
 
-/// The matcher's search range for two images alone when none is given: a sixth of the width
+/// The matcher's search range for two images alone when none is given and the images give none
+/// (too little texture for the coarse pass): a sixth of the width
 /// (Middlebury's quarter-size pairs need about a seventh), rounded up to 16 px, in 16..=256.
 pub fn default_max_disparity(width: u32) -> u32 {
     (width.div_ceil(6).div_ceil(16) * 16).clamp(16, 256)
@@ -163,7 +170,8 @@ pub struct CyclopeanPlan {
     rig: (Option<f64>, Option<f64>, f64, f64),
     outputs: OutputSet,
     fill: bool,
-    max_disparity: Option<u32>,
+    /// The search range's ends given (min, max); the others are estimated.
+    range: (Option<i32>, Option<i32>),
     min_confidence: Option<f64>,
     confidence: bool,
 }
@@ -214,6 +222,7 @@ impl CyclopeanRequest {
         }
         for (flag, given) in [
             ("--max-disparity", self.max_disparity.is_some()),
+            ("--min-disparity", self.min_disparity.is_some()),
             ("--min-confidence", self.min_confidence.is_some()),
             ("--confidence", self.confidence),
         ] {
@@ -227,11 +236,13 @@ impl CyclopeanRequest {
                 format!("{c} outside [0, 1] (the matcher's confidence)"),
             )));
         }
-        if self.max_disparity == Some(0) {
-            return Err(ArgError::Invalid(crate::Error::param(
-                "--max-disparity",
-                "0 px searches nothing: give at least 1",
-            )));
+        if let (Some(lo), Some(hi)) = (self.min_disparity, self.max_disparity) {
+            if lo >= hi {
+                return Err(ArgError::Invalid(crate::Error::param(
+                    "--min-disparity/--max-disparity",
+                    format!("{lo}..{hi} px searches nothing: the minimum must be below the maximum"),
+                )));
+            }
         }
         let metric = match kind {
             StereoKind::Disparity | StereoKind::Images => {
@@ -277,7 +288,7 @@ impl CyclopeanRequest {
             rig: (self.focal, self.baseline, self.doffs, self.position.unwrap_or(0.5)),
             outputs,
             fill: self.fill,
-            max_disparity: self.max_disparity,
+            range: (self.min_disparity, self.max_disparity),
             min_confidence: self.min_confidence,
             confidence: self.confidence,
         })
@@ -321,6 +332,30 @@ impl CyclopeanRequest {
     }
 }
 
+/// `out` with its holes taken from `dense` where that view has a pixel, marked [`FILLED`].
+fn holes_from(
+    mut out: crate::cyclopean::CyclopeanOutput,
+    dense: &crate::cyclopean::CyclopeanOutput,
+) -> crate::Result<crate::cyclopean::CyclopeanOutput> {
+    let missing = || crate::Error::param("fill", "the dense view needs colour and depth");
+    let (dc, dd) = (
+        dense.color.as_ref().ok_or_else(missing)?,
+        dense.depth.as_ref().ok_or_else(missing)?,
+    );
+    let (oc, od) = (
+        out.color.as_mut().ok_or_else(missing)?,
+        out.depth.as_mut().ok_or_else(missing)?,
+    );
+    for (i, s) in out.sources.iter_mut().enumerate() {
+        if *s == 0 && dense.sources[i] != 0 {
+            *s = FILLED;
+            oc.data[3 * i..3 * i + 3].copy_from_slice(&dc.data[3 * i..3 * i + 3]);
+            od.data[i] = dd.data[i];
+        }
+    }
+    Ok(out)
+}
+
 /// An eye's estimated disparities with those below `min` confidence (if any) made unknown (0).
 fn confident(eye: &mut EyeEstimate, min: Option<f64>) {
     let Some(min) = min else { return };
@@ -343,6 +378,22 @@ pub struct Framed {
     /// Two images alone with `confidence` asked for: the matcher's confidence of the left and
     /// the right eye (rows top-down, in [0, 1], 0 where the disparity is unknown).
     pub confidence: Option<[DepthMap; 2]>,
+    /// Two images alone: the disparity range searched, and whether it was estimated (else given).
+    pub range: Option<(DisparityRange, bool)>,
+    /// Two images alone with `fill`: the same frame on disparities made dense
+    /// ([`crate::cyclopean::densify`]); what it renders fills the holes of `frame`'s view.
+    pub dense: Option<StereoFrame>,
+}
+
+/// A pair alone's disparities ([`CyclopeanPlan::frame`]).
+struct Estimate {
+    /// Left and right disparities, stored as d + offset (0 unknown), the input's columns.
+    left: DepthMap,
+    right: DepthMap,
+    confidence: Option<[DepthMap; 2]>,
+    offset: u32,
+    range: DisparityRange,
+    estimated: bool,
 }
 
 /// The decoded inputs of one view, each eye's colour with its disparity or depth.
@@ -441,12 +492,32 @@ impl CyclopeanPlan {
     ) -> crate::Result<Framed> {
         let [left_rgb, right_rgb, left_map, cameras_name] = names;
         match input {
-            StereoInput::Disparity { left, right } => self.disparity_frame(left, right, left_map),
+            StereoInput::Disparity { left, right } => self.disparity_frame(left, right, left_map, 0),
             StereoInput::Images { left, right } => {
-                let (dl, dr, confidence) = self.estimate(device, &left, &right, left_rgb, reuse)?;
+                let mut reuse = reuse;
+                let est = self.estimate(device, &left, &right, left_rgb, reuse.as_deref_mut())?;
+                let dense = match self.fill {
+                    true => {
+                        let mut own;
+                        let densifier = match reuse {
+                            Some(r) => r.densifier(device)?,
+                            None => {
+                                own = Densifier::new(device)?;
+                                &mut own
+                            }
+                        };
+                        let dl = densifier.densify(&est.left, &left)?.disparity;
+                        let dr = densifier.densify(&est.right, &right)?.disparity;
+                        let eyes = ((left.clone(), dl), (right.clone(), dr));
+                        Some(self.disparity_frame(eyes.0, eyes.1, left_map, est.offset)?.frame)
+                    }
+                    false => None,
+                };
                 Ok(Framed {
-                    confidence,
-                    ..self.disparity_frame((left, dl), (right, dr), left_map)?
+                    confidence: est.confidence,
+                    range: Some((est.range, est.estimated)),
+                    dense,
+                    ..self.disparity_frame((left, est.left), (right, est.right), left_map, est.offset)?
                 })
             }
             StereoInput::Cameras { left, right, cameras } => {
@@ -472,13 +543,46 @@ impl CyclopeanPlan {
                     mid,
                     fixation,
                     confidence: None,
+                    range: None,
+                    dense: None,
                 })
             }
         }
     }
 
-    /// Both eyes' disparities of a pair alone, by the census matcher on `device` (those below
-    /// the minimum confidence made unknown), and their confidence when asked for.
+    /// The search range of a pair alone: the ends given, the others estimated from the images
+    /// (a lone `--max-disparity` keeps its meaning of a search from 0 where the images show no
+    /// negative disparity; without an estimate, 0..=[`default_max_disparity`]). True when an end
+    /// was estimated.
+    fn range(&self, left: &RgbImage, right: &RgbImage, left_rgb: InputName) -> crate::Result<(DisparityRange, bool)> {
+        let (lo, hi) = self.range;
+        let estimated = match (lo, hi) {
+            (Some(_), Some(_)) => None,
+            _ => estimate_range(left, right)?,
+        };
+        let base = estimated.unwrap_or(DisparityRange {
+            min: 0,
+            max: default_max_disparity(left.width) as i32,
+        });
+        let range = DisparityRange {
+            min: lo.unwrap_or(match hi {
+                Some(_) => base.min.min(0),
+                None => base.min,
+            }),
+            max: hi.unwrap_or(match lo {
+                Some(lo) => base.max.max(lo + 1),
+                None => base.max,
+            }),
+        };
+        range
+            .validate(left.width)
+            .map_err(|e| left_rgb.error(format!("{} px wide: {e}", left.width)))?;
+        Ok((range, lo.is_none() || hi.is_none()))
+    }
+
+    /// Both eyes' disparities of a pair alone over its signed range, by the census matcher on
+    /// `device` (those below the minimum confidence made unknown), and their confidence when
+    /// asked for. Stored as d + offset ([`SignedSearch`]).
     fn estimate(
         &self,
         device: &Device,
@@ -486,32 +590,51 @@ impl CyclopeanPlan {
         right: &RgbImage,
         left_rgb: InputName,
         reuse: Option<&mut Reused>,
-    ) -> crate::Result<(DepthMap, DepthMap, Option<[DepthMap; 2]>)> {
-        let max = self.max_disparity.unwrap_or(default_max_disparity(left.width));
-        if max >= left.width {
-            return Err(left_rgb.error(format!(
-                "{} px wide: the search range (--max-disparity {max}) must be less than the width",
-                left.width
-            )));
-        }
+    ) -> crate::Result<Estimate> {
+        let (range, estimated) = self.range(left, right, left_rgb)?;
+        let search = SignedSearch::new(range);
+        let widened;
+        let (l, r) = match search.offset {
+            0 => (left, right),
+            _ => {
+                widened = search.widen(left, right)?;
+                (&widened.0, &widened.1)
+            }
+        };
         let mut own;
         let matcher = match reuse {
-            Some(r) => r.matcher(device, left.width, left.height, max)?,
+            Some(re) => re.matcher(device, l.width, l.height, search.max_disparity)?,
             None => {
-                own = Matcher::new(device, left.width, left.height, max)?;
+                own = Matcher::new(device, l.width, l.height, search.max_disparity)?;
                 &mut own
             }
         };
         // The confidence stage runs only when something reads it.
-        if self.min_confidence.is_none() && !self.confidence {
-            let (l, r) = matcher.estimate(left, right)?;
-            return Ok((l, r, None));
-        }
-        let [mut l, mut r] = matcher.estimate_with_confidence(left, right)?;
-        confident(&mut l, self.min_confidence);
-        confident(&mut r, self.min_confidence);
-        let confidence = self.confidence.then_some([l.confidence, r.confidence]);
-        Ok((l.disparity, r.disparity, confidence))
+        let (dl, dr, confidence) = if self.min_confidence.is_none() && !self.confidence {
+            let (dl, dr) = matcher.estimate(l, r)?;
+            (dl, dr, None)
+        } else {
+            let [mut el, mut er] = matcher.estimate_with_confidence(l, r)?;
+            confident(&mut el, self.min_confidence);
+            confident(&mut er, self.min_confidence);
+            let confidence = match self.confidence {
+                true => {
+                    let (cl, cr) = search.crop(el.confidence, er.confidence, left.width)?;
+                    Some([cl, cr])
+                }
+                false => None,
+            };
+            (el.disparity, er.disparity, confidence)
+        };
+        let (dl, dr) = search.crop(dl, dr, left.width)?;
+        Ok(Estimate {
+            left: dl,
+            right: dr,
+            confidence,
+            offset: search.offset,
+            range,
+            estimated,
+        })
     }
 
     /// A rectified pair with disparities: the frame, the view and the seed's fixation (the
@@ -521,14 +644,21 @@ impl CyclopeanPlan {
         left: (RgbImage, DepthMap),
         right: (RgbImage, DepthMap),
         left_map: InputName,
+        offset: u32,
     ) -> crate::Result<Framed> {
         let (focal, baseline, doffs, position) = self.rig;
-        // Without a calibration only f B matters for the view; any nominal values do.
+        // Without a calibration only f B matters for the view; any nominal values do, and a
+        // signed range's offset becomes the principal points' (every shift stays t d, every
+        // depth positive). With one, the depth is the calibration's: f B / (d + doffs).
         let rig = DisparityRig {
             focal_px: focal.unwrap_or(left.0.width as f64),
             baseline: baseline.unwrap_or(0.1),
-            doffs,
+            doffs: match focal {
+                Some(_) => doffs,
+                None => doffs + offset as f64,
+            },
             position,
+            offset: offset as f64,
         };
         let known = left.1.data.iter().any(|&d| d.is_finite() && d > 0.0);
         let (frame, mid) = disparity_frame(left, right, &rig, Conventions::default())?;
@@ -552,6 +682,8 @@ impl CyclopeanPlan {
             mid,
             fixation,
             confidence: None,
+            range: None,
+            dense: None,
         })
     }
 
@@ -559,12 +691,16 @@ impl CyclopeanPlan {
     /// A sequence passes what it keeps between frames (`reuse`): the default method's renderer
     /// and the fill are reused, and with `fill` the holes the last frame's eyes saw take the
     /// temporal history first and the fill fills the rest (both count as filled in the mask).
+    /// `dense`: two images alone with `fill`, the frame on dense disparities; its view fills
+    /// the holes of `frame`'s first (pixels from filled disparities count as filled, so the
+    /// mask's rendered pixels stay those of matched disparities), then the fill fills the rest.
     pub fn synthesise(
         &self,
         device: &Device,
         frame: &StereoFrame,
         mid: &MiddleCamera,
         fixation: f64,
+        dense: Option<&StereoFrame>,
         mut reuse: Option<&mut Reused>,
     ) -> crate::Result<Synthesised> {
         let t0 = std::time::Instant::now();
@@ -575,16 +711,24 @@ impl CyclopeanPlan {
             color: self.outputs.rgb || self.fill,
             depth: self.outputs.depth || self.fill,
         };
-        let (mut out, timing) = match (self.method, params) {
+        let render = |frame: &StereoFrame, reuse: &mut Option<&mut Reused>| match (self.method, params) {
             (CyclopeanMethod::Seed | CyclopeanMethod::Refine, Some(p)) => {
-                CyclopeanRenderer::with_outputs(device, frame, p, wanted)?.render(mid)?
+                CyclopeanRenderer::with_outputs(device, frame, p, wanted)?.render(mid)
             }
-            (CyclopeanMethod::Forward, _) => ForwardWarp::new(device, frame, &BreakRule::default())?.render(mid)?,
-            _ => match &mut reuse {
-                Some(r) => r.splat(device, frame, wanted)?.render(mid)?,
-                None => SplatRenderer::new(device, frame, SplatParams::default(), wanted)?.render(mid)?,
+            (CyclopeanMethod::Forward, _) => ForwardWarp::new(device, frame, &BreakRule::default())?.render(mid),
+            _ => match reuse {
+                Some(r) => r.splat(device, frame, wanted)?.render(mid),
+                None => SplatRenderer::new(device, frame, SplatParams::default(), wanted)?.render(mid),
             },
         };
+        let (mut out, mut timing) = render(frame, &mut reuse)?;
+        if let Some(dense) = dense.filter(|_| self.fill) {
+            dense.validate()?;
+            let (from_dense, t) = render(dense, &mut reuse)?;
+            timing.wall_ms += t.wall_ms;
+            timing.gpu_ms = timing.gpu_ms.zip(t.gpu_ms).map(|(a, b)| a + b);
+            out = holes_from(out, &from_dense)?;
+        }
         if self.fill {
             out = match reuse {
                 Some(r) => {

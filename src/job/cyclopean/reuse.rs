@@ -5,6 +5,7 @@
 //! its renderers and drops them.
 
 use crate::convention::Conventions;
+use crate::cyclopean::densify::Densifier;
 use crate::cyclopean::fill::Filler;
 use crate::cyclopean::matcher::Matcher;
 use crate::cyclopean::splat::{SplatParams, SplatRenderer};
@@ -20,6 +21,7 @@ pub struct Reused {
     matcher: Option<((u32, u32, u32), Matcher)>,
     splat: Option<SplatRenderer>,
     filler: Option<Filler>,
+    densifier: Option<Densifier>,
     history: Option<(Conventions, Accumulator)>,
 }
 
@@ -65,6 +67,15 @@ impl Reused {
             }
         };
         Ok(&mut self.matcher.insert((key, matcher)).1)
+    }
+
+    /// The densifier (two images alone with the fill).
+    pub(crate) fn densifier(&mut self, device: &Device) -> Result<&mut Densifier> {
+        let densifier = match self.densifier.take() {
+            Some(d) => d,
+            None => Densifier::new(device)?,
+        };
+        Ok(self.densifier.insert(densifier))
     }
 
     /// The fill.

@@ -126,16 +126,23 @@ pub(crate) struct CyclopeanArgs {
     /// only with --focal and --baseline). Colour and depth not listed are not read back.
     #[arg(help_heading = OUTPUTS, long)]
     outputs: Option<String>,
-    /// Fill the holes (pixels no eye saw) from the background side along the row, so the frame
-    /// is complete; filled pixels are 128 in middle_mask.png (rendered ones 255). Off: holes
-    /// stay 0.
+    /// Fill the holes (pixels no eye saw) so the frame is complete: two images alone first
+    /// render on disparities made dense (unknown ones filled from similar-coloured neighbours,
+    /// leaning to the background), then every remaining hole takes the background layer around
+    /// it in 2-D. Filled pixels are 128 in middle_mask.png (rendered from matched or given
+    /// disparities: 255). Off: holes stay 0.
     #[arg(help_heading = OUTPUTS, long)]
     fill: bool,
-    /// Two images alone (no disparities, no depth): the disparities are estimated by the census
-    /// matcher over 0..=N px (a rectified pair; default a sixth of the width, rounded up to 16,
-    /// in 16..=256).
-    #[arg(help_heading = INPUTS, long, value_name = "N", value_parser = clap::value_parser!(u32).range(1..=i64::from(viewsynth::io::MAX_DIMENSION)))]
-    max_disparity: Option<u32>,
+    /// Two images alone (no disparities, no depth): the largest disparity the census matcher
+    /// searches, pixels (default: estimated from the images by a coarse pass, with a margin;
+    /// the range used is printed).
+    #[arg(help_heading = INPUTS, long, value_name = "N", allow_hyphen_values = true, value_parser = clap::value_parser!(i32).range(-i64::from(viewsynth::io::MAX_DIMENSION)..=i64::from(viewsynth::io::MAX_DIMENSION)))]
+    max_disparity: Option<i32>,
+    /// Two images alone: the smallest disparity searched, pixels; negative for pairs whose
+    /// disparities cross zero (a converged rig, images cropped after rectification). Default:
+    /// estimated from the images.
+    #[arg(help_heading = INPUTS, long, value_name = "N", allow_hyphen_values = true, value_parser = clap::value_parser!(i32).range(-i64::from(viewsynth::io::MAX_DIMENSION)..=i64::from(viewsynth::io::MAX_DIMENSION)))]
+    min_disparity: Option<i32>,
     /// Two images alone: drop estimated disparities whose confidence is below C, in [0, 1]
     /// (the eyes' agreement times 1 / (1 + the local disparity variance)): fewer pixels, more
     /// of them right.
@@ -183,6 +190,7 @@ impl CyclopeanArgs {
             outputs: crate::options::parse_outputs(self.outputs.as_deref())?,
             fill: self.fill,
             max_disparity: self.max_disparity,
+            min_disparity: self.min_disparity,
             min_confidence: self.min_confidence,
             confidence: self.confidence,
         })

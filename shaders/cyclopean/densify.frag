@@ -1,0 +1,80 @@
+// Dense disparities (densify.rs holds the f64 twin and the rule): an unknown disparity takes,
+// from the first known pixel along each of 16 directions, the weighted 15 % quantile of their
+// disparities, weights falling with the colour difference and the distance. The low quantile
+// leans to the background side (an occluded pixel belongs to the surface behind its occluder);
+// the colour weights keep a textureless region on its own surface. Integer weights and a
+// comparison sort: the GPU picks the twin's candidate, bit for bit.
+// Known disparities pass through with flag 0; filled ones carry u_filled.
+
+layout(location = 0) out float o_disparity;
+layout(location = 1) out float o_filled;  // R8 normalised: bits / 255 stores the bits
+
+bool known(ivec2 q) {
+    return texelFetch(u_disparity, q, 0).r > 0.0;
+}
+
+uvec3 colour(ivec2 q) {
+    return uvec3(round(texelFetch(u_color, q, 0).rgb * 255.0));
+}
+
+void main() {
+    ivec2 p = ivec2(gl_FragCoord.xy);
+    float own = texelFetch(u_disparity, p, 0).r;
+    if (own > 0.0) {
+        o_disparity = own;
+        o_filled = 0.0;
+        return;
+    }
+    uvec3 c = colour(p);
+    float v[16];
+    uint w[16];
+    int n = 0;
+    for (int i = 0; i < DIRECTION_COUNT; ++i) {
+        ivec2 d = DIRECTIONS[i];
+        int m = max(abs(d.x), abs(d.y));
+        for (int k = 1; k * m <= u_radius; ++k) {
+            ivec2 q = p + k * d;
+            if (any(lessThan(q, ivec2(0))) || any(greaterThanEqual(q, u_size))) {
+                break;
+            }
+            if (known(q)) {
+                uvec3 cq = colour(q);
+                uvec3 diff = max(c, cq) - min(c, cq);
+                uint s = COLOUR_SOFTNESS + diff.r + diff.g + diff.b;
+                float value = texelFetch(u_disparity, q, 0).r;
+                uint weight = ((1u << 30) / (s * s)) / uint(k * m);
+                // Insertion by disparity; equal ones keep direction order (as the twin's stable sort).
+                int j = n;
+                while (j > 0 && v[j - 1] > value) {
+                    v[j] = v[j - 1];
+                    w[j] = w[j - 1];
+                    --j;
+                }
+                v[j] = value;
+                w[j] = weight;
+                ++n;
+                break;
+            }
+        }
+    }
+    if (n == 0) {
+        o_disparity = 0.0;
+        o_filled = 0.0;
+        return;
+    }
+    uint total = 0u;
+    for (int i = 0; i < n; ++i) {
+        total += w[i];
+    }
+    uint running = 0u;
+    int pick = n - 1;
+    for (int i = 0; i < n; ++i) {
+        running += w[i];
+        if (running * 100u >= total * QUANTILE_PERCENT) {
+            pick = i;
+            break;
+        }
+    }
+    o_disparity = v[pick];
+    o_filled = float(u_filled) / 255.0;
+}
