@@ -33,6 +33,8 @@ pub(super) struct Flight {
     pub rows: RowOrder,
     /// Submitted and not yet waited for.
     pub busy: bool,
+    /// The number of its run among the executor's submissions (valid while busy).
+    pub serial: u64,
     /// Host time of recording and submitting.
     pub submit_ms: f64,
 }
@@ -60,6 +62,7 @@ impl Flight {
             size: (0, 0),
             rows: RowOrder::TopDown,
             busy: false,
+            serial: 0,
             submit_ms: 0.0,
         })
     }
@@ -130,13 +133,16 @@ impl Flight {
         })
     }
 
-    /// A descriptor pool with room for `sets` sets (reset, or made larger).
+    /// A descriptor pool with room for `sets` sets (reset, or made larger). A run without
+    /// steps (a mesh that keeps no triangle) still gets a pool: the first run of a flight may
+    /// be one, and resetting the null handle it starts with crashed the driver.
     pub fn reset_pool(&mut self, sets: usize) -> Result<()> {
         let d = &self.vk.device;
+        let sets = sets.max(1);
         // SAFETY: the flight is not in flight, so no set of its pool is in use; the old pool is
-        // destroyed before its handle is replaced.
+        // destroyed before its handle is replaced; a null pool is never reset.
         unsafe {
-            if sets <= self.pool_sets {
+            if self.pool != vk::DescriptorPool::null() && sets <= self.pool_sets {
                 return d
                     .reset_descriptor_pool(self.pool, vk::DescriptorPoolResetFlags::empty())
                     .map_err(vk_err("vkResetDescriptorPool"));
