@@ -640,7 +640,9 @@ impl Executor for VkExecutor {
         let waited = f.wait_fence();
         f.busy = false;
         waited?;
-        let outputs = (0..f.outputs.len()).map(|i| f.read_output(i)).collect();
+        let outputs = (0..f.outputs.len())
+            .map(|i| f.read_output(i))
+            .collect::<Result<Vec<_>>>()?;
         let timing = Timing {
             gpu_ms: None,
             wall_ms: f.submit_ms,

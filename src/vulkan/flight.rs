@@ -118,19 +118,22 @@ impl Flight {
 
     /// Output `i`'s texels after the fence, rows top-down (files are top-down: a bottom-up
     /// memory order is flipped here, as GL does on the GPU), RGBA8 packed to RGB.
-    pub fn read_output(&self, i: usize) -> Option<Vec<u8>> {
-        let f = self.outputs.get(i).copied().flatten()?;
-        let buffer = self.readback.get(i)?.as_ref()?;
+    pub fn read_output(&self, i: usize) -> Result<Option<Vec<u8>>> {
+        let Some(f) = self.outputs.get(i).copied().flatten() else { return Ok(None) };
+        let Some(buffer) = self.readback.get(i).and_then(Option::as_ref) else { return Ok(None) };
         let (w, h) = self.size;
         let row_bytes = w as usize * f.texel_bytes();
-        let rows = self
-            .rows
-            .convert_rows(buffer.read(row_bytes * h as usize).to_vec(), row_bytes);
-        Some(match f {
+        let copy = crate::alloc::try_copy(buffer.read(row_bytes * h as usize), "readback")?;
+        let rows = self.rows.convert_rows(copy, row_bytes);
+        Ok(Some(match f {
             // Files hold RGB; the GL executor packs on the GPU, here while copying out.
-            Format::Rgba8 => rows.chunks_exact(4).flat_map(|p| [p[0], p[1], p[2]]).collect(),
+            Format::Rgba8 => {
+                let mut rgb = crate::alloc::try_with_capacity(rows.len() / 4 * 3, "colour readback")?;
+                rgb.extend(rows.chunks_exact(4).flat_map(|p| [p[0], p[1], p[2]]));
+                rgb
+            }
             _ => rows,
-        })
+        }))
     }
 
     /// A descriptor pool with room for `sets` sets (reset, or made larger). A run without
