@@ -51,7 +51,10 @@ mod tests {
         // More than any address space holds: the allocator refuses, the process goes on.
         let len = usize::MAX / 8;
         let e = try_with_capacity::<u32>(len, "depth readback").unwrap_err().to_string();
-        assert!(e.contains("depth readback") && e.contains(&(len * 4).to_string()), "{e}");
+        assert!(
+            e.contains("depth readback") && e.contains(&(len * 4).to_string()),
+            "{e}"
+        );
         assert!(try_filled(0u8, 1 << 62, "colour").is_err());
         let v: Vec<f32> = try_pod_collect(bytemuck::cast_slice(&[1.5f32, 2.0]), "d").unwrap();
         assert_eq!(v, [1.5, 2.0]);

@@ -456,7 +456,9 @@ impl FileSet {
         let mut stale = Vec::new();
         for e in fs::read_dir(&self.dir).map_err(|e| Error::io(&self.shown, e))? {
             let e = e.map_err(|e| Error::io(&self.shown, e))?;
-            let Some(name) = e.file_name().to_str().map(str::to_string) else { continue };
+            let Some(name) = e.file_name().to_str().map(str::to_string) else {
+                continue;
+            };
             let regular = e.file_type().is_ok_and(|t| t.is_file());
             if regular && owned(&name) && !order.contains(&name) && check_plain_name(&name, &self.shown).is_ok() {
                 stale.push(name);

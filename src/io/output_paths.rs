@@ -44,7 +44,10 @@ fn input_key(path: &Path) -> Option<(PathBuf, (u64, u64))> {
 
 /// Refuses an output that is one of `inputs` or another of `outputs` (see the module notes).
 pub fn check_outputs(inputs: &[NamedPath<'_>], outputs: &[NamedPath<'_>]) -> Result<()> {
-    let ins: Vec<_> = inputs.iter().filter_map(|&(o, p)| input_key(p).map(|k| (o, p, k))).collect();
+    let ins: Vec<_> = inputs
+        .iter()
+        .filter_map(|&(o, p)| input_key(p).map(|k| (o, p, k)))
+        .collect();
     let mut seen: Vec<(&str, &Path, PathBuf)> = Vec::new();
     for &(option, path) in outputs {
         let Some(key) = output_key(path) else { continue };
@@ -58,7 +61,10 @@ pub fn check_outputs(inputs: &[NamedPath<'_>], outputs: &[NamedPath<'_>]) -> Res
                 ),
             ));
         }
-        let identity = fs::metadata(path).ok().filter(|m| m.is_file()).map(|m| (m.dev(), m.ino()));
+        let identity = fs::metadata(path)
+            .ok()
+            .filter(|m| m.is_file())
+            .map(|m| (m.dev(), m.ino()));
         if let Some((input, input_path, _)) = ins
             .iter()
             .find(|(_, _, (real, id))| *real == key || Some(*id) == identity)
@@ -74,7 +80,9 @@ pub fn check_outputs(inputs: &[NamedPath<'_>], outputs: &[NamedPath<'_>]) -> Res
 /// the folder under a name the run writes (`writes(name)`).
 pub fn check_out_dir(out_dir: &Path, writes: impl Fn(&str) -> bool, inputs: &[NamedPath<'_>]) -> Result<()> {
     // A folder not made yet holds no input.
-    let Ok(dir) = fs::canonicalize(out_dir) else { return Ok(()) };
+    let Ok(dir) = fs::canonicalize(out_dir) else {
+        return Ok(());
+    };
     for &(option, path) in inputs {
         let Some((real, _)) = input_key(path) else { continue };
         let name = real.file_name().and_then(|n| n.to_str()).unwrap_or_default();
@@ -112,7 +120,10 @@ mod tests {
         let inputs = [("--a-rgb", a.as_path())];
         // The same name twice, even spelled differently.
         let e = check_outputs(&inputs, &[("--diff", &x), ("--json", &dir.join("./x.png"))]).unwrap_err();
-        assert!(e.to_string().contains("--json") && e.to_string().contains("--diff"), "{e}");
+        assert!(
+            e.to_string().contains("--json") && e.to_string().contains("--diff"),
+            "{e}"
+        );
         // An input itself, through a hard link, and through a symlink's target.
         for out in [a.clone(), dir.join("hard.png"), dir.join("sub/../a.png")] {
             let e = check_outputs(&inputs, &[("--json", &out)]).unwrap_err().to_string();
@@ -124,7 +135,9 @@ mod tests {
         let null = Path::new("/dev/null");
         assert!(check_outputs(&inputs, &[("--diff", null), ("--json", null)]).is_ok());
         // An out-dir that would write one of its inputs' names.
-        let e = check_out_dir(&dir, |n| n.starts_with("a."), &inputs).unwrap_err().to_string();
+        let e = check_out_dir(&dir, |n| n.starts_with("a."), &inputs)
+            .unwrap_err()
+            .to_string();
         assert!(e.contains("--out-dir") && e.contains("--a-rgb"), "{e}");
         assert!(check_out_dir(&dir, |n| n.starts_with("s2_"), &inputs).is_ok());
         assert!(check_out_dir(&dir.join("missing"), |_| true, &inputs).is_ok());

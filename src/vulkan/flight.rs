@@ -119,8 +119,12 @@ impl Flight {
     /// Output `i`'s texels after the fence, rows top-down (files are top-down: a bottom-up
     /// memory order is flipped here, as GL does on the GPU), RGBA8 packed to RGB.
     pub fn read_output(&self, i: usize) -> Result<Option<Vec<u8>>> {
-        let Some(f) = self.outputs.get(i).copied().flatten() else { return Ok(None) };
-        let Some(buffer) = self.readback.get(i).and_then(Option::as_ref) else { return Ok(None) };
+        let Some(f) = self.outputs.get(i).copied().flatten() else {
+            return Ok(None);
+        };
+        let Some(buffer) = self.readback.get(i).and_then(Option::as_ref) else {
+            return Ok(None);
+        };
         let (w, h) = self.size;
         let row_bytes = w as usize * f.texel_bytes();
         let copy = crate::alloc::try_copy(buffer.read(row_bytes * h as usize), "readback")?;

@@ -44,8 +44,21 @@ fn frame(dir: &Path, tag: &str, w: u32, h: u32, depth: impl Fn(u32) -> f32) -> (
 
 fn refocus_args<'a>(rgb: &'a Path, depth: &'a Path, out: &'a Path) -> Vec<&'a str> {
     vec![
-        "refocus", "--fx", "16", "--fy", "16", "--cx", "7.5", "--cy", "5.5", "--rgb", s(rgb), "--depth",
-        s(depth), "--out-dir", s(out),
+        "refocus",
+        "--fx",
+        "16",
+        "--fy",
+        "16",
+        "--cx",
+        "7.5",
+        "--cy",
+        "5.5",
+        "--rgb",
+        s(rgb),
+        "--depth",
+        s(depth),
+        "--out-dir",
+        s(out),
     ]
 }
 
@@ -64,7 +77,13 @@ fn a_mesh_that_keeps_no_triangle_renders_an_empty_view_on_both_apis() {
             let mut args = refocus_args(&rgb, depth, &out);
             args.extend(["--zoom-range", "1,2", "--method", "mesh", "--backend", backend]);
             let o = bin().args(&args).output().unwrap();
-            assert!(o.status.success(), "{backend} {}: {:?} {}", depth.display(), o.status, text(&o));
+            assert!(
+                o.status.success(),
+                "{backend} {}: {:?} {}",
+                depth.display(),
+                o.status,
+                text(&o)
+            );
             for tag in ["s1", "s2"] {
                 let mask = io::load_mask_png(&out.join(format!("{tag}_mask.png"))).unwrap();
                 assert!(mask.data.iter().all(|&m| m == 0), "{backend} {tag}: a pixel is valid");
@@ -78,13 +97,24 @@ fn a_mesh_that_keeps_no_triangle_renders_an_empty_view_on_both_apis() {
         std::fs::write(&manifest, format!("rgb,depth,fx,fy,cx,cy,name\n{rows}")).unwrap();
         let out = d.join(format!("batch-{backend}"));
         let o = bin()
-            .args(["refocus", "--batch", s(&manifest), "--zoom-range", "1,2", "--method", "mesh"])
+            .args([
+                "refocus",
+                "--batch",
+                s(&manifest),
+                "--zoom-range",
+                "1,2",
+                "--method",
+                "mesh",
+            ])
             .args(["--backend", backend, "--out-dir", s(&out)])
             .output()
             .unwrap();
         assert!(o.status.success(), "batch on {backend}: {:?} {}", o.status, text(&o));
         for name in ["a", "b", "c", "d"] {
-            assert!(out.join(name).join("manifest.json").is_file(), "{backend}: frame {name} missing");
+            assert!(
+                out.join(name).join("manifest.json").is_file(),
+                "{backend}: frame {name} missing"
+            );
         }
     }
 }
@@ -111,9 +141,15 @@ fn a_full_stdout_is_exit_1_with_a_message() {
         let o = limited("true", &args, "/dev/full");
         let err = text(&o);
         assert_eq!(o.status.code(), Some(1), "{args:?}: {:?} {err}", o.status);
-        assert!(err.contains("writing to stdout") && !err.contains("panicked"), "{args:?}: {err}");
+        assert!(
+            err.contains("writing to stdout") && !err.contains("panicked"),
+            "{args:?}: {err}"
+        );
     }
-    assert!(out.join("manifest.json").is_file(), "refocus had committed before printing");
+    assert!(
+        out.join("manifest.json").is_file(),
+        "refocus had committed before printing"
+    );
 }
 
 /// `ulimit -f`: the file that grows past it fails with EFBIG, named ("File too large"), exit 1;
@@ -153,13 +189,25 @@ fn running_out_of_descriptors_leaves_no_staging_folder() {
     for limit in [32, 24, 16] {
         let out = d.join(format!("out-{limit}"));
         let args = [
-            "refocus", "--batch", s(&manifest), "--jobs", "8", "--zoom-range", "1,2", "--out-dir", s(&out),
+            "refocus",
+            "--batch",
+            s(&manifest),
+            "--jobs",
+            "8",
+            "--zoom-range",
+            "1,2",
+            "--out-dir",
+            s(&out),
         ];
         let o = limited(&format!("ulimit -n {limit}"), &args, "/dev/null");
         assert!(o.status.code().is_some(), "ulimit -n {limit}: killed: {:?}", o.status);
         let mut left = temporaries(&out);
         for frame in files_in(&out) {
-            left.extend(temporaries(&out.join(&frame)).into_iter().map(|t| format!("{frame}/{t}")));
+            left.extend(
+                temporaries(&out.join(&frame))
+                    .into_iter()
+                    .map(|t| format!("{frame}/{t}")),
+            );
         }
         assert!(left.is_empty(), "ulimit -n {limit} left {left:?}; {}", text(&o));
     }
@@ -177,8 +225,21 @@ fn running_out_of_memory_at_a_readback_is_an_error_naming_the_size() {
     for kb in (560..=760).step_by(20) {
         let out = d.join(format!("out-{kb}"));
         let mut args = vec![
-            "refocus", "--fx", "1000", "--fy", "1000", "--cx", "512", "--cy", "512", "--rgb", s(&rgb), "--depth",
-            s(&depth), "--out-dir", s(&out),
+            "refocus",
+            "--fx",
+            "1000",
+            "--fy",
+            "1000",
+            "--cx",
+            "512",
+            "--cy",
+            "512",
+            "--rgb",
+            s(&rgb),
+            "--depth",
+            s(&depth),
+            "--out-dir",
+            s(&out),
         ];
         args.extend(["--zoom-range", "2.5"]);
         let o = limited(&format!("ulimit -v {}", kb * 1000), &args, "/dev/null");
@@ -272,11 +333,22 @@ fn the_previous_sets_leftovers_go_at_commit() {
     let d = scratch("r4-stale");
     let frames = d.join("frames");
     let o = bin()
-        .args(["scene", "--width", "48", "--height", "32", "--frames", "3", "--out-dir", s(&frames)])
+        .args([
+            "scene",
+            "--width",
+            "48",
+            "--height",
+            "32",
+            "--frames",
+            "3",
+            "--out-dir",
+            s(&frames),
+        ])
         .output()
         .unwrap();
     assert!(o.status.success(), "{}", text(&o));
-    let seq: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(frames.join("sequence.json")).unwrap()).unwrap();
+    let seq: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(frames.join("sequence.json")).unwrap()).unwrap();
     let two = frames.join("two.json");
     let first_two: Vec<_> = seq["frames"].as_array().unwrap()[..2].to_vec();
     std::fs::write(&two, serde_json::json!({ "frames": first_two }).to_string()).unwrap();
@@ -286,7 +358,15 @@ fn the_previous_sets_leftovers_go_at_commit() {
         std::fs::write(out.join("notes.txt"), "mine").unwrap();
         for file in [frames.join("sequence.json"), two.clone()] {
             let o = bin()
-                .args(["cyclopean", "--sequence", s(&file), "--backend", backend, "--out-dir", s(&out)])
+                .args([
+                    "cyclopean",
+                    "--sequence",
+                    s(&file),
+                    "--backend",
+                    backend,
+                    "--out-dir",
+                    s(&out),
+                ])
                 .output()
                 .unwrap();
             assert!(o.status.success(), "{backend}: {}", text(&o));
@@ -298,8 +378,17 @@ fn the_previous_sets_leftovers_go_at_commit() {
         let pair = d.join(format!("pair-{backend}"));
         let (left, right) = (frames.join("00000_left_rgb.png"), frames.join("00000_right_rgb.png"));
         let pair_args = [
-            "cyclopean", "--left-rgb", s(&left), "--right-rgb", s(&right), "--max-disparity",
-            "16", "--backend", backend, "--out-dir", s(&pair),
+            "cyclopean",
+            "--left-rgb",
+            s(&left),
+            "--right-rgb",
+            s(&right),
+            "--max-disparity",
+            "16",
+            "--backend",
+            backend,
+            "--out-dir",
+            s(&pair),
         ];
         for extra in [&["--focal", "60", "--baseline", "0.06"][..], &[]] {
             let o = bin().args(pair_args).args(extra).output().unwrap();
@@ -318,7 +407,8 @@ fn json_to_a_device_or_fifo_is_written_in_place() {
     let base = ["compare", "--a-rgb", s(&a), "--b-rgb", s(&a)];
     let o = bin().args(base).args(["--json", "/dev/stdout"]).output().unwrap();
     assert!(o.status.success(), "{}", text(&o));
-    let json: serde_json::Value = serde_json::from_slice(&o.stdout[..o.stdout.iter().rposition(|&c| c == b'}').unwrap() + 1]).unwrap();
+    let json: serde_json::Value =
+        serde_json::from_slice(&o.stdout[..o.stdout.iter().rposition(|&c| c == b'}').unwrap() + 1]).unwrap();
     assert_eq!(json["passed"], true);
     let o = bin().args(base).args(["--json", "/dev/null"]).output().unwrap();
     assert!(o.status.success(), "{}", text(&o));
@@ -353,12 +443,19 @@ fn broken_out_dir_links_and_fifo_faces_are_named_as_such() {
     }
     let faces = d.join("faces");
     std::fs::create_dir_all(&faces).unwrap();
-    assert!(Command::new("mkfifo").arg(faces.join("left_pz.png")).status().unwrap().success());
+    assert!(Command::new("mkfifo")
+        .arg(faces.join("left_pz.png"))
+        .status()
+        .unwrap()
+        .success());
     let o = bin()
         .args(["stitch", "--faces", s(&faces), "--out-dir", s(&d.join("ods"))])
         .output()
         .unwrap();
     let err = text(&o);
     assert_eq!(o.status.code(), Some(1), "{err}");
-    assert!(err.contains("left_pz.png") && err.contains("not a regular file"), "{err}");
+    assert!(
+        err.contains("left_pz.png") && err.contains("not a regular file"),
+        "{err}"
+    );
 }

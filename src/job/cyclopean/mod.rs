@@ -171,9 +171,15 @@ impl CyclopeanJob {
             super::check_npz_key(o.npz_key.as_deref(), &[left, right])?;
         }
         let plan = o.request.plan(kind)?;
-        let mut inputs = vec![("--left-rgb", o.left_rgb.as_path()), ("--right-rgb", o.right_rgb.as_path())];
+        let mut inputs = vec![
+            ("--left-rgb", o.left_rgb.as_path()),
+            ("--right-rgb", o.right_rgb.as_path()),
+        ];
         if let Some((l, r)) = &maps {
-            inputs.extend([("--left-depth/disparity", l.as_path()), ("--right-depth/disparity", r.as_path())]);
+            inputs.extend([
+                ("--left-depth/disparity", l.as_path()),
+                ("--right-depth/disparity", r.as_path()),
+            ]);
         }
         inputs.extend(o.cameras.as_deref().map(|c| ("--cameras", c)));
         io::check_out_dir(&o.out_dir, owned_name, &inputs).map_err(ArgError::Invalid)?;

@@ -15,7 +15,10 @@ pub(crate) fn compare(job: &CompareJob) -> Result<ExitCode> {
         let over = if job.masked() { " (in the mask)" } else { "" };
         outln!(
             "colour: PSNR {:.2} dB, RMSE {:.4} levels, max difference {} levels over {} pixels{over}",
-            cmp.psnr_db, cmp.color_rmse, cmp.max_color_diff, cmp.pixels
+            cmp.psnr_db,
+            cmp.color_rmse,
+            cmp.max_color_diff,
+            cmp.pixels
         );
         if let Some(p) = job.diff() {
             outln!(

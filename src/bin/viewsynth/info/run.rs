@@ -21,7 +21,10 @@ pub(crate) fn info(request: &InfoRequest) -> Result<()> {
     outln!("renderer:    {}", i.renderer);
     outln!(
         "GL version:  {} (core {}.{}), GLSL {}",
-        i.version, i.gl_major, i.gl_minor, i.glsl_version
+        i.version,
+        i.gl_major,
+        i.gl_minor,
+        i.glsl_version
     );
     outln!("EGL:         {} via {} platform", i.egl_version, i.platform);
     let dev = i.device_index.map_or("-".to_string(), |d| d.to_string());
@@ -40,7 +43,9 @@ pub(crate) fn info(request: &InfoRequest) -> Result<()> {
     );
     outln!(
         "limits:      max texture {}, max viewport {}x{}",
-        i.max_texture_size, i.max_viewport[0], i.max_viewport[1]
+        i.max_texture_size,
+        i.max_viewport[0],
+        i.max_viewport[1]
     );
     outln!(
         "GPU timers:  {}",
