@@ -734,6 +734,8 @@ pub fn write_paths_all_or_none(jobs: Vec<(PathBuf, PathWriter<'_>)>) -> Result<V
     }
     let mut done = Vec::new();
     for (path, write) in streams {
+        // Held open while writing: a FIFO's reader then sees one writer, start to end.
+        let _reader_present = check_reader(&path)?;
         write(&path)?;
         done.push(path);
     }
@@ -741,6 +743,30 @@ pub fn write_paths_all_or_none(jobs: Vec<(PathBuf, PathWriter<'_>)>) -> Result<V
         done.extend(set.commit()?);
     }
     Ok(done)
+}
+
+/// A FIFO without a reader would block the run forever: refused at once, naming it. Returns
+/// the FIFO opened for writing (without blocking), to hold while the writer writes.
+fn check_reader(path: &Path) -> Result<Option<File>> {
+    use std::os::unix::fs::{FileTypeExt, OpenOptionsExt};
+    if !fs::metadata(path).is_ok_and(|m| m.file_type().is_fifo()) {
+        return Ok(None);
+    }
+    match fs::OpenOptions::new()
+        .write(true)
+        .custom_flags(libc::O_NONBLOCK)
+        .open(path)
+    {
+        Ok(f) => Ok(Some(f)),
+        Err(e) if e.raw_os_error() == Some(libc::ENXIO) => Err(Error::io(
+            path,
+            io::Error::new(
+                io::ErrorKind::BrokenPipe,
+                "a FIFO that no process reads: start its reader first",
+            ),
+        )),
+        Err(e) => Err(Error::io(path, e)),
+    }
 }
 
 /// Whether `path` is written in place: a character device or FIFO (after symlinks), or a path
