@@ -139,7 +139,7 @@ pub const PROGRAMS: &[ProgramEntry] = &[
             "comp",
             &["common/bindings.glsl", "common/camera.glsl", "cyclopean/temporal_params.glsl", "cyclopean/temporal_reproject.comp"],
         )],
-        switches: &[],
+        switches: &[("WINNER_STAGE", &[0, 1])],
         vulkan: Some(&[]),
     },
     ProgramEntry {

@@ -82,6 +82,15 @@ pub enum Error {
     /// The Vulkan loader or a device is missing, or a Vulkan call failed (`--backend vulkan`).
     #[error("Vulkan error: {0}")]
     Vulkan(String),
+    /// An image-sized buffer could not be allocated (`ulimit -v`, a full machine): the run
+    /// stops with this error instead of aborting.
+    #[error("out of memory: {what} needs {bytes} bytes ({:.1} MiB) more than this process may allocate", *bytes as f64 / 1048576.0)]
+    OutOfMemory {
+        /// What the buffer was for.
+        what: String,
+        /// Its size.
+        bytes: usize,
+    },
 }
 
 /// Most characters of an input a message quotes (a name, a key, a line).

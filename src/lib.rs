@@ -20,6 +20,7 @@
 //!   encode/decode and the background rule.
 //! - [`io`]: colour, depth and mask files (loaders with a pixel budget, atomic all-or-none
 //!   savers, out-dir confinement).
+//! - [`alloc`]: fallible allocation of image-sized buffers (out of memory is an error).
 //! - [`gpu`]: the EGL context and device choice, RAII GL objects, programs, readback, timers.
 //! - [`progress`]: the stages of long runs (demo, report) handed to the caller.
 //! - [`view`]: the output shape shared by every GPU pass and its f64 twin.
@@ -44,6 +45,7 @@
 
 #![warn(missing_docs)]
 
+pub mod alloc;
 pub mod bench;
 pub mod camera;
 pub mod compare;

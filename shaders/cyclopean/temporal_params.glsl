@@ -8,7 +8,8 @@ layout(std140, binding = 0) uniform TemporalParams {
     mat4 u_view_m;
     ivec2 u_size_h;          // W, H of the previous view
     ivec2 u_size_m;          // W, H of the current view
-    uint u_stage;            // reprojection: 0 nearest distance, 1 its texel
+    uint u_stage;            // reprojection: 0 nearest distance, 1 its texel (the shader is
+                             // compiled per stage, WINNER_STAGE; kept for the layout and tools)
     int u_flip_rows;         // 1: memory rows are bottom-up (texel indices count top-down rows)
     float u_alpha;           // weight of the current frame where both agree (1: no blending)
     float u_depth_tolerance; // relative distance difference above which the history is rejected

@@ -53,10 +53,13 @@ void main() {
         return;
     }
     uint bits = floatBitsToUint(zm);
-    if (u_stage == 0u) {
-        imageAtomicMin(u_nearest, ivec2(px), bits);
-    } else if (imageLoad(u_nearest, ivec2(px)).r == bits) {
+    // The stage is compiled in (WINNER_STAGE), not read from u_stage: see ProgramKind.
+#if WINNER_STAGE == 0
+    imageAtomicMin(u_nearest, ivec2(px), bits);
+#else
+    if (imageLoad(u_nearest, ivec2(px)).r == bits) {
         int row = u_flip_rows != 0 ? u_size_h.y - 1 - t.y : t.y;
         imageAtomicMin(u_winner, ivec2(px), uint(row * u_size_h.x + t.x));
     }
+#endif
 }

@@ -225,6 +225,18 @@ pub fn batch_bench(
         let out = scratch.path().join(name);
         let s = run_batch(&device, &frames, &out, &opts(jobs), || ())?;
         let _ = std::fs::remove_dir_all(&out);
+        // A frame rate over the frames that happened to load measures another input: every
+        // frame of the manifest renders, or the benchmark is refused, naming the first failure.
+        if let Some((frame, error)) = s.failed.first() {
+            return Err(Error::decode(
+                &manifest,
+                format!(
+                    "{} of {} frames failed, so no frame rate is reported; first: frame {frame}: {error}",
+                    s.failed.len(),
+                    frames.len()
+                ),
+            ));
+        }
         Ok(summarise(jobs, &s))
     };
     let gl = crate::pass::Device::gl(gpu)?;

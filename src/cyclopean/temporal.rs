@@ -195,7 +195,7 @@ impl Accumulator {
         let groups = Groups::Fixed([hist.mid.width.div_ceil(8), hist.mid.height.div_ceil(8)]);
         let reproject = |k: usize| {
             Step::Dispatch(Dispatch {
-                program: ShaderProgram::new(self.conv, ProgramKind::CyclopeanTemporalReproject),
+                program: ShaderProgram::new(self.conv, ProgramKind::CyclopeanTemporalReproject { winner: k == 1 }),
                 params: bytemuck::bytes_of(&blocks[k]),
                 images: &reproject_images,
                 storage_images: &storage,

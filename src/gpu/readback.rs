@@ -192,7 +192,7 @@ impl PendingRead {
 
     /// Wait and return the bytes as a new vector.
     pub fn finish(self) -> Result<Vec<u8>> {
-        let mut out = vec![0u8; self.len];
+        let mut out = crate::alloc::try_filled(0u8, self.len, "readback")?;
         self.finish_into(&mut out)?;
         Ok(out)
     }
@@ -202,7 +202,7 @@ impl PendingRead {
         if self.len % 4 != 0 {
             return Err(Error::Gl(format!("readback of {} bytes is not f32 data", self.len)));
         }
-        let mut out = vec![0f32; self.len / 4];
+        let mut out = crate::alloc::try_filled(0f32, self.len / 4, "depth readback")?;
         self.finish_into(bytemuck::cast_slice_mut(&mut out))?;
         Ok(out)
     }

@@ -198,7 +198,12 @@ pub enum ProgramKind {
     CyclopeanFill,
     /// cyclopean/temporal_reproject.comp: the previous middle view moved into the current
     /// camera, nearest first (compute).
-    CyclopeanTemporalReproject,
+    CyclopeanTemporalReproject {
+        /// The second stage (keep the winning texel), not the first (the nearest distance).
+        /// Compiled in, not a uniform: lavapipe recompiles a shader whenever a uniform its
+        /// control flow reads changes, and kept every compile (0.4 MB a frame of a sequence).
+        winner: bool,
+    },
     /// cyclopean/temporal_compose.frag: the current view accumulated with that history.
     CyclopeanTemporalCompose,
     /// cyclopean/matcher_*.comp: one stage of the census stereo matcher (compute).
@@ -297,7 +302,7 @@ impl ProgramKind {
             ProgramKind::CyclopeanEdgeSnap => "cyclopean/edge_snap",
             ProgramKind::CyclopeanDensify => "cyclopean/densify",
             ProgramKind::CyclopeanFill => "cyclopean/fill",
-            ProgramKind::CyclopeanTemporalReproject => "cyclopean/temporal_reproject",
+            ProgramKind::CyclopeanTemporalReproject { .. } => "cyclopean/temporal_reproject",
             ProgramKind::CyclopeanTemporalCompose => "cyclopean/temporal_compose",
             ProgramKind::CyclopeanMatcher(stage) => stage.program_name(),
             ProgramKind::ReprojectShift { .. } => "reproject/shift",
@@ -324,13 +329,13 @@ impl ProgramKind {
                 flag("BLEND_SOFT", blend_soft),
             ],
             ProgramKind::CyclopeanForward => vec![int("TRI_TEX_WIDTH", TRI_TEX_WIDTH.into())],
+            ProgramKind::CyclopeanTemporalReproject { winner } => vec![flag("WINNER_STAGE", winner)],
             ProgramKind::CyclopeanSplat
             | ProgramKind::CyclopeanSplatGather
             | ProgramKind::CyclopeanSplatEdges
             | ProgramKind::CyclopeanEdgeSnap
             | ProgramKind::CyclopeanDensify
             | ProgramKind::CyclopeanFill
-            | ProgramKind::CyclopeanTemporalReproject
             | ProgramKind::CyclopeanTemporalCompose
             | ProgramKind::CyclopeanMatcher(_)
             | ProgramKind::SceneRaytrace => vec![],
@@ -424,7 +429,8 @@ impl ShaderProgram {
             ProgramKind::CyclopeanEdgeSnap,
             ProgramKind::CyclopeanDensify,
             ProgramKind::CyclopeanFill,
-            ProgramKind::CyclopeanTemporalReproject,
+            ProgramKind::CyclopeanTemporalReproject { winner: false },
+            ProgramKind::CyclopeanTemporalReproject { winner: true },
             ProgramKind::CyclopeanTemporalCompose,
             ProgramKind::SceneRaytrace,
         ]);

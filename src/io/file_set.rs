@@ -79,6 +79,7 @@ impl OutDir {
     /// in it (never those of a live process). The folder itself may be a symlink: where it
     /// points is the out-dir.
     pub fn prepare(dir: &Path) -> Result<Self> {
+        check_not_a_broken_link(dir)?;
         fs::create_dir_all(dir).map_err(|e| Error::io(dir, e))?;
         let real = fs::canonicalize(dir).map_err(|e| Error::io(dir, e))?;
         if !real.is_dir() {
@@ -158,6 +159,31 @@ impl OutDir {
     }
 }
 
+/// A symlink that leads nowhere (dangling, or a loop) is refused saying so: creating the folder
+/// would fail with a bare "File exists".
+fn check_not_a_broken_link(dir: &Path) -> Result<()> {
+    let is_link = fs::symlink_metadata(dir).is_ok_and(|m| m.file_type().is_symlink());
+    if !is_link {
+        return Ok(());
+    }
+    let what = match fs::metadata(dir) {
+        Ok(_) => return Ok(()),
+        Err(e) if e.raw_os_error() == Some(libc::ELOOP) => "is a symlink loop".to_string(),
+        Err(e) if e.kind() == io::ErrorKind::NotFound => format!(
+            "is a dangling symlink (to {}, which does not exist)",
+            fs::read_link(dir).map(|t| t.display().to_string()).unwrap_or_default()
+        ),
+        Err(e) => return Err(Error::io(dir, e)),
+    };
+    Err(Error::io(
+        dir,
+        io::Error::new(
+            io::ErrorKind::NotFound,
+            format!("the output directory {what}: create its target or give another --out-dir"),
+        ),
+    ))
+}
+
 fn outside(path: &Path, root: &Path, what: &str) -> Error {
     Error::io(
         path,
@@ -193,15 +219,19 @@ pub struct FileSet {
     /// Destination folder (real path) and how to name it in messages.
     dir: PathBuf,
     shown: PathBuf,
-    staging: tempfile::TempDir,
-    /// The staging folder's lock, held while this set lives.
+    /// The staging folder's lock, held while this set lives (released before the folder is
+    /// removed on drop: one descriptor more for the removal when they ran out).
     _lock: File,
+    staging: Staging,
     /// Names written through [`FileSet::write`] and [`FileSet::write_all`], in order.
     written: Vec<String>,
     /// Names of [`FileSet::write`] not synced yet (synced at commit, all at once).
     unsynced: Vec<String>,
     /// The background syncs of [`FileSet::write_all`]'s files, joined at commit.
     syncing: Vec<std::thread::JoinHandle<Result<()>>>,
+    /// The names the command owns in the folder ([`FileSet::replacing`]): those of a previous
+    /// set that this one does not write are removed at commit.
+    owned: Option<fn(&str) -> bool>,
 }
 
 impl FileSet {
@@ -217,7 +247,17 @@ impl FileSet {
             written: Vec::new(),
             unsynced: Vec::new(),
             syncing: Vec::new(),
+            owned: None,
         })
+    }
+
+    /// This set replaces the previous one of its command: at commit, a regular file of the
+    /// folder named as the command names its outputs (`owned`) that this set does not write
+    /// is removed, in the same journalled commit (a 3-frame sequence rerun as 2 frames leaves
+    /// no third frame; a run without depth leaves no old depth file).
+    pub fn replacing(mut self, owned: fn(&str) -> bool) -> Self {
+        self.owned = Some(owned);
+        self
     }
 
     fn shown_as(mut self, shown: &Path) -> Self {
@@ -265,12 +305,18 @@ impl FileSet {
     /// final path. Returns the final path.
     pub fn write(&mut self, name: &str, write: impl FnOnce(&mut BufWriter<File>) -> Result<()>) -> Result<PathBuf> {
         let shown = self.check_new_name(name)?;
+        self.staging.names.push(name.to_string());
         let file = File::create_new(self.staging.path().join(name)).map_err(|e| Error::io(&shown, e))?;
         // Synced at commit, with the set's other files at once (see `sync_written`).
         write_file(file, &shown, write)?;
         self.written.push(name.to_string());
         self.unsynced.push(name.to_string());
         Ok(shown)
+    }
+
+    /// Names about to be created in the staging folder (removed by name if the set is dropped).
+    fn note_staged(&mut self, names: impl IntoIterator<Item = String>) {
+        self.staging.names.extend(names);
     }
 
     /// The final path of `name`, refused unless it is a plain name not yet written in this set.
@@ -326,6 +372,7 @@ impl FileSet {
         for name in &order {
             check_replaceable(&self.dir.join(name)).map_err(|e| self.final_error_for(name, e))?;
         }
+        let stale = self.stale(&order)?;
         self.sync_written()?;
         let FileSet {
             dir,
@@ -335,7 +382,13 @@ impl FileSet {
             ..
         } = self;
         let final_path = |name: &str| shown.join(name);
-        let journal = order.join("\n");
+        // Removals are journalled after the renames as `/name` ('/' is in no plain name).
+        let journal = order
+            .iter()
+            .cloned()
+            .chain(stale.iter().map(|n| format!("/{n}")))
+            .collect::<Vec<_>>()
+            .join("\n");
         let journal_path = staging.path().join(JOURNAL_NAME);
         let mut file = File::create_new(&journal_path).map_err(|e| Error::io(&shown, e))?;
         file.write_all(journal.as_bytes())
@@ -352,6 +405,9 @@ impl FileSet {
                 fs::rename(staging.join(name), dir.join(name)).map_err(|e| Error::io(final_path(name), e))?;
                 fault_point("renamed")?;
                 done.push(final_path(name));
+            }
+            for name in &stale {
+                remove_stale(&dir.join(name)).map_err(|e| Error::io(final_path(name), e))?;
             }
             // Make the renames durable; failure to sync the folder is not worth failing the run.
             sync_dir(&dir);
@@ -391,6 +447,25 @@ impl FileSet {
                 .into_iter()
                 .try_for_each(|h| h.join().unwrap_or_else(|_| Err(sync_panicked(&self.shown))))
         })
+    }
+
+    /// The regular files of the previous set (see [`FileSet::replacing`]) that `order` does
+    /// not replace, sorted.
+    fn stale(&self, order: &[String]) -> Result<Vec<String>> {
+        let Some(owned) = self.owned else { return Ok(Vec::new()) };
+        let mut stale = Vec::new();
+        for e in fs::read_dir(&self.dir).map_err(|e| Error::io(&self.shown, e))? {
+            let e = e.map_err(|e| Error::io(&self.shown, e))?;
+            let Some(name) = e.file_name().to_str().map(str::to_string) else {
+                continue;
+            };
+            let regular = e.file_type().is_ok_and(|t| t.is_file());
+            if regular && owned(&name) && !order.contains(&name) && check_plain_name(&name, &self.shown).is_ok() {
+                stale.push(name);
+            }
+        }
+        stale.sort();
+        Ok(stale)
     }
 
     fn final_error_for(&self, name: &str, e: Error) -> Error {
@@ -434,6 +509,12 @@ fn roll_forward(dir: &Path, staging: &Path) -> bool {
         return false;
     };
     for name in journal.lines() {
+        if let Some(stale) = name.strip_prefix('/') {
+            if check_plain_name(stale, dir).is_err() || remove_stale(&dir.join(stale)).is_err() {
+                return false;
+            }
+            continue;
+        }
         // Names were checked when the set was made; anything else is not ours to move.
         if check_plain_name(name, dir).is_err() {
             return false;
@@ -453,15 +534,33 @@ fn roll_forward(dir: &Path, staging: &Path) -> bool {
     fs::remove_dir_all(staging).is_ok()
 }
 
+/// Removes a previous set's file: gone already is fine, anything but a regular file stays.
+fn remove_stale(path: &Path) -> io::Result<()> {
+    match fs::symlink_metadata(path) {
+        Ok(m) if m.is_file() => match fs::remove_file(path) {
+            Err(e) if e.kind() == io::ErrorKind::NotFound => Ok(()),
+            r => r,
+        },
+        Ok(_) => Ok(()),
+        Err(e) if e.kind() == io::ErrorKind::NotFound => Ok(()),
+        Err(e) => Err(e),
+    }
+}
+
 /// Makes a staging folder in `dir` and takes its lock. A cleaner of another run may take the
 /// folder between its creation and its lock (it looks orphaned then): this maker notices (see
 /// [`claim_lock`]) and makes another.
-fn make_staging(dir: &Path) -> Result<(tempfile::TempDir, File)> {
+fn make_staging(dir: &Path) -> Result<(Staging, File)> {
     for _ in 0..STAGING_TRIES {
-        let staging = tempfile::Builder::new()
-            .prefix(&own_prefix())
-            .tempdir_in(dir)
-            .map_err(|e| Error::io(dir, e))?;
+        let staging = Staging {
+            path: tempfile::Builder::new()
+                .prefix(&own_prefix())
+                .tempdir_in(dir)
+                .map_err(|e| Error::io(dir, e))?
+                .keep(),
+            names: Vec::new(),
+            kept: false,
+        };
         match claim_lock(staging.path()) {
             Ok(Some(lock)) => return Ok((staging, lock)),
             // Taken by a cleaner: dropping `staging` removes what it left, if anything.
@@ -475,6 +574,65 @@ fn make_staging(dir: &Path) -> Result<(tempfile::TempDir, File)> {
             "another process removed each of {STAGING_TRIES} staging folders as soon as it was made"
         )),
     ))
+}
+
+/// A set's staging folder, removed when dropped uncommitted, even when the process ran out of
+/// file descriptors (EMFILE: often the very error that failed the set). A removal that lists
+/// the folder needs a descriptor, unlinking a name does not: the names staged are removed by
+/// name, the listing (for files staged by path) is retried while other threads free theirs,
+/// then the lock file and the folder go. `tempfile::TempDir` tried one listing and silently
+/// left the folder, with its partial files, when it failed.
+#[derive(Debug)]
+struct Staging {
+    path: PathBuf,
+    /// Names created in it so far.
+    names: Vec<String>,
+    /// Handed over to the commit: no longer removed on drop.
+    kept: bool,
+}
+
+/// How long [`Staging`]'s removal waits, in all, for a descriptor to list its folder.
+const STAGING_LIST_TRIES: usize = 50;
+
+impl Staging {
+    fn path(&self) -> &Path {
+        &self.path
+    }
+
+    /// The folder, no longer removed on drop.
+    fn keep(mut self) -> PathBuf {
+        self.kept = true;
+        std::mem::take(&mut self.path)
+    }
+}
+
+impl Drop for Staging {
+    fn drop(&mut self) {
+        if self.kept {
+            return;
+        }
+        for name in self.names.iter().map(String::as_str).chain([JOURNAL_NAME]) {
+            let _ = fs::remove_file(self.path.join(name));
+        }
+        for _ in 0..STAGING_LIST_TRIES {
+            match fs::read_dir(&self.path) {
+                Ok(entries) => {
+                    for e in entries.flatten() {
+                        if e.file_name() != LOCK_NAME {
+                            let _ = fs::remove_file(e.path());
+                        }
+                    }
+                    break;
+                }
+                Err(e) if matches!(e.raw_os_error(), Some(libc::EMFILE | libc::ENFILE)) => {
+                    std::thread::sleep(std::time::Duration::from_millis(10));
+                }
+                Err(_) => break,
+            }
+        }
+        let _ = fs::remove_file(self.path.join(LOCK_NAME));
+        let _ = fs::remove_dir(&self.path);
+    }
 }
 
 /// Creates the lock file of the staging folder `staging` and takes its lock: `Some` when this
@@ -545,9 +703,13 @@ pub(crate) fn recover_staging(dir: &Path, staging: &Path) -> bool {
 /// Writes files at arbitrary paths (e.g. `compare --diff D --json J`) all-or-none: each is
 /// staged in a [`FileSet`] of its own folder, and nothing is renamed until every one was
 /// written and every destination checked (absent, a regular file or a symlink; never a
-/// folder, FIFO or device). Returns the paths written.
+/// folder). A character device or FIFO (`--json /dev/stdout`, `/dev/null`, a pipe), or any
+/// path under `/dev/`, is a stream, not a file to replace: it is written in place, without
+/// staging, after the staged files were written and before they are renamed. Returns the
+/// paths written.
 pub fn write_paths_all_or_none(jobs: Vec<(PathBuf, PathWriter<'_>)>) -> Result<Vec<PathBuf>> {
     let mut sets = Vec::with_capacity(jobs.len());
+    let mut streams = Vec::new();
     for (path, _) in &jobs {
         if path.file_name().is_none() {
             return Err(Error::io(
@@ -555,9 +717,15 @@ pub fn write_paths_all_or_none(jobs: Vec<(PathBuf, PathWriter<'_>)>) -> Result<V
                 io::Error::new(io::ErrorKind::InvalidInput, "path has no file name"),
             ));
         }
-        check_replaceable(path)?;
+        if !is_stream(path) {
+            check_replaceable(path)?;
+        }
     }
     for (path, write) in jobs {
+        if is_stream(&path) {
+            streams.push((path, write));
+            continue;
+        }
         let dir = super::atomic::parent_dir(&path).to_path_buf();
         let name = path.file_name().map(|n| n.to_os_string()).unwrap_or_default();
         let set = FileSet::new(&dir)?.shown_as(&dir);
@@ -565,10 +733,48 @@ pub fn write_paths_all_or_none(jobs: Vec<(PathBuf, PathWriter<'_>)>) -> Result<V
         sets.push(set);
     }
     let mut done = Vec::new();
+    for (path, write) in streams {
+        // Held open while writing: a FIFO's reader then sees one writer, start to end.
+        let _reader_present = check_reader(&path)?;
+        write(&path)?;
+        done.push(path);
+    }
     for set in sets {
         done.extend(set.commit()?);
     }
     Ok(done)
+}
+
+/// A FIFO without a reader would block the run forever: refused at once, naming it. Returns
+/// the FIFO opened for writing (without blocking), to hold while the writer writes.
+fn check_reader(path: &Path) -> Result<Option<File>> {
+    use std::os::unix::fs::{FileTypeExt, OpenOptionsExt};
+    if !fs::metadata(path).is_ok_and(|m| m.file_type().is_fifo()) {
+        return Ok(None);
+    }
+    match fs::OpenOptions::new()
+        .write(true)
+        .custom_flags(libc::O_NONBLOCK)
+        .open(path)
+    {
+        Ok(f) => Ok(Some(f)),
+        Err(e) if e.raw_os_error() == Some(libc::ENXIO) => Err(Error::io(
+            path,
+            io::Error::new(
+                io::ErrorKind::BrokenPipe,
+                "a FIFO that no process reads: start its reader first",
+            ),
+        )),
+        Err(e) => Err(Error::io(path, e)),
+    }
+}
+
+/// Whether `path` is written in place: a character device or FIFO (after symlinks), or a path
+/// under `/dev/` (`/dev/stdout` resolves to whatever stdout is, a regular file included).
+fn is_stream(path: &Path) -> bool {
+    use std::os::unix::fs::FileTypeExt;
+    path.starts_with("/dev/")
+        || fs::metadata(path).is_ok_and(|m| m.file_type().is_char_device() || m.file_type().is_fifo())
 }
 
 /// Writes one file given its path (the path-based savers: `io::save_rgb`, ...).

@@ -24,6 +24,7 @@ mod mask;
 mod netpbm;
 mod npy;
 mod npz;
+mod output_paths;
 mod outputs;
 mod pfm;
 mod pgm;
@@ -53,6 +54,7 @@ pub use json::{load_json, read_text, MAX_JSON_BYTES, MAX_JSON_MAGNITUDE};
 pub use mask::{load_mask_png, save_mask_png, save_mask_png_with, MASK_FILLED};
 pub use npy::{load_npy, save_npy_f32, NpyArray, NpyDtype};
 pub use npz::load_npz_array;
+pub use output_paths::{check_out_dir, check_outputs, NamedPath};
 pub use outputs::{
     file_crc32, file_records, write_float_exrs, write_view, DepthFormats, FileFormats, FileRecord, OutputSet,
     RgbFormat, ViewFiles, ViewNames,

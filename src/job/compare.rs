@@ -115,6 +115,21 @@ impl CompareJob {
                 far: o.far,
             });
         }
+        let inputs: Vec<io::NamedPath<'_>> = [
+            ("--a-rgb", Some(&o.a.rgb)),
+            ("--a-depth", o.a.depth.as_ref()),
+            ("--b-rgb", Some(&o.b.rgb)),
+            ("--b-depth", o.b.depth.as_ref()),
+            ("--mask", o.mask.as_ref()),
+        ]
+        .into_iter()
+        .filter_map(|(option, p)| p.map(|p| (option, p.as_path())))
+        .collect();
+        let mut outputs: Vec<io::NamedPath<'_>> = o.diff.iter().map(|p| ("--diff", p.as_path())).collect();
+        if let Some(JsonOutput::File(p)) = &o.json {
+            outputs.push(("--json", p));
+        }
+        io::check_outputs(&inputs, &outputs).map_err(ArgError::Invalid)?;
         Ok(CompareJob {
             a: o.a,
             b: o.b,

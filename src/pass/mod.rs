@@ -242,7 +242,7 @@ impl Rendered {
         let (w, h) = self.size;
         self.outputs[i]
             .take()
-            .map(|d| crate::io::DepthMap::new(w, h, bytemuck::pod_collect_to_vec(&d)))
+            .map(|d| crate::io::DepthMap::new(w, h, crate::alloc::try_pod_collect(&d, "depth readback")?))
             .transpose()
     }
 

@@ -99,11 +99,18 @@ pub fn view_z_of(depth: &DepthMap, kind: &DepthEncoding, conv: &Conventions) -> 
 /// candidate and what it should hold, or every file found when more than one exists (which
 /// one is meant cannot be guessed).
 fn find_face_file(dir: &Path, stem: &str, exts: &[&str], what: &str) -> Result<PathBuf> {
-    let found: Vec<PathBuf> = exts
-        .iter()
-        .map(|e| dir.join(format!("{stem}.{e}")))
-        .filter(|p| p.is_file())
-        .collect();
+    let candidates: Vec<PathBuf> = exts.iter().map(|e| dir.join(format!("{stem}.{e}"))).collect();
+    // A FIFO, device or folder under a face's name is named as such, not taken for absent.
+    if let Some(odd) = candidates.iter().find(|p| p.exists() && !p.is_file()) {
+        return Err(Error::io(
+            odd,
+            std::io::Error::new(
+                std::io::ErrorKind::InvalidInput,
+                format!("{what}: not a regular file (faces are read from regular files only)"),
+            ),
+        ));
+    }
+    let found: Vec<PathBuf> = candidates.into_iter().filter(|p| p.is_file()).collect();
     if found.len() > 1 {
         let names: Vec<String> = found.iter().map(|p| p.display().to_string()).collect();
         return Err(Error::decode(

@@ -184,6 +184,10 @@ pub struct VkCensus {
     pub submit_objects: usize,
     /// vkQueueWaitIdle / vkDeviceWaitIdle calls (never on the frame path).
     pub wait_idles: usize,
+    /// Bytes of device memory allocated and not yet freed: what the objects above hold now.
+    /// A steady state keeps it flat, whatever it frees and makes again (objects kept past
+    /// their use, a growing arena or graveyard, show here even when no count moves).
+    pub live_bytes: u64,
 }
 
 /// What [`VulkanContext::count`] adds to.
@@ -325,6 +329,17 @@ impl VulkanContext {
     /// What was created on this device so far ([`VkCensus`]).
     pub fn census(&self) -> VkCensus {
         self.census.get()
+    }
+
+    /// Count `bytes` of device memory allocated (`freed`: given back).
+    pub(crate) fn count_bytes(&self, bytes: u64, freed: bool) {
+        let mut c = self.census.get();
+        c.live_bytes = if freed {
+            c.live_bytes.saturating_sub(bytes)
+        } else {
+            c.live_bytes + bytes
+        };
+        self.census.set(c);
     }
 
     /// Count one more created object.

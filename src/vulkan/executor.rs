@@ -119,8 +119,13 @@ pub struct VkExecutor {
     flights: Vec<Flight>,
     /// The flight the next submit uses (image writes are queued into it first).
     open: Option<usize>,
-    /// Objects freed while a run was in flight, dropped once none is.
-    graveyard: Vec<Grave>,
+    /// Objects freed while runs were in flight, each with the last run submitted before it
+    /// was freed: dropped once every run up to that one has been waited for. (Dropping only
+    /// when no run at all was in flight kept every grave of a stream that always keeps one in
+    /// flight: memory grew with every frame.)
+    graveyard: Vec<(u64, Grave)>,
+    /// Runs submitted so far (a flight's `serial` is its run's number).
+    submitted: u64,
 }
 
 /// An object a run in flight may still use.
@@ -197,6 +202,7 @@ impl VkExecutor {
             flights: Vec::new(),
             open: None,
             graveyard: Vec::new(),
+            submitted: 0,
         };
         me.push_layout((0, 0, 0), set)?;
         Ok(me)
@@ -327,10 +333,21 @@ impl VkExecutor {
         Ok(self.targets.len() - 1)
     }
 
-    /// Keep `grave` until no run is in flight (dropped at once when none is).
+    /// Keep `grave` until every run submitted so far has been waited for (dropped at once
+    /// when none is in flight).
     fn bury(&mut self, grave: Grave) {
         if self.flights.iter().any(|f| f.busy) {
-            self.graveyard.push(grave);
+            self.graveyard.push((self.submitted, grave));
+        }
+        self.sweep();
+    }
+
+    /// Drop the graves no run in flight can still use: those freed after the oldest busy run
+    /// was submitted are kept, the rest go.
+    fn sweep(&mut self) {
+        match self.flights.iter().filter(|f| f.busy).map(|f| f.serial).min() {
+            Some(oldest) => self.graveyard.retain(|(last, _)| *last >= oldest),
+            None => self.graveyard.clear(),
         }
     }
 
@@ -623,14 +640,14 @@ impl Executor for VkExecutor {
         let waited = f.wait_fence();
         f.busy = false;
         waited?;
-        let outputs = (0..f.outputs.len()).map(|i| f.read_output(i)).collect();
+        let outputs = (0..f.outputs.len())
+            .map(|i| f.read_output(i))
+            .collect::<Result<Vec<_>>>()?;
         let timing = Timing {
             gpu_ms: None,
             wall_ms: f.submit_ms,
         };
-        if !self.flights.iter().any(|f| f.busy) {
-            self.graveyard.clear();
-        }
+        self.sweep();
         Ok(Rendered {
             outputs,
             timing,
@@ -889,6 +906,8 @@ impl VkExecutor {
         })?;
         let flight = &mut self.flights[f];
         flight.busy = true;
+        self.submitted += 1;
+        flight.serial = self.submitted;
         flight.submit_ms = t0.elapsed().as_secs_f64() * 1e3;
         Ok(())
     }

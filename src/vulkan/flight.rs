@@ -33,6 +33,8 @@ pub(super) struct Flight {
     pub rows: RowOrder,
     /// Submitted and not yet waited for.
     pub busy: bool,
+    /// The number of its run among the executor's submissions (valid while busy).
+    pub serial: u64,
     /// Host time of recording and submitting.
     pub submit_ms: f64,
 }
@@ -60,6 +62,7 @@ impl Flight {
             size: (0, 0),
             rows: RowOrder::TopDown,
             busy: false,
+            serial: 0,
             submit_ms: 0.0,
         })
     }
@@ -115,28 +118,38 @@ impl Flight {
 
     /// Output `i`'s texels after the fence, rows top-down (files are top-down: a bottom-up
     /// memory order is flipped here, as GL does on the GPU), RGBA8 packed to RGB.
-    pub fn read_output(&self, i: usize) -> Option<Vec<u8>> {
-        let f = self.outputs.get(i).copied().flatten()?;
-        let buffer = self.readback.get(i)?.as_ref()?;
+    pub fn read_output(&self, i: usize) -> Result<Option<Vec<u8>>> {
+        let Some(f) = self.outputs.get(i).copied().flatten() else {
+            return Ok(None);
+        };
+        let Some(buffer) = self.readback.get(i).and_then(Option::as_ref) else {
+            return Ok(None);
+        };
         let (w, h) = self.size;
         let row_bytes = w as usize * f.texel_bytes();
-        let rows = self
-            .rows
-            .convert_rows(buffer.read(row_bytes * h as usize).to_vec(), row_bytes);
-        Some(match f {
+        let copy = crate::alloc::try_copy(buffer.read(row_bytes * h as usize), "readback")?;
+        let rows = self.rows.convert_rows(copy, row_bytes);
+        Ok(Some(match f {
             // Files hold RGB; the GL executor packs on the GPU, here while copying out.
-            Format::Rgba8 => rows.chunks_exact(4).flat_map(|p| [p[0], p[1], p[2]]).collect(),
+            Format::Rgba8 => {
+                let mut rgb = crate::alloc::try_with_capacity(rows.len() / 4 * 3, "colour readback")?;
+                rgb.extend(rows.chunks_exact(4).flat_map(|p| [p[0], p[1], p[2]]));
+                rgb
+            }
             _ => rows,
-        })
+        }))
     }
 
-    /// A descriptor pool with room for `sets` sets (reset, or made larger).
+    /// A descriptor pool with room for `sets` sets (reset, or made larger). A run without
+    /// steps (a mesh that keeps no triangle) still gets a pool: the first run of a flight may
+    /// be one, and resetting the null handle it starts with crashed the driver.
     pub fn reset_pool(&mut self, sets: usize) -> Result<()> {
         let d = &self.vk.device;
+        let sets = sets.max(1);
         // SAFETY: the flight is not in flight, so no set of its pool is in use; the old pool is
-        // destroyed before its handle is replaced.
+        // destroyed before its handle is replaced; a null pool is never reset.
         unsafe {
-            if sets <= self.pool_sets {
+            if self.pool != vk::DescriptorPool::null() && sets <= self.pool_sets {
                 return d
                     .reset_descriptor_pool(self.pool, vk::DescriptorPoolResetFlags::empty())
                     .map_err(vk_err("vkResetDescriptorPool"));

@@ -13,6 +13,8 @@ pub struct Buffer {
     memory: vk::DeviceMemory,
     ptr: *mut u8,
     pub size: usize,
+    /// Bytes of its allocation (counted in the census until dropped).
+    bytes: u64,
 }
 
 impl Buffer {
@@ -49,10 +51,12 @@ impl Buffer {
                     memory,
                     ptr: ptr.cast(),
                     size,
+                    bytes: req.size,
                 }),
                 Err(r) => {
                     d.destroy_buffer(raw, None);
                     d.free_memory(memory, None);
+                    vk.count_bytes(req.size, true);
                     Err(Error::Vulkan(format!("binding/mapping buffer memory: {r}")))
                 }
             }
@@ -90,6 +94,7 @@ impl Drop for Buffer {
             self.vk.device.destroy_buffer(self.raw, None);
             self.vk.device.free_memory(self.memory, None);
         }
+        self.vk.count_bytes(self.bytes, true);
     }
 }
 
@@ -102,6 +107,8 @@ pub struct Image {
     pub width: u32,
     pub height: u32,
     pub aspect: vk::ImageAspectFlags,
+    /// Bytes of its allocation (counted in the census until dropped).
+    bytes: u64,
 }
 
 impl Image {
@@ -155,10 +162,12 @@ impl Image {
                     width,
                     height,
                     aspect,
+                    bytes: req.size,
                 }),
                 Err(r) => {
                     d.destroy_image(raw, None);
                     d.free_memory(memory, None);
+                    vk.count_bytes(req.size, true);
                     Err(Error::Vulkan(format!("binding image memory / creating its view: {r}")))
                 }
             }
@@ -265,10 +274,12 @@ fn allocate(vk: &Vk, req: &vk::MemoryRequirements, index: u32, undo: impl FnOnce
         .memory_type_index(index);
     vk.count(super::context::Created::Allocation);
     // SAFETY: plain allocation; the caller owns the memory and frees it in its Drop.
-    unsafe { vk.device.allocate_memory(&alloc, None) }.map_err(|r| {
+    let memory = unsafe { vk.device.allocate_memory(&alloc, None) }.map_err(|r| {
         undo();
         Error::Vulkan(format!("vkAllocateMemory ({} bytes): {r}", req.size))
-    })
+    })?;
+    vk.count_bytes(req.size, false);
+    Ok(memory)
 }
 
 pub fn range(aspect: vk::ImageAspectFlags) -> vk::ImageSubresourceRange {
@@ -288,6 +299,7 @@ impl Drop for Image {
             self.vk.device.destroy_image(self.raw, None);
             self.vk.device.free_memory(self.memory, None);
         }
+        self.vk.count_bytes(self.bytes, true);
     }
 }
 

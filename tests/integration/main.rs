@@ -25,6 +25,7 @@ mod gl_objects;
 mod gpu_context;
 mod hostile;
 mod hostile_round3;
+mod hostile_round4;
 mod limits;
 mod matcher;
 mod pass_contract;

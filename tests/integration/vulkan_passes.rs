@@ -90,7 +90,9 @@ fn every_parameter_block_has_the_layout_the_gl_compiler_reports() {
     check_block::<ForwardParams>(ProgramKind::CyclopeanForward);
     check_block::<RefocusParams>(ProgramKind::RefocusFullscreen { want_rgb: true });
     check_block::<viewsynth::cyclopean::fill::FillParams>(ProgramKind::CyclopeanFill);
-    check_block::<viewsynth::cyclopean::temporal::TemporalParams>(ProgramKind::CyclopeanTemporalReproject);
+    check_block::<viewsynth::cyclopean::temporal::TemporalParams>(ProgramKind::CyclopeanTemporalReproject {
+        winner: true,
+    });
     check_block::<viewsynth::cyclopean::temporal::TemporalParams>(ProgramKind::CyclopeanTemporalCompose);
     for stage in viewsynth::gpu::shaders::MatcherStage::ALL {
         check_block::<viewsynth::cyclopean::matcher::gpu::MatcherParams>(ProgramKind::CyclopeanMatcher(stage));

@@ -18,11 +18,27 @@ use clap::{Parser, Subcommand};
 use std::process::ExitCode;
 use viewsynth::io;
 
+/// `println!` for a command's results, through [`stdout::write`]: returns from the enclosing
+/// function with an error (exit 1) when stdout refuses the text.
+macro_rules! outln {
+    ($($arg:tt)*) => {
+        $crate::stdout::write(format_args!($($arg)*), true)?
+    };
+}
+
+/// `print!` through [`stdout::write`] (see [`outln!`]).
+macro_rules! out {
+    ($($arg:tt)*) => {
+        $crate::stdout::write(format_args!($($arg)*), false)?
+    };
+}
+
 #[cfg(test)]
 mod front_ends;
 mod host;
 mod options;
 mod progress;
+mod stdout;
 mod text;
 
 mod bench {
@@ -161,10 +177,12 @@ fn job<A, J: TryFrom<A, Error = viewsynth::job::ArgError>>(args: A) -> Result<J>
 
 fn main() -> ExitCode {
     quiet_on_closed_pipe();
+    file_too_large_is_an_error();
     let cli = Cli::parse();
     let result = io::set_max_pixels(cli.max_pixels)
         .map_err(anyhow::Error::from)
-        .and_then(|()| run(cli.command));
+        .and_then(|()| run(cli.command))
+        .and_then(|code| stdout::flush().map(|()| code).map_err(anyhow::Error::from));
     match result {
         Ok(code) => code,
         Err(e) => {
@@ -191,6 +209,18 @@ fn quiet_on_closed_pipe() {
     // SAFETY: at the start of main, before any thread exists; SIG_DFL is a valid disposition.
     unsafe {
         libc::signal(libc::SIGPIPE, libc::SIG_DFL);
+    }
+}
+
+/// A file growing past `ulimit -f` raises SIGXFSZ, whose default action kills the process
+/// (status 153, no message, after the earlier files of the set were already written to the
+/// staging folder). Ignored, the write fails with EFBIG instead: the set's error path names the
+/// file ("File too large"), removes the staging folder and exits 1, leaving the previous files.
+fn file_too_large_is_an_error() {
+    #[cfg(unix)]
+    // SAFETY: at the start of main, before any thread exists; SIG_IGN is a valid disposition.
+    unsafe {
+        libc::signal(libc::SIGXFSZ, libc::SIG_IGN);
     }
 }
 

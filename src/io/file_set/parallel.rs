@@ -39,6 +39,7 @@ impl FileSet {
             names.push((name.clone(), shown));
         }
         let mut work = Vec::with_capacity(files.len());
+        self.note_staged(names.iter().map(|(n, _)| n.clone()));
         for ((_, write), (name, shown)) in files.into_iter().zip(&names) {
             match File::create_new(self.staging().join(name)) {
                 Ok(file) => work.push((file, write)),

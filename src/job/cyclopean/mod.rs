@@ -26,6 +26,13 @@ pub use sequence::{load_sequence, CyclopeanSequenceJob, SequenceFrame, MAX_SEQUE
 /// The files of each eye's matcher confidence (`--confidence`), left then right.
 pub const CONFIDENCE_FILES: [&str; 2] = ["left_confidence.exr", "right_confidence.exr"];
 
+/// Whether `name` is one this command writes into its folder: a pair's files and a
+/// sequence's frames all start with `middle_`, beside the confidence files. A run's set replaces
+/// the previous run's files of these names ([`io::FileSet::replacing`]).
+pub(crate) fn owned_name(name: &str) -> bool {
+    name.starts_with("middle_") || CONFIDENCE_FILES.contains(&name)
+}
+
 /// How the middle view is synthesised.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, serde::Deserialize)]
 #[serde(rename_all = "kebab-case")]
@@ -164,6 +171,18 @@ impl CyclopeanJob {
             super::check_npz_key(o.npz_key.as_deref(), &[left, right])?;
         }
         let plan = o.request.plan(kind)?;
+        let mut inputs = vec![
+            ("--left-rgb", o.left_rgb.as_path()),
+            ("--right-rgb", o.right_rgb.as_path()),
+        ];
+        if let Some((l, r)) = &maps {
+            inputs.extend([
+                ("--left-depth/disparity", l.as_path()),
+                ("--right-depth/disparity", r.as_path()),
+            ]);
+        }
+        inputs.extend(o.cameras.as_deref().map(|c| ("--cameras", c)));
+        io::check_out_dir(&o.out_dir, owned_name, &inputs).map_err(ArgError::Invalid)?;
         Ok(CyclopeanJob {
             left_rgb: o.left_rgb,
             right_rgb: o.right_rgb,
@@ -193,7 +212,7 @@ impl CyclopeanJob {
         let device = host.open_device(&self.gpu, self.backend)?;
         let view = self.render(&device, host, None)?;
         let out_dir = io::OutDir::prepare(&self.out_dir)?;
-        let mut set = out_dir.file_set()?;
+        let mut set = out_dir.file_set()?.replacing(owned_name);
         io::write_view(
             &mut set,
             &io::ViewNames::tagged("middle"),

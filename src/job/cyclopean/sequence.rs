@@ -177,7 +177,11 @@ impl CyclopeanSequenceJob {
             // The folder once the first frame rendered: a refused first input leaves none.
             let set = match &mut set {
                 Some(set) => set,
-                None => set.insert(io::OutDir::prepare(self.out_dir())?.file_set()?),
+                None => set.insert(
+                    io::OutDir::prepare(self.out_dir())?
+                        .file_set()?
+                        .replacing(super::owned_name),
+                ),
             };
             let names = io::ViewNames::tagged(&format!("middle_{k:05}"));
             io::write_view(set, &names, &view.done.view, &job.formats())?;

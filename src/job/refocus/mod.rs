@@ -97,6 +97,12 @@ impl RefocusCommand {
         };
         super::check_npz_key(o.npz_key.as_deref(), &[&depth])?;
         let intrinsics = SourceIntrinsics::resolve(o.intrinsics_file.as_deref(), o.intrinsics)?;
+        // Every target's files start with its tag; the manifest goes last.
+        let writes =
+            |name: &str| name == io::MANIFEST_NAME || plan.tags.iter().any(|t| name.starts_with(&format!("{t}_")));
+        let mut inputs = vec![("--rgb", rgb.as_path()), ("--depth", depth.as_path())];
+        inputs.extend(o.intrinsics_file.as_deref().map(|p| ("--intrinsics", p)));
+        io::check_out_dir(&o.out_dir, writes, &inputs).map_err(ArgError::Invalid)?;
         Ok(RefocusCommand::Frame(RefocusJob {
             rgb,
             depth,

@@ -6,8 +6,8 @@ use viewsynth::job::bench::{BenchJob, BenchReport};
 
 pub(crate) fn bench(job: &BenchJob, json: bool) -> Result<()> {
     match job.run(&CliHost::default())? {
-        BenchReport::Batch(report) if json => println!("{}", serde_json::to_string_pretty(&report)?),
-        BenchReport::Batch(report) => println!("{}", report.table()),
+        BenchReport::Batch(report) if json => outln!("{}", serde_json::to_string_pretty(&report)?),
+        BenchReport::Batch(report) => outln!("{}", report.table()),
         BenchReport::Frames {
             renderer,
             cases,
@@ -15,11 +15,11 @@ pub(crate) fn bench(job: &BenchJob, json: bool) -> Result<()> {
             ..
         } if json => {
             let report = serde_json::json!({ "renderer": renderer, "vulkan_device": vulkan_device, "cases": cases });
-            println!("{}", serde_json::to_string_pretty(&report)?);
+            outln!("{}", serde_json::to_string_pretty(&report)?);
         }
         BenchReport::Frames { tables, .. } => {
             for t in tables {
-                println!("{t}");
+                outln!("{t}");
             }
         }
     }

@@ -10,25 +10,28 @@ pub(crate) fn compare(job: &CompareJob) -> Result<ExitCode> {
     let r = job.run(&CliHost::default())?;
     let cmp = &r.comparison;
     if job.json() == Some(&JsonOutput::Stdout) {
-        println!("{}", r.json);
+        outln!("{}", r.json);
     } else {
         let over = if job.masked() { " (in the mask)" } else { "" };
-        println!(
+        outln!(
             "colour: PSNR {:.2} dB, RMSE {:.4} levels, max difference {} levels over {} pixels{over}",
-            cmp.psnr_db, cmp.color_rmse, cmp.max_color_diff, cmp.pixels
+            cmp.psnr_db,
+            cmp.color_rmse,
+            cmp.max_color_diff,
+            cmp.pixels
         );
         if let Some(p) = job.diff() {
-            println!(
+            outln!(
                 "diff: {} = |A - B| x {:.3} (the largest difference is white)",
                 p.display(),
                 cmp.diff_scale
             );
         }
         if let (Some(abs), Some(rel), Some(d)) = (cmp.depth_max_abs, cmp.depth_max_rel, cmp.mask_disagreement) {
-            println!("depth: max abs {abs:.3e} m, max rel {rel:.3e}; valid in only one: {d} pixels");
+            outln!("depth: max abs {abs:.3e} m, max rel {rel:.3e}; valid in only one: {d} pixels");
         }
         if let Some(s) = &cmp.suspicion {
-            println!("suspicion: {s}");
+            outln!("suspicion: {s}");
         }
     }
     if r.broken.is_empty() {

@@ -12,7 +12,7 @@ pub(crate) fn cyclopean(job: &CyclopeanRun) -> Result<()> {
         CyclopeanRun::Sequence(job) => (job.run(&host)?, job.out_dir()),
     };
     if r.frames > 1 {
-        println!(
+        outln!(
             "{} views {}x{}: {:.1} % valid on average, render {:.1} ms in all; wrote {} files in {}",
             r.frames,
             r.width,
@@ -24,7 +24,7 @@ pub(crate) fn cyclopean(job: &CyclopeanRun) -> Result<()> {
         );
         return Ok(());
     }
-    println!(
+    outln!(
         "view {}x{}: {:.1} % valid, render {:.1} ms; wrote {} in {}",
         r.width,
         r.height,

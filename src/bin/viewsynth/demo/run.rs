@@ -7,7 +7,7 @@ use viewsynth::job::report::DemoJob;
 pub(crate) fn demo(job: &DemoJob, verbose: bool) -> Result<()> {
     let written = job.run(&CliHost::default())?;
     crate::report::run::print_report(&written, verbose)?;
-    println!(
+    outln!(
         "demo outputs in {}: fullscreen/ and mesh/ (refocus at 5 scales, refocus_check.md), \
          cyclopean/, reproject/, stitch/",
         job.out_dir.display()

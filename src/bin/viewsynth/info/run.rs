@@ -14,23 +14,26 @@ pub(crate) fn info(request: &InfoRequest) -> Result<()> {
     let gpu = CliHost::default().open_gpu(&request.gpu)?;
     let i = gpu.info();
     if request.json {
-        println!("{}", serde_json::to_string_pretty(i)?);
+        outln!("{}", serde_json::to_string_pretty(i)?);
         return Ok(());
     }
-    println!("vendor:      {}", i.vendor);
-    println!("renderer:    {}", i.renderer);
-    println!(
+    outln!("vendor:      {}", i.vendor);
+    outln!("renderer:    {}", i.renderer);
+    outln!(
         "GL version:  {} (core {}.{}), GLSL {}",
-        i.version, i.gl_major, i.gl_minor, i.glsl_version
+        i.version,
+        i.gl_major,
+        i.gl_minor,
+        i.glsl_version
     );
-    println!("EGL:         {} via {} platform", i.egl_version, i.platform);
+    outln!("EGL:         {} via {} platform", i.egl_version, i.platform);
     let dev = i.device_index.map_or("-".to_string(), |d| d.to_string());
-    println!(
+    outln!(
         "device:      {dev} of {} ({})",
         i.device_count,
         i.device_file.as_deref().unwrap_or("no DRM file")
     );
-    println!(
+    outln!(
         "device ext:  {}",
         if i.device_extensions.is_empty() {
             "-"
@@ -38,11 +41,13 @@ pub(crate) fn info(request: &InfoRequest) -> Result<()> {
             &i.device_extensions
         }
     );
-    println!(
+    outln!(
         "limits:      max texture {}, max viewport {}x{}",
-        i.max_texture_size, i.max_viewport[0], i.max_viewport[1]
+        i.max_texture_size,
+        i.max_viewport[0],
+        i.max_viewport[1]
     );
-    println!(
+    outln!(
         "GPU timers:  {}",
         if i.gpu_timers_meaningful {
             "yes"
@@ -50,8 +55,8 @@ pub(crate) fn info(request: &InfoRequest) -> Result<()> {
             "no (wall clock with glFinish)"
         }
     );
-    println!("rendering:   {}", if i.software { "software" } else { "hardware" });
-    print!("{}", device_table(i));
+    outln!("rendering:   {}", if i.software { "software" } else { "hardware" });
+    out!("{}", device_table(i));
     Ok(())
 }
 
@@ -89,11 +94,11 @@ fn info_vulkan(request: &InfoRequest) -> Result<()> {
     let auto = viewsynth::vulkan::auto_pick(&devices);
     if request.json {
         let v = serde_json::json!({ "devices": devices, "auto_device": auto });
-        println!("{}", serde_json::to_string_pretty(&v)?);
+        outln!("{}", serde_json::to_string_pretty(&v)?);
     } else {
-        println!("Vulkan devices: {}", devices.len());
+        outln!("Vulkan devices: {}", devices.len());
         for d in &devices {
-            println!(
+            outln!(
                 "  {}: {} ({}, {}), API {}, driver {} {}, max image {}{}{}",
                 d.index,
                 d.name,
@@ -116,8 +121,8 @@ fn info_vulkan(request: &InfoRequest) -> Result<()> {
             );
         }
         match auto {
-            Some(i) => println!("auto picks: device {i}"),
-            None => println!("auto picks: none (no usable device)"),
+            Some(i) => outln!("auto picks: device {i}"),
+            None => outln!("auto picks: none (no usable device)"),
         }
     }
     // The same refusal a rendering command would give.

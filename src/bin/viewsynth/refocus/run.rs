@@ -14,7 +14,7 @@ pub(crate) fn refocus(command: RefocusCommand) -> Result<()> {
 fn frame(job: &RefocusJob) -> Result<()> {
     let report = job.run(&CliHost::default())?;
     for e in &report.manifest.outputs {
-        println!(
+        outln!(
             "s={:<6} fx'={:<9.3} {}x{} coverage {:>6.2}%  render {:>7.2} ms",
             e.scale,
             e.intrinsics.fx,
@@ -24,7 +24,7 @@ fn frame(job: &RefocusJob) -> Result<()> {
             e.render_ms
         );
     }
-    println!(
+    outln!(
         "wrote {} targets; manifest {}",
         report.manifest.outputs.len(),
         report.manifest_path.display()
@@ -42,7 +42,7 @@ fn batch(job: &RefocusBatchJob) -> Result<()> {
         ),
         None => String::new(),
     };
-    println!(
+    outln!(
         "{} frames{shard_note}: {} rendered, {} already done (resume), {} failed; {:.1} s, {:.2} frames/s",
         report.frames,
         summary.rendered,

@@ -15,16 +15,16 @@ pub(crate) fn report(job: &ReportJob, verbose: bool) -> Result<()> {
 /// hundreds of lines: a terminal gets the medians, the file gets everything.
 pub(crate) fn print_report(written: &WrittenReport, verbose: bool) -> Result<()> {
     match written.markdown() {
-        Some(md) if verbose => println!("{}", std::fs::read_to_string(md)?),
-        _ => print!("{}", written.report.summary()),
+        Some(md) if verbose => outln!("{}", std::fs::read_to_string(md)?),
+        _ => out!("{}", written.report.summary()),
     }
     let names = crate::text::file_names(&written.files);
     match written.files.first().and_then(|f| f.parent()) {
-        Some(dir) if !verbose => println!(
+        Some(dir) if !verbose => outln!(
             "wrote {names} in {} (the full table: report.md, or --verbose)",
             dir.display()
         ),
-        Some(dir) => println!("wrote {names} in {}", dir.display()),
+        Some(dir) => outln!("wrote {names} in {}", dir.display()),
         None => {}
     }
     Ok(())

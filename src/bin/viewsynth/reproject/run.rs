@@ -8,7 +8,7 @@ use viewsynth::job::reproject::{view_name, ReprojectJob};
 pub(crate) fn reproject(job: &ReprojectJob) -> Result<()> {
     let r = job.run(&CliHost::default())?;
     for t in &r.targets {
-        println!(
+        outln!(
             "{} -> {} ({}): {}x{}, coverage {:.2} %, render {} (setup + shader compile {:.1} ms)",
             view_name(r.from),
             view_name(Some(t.to)),
@@ -20,6 +20,6 @@ pub(crate) fn reproject(job: &ReprojectJob) -> Result<()> {
             t.setup_ms,
         );
     }
-    println!("wrote {} in {}", file_names(&r.written), job.out_dir().display());
+    outln!("wrote {} in {}", file_names(&r.written), job.out_dir().display());
     Ok(())
 }

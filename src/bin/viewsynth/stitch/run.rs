@@ -7,9 +7,9 @@ use viewsynth::job::stitch::StitchJob;
 
 pub(crate) fn stitch(job: &StitchJob) -> Result<()> {
     let r = job.run(&CliHost::default())?;
-    println!("faces: {}, FOV {} deg, in {:.0} ms", r.source, r.fov, r.faces_ms);
-    println!("upload + shader compile {:.1} ms", r.setup_ms);
-    println!(
+    outln!("faces: {}, FOV {} deg, in {:.0} ms", r.source, r.fov, r.faces_ms);
+    outln!("upload + shader compile {:.1} ms", r.setup_ms);
+    outln!(
         "stitch ({}, overlap {} deg, IPD {} m): {}x{} per eye, top-bottom {}x{}, render {}",
         r.params.method.label(),
         r.params.overlap_deg,
@@ -22,13 +22,13 @@ pub(crate) fn stitch(job: &StitchJob) -> Result<()> {
     );
     if let Some(t) = &r.truth {
         let s = &t.score;
-        println!(
+        outln!(
             "vs ODS ground truth (ray-traced in {:.0} ms): seam band PSNR {:.2} dB (MAE {:.2}, {} px per eye), whole image PSNR {:.2} dB (MAE {:.2})",
             t.truth_ms, s.seam_psnr_db, s.seam_mae, s.seam_pixels, s.whole_psnr_db, s.whole_mae
         );
     }
     for p in &r.written {
-        println!("wrote {}", p.display());
+        outln!("wrote {}", p.display());
     }
     Ok(())
 }

@@ -6,7 +6,7 @@ use viewsynth::job::stress::StressJob;
 
 pub(crate) fn stress(job: &StressJob) -> Result<()> {
     let rows = job.run(&CliHost::default())?;
-    println!("{}", viewsynth::stress::table(&rows));
+    outln!("{}", viewsynth::stress::table(&rows));
     job.write_json(&rows)?;
     Ok(StressJob::outcome(&rows)?)
 }
