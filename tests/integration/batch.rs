@@ -34,6 +34,8 @@ fn setup(name: &str, n: usize) -> (tempfile::TempDir, PathBuf) {
 
 fn options(jobs: usize) -> BatchOptions {
     BatchOptions {
+        zoom_random: None,
+        rgb_everywhere: false,
         scales: vec![0.5, 1.0, 1.75],
         size: None,
         principal: None,
@@ -141,6 +143,8 @@ fn resume_redoes_frames_whose_settings_or_files_changed() {
 
     // Other scales: every frame is redone.
     let other = BatchOptions {
+        zoom_random: None,
+        rgb_everywhere: false,
         scales: vec![0.5, 2.0],
         ..options(1)
     };

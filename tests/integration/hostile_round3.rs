@@ -916,6 +916,7 @@ fn round3_library_passes_refuse_unusable_depth_and_are_finite_where_valid() {
                 rule: BreakRule::default(),
                 method,
                 outputs: OutputSet::default(),
+                rgb_everywhere: false,
                 conv,
             };
             cases += 2;
@@ -942,6 +943,7 @@ fn round3_library_passes_refuse_unusable_depth_and_are_finite_where_valid() {
                     rule: BreakRule::default(),
                     method,
                     outputs: OutputSet::default(),
+                    rgb_everywhere: false,
                     conv,
                 };
                 cases += 1;
@@ -970,6 +972,7 @@ fn round3_library_passes_refuse_unusable_depth_and_are_finite_where_valid() {
             rule: BreakRule::default(),
             method: Method::Fullscreen,
             outputs: OutputSet::default(),
+            rgb_everywhere: false,
             conv,
         };
         match refocus::pass::gpu(&g, &input) {
