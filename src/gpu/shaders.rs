@@ -321,8 +321,7 @@ impl ProgramKind {
                 int("TRI_TEX_WIDTH", TRI_TEX_WIDTH.into()),
             ],
             ProgramKind::RefocusColourEverywhere => vec![int("TRI_TEX_WIDTH", TRI_TEX_WIDTH.into())],
-            ProgramKind::RefocusMeshInterior { want_rgb }
-            | ProgramKind::RefocusMeshBoundary { want_rgb } => {
+            ProgramKind::RefocusMeshInterior { want_rgb } | ProgramKind::RefocusMeshBoundary { want_rgb } => {
                 vec![flag("WANT_RGB", want_rgb), int("TRI_TEX_WIDTH", TRI_TEX_WIDTH.into())]
             }
             ProgramKind::CyclopeanGather {

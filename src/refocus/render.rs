@@ -388,7 +388,12 @@ impl Refocuser {
                 if want_rgb && self.rgb_everywhere {
                     // Colour inside the frame at the far depth first; the kept triangles then
                     // overwrite what they cover.
-                    steps.push(draw(ProgramKind::RefocusColourEverywhere, &interior_images[..], 1, None));
+                    steps.push(draw(
+                        ProgramKind::RefocusColourEverywhere,
+                        &interior_images[..],
+                        1,
+                        None,
+                    ));
                 }
                 if let Some((indices, count)) = m.interior {
                     steps.push(draw(

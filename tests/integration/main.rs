@@ -32,6 +32,7 @@ mod refocus_accuracy;
 mod refocus_conventions;
 mod refocus_edge_cases;
 mod refocus_oracle;
+mod refocus_rgb_everywhere;
 mod reproject;
 mod scene;
 mod shader_library;

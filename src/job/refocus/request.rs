@@ -229,7 +229,12 @@ impl RefocusRequest {
                 "give fixed scales (--zoom-range) or a random range, not both",
             )));
         }
-        Ok(Some(ZoomRandom::new(lo, hi, self.samples.unwrap_or(1), self.seed.unwrap_or(0))?))
+        Ok(Some(ZoomRandom::new(
+            lo,
+            hi,
+            self.samples.unwrap_or(1),
+            self.seed.unwrap_or(0),
+        )?))
     }
 
     /// The settings of a batch, checked: per-frame settings given are refused by name.

@@ -115,9 +115,7 @@ fn read_rows(path: &Path) -> Result<Vec<IndexRow>> {
     text.lines()
         .filter(|l| !l.trim().is_empty())
         .enumerate()
-        .map(|(i, l)| {
-            serde_json::from_str(l).map_err(|e| Error::decode(path, format!("line {}: {e}", i + 1)))
-        })
+        .map(|(i, l)| serde_json::from_str(l).map_err(|e| Error::decode(path, format!("line {}: {e}", i + 1))))
         .collect()
 }
 
@@ -172,14 +170,21 @@ pub fn join_index(root: &Path) -> Result<(PathBuf, usize)> {
     let Some((&n, (found, _))) = counts.iter().max_by_key(|(_, (_, t))| *t) else {
         return Err(Error::param(
             "index",
-            format!("{}: no index part (index.part-K-of-N.jsonl); run refocus --batch into it first", root.display()),
+            format!(
+                "{}: no index part (index.part-K-of-N.jsonl); run refocus --batch into it first",
+                root.display()
+            ),
         ));
     };
     let missing: Vec<String> = (0..n).filter(|j| !found.contains(j)).map(|j| part_name(j, n)).collect();
     if !missing.is_empty() {
         return Err(Error::param(
             "index",
-            format!("{}: shards still to run: {} missing", root.display(), missing.join(", ")),
+            format!(
+                "{}: shards still to run: {} missing",
+                root.display(),
+                missing.join(", ")
+            ),
         ));
     }
     let path = join_parts(root, n)?;

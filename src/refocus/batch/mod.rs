@@ -24,11 +24,11 @@ mod pipeline;
 mod resume;
 mod zoom;
 
+pub use index::{join_index, read_index, IndexRow, INDEX_NAME};
 pub use manifest::{
     load_manifest, BatchFrame, MAX_JSON_MANIFEST_BYTES, MAX_MANIFEST_BYTES, MAX_MANIFEST_ROWS, MAX_MANIFEST_ROW_BYTES,
 };
 pub use pipeline::{run_batch, BatchSummary, StageTimes};
-pub use index::{join_index, read_index, IndexRow, INDEX_NAME};
 pub use zoom::{ZoomRandom, MAX_SAMPLES};
 
 use super::{BreakRule, Method};

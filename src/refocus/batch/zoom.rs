@@ -142,9 +142,18 @@ mod tests {
 
     #[test]
     fn bad_ranges_and_counts_are_refused_by_name() {
-        assert!(ZoomRandom::new(0.0, 1.0, 1, 0).unwrap_err().to_string().contains("--zoom-random"));
-        assert!(ZoomRandom::new(2.0, 1.0, 1, 0).unwrap_err().to_string().contains("--zoom-random"));
+        assert!(ZoomRandom::new(0.0, 1.0, 1, 0)
+            .unwrap_err()
+            .to_string()
+            .contains("--zoom-random"));
+        assert!(ZoomRandom::new(2.0, 1.0, 1, 0)
+            .unwrap_err()
+            .to_string()
+            .contains("--zoom-random"));
         assert!(ZoomRandom::new(1.0, f64::INFINITY, 1, 0).is_err());
-        assert!(ZoomRandom::new(0.5, 1.0, 0, 0).unwrap_err().to_string().contains("--samples"));
+        assert!(ZoomRandom::new(0.5, 1.0, 0, 0)
+            .unwrap_err()
+            .to_string()
+            .contains("--samples"));
     }
 }
