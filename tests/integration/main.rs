@@ -4,6 +4,7 @@
 mod batch;
 mod cli;
 mod cli_batch;
+mod cli_batch_augment;
 mod cli_cameras_cv;
 mod cli_compare;
 mod cli_depth_out;
