@@ -109,9 +109,7 @@ impl Progress {
 #[pyfunction]
 #[pyo3(signature = (path, *, depth_scale = None))]
 pub fn read_depth<'py>(py: Python<'py>, path: PathBuf, depth_scale: Option<f64>) -> PyResult<Bound<'py, PyAny>> {
-    let png16 = path
-        .extension()
-        .is_some_and(|e| e.eq_ignore_ascii_case("png"));
+    let png16 = path.extension().is_some_and(|e| e.eq_ignore_ascii_case("png"));
     // The CLI's png16 output holds millimetres.
     let scale = depth_scale.or(png16.then_some(1000.0));
     let decode = DepthDecode {

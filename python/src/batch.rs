@@ -228,7 +228,8 @@ pub fn refocus_batch<'py>(py: Python<'py>, gpu: Backend, a: BatchArgs<'_, 'py>) 
     let opts = options(&a)?;
     let frames = frames(a.frames)?;
     let out_dir = a.out_dir;
-    let progress = crate::augment::Progress::new(a.augment.progress, crate::augment::frames_in_share(frames.len(), &opts))?;
+    let progress =
+        crate::augment::Progress::new(a.augment.progress, crate::augment::frames_in_share(frames.len(), &opts))?;
     // Paths and options were copied out of Python above; see SameThread for why the move is sound.
     let work = SameThread((gpu, frames, out_dir, opts, progress));
     let result = py.detach(move || {

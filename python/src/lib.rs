@@ -14,6 +14,7 @@ mod ints;
 mod renderer;
 mod reproject;
 mod shared;
+mod stack;
 mod stitch;
 
 use pyo3::prelude::*;

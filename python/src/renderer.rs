@@ -347,6 +347,9 @@ impl Renderer {
     /// |za - zb| > tau_rel * min(za, zb) or > tau_abs metres (inf disables).
     /// method: "fullscreen" (fast, default) or "mesh"; both give the same images.
     /// rgb_everywhere: colour at every pixel inside the source frame (mask and depth unchanged).
+    /// Stacks: rgb uint8[N, H, W, 3], depth float32[N, H, W], K 3x3 or [N, 3, 3] give a list of
+    /// N lists, each what the single call gives. Strided arrays (slices, bgr[..., ::-1]) are
+    /// copied once, as contiguous ones are.
     ///
     /// Returns one dict per target, in order: "scale" (fx'/fx), "K" (float64[3, 3]),
     /// "coverage" (fraction of valid pixels; None with rgb alone), "timings" (setup_ms: upload
@@ -376,6 +379,29 @@ impl Renderer {
         method: &str,
         rgb_everywhere: bool,
     ) -> PyResult<Bound<'py, PyList>> {
+        if let Some(frames) = crate::stack::frames(rgb, depth, K)? {
+            let views = PyList::empty(py);
+            for (rgb, depth, k) in frames {
+                let (s, o) = (scales.clone(), outputs);
+                let one = self.refocus(
+                    py,
+                    &rgb,
+                    &depth,
+                    &k,
+                    s,
+                    K_out,
+                    size,
+                    principal,
+                    o,
+                    tau_rel,
+                    tau_abs,
+                    method,
+                    rgb_everywhere,
+                );
+                views.append(one?)?;
+            }
+            return Ok(views);
+        }
         let gpu = self.gpu()?.clone();
         let k = arrays::intrinsics(K, "K")?;
         let source = RefocusSource::new(arrays::rgb_image(rgb, "rgb")?, arrays::float_map(depth, "depth")?, k)

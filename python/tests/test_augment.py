@@ -82,3 +82,28 @@ def test_read_depth_reads_every_format_the_cli_writes(renderer, tmp_path):
     assert np.abs(png[valid] - npy[valid]).max() <= 0.0005 + 1e-6  # millimetres, rounded
     with pytest.raises(vs.FileError, match="missing.exr"):
         vs.read_depth(tmp_path / "missing.exr")
+
+
+def test_a_stack_of_four_equals_four_single_calls(renderer):
+    frames = [make_frame(64, 48, seed=s) for s in range(4)]
+    rgb = np.stack([f[0] for f in frames])
+    depth = np.stack([f[1] for f in frames])
+    Ks = np.stack([f[2] for f in frames])
+    for K in (Ks, frames[0][2]):  # one K per frame, or one for all
+        stacked = renderer.refocus(rgb, depth, K, scales=[0.7, 1.3], rgb_everywhere=True)
+        assert len(stacked) == 4
+        for i, views in enumerate(stacked):
+            k = K[i] if K.ndim == 3 else K
+            single = renderer.refocus(rgb[i], depth[i], k, scales=[0.7, 1.3], rgb_everywhere=True)
+            for a, b in zip(views, single):
+                for key in ("rgb", "depth", "mask", "K"):
+                    assert np.array_equal(a[key], b[key]), (i, key)
+    # A strided stack (BGR turned RGB) too.
+    bgr = np.ascontiguousarray(rgb[..., ::-1])
+    strided = renderer.refocus(bgr[..., ::-1], depth, Ks, scales=[1.0])
+    assert all(np.array_equal(s[0]["rgb"], renderer.refocus(rgb[i], depth[i], Ks[i], scales=[1.0])[0]["rgb"])
+               for i, s in enumerate(strided))
+    with pytest.raises(vs.InvalidInputError, match="depth"):
+        renderer.refocus(rgb, depth[0], Ks)
+    with pytest.raises(vs.InvalidInputError, match="K"):
+        renderer.refocus(rgb, depth, Ks[:3])
