@@ -33,6 +33,9 @@ const REFOCUS_FRAG: [&str; 5] = [
     "common/refocus_sample.glsl",
 ];
 const REFOCUS_SWITCHES: &[(&str, &[i64])] = &[("WANT_RGB", &[0, 1]), ("TRI_TEX_WIDTH", &[TRI_TEX_WIDTH])];
+/// The full-screen pass also colours every in-frame pixel under `--rgb-everywhere`.
+const REFOCUS_FULLSCREEN_SWITCHES: &[(&str, &[i64])] =
+    &[("WANT_RGB", &[0, 1]), ("RGB_EVERYWHERE", &[0, 1]), ("TRI_TEX_WIDTH", &[TRI_TEX_WIDTH])];
 const SPLAT_GATHER_COMMON: [&str; 5] = [
     "common/bindings.glsl",
     "common/camera.glsl",
@@ -53,7 +56,19 @@ pub const PROGRAMS: &[ProgramEntry] = &[
                 &[REFOCUS_FRAG[0], REFOCUS_FRAG[1], REFOCUS_FRAG[2], REFOCUS_FRAG[3], REFOCUS_FRAG[4], "refocus/fullscreen.frag"],
             ),
         ],
-        switches: REFOCUS_SWITCHES,
+        switches: REFOCUS_FULLSCREEN_SWITCHES,
+        vulkan: Some(&[]),
+    },
+    ProgramEntry {
+        name: "refocus/colour_everywhere",
+        stages: &[
+            ("vert", FULLSCREEN_VERT),
+            (
+                "frag",
+                &[REFOCUS_FRAG[0], REFOCUS_FRAG[1], REFOCUS_FRAG[2], REFOCUS_FRAG[3], REFOCUS_FRAG[4], "refocus/colour_everywhere.frag"],
+            ),
+        ],
+        switches: &[("TRI_TEX_WIDTH", &[TRI_TEX_WIDTH])],
         vulkan: Some(&[]),
     },
     ProgramEntry {

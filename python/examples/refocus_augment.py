@@ -2,8 +2,10 @@
 
 `RefocusAugment` wraps any map-style dataset whose items are (rgb uint8[H, W, 3], depth
 float32[H, W] in metres, K 3x3) and returns each item re-rendered at a random zoom s in
-[zoom_min, zoom_max] from the same pose, at the same size, with its new K and a validity mask
-(what the source did not see stays invalid: mask False, rgb 0, depth 0). It has the
+[zoom_min, zoom_max] (log-uniform, as `refocus --zoom-random`: zooming in and out equally often)
+from the same pose, at the same size, with its new K and a validity mask (what the source did not
+see stays invalid: mask False, depth 0). Colour is sampled everywhere inside the source frame
+(`rgb_everywhere=True`), so training images have no black holes at depth gaps and edges. It has the
 `__len__`/`__getitem__` of a torch.utils.data.Dataset, so it plugs into a DataLoader as is;
 torch itself is not needed here.
 
@@ -15,9 +17,11 @@ Renderer itself; otherwise use DataLoader(..., multiprocessing_context="spawn").
     loader = DataLoader(RefocusAugment(my_rgbd_dataset), batch_size=8, num_workers=4,
                         multiprocessing_context="spawn")
 
-Run this file to refocus a synthetic frame: python examples/refocus_augment.py
+Run this file to refocus a synthetic frame in two spawned worker processes (as DataLoader
+workers would): python examples/refocus_augment.py
 """
 
+import multiprocessing
 import os
 import threading
 
@@ -37,7 +41,7 @@ class RefocusAugment:
         self.seed = seed
         self.epoch = 0
         self.device = device
-        self.options = refocus_options
+        self.options = {"rgb_everywhere": True, **refocus_options}
         self._local = threading.local()
 
     def __getstate__(self):
@@ -68,7 +72,7 @@ class RefocusAugment:
     def __getitem__(self, index):
         rgb, depth, K = self.base[index]
         rng = np.random.default_rng((self.seed, self.epoch, index))
-        scale = float(rng.uniform(*self.zoom))
+        scale = float(np.exp(rng.uniform(np.log(self.zoom[0]), np.log(self.zoom[1]))))
         (view,) = self.renderer().refocus(rgb, depth, K, scales=[scale], **self.options)
         return {
             "rgb": view["rgb"],
@@ -89,11 +93,19 @@ def synthetic_frame(width=160, height=120):
     return rgb, depth, K
 
 
+def _item(args):
+    data, i = args
+    return i, os.getpid(), data[i]
+
+
 if __name__ == "__main__":
     data = RefocusAugment([synthetic_frame()] * 4, zoom_min=0.6, zoom_max=1.8)
-    for i in range(len(data)):
-        item = data[i]
+    # Workers as a DataLoader's: spawned, each opening its own Renderer on its first item.
+    with multiprocessing.get_context("spawn").Pool(2) as pool:
+        items = pool.map(_item, [(data, i) for i in range(len(data))])
+    for i, pid, item in items:
         print(
+            f"worker {pid} "
             f"item {i}: zoom {item['scale']:.3f}  fx' {item['K'][0, 0]:.1f}  "
             f"rgb {item['rgb'].shape}  valid {item['mask'].mean():.1%}"
         )

@@ -1,5 +1,6 @@
-//! numpy in: strict checks with messages naming the argument (dtype, shape, C order), then one
-//! copy into the library's owned images. numpy out: the library's buffers handed to numpy without
+//! numpy in: strict checks with messages naming the argument (dtype, shape, alignment), then one
+//! copy into the library's owned images (a strided view, e.g. `bgr[..., ::-1]`, a slice or a
+//! transpose, is copied in C order by that same one copy). numpy out: the library's buffers handed to numpy without
 //! a copy.
 
 use crate::errors;
@@ -20,7 +21,7 @@ fn shape_text(shape: &[usize]) -> String {
     }
 }
 
-/// `obj` as a numpy array of element type `T`, C-contiguous and aligned, with `ndim` axes.
+/// `obj` as a numpy array of element type `T`, aligned, with `ndim` axes (any strides).
 fn checked<'py, T: numpy::Element>(
     obj: &Bound<'py, PyAny>,
     name: &str,
@@ -49,17 +50,27 @@ fn checked<'py, T: numpy::Element>(
         ));
     }
     let aligned: bool = array.getattr("flags")?.getattr("aligned")?.extract()?;
-    if !array.is_c_contiguous() || !aligned {
+    if !aligned {
         return Err(errors::invalid(
             name,
             format!(
-                "array of shape {} is not C-contiguous and aligned (a slice, transpose or view); \
-                 pass numpy.ascontiguousarray({name})",
+                "array of shape {} is not aligned (a view into a packed buffer); pass numpy.ascontiguousarray({name})",
                 shape_text(array.shape())
             ),
         ));
     }
     Ok(array.cast::<PyArrayDyn<T>>()?.clone())
+}
+
+/// The elements in C order: one copy, straight from memory when C-contiguous, else walked in
+/// logical order through the strides (numpy's own copy would be a second one).
+fn c_order<T: numpy::Element + Copy>(array: &Bound<'_, PyArrayDyn<T>>) -> PyResult<Vec<T>> {
+    let view = array.readonly();
+    // `as_slice` also takes Fortran order, whose memory is not C order: ask for C order itself.
+    match array.is_c_contiguous() {
+        true => Ok(view.as_slice()?.to_vec()),
+        false => Ok(view.as_array().iter().copied().collect()),
+    }
 }
 
 fn size(shape: &[usize], name: &str) -> PyResult<(u32, u32)> {
@@ -82,7 +93,7 @@ pub fn rgb_image(obj: &Bound<'_, PyAny>, name: &str) -> PyResult<RgbImage> {
         ));
     }
     let (w, h) = size(&shape, name)?;
-    let data = array.readonly().as_slice()?.to_vec();
+    let data = c_order(&array)?;
     RgbImage::new(w, h, data).map_err(errors::from_library)
 }
 
@@ -91,7 +102,7 @@ pub fn rgb_image(obj: &Bound<'_, PyAny>, name: &str) -> PyResult<RgbImage> {
 pub fn float_map(obj: &Bound<'_, PyAny>, name: &str) -> PyResult<DepthMap> {
     let array = checked::<f32>(obj, name, 2, "float32[H, W]")?;
     let (w, h) = size(array.shape(), name)?;
-    let mut data = array.readonly().as_slice()?.to_vec();
+    let mut data = c_order(&array)?;
     // The library's rule for every depth input: magnitudes no pass computes finitely are holes.
     viewsynth::depth::clear_unusable_depth(&mut data);
     DepthMap::new(w, h, data).map_err(errors::from_library)
@@ -120,8 +131,7 @@ pub fn rgb_faces(obj: &Bound<'_, PyAny>, name: &str) -> PyResult<Vec<RgbImage>> 
     let array = checked::<u8>(obj, name, 4, expected)?;
     let shape = array.shape().to_vec();
     let n = face_side(&shape, shape[3] == 3, name, expected)?;
-    let data = array.readonly();
-    let data = data.as_slice()?;
+    let data = c_order(&array)?;
     data.chunks_exact(data.len() / 6)
         .map(|face| RgbImage::new(n, n, face.to_vec()).map_err(errors::from_library))
         .collect()
@@ -133,8 +143,7 @@ pub fn depth_faces(obj: &Bound<'_, PyAny>, name: &str) -> PyResult<Vec<DepthMap>
     let array = checked::<f32>(obj, name, 3, expected)?;
     let shape = array.shape().to_vec();
     let n = face_side(&shape, true, name, expected)?;
-    let data = array.readonly();
-    let data = data.as_slice()?;
+    let data = c_order(&array)?;
     data.chunks_exact(data.len() / 6)
         .map(|face| {
             let mut face = face.to_vec();

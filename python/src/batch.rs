@@ -191,6 +191,8 @@ pub struct BatchArgs<'a, 'py> {
     pub resume: bool,
     pub jobs: Option<usize>,
     pub shard: Option<&'a str>,
+    /// rgb_everywhere, random zoom and progress (augment.rs).
+    pub augment: crate::augment::Augment<'py>,
 }
 
 /// The settings as the library's request, checked by it as the CLI's `refocus --batch`.
@@ -213,6 +215,10 @@ fn options(a: &BatchArgs<'_, '_>) -> PyResult<BatchOptions> {
         resume: a.resume,
         jobs: a.jobs,
         shard: a.shard.map(str::to_string),
+        rgb_everywhere: a.augment.rgb_everywhere,
+        zoom_random: a.augment.zoom_random,
+        samples: a.augment.samples,
+        seed: a.augment.seed,
     };
     request.batch(Conventions::default()).map_err(errors::from_request)
 }
@@ -222,14 +228,19 @@ pub fn refocus_batch<'py>(py: Python<'py>, gpu: Backend, a: BatchArgs<'_, 'py>) 
     let opts = options(&a)?;
     let frames = frames(a.frames)?;
     let out_dir = a.out_dir;
+    let progress =
+        crate::augment::Progress::new(a.augment.progress, crate::augment::frames_in_share(frames.len(), &opts))?;
     // Paths and options were copied out of Python above; see SameThread for why the move is sound.
-    let work = SameThread((gpu, frames, out_dir, opts));
+    let work = SameThread((gpu, frames, out_dir, opts, progress));
     let result = py.detach(move || {
         let work = work;
-        let (gpu, frames, out_dir, opts) = work.0;
-        SameThread(run_batch(&gpu, &frames, &out_dir, &opts, || {}))
+        let (gpu, frames, out_dir, opts, progress) = work.0;
+        let summary = run_batch(&gpu, &frames, &out_dir, &opts, || progress.advance());
+        SameThread((summary, progress))
     });
-    let summary = result.0.map_err(errors::from_library)?;
+    let (summary, progress) = result.0;
+    progress.finish()?;
+    let summary = summary.map_err(errors::from_library)?;
     let text = serde_json::to_string(&summary).map_err(|e| pyo3::exceptions::PyRuntimeError::new_err(e.to_string()))?;
     py.import("json")?.call_method1("loads", (text,))
 }

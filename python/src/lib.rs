@@ -4,6 +4,7 @@
 //! batch's writers): `batch`.
 
 mod arrays;
+mod augment;
 mod backend;
 mod batch;
 mod context;
@@ -13,6 +14,7 @@ mod ints;
 mod renderer;
 mod reproject;
 mod shared;
+mod stack;
 mod stitch;
 
 use pyo3::prelude::*;
@@ -57,6 +59,7 @@ fn _viewsynth(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<renderer::Renderer>()?;
     m.add_function(wrap_pyfunction!(info, m)?)?;
     m.add_function(wrap_pyfunction!(batch::load_manifest, m)?)?;
+    m.add_function(wrap_pyfunction!(augment::read_depth, m)?)?;
     m.add_function(wrap_pyfunction!(_request_defaults, m)?)?;
     m.add_function(wrap_pyfunction!(_keyword, m)?)?;
     m.add("_REQUEST_COMMANDS", viewsynth::job::REQUEST_COMMANDS.to_vec())?;

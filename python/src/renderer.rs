@@ -23,6 +23,7 @@ struct RefocusJob {
     method: Method,
     outputs: OutputSet,
     targets: Vec<PinholeCamera>,
+    rgb_everywhere: bool,
 }
 
 /// The GPU work of one call: upload the source once, render every target.
@@ -36,6 +37,7 @@ fn render_all(gpu: &Backend, job: &RefocusJob) -> viewsynth::Result<(f64, Vec<Re
         job.outputs,
         Conventions::default(),
     )?;
+    refocuser.set_rgb_everywhere(job.rgb_everywhere);
     let setup_ms = t0.elapsed().as_secs_f64() * 1e3;
     let rendered = job
         .targets
@@ -344,6 +346,10 @@ impl Renderer {
     /// tau_rel, tau_abs: an edge between neighbouring depths za, zb breaks when
     /// |za - zb| > tau_rel * min(za, zb) or > tau_abs metres (inf disables).
     /// method: "fullscreen" (fast, default) or "mesh"; both give the same images.
+    /// rgb_everywhere: colour at every pixel inside the source frame (mask and depth unchanged).
+    /// Stacks: rgb uint8[N, H, W, 3], depth float32[N, H, W], K 3x3 or [N, 3, 3] give a list of
+    /// N lists, each what the single call gives. Strided arrays (slices, bgr[..., ::-1]) are
+    /// copied once, as contiguous ones are.
     ///
     /// Returns one dict per target, in order: "scale" (fx'/fx), "K" (float64[3, 3]),
     /// "coverage" (fraction of valid pixels; None with rgb alone), "timings" (setup_ms: upload
@@ -356,7 +362,7 @@ impl Renderer {
     /// memory layout or value; GpuError if the GPU fails.
     #[allow(non_snake_case, clippy::too_many_arguments)]
     #[pyo3(signature = (rgb, depth, K, *, scales = None, K_out = None, size = None, principal = None,
-                        outputs = None, tau_rel = 0.05, tau_abs = 0.2, method = "fullscreen"))]
+                        outputs = None, tau_rel = 0.05, tau_abs = 0.2, method = "fullscreen", rgb_everywhere = false))]
     fn refocus<'py>(
         &mut self,
         py: Python<'py>,
@@ -371,7 +377,31 @@ impl Renderer {
         tau_rel: f64,
         tau_abs: f64,
         method: &str,
+        rgb_everywhere: bool,
     ) -> PyResult<Bound<'py, PyList>> {
+        if let Some(frames) = crate::stack::frames(rgb, depth, K)? {
+            let views = PyList::empty(py);
+            for (rgb, depth, k) in frames {
+                let (s, o) = (scales.clone(), outputs);
+                let one = self.refocus(
+                    py,
+                    &rgb,
+                    &depth,
+                    &k,
+                    s,
+                    K_out,
+                    size,
+                    principal,
+                    o,
+                    tau_rel,
+                    tau_abs,
+                    method,
+                    rgb_everywhere,
+                );
+                views.append(one?)?;
+            }
+            return Ok(views);
+        }
         let gpu = self.gpu()?.clone();
         let k = arrays::intrinsics(K, "K")?;
         let source = RefocusSource::new(arrays::rgb_image(rgb, "rgb")?, arrays::float_map(depth, "depth")?, k)
@@ -387,6 +417,7 @@ impl Renderer {
             tau_rel,
             tau_abs,
             method: choice("--method", method)?,
+            rgb_everywhere,
             ..Default::default()
         };
         let plan = request.frame().map_err(errors::from_request)?;
@@ -423,6 +454,7 @@ impl Renderer {
             method,
             outputs,
             targets,
+            rgb_everywhere,
         };
         // The inputs were copied out of numpy above, so other Python threads may run (and even
         // modify those arrays) while the GPU works.
@@ -744,7 +776,8 @@ impl Renderer {
     /// "rle", "zip", "piz"), depth_trunc (metres), resume (skip frames finished with the same
     /// settings; False = the CLI's --force), jobs (decode and encode threads around the GL
     /// thread, default the core count; 0 = every stage in turn on this thread), shard ("K/N"):
-    /// the CLI's options of the same names.
+    /// the CLI's options of the same names; so are rgb_everywhere, zoom_random=(lo, hi), samples
+    /// and seed (--zoom-random, log-uniform draws). progress: f(done, total) per frame, or True.
     ///
     /// Returns the batch summary: "rendered", "skipped", "other_shards", "failed" (a list of
     /// [frame name, error message]: a failed frame leaves no folder and does not stop the
@@ -756,7 +789,8 @@ impl Renderer {
     #[pyo3(signature = (frames, out_dir, *, scales = None, size = None, principal = None,
                         outputs = None, tau_rel = 0.05, tau_abs = 0.2, method = "fullscreen", rgb_format = "png",
                         depth_format = None, depth_preview = false, png_compression = "fast",
-                        exr_compression = "zip", depth_trunc = None, resume = true, jobs = None, shard = None))]
+                        exr_compression = "zip", depth_trunc = None, resume = true, jobs = None, shard = None,
+                        rgb_everywhere = false, zoom_random = None, samples = None, seed = None, progress = None))]
     fn refocus_batch<'py>(
         &mut self,
         py: Python<'py>,
@@ -778,6 +812,11 @@ impl Renderer {
         resume: bool,
         #[pyo3(from_py_with = crate::ints::jobs)] jobs: Option<usize>,
         shard: Option<&str>,
+        rgb_everywhere: bool,
+        zoom_random: Option<(f64, f64)>,
+        samples: Option<usize>,
+        seed: Option<u64>,
+        progress: Option<Bound<'py, PyAny>>,
     ) -> PyResult<Bound<'py, PyAny>> {
         let gpu = self.gpu()?.clone();
         crate::batch::refocus_batch(
@@ -802,6 +841,13 @@ impl Renderer {
                 resume,
                 jobs,
                 shard,
+                augment: crate::augment::Augment {
+                    rgb_everywhere,
+                    zoom_random,
+                    samples,
+                    seed,
+                    progress,
+                },
             },
         )
     }

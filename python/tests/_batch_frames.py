@@ -52,9 +52,12 @@ def without_timings(manifest):
 
 def assert_same_batch_output(a: Path, b: Path):
     """Two batch output folders hold the same frame folders and the same files, byte for byte,
-    and the same manifests but for the timings. Returns the frame folder names."""
-    frames = sorted(p.name for p in a.iterdir())
-    assert frames == sorted(p.name for p in b.iterdir())
+    and the same manifests but for the timings; the same index rows where both have an index.
+    Returns the frame folder names."""
+    frames = sorted(p.name for p in a.iterdir() if p.is_dir())
+    assert frames == sorted(p.name for p in b.iterdir() if p.is_dir())
+    if (a / "index.jsonl").is_file() and (b / "index.jsonl").is_file():
+        assert (a / "index.jsonl").read_text() == (b / "index.jsonl").read_text()
     for name in frames:
         files = sorted(p.name for p in (a / name).iterdir())
         assert files == sorted(p.name for p in (b / name).iterdir()), name

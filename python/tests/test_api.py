@@ -1,7 +1,7 @@
 """The public surface: info(), require_gpu, the .pyi stubs against the module, the example."""
 
 import ast
-import runpy
+import subprocess
 import sys
 from pathlib import Path
 
@@ -128,5 +128,9 @@ def test_augment_example_draws_seeded_zooms():
         assert not border.any() if it["scale"] < 0.95 else border.all()
         # The box's silhouette breaks the mesh: invalid pixels inside the frame either way.
         assert not m[10:-10, 10:-10].all()
-    # The example's script entry point runs as documented.
-    runpy.run_path(str(EXAMPLES / "refocus_augment.py"), run_name="__main__")
+    # The example's script entry point runs as documented: items drawn in two spawned worker
+    # processes (a subprocess, as spawn re-imports the script as its workers' main module).
+    done = subprocess.run([sys.executable, str(EXAMPLES / "refocus_augment.py")], capture_output=True, text=True)
+    assert done.returncode == 0, done.stderr
+    lines = done.stdout.splitlines()
+    assert len(lines) == 4 and all(line.startswith("worker ") for line in lines), done.stdout

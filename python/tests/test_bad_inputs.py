@@ -33,11 +33,22 @@ def test_wrong_dtypes(renderer, frame):
     check(renderer, frame, "K", ["3x3 matrix of numbers"], K=[["a", 0, 1], [0, 1, 1], [0, 0, 1]])
 
 
-def test_non_contiguous(renderer, frame):
+def test_strided_arrays_are_taken_as_their_contiguous_copies(renderer, frame):
+    # A BGR image turned RGB, a Fortran-ordered depth, a transposed view: each gives what its
+    # C-contiguous copy gives (the binding copies once, in C order).
     rgb, depth, K = frame
-    check(renderer, frame, "rgb", ["not C-contiguous", "ascontiguousarray"], rgb=rgb[:, ::2])
-    check(renderer, frame, "depth", ["not C-contiguous"], depth=np.asfortranarray(depth))
-    check(renderer, frame, "depth", ["not C-contiguous"], depth=depth.T.copy().T)
+    bgr = np.ascontiguousarray(rgb[..., ::-1])
+    want = renderer.refocus(rgb, depth, K, scales=[0.8, 1.5])
+    for got in (renderer.refocus(bgr[..., ::-1], depth, K, scales=[0.8, 1.5]),
+                renderer.refocus(rgb, np.asfortranarray(depth), K, scales=[0.8, 1.5]),
+                renderer.refocus(rgb, depth.T.copy().T, K, scales=[0.8, 1.5])):
+        for a, b in zip(want, got):
+            for key in ("rgb", "depth", "mask"):
+                assert np.array_equal(a[key], b[key], equal_nan=True), key
+    wide = np.zeros((72, 192, 3), np.uint8)
+    wide[:, ::2] = rgb
+    one = renderer.refocus(rgb, depth, K, scales=[1.0])[0]["rgb"]
+    assert np.array_equal(renderer.refocus(wide[:, ::2], depth, K, scales=[1.0])[0]["rgb"], one)
 
 
 def test_wrong_shapes(renderer, frame):

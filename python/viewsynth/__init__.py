@@ -8,12 +8,14 @@
     right = r.reproject(rgb, depth, K, baseline=0.1)["right"]
     ods = r.stitch(left_rgb, left_depth, right_rgb, right_depth, width=2048, height=1024)["rgb"]
     r.refocus_batch(vs.load_manifest("frames.csv"), "out/")   # files, as `viewsynth refocus --batch`
+    rows = vs.read_index("out/")             # one dict per target; vs.read_depth(rows[0]["depth"])
 
 A Renderer belongs to the thread that created it, and to the process that created it:
 see the Renderer docstring for threads, fork and spawn.
 """
 
-from ._viewsynth import FACE_ORDER, Renderer, __version__, info, load_manifest
+from ._viewsynth import FACE_ORDER, Renderer, __version__, info, load_manifest, read_depth
+from .dataset import read_index
 from .errors import (
     FileError,
     GpuError,
@@ -29,6 +31,8 @@ __all__ = [
     "Renderer",
     "info",
     "load_manifest",
+    "read_depth",
+    "read_index",
     "FACE_ORDER",
     "__version__",
     "ViewsynthError",

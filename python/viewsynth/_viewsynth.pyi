@@ -2,7 +2,7 @@
 
 import os
 from types import TracebackType
-from typing import Any, Dict, List, Literal, Mapping, Optional, Sequence, Tuple, TypedDict, Union
+from typing import Callable, Any, Dict, List, Literal, Mapping, Optional, Sequence, Tuple, TypedDict, Union
 
 import numpy as np
 import numpy.typing as npt
@@ -177,6 +177,7 @@ class Renderer:
         tau_rel: float = 0.05,
         tau_abs: float = 0.2,
         method: Literal["fullscreen", "mesh"] = "fullscreen",
+        rgb_everywhere: bool = False,
     ) -> List[RefocusView]:
         """Re-render rgb uint8[H, W, 3] + depth float32[H, W] (metres) with intrinsics K at
         other focal lengths (scales=[...] or K_out=[...]), same pose. size is (width, height).
@@ -295,11 +296,21 @@ class Renderer:
         resume: bool = True,
         jobs: Optional[int] = None,
         shard: Optional[str] = None,
+        rgb_everywhere: bool = False,
+        zoom_random: Optional[Tuple[float, float]] = None,
+        samples: Optional[int] = None,
+        seed: Optional[int] = None,
+        progress: Union[None, bool, Callable[[int, int], Any]] = None,
     ) -> BatchSummary:
         """`viewsynth refocus --batch` on this context: frames (a manifest path or dicts with
         its keys) from files into out_dir/<name>/, the CLI's files byte for byte.
         See help(viewsynth.Renderer.refocus_batch)."""
         ...
+
+def read_depth(path: Union[str, "os.PathLike[str]"], *, depth_scale: Optional[float] = None) -> npt.NDArray[np.float32]:
+    """A depth file the CLI writes (EXR, NPY, 16-bit PNG in millimetres) or reads, as float32[H, W]
+    view-space Z in metres, 0 where invalid."""
+    ...
 
 def info(device: str = "auto") -> Dict[str, Any]:
     """Describe the EGL/OpenGL context viewsynth renders with."""

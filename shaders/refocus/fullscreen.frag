@@ -49,11 +49,16 @@ void main() {
         return;
     }
     ivec2 c0 = ivec2(cx.x, cy.x);
+#if WANT_RGB && RGB_EVERYWHERE
+    // Same pose: where a source pixel lands does not depend on its depth, so every pixel inside
+    // the source frame gets its bilinear colour; depth and mask keep their meaning below.
+    o_rgb = vec4(cell_rgb(c0, clamp(vec2(cx.y, cy.y), 0.0, 1.0)), 1.0);
+#endif
     float z = surface_depth(c0, vec2(cx.y, cy.y), bvec2(cx.z != 0.0, cy.z != 0.0));
     if (z >= NONE) {
         return;
     }
-#if WANT_RGB
+#if WANT_RGB && !RGB_EVERYWHERE
     // Cell c spans source pixels c - 1 .. c (clamped at the border ring), exactly the bilinear
     // footprint of its points, with the local coordinate as weight.
     o_rgb = vec4(cell_rgb(c0, clamp(vec2(cx.y, cy.y), 0.0, 1.0)), 1.0);

@@ -209,6 +209,8 @@ pub fn batch_bench(
     let (w, h) = io::load_rgb(&first.rgb).map(|i| (i.width, i.height))?;
     let scales = crate::refocus::manifest::DEFAULT_SCALES.to_vec();
     let opts = |jobs: usize| BatchOptions {
+        zoom_random: None,
+        rgb_everywhere: false,
         scales: scales.clone(),
         size: None,
         principal: None,

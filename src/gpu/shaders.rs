@@ -160,7 +160,13 @@ pub enum ProgramKind {
     RefocusFullscreen {
         /// Colour is written as well as depth and mask (`WANT_RGB`).
         want_rgb: bool,
+        /// Colour at every pixel inside the source frame, not only where covered
+        /// (`RGB_EVERYWHERE`, `--rgb-everywhere`).
+        rgb_everywhere: bool,
     },
+    /// refocus/colour_everywhere.frag: the mesh path's first draw under `--rgb-everywhere`
+    /// (colour inside the source frame, far depth, no mask).
+    RefocusColourEverywhere,
     /// refocus/mesh_interior.*: interior grid triangles, indexed.
     RefocusMeshInterior {
         /// Colour is written as well as depth and mask (`WANT_RGB`).
@@ -292,6 +298,7 @@ impl ProgramKind {
     pub fn name(&self) -> &'static str {
         match self {
             ProgramKind::RefocusFullscreen { .. } => "refocus/fullscreen",
+            ProgramKind::RefocusColourEverywhere => "refocus/colour_everywhere",
             ProgramKind::RefocusMeshInterior { .. } => "refocus/mesh_interior",
             ProgramKind::RefocusMeshBoundary { .. } => "refocus/mesh_boundary",
             ProgramKind::CyclopeanGather { .. } => "cyclopean/gather",
@@ -314,9 +321,16 @@ impl ProgramKind {
     /// The program's own switches.
     fn defines(&self) -> Vec<Define> {
         match *self {
-            ProgramKind::RefocusFullscreen { want_rgb }
-            | ProgramKind::RefocusMeshInterior { want_rgb }
-            | ProgramKind::RefocusMeshBoundary { want_rgb } => {
+            ProgramKind::RefocusFullscreen {
+                want_rgb,
+                rgb_everywhere,
+            } => vec![
+                flag("WANT_RGB", want_rgb),
+                flag("RGB_EVERYWHERE", rgb_everywhere),
+                int("TRI_TEX_WIDTH", TRI_TEX_WIDTH.into()),
+            ],
+            ProgramKind::RefocusColourEverywhere => vec![int("TRI_TEX_WIDTH", TRI_TEX_WIDTH.into())],
+            ProgramKind::RefocusMeshInterior { want_rgb } | ProgramKind::RefocusMeshBoundary { want_rgb } => {
                 vec![flag("WANT_RGB", want_rgb), int("TRI_TEX_WIDTH", TRI_TEX_WIDTH.into())]
             }
             ProgramKind::CyclopeanGather {
@@ -409,8 +423,14 @@ impl ShaderProgram {
     /// Every program of the library (each switch at each value) under `conv`.
     pub fn all(conv: Conventions) -> Vec<ShaderProgram> {
         let mut kinds = Vec::new();
+        kinds.push(ProgramKind::RefocusColourEverywhere);
         for want_rgb in [false, true] {
-            kinds.push(ProgramKind::RefocusFullscreen { want_rgb });
+            for rgb_everywhere in [false, true] {
+                kinds.push(ProgramKind::RefocusFullscreen {
+                    want_rgb,
+                    rgb_everywhere,
+                });
+            }
             kinds.push(ProgramKind::RefocusMeshInterior { want_rgb });
             kinds.push(ProgramKind::RefocusMeshBoundary { want_rgb });
         }

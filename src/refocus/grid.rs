@@ -248,6 +248,14 @@ impl Grid {
 /// (1e-5 x the depth change across the cell).
 pub const CELL_EPS: f64 = 1e-5;
 
+/// The source-image span, along an axis of `n` pixels, of the points the lookups locate (the
+/// grid with its border ring, [-0.5, n - 0.5], widened by half the closed tolerance): the source
+/// frame as the passes see it. `--rgb-everywhere` colours exactly the points inside it on both
+/// axes, so the twin uses it too.
+pub fn frame_span(n: u32) -> (f64, f64) {
+    (-0.5 - 0.5 * CELL_EPS, n as f64 - 0.5 + 0.5 * CELL_EPS)
+}
+
 /// Same-pose lookup along one axis, for the full-screen path: for each target column (or row)
 /// x, the source coordinate u = c_src + (x - c_dst) * ratio is located in f64 and stored as
 /// [cell, local coordinate in it, 1 if u lies on (within CELL_EPS of) the cell's left/top
@@ -256,6 +264,7 @@ pub const CELL_EPS: f64 = 1e-5;
 /// The mapping is separable: W' + H' of these replace per-pixel double arithmetic.
 pub fn axis_lookup(n_src: u32, c_src: f64, c_dst: f64, ratio: f64, n_dst: u32) -> Vec<[f32; 4]> {
     let n = n_src as i64;
+    let (lo, hi) = frame_span(n_src);
     let local = |u: f64, i: i64| {
         let x0 = Grid::vertex_pos(i, n_src);
         (u - x0) / (Grid::vertex_pos(i + 1, n_src) - x0)
@@ -263,7 +272,6 @@ pub fn axis_lookup(n_src: u32, c_src: f64, c_dst: f64, ratio: f64, n_dst: u32) -
     (0..n_dst)
         .map(|x| {
             let u = c_src + (x as f64 - c_dst) * ratio;
-            let (lo, hi) = (-0.5 - 0.5 * CELL_EPS, n as f64 - 0.5 + 0.5 * CELL_EPS);
             if !(u >= lo && u <= hi) {
                 return [-1.0, 0.0, 0.0, 0.0];
             }

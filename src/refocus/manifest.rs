@@ -127,6 +127,17 @@ depth: view-space Z in metres (distance along the optical axis), float32, 0 wher
 mask: 255 where a kept triangle covers the pixel centre, 0 elsewhere; rows top-down; \
 K' follows OpenCV: pixel (u, v) has its centre at (u, v).";
 
+/// [`MANIFEST_NOTES`], amended under `--rgb-everywhere`.
+pub fn manifest_notes(rgb_everywhere: bool) -> String {
+    match rgb_everywhere {
+        false => MANIFEST_NOTES.to_string(),
+        true => format!(
+            "{MANIFEST_NOTES} rgb_everywhere: rgb is sampled bilinearly at every pixel inside the source frame, \
+             covered or not (0 only outside it); depth and mask still mark valid geometry only."
+        ),
+    }
+}
+
 /// The manifest written as `manifest.json` beside the outputs.
 #[derive(Debug, Clone, Serialize)]
 pub struct Manifest {
@@ -144,6 +155,9 @@ pub struct Manifest {
     pub renderer: String,
     /// What the files hold: depth is view-space Z in metres with 0 = invalid; mask 255 = valid.
     pub notes: String,
+    /// `--rgb-everywhere`: colour at every pixel inside the source frame (absent when off).
+    #[serde(skip_serializing_if = "std::ops::Not::not")]
+    pub rgb_everywhere: bool,
     /// The settings a batch frame was made with; resume redoes the frame when they differ.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub settings: Option<serde_json::Value>,

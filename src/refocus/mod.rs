@@ -20,7 +20,7 @@ pub mod pass;
 pub mod reference;
 mod render;
 
-pub use grid::{axis_lookup, valid_depth, BreakRule, Grid};
+pub use grid::{axis_lookup, frame_span, valid_depth, BreakRule, Grid};
 pub use mesh::TRI_TEX_WIDTH;
 pub use pass::RefocusInput;
 pub use render::{PendingRefocus, RefocusOutput, RefocusParams, Refocuser};

@@ -1,10 +1,10 @@
 //! The refocus pass/twin contract: one [`RefocusInput`] (source, target camera, settings), and
 //! [`gpu()`] and [`reference()`] over it, both returning a [`ViewOutput`]. Thin over
-//! [`Refocuser`] and [`refocus_reference`]: no numerics of its own, so the views are exactly
+//! [`Refocuser`] and [`super::reference::refocus_reference_with`]: no numerics of its own, so the views are exactly
 //! what those return. A caller refocusing many targets of one source keeps a [`Refocuser`]
 //! (programs and uploads are per renderer); this is the shape the tests hold both sides to.
 
-use super::reference::refocus_reference;
+use super::reference::refocus_reference_with;
 use super::{BreakRule, Method, OutputSet, RefocusSource, Refocuser};
 use crate::camera::PinholeCamera;
 use crate::convention::Conventions;
@@ -25,6 +25,8 @@ pub struct RefocusInput<'a> {
     pub method: Method,
     /// Which planes to produce; both sides leave out the others.
     pub outputs: OutputSet,
+    /// Colour every pixel inside the source frame, covered or not (`--rgb-everywhere`).
+    pub rgb_everywhere: bool,
     /// GPU conventions; the outputs are top-down view Z whatever they are, so the twin has no use
     /// for them.
     pub conv: Conventions,
@@ -33,15 +35,16 @@ pub struct RefocusInput<'a> {
 /// The GPU refocus of `input` (one [`Refocuser`], one target) on `device`: a GL context or
 /// either executor's [`crate::pass::Device`].
 pub fn gpu(device: impl ToDevice, input: &RefocusInput) -> Result<ViewOutput> {
-    let out = Refocuser::new(
+    let mut r = Refocuser::new(
         device,
         input.source,
         &input.rule,
         input.method,
         input.outputs,
         input.conv,
-    )?
-    .render(input.target)?;
+    )?;
+    r.set_rgb_everywhere(input.rgb_everywhere);
+    let out = r.render(input.target)?;
     Ok(ViewOutput::from_refocus(&out))
 }
 
@@ -51,7 +54,7 @@ pub fn reference(input: &RefocusInput) -> Result<ViewOutput> {
     input.source.validate()?;
     // As the renderer does: the twin refuses what the GPU refuses.
     input.target.validate("target camera")?;
-    let r = refocus_reference(input.source, &input.rule, input.target);
+    let r = refocus_reference_with(input.source, &input.rule, input.target, input.rgb_everywhere);
     let mut view = ViewOutput::from_refocus_reference(&r);
     let o = input.outputs;
     if !o.rgb {

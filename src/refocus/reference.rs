@@ -1,7 +1,7 @@
 //! Float64 CPU twin of the GPU refocus passes: same grid, same break rule, same triangulation,
 //! exact ray/triangle depth and exact bilinear colour. The tests hold both GPU paths to it.
 
-use super::grid::{Grid, TRI1, TRI2};
+use super::grid::{frame_span, Grid, TRI1, TRI2};
 use super::{source_point, RefocusSource};
 use crate::camera::PinholeCamera;
 use crate::refocus::BreakRule;
@@ -97,6 +97,19 @@ pub fn bilinear_rgb(src: &RefocusSource, u: f64, v: f64) -> [f64; 3] {
 
 /// Reference refocus of `src` into `target` (same pose).
 pub fn refocus_reference(src: &RefocusSource, rule: &BreakRule, target: &PinholeCamera) -> ReferenceImage {
+    refocus_reference_with(src, rule, target, false)
+}
+
+/// [`refocus_reference`], and with `rgb_everywhere` the colour of every pixel whose source point
+/// lies inside the source frame ([`frame_span`] on both axes, as the passes' lookups decide),
+/// covered or not; depth and mask are the same either way.
+pub fn refocus_reference_with(
+    src: &RefocusSource,
+    rule: &BreakRule,
+    target: &PinholeCamera,
+    rgb_everywhere: bool,
+) -> ReferenceImage {
+    let (span_u, span_v) = (frame_span(src.rgb.width), frame_span(src.rgb.height));
     let grid = Grid {
         width: src.depth.width,
         height: src.depth.height,
@@ -113,10 +126,12 @@ pub fn refocus_reference(src: &RefocusSource, rule: &BreakRule, target: &Pinhole
     for y in 0..target.height {
         for x in 0..target.width {
             let [u, v] = source_point(&src.k, &target.k, x as f64, y as f64);
+            let o = y as usize * target.width as usize + x as usize;
             if let Some(z) = surface_depth(&grid, &src.depth.data, &keep, u, v) {
-                let o = y as usize * target.width as usize + x as usize;
                 out.depth[o] = z;
                 out.mask[o] = true;
+                out.rgb[o] = bilinear_rgb(src, u, v);
+            } else if rgb_everywhere && (span_u.0..=span_u.1).contains(&u) && (span_v.0..=span_v.1).contains(&v) {
                 out.rgb[o] = bilinear_rgb(src, u, v);
             }
         }

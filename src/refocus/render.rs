@@ -101,6 +101,8 @@ pub struct Refocuser {
     outputs: OutputSet,
     rule: BreakRule,
     method: Method,
+    /// `--rgb-everywhere`: colour at every target pixel inside the source frame.
+    rgb_everywhere: bool,
     source: Option<Source>,
     images: SourceImages,
     /// Most recently used last.
@@ -177,10 +179,23 @@ impl Refocuser {
             outputs,
             rule: *rule,
             method,
+            rgb_everywhere: false,
             source: None,
             images: SourceImages::default(),
             lookups: Vec::new(),
         })
+    }
+
+    /// Colour every target pixel inside the source frame (bilinear from the source whatever its
+    /// depth: same pose, so where a source pixel lands does not depend on it), not only those a
+    /// kept triangle covers; depth and mask are unchanged. Off by default (the seed's rule).
+    pub fn set_rgb_everywhere(&mut self, on: bool) {
+        self.rgb_everywhere = on;
+    }
+
+    /// Whether [`Refocuser::set_rgb_everywhere`] is on.
+    pub fn rgb_everywhere(&self) -> bool {
+        self.rgb_everywhere
     }
 
     /// The device this refocuser renders on.
@@ -353,12 +368,15 @@ impl Refocuser {
             })
         };
         let (keep_images, interior_images, pulled_images);
-        let mut steps = Vec::with_capacity(2);
+        let mut steps = Vec::with_capacity(3);
         match &source.geometry {
             Geometry::Fullscreen { keep } => {
                 keep_images = with(*keep);
                 steps.push(draw(
-                    ProgramKind::RefocusFullscreen { want_rgb },
+                    ProgramKind::RefocusFullscreen {
+                        want_rgb,
+                        rgb_everywhere: want_rgb && self.rgb_everywhere,
+                    },
                     &keep_images[..],
                     1,
                     None,
@@ -367,6 +385,16 @@ impl Refocuser {
             Geometry::Mesh(mesh) => {
                 let m = mesh.draws((tk.fx / sk.fx).min(tk.fy / sk.fy));
                 interior_images = shared;
+                if want_rgb && self.rgb_everywhere {
+                    // Colour inside the frame at the far depth first; the kept triangles then
+                    // overwrite what they cover.
+                    steps.push(draw(
+                        ProgramKind::RefocusColourEverywhere,
+                        &interior_images[..],
+                        1,
+                        None,
+                    ));
+                }
                 if let Some((indices, count)) = m.interior {
                     steps.push(draw(
                         ProgramKind::RefocusMeshInterior { want_rgb },

@@ -202,6 +202,7 @@ fn refocus_rows(gpu: &Gpu, opts: StressOptions) -> Result<Vec<StressRow>> {
                 rule: BreakRule::default(),
                 method,
                 outputs: OutputSet::default(),
+                rgb_everywhere: false,
                 conv,
             };
             let tag = format!("{tag} {method:?}");

@@ -34,6 +34,8 @@ fn setup(name: &str, n: usize) -> (tempfile::TempDir, PathBuf) {
 
 fn options(jobs: usize) -> BatchOptions {
     BatchOptions {
+        zoom_random: None,
+        rgb_everywhere: false,
         scales: vec![0.5, 1.0, 1.75],
         size: None,
         principal: None,
@@ -56,10 +58,11 @@ fn options(jobs: usize) -> BatchOptions {
     }
 }
 
-/// Every file under `dir` except manifests (they hold timings), by relative path.
+/// Every file under `dir`'s frame folders except manifests (they hold timings), by relative
+/// path (the index at the root lists the same files).
 fn files(dir: &Path) -> BTreeMap<String, Vec<u8>> {
     let mut out = BTreeMap::new();
-    for frame in std::fs::read_dir(dir).unwrap().flatten() {
+    for frame in std::fs::read_dir(dir).unwrap().flatten().filter(|e| e.path().is_dir()) {
         for f in std::fs::read_dir(frame.path()).unwrap().flatten() {
             let name = f.file_name().to_string_lossy().into_owned();
             if name != "manifest.json" {
@@ -123,7 +126,21 @@ fn shards_partition_the_manifest() {
         .map(|e| e.file_name().to_string_lossy().into_owned())
         .collect();
     names.sort();
-    assert_eq!(names, (0..7).map(|i| format!("f{i}")).collect::<Vec<_>>());
+    let frames: Vec<String> = (0..7).map(|i| format!("f{i}")).collect();
+    // The frame folders, each shard's index part and the index the last shard joined.
+    let parts = [
+        "index.jsonl",
+        "index.part-0-of-3.jsonl",
+        "index.part-1-of-3.jsonl",
+        "index.part-2-of-3.jsonl",
+    ];
+    assert_eq!(names, [&frames[..], &parts.map(String::from)[..]].concat());
+    assert_eq!(
+        viewsynth::refocus::batch::read_index(&out.join("index.jsonl"))
+            .unwrap()
+            .len(),
+        7 * 3
+    );
     assert!("3/3".parse::<Shard>().is_err() && "1/0".parse::<Shard>().is_err() && "a/2".parse::<Shard>().is_err());
     assert_eq!("2/5".parse::<Shard>().unwrap(), Shard { index: 2, count: 5 });
 }
@@ -141,6 +158,8 @@ fn resume_redoes_frames_whose_settings_or_files_changed() {
 
     // Other scales: every frame is redone.
     let other = BatchOptions {
+        zoom_random: None,
+        rgb_everywhere: false,
         scales: vec![0.5, 2.0],
         ..options(1)
     };

@@ -12,7 +12,7 @@ use viewsynth::io::{self, DepthMap, RgbImage};
 
 /// Two input pairs (`rgb{0,1}.png`, `depth{0,1}.npy`, 32 x 24) and a manifest of `n` frames
 /// `f0..` alternating between them (frame i uses pair i % 2).
-fn setup(name: &str, n: usize) -> (PathBuf, PathBuf) {
+pub(crate) fn setup(name: &str, n: usize) -> (PathBuf, PathBuf) {
     let dir = scratch(name);
     for p in 0..2u32 {
         let (w, h) = (32u32, 24u32);
@@ -199,7 +199,13 @@ fn shard_k_of_n_from_the_cli_takes_the_frames_with_i_mod_n_equal_k_and_resumes_p
                 )),
                 "{text}"
             );
-            assert_eq!(files_in(&own), want, "shard {k}/{n}");
+            // The frame folders, beside the shard's index part.
+            let frames: Vec<String> = files_in(&own)
+                .into_iter()
+                .filter(|f| !f.starts_with("index."))
+                .collect();
+            assert_eq!(frames, want, "shard {k}/{n}");
+            assert!(own.join(format!("index.part-{k}-of-{n}.jsonl")).is_file());
             // Into a folder the earlier shards wrote: only its own frames are rendered, the
             // others' untouched; run again, all of its frames resume.
             let before = manifests(&shared);
@@ -217,7 +223,9 @@ fn shard_k_of_n_from_the_cli_takes_the_frames_with_i_mod_n_equal_k_and_resumes_p
             assert_eq!(manifests(&shared), after);
         }
         // Together the shards made every frame once; unsharded, all resume.
-        assert_eq!(files_in(&shared).len(), 7);
+        // (beside them the N index parts and the index the last shard joined)
+        assert_eq!(files_in(&shared).len(), 7 + n + 1);
+        assert_eq!(io_index_rows(&shared), 7 * 2);
         assert_eq!(counts(&batch(&manifest, &shared, &[])), (0, 7));
     }
 }
@@ -362,4 +370,11 @@ fn a_batch_ended_after_any_commit_step_resumes_to_every_frame_complete() {
         failures.len(),
         failures.join("\n")
     );
+}
+
+/// Rows of the batch index under `out`.
+fn io_index_rows(out: &Path) -> usize {
+    viewsynth::refocus::batch::read_index(&out.join(viewsynth::refocus::batch::INDEX_NAME))
+        .unwrap()
+        .len()
 }

@@ -922,6 +922,7 @@ fn round3_library_passes_refuse_unusable_depth_and_are_finite_where_valid() {
                 rule: BreakRule::default(),
                 method,
                 outputs: OutputSet::default(),
+                rgb_everywhere: false,
                 conv,
             };
             cases += 2;
@@ -948,6 +949,7 @@ fn round3_library_passes_refuse_unusable_depth_and_are_finite_where_valid() {
                     rule: BreakRule::default(),
                     method,
                     outputs: OutputSet::default(),
+                    rgb_everywhere: false,
                     conv,
                 };
                 cases += 1;
@@ -976,6 +978,7 @@ fn round3_library_passes_refuse_unusable_depth_and_are_finite_where_valid() {
             rule: BreakRule::default(),
             method: Method::Fullscreen,
             outputs: OutputSet::default(),
+            rgb_everywhere: false,
             conv,
         };
         match refocus::pass::gpu(&g, &input) {

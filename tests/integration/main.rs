@@ -4,6 +4,7 @@
 mod batch;
 mod cli;
 mod cli_batch;
+mod cli_batch_augment;
 mod cli_cameras_cv;
 mod cli_compare;
 mod cli_depth_out;
@@ -34,6 +35,7 @@ mod refocus_accuracy;
 mod refocus_conventions;
 mod refocus_edge_cases;
 mod refocus_oracle;
+mod refocus_rgb_everywhere;
 mod reproject;
 mod scene;
 mod shader_library;

@@ -65,6 +65,7 @@ fn refocus_pass_and_twin_are_the_renderer_and_the_twin() {
             rule: BreakRule::default(),
             method,
             outputs: OutputSet::default(),
+            rgb_everywhere: false,
             conv: other_conventions(),
         };
         let direct = Refocuser::new(&g, &src, &input.rule, method, input.outputs, input.conv)
@@ -86,6 +87,7 @@ fn refocus_pass_and_twin_are_the_renderer_and_the_twin() {
         rule: BreakRule::default(),
         method: Method::Fullscreen,
         outputs: OutputSet::parse("depth").unwrap(),
+        rgb_everywhere: false,
         conv: Conventions::default(),
     };
     for v in [

@@ -55,6 +55,7 @@ fn check_source_on(name: &str, src: &RefocusSource, device: &Device) {
                     rule: BreakRule::default(),
                     method,
                     outputs: OutputSet::default(),
+                    rgb_everywhere: false,
                     conv: Conventions::default(),
                 };
                 let out = pass::gpu(device, &input).expect("render");

@@ -88,7 +88,10 @@ fn every_parameter_block_has_the_layout_the_gl_compiler_reports() {
     check_block::<SplatGatherBlock>(ProgramKind::CyclopeanSplatGather);
     check_block::<SplatGatherBlock>(ProgramKind::CyclopeanSplatEdges);
     check_block::<ForwardParams>(ProgramKind::CyclopeanForward);
-    check_block::<RefocusParams>(ProgramKind::RefocusFullscreen { want_rgb: true });
+    check_block::<RefocusParams>(ProgramKind::RefocusFullscreen {
+        want_rgb: true,
+        rgb_everywhere: false,
+    });
     check_block::<viewsynth::cyclopean::fill::FillParams>(ProgramKind::CyclopeanFill);
     check_block::<viewsynth::cyclopean::temporal::TemporalParams>(ProgramKind::CyclopeanTemporalReproject {
         winner: true,

@@ -57,6 +57,10 @@ mod demo {
     pub(crate) mod args;
     pub(crate) mod run;
 }
+mod index {
+    pub(crate) mod args;
+    pub(crate) mod run;
+}
 mod info {
     pub(crate) mod args;
     pub(crate) mod run;
@@ -111,6 +115,10 @@ enum Command {
     /// Re-render RGB + metric depth at other focal lengths (same pose).
     #[command(allow_negative_numbers = true, after_help = refocus::args::EXAMPLES)]
     Refocus(Box<refocus::args::RefocusArgs>),
+    /// Join the index parts that `refocus --batch` runs (shards) wrote into OUT/index.jsonl: one
+    /// row per target (frame, scale, K', size, coverage, files).
+    #[command(after_help = index::args::EXAMPLES)]
+    Index(index::args::IndexArgs),
     /// Synthesise the middle (spectator) view of a stereo pair from each eye's colour and depth.
     #[command(allow_negative_numbers = true, after_help = cyclopean::args::EXAMPLES)]
     Cyclopean(Box<cyclopean::args::CyclopeanArgs>),
@@ -246,6 +254,7 @@ fn run(command: Command) -> Result<ExitCode> {
     match command {
         Command::Info(a) => info::run::info(&job(a)?)?,
         Command::Refocus(a) => refocus::run::refocus(job(*a)?)?,
+        Command::Index(a) => index::run::index(&a)?,
         Command::Cyclopean(a) => cyclopean::run::cyclopean(&job(*a)?)?,
         Command::Reproject(a) => reproject::run::reproject(&job(*a)?)?,
         Command::Stitch(a) => stitch::run::stitch(&job(*a)?)?,

@@ -155,6 +155,7 @@ impl RefocusJob {
         let files = &plan.files;
         let device = host.open_device(&self.gpu, self.backend)?;
         let mut refocuser = Refocuser::new(&device, &src, &plan.rule, plan.method, files.outputs, conv)?;
+        refocuser.set_rgb_everywhere(plan.rgb_everywhere);
         host.event(Event::Started {
             what: "refocus targets",
             total: targets.len() as u64,
@@ -175,7 +176,8 @@ impl RefocusJob {
             break_rule: plan.rule,
             conventions: conv,
             renderer: refocuser.renderer(),
-            notes: job::MANIFEST_NOTES.to_string(),
+            notes: job::manifest_notes(plan.rgb_everywhere),
+            rgb_everywhere: plan.rgb_everywhere,
             settings: None,
             files: job::file_records(set.staging(), &entries).map_err(|e| set.final_error(e))?,
             outputs: entries,

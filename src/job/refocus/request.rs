@@ -10,7 +10,7 @@ use crate::camera::PinholeCamera;
 use crate::convention::Conventions;
 use crate::io::{self, FileFormats, OutputSet, RgbFormat};
 use crate::job::{ArgError, FileOptions, PerFrameOption};
-use crate::refocus::batch::{BatchOptions, Shard};
+use crate::refocus::batch::{BatchOptions, Shard, ZoomRandom};
 use crate::refocus::manifest::{self, TargetSpec, DEFAULT_SCALES};
 use crate::refocus::{BreakRule, Method};
 use serde::Serialize;
@@ -56,6 +56,14 @@ pub struct RefocusRequest {
     pub jobs: Option<usize>,
     /// Batch: `K/N`.
     pub shard: Option<String>,
+    /// Colour every pixel inside the source frame, covered or not.
+    pub rgb_everywhere: bool,
+    /// Batch: random scales per frame in [LO, HI] instead of `scales`.
+    pub zoom_random: Option<(f64, f64)>,
+    /// Batch: scales drawn per frame with `zoom_random` (none: 1).
+    pub samples: Option<usize>,
+    /// Batch: the seed of `zoom_random` (none: 0).
+    pub seed: Option<u64>,
 }
 
 impl Default for RefocusRequest {
@@ -78,6 +86,10 @@ impl Default for RefocusRequest {
             resume: true,
             jobs: None,
             shard: None,
+            rgb_everywhere: false,
+            zoom_random: None,
+            samples: None,
+            seed: None,
         }
     }
 }
@@ -99,6 +111,8 @@ pub struct FramePlan {
     pub files: FileFormats,
     /// Depth truncation, metres.
     pub depth_trunc: Option<f64>,
+    /// Colour every pixel inside the source frame.
+    pub rgb_everywhere: bool,
 }
 
 /// How the target focal lengths are given.
@@ -167,6 +181,12 @@ impl RefocusRequest {
                 "applies with --batch only (it picks the manifest rows a run takes)",
             )));
         }
+        if self.zoom_random.is_some() || self.samples.is_some() || self.seed.is_some() {
+            return Err(ArgError::Invalid(crate::Error::param(
+                "--zoom-random",
+                "applies with --batch only (scales are drawn from the seed and each frame's name)",
+            )));
+        }
         let rule = self.rule()?;
         if let Some((w, h)) = self.size {
             io::check_output_pixels("--width-out/--height-out", w, h)?;
@@ -188,11 +208,38 @@ impl RefocusRequest {
             method: self.method,
             files: self.files()?,
             depth_trunc: self.depth_trunc,
+            rgb_everywhere: self.rgb_everywhere,
         })
+    }
+
+    /// `zoom_random`, `samples` and `seed`, checked together.
+    fn zoom_random(&self) -> Result<Option<ZoomRandom>, ArgError> {
+        let Some((lo, hi)) = self.zoom_random else {
+            if self.samples.is_some() || self.seed.is_some() {
+                return Err(ArgError::Invalid(crate::Error::param(
+                    "--samples/--seed",
+                    "apply with --zoom-random LO,HI only",
+                )));
+            }
+            return Ok(None);
+        };
+        if self.scales.is_some() {
+            return Err(ArgError::Invalid(crate::Error::param(
+                "--zoom-random",
+                "give fixed scales (--zoom-range) or a random range, not both",
+            )));
+        }
+        Ok(Some(ZoomRandom::new(
+            lo,
+            hi,
+            self.samples.unwrap_or(1),
+            self.seed.unwrap_or(0),
+        )?))
     }
 
     /// The settings of a batch, checked: per-frame settings given are refused by name.
     pub fn batch(&self, conv: Conventions) -> Result<BatchOptions, ArgError> {
+        let zoom_random = self.zoom_random()?;
         let Focals::Scales(scales) = self.focals()? else {
             return Err(ArgError::PerFrameInBatch(PerFrameOption::FocalList));
         };
@@ -200,6 +247,8 @@ impl RefocusRequest {
         let shard: Option<Shard> = self.shard.as_deref().map(str::parse).transpose()?;
         Ok(BatchOptions {
             scales,
+            zoom_random,
+            rgb_everywhere: self.rgb_everywhere,
             size: self.size,
             principal: self.principal,
             rule: self.rule()?,

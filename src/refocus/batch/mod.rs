@@ -18,14 +18,18 @@
 //! The parts: [`manifest`] reads the frame list, [`resume`] decides which frames are finished,
 //! [`pipeline`] runs the stages.
 
+mod index;
 mod manifest;
 mod pipeline;
 mod resume;
+mod zoom;
 
+pub use index::{join_index, read_index, IndexRow, INDEX_NAME};
 pub use manifest::{
     load_manifest, BatchFrame, MAX_JSON_MANIFEST_BYTES, MAX_MANIFEST_BYTES, MAX_MANIFEST_ROWS, MAX_MANIFEST_ROW_BYTES,
 };
 pub use pipeline::{run_batch, BatchSummary, StageTimes};
+pub use zoom::{ZoomRandom, MAX_SAMPLES};
 
 use super::{BreakRule, Method};
 use crate::convention::Conventions;
@@ -79,8 +83,12 @@ impl std::str::FromStr for Shard {
 /// Everything a batch applies to each frame.
 #[derive(Debug, Clone)]
 pub struct BatchOptions {
-    /// Focal scales of the targets: fx' = s fx.
+    /// Focal scales of the targets: fx' = s fx (every frame; unused with `zoom_random`).
     pub scales: Vec<f64>,
+    /// Random scales per frame instead of `scales` (`--zoom-random`).
+    pub zoom_random: Option<ZoomRandom>,
+    /// Colour every pixel inside the source frame (`--rgb-everywhere`).
+    pub rgb_everywhere: bool,
     /// Output size (width, height) in pixels; None keeps each source's size.
     pub size: Option<(u32, u32)>,
     /// Output principal point, pixels; None keeps the source's offset from the image centre.
@@ -102,4 +110,22 @@ pub struct BatchOptions {
     pub jobs: usize,
     /// This process's share of the manifest; None renders every frame.
     pub shard: Option<Shard>,
+}
+
+impl BatchOptions {
+    /// The frame's focal scales and their file tags: the fixed list (`s{s}`), or its random
+    /// draw (`z{k}_s{s}`).
+    pub fn frame_targets(&self, frame: &str) -> (Vec<f64>, Vec<String>) {
+        match &self.zoom_random {
+            Some(z) => {
+                let scales = z.scales(frame);
+                let tags = ZoomRandom::tags(&scales);
+                (scales, tags)
+            }
+            None => (
+                self.scales.clone(),
+                self.scales.iter().map(|&s| super::manifest::scale_tag(s)).collect(),
+            ),
+        }
+    }
 }

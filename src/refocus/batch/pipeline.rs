@@ -55,13 +55,16 @@ pub struct BatchSummary {
     /// Most frames held in memory at once: decoded and queued, on the GL thread, mapped and
     /// queued for encoding, being encoded.
     pub frames_in_flight: usize,
+    /// `index.jsonl`, when this run joined it (it was the last of its shards, or unsharded).
+    pub index: Option<std::path::PathBuf>,
 }
 
 struct WriteJob {
     name: String,
     /// The batch's --out-dir; the frame's folder is `name` inside it.
     root: io::OutDir,
-    outputs: Vec<(f64, RefocusOutput)>,
+    /// (file tag, scale, outputs) per target.
+    outputs: Vec<(String, f64, RefocusOutput)>,
     manifest: Manifest,
 }
 
@@ -72,8 +75,8 @@ fn write_frame(job: WriteJob, files: &FileFormats) -> Result<()> {
     let dir = job.root.subdir(&job.name)?;
     let mut set = dir.file_set()?;
     let mut record = job.manifest;
-    for (scale, out) in job.outputs {
-        let entry = manifest::write_target(&mut set, &manifest::scale_tag(scale), scale, out, files)?;
+    for (tag, scale, out) in job.outputs {
+        let entry = manifest::write_target(&mut set, &tag, scale, out, files)?;
         record.outputs.push(entry);
     }
     record.files = manifest::file_records(set.staging(), &record.outputs)?;
@@ -111,6 +114,7 @@ struct InFlight {
     name: String,
     root: io::OutDir,
     scales: Vec<f64>,
+    tags: Vec<String>,
     pending: Vec<PendingRefocus>,
     manifest: Manifest,
 }
@@ -126,8 +130,9 @@ fn submit_frame(
     stages: &mut StageTimes,
 ) -> Result<InFlight> {
     let t0 = Instant::now();
+    let (scales, tags) = opts.frame_targets(&name);
     let targets = TargetSpec {
-        scales: opts.scales.clone(),
+        scales: scales.clone(),
         size: opts.size,
         principal: opts.principal,
     }
@@ -147,7 +152,8 @@ fn submit_frame(
         break_rule: opts.rule,
         conventions: opts.conv,
         renderer: refocuser.renderer(),
-        notes: manifest::MANIFEST_NOTES.to_string(),
+        notes: manifest::manifest_notes(opts.rgb_everywhere),
+        rgb_everywhere: opts.rgb_everywhere,
         settings: Some(settings),
         files: Vec::new(),
         outputs: Vec::new(),
@@ -155,7 +161,8 @@ fn submit_frame(
     Ok(InFlight {
         name,
         root,
-        scales: opts.scales.clone(),
+        scales,
+        tags,
         pending,
         manifest,
     })
@@ -166,13 +173,13 @@ fn collect_frame(f: InFlight, stages: &mut StageTimes) -> std::result::Result<Wr
     let t0 = Instant::now();
     let mut outputs = Vec::with_capacity(f.pending.len());
     let mut gpu_ms = None;
-    for (s, p) in f.scales.iter().zip(f.pending) {
+    for ((s, tag), p) in f.scales.iter().zip(f.tags).zip(f.pending) {
         match p.wait() {
             Ok(o) => {
                 if let Some(g) = o.render.gpu_ms {
                     *gpu_ms.get_or_insert(0.0) += g;
                 }
-                outputs.push((*s, o));
+                outputs.push((tag, *s, o));
             }
             Err(e) => return Err((f.name, e)),
         }
@@ -197,7 +204,7 @@ pub fn run_batch(
     opts: &BatchOptions,
     progress: impl Fn(),
 ) -> Result<BatchSummary> {
-    if opts.scales.is_empty() {
+    if opts.scales.is_empty() && opts.zoom_random.is_none() {
         return Err(Error::param("scales", "no focal scale given"));
     }
     if let Some(m) = opts.depth_trunc {
@@ -232,6 +239,7 @@ pub fn run_batch(
         todo.push(frame);
     }
     let mut refocuser = Refocuser::with_settings(device, &opts.rule, opts.method, opts.files.outputs, opts.conv)?;
+    refocuser.set_rgb_everywhere(opts.rgb_everywhere);
     let files = opts.files;
     let mut stages = StageTimes::default();
 
@@ -268,6 +276,7 @@ pub fn run_batch(
         }
         summary.frames_in_flight = 1;
         summary.stages = stages;
+        summary.index = super::index::write_part(root.real_path(), frames, opts)?;
         summary.wall_s = t_start.elapsed().as_secs_f64();
         return Ok(summary);
     }
@@ -375,6 +384,7 @@ pub fn run_batch(
         }
     });
     summary.stages = stages;
+    summary.index = super::index::write_part(root.real_path(), frames, opts)?;
     summary.wall_s = t_start.elapsed().as_secs_f64();
     Ok(summary)
 }

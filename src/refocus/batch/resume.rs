@@ -38,6 +38,20 @@ pub(super) fn frame_settings(frame: &BatchFrame, opts: &BatchOptions) -> serde_j
     if let Some(m) = opts.depth_trunc {
         settings["depth_trunc"] = m.into();
     }
+    if let Some(z) = &opts.zoom_random {
+        let name = frame.name.as_deref().unwrap_or_default();
+        settings["zoom_random"] = serde_json::json!({
+            "range": [z.lo, z.hi],
+            "samples": z.samples,
+            "seed": z.seed,
+            "distribution": "log-uniform",
+            "scales": z.scales(name),
+        });
+        settings["scales"] = serde_json::Value::Null;
+    }
+    if opts.rgb_everywhere {
+        settings["rgb_everywhere"] = true.into();
+    }
     settings
 }
 

@@ -58,6 +58,17 @@ pub(crate) struct RefocusArgs {
     /// Target focal scales s (fx' = s fx) [default: 0.5,0.75,1,1.5,2].
     #[arg(help_heading = TARGETS, long, value_delimiter = ',', value_parser = finite_value)]
     zoom_range: Option<Vec<f64>>,
+    /// With --batch: K random focal scales per frame in [LO, HI] (log-uniform: zooming in and
+    /// out equally often), drawn from --seed and the frame's name, so reruns, resumed and
+    /// sharded runs draw the same; files z{k}_s{s}_*, scales recorded in each frame's manifest.
+    #[arg(help_heading = TARGETS, long, value_name = "LO,HI", value_delimiter = ',', conflicts_with_all = ["zoom_range", "focal_list"], value_parser = finite_value)]
+    zoom_random: Option<Vec<f64>>,
+    /// With --zoom-random: scales drawn per frame [default: 1].
+    #[arg(help_heading = TARGETS, long, value_name = "K", requires = "zoom_random", value_parser = clap::builder::RangedU64ValueParser::<usize>::new().range(1..=viewsynth::refocus::batch::MAX_SAMPLES as u64))]
+    samples: Option<usize>,
+    /// With --zoom-random: the seed [default: 0].
+    #[arg(help_heading = TARGETS, long, value_name = "S", requires = "zoom_random")]
+    seed: Option<u64>,
     /// Output width in pixels (default: the source's; with --height-out).
     #[arg(help_heading = TARGETS, long, requires = "height_out", value_parser = clap::value_parser!(u32).range(1..=i64::from(io::MAX_DIMENSION)))]
     width_out: Option<u32>,
@@ -81,6 +92,11 @@ pub(crate) struct RefocusArgs {
     /// default) or mesh (the triangles rasterised); both give the same output.
     #[arg(help_heading = METHOD, long, value_enum, default_value = "fullscreen")]
     method: MethodArg,
+    /// Colour every output pixel inside the source frame, bilinear from the source whatever its
+    /// depth (same pose: where a pixel lands does not depend on it); depth and mask unchanged,
+    /// valid geometry only. For training images without black holes at depth gaps and edges.
+    #[arg(help_heading = METHOD, long)]
+    rgb_everywhere: bool,
     /// Output folder (created if missing): per zoom scale s, s{s}_rgb.png (s{s}_rgb.jpg, s{s}_rgb.exr
     /// with --rgb-format), s{s}_depth.exr, s{s}_depth.npy, s{s}_depth.png (those in --depth-format),
     /// s{s}_depth_preview.png (--depth-preview), s{s}_mask.png (those in --outputs; f{fx'}_rgb.png
@@ -134,6 +150,19 @@ impl RefocusArgs {
             resume: !self.force,
             jobs: self.jobs,
             shard: self.shard.clone(),
+            rgb_everywhere: self.rgb_everywhere,
+            zoom_random: match self.zoom_random.as_deref() {
+                None => None,
+                Some(&[lo, hi]) => Some((lo, hi)),
+                Some(other) => {
+                    return Err(ArgError::Invalid(viewsynth::Error::param(
+                        "--zoom-random",
+                        format!("{} values given: expected LO,HI", other.len()),
+                    )))
+                }
+            },
+            samples: self.samples,
+            seed: self.seed,
             ..Default::default()
         };
         self.files.fill_refocus(&mut r)?;

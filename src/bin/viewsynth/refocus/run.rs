@@ -51,6 +51,10 @@ fn batch(job: &RefocusBatchJob) -> Result<()> {
         summary.wall_s,
         summary.rendered as f64 / summary.wall_s.max(1e-9)
     );
+    match &summary.index {
+        Some(p) => println!("index: {}", p.display()),
+        None => println!("index: this shard's part written; the last shard (or `viewsynth index`) joins them"),
+    }
     for (name, e) in &summary.failed {
         eprintln!("failed: {name}: {e}");
     }

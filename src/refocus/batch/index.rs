@@ -1,0 +1,210 @@
+//! The dataset index: `index.jsonl` at the batch's out-dir root, one JSON row per target (frame,
+//! scale, K', size, coverage, file paths relative to the out-dir), so a data loader reads one
+//! file instead of walking every frame folder.
+//!
+//! Rows are made from the frames' own `manifest.json` files (the frames as they are on disk),
+//! never from what a run meant to write. Each run writes its part, `index.part-K-of-N.jsonl`
+//! (K/N its shard, 0/1 unsharded): the rows of every frame of its share whose manifest records
+//! this run's settings. Then, when all N parts of that N are there, it joins them into
+//! `index.jsonl` (so the last shard to finish joins; `viewsynth index OUT` joins by hand). Parts
+//! and the index are written atomically: a killed run leaves the previous ones, and the resumed
+//! run writes them whole again.
+
+use super::resume::frame_settings;
+use super::{BatchFrame, BatchOptions};
+use crate::camera::Intrinsics;
+use crate::error::{Error, Result};
+use serde::{Deserialize, Serialize};
+use std::path::{Path, PathBuf};
+
+/// The joined index's file name, at the out-dir's root.
+pub const INDEX_NAME: &str = "index.jsonl";
+
+/// One target of one frame.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct IndexRow {
+    /// The frame's name (its folder under the out-dir).
+    pub frame: String,
+    /// The frame's row in the batch manifest (0-based): the index's order.
+    pub frame_index: usize,
+    /// The target's place among the frame's targets.
+    pub target: usize,
+    /// Focal scale s: fx' = s fx.
+    pub scale: f64,
+    /// The target intrinsics K' (pixels, OpenCV centres).
+    pub intrinsics: Intrinsics,
+    /// Output width in pixels.
+    pub width: u32,
+    /// Output height in pixels.
+    pub height: u32,
+    /// Fraction of pixels with valid geometry (mask 1), when a mask or depth was written.
+    pub coverage: Option<f64>,
+    /// Colour file, relative to the out-dir.
+    pub rgb: Option<String>,
+    /// Depth file (the first of EXR, NPY, 16-bit PNG written), relative to the out-dir.
+    pub depth: Option<String>,
+    /// Mask file, relative to the out-dir.
+    pub mask: Option<String>,
+    /// The frame's manifest, relative to the out-dir.
+    pub manifest: String,
+}
+
+/// A part's file name.
+fn part_name(index: usize, count: usize) -> String {
+    format!("index.part-{index}-of-{count}.jsonl")
+}
+
+/// (K, N) of a part's file name.
+fn parse_part_name(name: &str) -> Option<(usize, usize)> {
+    let rest = name.strip_prefix("index.part-")?.strip_suffix(".jsonl")?;
+    let (k, n) = rest.split_once("-of-")?;
+    Some((k.parse().ok()?, n.parse().ok()?))
+}
+
+/// The rows of one finished frame: its manifest, when it records `settings`.
+fn frame_rows(root: &Path, name: &str, frame_index: usize, settings: &serde_json::Value) -> Option<Vec<IndexRow>> {
+    let manifest_path = root.join(name).join(crate::io::MANIFEST_NAME);
+    if std::fs::symlink_metadata(&manifest_path).map_or(true, |m| !m.is_file() || m.len() > 16 << 20) {
+        return None;
+    }
+    let text = crate::io::read_text(&manifest_path, 16 << 20).ok()?;
+    let m: serde_json::Value = serde_json::from_str(&text).ok()?;
+    if m.get("settings") != Some(settings) {
+        return None;
+    }
+    let rel = |v: &serde_json::Value| v.as_str().map(|f| format!("{name}/{f}"));
+    let outputs = m.get("outputs")?.as_array()?;
+    outputs
+        .iter()
+        .enumerate()
+        .map(|(target, o)| {
+            let depth = ["depth_exr", "depth_npy", "depth_png16"]
+                .iter()
+                .find_map(|k| o.get(*k).and_then(rel));
+            Some(IndexRow {
+                frame: name.to_string(),
+                frame_index,
+                target,
+                scale: o.get("scale")?.as_f64()?,
+                intrinsics: serde_json::from_value(o.get("intrinsics")?.clone()).ok()?,
+                width: o.get("width")?.as_u64()? as u32,
+                height: o.get("height")?.as_u64()? as u32,
+                coverage: o.get("coverage").and_then(|c| c.as_f64()),
+                rgb: o.get("rgb").and_then(rel),
+                depth,
+                mask: o.get("mask").and_then(rel),
+                manifest: format!("{name}/{}", crate::io::MANIFEST_NAME),
+            })
+        })
+        .collect()
+}
+
+fn write_rows(path: &Path, rows: &[IndexRow]) -> Result<()> {
+    crate::io::atomic_write(path, |w| {
+        use std::io::Write;
+        for r in rows {
+            let line = serde_json::to_string(r).map_err(|e| Error::encode(path, e.to_string()))?;
+            writeln!(w, "{line}").map_err(|e| Error::io(path, e))?;
+        }
+        Ok(())
+    })
+}
+
+fn read_rows(path: &Path) -> Result<Vec<IndexRow>> {
+    let text = crate::io::read_text(path, 1 << 30)?;
+    text.lines()
+        .filter(|l| !l.trim().is_empty())
+        .enumerate()
+        .map(|(i, l)| serde_json::from_str(l).map_err(|e| Error::decode(path, format!("line {}: {e}", i + 1))))
+        .collect()
+}
+
+/// Write this run's part (its share of `frames` as they are on disk under `root`) and, when
+/// every part of its N is there, join them; returns the joined index's path if it joined.
+pub fn write_part(root: &Path, frames: &[BatchFrame], opts: &BatchOptions) -> Result<Option<PathBuf>> {
+    let (k, n) = opts.shard.map_or((0, 1), |s| (s.index, s.count));
+    let mut rows = Vec::new();
+    for (i, frame) in frames.iter().enumerate() {
+        if i % n != k {
+            continue;
+        }
+        let name = frame.name.as_deref().unwrap_or_default();
+        if let Some(r) = frame_rows(root, name, i, &frame_settings(frame, opts)) {
+            rows.extend(r);
+        }
+    }
+    write_rows(&root.join(part_name(k, n)), &rows)?;
+    if (0..n).all(|j| root.join(part_name(j, n)).is_file()) {
+        return join_parts(root, n).map(Some);
+    }
+    Ok(None)
+}
+
+/// Join the N parts under `root` into `index.jsonl` (rows by manifest row, then target).
+fn join_parts(root: &Path, n: usize) -> Result<PathBuf> {
+    let mut rows = Vec::new();
+    for j in 0..n {
+        rows.extend(read_rows(&root.join(part_name(j, n)))?);
+    }
+    rows.sort_by_key(|r| (r.frame_index, r.target));
+    let path = root.join(INDEX_NAME);
+    write_rows(&path, &rows)?;
+    Ok(path)
+}
+
+/// `viewsynth index OUT`: join the parts a batch's runs left under `root`. Where parts of
+/// several shard counts are there, the count whose newest part is newest; an incomplete set
+/// is an error naming the missing parts.
+pub fn join_index(root: &Path) -> Result<(PathBuf, usize)> {
+    let entries = std::fs::read_dir(root).map_err(|e| Error::io(root, e))?;
+    // Per shard count N: the parts found and the newest modification time.
+    let mut counts: std::collections::BTreeMap<usize, (Vec<usize>, std::time::SystemTime)> = Default::default();
+    for e in entries.flatten() {
+        let name = e.file_name().to_string_lossy().to_string();
+        let Some((k, n)) = parse_part_name(&name) else { continue };
+        let modified = e.metadata().and_then(|m| m.modified()).unwrap_or(std::time::UNIX_EPOCH);
+        let entry = counts.entry(n).or_insert((Vec::new(), std::time::UNIX_EPOCH));
+        entry.0.push(k);
+        entry.1 = entry.1.max(modified);
+    }
+    let Some((&n, (found, _))) = counts.iter().max_by_key(|(_, (_, t))| *t) else {
+        return Err(Error::param(
+            "index",
+            format!(
+                "{}: no index part (index.part-K-of-N.jsonl); run refocus --batch into it first",
+                root.display()
+            ),
+        ));
+    };
+    let missing: Vec<String> = (0..n).filter(|j| !found.contains(j)).map(|j| part_name(j, n)).collect();
+    if !missing.is_empty() {
+        return Err(Error::param(
+            "index",
+            format!(
+                "{}: shards still to run: {} missing",
+                root.display(),
+                missing.join(", ")
+            ),
+        ));
+    }
+    let path = join_parts(root, n)?;
+    let rows = read_rows(&path)?.len();
+    Ok((path, rows))
+}
+
+/// Read `index.jsonl` (or a part).
+pub fn read_index(path: &Path) -> Result<Vec<IndexRow>> {
+    read_rows(path)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn part_names_round_trip() {
+        assert_eq!(parse_part_name(&part_name(3, 8)), Some((3, 8)));
+        assert_eq!(parse_part_name("index.jsonl"), None);
+        assert_eq!(parse_part_name("index.part-x-of-2.jsonl"), None);
+    }
+}
