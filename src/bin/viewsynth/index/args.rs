@@ -12,5 +12,6 @@ Examples:
 #[derive(Args)]
 pub(crate) struct IndexArgs {
     /// A `refocus --batch` output folder holding its runs' index parts.
+    #[arg(help_heading = crate::options::INPUTS)]
     pub(crate) out_dir: PathBuf,
 }
