@@ -7,6 +7,7 @@
 //!   within [`SAME_SURFACE`] (relative) of the one before it: a chain, so a slanted surface stays
 //!   one layer while an occluder's edge, a jump in depth, starts another;
 //! - the hole takes that layer's colour and depth, weighted by 1 / distance^2.
+//!
 //! A disocclusion uncovers what lies behind the occluder, so the foreground does not bleed into
 //! it; a hole inside one surface is interpolated across it from every side.
 //! Filled pixels carry [`FILLED`] alone in their source bits, so the mask file tells them apart
