@@ -53,7 +53,10 @@ fn render(
         ..
     } = plan.frame(&device, input, names, None)?;
     gpu.check_image_size("the view (cameras[\"middle\"] width/height)", mid.width, mid.height)?;
-    Ok((plan.synthesise(&device, &frame, &mid, fixation, dense.as_ref(), None)?, confidence))
+    Ok((
+        plan.synthesise(&device, &frame, &mid, fixation, dense.as_ref(), None)?,
+        confidence,
+    ))
 }
 
 fn eye(
