@@ -78,6 +78,8 @@ pub fn from_library(e: Error) -> PyErr {
         Error::Egl(_) | Error::SoftwareRenderer { .. } => raise(Kind::GpuUnavailable, message, None),
         Error::Gl(_) | Error::Vulkan(_) => raise(Kind::Gpu, message, None),
         Error::Io { .. } | Error::Decode { .. } | Error::Encode { .. } => raise(Kind::File, message, None),
+        // Python's own class for it: the host could not allocate an image-sized buffer.
+        Error::OutOfMemory { .. } => pyo3::exceptions::PyMemoryError::new_err(message),
     }
 }
 

@@ -589,6 +589,7 @@ impl Renderer {
             outputs: outputs_given(outputs)?,
             fill,
             max_disparity: max_disparity.map(|m| m.min(i32::MAX as u32) as i32),
+            min_disparity: None,
             min_confidence,
             confidence,
         };
