@@ -614,24 +614,32 @@ impl Drop for Staging {
         for name in self.names.iter().map(String::as_str).chain([JOURNAL_NAME]) {
             let _ = fs::remove_file(self.path.join(name));
         }
-        for _ in 0..STAGING_LIST_TRIES {
-            match fs::read_dir(&self.path) {
-                Ok(entries) => {
-                    for e in entries.flatten() {
-                        if e.file_name() != LOCK_NAME {
-                            let _ = fs::remove_file(e.path());
-                        }
-                    }
-                    break;
+        if let Ok(entries) = read_dir_patiently(&self.path) {
+            for e in entries.flatten() {
+                if e.file_name() != LOCK_NAME {
+                    let _ = fs::remove_file(e.path());
                 }
-                Err(e) if matches!(e.raw_os_error(), Some(libc::EMFILE | libc::ENFILE)) => {
-                    std::thread::sleep(std::time::Duration::from_millis(10));
-                }
-                Err(_) => break,
             }
         }
         let _ = fs::remove_file(self.path.join(LOCK_NAME));
         let _ = fs::remove_dir(&self.path);
+    }
+}
+
+/// `fs::read_dir(path)`, retried while the process has no descriptor to spare (EMFILE, ENFILE:
+/// other threads free theirs), for at most [`STAGING_LIST_TRIES`] x 10 ms. Listing a folder
+/// needs a descriptor; the commit's own cleanup failed on it under `ulimit -n` and left the
+/// emptied staging folder of a committed set behind.
+fn read_dir_patiently(path: &Path) -> io::Result<fs::ReadDir> {
+    let mut tries = 0;
+    loop {
+        match fs::read_dir(path) {
+            Err(e) if matches!(e.raw_os_error(), Some(libc::EMFILE | libc::ENFILE)) && tries < STAGING_LIST_TRIES => {
+                tries += 1;
+                std::thread::sleep(std::time::Duration::from_millis(10));
+            }
+            r => return r,
+        }
     }
 }
 
@@ -661,7 +669,7 @@ fn remove_staging(staging: &Path) -> io::Result<()> {
     };
     gone(fs::remove_file(staging.join(JOURNAL_NAME)))?;
     fault_point("journal removed").map_err(io::Error::other)?;
-    for e in fs::read_dir(staging)?.flatten() {
+    for e in read_dir_patiently(staging)?.flatten() {
         if e.file_name() != LOCK_NAME {
             gone(fs::remove_file(e.path()))?;
         }
