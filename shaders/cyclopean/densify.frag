@@ -9,7 +9,7 @@
 layout(location = 0) out float o_disparity;
 layout(location = 1) out float o_filled;  // R8 normalised: bits / 255 stores the bits
 
-bool known(ivec2 q) {
+bool walk_stops_at(ivec2 q) {
     return texelFetch(u_disparity, q, 0).r > 0.0;
 }
 
@@ -30,32 +30,26 @@ void main() {
     uint w[16];
     int n = 0;
     for (int i = 0; i < DIRECTION_COUNT; ++i) {
-        ivec2 d = DIRECTIONS[i];
-        int m = max(abs(d.x), abs(d.y));
-        for (int k = 1; k * m <= u_radius; ++k) {
-            ivec2 q = p + k * d;
-            if (any(lessThan(q, ivec2(0))) || any(greaterThanEqual(q, u_size))) {
-                break;
-            }
-            if (known(q)) {
-                uvec3 cq = colour(q);
-                uvec3 diff = max(c, cq) - min(c, cq);
-                uint s = COLOUR_SOFTNESS + diff.r + diff.g + diff.b;
-                float value = texelFetch(u_disparity, q, 0).r;
-                uint weight = ((1u << 30) / (s * s)) / uint(k * m);
-                // Insertion by disparity; equal ones keep direction order (as the twin's stable sort).
-                int j = n;
-                while (j > 0 && v[j - 1] > value) {
-                    v[j] = v[j - 1];
-                    w[j] = w[j - 1];
-                    --j;
-                }
-                v[j] = value;
-                w[j] = weight;
-                ++n;
-                break;
-            }
+        ivec2 q;
+        int r = first_along(p, DIRECTIONS[i], u_size, u_radius, q);
+        if (r == 0) {
+            continue;
         }
+        uvec3 cq = colour(q);
+        uvec3 diff = max(c, cq) - min(c, cq);
+        uint s = COLOUR_SOFTNESS + diff.r + diff.g + diff.b;
+        float value = texelFetch(u_disparity, q, 0).r;
+        uint weight = ((1u << 30) / (s * s)) / uint(r);
+        // Insertion by disparity; equal ones keep direction order (as the twin's stable sort).
+        int j = n;
+        while (j > 0 && v[j - 1] > value) {
+            v[j] = v[j - 1];
+            w[j] = w[j - 1];
+            --j;
+        }
+        v[j] = value;
+        w[j] = weight;
+        ++n;
     }
     if (n == 0) {
         o_disparity = 0.0;

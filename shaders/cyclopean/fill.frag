@@ -11,6 +11,10 @@ layout(location = 0) out vec4 o_color;
 layout(location = 1) out float o_depth;
 layout(location = 2) out float o_sources;  // R8 normalised: bits / 255 stores the bits
 
+bool walk_stops_at(ivec2 q) {
+    return texelFetch(u_sources, q, 0).r != 0u;
+}
+
 void main() {
     ivec2 p = ivec2(gl_FragCoord.xy);
     uint bits = texelFetch(u_sources, p, 0).r;
@@ -26,30 +30,24 @@ void main() {
     int n = 0;
     int radius = max(u_size.x, u_size.y);
     for (int i = 0; i < DIRECTION_COUNT; ++i) {
-        ivec2 d = DIRECTIONS[i];
-        int m = max(abs(d.x), abs(d.y));
-        for (int k = 1; k * m <= radius; ++k) {
-            ivec2 q = p + k * d;
-            if (any(lessThan(q, ivec2(0))) || any(greaterThanEqual(q, u_size))) {
-                break;
-            }
-            if (texelFetch(u_sources, q, 0).r != 0u) {
-                float zq = texelFetch(u_depth, q, 0).r;
-                // Insertion far to near; equal depths keep direction order (the twin's stable sort).
-                int j = n;
-                while (j > 0 && z[j - 1] < zq) {
-                    z[j] = z[j - 1];
-                    r[j] = r[j - 1];
-                    at[j] = at[j - 1];
-                    --j;
-                }
-                z[j] = zq;
-                r[j] = k * m;
-                at[j] = q;
-                ++n;
-                break;
-            }
+        ivec2 q;
+        int r_q = first_along(p, DIRECTIONS[i], u_size, radius, q);
+        if (r_q == 0) {
+            continue;
         }
+        float zq = texelFetch(u_depth, q, 0).r;
+        // Insertion far to near; equal depths keep direction order (the twin's stable sort).
+        int j = n;
+        while (j > 0 && z[j - 1] < zq) {
+            z[j] = z[j - 1];
+            r[j] = r[j - 1];
+            at[j] = at[j - 1];
+            --j;
+        }
+        z[j] = zq;
+        r[j] = r_q;
+        at[j] = q;
+        ++n;
     }
     if (n == 0) {
         o_color = vec4(0.0);
