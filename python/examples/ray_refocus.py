@@ -9,7 +9,9 @@ GPUs, so Ray gives each its own GPU through CUDA_VISIBLE_DEVICES, which device="
 a CPU-only machine `num_gpus=0` and Mesa llvmpipe renders). Each actor writes its frames with
 `Renderer.refocus_batch`, the library's batch: the same decoders, writers and folder layout as
 `viewsynth refocus --batch MANIFEST --out-dir OUT`, so OUT/<frame name>/ holds the same files
-either way (and a rerun skips finished frames, as the CLI's resume).
+either way (and a rerun skips finished frames, as the CLI's resume). Actors write no index
+(`index=False`: each holds only a share); the driver writes OUT/index.jsonl once over the whole
+manifest with viewsynth.write_index, so it equals the CLI's.
 
 The manifest is the CLI's (CSV with rgb,depth,fx,fy,cx,cy[,depth_scale,name], or JSON); frame
 names come from viewsynth.load_manifest, so they do not depend on how Ray splits the frames.
@@ -31,7 +33,8 @@ class RefocusFrames:
 
     def __init__(self, out_dir, options):
         self.out_dir = out_dir
-        self.options = options
+        # Each call holds an arbitrary share of the manifest: the driver writes the index.
+        self.options = dict(options, index=False)
         # A Renderer belongs to the thread that opened it; Ray may call from another thread
         # than the constructor's, so open it lazily on the calling thread.
         self.local = threading.local()
@@ -56,7 +59,8 @@ class RefocusFrames:
 
 def refocus_with_ray(manifest, out_dir, options, batch_size=4, max_actors=None):
     """Refocus every frame of `manifest` into `out_dir` on the running Ray cluster (ray.init
-    first); returns a list of {"name", "ok", "error"}, one per frame."""
+    first), then write out_dir/index.jsonl over the whole manifest; returns a list of
+    {"name", "ok", "error"}, one per frame."""
     frames = vs.load_manifest(manifest)
     gpus = int(ray.cluster_resources().get("GPU", 0))
     if max_actors is None:
@@ -70,7 +74,10 @@ def refocus_with_ray(manifest, out_dir, options, batch_size=4, max_actors=None):
         num_gpus=1 if gpus else 0,
         compute=ray.data.ActorPoolStrategy(min_size=1, max_size=max_actors),
     )
-    return sorted(results.take_all(), key=lambda r: r["name"])
+    results = sorted(results.take_all(), key=lambda r: r["name"])
+    settings = {k: v for k, v in options.items() if k not in ("resume", "jobs")}
+    vs.write_index(frames, out_dir, **settings)
+    return results
 
 
 def main(argv=None):

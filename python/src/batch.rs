@@ -130,7 +130,7 @@ fn frame_from_mapping(obj: &Bound<'_, PyAny>, i: usize) -> PyResult<BatchFrame> 
 }
 
 /// The frames of a refocus_batch call: a manifest path, or a sequence of frame dicts.
-fn frames(obj: &Bound<'_, PyAny>) -> PyResult<Vec<BatchFrame>> {
+pub fn frames(obj: &Bound<'_, PyAny>) -> PyResult<Vec<BatchFrame>> {
     if obj.cast::<PyString>().is_ok() || obj.hasattr("__fspath__")? {
         let path: PathBuf = obj
             .extract()
@@ -191,12 +191,14 @@ pub struct BatchArgs<'a, 'py> {
     pub resume: bool,
     pub jobs: Option<usize>,
     pub shard: Option<&'a str>,
+    /// Write the index part (and join it); False where the caller splits the manifest itself.
+    pub index: bool,
     /// rgb_everywhere, random zoom and progress (augment.rs).
     pub augment: crate::augment::Augment<'py>,
 }
 
 /// The settings as the library's request, checked by it as the CLI's `refocus --batch`.
-fn options(a: &BatchArgs<'_, '_>) -> PyResult<BatchOptions> {
+pub fn options(a: &BatchArgs<'_, '_>) -> PyResult<BatchOptions> {
     let request = RefocusRequest {
         scales: a.scales.clone(),
         focal_list: None,
@@ -220,7 +222,9 @@ fn options(a: &BatchArgs<'_, '_>) -> PyResult<BatchOptions> {
         samples: a.augment.samples,
         seed: a.augment.seed,
     };
-    request.batch(Conventions::default()).map_err(errors::from_request)
+    let mut opts = request.batch(Conventions::default()).map_err(errors::from_request)?;
+    opts.index = a.index;
+    Ok(opts)
 }
 
 /// Validates `a`, runs the batch with the GIL released, and returns its summary as a dict.

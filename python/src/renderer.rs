@@ -779,6 +779,9 @@ impl Renderer {
     /// thread, default the core count; 0 = every stage in turn on this thread), shard ("K/N"):
     /// the CLI's options of the same names; so are rgb_everywhere, zoom_random=(lo, hi), samples
     /// and seed (--zoom-random, log-uniform draws). progress: f(done, total) per frame, or True.
+    /// index: write out_dir/index.jsonl (the CLI's, joined over shards); pass False when frames
+    /// is a share of a manifest you split yourself (Ray, Dask), then call viewsynth.write_index
+    /// once over the whole manifest.
     ///
     /// Returns the batch summary: "rendered", "skipped", "other_shards", "failed" (a list of
     /// [frame name, error message]: a failed frame leaves no folder and does not stop the
@@ -791,7 +794,8 @@ impl Renderer {
                         outputs = None, tau_rel = 0.05, tau_abs = 0.2, method = "fullscreen", rgb_format = "png",
                         depth_format = None, depth_preview = false, png_compression = "fast",
                         exr_compression = "zip", depth_trunc = None, resume = true, jobs = None, shard = None,
-                        rgb_everywhere = false, zoom_random = None, samples = None, seed = None, progress = None))]
+                        rgb_everywhere = false, zoom_random = None, samples = None, seed = None, progress = None,
+                        index = true))]
     fn refocus_batch<'py>(
         &mut self,
         py: Python<'py>,
@@ -818,6 +822,7 @@ impl Renderer {
         samples: Option<usize>,
         seed: Option<u64>,
         progress: Option<Bound<'py, PyAny>>,
+        index: bool,
     ) -> PyResult<Bound<'py, PyAny>> {
         let gpu = self.gpu()?.clone();
         crate::batch::refocus_batch(
@@ -842,6 +847,7 @@ impl Renderer {
                 resume,
                 jobs,
                 shard,
+                index,
                 augment: crate::augment::Augment {
                     rgb_everywhere,
                     zoom_random,

@@ -62,6 +62,27 @@ def test_a_failed_frame_is_listed_and_the_others_complete(renderer, cli, tmp_pat
     assert_same_batch_output(tmp_path / "cli", tmp_path / "py")
 
 
+def test_shares_without_index_then_write_index_equal_the_cli_index(renderer, cli, tmp_path):
+    # A scheduler's shares (Ray, Dask): each call writes no index; one write_index over the whole
+    # manifest then gives the CLI's index.jsonl byte for byte. Before index=False each share
+    # wrote its own index.jsonl, numbered from 0 and holding only its frames.
+    manifest = write_manifest(tmp_path / "in", broken=True)
+    run_cli_batch(cli, manifest, tmp_path / "cli", expect_rc=1)
+    frames = vs.load_manifest(manifest)
+    for share in (frames[3:], frames[1:3], frames[:1]):
+        renderer.refocus_batch(share, tmp_path / "py", index=False, **OPTIONS)
+        assert not (tmp_path / "py" / "index.jsonl").exists()
+    assert not list((tmp_path / "py").glob("index.part-*"))
+    settings = {k: v for k, v in OPTIONS.items() if k not in ("resume", "jobs")}
+    path, rows = vs.write_index(frames, tmp_path / "py", **settings)
+    assert path == str(tmp_path / "py" / "index.jsonl") and rows == 3 * len(SCALES)
+    assert_same_batch_output(tmp_path / "cli", tmp_path / "py")
+    assert (tmp_path / "py" / "index.jsonl").read_text() == (tmp_path / "cli" / "index.jsonl").read_text()
+    # Other settings than the frames were made with: no frame is theirs, so no row.
+    _, rows = vs.write_index(frames, tmp_path / "py", **dict(settings, scales=[1.5]))
+    assert rows == 0
+
+
 def batch_error(renderer, tmp_path, frames, parameter, words, **options):
     with pytest.raises(vs.InvalidInputError) as err:
         renderer.refocus_batch(frames, tmp_path / "out", **options)

@@ -9,12 +9,13 @@
     ods = r.stitch(left_rgb, left_depth, right_rgb, right_depth, width=2048, height=1024)["rgb"]
     r.refocus_batch(vs.load_manifest("frames.csv"), "out/")   # files, as `viewsynth refocus --batch`
     rows = vs.read_index("out/")             # one dict per target; vs.read_depth(rows[0]["depth"])
+    vs.write_index(frames, "out/")           # after shares rendered with refocus_batch(index=False)
 
 A Renderer belongs to the thread that created it, and to the process that created it:
 see the Renderer docstring for threads, fork and spawn.
 """
 
-from ._viewsynth import FACE_ORDER, Renderer, __version__, info, load_manifest, read_depth
+from ._viewsynth import FACE_ORDER, Renderer, __version__, info, load_manifest, read_depth, write_index
 from .dataset import read_index
 from .errors import (
     FileError,
@@ -33,6 +34,7 @@ __all__ = [
     "load_manifest",
     "read_depth",
     "read_index",
+    "write_index",
     "FACE_ORDER",
     "__version__",
     "ViewsynthError",

@@ -301,11 +301,38 @@ class Renderer:
         samples: Optional[int] = None,
         seed: Optional[int] = None,
         progress: Union[None, bool, Callable[[int, int], Any]] = None,
+        index: bool = True,
     ) -> BatchSummary:
         """`viewsynth refocus --batch` on this context: frames (a manifest path or dicts with
         its keys) from files into out_dir/<name>/, the CLI's files byte for byte.
         See help(viewsynth.Renderer.refocus_batch)."""
         ...
+
+def write_index(
+    frames: Union[str, "os.PathLike[str]", Sequence[Mapping[str, Any]]],
+    out_dir: Union[str, "os.PathLike[str]"],
+    *,
+    scales: Optional[Sequence[float]] = None,
+    size: Optional[Tuple[int, int]] = None,
+    principal: Optional[Tuple[float, float]] = None,
+    outputs: Optional[Union[OutputName, Sequence[OutputName]]] = None,
+    tau_rel: float = 0.05,
+    tau_abs: float = 0.2,
+    method: Literal["fullscreen", "mesh"] = "fullscreen",
+    rgb_format: Literal["png", "jpeg", "jpg", "exr"] = "png",
+    depth_format: Optional[Union[str, Sequence[Literal["exr", "npy", "png16"]]]] = None,
+    depth_preview: bool = False,
+    png_compression: Literal["fast", "default", "best"] = "fast",
+    exr_compression: Literal["none", "rle", "zip", "piz"] = "zip",
+    depth_trunc: Optional[float] = None,
+    rgb_everywhere: bool = False,
+    zoom_random: Optional[Tuple[float, float]] = None,
+    samples: Optional[int] = None,
+    seed: Optional[int] = None,
+) -> Tuple[str, int]:
+    """out_dir/index.jsonl over the whole manifest `frames`, after shares of it were rendered with
+    Renderer.refocus_batch(..., index=False) under the same settings; no GPU. Returns (path, rows)."""
+    ...
 
 def read_depth(path: Union[str, "os.PathLike[str]"], *, depth_scale: Optional[float] = None) -> npt.NDArray[np.float32]:
     """A depth file the CLI writes (EXR, NPY, 16-bit PNG in millimetres) or reads, as float32[H, W]

@@ -16,7 +16,9 @@ def read_index(out_dir, absolute=True):
     stay relative to it, as stored.
 
     The index is written when a run (or the last of its shards) ends; after shards ran
-    separately, ``viewsynth index OUT`` joins their parts.
+    separately, ``viewsynth index OUT`` joins their parts. Where a scheduler hands workers shares
+    of a manifest (Ray, Dask), each calls ``refocus_batch(..., index=False)`` and the driver
+    calls ``viewsynth.write_index`` once over the whole manifest.
     """
     path = os.path.join(os.fspath(out_dir), INDEX_NAME)
     rows = []

@@ -222,6 +222,7 @@ pub fn batch_bench(
         resume: false,
         jobs,
         shard: None,
+        index: true,
     };
     let run = |device: crate::pass::Device, jobs: usize, name: &str| -> Result<BatchRun> {
         let out = scratch.path().join(name);

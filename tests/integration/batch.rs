@@ -55,6 +55,7 @@ fn options(jobs: usize) -> BatchOptions {
         resume: true,
         jobs,
         shard: None,
+        index: true,
     }
 }
 

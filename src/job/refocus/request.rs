@@ -259,6 +259,7 @@ impl RefocusRequest {
             resume: self.resume,
             jobs,
             shard,
+            index: true,
         })
     }
 }

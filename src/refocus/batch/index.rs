@@ -99,6 +99,18 @@ fn frame_rows(root: &Path, name: &str, frame_index: usize, settings: &serde_json
         .collect()
 }
 
+/// The rows of the manifest rows `take` picks, in manifest order.
+fn rows_of(root: &Path, frames: &[BatchFrame], opts: &BatchOptions, take: impl Fn(usize) -> bool) -> Vec<IndexRow> {
+    let mut rows = Vec::new();
+    for (i, frame) in frames.iter().enumerate().filter(|(i, _)| take(*i)) {
+        let name = frame.name.as_deref().unwrap_or_default();
+        if let Some(r) = frame_rows(root, name, i, &frame_settings(frame, opts)) {
+            rows.extend(r);
+        }
+    }
+    rows
+}
+
 fn write_rows(path: &Path, rows: &[IndexRow]) -> Result<()> {
     crate::io::atomic_write(path, |w| {
         use std::io::Write;
@@ -123,21 +135,22 @@ fn read_rows(path: &Path) -> Result<Vec<IndexRow>> {
 /// every part of its N is there, join them; returns the joined index's path if it joined.
 pub fn write_part(root: &Path, frames: &[BatchFrame], opts: &BatchOptions) -> Result<Option<PathBuf>> {
     let (k, n) = opts.shard.map_or((0, 1), |s| (s.index, s.count));
-    let mut rows = Vec::new();
-    for (i, frame) in frames.iter().enumerate() {
-        if i % n != k {
-            continue;
-        }
-        let name = frame.name.as_deref().unwrap_or_default();
-        if let Some(r) = frame_rows(root, name, i, &frame_settings(frame, opts)) {
-            rows.extend(r);
-        }
-    }
+    let rows = rows_of(root, frames, opts, |i| i % n == k);
     write_rows(&root.join(part_name(k, n)), &rows)?;
     if (0..n).all(|j| root.join(part_name(j, n)).is_file()) {
         return join_parts(root, n).map(Some);
     }
     Ok(None)
+}
+
+/// Write `index.jsonl` over the whole of `frames` (the full manifest, shards ignored) as they
+/// are on disk under `root`, for callers that rendered the manifest in subsets of their own
+/// choosing with [`BatchOptions::index`] off. Returns its path and row count.
+pub fn write_index(root: &Path, frames: &[BatchFrame], opts: &BatchOptions) -> Result<(PathBuf, usize)> {
+    let rows = rows_of(root, frames, opts, |_| true);
+    let path = root.join(INDEX_NAME);
+    write_rows(&path, &rows)?;
+    Ok((path, rows.len()))
 }
 
 /// Join the N parts under `root` into `index.jsonl` (rows by manifest row, then target).

@@ -24,7 +24,7 @@ mod pipeline;
 mod resume;
 mod zoom;
 
-pub use index::{join_index, read_index, IndexRow, INDEX_NAME};
+pub use index::{join_index, read_index, write_index, IndexRow, INDEX_NAME};
 pub use manifest::{
     load_manifest, BatchFrame, MAX_JSON_MANIFEST_BYTES, MAX_MANIFEST_BYTES, MAX_MANIFEST_ROWS, MAX_MANIFEST_ROW_BYTES,
 };
@@ -110,6 +110,10 @@ pub struct BatchOptions {
     pub jobs: usize,
     /// This process's share of the manifest; None renders every frame.
     pub shard: Option<Shard>,
+    /// Write this run's index part and join the parts when all are there (the CLI always
+    /// does). Off for a caller that hands each run an arbitrary subset of the manifest (Ray,
+    /// Dask), which then writes the index once over the whole manifest with [`write_index`].
+    pub index: bool,
 }
 
 impl BatchOptions {

@@ -276,7 +276,9 @@ pub fn run_batch(
         }
         summary.frames_in_flight = 1;
         summary.stages = stages;
-        summary.index = super::index::write_part(root.real_path(), frames, opts)?;
+        if opts.index {
+            summary.index = super::index::write_part(root.real_path(), frames, opts)?;
+        }
         summary.wall_s = t_start.elapsed().as_secs_f64();
         return Ok(summary);
     }
@@ -384,7 +386,9 @@ pub fn run_batch(
         }
     });
     summary.stages = stages;
-    summary.index = super::index::write_part(root.real_path(), frames, opts)?;
+    if opts.index {
+        summary.index = super::index::write_part(root.real_path(), frames, opts)?;
+    }
     summary.wall_s = t_start.elapsed().as_secs_f64();
     Ok(summary)
 }
