@@ -5,6 +5,10 @@
 // a slanted surface stays one layer, an occluder's edge starts another); the pixel takes that
 // layer's colour and depth, weighted by 1 / distance^2. So a disocclusion takes what lies behind
 // the occluder, and a hole in one surface is interpolated across it in 2-D, without row streaks.
+// Candidates count only up to u_reach (2) times the row's far end: a walk along a thin hole
+// that meets a far surface beyond it is none of the hole's sides.
+// In a border strip (the row runs off the image with no rendered pixel: beyond both eyes' frames,
+// nothing uncovered) the layer is the chain of the nearest candidate instead of the farthest.
 // Rendered pixels pass through unchanged; filled ones carry only u_filled.
 
 layout(location = 0) out vec4 o_color;
@@ -29,10 +33,16 @@ void main() {
     ivec2 at[16];
     int n = 0;
     int radius = max(u_size.x, u_size.y);
+    // The row (directions 0 and 8: +x, -x): off the image with no rendered pixel either way is a
+    // border strip; inside, candidates count up to u_reach times its span.
+    ivec2 q;
+    int r_right = first_along(p, DIRECTIONS[0], u_size, radius, q);
+    int r_left = first_along(p, DIRECTIONS[8], u_size, radius, q);
+    bool border_strip = r_right == 0 || r_left == 0;
+    int reach = border_strip ? radius : u_reach * max(r_right, r_left);
     for (int i = 0; i < DIRECTION_COUNT; ++i) {
-        ivec2 q;
         int r_q = first_along(p, DIRECTIONS[i], u_size, radius, q);
-        if (r_q == 0) {
+        if (r_q == 0 || r_q > reach) {
             continue;
         }
         float zq = texelFetch(u_depth, q, 0).r;
@@ -55,14 +65,27 @@ void main() {
         o_sources = 0.0;
         return;
     }
-    int layer = 1;
-    while (layer < n && z[layer - 1] - z[layer] <= u_same_surface * z[layer - 1]) {
-        ++layer;
+    // The layer's seed: the farthest candidate, or in a border strip the first of the nearest.
+    int seed = 0;
+    if (border_strip) {
+        for (int i = 1; i < n; ++i) {
+            if (r[i] < r[seed]) {
+                seed = i;
+            }
+        }
+    }
+    int lo = seed;
+    while (lo > 0 && z[lo - 1] - z[lo] <= u_same_surface * z[lo - 1]) {
+        --lo;
+    }
+    int hi = seed + 1;
+    while (hi < n && z[hi - 1] - z[hi] <= u_same_surface * z[hi - 1]) {
+        ++hi;
     }
     vec4 color = vec4(0.0);
     float depth = 0.0;
     float total = 0.0;
-    for (int i = 0; i < layer; ++i) {
+    for (int i = lo; i < hi; ++i) {
         float w = 1.0 / float(r[i] * r[i]);
         color += w * texelFetch(u_color, at[i], 0);
         depth += w * z[i];

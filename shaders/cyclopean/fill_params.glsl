@@ -5,6 +5,7 @@ layout(std140, binding = 0) uniform FillParams {
     ivec2 u_size;     // W, H of the middle view
     uint u_filled;    // the source bit filled pixels carry (fill.rs FILLED)
     float u_same_surface;  // relative depth difference below which both sides are one surface
+    int u_reach;      // candidates count up to this multiple of the row's span (fill.rs REACH)
 };
 layout(binding = 1) uniform sampler2D u_color;     // RGBA8 middle colour
 layout(binding = 2) uniform sampler2D u_depth;     // R32F middle distance, 0 = none

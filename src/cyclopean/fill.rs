@@ -3,10 +3,17 @@
 //! background layer around them (issue 38; the first fill went along the row, and its large
 //! holes became visible horizontal streaks across slanted, textured surfaces):
 //! - from the hole, walk the 16 directions of [`super::walk`] to the first rendered pixel in each;
+//! - keep those no farther than twice the row's far end ([`REACH`]): the surfaces across the
+//!   hole, not one that a walk along a thin hole meets far beyond it (the wall behind a floor);
 //! - sort those candidates far to near; the background layer is the farthest and every next one
 //!   within [`SAME_SURFACE`] (relative) of the one before it: a chain, so a slanted surface stays
 //!   one layer while an occluder's edge, a jump in depth, starts another;
-//! - the hole takes that layer's colour and depth, weighted by 1 / distance^2.
+//! - the hole takes that layer's colour and depth, weighted by 1 / distance^2;
+//! - except in a border strip (the row runs off the image on one side with no rendered pixel:
+//!   a part of the view beyond both eyes' frames, which no occluder uncovered), where the
+//!   layer is the chain of the nearest candidate: the surfaces next to the strip continue into
+//!   it, where the farthest would be whatever a long walk along the strip reaches (the wall above
+//!   a floor).
 //!
 //! A disocclusion uncovers what lies behind the occluder, so the foreground does not bleed into
 //! it; a hole inside one surface is interpolated across it from every side.
@@ -32,12 +39,23 @@ crate::param_block! {
         u_size: [i32; 2],
         u_filled: u32,
         u_same_surface: f32,
+        u_reach: i32,
     }
 }
 
 /// Relative depth difference below which the pixels either side of a hole are taken as one
 /// surface, and the hole is interpolated between them instead of copied from the farther.
 pub const SAME_SURFACE: f32 = 0.05;
+
+/// [`super::walk::DIRECTIONS`]' entries along the row: +x and -x.
+const ROW_RIGHT: usize = 0;
+const ROW_LEFT: usize = 8;
+
+/// Candidates count up to this multiple of the row's span, the farther row hit (inside the
+/// image): 2, so every direction that crosses a vertical gap still does (the steepest, (1, 2),
+/// at twice its width). With 1 the built-in scene's frame 4 gained 0.1 dB, but a large hole in
+/// a slanted plane lost its steep directions, its chain broke and it took one side's depth.
+pub const REACH: i64 = 2;
 
 /// Fills middle views on one device.
 pub struct Filler {
@@ -90,6 +108,7 @@ impl Filler {
             u_size: [w as i32, h as i32],
             u_filled: FILLED.into(),
             u_same_surface: SAME_SURFACE,
+            u_reach: REACH as i32,
         };
         // Memory rows are the top-down rows: the rule is symmetric, nothing to flip.
         let target = Target::view(w, h, true, true, crate::convention::RowOrder::TopDown);
@@ -127,10 +146,25 @@ pub fn fill_reference(out: &CyclopeanOutput, width: u32, height: u32) -> Result<
             if out.sources[i] != 0 {
                 continue;
             }
-            // (depth, distance, index) of the first rendered pixel along each direction.
-            let mut candidates: Vec<(f32, i64, usize)> = super::walk::DIRECTIONS
+            // (depth, distance, index) of the first rendered pixel along each direction; and
+            // whether the row runs off the image either way with none (a border strip).
+            let hits: Vec<_> = super::walk::DIRECTIONS
                 .iter()
-                .filter_map(|&d| super::walk::first_along((x, y), d, (w, h), w.max(h), valid))
+                .map(|&d| super::walk::first_along((x, y), d, (w, h), w.max(h), valid))
+                .collect();
+            let (right, left) = (hits[ROW_RIGHT], hits[ROW_LEFT]);
+            let border_strip = right.is_none() || left.is_none();
+            // Inside, the reach: twice the row's far end. A hole's two sides are across it along
+            // the row (the baseline's direction), so a walk along a thin hole that meets a far
+            // surface beyond its end is no candidate.
+            let reach = match (right, left) {
+                (Some((_, a)), Some((_, b))) => REACH * a.max(b),
+                _ => i64::MAX,
+            };
+            let mut candidates: Vec<(f32, i64, usize)> = hits
+                .into_iter()
+                .flatten()
+                .filter(|&(_, r)| r <= reach)
                 .map(|((qx, qy), r)| {
                     let j = (qy * w + qx) as usize;
                     (depth.data[j], r, j)
@@ -143,12 +177,24 @@ pub fn fill_reference(out: &CyclopeanOutput, width: u32, height: u32) -> Result<
             }
             // Far to near, stable (the shader's insertion keeps direction order at equal depths).
             candidates.sort_by(|a, b| b.0.total_cmp(&a.0));
-            let layer = 1 + candidates
-                .windows(2)
-                .take_while(|p| p[0].0 - p[1].0 <= SAME_SURFACE * p[0].0)
-                .count();
+            // The layer's seed: the farthest candidate, or in a border strip the nearest one
+            // (first of the nearest in far-to-near order); then its chain either way.
+            let seed = match border_strip {
+                false => 0,
+                true => (0..candidates.len())
+                    .min_by_key(|&k| candidates[k].1)
+                    .expect("not empty"),
+            };
+            let linked = |k: usize| candidates[k - 1].0 - candidates[k].0 <= SAME_SURFACE * candidates[k - 1].0;
+            let (mut lo, mut hi) = (seed, seed + 1);
+            while lo > 0 && linked(lo) {
+                lo -= 1;
+            }
+            while hi < candidates.len() && linked(hi) {
+                hi += 1;
+            }
             let (mut rgb, mut z, mut total) = ([0f32; 3], 0f32, 0f32);
-            for &(zq, r, j) in &candidates[..layer] {
+            for &(zq, r, j) in &candidates[lo..hi] {
                 let wq = 1.0 / (r * r) as f32;
                 for (c, acc) in rgb.iter_mut().enumerate() {
                     *acc += wq * (color.data[3 * j + c] as f32 / 255.0);
@@ -253,6 +299,59 @@ mod tests {
             "row-to-row {along_rows} vs column-to-column {along_columns}"
         );
         assert!(f.sources.iter().all(|s| *s != 0), "the hole is filled");
+    }
+
+    #[test]
+    fn a_thin_hole_takes_its_sides_not_a_far_surface_beyond_its_end() {
+        // Columns: foreground (1 m) | a one-pixel hole | background (3 m); above the hole's end,
+        // in its column, a far wall (20 m) that the upward walk meets: beyond twice the row's
+        // span (1 px) from row 3 on, so no candidate there. The farthest rule alone painted the wall in.
+        let (w, h) = (5usize, 6usize);
+        let mut z = vec![0f32; w * h];
+        let mut sources = vec![1u8; w * h];
+        for y in 0..h {
+            for x in 0..w {
+                z[y * w + x] = match (x, y) {
+                    (2, 0) => 20.0,
+                    (2, _) => 0.0,
+                    (x, _) if x < 2 => 1.0,
+                    _ => 3.0,
+                };
+            }
+            if y > 0 {
+                sources[y * w + 2] = 0;
+            }
+        }
+        let f = fill_reference(&view(w as u32, h as u32, z, sources), w as u32, h as u32).unwrap();
+        // Rows 1-2 see the wall within reach (2 px); from row 3 it is beyond.
+        for y in 3..h {
+            assert_eq!(f.depth.as_ref().unwrap().data[y * w + 2], 3.0, "row {y}");
+        }
+    }
+
+    #[test]
+    fn a_border_strip_continues_the_surface_next_to_it() {
+        // A wall (10 m) across rows 0-1; below, a floor (2 m) in columns 0-3 and nothing in 4-5:
+        // the strip beyond both eyes. Its row runs off the image, so it takes the nearest
+        // candidate's layer (the floor), not the farthest (the wall up the strip).
+        let (w, h) = (6usize, 8usize);
+        let z: Vec<f32> = (0..w * h)
+            .map(|i| match (i % w, i / w) {
+                (_, 0 | 1) => 10.0,
+                (x, _) if x < 4 => 2.0,
+                _ => 0.0,
+            })
+            .collect();
+        let sources = z.iter().map(|&d| (d > 0.0) as u8).collect();
+        let f = fill_reference(&view(w as u32, h as u32, z, sources), w as u32, h as u32).unwrap();
+        // From row 4, where the floor is nearer than the wall (rows 2-3 have the wall as near as
+        // the floor in some direction: a tie goes to the farther).
+        for y in 4..h {
+            for x in 4..w {
+                assert_eq!(f.depth.as_ref().unwrap().data[y * w + x], 2.0, "({x}, {y})");
+                assert_eq!(f.sources[y * w + x], FILLED);
+            }
+        }
     }
 
     #[test]
