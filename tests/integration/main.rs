@@ -16,6 +16,7 @@ mod cli_reproject_stitch;
 mod cli_sequence;
 mod common;
 mod compare;
+mod compare_robust;
 mod cyclopean;
 mod cyclopean_dense;
 mod cyclopean_fill;
