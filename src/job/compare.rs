@@ -7,7 +7,7 @@ use super::{ArgError, Event, Host, JobError};
 use crate::compare::{compare_with, Comparison, Measures, Side, Thresholds};
 use crate::convention::{Conventions, DepthPlanes};
 use crate::depth::DepthEncoding;
-use crate::io::{self, DepthDecode, DepthSummary};
+use crate::io::{self, DepthDecode};
 use std::path::{Path, PathBuf};
 
 /// What a side's depth file holds.
@@ -205,7 +205,7 @@ impl CompareJob {
                 );
                 host.event(Event::InputDepth {
                     path,
-                    summary: &DepthSummary::of(&side.storage.view_z_map(&side.conv, depth)),
+                    summary: &side.storage.summary(&side.conv, depth),
                     hint: &hint,
                 });
             }

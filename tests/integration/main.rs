@@ -12,6 +12,7 @@ mod cli_end_to_end;
 mod cli_formats;
 mod cli_output;
 mod cli_outputs_table;
+mod cli_plausibility;
 mod cli_reproject_stitch;
 mod cli_sequence;
 mod common;

@@ -35,7 +35,8 @@ pub(crate) struct RefocusArgs {
     depth: Option<PathBuf>,
     /// Raw units per metre for integer depth: 5000 for TUM, 1000 for SUN RGB-D (with
     /// --sun-bit-rotate) and millimetre PNGs. Divides float depth too when given. (NYU v2 raw PGM
-    /// holds Kinect disparity, not depth: no scale fits; convert it first.)
+    /// holds Kinect disparity, not depth: no scale fits; convert it first.) With --batch: the
+    /// scale of every frame whose manifest row gives no depth_scale.
     #[arg(help_heading = INPUTS, long, value_parser = finite_value)]
     depth_scale: Option<f64>,
     /// Array of an .npz depth file to read (default: the only array, else the first
@@ -127,7 +128,7 @@ pub(crate) struct RefocusArgs {
     #[command(flatten)]
     gpu: GpuArgs,
     /// Rendering API: gl, or vulkan (the same shaders as SPIR-V on a Vulkan device, --device
-    /// an index of `viewsynth info --backend vulkan`; single frames, not --batch).
+    /// an index of `viewsynth info --backend vulkan`; single frames and --batch alike).
     #[arg(help_heading = GPU, long, value_enum, default_value = "gl")]
     backend: BackendArg,
 }
