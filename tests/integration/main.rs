@@ -10,6 +10,7 @@ mod cli_compare;
 mod cli_depth_out;
 mod cli_end_to_end;
 mod cli_formats;
+mod cli_help;
 mod cli_output;
 mod cli_outputs_table;
 mod cli_plausibility;

@@ -21,7 +21,12 @@ pub(crate) const EXAMPLES: &str = "\
 Examples:
   # a cyclopean middle view of Cones against the real middle view, where it is valid
   viewsynth compare --a-rgb out/cones/middle_rgb.png --b-rgb ../shared/data/middlebury2003_cones/im4.png \\
-      --mask out/cones/middle_mask.png --min-psnr 25 --json out/cones/compare.json";
+      --mask out/cones/middle_mask.png --min-psnr 25 --flip-map out/cones/flip.png --json out/cones/compare.json
+  # a CI gate: GL against a Vulkan reversed-Z rendering of one frame, at most 0.2 % bad pixels
+  viewsynth scene --width 320 --height 240 --ndc vulkan --reversed-z --out-dir out/scene_vk
+  viewsynth compare --a-rgb out/scene/middle_rgb.png --a-depth out/scene/middle_device_depth.exr --a-depth-kind device \\
+      --b-rgb out/scene_vk/middle_rgb.png --b-depth out/scene_vk/middle_device_depth.exr --b-depth-kind device \\
+      --b-ndc vulkan --b-reversed-z --near 0.05 --far 100 --max-bad-share 0.002 --max-flip 0.01";
 
 #[derive(Args)]
 pub(crate) struct CompareArgs {
@@ -81,6 +86,7 @@ pub(crate) struct CompareArgs {
     #[arg(help_heading = OUTPUTS, long, value_name = "FILE")]
     flip_map: Option<PathBuf>,
     /// Write the summary as JSON to FILE (without FILE, or "-": print it instead of text).
+    ///
     /// An infinite PSNR is written as the string "inf".
     #[arg(help_heading = OUTPUTS, long, value_name = "FILE", num_args = 0..=1, default_missing_value = "-")]
     json: Option<PathBuf>,
