@@ -129,6 +129,7 @@ impl CompareJob {
         .filter_map(|(option, p)| p.map(|p| (option, p.as_path())))
         .collect();
         let mut outputs: Vec<io::NamedPath<'_>> = o.diff.iter().map(|p| ("--diff", p.as_path())).collect();
+        outputs.extend(o.flip_map.iter().map(|p| ("--flip-map", p.as_path())));
         if let Some(JsonOutput::File(p)) = &o.json {
             outputs.push(("--json", p));
         }
