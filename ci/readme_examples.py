@@ -135,8 +135,8 @@ DOCS_ORDER = ["scene", "refocus", "cyclopean", "compare", "reproject", "stitch",
 
 # The order of the commands whose `--help` examples run last, and the files the examples name
 # as a user's own (a manifest), written into the scratch repository first.
-HELP_ORDER = ["scene", "cyclopean", "compare", "refocus", "reproject", "stitch", "info", "bench",
-              "stress", "report", "demo"]
+HELP_ORDER = ["scene", "cyclopean", "compare", "refocus", "index", "reproject", "stitch", "info",
+              "bench", "stress", "report", "demo"]
 HELP_FIXTURES = {
     "frames.csv": "rgb,depth,fx,fy,cx,cy,name\n"
     "../shared/data/rgbd_open3d_testdata/TUM_color.png,../shared/data/rgbd_open3d_testdata/TUM_depth.png,"

@@ -117,7 +117,7 @@ enum Command {
     Refocus(Box<refocus::args::RefocusArgs>),
     /// Join the index parts that `refocus --batch` runs (shards) wrote into OUT/index.jsonl: one
     /// row per target (frame, scale, K', size, coverage, files).
-    #[command(after_help = index::args::EXAMPLES)]
+    #[command(after_help = SHORT_HELP_NOTE, after_long_help = index::args::EXAMPLES)]
     Index(index::args::IndexArgs),
     /// Synthesise the middle (spectator) view of a stereo pair from each eye's colour and depth.
     #[command(allow_negative_numbers = true, after_help = SHORT_HELP_NOTE, after_long_help = cyclopean::args::EXAMPLES)]
