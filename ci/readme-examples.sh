@@ -1,5 +1,6 @@
 #!/usr/bin/env bash
-# Every example of README.md, run as written: each ```sh and ```python block in order, in a
+# Every example of README.md, of each docs/ page and of each command's --help, run as written:
+# each ```sh and ```python block in order (see ci/readme_examples.py for the order), in a
 # scratch folder laid out as the README assumes (the repository root, ../shared/data beside it),
 # each `# => ...` line the README states checked against the block's output (a stale figure
 # fails). Called by .ci/run after the Rust tests (target/release/viewsynth) and
@@ -35,4 +36,4 @@ ln -s "$BIN" "$SCRATCH/bin/viewsynth"
 
 export VIEWSYNTH_BIN="$BIN"
 export PATH="$SCRATCH/bin:$VENV/bin:$PATH"
-python3 ci/readme_examples.py README.md "$SCRATCH"
+python3 ci/readme_examples.py README.md "$SCRATCH" "$@"

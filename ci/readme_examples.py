@@ -1,6 +1,8 @@
-"""Run every ```sh and ```python block of README.md, in order, in a scratch folder laid out as
-the README assumes (the repository root, with ../shared/data beside it), and check every output
-line a block states. Called by ci/readme-examples.sh; see there for the environment it needs.
+"""Run every ```sh and ```python block of README.md and of every docs/ page (in DOCS_ORDER: a
+page that uses another's outputs comes after it), then every command's examples from
+`viewsynth <command> --help`, in order, in one scratch folder laid out as the README assumes (the
+repository root, with ../shared/data beside it), and check every output line a block states.
+Called by ci/readme-examples.sh; see there for the environment it needs.
 
 A stated output is a line `# => TEXT` in a block: some line of that block's output (stdout and
 stderr together) must hold TEXT, runs of spaces compared as one, `...` standing for any text in
@@ -66,7 +68,7 @@ def blocks(readme):
         else:
             lines.append(line)
     if kind is not None:
-        sys.exit(f"readme-examples: README.md:{start}: a ```{kind} block is never closed")
+        sys.exit(f"readme-examples: line {start}: a ```{kind} block is never closed")
     return out
 
 
@@ -126,15 +128,67 @@ def found(expected, output):
     return False
 
 
+# The docs/ pages in the order their examples run (after README.md): a page that reads another
+# page's outputs (out/scene, out/cones, ...) comes after it. Every page must be listed.
+DOCS_ORDER = ["scene", "refocus", "cyclopean", "compare", "reproject", "stitch", "demo", "report",
+              "bench", "stress", "info", "python", "docker", "formats", "internals"]
+
+# The order of the commands whose `--help` examples run last, and the files the examples name
+# as a user's own (a manifest), written into the scratch repository first.
+HELP_ORDER = ["scene", "cyclopean", "compare", "refocus", "index", "reproject", "stitch", "info",
+              "bench", "stress", "report", "demo"]
+HELP_FIXTURES = {
+    "frames.csv": "rgb,depth,fx,fy,cx,cy,name\n"
+    "../shared/data/rgbd_open3d_testdata/TUM_color.png,../shared/data/rgbd_open3d_testdata/TUM_depth.png,"
+    "525,525,319.5,239.5,tum\n",
+}
+
+
+def pages(readme_path):
+    """(name, text) of README.md and every docs/ page, in the order they run."""
+    docs = os.path.join(os.path.dirname(os.path.abspath(readme_path)), "docs")
+    found = sorted(f[:-3] for f in os.listdir(docs) if f.endswith(".md"))
+    missing = [f for f in found if f not in DOCS_ORDER]
+    if missing:
+        sys.exit(f"readme-examples: docs/{missing[0]}.md is not in DOCS_ORDER: its examples would not run")
+    out = [("README.md", open(readme_path, encoding="utf-8").read())]
+    for name in DOCS_ORDER:
+        out.append((f"docs/{name}.md", open(os.path.join(docs, name + ".md"), encoding="utf-8").read()))
+    return out
+
+
+def help_examples():
+    """(name, text) of each command's `--help` examples, as one ```sh block each."""
+    listed = subprocess.run(["viewsynth", "--help"], stdout=subprocess.PIPE, check=True).stdout.decode()
+    commands = re.findall(r"^  ([a-z]+)\s", listed.split("Commands:")[1].split("Options:")[0], re.M)
+    commands = [c for c in commands if c != "help"]
+    unordered = [c for c in commands if c not in HELP_ORDER]
+    if unordered:
+        sys.exit(f"readme-examples: command '{unordered[0]}' is not in HELP_ORDER: its --help examples would not run")
+    out = []
+    for c in HELP_ORDER:
+        text = subprocess.run(["viewsynth", c, "--help"], stdout=subprocess.PIPE, check=True).stdout.decode()
+        if "Examples:" not in text:
+            sys.exit(f"readme-examples: `viewsynth {c} --help` shows no examples")
+        lines = text.split("Examples:", 1)[1].strip("\n").splitlines()
+        out.append((f"viewsynth {c} --help", "```sh\n" + "\n".join(l[2:] for l in lines) + "\n```\n"))
+    return out
+
+
 def main():
     readme_path, scratch = sys.argv[1], sys.argv[2]
     repo = os.path.join(scratch, "repo")
-    readme = open(readme_path, encoding="utf-8").read()
-    all_blocks = blocks(readme)
+    for name, text in HELP_FIXTURES.items():
+        with open(os.path.join(repo, name), "w", encoding="utf-8") as f:
+            f.write(text)
+    # By hand: a third argument runs only the pages whose name holds it (e.g. "compare").
+    only = sys.argv[3] if len(sys.argv) > 3 else ""
+    all_blocks = [(page, kind, line, text) for page, doc in pages(readme_path) + help_examples()
+                  for kind, line, text in blocks(doc) if only in page]
     notes, failures, checked = [], [], 0
     t_all = time.time()
-    for i, (kind, line, text) in enumerate(all_blocks, 1):
-        where = f"README.md:{line} ({kind} block {i} of {len(all_blocks)})"
+    for i, (page, kind, line, text) in enumerate(all_blocks, 1):
+        where = f"{page}:{line} ({kind} block {i} of {len(all_blocks)})"
         if kind == "sh":
             script = substitute(text, where, notes)
             cmd = ["bash", "-eo", "pipefail", "-c", script]

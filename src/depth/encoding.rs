@@ -183,6 +183,17 @@ impl DepthEncoding {
         }
     }
 
+    /// The summary of `depth` decoded to view Z in metres (see [`Self::view_z_map`]), with the
+    /// checks for degenerate device depth when it is device depth.
+    pub fn summary(&self, conv: &Conventions, depth: &DepthMap) -> crate::io::DepthSummary {
+        let z = self.view_z_map(conv, depth);
+        let s = crate::io::DepthSummary::of(&z);
+        match *self {
+            DepthEncoding::Device { planes } => s.with_device_planes(&z, planes),
+            _ => s,
+        }
+    }
+
     /// View Z of stored value `stored` seen through a pixel whose ray has length `ray_length`
     /// per unit Z ([`Self::ray_length`]; read by view distance only), in f64; None where
     /// invalid. Device depth is inverted in closed form, Z = B / (z_ndc - A).

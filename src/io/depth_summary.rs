@@ -1,11 +1,15 @@
 //! What a loaded depth map holds, in metres (size, valid fraction, min / median / max), and the
 //! signs that it was decoded with the wrong scale or kind: a wrong `--depth-scale`, a missing
 //! SUN RGB-D bit rotation, disparity or device depth read as metres all load without error
-//! and render a plausible-looking wrong result.
+//! and render a plausible-looking wrong result. Device depth decoded under the wrong NDC range,
+//! reversed-Z or planes degenerates instead: nearly every pixel at one plane (Vulkan reversed-Z
+//! read as GL standard-Z puts a whole room within a millimetre of the near plane), or a spread
+//! no scene has; [`DepthSummary::with_device_planes`] adds those checks.
 
 use std::fmt;
 
 use super::DepthMap;
+use crate::convention::DepthPlanes;
 
 /// Medians outside this range (metres) are implausible for RGB-D cameras and most scenes.
 pub const PLAUSIBLE_MEDIAN_M: (f64, f64) = (0.05, 20.0);
@@ -23,6 +27,14 @@ pub struct DepthSummary {
     pub at_max: usize,
     /// (min, median, max) of the valid values; None when none is valid.
     pub range: Option<(f64, f64, f64)>,
+    /// (5th, 95th) percentile of the valid values; None when none is valid.
+    pub p05_p95: Option<(f64, f64)>,
+    /// The planes device depth was decoded with, when it was ([`Self::with_device_planes`]).
+    pub device_planes: Option<DepthPlanes>,
+    /// Valid pixels within 10 % of the near plane (device depth only).
+    pub at_near: usize,
+    /// Valid pixels within 10 % of a finite far plane (device depth only).
+    pub at_far: usize,
     /// Invalid pixels are background the input may rightly hold much of (a 360 capture's sky):
     /// no [`DepthWarning::MostlyInvalid`]. Set by [`Self::with_background_expected`].
     pub background_expected: bool,
@@ -55,7 +67,29 @@ pub enum DepthWarning {
         /// The median of the valid values, metres.
         median: f64,
     },
+    /// Device depth: nearly every valid pixel decodes to within 10 % of one plane.
+    AtOnePlane {
+        /// "near" or "far".
+        plane: &'static str,
+        /// The plane, metres.
+        at_m: f64,
+        /// Fraction of the valid pixels there.
+        share: f64,
+    },
+    /// Device depth: the middle 90 % of the pixels spans less than 0.1 % of the median.
+    NoSpread {
+        /// (95th - 5th percentile) / median.
+        relative_spread: f64,
+    },
 }
+
+/// Share of the valid pixels at one plane that makes decoded device depth degenerate.
+const AT_ONE_PLANE: f64 = 0.9;
+/// Relative spread of the middle 90 % below which no scene decodes (a wall square to the
+/// camera aside).
+const NO_SPREAD: f64 = 1e-3;
+/// Valid pixels a map needs before its lack of spread says anything (64 x 64).
+const NO_SPREAD_MIN_PIXELS: usize = 4096;
 
 impl DepthSummary {
     /// Counts and ranks the valid (finite, > 0) values of `depth`.
@@ -77,6 +111,13 @@ impl DepthSummary {
                 .fold((f32::MAX, f32::MIN), |(l, h), v| (l.min(*v), h.max(*v)));
             Some((f64::from(lo), median, f64::from(hi)))
         };
+        let p05_p95 = (!valid.is_empty()).then(|| {
+            let n = valid.len();
+            let rank = |p: f64| ((p * n as f64).ceil() as usize).clamp(1, n) - 1;
+            let p05 = f64::from(*valid.select_nth_unstable_by(rank(0.05), f32::total_cmp).1);
+            let p95 = f64::from(*valid.select_nth_unstable_by(rank(0.95), f32::total_cmp).1);
+            (p05, p95)
+        });
         let at_max = range.map_or(0, |(_, _, hi)| valid.iter().filter(|v| f64::from(**v) == hi).count());
         DepthSummary {
             width: depth.width,
@@ -84,7 +125,33 @@ impl DepthSummary {
             valid: valid.len(),
             at_max,
             range,
+            p05_p95,
+            device_planes: None,
+            at_near: 0,
+            at_far: 0,
             background_expected: false,
+        }
+    }
+
+    /// The summary of device depth decoded to view Z (`view_z`, the map summarised) with
+    /// `planes`: adds the checks for a degenerate decoding (nearly all at one plane, no spread).
+    pub fn with_device_planes(self, view_z: &DepthMap, planes: DepthPlanes) -> Self {
+        let valid = || {
+            view_z
+                .data
+                .iter()
+                .map(|v| f64::from(*v))
+                .filter(|v| v.is_finite() && *v > 0.0)
+        };
+        DepthSummary {
+            device_planes: Some(planes),
+            at_near: valid().filter(|z| *z <= 1.1 * planes.near).count(),
+            at_far: if planes.far.is_finite() {
+                valid().filter(|z| *z >= planes.far / 1.1).count()
+            } else {
+                0
+            },
+            ..self
         }
     }
 
@@ -123,6 +190,25 @@ impl DepthSummary {
                 fraction: saturated,
                 value: hi,
             });
+        }
+        if let Some(planes) = self.device_planes {
+            let valid = self.valid.max(1) as f64;
+            for (plane, at_m, count) in [("near", planes.near, self.at_near), ("far", planes.far, self.at_far)] {
+                if count as f64 / valid >= AT_ONE_PLANE {
+                    w.push(DepthWarning::AtOnePlane {
+                        plane,
+                        at_m,
+                        share: count as f64 / valid,
+                    });
+                }
+            }
+            if let Some((p05, p95)) = self.p05_p95 {
+                let relative_spread = (p95 - p05) / median;
+                // Only over a real image's worth of pixels: a tiny synthetic map may well be flat.
+                if relative_spread < NO_SPREAD && self.valid >= NO_SPREAD_MIN_PIXELS && w.is_empty() {
+                    w.push(DepthWarning::NoSpread { relative_spread });
+                }
+            }
         }
         if median > PLAUSIBLE_MEDIAN_M.1 {
             w.push(DepthWarning::MedianTooFar { median });
@@ -171,6 +257,19 @@ impl fmt::Display for DepthWarning {
                 "median depth {median:.4} m is implausibly near (< {} m)",
                 PLAUSIBLE_MEDIAN_M.0
             ),
+            DepthWarning::AtOnePlane { plane, at_m, share } => write!(
+                f,
+                "{:.1} % of the pixels decode to within 10 % of the {plane} plane ({at_m} m): no scene \
+                 looks like that; device depth read under the wrong --ndc or --reversed-z (e.g. \
+                 Vulkan reversed-Z needs --ndc vulkan --reversed-z), or with the wrong --near/--far",
+                share * 100.0
+            ),
+            DepthWarning::NoSpread { relative_spread } => write!(
+                f,
+                "the middle 90 % of the pixels spans {:.3} % of the median depth: no spread any \
+                 scene but a wall square to the camera has; check --ndc, --reversed-z and --near/--far",
+                relative_spread * 100.0
+            ),
         }
     }
 }
@@ -182,6 +281,48 @@ mod tests {
     fn map(data: Vec<f32>) -> DepthMap {
         let n = data.len() as u32;
         DepthMap::new(n, 1, data).unwrap()
+    }
+
+    #[test]
+    fn degenerate_device_depth_warns_naming_the_convention_options() {
+        let planes = DepthPlanes { near: 0.05, far: 100.0 };
+        // The issue's case: Vulkan reversed-Z depth read as GL standard-Z, 0.0500 to 0.0513 m.
+        let z = map((0..10_000).map(|i| 0.05 + 1.3e-7 * i as f32).collect());
+        let w = DepthSummary::of(&z).with_device_planes(&z, planes).warnings();
+        assert!(
+            matches!(w[..], [DepthWarning::AtOnePlane { plane: "near", share, .. }] if share == 1.0),
+            "{w:?}"
+        );
+        let text = w[0].to_string();
+        assert!(
+            ["--ndc", "--reversed-z", "--near/--far"]
+                .iter()
+                .all(|o| text.contains(o)),
+            "{text}"
+        );
+        // Nearly all at the far plane.
+        let z = map((0..10_000).map(|i| 95.0 + 1e-4 * i as f32).collect());
+        let w = DepthSummary::of(&z).with_device_planes(&z, planes).warnings();
+        assert!(
+            w.iter()
+                .any(|w| matches!(w, DepthWarning::AtOnePlane { plane: "far", .. })),
+            "{w:?}"
+        );
+        // 10,000 pixels within 0.01 % of 3 m: no spread; a scene from 1 to 6 m: plausible.
+        let z = map((0..10_000).map(|i| 3.0 + 3e-8 * i as f32).collect());
+        let w = DepthSummary::of(&z).with_device_planes(&z, planes).warnings();
+        assert!(matches!(w[..], [DepthWarning::NoSpread { .. }]), "{w:?}");
+        let z = map((0..10_000).map(|i| 1.0 + 5e-4 * i as f32).collect());
+        assert!(DepthSummary::of(&z)
+            .with_device_planes(&z, planes)
+            .warnings()
+            .is_empty());
+        // Linear depth is not checked for planes it was never written with.
+        let z = map(vec![0.05; 10_000]);
+        assert!(!DepthSummary::of(&z)
+            .warnings()
+            .iter()
+            .any(|w| matches!(w, DepthWarning::AtOnePlane { .. })));
     }
 
     #[test]

@@ -4,10 +4,10 @@
 
 use super::error::InContext;
 use super::{ArgError, Event, Host, JobError};
-use crate::compare::{compare_masked, Comparison, Side, Thresholds};
+use crate::compare::{compare_with, Comparison, Measures, Side, Thresholds};
 use crate::convention::{Conventions, DepthPlanes};
 use crate::depth::DepthEncoding;
-use crate::io::{self, DepthDecode, DepthSummary};
+use crate::io::{self, DepthDecode};
 use std::path::{Path, PathBuf};
 
 /// What a side's depth file holds.
@@ -57,6 +57,8 @@ pub struct CompareOptions {
     pub far: f64,
     /// Where to write the colour difference.
     pub diff: Option<PathBuf>,
+    /// Where to write FLIP's magma error map.
+    pub flip_map: Option<PathBuf>,
     /// Compare only where this image is nonzero.
     pub mask: Option<PathBuf>,
     /// CI limits.
@@ -73,6 +75,7 @@ pub struct CompareJob {
     npz_key: Option<String>,
     planes: DepthPlanes,
     diff: Option<PathBuf>,
+    flip_map: Option<PathBuf>,
     mask: Option<PathBuf>,
     thresholds: Thresholds,
     json: Option<JsonOutput>,
@@ -126,6 +129,7 @@ impl CompareJob {
         .filter_map(|(option, p)| p.map(|p| (option, p.as_path())))
         .collect();
         let mut outputs: Vec<io::NamedPath<'_>> = o.diff.iter().map(|p| ("--diff", p.as_path())).collect();
+        outputs.extend(o.flip_map.iter().map(|p| ("--flip-map", p.as_path())));
         if let Some(JsonOutput::File(p)) = &o.json {
             outputs.push(("--json", p));
         }
@@ -139,6 +143,7 @@ impl CompareJob {
                 far: o.far,
             },
             diff: o.diff,
+            flip_map: o.flip_map,
             mask: o.mask,
             thresholds: o.thresholds,
             json: o.json,
@@ -153,6 +158,16 @@ impl CompareJob {
     /// Where the diff image goes.
     pub fn diff(&self) -> Option<&Path> {
         self.diff.as_deref()
+    }
+
+    /// Where FLIP's error map goes.
+    pub fn flip_map(&self) -> Option<&Path> {
+        self.flip_map.as_deref()
+    }
+
+    /// The limits checked.
+    pub fn thresholds(&self) -> &Thresholds {
+        &self.thresholds
     }
 
     /// Whether a mask limits the comparison.
@@ -191,16 +206,21 @@ impl CompareJob {
                 );
                 host.event(Event::InputDepth {
                     path,
-                    summary: &DepthSummary::of(&side.storage.view_z_map(&side.conv, depth)),
+                    summary: &side.storage.summary(&side.conv, depth),
                     hint: &hint,
                 });
             }
         }
         let mask = self.mask.as_deref().map(io::load_mask_png).transpose()?;
-        let (comparison, diff) = compare_masked(&sa, &sb, mask.as_ref()).within(|| match &self.mask {
+        let measures = Measures {
+            bad: self.thresholds.bad,
+            flip: true,
+        };
+        let compared = compare_with(&sa, &sb, mask.as_ref(), measures).within(|| match &self.mask {
             Some(m) => format!("comparing A and B over {}", m.display()),
             None => "comparing A and B".to_string(),
         })?;
+        let (comparison, diff) = (compared.comparison, compared.diff);
         let broken = self.thresholds.broken(&comparison);
         let summary = Summary {
             comparison: &comparison,
@@ -210,10 +230,13 @@ impl CompareJob {
         };
         let json =
             serde_json::to_string_pretty(&summary).map_err(|e| crate::Error::encode("summary", e.to_string()))?;
-        // Both files or neither (`--diff d.png --json /nonexistent/x.json` leaves no d.png).
+        // All files or none (`--diff d.png --json /nonexistent/x.json` leaves no d.png).
         let mut files: Vec<(std::path::PathBuf, io::PathWriter<'_>)> = Vec::new();
         if let Some(p) = &self.diff {
             files.push((p.clone(), Box::new(|staged: &Path| io::save_rgb(staged, &diff))));
+        }
+        if let (Some(p), Some(map)) = (&self.flip_map, &compared.flip_map) {
+            files.push((p.clone(), Box::new(move |staged: &Path| io::save_rgb(staged, map))));
         }
         if let Some(JsonOutput::File(p)) = &self.json {
             let json = &json;

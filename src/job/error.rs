@@ -246,6 +246,10 @@ pub enum PerFrameOption {
     Intrinsics,
     /// `--focal-list`.
     FocalList,
+    /// `--sun-bit-rotate` (a manifest column).
+    SunBitRotate,
+    /// `--npz-key`.
+    NpzKey,
 }
 
 impl std::fmt::Display for PerFrameOption {
@@ -255,6 +259,10 @@ impl std::fmt::Display for PerFrameOption {
                 "--intrinsics/--fx/--fy/--cx/--cy are per frame: with --batch they come from the manifest"
             }
             PerFrameOption::FocalList => "--focal-list is per frame; with --batch give --zoom-range scales",
+            PerFrameOption::SunBitRotate => {
+                "--sun-bit-rotate is per frame: with --batch give the manifest a sun_bit_rotate column"
+            }
+            PerFrameOption::NpzKey => "--npz-key is per frame: with --batch give depth files the key is not needed for",
         })
     }
 }

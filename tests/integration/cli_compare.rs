@@ -211,3 +211,71 @@ fn bad_thresholds_and_masks_fail_cleanly() {
         "{err}"
     );
 }
+
+/// The case: the built-in scene written by `viewsynth scene` under GL conventions and
+/// as Vulkan reversed-Z at 640x480, where one pixel of 307,200 is off by 140 % in depth.
+#[test]
+fn gl_against_vulkan_at_640x480_one_stray_pixel_and_the_missing_conventions() {
+    let d = scratch("cmp-scene");
+    for (dir, extra) in [("gl", &[][..]), ("vk", &["--ndc", "vulkan", "--reversed-z"][..])] {
+        let o = bin()
+            .args([
+                "scene",
+                "--width",
+                "640",
+                "--height",
+                "480",
+                "--out-dir",
+                s(&d.join(dir)),
+            ])
+            .args(extra)
+            .output()
+            .unwrap();
+        assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    }
+    let run = |extra: &[&str]| {
+        bin()
+            .args(["compare", "--near", "0.05", "--far", "100"])
+            .args(["--a-rgb", s(&d.join("gl/middle_rgb.png")), "--a-depth-kind", "device"])
+            .args(["--a-depth", s(&d.join("gl/middle_device_depth.exr"))])
+            .args(["--b-rgb", s(&d.join("vk/middle_rgb.png")), "--b-depth-kind", "device"])
+            .args(["--b-depth", s(&d.join("vk/middle_device_depth.exr"))])
+            .args(extra)
+            .output()
+            .unwrap()
+    };
+    let vk = ["--b-ndc", "vulkan", "--b-reversed-z"];
+    // The share gate passes; the maximum fails on the one pixel.
+    let o = run(&[&vk[..], &["--max-bad-share", "0.001"]].concat());
+    let out = String::from_utf8_lossy(&o.stdout);
+    assert_eq!(o.status.code(), Some(0), "{out}{}", String::from_utf8_lossy(&o.stderr));
+    assert!(
+        out.contains("depth relative error: median") && out.contains("over 1.00e-3: 3.3e-4 %"),
+        "{out}"
+    );
+    let o = run(&[&vk[..], &["--max-depth-rel", "1e-4"]].concat());
+    assert_eq!(o.status.code(), Some(1));
+    assert!(String::from_utf8_lossy(&o.stderr).contains("max relative depth error 1.400e0 > 1e-4"));
+    // Without B's conventions the check names reversed-Z (it said nothing at this size).
+    let o = run(&["--json"]);
+    let j: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+    assert!(
+        j["suspicion"]
+            .as_str()
+            .unwrap_or_default()
+            .contains("reversed-Z true (declared false"),
+        "{j}"
+    );
+    // The JSON holds both distributions, and the FLIP map is written.
+    let flip = d.join("flip.png");
+    let o = run(&[&vk[..], &["--json", "--flip-map", s(&flip)]].concat());
+    let j: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+    for key in ["median", "p99", "p99_9", "max", "share_over"] {
+        assert!(
+            !j["color_error"][key].is_null() && !j["depth_rel_error"][key].is_null(),
+            "{key}: {j}"
+        );
+    }
+    assert!(j["flip_mean"].as_f64().is_some_and(|m| (0.0..0.01).contains(&m)), "{j}");
+    assert_eq!(viewsynth::io::load_rgb(&flip).unwrap().width, 640);
+}

@@ -82,7 +82,7 @@ fn flipped_rows_ndc_stored_as_window_depth_and_reversed_z_mismatch_are_named() {
     assert!(
         c.suspicion
             .as_deref()
-            .is_some_and(|s| s.contains("reversed-Z true (declared false)")),
+            .is_some_and(|s| s.contains("reversed-Z true (declared false")),
         "{c:?}"
     );
     // Sizes must match.
@@ -148,6 +148,7 @@ fn thresholds_name_each_limit_broken() {
         max_color_rmse: Some(4.0),
         min_psnr_db: Some(40.0),
         max_depth_rel: Some(0.05),
+        ..Default::default()
     };
     let broken = all.broken(&c);
     assert_eq!(broken.len(), 3, "{broken:?}");
@@ -159,6 +160,7 @@ fn thresholds_name_each_limit_broken() {
         max_color_rmse: Some(5.0),
         min_psnr_db: Some(30.0),
         max_depth_rel: Some(0.11),
+        ..Default::default()
     };
     assert!(loose.broken(&c).is_empty(), "{:?}", loose.broken(&c));
     let mut no_depth = strip(100, 2.0);

@@ -325,6 +325,8 @@ fn outputs_never_land_on_inputs_or_on_each_other() {
         (vec!["--json", s(&a)], ["--a-rgb", "--json"]),
         (vec!["--json", s(&alias)], ["--a-rgb", "--json"]),
         (vec!["--mask", s(&mask), "--diff", s(&mask)], ["--mask", "--diff"]),
+        (vec!["--flip-map", s(&b)], ["--b-rgb", "--flip-map"]),
+        (vec!["--diff", s(&x), "--flip-map", &dotted], ["--diff", "--flip-map"]),
     ];
     let before: Vec<Vec<u8>> = [&a, &b, &mask].iter().map(|p| std::fs::read(p).unwrap()).collect();
     for (extra, names) in cases {

@@ -1,5 +1,5 @@
 //! The command line as a job's [`Host`]: opens the GPU (warning loudly when it renders in
-//! software although hardware is visible), prints the input summaries and notes to stderr, and
+//! software although hardware is visible, with a note when no hardware is), prints the input summaries and notes to stderr, and
 //! shows progress.
 
 use crate::progress::{Progress, StageProgress};
@@ -17,8 +17,12 @@ pub(crate) struct CliHost {
 impl Host for CliHost {
     fn open_gpu(&self, request: &GpuRequest) -> viewsynth::Result<Gpu> {
         let gpu = request.open()?;
-        if let Some(w) = &gpu.info().software_warning {
+        let info = gpu.info();
+        if let Some(w) = &info.software_warning {
             eprintln!("\n*** WARNING: {w} ***\n");
+        } else if info.software {
+            // No hardware visible: not alarming, but never silent (as for Vulkan below).
+            eprintln!("note: OpenGL renders in software ({}): no GPU in use", info.renderer);
         }
         Ok(gpu)
     }

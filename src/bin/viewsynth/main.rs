@@ -110,56 +110,60 @@ struct Cli {
 #[derive(Subcommand)]
 enum Command {
     /// Print the GPU, GL version, EGL platform/device and limits this machine renders with.
-    #[command(allow_negative_numbers = true, after_help = info::args::EXAMPLES)]
+    #[command(allow_negative_numbers = true, after_help = SHORT_HELP_NOTE, after_long_help = info::args::EXAMPLES)]
     Info(info::args::InfoArgs),
     /// Re-render RGB + metric depth at other focal lengths (same pose).
-    #[command(allow_negative_numbers = true, after_help = refocus::args::EXAMPLES)]
+    #[command(allow_negative_numbers = true, after_help = SHORT_HELP_NOTE, after_long_help = refocus::args::EXAMPLES)]
     Refocus(Box<refocus::args::RefocusArgs>),
     /// Join the index parts that `refocus --batch` runs (shards) wrote into OUT/index.jsonl: one
     /// row per target (frame, scale, K', size, coverage, files).
-    #[command(after_help = index::args::EXAMPLES)]
+    #[command(after_help = SHORT_HELP_NOTE, after_long_help = index::args::EXAMPLES)]
     Index(index::args::IndexArgs),
     /// Synthesise the middle (spectator) view of a stereo pair from each eye's colour and depth.
-    #[command(allow_negative_numbers = true, after_help = cyclopean::args::EXAMPLES)]
+    #[command(allow_negative_numbers = true, after_help = SHORT_HELP_NOTE, after_long_help = cyclopean::args::EXAMPLES)]
     Cyclopean(Box<cyclopean::args::CyclopeanArgs>),
     /// Reproject one view of a parallel stereo rig (left eye, centre view or right eye) to the
     /// other eye(s) from colour + depth (view Z, device depth or disparity); disocclusions stay
     /// invalid (mask 0), nothing is hole-filled.
-    #[command(allow_negative_numbers = true, after_help = reproject::args::EXAMPLES)]
+    #[command(allow_negative_numbers = true, after_help = SHORT_HELP_NOTE, after_long_help = reproject::args::EXAMPLES)]
     Reproject(Box<reproject::args::ReprojectArgs>),
     /// Stitch an omni-directional stereo (ODS) 360 equirect (top-bottom, left eye on top) from
     /// six over-wide cube faces per eye: the built-in scene's, or your own from --faces DIR.
-    #[command(allow_negative_numbers = true, after_help = stitch::args::EXAMPLES)]
+    #[command(allow_negative_numbers = true, after_help = SHORT_HELP_NOTE, after_long_help = stitch::args::EXAMPLES)]
     Stitch(Box<stitch::args::StitchArgs>),
     /// Ray-trace a ground-truth scene (built-in or JSON) on the GPU from a stereo rig: left, right
     /// and middle colour, view distance and device depth, and a cameras.json that
     /// `viewsynth cyclopean` reads.
-    #[command(allow_negative_numbers = true, after_help = scene::args::EXAMPLES)]
+    #[command(allow_negative_numbers = true, after_help = SHORT_HELP_NOTE, after_long_help = scene::args::EXAMPLES)]
     Scene(scene::args::SceneArgs),
     /// Compare two renderings (e.g. ours and a Vulkan renderer's) after converting row order,
-    /// NDC depth range, reversed-Z and device vs linear depth; names a convention that fits far
-    /// better than the declared one. Writes a diff image.
-    #[command(allow_negative_numbers = true, after_help = compare::args::EXAMPLES)]
+    /// NDC depth range, reversed-Z and device vs linear depth: error distributions, share gates
+    /// and FLIP for CI; names a convention that fits far better than the declared one.
+    #[command(allow_negative_numbers = true, after_help = SHORT_HELP_NOTE, after_long_help = compare::args::EXAMPLES)]
     Compare(Box<compare::args::CompareArgs>),
     /// Render the built-in scene, refocus it at 5 scales, synthesise the cyclopean middle view of
     /// a stereo pair with each method, and write every output plus the error/run-time report.
-    #[command(allow_negative_numbers = true, after_help = demo::args::EXAMPLES)]
+    #[command(allow_negative_numbers = true, after_help = SHORT_HELP_NOTE, after_long_help = demo::args::EXAMPLES)]
     Demo(demo::args::DemoArgs),
     /// Measure every method's error against ground truth (built-in scene, and real data when
     /// --data-dir holds ../shared/data's sets) next to its run time: report.{md,csv,svg}.
-    #[command(allow_negative_numbers = true, after_help = report::args::EXAMPLES)]
+    #[command(allow_negative_numbers = true, after_help = SHORT_HELP_NOTE, after_long_help = report::args::EXAMPLES)]
     Report(report::args::ReportArgs),
     /// Benchmark refocus (mesh and full-screen paths) and cyclopean (2 x 1280x720 eyes) and print
     /// median timings.
-    #[command(allow_negative_numbers = true, after_help = bench::args::EXAMPLES)]
+    #[command(allow_negative_numbers = true, after_help = SHORT_HELP_NOTE, after_long_help = bench::args::EXAMPLES)]
     Bench(bench::args::BenchArgs),
     /// Sweep stiff and extreme cases of every capability (focal scales 0.05..20, 1 mm..100 km,
     /// near/far 1e-7, standard vs reversed-Z, NaN/Inf depth, 1x1 to the largest image, parallel
     /// gaze, zero IPD, ...): GPU f32 against the f64 reference, as a table with the first failing
     /// case. Exits 1 if any case fails.
-    #[command(allow_negative_numbers = true, after_help = stress::args::EXAMPLES)]
+    #[command(allow_negative_numbers = true, after_help = SHORT_HELP_NOTE, after_long_help = stress::args::EXAMPLES)]
     Stress(stress::args::StressArgs),
 }
+
+/// What `-h` ends with: it lists the options in a line each; `--help` adds the detail and the
+/// examples.
+const SHORT_HELP_NOTE: &str = "Examples and each option in detail: --help";
 
 /// Exit status of a failure found while running.
 const RUN_ERROR: u8 = 1;
@@ -310,7 +314,7 @@ mod tests {
                     options += 1;
                 }
             }
-            let after = sub.get_after_help().map(|h| h.to_string()).unwrap_or_default();
+            let after = sub.get_after_long_help().map(|h| h.to_string()).unwrap_or_default();
             assert!(
                 after.starts_with("Examples:") && after.contains(&format!("viewsynth {name}")),
                 "viewsynth {name} --help shows no example of itself: {after:?}"

@@ -330,7 +330,7 @@ impl CyclopeanJob {
                 );
                 host.event(Event::InputDepth {
                     path,
-                    summary: &DepthSummary::of(&view_z_in_metres(eye, frame.depth_kind, &frame.conv)?),
+                    summary: &depth_summary(eye, frame.depth_kind, &frame.conv)?,
                     hint: &hint,
                 });
             }
@@ -353,15 +353,15 @@ pub(crate) struct RenderedView {
     size: (u32, u32),
 }
 
-/// An eye's depth as view Z in metres (0 where invalid), for the input summary.
-fn view_z_in_metres(eye: &EyeInput, kind: FrameDepth, conv: &Conventions) -> crate::Result<DepthMap> {
+/// An eye's depth as view Z in metres, summarised (device depth checked for a degenerate decoding).
+fn depth_summary(eye: &EyeInput, kind: FrameDepth, conv: &Conventions) -> crate::Result<DepthSummary> {
     let input = match kind {
         FrameDepth::ViewZ => DepthEncoding::ViewZ,
         FrameDepth::Device => DepthEncoding::Device {
             planes: DepthPlanes::from_gl_projection(&eye.proj, conv)?,
         },
     };
-    Ok(input.view_z_map(conv, &eye.depth))
+    Ok(input.summary(conv, &eye.depth))
 }
 
 /// A scale option, when given, must be finite and > 0 (refused by its own name, before any

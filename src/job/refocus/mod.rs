@@ -77,6 +77,8 @@ pub struct RefocusJob {
 #[derive(Debug)]
 pub struct RefocusBatchJob {
     manifest: PathBuf,
+    /// `--depth-scale`: the scale of frames whose manifest row gives none.
+    depth_scale: Option<f64>,
     options: BatchOptions,
     out_dir: PathBuf,
     gpu: GpuRequest,
@@ -220,8 +222,16 @@ impl RefocusBatchJob {
         if o.intrinsics_file.is_some() || o.intrinsics.iter().any(Option::is_some) {
             return Err(ArgError::PerFrameInBatch(PerFrameOption::Intrinsics));
         }
+        // A flag the batch cannot apply is refused, never ignored.
+        if o.decode.sun_rgbd_bit_rotate {
+            return Err(ArgError::PerFrameInBatch(PerFrameOption::SunBitRotate));
+        }
+        if o.npz_key.is_some() {
+            return Err(ArgError::PerFrameInBatch(PerFrameOption::NpzKey));
+        }
         Ok(RefocusBatchJob {
             manifest,
+            depth_scale: o.decode.scale,
             options: o.request.batch(o.conventions)?,
             out_dir: o.out_dir,
             gpu: o.gpu,
@@ -232,7 +242,13 @@ impl RefocusBatchJob {
     /// Refocuses every frame (of this shard) into `<out-dir>/<name>/`, skipping those finished
     /// with the same settings unless forced; a failed frame is reported, the others complete.
     pub fn run(&self, host: &dyn Host) -> Result<RefocusBatchReport, JobError> {
-        let frames = load_manifest(&self.manifest)?;
+        let mut frames = load_manifest(&self.manifest)?;
+        // --depth-scale is the scale of every frame whose row gives none (a row's own wins).
+        if let Some(scale) = self.depth_scale {
+            for f in frames.iter_mut().filter(|f| f.depth_scale.is_none()) {
+                f.depth_scale = Some(scale);
+            }
+        }
         io::OutDir::prepare(&self.out_dir)?;
         let device = host.open_device(&self.gpu, self.backend)?;
         host.event(Event::Started {

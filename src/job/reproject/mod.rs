@@ -15,7 +15,7 @@ use crate::cyclopean::{FrameDepth, MiddleCamera};
 use crate::depth::DepthEncoding;
 use crate::gpu::Timing;
 use crate::io::FileFormats;
-use crate::io::{self, DepthDecode, DepthSummary};
+use crate::io::{self, DepthDecode};
 use crate::reproject::{Geometry, ReprojectParams, ReprojectSource};
 use crate::view::ViewOutput;
 use serde::{Deserialize, Serialize};
@@ -310,7 +310,7 @@ impl ReprojectJob {
             .within(|| format!("{} and {}", self.color.display(), self.depth.display()))?;
         host.event(Event::InputDepth {
             path: &self.depth,
-            summary: &DepthSummary::of(&src.depth_kind.view_z_map(&src.conv, &src.depth)),
+            summary: &src.depth_kind.summary(&src.conv, &src.depth),
             hint: &format!("read as {what}"),
         });
         if src.inverse_depth_range().is_none() {

@@ -48,6 +48,10 @@ pub struct BatchSummary {
     pub other_shards: usize,
     /// (frame name, error) for every frame that failed; the others completed.
     pub failed: Vec<(String, String)>,
+    /// (frame name, warning) for every sign of a wrongly decoded depth map (the single-frame
+    /// command's input checks: a wrong depth_scale, disparity read as metres, ...), in manifest
+    /// order, each frame's once.
+    pub depth_warnings: Vec<(String, String)>,
     /// Wall time of the whole batch, seconds.
     pub wall_s: f64,
     /// Per-frame times of each pipeline stage.
@@ -91,14 +95,24 @@ fn write_frame(job: WriteJob, files: &FileFormats) -> Result<()> {
     Ok(())
 }
 
-/// Read and validate one frame's inputs (errors name the frame's files).
-fn decode_frame(frame: &BatchFrame, depth_trunc: Option<f64>) -> Result<RefocusSource> {
+/// Each frame's depth warnings as (index in the frames rendered, name, warning).
+type Warnings = Mutex<Vec<(usize, String, String)>>;
+
+/// Read and validate one frame's inputs (errors name the frame's files); the decoded depth is
+/// checked as the single-frame command checks it, its warnings added to `warnings`.
+fn decode_frame(frame: &BatchFrame, i: usize, depth_trunc: Option<f64>, warnings: &Warnings) -> Result<RefocusSource> {
     let decode = DepthDecode {
         scale: frame.depth_scale,
         sun_rgbd_bit_rotate: frame.sun_bit_rotate,
         ..Default::default()
     };
     let mut depth = io::load_depth(&frame.depth, &decode)?;
+    let found = io::DepthSummary::of(&depth).warnings();
+    if !found.is_empty() {
+        let name = frame.name.clone().unwrap_or_default();
+        let mut w = warnings.lock().unwrap_or_else(|e| e.into_inner());
+        w.extend(found.into_iter().map(|f| (i, name.clone(), f.to_string())));
+    }
     if let Some(m) = depth_trunc {
         io::truncate_depth(&mut depth, m)?;
     }
@@ -242,13 +256,19 @@ pub fn run_batch(
     refocuser.set_rgb_everywhere(opts.rgb_everywhere);
     let files = opts.files;
     let mut stages = StageTimes::default();
+    let warnings = Warnings::default();
+    let warned = |summary: &mut BatchSummary, warnings: Warnings| {
+        let mut w = warnings.into_inner().unwrap_or_else(|e| e.into_inner());
+        w.sort_by_key(|(i, _, _)| *i);
+        summary.depth_warnings = w.into_iter().map(|(_, name, text)| (name, text)).collect();
+    };
 
     if opts.jobs == 0 {
         // The synchronous baseline: each stage in turn on this thread.
-        for frame in todo {
+        for (i, frame) in todo.iter().enumerate() {
             let (name, settings) = (frame.name.clone().unwrap_or_default(), frame_settings(frame, opts));
             let t0 = Instant::now();
-            let result = decode_frame(frame, opts.depth_trunc).and_then(|src| {
+            let result = decode_frame(frame, i, opts.depth_trunc, &warnings).and_then(|src| {
                 stages.decode.push(ms_since(t0));
                 submit_frame(
                     &mut refocuser,
@@ -279,6 +299,7 @@ pub fn run_batch(
         if opts.index {
             summary.index = super::index::write_part(root.real_path(), frames, opts)?;
         }
+        warned(&mut summary, warnings);
         summary.wall_s = t_start.elapsed().as_secs_f64();
         return Ok(summary);
     }
@@ -292,12 +313,12 @@ pub fn run_batch(
     std::thread::scope(|scope| {
         let (decoded_tx, decoded_rx) = mpsc::sync_channel::<(usize, Result<RefocusSource>, f64)>(jobs);
         for _ in 0..jobs {
-            let (tx, next, todo) = (decoded_tx.clone(), &next, &todo);
+            let (tx, next, todo, warnings) = (decoded_tx.clone(), &next, &todo, &warnings);
             scope.spawn(move || loop {
                 let i = next.fetch_add(1, Ordering::Relaxed);
                 let Some(frame) = todo.get(i) else { break };
                 let t0 = Instant::now();
-                let src = decode_frame(frame, depth_trunc);
+                let src = decode_frame(frame, i, depth_trunc, warnings);
                 if tx.send((i, src, ms_since(t0))).is_err() {
                     break;
                 }
@@ -389,6 +410,7 @@ pub fn run_batch(
     if opts.index {
         summary.index = super::index::write_part(root.real_path(), frames, opts)?;
     }
+    warned(&mut summary, warnings);
     summary.wall_s = t_start.elapsed().as_secs_f64();
     Ok(summary)
 }

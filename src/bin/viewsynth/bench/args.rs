@@ -10,7 +10,7 @@ use viewsynth::job::ArgError;
 pub(crate) const EXAMPLES: &str = "\
 Examples:
   viewsynth bench --sizes 640x480 --repeats 3
-  viewsynth bench --batch 20 --jobs 2          # the pipelined refocus batch on 20 frames
+  viewsynth bench --batch 8 --jobs 2           # the pipelined refocus batch on 8 frames
   viewsynth bench --sizes 640x480 --json";
 
 #[derive(Args)]

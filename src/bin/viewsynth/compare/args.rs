@@ -4,7 +4,7 @@ use crate::options::{conventions, NdcArg, RowsArg};
 use crate::options::{CONVENTIONS, INPUTS, OUTPUTS, THRESHOLDS};
 use clap::{Args, ValueEnum};
 use std::path::{Path, PathBuf};
-use viewsynth::compare::Thresholds;
+use viewsynth::compare::{BadPixel, Thresholds};
 use viewsynth::job::compare::{CompareJob, CompareOptions, JsonOutput, SideDepth, SideOptions};
 use viewsynth::job::ArgError;
 
@@ -21,7 +21,12 @@ pub(crate) const EXAMPLES: &str = "\
 Examples:
   # a cyclopean middle view of Cones against the real middle view, where it is valid
   viewsynth compare --a-rgb out/cones/middle_rgb.png --b-rgb ../shared/data/middlebury2003_cones/im4.png \\
-      --mask out/cones/middle_mask.png --min-psnr 25 --json out/cones/compare.json";
+      --mask out/cones/middle_mask.png --min-psnr 25 --flip-map out/cones/flip.png --json out/cones/compare.json
+  # a CI gate: GL against a Vulkan reversed-Z rendering of one frame, at most 0.2 % bad pixels
+  viewsynth scene --width 320 --height 240 --ndc vulkan --reversed-z --out-dir out/scene_vk
+  viewsynth compare --a-rgb out/scene/middle_rgb.png --a-depth out/scene/middle_device_depth.exr --a-depth-kind device \\
+      --b-rgb out/scene_vk/middle_rgb.png --b-depth out/scene_vk/middle_device_depth.exr --b-depth-kind device \\
+      --b-ndc vulkan --b-reversed-z --near 0.05 --far 100 --max-bad-share 0.002 --max-flip 0.01";
 
 #[derive(Args)]
 pub(crate) struct CompareArgs {
@@ -51,13 +56,37 @@ pub(crate) struct CompareArgs {
     #[arg(help_heading = THRESHOLDS, long, value_name = "X")]
     min_psnr: Option<f64>,
     /// Fail (exit 1) when the largest relative depth error (pixels valid in both) exceeds X.
+    ///
+    /// One stray pixel decides a maximum: to gate CI, prefer --max-bad-share.
     #[arg(help_heading = THRESHOLDS, long, value_name = "X", requires = "a_depth")]
     max_depth_rel: Option<f64>,
+    /// Fail (exit 1) when more than this share of the compared pixels is bad (0.001 = 0.1 %).
+    ///
+    /// Checked for colour (a pixel is bad when a channel differs by more than --bad-colour
+    /// levels) and, with depth, for depth (relative error over --bad-depth-rel, pixels valid in
+    /// both). The share over each threshold is in the JSON either way.
+    #[arg(help_heading = THRESHOLDS, long, value_name = "SHARE")]
+    max_bad_share: Option<f64>,
+    /// Per-pixel colour threshold of --max-bad-share: largest channel difference, 8-bit levels.
+    #[arg(help_heading = THRESHOLDS, long, visible_alias = "bad-color", value_name = "LEVELS", default_value_t = BadPixel::default().color_levels)]
+    bad_colour: f64,
+    /// Per-pixel depth threshold of --max-bad-share: relative view-Z error |A - B| / A.
+    #[arg(help_heading = THRESHOLDS, long, value_name = "X", default_value_t = BadPixel::default().depth_rel)]
+    bad_depth_rel: f64,
+    /// Fail (exit 1) when the FLIP mean (NVIDIA's perceptual error in [0, 1], B the
+    /// reference) exceeds X.
+    #[arg(help_heading = THRESHOLDS, long, value_name = "X")]
+    max_flip: Option<f64>,
     /// Write the colour difference here: |A - B| per channel, scaled so that the largest
     /// difference is white (x 255 / max; the factor is printed and in the JSON).
     #[arg(help_heading = OUTPUTS, long)]
     diff: Option<PathBuf>,
+    /// Write FLIP's error map here, in FLIP's magma colours (black: no visible difference,
+    /// yellow-white: the largest), B the reference; black outside --mask.
+    #[arg(help_heading = OUTPUTS, long, value_name = "FILE")]
+    flip_map: Option<PathBuf>,
     /// Write the summary as JSON to FILE (without FILE, or "-": print it instead of text).
+    ///
     /// An infinite PSNR is written as the string "inf".
     #[arg(help_heading = OUTPUTS, long, value_name = "FILE", num_args = 0..=1, default_missing_value = "-")]
     json: Option<PathBuf>,
@@ -121,11 +150,18 @@ impl TryFrom<CompareArgs> for CompareJob {
             near: a.near,
             far: a.far,
             diff: a.diff,
+            flip_map: a.flip_map,
             mask: a.mask,
             thresholds: Thresholds {
                 max_color_rmse: a.max_colour_rmse,
                 min_psnr_db: a.min_psnr,
                 max_depth_rel: a.max_depth_rel,
+                max_bad_share: a.max_bad_share,
+                bad: BadPixel {
+                    color_levels: a.bad_colour,
+                    depth_rel: a.bad_depth_rel,
+                },
+                max_flip_mean: a.max_flip,
             },
             json: a.json.map(|p| match p.as_path() == Path::new("-") {
                 true => JsonOutput::Stdout,

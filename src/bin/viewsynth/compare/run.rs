@@ -4,7 +4,21 @@
 use crate::host::CliHost;
 use anyhow::Result;
 use std::process::ExitCode;
+use viewsynth::compare::{percent, ErrorDistribution};
 use viewsynth::job::compare::{CompareJob, JsonOutput};
+
+/// "median m, p99 a, p99.9 b, max c; over T: s %", values through `fmt`.
+fn distribution(d: &ErrorDistribution, threshold: f64, fmt: impl Fn(f64) -> String) -> String {
+    format!(
+        "median {}, p99 {}, p99.9 {}, max {}; over {}: {}",
+        fmt(d.median),
+        fmt(d.p99),
+        fmt(d.p999),
+        fmt(d.max),
+        fmt(threshold),
+        d.share_over(threshold).map_or("-".into(), percent)
+    )
+}
 
 pub(crate) fn compare(job: &CompareJob) -> Result<ExitCode> {
     let r = job.run(&CliHost::default())?;
@@ -13,6 +27,7 @@ pub(crate) fn compare(job: &CompareJob) -> Result<ExitCode> {
         outln!("{}", r.json);
     } else {
         let over = if job.masked() { " (in the mask)" } else { "" };
+        let bad = job.thresholds().bad;
         outln!(
             "colour: PSNR {:.2} dB, RMSE {:.4} levels, max difference {} levels over {} pixels{over}",
             cmp.psnr_db,
@@ -20,6 +35,16 @@ pub(crate) fn compare(job: &CompareJob) -> Result<ExitCode> {
             cmp.max_color_diff,
             cmp.pixels
         );
+        outln!(
+            "colour error (levels): {}",
+            distribution(&cmp.color_error, bad.color_levels, |v| format!("{v}"))
+        );
+        if let Some(m) = cmp.flip_mean {
+            let map = job
+                .flip_map()
+                .map_or(String::new(), |p| format!(" (map: {})", p.display()));
+            outln!("FLIP: mean {m:.4}{map}");
+        }
         if let Some(p) = job.diff() {
             outln!(
                 "diff: {} = |A - B| x {:.3} (the largest difference is white)",
@@ -29,6 +54,12 @@ pub(crate) fn compare(job: &CompareJob) -> Result<ExitCode> {
         }
         if let (Some(abs), Some(rel), Some(d)) = (cmp.depth_max_abs, cmp.depth_max_rel, cmp.mask_disagreement) {
             outln!("depth: max abs {abs:.3e} m, max rel {rel:.3e}; valid in only one: {d} pixels");
+        }
+        if let Some(d) = &cmp.depth_rel_error {
+            outln!(
+                "depth relative error: {}",
+                distribution(d, bad.depth_rel, |v| format!("{v:.2e}"))
+            );
         }
         if let Some(s) = &cmp.suspicion {
             outln!("suspicion: {s}");

@@ -55,10 +55,11 @@ pub(crate) struct CyclopeanArgs {
     right_rgb: Option<PathBuf>,
     /// A sequence of frames, rendered in order: JSON `{"frames": [{"left_rgb": ..., "right_rgb":
     /// ..., "left_depth": ..., "right_depth": ..., "cameras": ...}, ...]}` (the keys of these
-    /// flags; disparities or neither as for one pair), paths relative to the file. Writes
-    /// middle_00000_rgb.png, ... for frame 0 and so on, all-or-none. With --fill, holes take
-    /// what earlier frames saw there (the last view moved into this frame's camera) before the
-    /// fill fills the rest.
+    /// flags; disparities or neither as for one pair), paths relative to the file.
+    ///
+    /// Writes middle_00000_rgb.png, ... for frame 0 and so on, all-or-none. With --fill, holes take
+    /// what earlier frames saw there (the last view moved into this frame's camera) before the fill
+    /// fills the rest.
     #[arg(
         help_heading = INPUTS,
         long,
@@ -67,7 +68,9 @@ pub(crate) struct CyclopeanArgs {
     )]
     sequence: Option<PathBuf>,
     /// Left disparity of a rectified pair, pixels (x_right = x_left - d); 0 or non-finite =
-    /// unknown. PGM/PNG (8/16-bit), PFM, NPY or EXR.
+    /// unknown.
+    ///
+    /// PGM/PNG (8/16-bit), PFM, NPY or EXR.
     #[arg(help_heading = INPUTS, long, conflicts_with_all = ["left_depth", "cameras"])]
     left_disparity: Option<PathBuf>,
     /// Right disparity, pixels (x_left = x_right + d).
@@ -122,25 +125,33 @@ pub(crate) struct CyclopeanArgs {
     /// Seed/refine only: dominant eye and its blend weight, e.g. `left:0.7`.
     #[arg(help_heading = METHOD, long)]
     dominant: Option<String>,
-    /// Outputs to write: any of rgb (or color), depth, mask. Default all (disparity input: depth
-    /// only with --focal and --baseline). Colour and depth not listed are not read back.
+    /// Outputs to write: any of rgb (or color), depth, mask.
+    ///
+    /// Default all (disparity input: depth only with --focal and --baseline). Colour and depth not
+    /// listed are not read back.
     #[arg(help_heading = OUTPUTS, long)]
     outputs: Option<String>,
-    /// Fill the holes (pixels no eye saw) so the frame is complete: two images alone first
-    /// render on disparities made dense (unknown ones filled from similar-coloured neighbours,
-    /// leaning to the background), then every remaining hole takes the background layer around
-    /// it in 2-D. Filled pixels are 128 in middle_mask.png (rendered from matched or given
-    /// disparities: 255). Off: holes stay 0.
+    /// Fill the holes (pixels no eye saw) so the frame is complete; filled pixels are 128 in
+    /// middle_mask.png.
+    ///
+    /// Two images alone first render on disparities made dense (unknown ones filled from
+    /// similar-coloured neighbours, leaning to the background), then every remaining hole takes
+    /// the background layer around it in 2-D. Filled pixels are 128 in middle_mask.png (rendered
+    /// from matched or given disparities: 255). Off: holes stay 0.
     #[arg(help_heading = OUTPUTS, long)]
     fill: bool,
     /// Two images alone (no disparities, no depth): the largest disparity the census matcher
-    /// searches, pixels (default: estimated from the images by a coarse pass, with a margin;
-    /// the range used is printed).
+    /// searches, pixels.
+    ///
+    /// Default: estimated from the images by a coarse pass, with a margin; the range used is
+    /// printed.
     #[arg(help_heading = INPUTS, long, value_name = "N", allow_hyphen_values = true, value_parser = clap::value_parser!(i32).range(-i64::from(viewsynth::io::MAX_DIMENSION)..=i64::from(viewsynth::io::MAX_DIMENSION)))]
     max_disparity: Option<i32>,
     /// Two images alone: the smallest disparity searched, pixels; negative for pairs whose
-    /// disparities cross zero (a converged rig, images cropped after rectification). Default:
-    /// estimated from the images.
+    /// disparities cross zero.
+    ///
+    /// Negative disparities come from a converged rig or images cropped after rectification.
+    /// Default: estimated from the images.
     #[arg(help_heading = INPUTS, long, value_name = "N", allow_hyphen_values = true, value_parser = clap::value_parser!(i32).range(-i64::from(viewsynth::io::MAX_DIMENSION)..=i64::from(viewsynth::io::MAX_DIMENSION)))]
     min_disparity: Option<i32>,
     /// Two images alone: drop estimated disparities whose confidence is below C, in [0, 1]

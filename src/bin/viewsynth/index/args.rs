@@ -7,7 +7,7 @@ use std::path::PathBuf;
 pub(crate) const EXAMPLES: &str = "\
 Examples:
   # two shards wrote index.part-0-of-2.jsonl and index.part-1-of-2.jsonl; join them
-  viewsynth index out/batch";
+  viewsynth index out/shards";
 
 #[derive(Args)]
 pub(crate) struct IndexArgs {

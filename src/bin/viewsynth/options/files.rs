@@ -25,8 +25,9 @@ pub(crate) struct FileOutputArgs {
     /// [default: exr].
     #[arg(long)]
     depth_format: Option<String>,
-    /// Also write s{tag}_depth_preview.png: the depth output colour-mapped (turbo: near red, far
-    /// blue, invalid black) over its 2nd-98th percentile, the range recorded in the manifest.
+    /// Also write a <view>_depth_preview.png beside each depth output (named as the command's
+    /// --out-dir lists): the depth colour-mapped (turbo: near red, far blue, invalid black) over
+    /// its 2nd-98th percentile (the range is recorded in the manifest where the command writes one).
     #[arg(long)]
     depth_preview: bool,
     /// PNG compression of colour and mask files: fast (the default: the fastest deflate level

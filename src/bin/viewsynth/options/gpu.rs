@@ -11,6 +11,7 @@ pub(crate) struct GpuArgs {
     #[arg(long, default_value = "auto")]
     device: String,
     /// Fail (exit 1) when the renderer is software (llvmpipe, softpipe) instead of warning.
+    ///
     /// VIEWSYNTH_REQUIRE_GPU=1 does the same.
     #[arg(long)]
     require_gpu: bool,

@@ -8,10 +8,11 @@ use viewsynth::job::finite_value;
 #[derive(Args, Clone)]
 #[command(next_help_heading = super::INTRINSICS)]
 pub(crate) struct IntrinsicsArgs {
-    /// Source intrinsics from a file, the format told from its content: a 3x3 K (JSON, nested
-    /// or 9 numbers, or whitespace text), Open3D PinholeCameraIntrinsic JSON, Middlebury
-    /// calib.txt (cam0) or COLMAP cameras.txt (PINHOLE, SIMPLE_PINHOLE). --fx/--fy/--cx/--cy
-    /// given as well override single values.
+    /// Source intrinsics from a file, the format told from its content: a 3x3 K (JSON, nested or 9
+    /// numbers, or whitespace text), Open3D PinholeCameraIntrinsic JSON, Middlebury calib.txt
+    /// (cam0) or COLMAP cameras.txt (PINHOLE, SIMPLE_PINHOLE).
+    ///
+    /// --fx/--fy/--cx/--cy given as well override single values.
     #[arg(long, value_name = "FILE")]
     pub intrinsics: Option<PathBuf>,
     /// Source focal length along x, in pixels.

@@ -22,8 +22,9 @@ Examples:
   viewsynth refocus --rgb ../shared/data/rgbd_open3d_testdata/TUM_color.png \\
       --depth ../shared/data/rgbd_open3d_testdata/TUM_depth.png --depth-scale 5000 \\
       --fx 525 --fy 525 --cx 319.5 --cy 239.5 --zoom-range 0.5,0.75,1,1.5,2 --out-dir out/tum
-  # every frame of a manifest, one shard of four
-  viewsynth refocus --batch frames.csv --zoom-range 0.5,2 --shard 0/4 --out-dir out/batch";
+  # every frame of a manifest (CSV: rgb,depth,fx,fy,cx,cy[,depth_scale,name]), one shard of four;
+  # --depth-scale for the rows that give no depth_scale
+  viewsynth refocus --batch frames.csv --depth-scale 5000 --zoom-range 0.5,2 --shard 0/4 --out-dir out/batch";
 
 #[derive(Args)]
 pub(crate) struct RefocusArgs {
@@ -34,8 +35,11 @@ pub(crate) struct RefocusArgs {
     #[arg(help_heading = INPUTS, long, required_unless_present = "batch")]
     depth: Option<PathBuf>,
     /// Raw units per metre for integer depth: 5000 for TUM, 1000 for SUN RGB-D (with
-    /// --sun-bit-rotate) and millimetre PNGs. Divides float depth too when given. (NYU v2 raw PGM
-    /// holds Kinect disparity, not depth: no scale fits; convert it first.)
+    /// --sun-bit-rotate) and millimetre PNGs.
+    ///
+    /// Divides float depth too when given. (NYU v2 raw PGM holds Kinect disparity, not depth: no
+    /// scale fits; convert it first.) With --batch: the scale of every frame whose manifest row
+    /// gives no depth_scale.
     #[arg(help_heading = INPUTS, long, value_parser = finite_value)]
     depth_scale: Option<f64>,
     /// Array of an .npz depth file to read (default: the only array, else the first
@@ -105,17 +109,21 @@ pub(crate) struct RefocusArgs {
     out_dir: PathBuf,
     #[command(flatten)]
     files: FileOutputArgs,
-    /// Refocus every frame of a manifest into <out-dir>/<name>/, with one GL context, files
-    /// encoded on writer threads, and resume. CSV with a header row rgb,depth,fx,fy,cx,cy and
-    /// optional depth_scale,name columns, or a JSON array of objects with those keys (and
-    /// sun_bit_rotate); relative paths are relative to the manifest.
+    /// Refocus every frame of a manifest into <out-dir>/<name>/, with one GL context, files encoded
+    /// on writer threads, and resume.
+    ///
+    /// CSV with a header row rgb,depth,fx,fy,cx,cy and optional depth_scale,name columns, or a JSON
+    /// array of objects with those keys (and sun_bit_rotate); relative paths are relative to the
+    /// manifest.
     #[arg(help_heading = BATCH, long, conflicts_with_all = ["rgb", "depth"])]
     batch: Option<PathBuf>,
     /// With --batch: render every frame again, even those finished with the same settings.
     #[arg(help_heading = BATCH, long, alias = "no-resume")]
     force: bool,
     /// With --batch: threads in each CPU pool (decoding inputs, encoding files) around the GL
-    /// thread; 0 runs every stage in turn on one thread. Default: the number of cores.
+    /// thread; 0 runs every stage in turn on one thread.
+    ///
+    /// Default: the number of cores.
     #[arg(help_heading = BATCH, long, alias = "writer-threads", value_parser = clap::builder::RangedU64ValueParser::<usize>::new().range(0..=viewsynth::refocus::batch::MAX_JOBS as u64))]
     jobs: Option<usize>,
     /// With --batch: process only shard K of N (frames whose manifest index i has i % N == K,
@@ -127,7 +135,7 @@ pub(crate) struct RefocusArgs {
     #[command(flatten)]
     gpu: GpuArgs,
     /// Rendering API: gl, or vulkan (the same shaders as SPIR-V on a Vulkan device, --device
-    /// an index of `viewsynth info --backend vulkan`; single frames, not --batch).
+    /// an index of `viewsynth info --backend vulkan`; single frames and --batch alike).
     #[arg(help_heading = GPU, long, value_enum, default_value = "gl")]
     backend: BackendArg,
 }

@@ -55,6 +55,18 @@ fn batch(job: &RefocusBatchJob) -> Result<()> {
         Some(p) => println!("index: {}", p.display()),
         None => println!("index: this shard's part written; the last shard (or `viewsynth index`) joins them"),
     }
+    for (name, w) in &summary.depth_warnings {
+        eprintln!("warning: frame {name}: depth {w}; check its depth_scale (or --depth-scale) and sun_bit_rotate");
+    }
+    let warned: std::collections::BTreeSet<&str> =
+        summary.depth_warnings.iter().map(|(name, _)| name.as_str()).collect();
+    if !warned.is_empty() {
+        eprintln!(
+            "warning: {} of {} frames rendered or tried have depth that looks wrongly decoded (listed above)",
+            warned.len(),
+            summary.rendered + summary.failed.len()
+        );
+    }
     for (name, e) in &summary.failed {
         eprintln!("failed: {name}: {e}");
     }

@@ -18,8 +18,9 @@ pub(crate) struct ReportArgs {
     /// Folder with middlebury2003_cones/ and middlebury2003_teddy/ (skipped when absent).
     #[arg(help_heading = INPUTS, long)]
     data_dir: Option<PathBuf>,
-    /// A user cyclopean case with a reference middle view, laid out as `viewsynth scene`
-    /// writes it (cameras.json, {left,right}_rgb.png, *_device_depth.exr, middle_rgb.png).
+    /// A user cyclopean case with a reference middle view, laid out as `viewsynth scene` writes it
+    /// (cameras.json, {left,right}_rgb.png, *_device_depth.exr, middle_rgb.png).
+    ///
     /// Repeatable.
     #[arg(help_heading = INPUTS, long = "case")]
     cases: Vec<PathBuf>,

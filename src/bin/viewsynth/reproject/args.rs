@@ -82,8 +82,9 @@ pub(crate) struct ReprojectArgs {
     /// Far plane (metres; may be inf) the device depth was written with (--depth-kind device).
     #[arg(help_heading = INPUTS, long, value_parser = finite_or_inf)]
     far: Option<f64>,
-    /// Full eye matrices instead of a rig: a cameras.json as `viewsynth scene` writes it (left
-    /// and right GL view and projection, conventions, depth kind: those of the file apply).
+    /// Full eye matrices instead of a rig: a cameras.json as `viewsynth scene` writes it (left and
+    /// right GL view and projection, conventions, depth kind: those of the file apply).
+    ///
     /// The source is --from's eye, the target the other eye; --method gather3d only.
     #[arg(help_heading = INPUTS, long, conflicts_with_all = ["intrinsics", "fx", "fy", "cx", "cy", "baseline", "separation", "near", "far", "focal"])]
     cameras: Option<PathBuf>,
@@ -97,6 +98,7 @@ pub(crate) struct ReprojectArgs {
     #[arg(help_heading = INTRINSICS, long, default_value_t = ReprojectRequest::default().doffs, value_parser = finite_value)]
     doffs: f64,
     /// Rectified rig: distance between the eyes in metres (x_right = x_left + doffs - f B / Z).
+    ///
     /// Also the baseline of --depth-kind disparity.
     #[arg(help_heading = TARGETS, long, value_parser = finite_value)]
     baseline: Option<f64>,

@@ -11,7 +11,7 @@ use viewsynth::job::ArgError;
 pub(crate) const EXAMPLES: &str = "\
 Examples:
   viewsynth stress --quick --only refocus,stitch
-  viewsynth stress --json out/stress.json";
+  viewsynth stress --quick --json out/stress.json   # the table as JSON (without --quick: every case)";
 
 #[derive(Args)]
 pub(crate) struct StressArgs {

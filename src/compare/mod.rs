@@ -1,14 +1,30 @@
 //! `viewsynth compare`: our outputs against another renderer's (e.g. a Vulkan renderer's colour
 //! and device depth), after converting conventions: row order, NDC depth range, reversed-Z and
-//! device vs linear depth. Reports colour PSNR, depth errors and mask agreement, writes a diff
-//! image, and names a convention that fits far better than the declared one (a flipped or
-//! mis-ranged input).
+//! device vs linear depth. Reports colour PSNR, the distribution of the per-pixel colour and
+//! depth errors (median, p99, p99.9, maximum, share over thresholds: `distribution.rs`), FLIP
+//! (`flip.rs`), mask agreement, a diff image, and names a reading of B's conventions that fits
+//! far better than the declared one (`diagnose.rs`). CI limits: `thresholds.rs`.
+
+mod diagnose;
+pub mod distribution;
+pub mod flip;
+mod thresholds;
+
+pub use distribution::{ErrorDistribution, ShareOver};
+pub use flip::Flip;
+pub use thresholds::{percent, BadPixel, Thresholds};
 
 use crate::convention::{Conventions, RowOrder};
 use crate::depth::{DepthEncoding, DepthKind};
 use crate::error::{Error, Result};
 use crate::io::{DepthMap, Mask, RgbImage};
 use crate::metrics;
+
+/// Per-pixel colour thresholds (largest channel difference, 8-bit levels) whose shares are
+/// always reported.
+pub const COLOR_LEVELS_REPORTED: [f64; 6] = [1.0, 2.0, 4.0, 8.0, 16.0, 32.0];
+/// Relative depth error thresholds whose shares are always reported.
+pub const DEPTH_REL_REPORTED: [f64; 5] = [1e-5, 1e-4, 1e-3, 1e-2, 1e-1];
 
 /// One side: colour and optional depth as stored in its files (rows in `conv.row_order`).
 pub struct Side {
@@ -32,19 +48,46 @@ pub struct Comparison {
     pub color_rmse: f64,
     /// Largest per-sample colour difference, 8-bit levels.
     pub max_color_diff: u8,
+    /// Per pixel, the largest channel difference in 8-bit levels: its distribution over the
+    /// compared pixels.
+    pub color_error: ErrorDistribution,
     /// Over pixels valid in both (after conversion to view Z).
     pub depth_max_abs: Option<f64>,
     /// Largest relative view-Z difference |A - B| / A, over pixels valid in both.
     pub depth_max_rel: Option<f64>,
+    /// The distribution of |A - B| / A over pixels valid in both.
+    pub depth_rel_error: Option<ErrorDistribution>,
     /// Pixels valid in exactly one side.
     pub mask_disagreement: Option<usize>,
     /// Pixels compared: all, or those of the mask.
     pub pixels: usize,
+    /// FLIP mean over the compared pixels (B the reference), when measured.
+    pub flip_mean: Option<f64>,
     /// A reading of B's conventions that fits far better than the declared one, if any.
     pub suspicion: Option<String>,
     /// The diff image is |A - B| times this, so the largest difference is white (255) and none
     /// saturates: 255 / max_color_diff, or 1 when A and B are identical.
     pub diff_scale: f64,
+}
+
+/// What [`compare_with`] measures beyond the defaults.
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub struct Measures {
+    /// The per-pixel thresholds of the share gate (their shares are reported too).
+    pub bad: BadPixel,
+    /// Run FLIP (B the reference): its mean and its magma error map.
+    pub flip: bool,
+}
+
+/// A comparison and its images.
+#[derive(Debug, Clone)]
+pub struct Compared {
+    /// The figures.
+    pub comparison: Comparison,
+    /// |A - B| per channel times `comparison.diff_scale`, black outside the mask.
+    pub diff: RgbImage,
+    /// FLIP's error map in its magma colours, black outside the mask (with `Measures::flip`).
+    pub flip_map: Option<RgbImage>,
 }
 
 /// JSON has no infinity: serde_json would write null. Writes "inf" / "-inf" instead.
@@ -63,55 +106,6 @@ fn optional_infinite_as_string<S: serde::Serializer>(v: &Option<f64>, s: S) -> s
     }
 }
 
-/// Pass/fail limits for `compare` in CI; unset limits are not checked.
-#[derive(Debug, Clone, Copy, Default, PartialEq, serde::Serialize)]
-pub struct Thresholds {
-    /// Largest colour RMSE allowed, 8-bit levels.
-    pub max_color_rmse: Option<f64>,
-    /// Smallest colour PSNR allowed, dB (inf: identical colour required).
-    #[serde(serialize_with = "optional_infinite_as_string")]
-    pub min_psnr_db: Option<f64>,
-    /// Largest relative view-Z error allowed over pixels valid in both.
-    pub max_depth_rel: Option<f64>,
-}
-
-impl Thresholds {
-    /// Refuses a negative or non-finite RMSE / depth limit and a NaN PSNR limit, naming the option.
-    pub fn validate(&self) -> Result<()> {
-        for (name, v) in [
-            ("max-colour-rmse", self.max_color_rmse),
-            ("max-depth-rel", self.max_depth_rel),
-        ] {
-            if let Some(v) = v.filter(|v| !(v.is_finite() && *v >= 0.0)) {
-                return Err(Error::param(name, format!("{v}: must be finite and >= 0")));
-            }
-        }
-        if let Some(v) = self.min_psnr_db.filter(|v| v.is_nan()) {
-            return Err(Error::param("min-psnr", format!("{v} is not a number")));
-        }
-        Ok(())
-    }
-
-    /// The limits `c` breaks, each as a sentence with the measured value.
-    pub fn broken(&self, c: &Comparison) -> Vec<String> {
-        let mut out = Vec::new();
-        if let Some(max) = self.max_color_rmse.filter(|max| c.color_rmse > *max) {
-            out.push(format!("colour RMSE {:.4} > {max} levels", c.color_rmse));
-        }
-        if let Some(min) = self.min_psnr_db.filter(|min| c.psnr_db < *min) {
-            out.push(format!("PSNR {:.2} dB < {min} dB", c.psnr_db));
-        }
-        if let Some(max) = self.max_depth_rel {
-            match c.depth_max_rel {
-                Some(rel) if rel > max => out.push(format!("max relative depth error {rel:.3e} > {max:e}")),
-                Some(_) => {}
-                None => out.push("max relative depth error: no depth was compared".into()),
-            }
-        }
-        out
-    }
-}
-
 fn to_top_down(color: &RgbImage, rows: RowOrder) -> RgbImage {
     let data = rows.convert_rows(color.data.clone(), color.width as usize * 3);
     RgbImage {
@@ -121,13 +115,21 @@ fn to_top_down(color: &RgbImage, rows: RowOrder) -> RgbImage {
     }
 }
 
-/// View distance per pixel (top-down), NaN where invalid.
-fn view_z(depth: &DepthMap, storage: DepthEncoding, conv: &Conventions) -> Vec<f64> {
+/// The stored depth values, rows top-down.
+fn stored_top_down(depth: &DepthMap, rows: RowOrder) -> Vec<f64> {
     let bytes: Vec<u8> = crate::gpu::pixels::f32_to_bytes(&depth.data);
-    let rows = conv.row_order.convert_rows(bytes, depth.width as usize * 4);
+    let rows = rows.convert_rows(bytes, depth.width as usize * 4);
     crate::gpu::pixels::bytes_to_f32(&rows)
         .into_iter()
-        .map(|d| storage.view_z(conv, d as f64, 1.0).unwrap_or(f64::NAN))
+        .map(f64::from)
+        .collect()
+}
+
+/// View distance per pixel (top-down), NaN where invalid.
+fn view_z(depth: &DepthMap, storage: DepthEncoding, conv: &Conventions) -> Vec<f64> {
+    stored_top_down(depth, conv.row_order)
+        .into_iter()
+        .map(|d| storage.view_z(conv, d, 1.0).unwrap_or(f64::NAN))
         .collect()
 }
 
@@ -152,20 +154,43 @@ fn color_error(a: &RgbImage, b: &RgbImage, selected: &[bool]) -> (f64, f64, u8) 
     (metrics::psnr_from_mse(mse), mse.sqrt(), max)
 }
 
-fn depth_error(a: &[f64], b: &[f64], selected: &[bool]) -> (f64, f64, usize, usize) {
-    let (mut abs, mut rel, mut disagree, mut both) = (0f64, 0f64, 0, 0);
+/// The largest channel difference of each selected pixel, levels.
+fn color_pixel_errors(a: &RgbImage, b: &RgbImage, selected: &[bool]) -> Vec<f64> {
+    a.data
+        .chunks_exact(3)
+        .zip(b.data.chunks_exact(3))
+        .zip(selected)
+        .filter(|(_, s)| **s)
+        .map(|((x, y), _)| f64::from(x.iter().zip(y).map(|(x, y)| x.abs_diff(*y)).max().unwrap_or(0)))
+        .collect()
+}
+
+/// Depth errors over the selected pixels valid in both.
+struct DepthErrors {
+    max_abs: f64,
+    /// |A - B| / A per pixel valid in both.
+    rel: Vec<f64>,
+    /// Pixels valid in exactly one side.
+    disagree: usize,
+}
+
+fn depth_error(a: &[f64], b: &[f64], selected: &[bool]) -> DepthErrors {
+    let mut e = DepthErrors {
+        max_abs: 0.0,
+        rel: Vec::new(),
+        disagree: 0,
+    };
     for ((x, y), _) in a.iter().zip(b).zip(selected).filter(|(_, s)| **s) {
         match (x.is_nan(), y.is_nan()) {
             (false, false) => {
-                both += 1;
-                abs = abs.max((x - y).abs());
-                rel = rel.max((x - y).abs() / x.abs());
+                e.max_abs = e.max_abs.max((x - y).abs());
+                e.rel.push((x - y).abs() / x.abs());
             }
             (true, true) => {}
-            _ => disagree += 1,
+            _ => e.disagree += 1,
         }
     }
-    (abs, rel, disagree, both)
+    e
 }
 
 /// Compare A and B after converting both to top-down images and view distance.
@@ -174,8 +199,13 @@ pub fn compare(a: &Side, b: &Side) -> Result<(Comparison, RgbImage)> {
 }
 
 /// [`compare`] over the pixels where `mask` (top-down, the images' size) is nonzero; the diff
-/// image is black elsewhere.
+/// image is black elsewhere. No FLIP; the default bad-pixel thresholds.
 pub fn compare_masked(a: &Side, b: &Side, mask: Option<&Mask>) -> Result<(Comparison, RgbImage)> {
+    let c = compare_with(a, b, mask, Measures::default())?;
+    Ok((c.comparison, c.diff))
+}
+
+fn check_sides(a: &Side, b: &Side, mask: Option<&Mask>) -> Result<Vec<bool>> {
     if (a.color.width, a.color.height) != (b.color.width, b.color.height) {
         return Err(Error::SizeMismatch {
             message: format!(
@@ -209,10 +239,17 @@ pub fn compare_masked(a: &Side, b: &Side, mask: Option<&Mask>) -> Result<(Compar
         Some(m) => m.data.iter().map(|v| *v != 0).collect(),
         None => vec![true; a.color.width as usize * a.color.height as usize],
     };
-    let pixels = selected.iter().filter(|s| **s).count();
-    if pixels == 0 {
+    if !selected.iter().any(|s| *s) {
         return Err(Error::param("mask", "selects no pixel: nothing to compare"));
     }
+    Ok(selected)
+}
+
+/// [`compare_masked`] measuring what `measures` asks: the share over its bad-pixel thresholds
+/// and FLIP.
+pub fn compare_with(a: &Side, b: &Side, mask: Option<&Mask>, measures: Measures) -> Result<Compared> {
+    let selected = check_sides(a, b, mask)?;
+    let pixels = selected.iter().filter(|s| **s).count();
     let (ca, cb) = (
         to_top_down(&a.color, a.conv.row_order),
         to_top_down(&b.color, b.conv.row_order),
@@ -223,29 +260,37 @@ pub fn compare_masked(a: &Side, b: &Side, mask: Option<&Mask>) -> Result<(Compar
     } else {
         255.0 / f64::from(max_color_diff)
     };
+    let mut levels = COLOR_LEVELS_REPORTED.to_vec();
+    levels.push(measures.bad.color_levels);
+    let color_error = ErrorDistribution::of(color_pixel_errors(&ca, &cb, &selected), &levels)
+        .expect("check_sides: the mask selects a pixel");
     let mut cmp = Comparison {
         psnr_db,
         color_rmse,
         max_color_diff,
+        color_error,
         depth_max_abs: None,
         depth_max_rel: None,
+        depth_rel_error: None,
         mask_disagreement: None,
         pixels,
+        flip_mean: None,
         suspicion: None,
         diff_scale,
     };
     let za = a.depth.as_ref().map(|d| view_z(d, a.storage, &a.conv));
     if let (Some(za), Some(db)) = (&za, &b.depth) {
-        let (abs, rel, disagree, both) = depth_error(za, &view_z(db, b.storage, &b.conv), &selected);
+        let e = depth_error(za, &view_z(db, b.storage, &b.conv), &selected);
+        let mut rels = DEPTH_REL_REPORTED.to_vec();
+        rels.push(measures.bad.depth_rel);
         // No pixel with depth on both sides (all NaN, say) compares nothing: no error is
         // measured, so a depth limit fails ("no depth was compared") instead of passing at 0.
-        if both > 0 {
-            cmp.depth_max_abs = Some(abs);
-            cmp.depth_max_rel = Some(rel);
-        }
-        cmp.mask_disagreement = Some(disagree);
+        cmp.depth_max_rel = e.rel.iter().copied().reduce(f64::max);
+        cmp.depth_max_abs = cmp.depth_max_rel.map(|_| e.max_abs);
+        cmp.depth_rel_error = ErrorDistribution::of(e.rel, &rels);
+        cmp.mask_disagreement = Some(e.disagree);
     }
-    cmp.suspicion = diagnose(b, &ca, za.as_deref(), &selected, &cmp);
+    cmp.suspicion = diagnose::diagnose(a, b, &ca, za.as_deref(), &selected, &cmp);
     let data = ca
         .data
         .chunks_exact(3)
@@ -267,64 +312,14 @@ pub fn compare_masked(a: &Side, b: &Side, mask: Option<&Mask>) -> Result<(Compar
         height: ca.height,
         data,
     };
-    Ok((cmp, diff))
-}
-
-/// Try the other readings of B's conventions; name one that fits much better than the declared.
-/// (GL and Vulkan NDC ranges give the same window depth for the same planes, so stored window
-/// depth cannot tell them apart; NDC z stored in place of window depth, and a reversed-Z
-/// mismatch, can be told.)
-fn diagnose(b: &Side, ca: &RgbImage, za: Option<&[f64]>, selected: &[bool], declared: &Comparison) -> Option<String> {
-    let other_rows = match b.conv.row_order {
-        RowOrder::BottomUp => RowOrder::TopDown,
-        RowOrder::TopDown => RowOrder::BottomUp,
-    };
-    let (flipped_psnr, _, _) = color_error(ca, &to_top_down(&b.color, other_rows), selected);
-    if flipped_psnr > declared.psnr_db + 10.0 {
-        return Some(format!(
-            "B's rows look flipped: read as {} it matches at {flipped_psnr:.1} dB (declared {}: {:.1} dB)",
-            other_rows.name(),
-            b.conv.row_order.name(),
-            declared.psnr_db
-        ));
-    }
-    let (za, db, DepthEncoding::Device { planes }) = (za?, b.depth.as_ref()?, b.storage) else {
-        return None;
-    };
-    let declared_rel = declared.depth_max_rel.unwrap_or(f64::INFINITY);
-    let fits = |depth: &DepthMap, conv: &Conventions| {
-        let (_, rel, disagree, both) =
-            depth_error(za, &view_z(depth, DepthEncoding::Device { planes }, conv), selected);
-        (both > 0 && disagree * 100 <= both).then_some(rel)
-    };
-    // NDC z in [-1, 1] stored where window depth is declared: window = (z + 1) / 2.
-    let as_window = DepthMap {
-        width: db.width,
-        height: db.height,
-        data: db.data.iter().map(|v| 0.5 * (v + 1.0)).collect(),
-    };
-    let toggled = Conventions {
-        reversed_z: !b.conv.reversed_z,
-        ..b.conv
-    };
-    let readings = [
-        (
-            fits(&as_window, &b.conv),
-            "GL NDC z in [-1, 1] stored instead of window depth".to_string(),
-        ),
-        (
-            fits(db, &toggled),
-            format!("reversed-Z {} (declared {})", toggled.reversed_z, b.conv.reversed_z),
-        ),
-    ];
-    let best = readings
-        .into_iter()
-        .filter_map(|(rel, what)| rel.map(|r| (r, what)))
-        .min_by(|x, y| x.0.total_cmp(&y.0));
-    match best {
-        Some((rel, what)) if rel * 100.0 < declared_rel && declared_rel > 1e-4 => Some(format!(
-            "B's depth fits {what} (max rel error {rel:.2e}) far better than as declared ({declared_rel:.2e})"
-        )),
-        _ => None,
-    }
+    let flip_map = measures.flip.then(|| {
+        let flip = Flip::of(&cb, &ca);
+        cmp.flip_mean = Some(flip.mean(&selected));
+        flip.magma_map(&selected)
+    });
+    Ok(Compared {
+        comparison: cmp,
+        diff,
+        flip_map,
+    })
 }
