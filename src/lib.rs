@@ -21,6 +21,7 @@
 //! - [`io`]: colour, depth and mask files (loaders with a pixel budget, atomic all-or-none
 //!   savers, out-dir confinement).
 //! - [`alloc`]: fallible allocation of image-sized buffers (out of memory is an error).
+//! - [`cpu_time`]: the process's CPU time, for the benchmarks' host-CPU figures.
 //! - [`gpu`]: the EGL context and device choice, RAII GL objects, programs, readback, timers.
 //! - [`progress`]: the stages of long runs (demo, report) handed to the caller.
 //! - [`view`]: the output shape shared by every GPU pass and its f64 twin.
@@ -50,6 +51,7 @@ pub mod bench;
 pub mod camera;
 pub mod compare;
 pub mod convention;
+pub mod cpu_time;
 pub mod cyclopean;
 pub mod demo;
 pub mod depth;
