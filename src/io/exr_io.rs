@@ -76,16 +76,12 @@ pub(crate) fn read_depth_channel(path: &Path) -> Result<RawDepth> {
     check_offset_table(path, &meta, &mut counted, len)?;
     let (file, _) = open_regular(path)?;
 
-    // On the calling thread: the `exr` crate's parallel reader builds a thread pool (a thread
-    // per core) for every file it reads, which cost a batch's decode threads as much CPU as
-    // the inflating itself; a batch decodes frames side by side instead.
     let image = exr::prelude::read()
         .no_deep_data()
         .largest_resolution_level()
         .all_channels()
         .all_layers()
         .all_attributes()
-        .non_parallel()
         .from_buffered(BufReader::new(file))
         .map_err(|e| exr_error(path, e))?;
     let layer = match image.layer_data.into_iter().next() {
