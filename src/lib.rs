@@ -37,7 +37,8 @@
 //!   capability, and the GPU-vs-reference image check.
 //! - [`report`]: the evaluation written as Markdown, CSV and SVG.
 //! - [`bench`](mod@bench): every benchmark: single-frame timings, the pipelined refocus batch
-//!   against its synchronous baseline (`bench::batch`), GL against Vulkan (`bench::vulkan`).
+//!   against its synchronous baseline (`bench::batch`) with its per-codec CPU and bytes
+//!   (`bench::codecs`), GL against Vulkan (`bench::vulkan`).
 //! - [`stress`]: stiff and extreme cases of every capability, GPU f32 against f64.
 //! - [`demo`]: the built-in scene rendered, refocused and synthesised, with its report.
 //! - [`pass`]: backend-neutral pass descriptions and the GL executor; [`vulkan`]: the Vulkan
