@@ -273,6 +273,13 @@ pub fn batch_bench(
         Ok(summarise(jobs, &s))
     };
     let gl = crate::pass::Device::gl(gpu)?;
+    let synchronous = run(gl.clone(), 0, "sync")?;
+    let pipelined = run(gl.clone(), jobs.max(1), "pipelined")?;
+    let vulkan = match vulkan {
+        Some(d) => Some((d.renderer(), run(d.clone(), jobs.max(1), "vulkan")?)),
+        None => None,
+    };
+    // After the runs: a manifest with a frame that does not load is refused by them, naming it.
     let codecs = {
         let decode = io::DepthDecode {
             scale: first.depth_scale,
@@ -296,12 +303,6 @@ pub fn batch_bench(
             scratch.path(),
             CODEC_REPEATS,
         )?
-    };
-    let synchronous = run(gl.clone(), 0, "sync")?;
-    let pipelined = run(gl, jobs.max(1), "pipelined")?;
-    let vulkan = match vulkan {
-        Some(d) => Some((d.renderer(), run(d.clone(), jobs.max(1), "vulkan")?)),
-        None => None,
     };
     let px = w as usize * h as usize;
     let out_px: usize = scales.len() * px;
