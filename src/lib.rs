@@ -21,6 +21,7 @@
 //! - [`io`]: colour, depth and mask files (loaders with a pixel budget, atomic all-or-none
 //!   savers, out-dir confinement).
 //! - [`alloc`]: fallible allocation of image-sized buffers (out of memory is an error).
+//! - [`cpu_time`]: the process's CPU time, for the benchmarks' host-CPU figures.
 //! - [`gpu`]: the EGL context and device choice, RAII GL objects, programs, readback, timers.
 //! - [`progress`]: the stages of long runs (demo, report) handed to the caller.
 //! - [`view`]: the output shape shared by every GPU pass and its f64 twin.
@@ -36,7 +37,8 @@
 //!   capability, and the GPU-vs-reference image check.
 //! - [`report`]: the evaluation written as Markdown, CSV and SVG.
 //! - [`bench`](mod@bench): every benchmark: single-frame timings, the pipelined refocus batch
-//!   against its synchronous baseline (`bench::batch`), GL against Vulkan (`bench::vulkan`).
+//!   against its synchronous baseline (`bench::batch`) with its per-codec CPU and bytes
+//!   (`bench::codecs`), GL against Vulkan (`bench::vulkan`).
 //! - [`stress`]: stiff and extreme cases of every capability, GPU f32 against f64.
 //! - [`demo`]: the built-in scene rendered, refocused and synthesised, with its report.
 //! - [`pass`]: backend-neutral pass descriptions and the GL executor; [`vulkan`]: the Vulkan
@@ -50,6 +52,7 @@ pub mod bench;
 pub mod camera;
 pub mod compare;
 pub mod convention;
+pub mod cpu_time;
 pub mod cyclopean;
 pub mod demo;
 pub mod depth;

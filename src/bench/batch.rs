@@ -2,6 +2,7 @@
 //! stage in turn on one thread) in the same run, on the built-in scene or a manifest, with the
 //! per-stage medians and the stage that bounds the throughput. Nothing here asserts a time.
 
+use super::codecs::{codec_rows, CodecRow};
 use crate::error::{Error, Result};
 use crate::gpu::Gpu;
 use crate::io::FileFormats;
@@ -42,6 +43,10 @@ pub struct StageMedians {
     pub wait: f64,
     /// GPU time of a frame's draws, where the driver's timer queries are meaningful.
     pub gpu_render: Option<f64>,
+    /// Process CPU ms of decode (synchronous run only: its pool threads included).
+    pub decode_cpu: Option<f64>,
+    /// Process CPU ms of encode (synchronous run only: its pool threads included).
+    pub encode_cpu: Option<f64>,
 }
 
 /// One batch run.
@@ -68,6 +73,12 @@ pub struct BatchRun {
     pub efficiency: f64,
     /// Most frames held in memory at once.
     pub frames_in_flight: usize,
+    /// Host CPU per frame: decode + upload + readback + encode medians (the stages a GPU
+    /// server's host runs; render is left out, on llvmpipe it is the rasteriser's, and so is
+    /// part of readback here).
+    pub host_cpu_ms: f64,
+    /// The frames/s that host CPU allows on `cores` cores: cores x 1000 / host_cpu_ms.
+    pub host_cpu_frames_per_s: f64,
 }
 
 /// The report: pipelined and synchronous on the same input.
@@ -101,6 +112,13 @@ pub struct BatchBench {
     pub speedup: f64,
     /// `--with-vulkan`: the device's name and the same pipelined run on it.
     pub vulkan: Option<(String, BatchRun)>,
+    /// Cores this process may use: the N of `host_cpu_frames_per_s`.
+    pub cores: usize,
+    /// The synchronous run's host CPU per frame (ms), flat for scripts.
+    pub host_cpu_ms: f64,
+    /// Per file kind and codec: encode CPU of the first frame's targets, decode CPU of each
+    /// input kind (`bench::codecs`).
+    pub codecs: Vec<CodecRow>,
 }
 
 pub(crate) fn median(mut v: Vec<f64>) -> f64 {
@@ -125,13 +143,21 @@ fn medians(s: &StageTimes) -> StageMedians {
         encode: median(s.encode.clone()),
         wait: median(s.wait.clone()),
         gpu_render: (!s.gpu_render.is_empty()).then(|| median(s.gpu_render.clone())),
+        decode_cpu: (!s.decode_cpu.is_empty()).then(|| median(s.decode_cpu.clone())),
+        encode_cpu: (!s.encode_cpu.is_empty()).then(|| median(s.encode_cpu.clone())),
     }
+}
+
+/// The cores this process may use (the N of the host-CPU frame rate).
+fn cores() -> usize {
+    std::thread::available_parallelism().map_or(1, |n| n.get())
 }
 
 fn summarise(jobs: usize, s: &BatchSummary) -> BatchRun {
     let m = medians(&s.stages);
     let fps = s.rendered as f64 / s.wall_s.max(1e-9);
     let gl = m.upload + m.render + m.readback;
+    let host_cpu = m.decode + m.upload + m.readback + m.encode;
     let effective = if jobs == 0 {
         vec![("one thread (all stages)".to_string(), m.decode + gl + m.encode)]
     } else {
@@ -164,8 +190,13 @@ fn summarise(jobs: usize, s: &BatchSummary) -> BatchRun {
         bound_by,
         efficiency: fps * bound_ms / 1e3,
         frames_in_flight: s.frames_in_flight,
+        host_cpu_ms: host_cpu,
+        host_cpu_frames_per_s: cores() as f64 * 1e3 / host_cpu.max(1e-9),
     }
 }
+
+/// Repeats of each codec measurement (medians).
+const CODEC_REPEATS: usize = 5;
 
 /// Write the built-in scene's frame and a manifest of `n` copies of it under `dir`.
 fn scene_manifest(dir: &Path, n: usize) -> Result<PathBuf> {
@@ -244,10 +275,35 @@ pub fn batch_bench(
     };
     let gl = crate::pass::Device::gl(gpu)?;
     let synchronous = run(gl.clone(), 0, "sync")?;
-    let pipelined = run(gl, jobs.max(1), "pipelined")?;
+    let pipelined = run(gl.clone(), jobs.max(1), "pipelined")?;
     let vulkan = match vulkan {
         Some(d) => Some((d.renderer(), run(d.clone(), jobs.max(1), "vulkan")?)),
         None => None,
+    };
+    // After the runs: a manifest with a frame that does not load is refused by them, naming it.
+    let codecs = {
+        let decode = io::DepthDecode {
+            scale: first.depth_scale,
+            sun_rgbd_bit_rotate: first.sun_bit_rotate,
+            ..Default::default()
+        };
+        let k = crate::camera::Intrinsics {
+            fx: first.fx,
+            fy: first.fy,
+            cx: first.cx,
+            cy: first.cy,
+        };
+        let (rgb, depth) = (io::load_rgb(&first.rgb)?, io::load_depth(&first.depth, &decode)?);
+        codec_rows(
+            &gl,
+            (&first.rgb, &first.depth),
+            rgb,
+            depth,
+            k,
+            &scales,
+            scratch.path(),
+            CODEC_REPEATS,
+        )?
     };
     let px = w as usize * h as usize;
     let out_px: usize = scales.len() * px;
@@ -265,9 +321,12 @@ pub fn batch_bench(
         stages_ms: pipelined.stages_ms,
         bound_by: pipelined.bound_by.clone(),
         speedup: pipelined.frames_per_s / synchronous.frames_per_s.max(1e-9),
+        cores: cores(),
+        host_cpu_ms: synchronous.host_cpu_ms,
         pipelined,
         synchronous,
         vulkan,
+        codecs,
     })
 }
 
@@ -320,6 +379,43 @@ impl BatchBench {
                 t,
                 "Vulkan row: {device}, the same pipeline and files; Vulkan / GL frames/s = {:.2}",
                 r.frames_per_s / self.pipelined.frames_per_s.max(1e-9)
+            );
+        }
+        let _ = writeln!(
+            t,
+            "\nhost CPU per frame (decode + upload + readback + encode medians; render left out):\n\n\
+             | run | host CPU ms / frame | frames/s it allows on {n} cores | measured frames/s | decode CPU ms | encode CPU ms |\n\
+             |---|---|---|---|---|---|",
+            n = self.cores
+        );
+        let cpu = |v: Option<f64>| v.map_or("-".to_string(), |v| format!("{v:.1}"));
+        for (name, r) in [("synchronous", &self.synchronous), ("pipelined", &self.pipelined)] {
+            let _ = writeln!(
+                t,
+                "| {name} | {:.1} | {:.1} | {:.2} | {} | {} |",
+                r.host_cpu_ms,
+                r.host_cpu_frames_per_s,
+                r.frames_per_s,
+                cpu(r.stages_ms.decode_cpu),
+                cpu(r.stages_ms.encode_cpu)
+            );
+        }
+        let _ = writeln!(
+            t,
+            "\nper codec (process CPU ms on one thread, medians; encode: the first frame's {} targets, \
+             decode: one file; * = the default output, or the format of the frames read):\n\n| stage | kind | codec | CPU ms | bytes |\n|---|---|---|---|---|",
+            self.scales.len()
+        );
+        for c in &self.codecs {
+            let _ = writeln!(
+                t,
+                "| {} | {} | {}{} | {:.2} | {} |",
+                c.stage,
+                c.kind,
+                c.codec,
+                if c.default { " *" } else { "" },
+                c.cpu_ms,
+                c.bytes
             );
         }
         t

@@ -4,6 +4,7 @@
 //! whole job with file writing. Printed as a Markdown table; nothing here asserts a time.
 
 pub mod batch;
+pub mod codecs;
 pub mod matcher;
 pub mod vulkan;
 

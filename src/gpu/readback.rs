@@ -161,7 +161,7 @@ impl PendingRead {
 
     /// Wait for the copy and copy the bytes into `out` (exactly `len()` long): one memcpy out of
     /// the mapped buffer, no conversion.
-    pub fn finish_into(mut self, out: &mut [u8]) -> Result<()> {
+    pub fn finish_into(self, out: &mut [u8]) -> Result<()> {
         if out.len() != self.len {
             return Err(Error::Gl(format!(
                 "readback into {} bytes, {} expected",
@@ -169,6 +169,15 @@ impl PendingRead {
                 self.len
             )));
         }
+        // SAFETY: `out` is `len` initialised bytes.
+        unsafe { self.copy_to(out.as_mut_ptr()) }
+    }
+
+    /// Waits, then copies the `len` bytes into `dst`.
+    ///
+    /// # Safety
+    /// `dst` must be valid for `len` bytes of writes.
+    unsafe fn copy_to(mut self, dst: *mut u8) -> Result<()> {
         self.wait()?;
         let gl = self.gpu.gl();
         let buffer = self.buffer.expect("buffer present until finished or dropped");
@@ -182,7 +191,7 @@ impl PendingRead {
                     gl.bind_buffer(glow::PIXEL_PACK_BUFFER, None);
                     return Err(Error::Gl("readback: mapping the pixel-pack buffer failed".into()));
                 }
-                std::ptr::copy_nonoverlapping(ptr, out.as_mut_ptr(), self.len);
+                std::ptr::copy_nonoverlapping(ptr, dst, self.len);
                 gl.unmap_buffer(glow::PIXEL_PACK_BUFFER);
                 gl.bind_buffer(glow::PIXEL_PACK_BUFFER, None);
             }
@@ -192,8 +201,15 @@ impl PendingRead {
 
     /// Wait and return the bytes as a new vector.
     pub fn finish(self) -> Result<Vec<u8>> {
-        let mut out = crate::alloc::try_filled(0u8, self.len, "readback")?;
-        self.finish_into(&mut out)?;
+        // Copied into the new vector's spare room, not into zeros written first: one pass over
+        // the image instead of two (the zeroing cost as much as the copy).
+        let len = self.len;
+        let mut out = crate::alloc::try_with_capacity::<u8>(len, "readback")?;
+        // SAFETY: the vector has room for `len` bytes, all written by the copy before `set_len`.
+        unsafe {
+            self.copy_to(out.as_mut_ptr())?;
+            out.set_len(len);
+        }
         Ok(out)
     }
 
@@ -202,8 +218,14 @@ impl PendingRead {
         if self.len % 4 != 0 {
             return Err(Error::Gl(format!("readback of {} bytes is not f32 data", self.len)));
         }
-        let mut out = crate::alloc::try_filled(0f32, self.len / 4, "depth readback")?;
-        self.finish_into(bytemuck::cast_slice_mut(&mut out))?;
+        let n = self.len / 4;
+        let mut out = crate::alloc::try_with_capacity::<f32>(n, "depth readback")?;
+        // SAFETY: as in `finish`: room for `n` f32 = `len` bytes, all written before `set_len`;
+        // any bit pattern is an f32.
+        unsafe {
+            self.copy_to(out.as_mut_ptr().cast::<u8>())?;
+            out.set_len(n);
+        }
         Ok(out)
     }
 

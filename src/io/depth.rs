@@ -6,7 +6,7 @@ use image::ImageFormat;
 
 use super::atomic::atomic_write;
 use super::decode::{decode_image, image_dimensions, Samples};
-use super::exr_io::{exr_dimensions, read_depth_channel, write_f32_channels};
+use super::exr_io::{exr_dimensions, read_depth_channel, write_f32_planes};
 use super::image_types::{decode_dims, encode_dims, DepthMap};
 use super::input::max_pixels;
 use super::netpbm::netpbm_dimensions;
@@ -158,14 +158,7 @@ pub(crate) fn encode_map_exr(
     compression: super::ExrCompression,
 ) -> Result<()> {
     encode_dims(path, map.width, map.height, 1, map.data.len())?;
-    write_f32_channels(
-        path,
-        out,
-        map.width,
-        map.height,
-        vec![(channel, map.data.clone())],
-        compression,
-    )
+    write_f32_planes(path, out, map.width, map.height, &[(channel, &map.data)], compression)
 }
 
 /// Writes `<f4`, shape (height, width), C order, NPY 1.0.
@@ -309,6 +302,7 @@ fn int_to_metres(raw: u32, scale: f64) -> f32 {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::io::exr_io::write_f32_channels;
     use crate::io::npy::build_npy;
     use crate::io::pfm::build_pfm;
     use crate::io::test_util::{list_dir, scratch_dir};

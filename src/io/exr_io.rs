@@ -211,12 +211,6 @@ fn choose_channel(names: &[String]) -> Option<usize> {
 
 /// Writes one scan-line layer of full-resolution f32 channels with the given compression.
 /// Each channel must hold `width * height` samples, rows top-down.
-///
-/// ZIP (the default) is compressed here, block by block, with libdeflate at its fastest level
-/// (the `exr` crate's own ZIP runs miniz_oxide at level 4: about 2.5x the CPU for files ~5 %
-/// smaller), in tasks on the rayon pool ([`zip_blocks`]); the blocks, header and offset table
-/// are the `exr` crate's, and any OpenEXR reader decodes the file. Other compressions go
-/// through the `exr` crate as they are.
 pub(crate) fn write_f32_channels(
     path: &Path,
     out: &mut BufWriter<File>,
@@ -225,9 +219,31 @@ pub(crate) fn write_f32_channels(
     channels: Vec<(&str, Vec<f32>)>,
     compression: super::ExrCompression,
 ) -> Result<()> {
+    let planes: Vec<(&str, &[f32])> = channels.iter().map(|(name, v)| (*name, v.as_slice())).collect();
+    write_f32_planes(path, out, width, height, &planes, compression)
+}
+
+/// [`write_f32_channels`] from borrowed samples.
+///
+/// ZIP (the default) is compressed here, block by block, with libdeflate at its fastest level
+/// (the `exr` crate's own ZIP runs miniz_oxide at level 4: about 2.5x the CPU for files ~5 %
+/// smaller), in tasks on the rayon pool ([`zip_blocks`]), straight from the caller's samples
+/// (no copy of the image); the blocks, header and offset table are the `exr` crate's, and any
+/// OpenEXR reader decodes the file. Other compressions go through the `exr` crate as they are,
+/// which takes its own copy of the samples.
+pub(crate) fn write_f32_planes(
+    path: &Path,
+    out: &mut BufWriter<File>,
+    width: u32,
+    height: u32,
+    channels: &[(&str, &[f32])],
+    compression: super::ExrCompression,
+) -> Result<()> {
+    let zip = compression == super::ExrCompression::Zip;
+    // With ZIP the layer only names the channels (its header); the samples stay the caller's.
     let list: SmallVec<[AnyChannel<FlatSamples>; 4]> = channels
-        .into_iter()
-        .map(|(name, data)| AnyChannel::new(name, FlatSamples::F32(data)))
+        .iter()
+        .map(|&(name, data)| AnyChannel::new(name, FlatSamples::F32(if zip { Vec::new() } else { data.to_vec() })))
         .collect();
     let layer = Layer::new(
         (width as usize, height as usize),
@@ -238,16 +254,10 @@ pub(crate) fn write_f32_channels(
     let image = Image::from_layer(layer);
     let result = if compression == super::ExrCompression::Zip {
         let headers = image.write().infer_meta_data();
-        let planes: Vec<&[f32]> = image
-            .layer_data
-            .channel_data
-            .list
-            .iter()
-            .map(|c| match &c.sample_data {
-                FlatSamples::F32(v) => v.as_slice(),
-                _ => unreachable!("only f32 channels are written"),
-            })
-            .collect();
+        // In the header's order: AnyChannels::sort orders the channels by name.
+        let mut sorted = channels.to_vec();
+        sorted.sort_by(|a, b| a.0.cmp(b.0));
+        let planes: Vec<&[f32]> = sorted.iter().map(|&(_, data)| data).collect();
         let lines = exr::prelude::Compression::ZIP16.scan_lines_per_block();
         let blocks = zip_blocks(&planes, width as usize, height as usize, lines);
         exr::block::write(out, headers, true, |_, writer| {

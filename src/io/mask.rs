@@ -32,18 +32,30 @@ pub(crate) fn encode_mask_png(
     compression: super::PngCompression,
 ) -> Result<()> {
     encode_dims(path, mask.width, mask.height, 1, mask.data.len())?;
-    let bytes: Vec<u8> = mask
-        .data
-        .iter()
-        .map(|&v| match v {
+    // The file's bytes go into this thread's buffer, kept between masks (no image-sized
+    // allocation per file on a batch's encode threads).
+    MASK_BYTES.with_borrow_mut(|bytes| {
+        bytes.clear();
+        bytes.extend(mask.data.iter().map(|&v| match v {
             0 => 0,
             MASK_FILLED => MASK_FILLED,
             _ => 255,
-        })
-        .collect();
-    PngEncoder::new_with_quality(out, compression.image_type(), compression.mask_filter())
-        .write_image(&bytes, mask.width, mask.height, ExtendedColorType::L8)
-        .map_err(|e| Error::encode(path, e.to_string()))
+        }));
+        let encoded = PngEncoder::new_with_quality(out, compression.image_type(), compression.mask_filter())
+            .write_image(bytes, mask.width, mask.height, ExtendedColorType::L8)
+            .map_err(|e| Error::encode(path, e.to_string()));
+        if bytes.capacity() > KEEP_MASK_BYTES {
+            *bytes = Vec::new();
+        }
+        encoded
+    })
+}
+
+/// Largest mask buffer a thread keeps between files (a 4096 x 4096 mask).
+const KEEP_MASK_BYTES: usize = 1 << 24;
+
+thread_local! {
+    static MASK_BYTES: std::cell::RefCell<Vec<u8>> = const { std::cell::RefCell::new(Vec::new()) };
 }
 
 /// Reads a PNG mask: a pixel is 1 when any of its colour samples is nonzero (alpha is

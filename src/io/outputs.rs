@@ -425,8 +425,11 @@ fn write_view_in(set: &mut FileSet, names: &ViewNames, view: &ViewOutput, format
             entry.depth_preview = Some(name);
             entry.depth_preview_range_m = range;
         }
-        let valid = depth.data.iter().filter(|z| **z > 0.0).count();
-        entry.coverage = Some(valid as f64 / depth.data.len().max(1) as f64);
+        // With a mask, coverage is the mask's (below): the depth is not counted again.
+        if !outputs.mask {
+            let valid = depth.data.iter().filter(|z| **z > 0.0).count();
+            entry.coverage = Some(valid as f64 / depth.data.len().max(1) as f64);
+        }
     }
     if outputs.mask {
         let mask = view.mask.as_ref().ok_or_else(|| missing("mask"))?;

@@ -28,10 +28,12 @@ pub fn load_rgb(path: &Path) -> Result<RgbImage> {
         channels,
         samples,
     } = decode_image(path, None)?;
-    let data = match &samples {
-        Samples::U8(s) => to_rgb8(s, channels, |v| v),
-        Samples::U16(s) => to_rgb8(s, channels, |v| (v >> 8) as u8),
-        Samples::F32(s) => to_rgb8(s, channels, unit_to_u8),
+    let data = match samples {
+        // 8-bit RGB is already the image's bytes: kept as decoded, no pass over the pixels.
+        Samples::U8(s) if channels == 3 => s,
+        Samples::U8(s) => to_rgb8(&s, channels, |v| v),
+        Samples::U16(s) => to_rgb8(&s, channels, |v| (v >> 8) as u8),
+        Samples::F32(s) => to_rgb8(&s, channels, unit_to_u8),
     };
     RgbImage::new(width, height, data).map_err(|e| Error::decode(path, e.to_string()))
 }

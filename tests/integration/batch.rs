@@ -229,3 +229,143 @@ fn the_jobs_limit_is_an_error_not_a_panic() {
     let e = run_batch(&g, &frames, &dir.path().join("o"), &options(30_000), || ()).unwrap_err();
     assert!(e.to_string().contains("jobs"), "{e}");
 }
+
+/// Every output kind the batch writes decodes to the values rendered (issue 35: the faster
+/// encode paths change no pixel or depth): colour PNG and EXR, depth EXR and NPY and the mask
+/// bit for bit, depth PNG16 to the millimetre it rounds to, JPEG within its loss. The TUM frame,
+/// the default scales, the synchronous and the pipelined batch; the reference is the same frame
+/// rendered by a `Refocuser` and kept in memory.
+#[test]
+fn every_output_kind_reads_back_as_rendered() {
+    use viewsynth::io::{DepthDecode, DepthFormats, RgbFormat};
+    use viewsynth::refocus::manifest::{scale_tag, TargetSpec, DEFAULT_SCALES};
+    use viewsynth::refocus::{RefocusSource, Refocuser};
+    let data = super::common::data_dir().join("rgbd_open3d_testdata");
+    let (rgb_path, depth_path) = (data.join("TUM_color.png"), data.join("TUM_depth.png"));
+    let dir = tempfile::Builder::new().prefix("readback-kinds").tempdir().unwrap();
+    let manifest = dir.path().join("frames.csv");
+    std::fs::write(
+        &manifest,
+        format!(
+            "rgb,depth,fx,fy,cx,cy,depth_scale,name\n{},{},525,525,319.5,239.5,5000,tum\n",
+            rgb_path.display(),
+            depth_path.display()
+        ),
+    )
+    .unwrap();
+    let frames = load_manifest(&manifest).unwrap();
+
+    // The rendered values, in memory.
+    let decode = DepthDecode {
+        scale: Some(5000.0),
+        ..Default::default()
+    };
+    let src = RefocusSource::new(
+        io::load_rgb(&rgb_path).unwrap(),
+        io::load_depth(&depth_path, &decode).unwrap(),
+        viewsynth::camera::Intrinsics {
+            fx: 525.0,
+            fy: 525.0,
+            cx: 319.5,
+            cy: 239.5,
+        },
+    )
+    .unwrap();
+    let gpu = gpu();
+    let mut refocuser = Refocuser::with_settings(
+        &gpu,
+        &BreakRule::default(),
+        Method::Fullscreen,
+        OutputSet::default(),
+        Conventions::default(),
+    )
+    .unwrap();
+    refocuser.set_source(&src).unwrap();
+    let targets = TargetSpec {
+        scales: DEFAULT_SCALES.to_vec(),
+        size: None,
+        principal: None,
+    }
+    .targets(&src.camera())
+    .unwrap();
+    let rendered: Vec<_> = targets
+        .iter()
+        .map(|t| refocuser.submit(t).unwrap().wait().unwrap())
+        .collect();
+
+    let bits = |v: &[f32]| v.iter().map(|z| z.to_bits()).collect::<Vec<_>>();
+    for (jobs, rgb_format) in [(0, RgbFormat::Png), (2, RgbFormat::Exr), (0, RgbFormat::Jpeg)] {
+        let mut opts = options(jobs);
+        opts.scales = DEFAULT_SCALES.to_vec();
+        opts.files = FileFormats {
+            rgb: rgb_format,
+            depth: DepthFormats {
+                exr: true,
+                npy: true,
+                png16: true,
+            },
+            ..Default::default()
+        };
+        let out = dir.path().join(format!("out-{jobs}-{}", rgb_format.extension()));
+        let summary = run_batch(&gpu, &frames, &out, &opts, || ()).unwrap();
+        assert!(summary.failed.is_empty(), "{:?}", summary.failed);
+        for (&scale, want) in DEFAULT_SCALES.iter().zip(&rendered) {
+            let tag = scale_tag(scale);
+            let file = |suffix: &str| out.join("tum").join(format!("{tag}_{suffix}"));
+            let (rgb, depth, mask) = (
+                want.rgb.as_ref().unwrap(),
+                want.depth.as_ref().unwrap(),
+                want.mask.as_ref().unwrap(),
+            );
+            let back = io::load_rgb(&file(&format!("rgb.{}", rgb_format.extension()))).unwrap();
+            assert_eq!((back.width, back.height), (rgb.width, rgb.height), "{tag}");
+            if rgb_format == RgbFormat::Jpeg {
+                // Lossy: quality 95 keeps the mean error of these frames near one level.
+                let mean = back
+                    .data
+                    .iter()
+                    .zip(&rgb.data)
+                    .map(|(a, b)| (i32::from(*a) - i32::from(*b)).unsigned_abs() as f64)
+                    .sum::<f64>()
+                    / rgb.data.len() as f64;
+                assert!(mean < 3.0, "{tag}: JPEG mean error {mean} levels");
+            } else {
+                assert!(back.data == rgb.data, "{tag}: colour ({rgb_format:?}) differs");
+            }
+            let exr = io::load_depth(&file("depth.exr"), &DepthDecode::default()).unwrap();
+            assert!(bits(&exr.data) == bits(&depth.data), "{tag}: EXR depth differs");
+            let npy = io::load_depth(&file("depth.npy"), &DepthDecode::default()).unwrap();
+            assert!(bits(&npy.data) == bits(&depth.data), "{tag}: NPY depth differs");
+            let mm = DepthDecode {
+                scale: Some(1000.0),
+                ..Default::default()
+            };
+            let png16 = io::load_depth(&file("depth.png"), &mm).unwrap();
+            for (i, (&got, &z)) in png16.data.iter().zip(&depth.data).enumerate() {
+                let units = (f64::from(z) * 1000.0).round();
+                let expect = if z > 0.0 && units <= 65535.0 {
+                    units / 1000.0
+                } else {
+                    0.0
+                };
+                // f32 of the millimetres: within an f32 rounding of the exact value.
+                assert!(
+                    (f64::from(got) - expect).abs() <= 1e-6 * expect.max(1.0),
+                    "{tag}: PNG16 pixel {i}: {got} for z = {z} (expected {expect})"
+                );
+            }
+            let mask_file = file("mask.png");
+            assert!(
+                io::load_mask_png(&mask_file).unwrap().data == mask.data,
+                "{tag}: mask differs"
+            );
+            let on_disk = image::open(&mask_file).unwrap();
+            assert_eq!(on_disk.color(), image::ColorType::L8, "{tag}");
+            let expect: Vec<u8> = mask.data.iter().map(|&m| if m == 0 { 0 } else { 255 }).collect();
+            assert!(
+                on_disk.into_luma8().into_raw() == expect,
+                "{tag}: mask bytes are not 0 / 255"
+            );
+        }
+    }
+}

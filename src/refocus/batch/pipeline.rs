@@ -35,6 +35,11 @@ pub struct StageTimes {
     /// GPU time of the draws (timer queries read after the fence) where the driver's timers
     /// are meaningful.
     pub gpu_render: Vec<f64>,
+    /// Process CPU ms of decode, synchronous batch only (nothing else runs then, so the
+    /// process's clock is the stage's own, pool threads included); empty when pipelined.
+    pub decode_cpu: Vec<f64>,
+    /// Process CPU ms of encode, as `decode_cpu`.
+    pub encode_cpu: Vec<f64>,
 }
 
 /// What a batch did, printed and written as JSON at the end.
@@ -121,6 +126,10 @@ fn decode_frame(frame: &BatchFrame, i: usize, depth_trunc: Option<f64>, warnings
 
 fn ms_since(t: Instant) -> f64 {
     t.elapsed().as_secs_f64() * 1e3
+}
+
+fn cpu_ms_since(c0: Option<f64>) -> Option<f64> {
+    Some(crate::cpu_time::process_cpu_ms()? - c0?)
 }
 
 /// A frame on the GL thread: uploaded, its targets queued.
@@ -267,9 +276,10 @@ pub fn run_batch(
         // The synchronous baseline: each stage in turn on this thread.
         for (i, frame) in todo.iter().enumerate() {
             let (name, settings) = (frame.name.clone().unwrap_or_default(), frame_settings(frame, opts));
-            let t0 = Instant::now();
+            let (t0, c0) = (Instant::now(), crate::cpu_time::process_cpu_ms());
             let result = decode_frame(frame, i, opts.depth_trunc, &warnings).and_then(|src| {
                 stages.decode.push(ms_since(t0));
+                stages.decode_cpu.extend(cpu_ms_since(c0));
                 submit_frame(
                     &mut refocuser,
                     name.clone(),
@@ -284,9 +294,10 @@ pub fn run_batch(
                 .map_err(|e| (name.clone(), e))
                 .and_then(|f| collect_frame(f, &mut stages));
             match result.and_then(|job| {
-                let t0 = Instant::now();
+                let (t0, c0) = (Instant::now(), crate::cpu_time::process_cpu_ms());
                 let r = write_frame(job, &files).map_err(|e| (name.clone(), e));
                 stages.encode.push(ms_since(t0));
+                stages.encode_cpu.extend(cpu_ms_since(c0));
                 r
             }) {
                 Ok(()) => summary.rendered += 1,
