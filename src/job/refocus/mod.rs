@@ -162,7 +162,10 @@ impl RefocusJob {
         });
         let mut entries: Vec<ManifestEntry> = Vec::new();
         // All targets and the manifest, or (on any failure) none: earlier runs' files stay.
-        let mut set = out_dir.file_set()?;
+        // The previous run's set, as its manifest lists it, goes where this one does not
+        // write the same names (fewer scales, no depth): the folder holds this run's set.
+        let previous = job::previous_files(out_dir.real_path());
+        let mut set = out_dir.file_set()?.replacing_listed(previous);
         for ((scale, target), tag) in scales.iter().zip(&targets).zip(&plan.tags) {
             let out = refocuser.render(target)?;
             entries.push(job::write_target(&mut set, tag, *scale, out, files)?);
