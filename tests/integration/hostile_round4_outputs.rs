@@ -378,3 +378,67 @@ fn refocus_replaces_the_set_its_previous_manifest_lists() {
         assert_eq!(std::fs::read_to_string(out.join("s3_rgb.png")).unwrap(), "mine");
     }
 }
+
+/// `refocus --batch`: a frame whose colour lies in its own output folder under a name the frame
+/// writes is refused before any frame is rendered (a run error: the frame list is a file), the
+/// manifest under an index name too; and a frame redone with fewer scales (another setting)
+/// leaves only its new set in its folder. On main the batch replaced the frame's input and
+/// left the old scale's files.
+#[test]
+fn a_batch_neither_writes_over_a_frames_input_nor_leaves_a_redone_frames_old_set() {
+    let d = scratch("r4-batch-set");
+    let out = d.join("out");
+    let frame_dir = out.join("f1");
+    std::fs::create_dir_all(&frame_dir).unwrap();
+    let (rgb, depth) = frame(&frame_dir, "s2", 16, 12);
+    let csv = |rgb: &Path, depth: &Path| format!("rgb,depth,fx,fy,cx,cy,name\n{},{},16,16,7.5,5.5,f1\n", s(rgb), s(depth));
+    let manifest = d.join("frames.csv");
+    std::fs::write(&manifest, csv(&rgb, &depth)).unwrap();
+    let batch = |manifest: &Path, scales: &str, backend: &str| {
+        run(&[
+            "refocus",
+            "--jobs",
+            "1",
+            "--zoom-range",
+            scales,
+            "--backend",
+            backend,
+            "--batch",
+            s(manifest),
+            "--out-dir",
+            s(&out),
+        ])
+    };
+    let before = std::fs::read(&rgb).unwrap();
+    let o = batch(&manifest, "1,2", "gl");
+    let err = text(&o);
+    assert_eq!(o.status.code(), Some(1), "{err}");
+    assert!(err.contains("--batch rgb") && err.contains("s2_rgb.png"), "{err}");
+    assert_eq!(std::fs::read(&rgb).unwrap(), before);
+    assert_eq!(files_in(&frame_dir), ["s2_depth.npy", "s2_rgb.png"]);
+    // The frame list itself named as the index a run writes.
+    let index = out.join("index.jsonl");
+    std::fs::write(&index, csv(&rgb, &depth)).unwrap();
+    let o = batch(&index, "1", "gl");
+    assert_eq!(o.status.code(), Some(1), "{}", text(&o));
+    assert!(text(&o).contains("--batch"), "{}", text(&o));
+    std::fs::remove_file(&index).unwrap();
+
+    // Inputs elsewhere: scales 1 and 2, then 1 alone (a new setting redoes the frame).
+    let src = d.join("src");
+    std::fs::create_dir_all(&src).unwrap();
+    let (rgb, depth) = frame(&src, "in", 16, 12);
+    std::fs::write(&manifest, csv(&rgb, &depth)).unwrap();
+    std::fs::remove_dir_all(&frame_dir).unwrap();
+    for &backend in BACKENDS {
+        let o = batch(&manifest, "1,2", backend);
+        assert!(o.status.success(), "{}", text(&o));
+        std::fs::write(frame_dir.join("s2_notes.txt"), "mine").unwrap();
+        assert!(files_in(&frame_dir).contains(&"s2_rgb.png".to_string()));
+        let o = batch(&manifest, "1", backend);
+        assert!(o.status.success(), "{}", text(&o));
+        let left: Vec<String> = files_in(&frame_dir).into_iter().filter(|f| f.starts_with("s2_")).collect();
+        assert_eq!(left, ["s2_notes.txt"], "{backend}");
+        std::fs::remove_dir_all(&frame_dir).unwrap();
+    }
+}

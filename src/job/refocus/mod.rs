@@ -232,10 +232,28 @@ impl RefocusBatchJob {
         })
     }
 
+    /// Refuses, before any frame is rendered, a batch whose files would replace one of its
+    /// inputs: the manifest under an index name in --out-dir, or a frame's colour or depth
+    /// under a name its folder `<out-dir>/<name>/` gets (by identity, as for one frame).
+    fn check_outputs(&self, frames: &[crate::refocus::batch::BatchFrame]) -> Result<(), JobError> {
+        let index = |n: &str| n.starts_with("index.") && n.ends_with(".jsonl");
+        io::check_out_dir(&self.out_dir, index, &[("--batch", self.manifest.as_path())]).map_err(ArgError::Invalid)?;
+        for frame in frames {
+            let name = frame.name.as_deref().unwrap_or_default();
+            let (_, tags) = self.options.frame_targets(name);
+            let writes =
+                |n: &str| n == io::MANIFEST_NAME || tags.iter().any(|t| n.starts_with(&format!("{t}_")));
+            let inputs = [("--batch rgb", frame.rgb.as_path()), ("--batch depth", frame.depth.as_path())];
+            io::check_out_dir(&self.out_dir.join(name), writes, &inputs).map_err(ArgError::Invalid)?;
+        }
+        Ok(())
+    }
+
     /// Refocuses every frame (of this shard) into `<out-dir>/<name>/`, skipping those finished
     /// with the same settings unless forced; a failed frame is reported, the others complete.
     pub fn run(&self, host: &dyn Host) -> Result<RefocusBatchReport, JobError> {
         let frames = load_manifest(&self.manifest)?;
+        self.check_outputs(&frames)?;
         io::OutDir::prepare(&self.out_dir)?;
         let device = host.open_device(&self.gpu, self.backend)?;
         host.event(Event::Started {
