@@ -491,10 +491,14 @@ impl FileSet {
     /// Stages the set's record ([`FileSet::replacing_recorded`]): the names of `order`, which
     /// then renames it just before the manifest (if any). Returns its name.
     fn write_record(&mut self, order: &mut Vec<String>) -> Result<Option<String>> {
-        let Some(Previous::Recorded(record)) = &self.previous else { return Ok(None) };
+        let Some(Previous::Recorded(record)) = &self.previous else {
+            return Ok(None);
+        };
         let record = record.clone();
         let text: String = order.iter().map(|n| format!("{n}\n")).collect();
-        self.write(&record, |w| w.write_all(text.as_bytes()).map_err(|e| Error::io(&record, e)))?;
+        self.write(&record, |w| {
+            w.write_all(text.as_bytes()).map_err(|e| Error::io(&record, e))
+        })?;
         let at = order.len() - usize::from(order.last().is_some_and(|n| n == MANIFEST_NAME));
         order.insert(at, record.clone());
         Ok(Some(record))
@@ -614,7 +618,9 @@ fn record_name(command: &str) -> String {
 /// The names a set record lists: none when it is missing, not a regular file, too large or not
 /// text (nothing is removed on the word of a file this program did not write).
 fn read_record(path: &Path) -> Vec<String> {
-    let Ok(m) = fs::symlink_metadata(path) else { return Vec::new() };
+    let Ok(m) = fs::symlink_metadata(path) else {
+        return Vec::new();
+    };
     if !m.is_file() || m.len() > MAX_RECORD_BYTES {
         return Vec::new();
     }
@@ -922,7 +928,13 @@ mod tests {
         assert_eq!(done.len(), 3);
         assert_eq!(
             list_dir(&dir),
-            [".viewsynth.test.set", "left_rgb.png", "right_depth.exr", "right_notes.txt", "right_rgb.png"]
+            [
+                ".viewsynth.test.set",
+                "left_rgb.png",
+                "right_depth.exr",
+                "right_notes.txt",
+                "right_rgb.png"
+            ]
         );
         // A file the user made after the first run, under a name the command could write.
         fs::write(dir.join("left_depth.exr"), "the user's").unwrap();
@@ -934,18 +946,33 @@ mod tests {
         run(&["left_rgb.png"]);
         assert_eq!(
             list_dir(&dir),
-            [".viewsynth.test.set", "left_depth.exr", "left_rgb.png", "right_notes.txt"]
+            [
+                ".viewsynth.test.set",
+                "left_depth.exr",
+                "left_rgb.png",
+                "right_notes.txt"
+            ]
         );
-        assert_eq!(fs::read_to_string(dir.join(".viewsynth.test.set")).unwrap(), "left_rgb.png\n");
+        assert_eq!(
+            fs::read_to_string(dir.join(".viewsynth.test.set")).unwrap(),
+            "left_rgb.png\n"
+        );
         // A listed set: its names go, unless written again; others stay.
-        let mut set = FileSet::new(&dir)
-            .unwrap()
-            .replacing_listed(["left_rgb.png".to_string(), "../x".to_string(), "gone.png".to_string()]);
+        let mut set = FileSet::new(&dir).unwrap().replacing_listed([
+            "left_rgb.png".to_string(),
+            "../x".to_string(),
+            "gone.png".to_string(),
+        ]);
         set.write("manifest.json", text("{}")).unwrap();
         set.commit().unwrap();
         assert_eq!(
             list_dir(&dir),
-            [".viewsynth.test.set", "left_depth.exr", "manifest.json", "right_notes.txt"]
+            [
+                ".viewsynth.test.set",
+                "left_depth.exr",
+                "manifest.json",
+                "right_notes.txt"
+            ]
         );
     }
 

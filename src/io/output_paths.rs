@@ -101,11 +101,17 @@ pub fn check_out_dir(out_dir: &Path, writes: impl Fn(&str) -> bool, inputs: &[Na
     // fails later, where the run prepares it, with its own message).
     let Ok(entries) = fs::read_dir(&dir) else { return Ok(()) };
     for e in entries.flatten() {
-        let Some(name) = e.file_name().to_str().map(str::to_string) else { continue };
+        let Some(name) = e.file_name().to_str().map(str::to_string) else {
+            continue;
+        };
         if !writes(&name) {
             continue;
         }
-        let Some(id) = fs::metadata(e.path()).ok().filter(|m| m.is_file()).map(|m| (m.dev(), m.ino())) else {
+        let Some(id) = fs::metadata(e.path())
+            .ok()
+            .filter(|m| m.is_file())
+            .map(|m| (m.dev(), m.ino()))
+        else {
             continue;
         };
         if let Some(&(option, path, _)) = ins.iter().find(|(_, _, (_, input))| *input == id) {

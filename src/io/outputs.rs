@@ -215,9 +215,13 @@ impl ViewNames {
     /// Whether `name` is one of the files this view may write (under any formats): its colour,
     /// depth, depth preview or mask, for the output-path checks made before any work.
     pub fn may_write(&self, name: &str) -> bool {
-        let Some((stem, _ext)) = name.rsplit_once('.') else { return false };
+        let Some((stem, _ext)) = name.rsplit_once('.') else {
+            return false;
+        };
         let stems = [self.rgb.as_str(), self.depth.as_str(), self.mask.as_str()];
-        let preview = stem.strip_suffix("_preview").is_some_and(|d| !d.is_empty() && d == self.depth);
+        let preview = stem
+            .strip_suffix("_preview")
+            .is_some_and(|d| !d.is_empty() && d == self.depth);
         preview || stems.iter().any(|s| !s.is_empty() && stem == *s)
     }
 }

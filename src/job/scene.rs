@@ -303,9 +303,9 @@ fn writes(name: &str) -> bool {
             .any(|s| io::ViewNames::named(&format!("{eye}_{s}"), "").may_write(frame))
     });
     let face = ["left", "right"].iter().any(|eye| {
-        FACE_TAGS.iter().any(|t| {
-            io::ViewNames::named(&format!("{eye}_{t}"), &format!("{eye}_{t}_depth")).may_write(name)
-        })
+        FACE_TAGS
+            .iter()
+            .any(|t| io::ViewNames::named(&format!("{eye}_{t}"), &format!("{eye}_{t}_depth")).may_write(name))
     });
     view || face || frame == "cameras.json" || name == "sequence.json"
 }

@@ -35,7 +35,10 @@ fn ok(args: &[&str]) {
 /// A `w` x `h` colour PNG and NPY depth map named `{stem}_rgb.png`, `{stem}_depth.npy`.
 fn frame(dir: &Path, stem: &str, w: u32, h: u32) -> (PathBuf, PathBuf) {
     let rgb: Vec<u8> = (0..w * h * 3).map(|i| (i % 251) as u8).collect();
-    let (r, d) = (dir.join(format!("{stem}_rgb.png")), dir.join(format!("{stem}_depth.npy")));
+    let (r, d) = (
+        dir.join(format!("{stem}_rgb.png")),
+        dir.join(format!("{stem}_depth.npy")),
+    );
     io::save_rgb(&r, &RgbImage::new(w, h, rgb).unwrap()).unwrap();
     let depth = (0..w * h).map(|i| 1.0 + 0.01 * (i % w) as f32).collect();
     io::save_depth_npy(&d, &DepthMap::new(w, h, depth).unwrap()).unwrap();
@@ -207,7 +210,9 @@ fn case(command: &str, d: &Path) -> Result<Case, &'static str> {
         "info" | "bench" => Err("writes no file (stdout only)"),
         "stress" => Err("reads no file: --json is its only output"),
         "demo" => Err("reads no file: renders the built-in scene"),
-        "report" => Err("its inputs (--case, --data-dir) are read-only folders of other names; it writes report.{md,csv,svg}"),
+        "report" => {
+            Err("its inputs (--case, --data-dir) are read-only folders of other names; it writes report.{md,csv,svg}")
+        }
         "index" => Err("reads only the index parts it joins and writes index.jsonl, a name no part has"),
         _ => Err(""),
     }
@@ -391,7 +396,8 @@ fn a_batch_neither_writes_over_a_frames_input_nor_leaves_a_redone_frames_old_set
     let frame_dir = out.join("f1");
     std::fs::create_dir_all(&frame_dir).unwrap();
     let (rgb, depth) = frame(&frame_dir, "s2", 16, 12);
-    let csv = |rgb: &Path, depth: &Path| format!("rgb,depth,fx,fy,cx,cy,name\n{},{},16,16,7.5,5.5,f1\n", s(rgb), s(depth));
+    let csv =
+        |rgb: &Path, depth: &Path| format!("rgb,depth,fx,fy,cx,cy,name\n{},{},16,16,7.5,5.5,f1\n", s(rgb), s(depth));
     let manifest = d.join("frames.csv");
     std::fs::write(&manifest, csv(&rgb, &depth)).unwrap();
     let batch = |manifest: &Path, scales: &str, backend: &str| {
@@ -437,7 +443,10 @@ fn a_batch_neither_writes_over_a_frames_input_nor_leaves_a_redone_frames_old_set
         assert!(files_in(&frame_dir).contains(&"s2_rgb.png".to_string()));
         let o = batch(&manifest, "1", backend);
         assert!(o.status.success(), "{}", text(&o));
-        let left: Vec<String> = files_in(&frame_dir).into_iter().filter(|f| f.starts_with("s2_")).collect();
+        let left: Vec<String> = files_in(&frame_dir)
+            .into_iter()
+            .filter(|f| f.starts_with("s2_"))
+            .collect();
         assert_eq!(left, ["s2_notes.txt"], "{backend}");
         std::fs::remove_dir_all(&frame_dir).unwrap();
     }

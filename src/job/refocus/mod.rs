@@ -241,9 +241,11 @@ impl RefocusBatchJob {
         for frame in frames {
             let name = frame.name.as_deref().unwrap_or_default();
             let (_, tags) = self.options.frame_targets(name);
-            let writes =
-                |n: &str| n == io::MANIFEST_NAME || tags.iter().any(|t| n.starts_with(&format!("{t}_")));
-            let inputs = [("--batch rgb", frame.rgb.as_path()), ("--batch depth", frame.depth.as_path())];
+            let writes = |n: &str| n == io::MANIFEST_NAME || tags.iter().any(|t| n.starts_with(&format!("{t}_")));
+            let inputs = [
+                ("--batch rgb", frame.rgb.as_path()),
+                ("--batch depth", frame.depth.as_path()),
+            ];
             io::check_out_dir(&self.out_dir.join(name), writes, &inputs).map_err(ArgError::Invalid)?;
         }
         Ok(())

@@ -56,18 +56,16 @@ fn check_faces_against_outputs(faces: &std::path::Path, out_dir: &std::path::Pat
         })
     };
     // An unreadable folder is reported where the run reads its faces.
-    let Ok(entries) = std::fs::read_dir(faces) else { return Ok(()) };
+    let Ok(entries) = std::fs::read_dir(faces) else {
+        return Ok(());
+    };
     let files: Vec<PathBuf> = entries
         .flatten()
         .filter(|e| e.file_name().to_str().is_some_and(is_face))
         .map(|e| e.path())
         .collect();
     let inputs: Vec<io::NamedPath<'_>> = files.iter().map(|p| ("--faces", p.as_path())).collect();
-    let writes = |name: &str| {
-        OUTPUT_NAMES
-            .iter()
-            .any(|n| io::ViewNames::named(n, "").may_write(name))
-    };
+    let writes = |name: &str| OUTPUT_NAMES.iter().any(|n| io::ViewNames::named(n, "").may_write(name));
     io::check_out_dir(out_dir, writes, &inputs).map_err(ArgError::Invalid)
 }
 
