@@ -207,7 +207,8 @@ fn case(command: &str, d: &Path) -> Result<Case, &'static str> {
                 keep: vec![a, b],
             })
         }
-        "info" | "bench" => Err("writes no file (stdout only)"),
+        "info" => Err("writes no file (stdout only)"),
+        "bench" => Err("writes only stdout and its own temporary folder, never a name the user gives"),
         "stress" => Err("reads no file: --json is its only output"),
         "demo" => Err("reads no file: renders the built-in scene"),
         "report" => {
