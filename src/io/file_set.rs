@@ -232,7 +232,23 @@ pub struct FileSet {
     /// The names the command owns in the folder ([`FileSet::replacing`]): those of a previous
     /// set that this one does not write are removed at commit.
     owned: Option<fn(&str) -> bool>,
+    /// Where the previous run of the command listed its set ([`FileSet::replacing_listed`],
+    /// [`FileSet::replacing_recorded`]).
+    previous: Option<Previous>,
 }
+
+/// The previous set of a command's run, as it was written down.
+#[derive(Debug)]
+enum Previous {
+    /// Its names, read by the command from its manifest.
+    Listed(Vec<String>),
+    /// Its names in the folder's record file of this name, rewritten by every commit.
+    Recorded(String),
+}
+
+/// The largest set record read (a 10 000-frame scene's is about 3 MB): a larger file is not
+/// one this program wrote, and nothing is removed on its word.
+const MAX_RECORD_BYTES: u64 = 64 << 20;
 
 impl FileSet {
     /// A set whose files go into `dir` (an existing folder) on commit. The staging folder is
@@ -248,6 +264,7 @@ impl FileSet {
             unsynced: Vec::new(),
             syncing: Vec::new(),
             owned: None,
+            previous: None,
         })
     }
 
@@ -257,6 +274,25 @@ impl FileSet {
     /// no third frame; a run without depth leaves no old depth file).
     pub fn replacing(mut self, owned: fn(&str) -> bool) -> Self {
         self.owned = Some(owned);
+        self
+    }
+
+    /// This set replaces the previous run's, whose names `previous` lists (as its manifest
+    /// recorded them): at commit, a regular file of that list that this set does not write is
+    /// removed, in the same journalled commit. A file the list does not name stays, whatever
+    /// its name (the user's own files in the folder).
+    pub fn replacing_listed(mut self, previous: impl IntoIterator<Item = String>) -> Self {
+        self.previous = Some(Previous::Listed(previous.into_iter().collect()));
+        self
+    }
+
+    /// As [`FileSet::replacing_listed`], for commands that write no manifest: the set's names
+    /// are recorded in the folder's hidden file `.viewsynth.{command}.set` (one name a line,
+    /// renamed with the set, not among the paths [`FileSet::commit`] returns), and the previous
+    /// run's record lists the names to replace. A folder with no record (first run, or written
+    /// by an older version) loses nothing.
+    pub fn replacing_recorded(mut self, command: &str) -> Self {
+        self.previous = Some(Previous::Recorded(record_name(command)));
         self
     }
 
@@ -369,6 +405,7 @@ impl FileSet {
             let manifest = order.remove(i);
             order.push(manifest);
         }
+        let record = self.write_record(&mut order)?;
         for name in &order {
             check_replaceable(&self.dir.join(name)).map_err(|e| self.final_error_for(name, e))?;
         }
@@ -404,7 +441,9 @@ impl FileSet {
             for name in &order {
                 fs::rename(staging.join(name), dir.join(name)).map_err(|e| Error::io(final_path(name), e))?;
                 fault_point("renamed")?;
-                done.push(final_path(name));
+                if record.as_ref() != Some(name) {
+                    done.push(final_path(name));
+                }
             }
             for name in &stale {
                 remove_stale(&dir.join(name)).map_err(|e| Error::io(final_path(name), e))?;
@@ -449,11 +488,46 @@ impl FileSet {
         })
     }
 
-    /// The regular files of the previous set (see [`FileSet::replacing`]) that `order` does
-    /// not replace, sorted.
+    /// Stages the set's record ([`FileSet::replacing_recorded`]): the names of `order`, which
+    /// then renames it just before the manifest (if any). Returns its name.
+    fn write_record(&mut self, order: &mut Vec<String>) -> Result<Option<String>> {
+        let Some(Previous::Recorded(record)) = &self.previous else {
+            return Ok(None);
+        };
+        let record = record.clone();
+        let text: String = order.iter().map(|n| format!("{n}\n")).collect();
+        self.write(&record, |w| {
+            w.write_all(text.as_bytes()).map_err(|e| Error::io(&record, e))
+        })?;
+        let at = order.len() - usize::from(order.last().is_some_and(|n| n == MANIFEST_NAME));
+        order.insert(at, record.clone());
+        Ok(Some(record))
+    }
+
+    /// The names the previous run's record or manifest lists (none when unreadable).
+    fn previous_names(&self) -> Vec<String> {
+        match &self.previous {
+            None => Vec::new(),
+            Some(Previous::Listed(names)) => names.clone(),
+            Some(Previous::Recorded(record)) => read_record(&self.dir.join(record)),
+        }
+    }
+
+    /// The regular files of the previous set (see [`FileSet::replacing`],
+    /// [`FileSet::replacing_listed`]) that `order` does not replace, sorted.
     fn stale(&self, order: &[String]) -> Result<Vec<String>> {
-        let Some(owned) = self.owned else { return Ok(Vec::new()) };
-        let mut stale = Vec::new();
+        let mut stale: Vec<String> = self
+            .previous_names()
+            .into_iter()
+            .filter(|name| {
+                !order.contains(name)
+                    && check_plain_name(name, &self.shown).is_ok()
+                    && fs::symlink_metadata(self.dir.join(name)).is_ok_and(|m| m.is_file())
+            })
+            .collect();
+        stale.sort();
+        stale.dedup();
+        let Some(owned) = self.owned else { return Ok(stale) };
         for e in fs::read_dir(&self.dir).map_err(|e| Error::io(&self.shown, e))? {
             let e = e.map_err(|e| Error::io(&self.shown, e))?;
             let Some(name) = e.file_name().to_str().map(str::to_string) else {
@@ -465,6 +539,7 @@ impl FileSet {
             }
         }
         stale.sort();
+        stale.dedup();
         Ok(stale)
     }
 
@@ -532,6 +607,26 @@ fn roll_forward(dir: &Path, staging: &Path) -> bool {
     }
     sync_dir(dir);
     fs::remove_dir_all(staging).is_ok()
+}
+
+/// The hidden record of a command's set in its folder ([`FileSet::replacing_recorded`]); not
+/// under [`TEMP_PREFIX`], which marks temporaries.
+fn record_name(command: &str) -> String {
+    format!(".viewsynth.{command}.set")
+}
+
+/// The names a set record lists: none when it is missing, not a regular file, too large or not
+/// text (nothing is removed on the word of a file this program did not write).
+fn read_record(path: &Path) -> Vec<String> {
+    let Ok(m) = fs::symlink_metadata(path) else {
+        return Vec::new();
+    };
+    if !m.is_file() || m.len() > MAX_RECORD_BYTES {
+        return Vec::new();
+    }
+    fs::read_to_string(path)
+        .map(|text| text.lines().filter(|l| !l.is_empty()).map(str::to_string).collect())
+        .unwrap_or_default()
 }
 
 /// Removes a previous set's file: gone already is fine, anything but a regular file stays.
@@ -815,6 +910,70 @@ mod tests {
         assert_eq!(names, ["a.txt", "b.txt", "manifest.json"]);
         assert_eq!(list_dir(out.real_path()), ["a.txt", "b.txt", "manifest.json"]);
         assert!(done[0].starts_with(root.join("out")));
+    }
+
+    #[test]
+    fn a_recorded_or_listed_set_replaces_only_the_previous_runs_files() {
+        let dir = scratch_dir("set-record");
+        fs::write(dir.join("right_notes.txt"), "the user's").unwrap();
+        let run = |names: &[&'static str]| {
+            let mut set = FileSet::new(&dir).unwrap().replacing_recorded("test");
+            for &n in names {
+                set.write(n, text("x")).unwrap();
+            }
+            set.commit().unwrap()
+        };
+        let done = run(&["left_rgb.png", "right_rgb.png", "right_depth.exr"]);
+        // The record is renamed with the set but is not among the files the run reports.
+        assert_eq!(done.len(), 3);
+        assert_eq!(
+            list_dir(&dir),
+            [
+                ".viewsynth.test.set",
+                "left_rgb.png",
+                "right_depth.exr",
+                "right_notes.txt",
+                "right_rgb.png"
+            ]
+        );
+        // A file the user made after the first run, under a name the command could write.
+        fs::write(dir.join("left_depth.exr"), "the user's").unwrap();
+        // A failed rerun removes nothing.
+        let mut set = FileSet::new(&dir).unwrap().replacing_recorded("test");
+        set.write("left_rgb.png", text("y")).unwrap();
+        drop(set);
+        assert_eq!(list_dir(&dir).len(), 6);
+        run(&["left_rgb.png"]);
+        assert_eq!(
+            list_dir(&dir),
+            [
+                ".viewsynth.test.set",
+                "left_depth.exr",
+                "left_rgb.png",
+                "right_notes.txt"
+            ]
+        );
+        assert_eq!(
+            fs::read_to_string(dir.join(".viewsynth.test.set")).unwrap(),
+            "left_rgb.png\n"
+        );
+        // A listed set: its names go, unless written again; others stay.
+        let mut set = FileSet::new(&dir).unwrap().replacing_listed([
+            "left_rgb.png".to_string(),
+            "../x".to_string(),
+            "gone.png".to_string(),
+        ]);
+        set.write("manifest.json", text("{}")).unwrap();
+        set.commit().unwrap();
+        assert_eq!(
+            list_dir(&dir),
+            [
+                ".viewsynth.test.set",
+                "left_depth.exr",
+                "manifest.json",
+                "right_notes.txt"
+            ]
+        );
     }
 
     #[test]

@@ -77,17 +77,45 @@ pub fn check_outputs(inputs: &[NamedPath<'_>], outputs: &[NamedPath<'_>]) -> Res
 }
 
 /// Refuses an `--out-dir` run whose files would replace one of `inputs`: an input directly in
-/// the folder under a name the run writes (`writes(name)`).
+/// the folder under a name the run writes (`writes(name)`), or a name the run writes that is
+/// already the input's file under another name (a hard link, a symlink).
 pub fn check_out_dir(out_dir: &Path, writes: impl Fn(&str) -> bool, inputs: &[NamedPath<'_>]) -> Result<()> {
     // A folder not made yet holds no input.
     let Ok(dir) = fs::canonicalize(out_dir) else {
         return Ok(());
     };
-    for &(option, path) in inputs {
-        let Some((real, _)) = input_key(path) else { continue };
+    let ins: Vec<_> = inputs
+        .iter()
+        .filter_map(|&(o, p)| input_key(p).map(|k| (o, p, k)))
+        .collect();
+    for &(option, path, (ref real, _)) in &ins {
         let name = real.file_name().and_then(|n| n.to_str()).unwrap_or_default();
         if real.parent() == Some(dir.as_path()) && writes(name) {
             return Err(replaces_input("--out-dir", &out_dir.join(name), option, path));
+        }
+    }
+    if ins.is_empty() {
+        return Ok(());
+    }
+    // The folder's own names the run writes, by identity (one listing; an unreadable folder
+    // fails later, where the run prepares it, with its own message).
+    let Ok(entries) = fs::read_dir(&dir) else { return Ok(()) };
+    for e in entries.flatten() {
+        let Some(name) = e.file_name().to_str().map(str::to_string) else {
+            continue;
+        };
+        if !writes(&name) {
+            continue;
+        }
+        let Some(id) = fs::metadata(e.path())
+            .ok()
+            .filter(|m| m.is_file())
+            .map(|m| (m.dev(), m.ino()))
+        else {
+            continue;
+        };
+        if let Some(&(option, path, _)) = ins.iter().find(|(_, _, (_, input))| *input == id) {
+            return Err(replaces_input("--out-dir", &out_dir.join(&name), option, path));
         }
     }
     Ok(())
@@ -142,5 +170,11 @@ mod tests {
         assert!(e.contains("--out-dir") && e.contains("--a-rgb"), "{e}");
         assert!(check_out_dir(&dir, |n| n.starts_with("s2_"), &inputs).is_ok());
         assert!(check_out_dir(&dir.join("missing"), |_| true, &inputs).is_ok());
+        // A name the run writes that is the input under another name: a hard link, a symlink.
+        for alias in ["hard.png", "link.png"] {
+            let e = check_out_dir(&dir, |n| n == alias, &inputs).unwrap_err().to_string();
+            assert!(e.contains(alias) && e.contains("--a-rgb"), "{alias}: {e}");
+        }
+        assert!(check_out_dir(&dir, |n| n == "x.png", &inputs).is_ok());
     }
 }

@@ -212,6 +212,21 @@ impl ViewNames {
 }
 
 impl ViewNames {
+    /// Whether `name` is one of the files this view may write (under any formats): its colour,
+    /// depth, depth preview or mask, for the output-path checks made before any work.
+    pub fn may_write(&self, name: &str) -> bool {
+        let Some((stem, _ext)) = name.rsplit_once('.') else {
+            return false;
+        };
+        let stems = [self.rgb.as_str(), self.depth.as_str(), self.mask.as_str()];
+        let preview = stem
+            .strip_suffix("_preview")
+            .is_some_and(|d| !d.is_empty() && d == self.depth);
+        preview || stems.iter().any(|s| !s.is_empty() && stem == *s)
+    }
+}
+
+impl ViewNames {
     /// A colour file `{rgb}.png` (stitch's `ods_top_bottom`), with the depth file beside it
     /// named `{depth}.exr` where a view has one (scene's `left_view_z`).
     pub fn named(rgb: &str, depth: &str) -> Self {

@@ -127,6 +127,9 @@ impl SceneJob {
                 "is for one frame: not with --frames",
             )));
         }
+        if let SceneSource::File(path) = &scene {
+            io::check_out_dir(&o.out_dir, writes, &[("--scene", path)]).map_err(ArgError::Invalid)?;
+        }
         let mut rig = StereoRig::demo(o.width, o.height);
         rig.camera.validate("scene camera")?;
         rig.ipd = o.ipd;
@@ -180,7 +183,7 @@ impl SceneJob {
         let (rig, conv) = (&self.rig, self.conventions);
         let (width, height) = (rig.camera.width, rig.camera.height);
         let out = io::OutDir::prepare(&self.out_dir)?;
-        let mut set = out.file_set()?;
+        let mut set = out.file_set()?.replacing_recorded("scene");
         let gpu = host.open_device(&self.gpu, self.backend)?;
         let mut renderer = SceneRenderer::new(&gpu, scene)?;
         let proj = gl_projection(&rig.camera, &rig.planes, &conv);
@@ -284,6 +287,27 @@ impl SceneJob {
             frames: self.frames,
         })
     }
+}
+
+/// Whether `name` is one a scene run may write: a frame's files (prefixed `{k:05}_` in a
+/// sequence), `sequence.json`, a cube face's files.
+fn writes(name: &str) -> bool {
+    let frame = name
+        .split_once('_')
+        .filter(|(k, _)| k.len() == 5 && k.bytes().all(|b| b.is_ascii_digit()))
+        .map_or(name, |(_, rest)| rest);
+    let stems = ["rgb", "view_z", "device_depth"];
+    let view = ["left", "right", "middle"].iter().any(|eye| {
+        stems
+            .iter()
+            .any(|s| io::ViewNames::named(&format!("{eye}_{s}"), "").may_write(frame))
+    });
+    let face = ["left", "right"].iter().any(|eye| {
+        FACE_TAGS
+            .iter()
+            .any(|t| io::ViewNames::named(&format!("{eye}_{t}"), &format!("{eye}_{t}_depth")).may_write(name))
+    });
+    view || face || frame == "cameras.json" || name == "sequence.json"
 }
 
 /// `value` as pretty JSON into the set as `name` (`path` names it in errors).

@@ -240,6 +240,26 @@ pub fn write_output(dir: &Path, scale: f64, out: &RefocusOutput, files: &FileFor
     Ok(entry)
 }
 
+/// The files the previous run's `manifest.json` in `dir` lists (its `files`), for the set that
+/// replaces it ([`FileSet::replacing_listed`]): none when there is no manifest, or one this
+/// program did not write (not a regular file, far too large, not JSON with `files`).
+pub fn previous_files(dir: &Path) -> Vec<String> {
+    let path = dir.join(io::MANIFEST_NAME);
+    // A manifest is a few kB (a few MB for thousands of targets).
+    let Ok(text) = io::read_text(&path, 16 << 20) else {
+        return Vec::new();
+    };
+    let Ok(m) = serde_json::from_str::<serde_json::Value>(&text) else {
+        return Vec::new();
+    };
+    m.get("files")
+        .and_then(|f| f.as_array())
+        .into_iter()
+        .flatten()
+        .filter_map(|f| f.get("name").and_then(|n| n.as_str()).map(str::to_string))
+        .collect()
+}
+
 /// Write `manifest.json` atomically.
 pub fn write_manifest(dir: &Path, manifest: &Manifest) -> Result<PathBuf> {
     let path = dir.join("manifest.json");

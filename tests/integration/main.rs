@@ -30,6 +30,7 @@ mod gpu_context;
 mod hostile;
 mod hostile_round3;
 mod hostile_round4;
+mod hostile_round4_outputs;
 mod limits;
 mod matcher;
 mod pass_contract;

@@ -164,7 +164,10 @@ impl RefocusJob {
         });
         let mut entries: Vec<ManifestEntry> = Vec::new();
         // All targets and the manifest, or (on any failure) none: earlier runs' files stay.
-        let mut set = out_dir.file_set()?;
+        // The previous run's set, as its manifest lists it, goes where this one does not
+        // write the same names (fewer scales, no depth): the folder holds this run's set.
+        let previous = job::previous_files(out_dir.real_path());
+        let mut set = out_dir.file_set()?.replacing_listed(previous);
         for ((scale, target), tag) in scales.iter().zip(&targets).zip(&plan.tags) {
             let out = refocuser.render(target)?;
             entries.push(job::write_target(&mut set, tag, *scale, out, files)?);
@@ -239,6 +242,25 @@ impl RefocusBatchJob {
         })
     }
 
+    /// Refuses, before any frame is rendered, a batch whose files would replace one of its
+    /// inputs: the manifest under an index name in --out-dir, or a frame's colour or depth
+    /// under a name its folder `<out-dir>/<name>/` gets (by identity, as for one frame).
+    fn check_outputs(&self, frames: &[crate::refocus::batch::BatchFrame]) -> Result<(), JobError> {
+        let index = |n: &str| n.starts_with("index.") && n.ends_with(".jsonl");
+        io::check_out_dir(&self.out_dir, index, &[("--batch", self.manifest.as_path())]).map_err(ArgError::Invalid)?;
+        for frame in frames {
+            let name = frame.name.as_deref().unwrap_or_default();
+            let (_, tags) = self.options.frame_targets(name);
+            let writes = |n: &str| n == io::MANIFEST_NAME || tags.iter().any(|t| n.starts_with(&format!("{t}_")));
+            let inputs = [
+                ("--batch rgb", frame.rgb.as_path()),
+                ("--batch depth", frame.depth.as_path()),
+            ];
+            io::check_out_dir(&self.out_dir.join(name), writes, &inputs).map_err(ArgError::Invalid)?;
+        }
+        Ok(())
+    }
+
     /// Refocuses every frame (of this shard) into `<out-dir>/<name>/`, skipping those finished
     /// with the same settings unless forced; a failed frame is reported, the others complete.
     pub fn run(&self, host: &dyn Host) -> Result<RefocusBatchReport, JobError> {
@@ -249,6 +271,7 @@ impl RefocusBatchJob {
                 f.depth_scale = Some(scale);
             }
         }
+        self.check_outputs(&frames)?;
         io::OutDir::prepare(&self.out_dir)?;
         let device = host.open_device(&self.gpu, self.backend)?;
         host.event(Event::Started {

@@ -201,6 +201,18 @@ impl ReprojectJob {
             None => rig_views(&o)?,
         };
         super::cyclopean::check_scale("--depth-scale", o.depth_scale)?;
+        let eyes = match &views {
+            Views::Rig(rig) => rig.plan.targets().to_vec(),
+            Views::Cameras { to, .. } => vec![*to],
+        };
+        let writes = |name: &str| {
+            eyes.iter()
+                .any(|&e| io::ViewNames::tagged(view_name(Some(e))).may_write(name))
+        };
+        let mut inputs = vec![("--color", o.color.as_path()), ("--depth", o.depth.as_path())];
+        inputs.extend(o.intrinsics_file.as_deref().map(|p| ("--intrinsics", p)));
+        inputs.extend(o.cameras.as_deref().map(|p| ("--cameras", p)));
+        io::check_out_dir(&o.out_dir, writes, &inputs).map_err(ArgError::Invalid)?;
         Ok(ReprojectJob {
             decode: DepthDecode {
                 scale: o.depth_scale,
@@ -246,7 +258,7 @@ impl ReprojectJob {
         let results = request::render_targets(&gpu, &src, &targets, self.params)?;
         let (width, height) = (src.color.width, src.color.height);
         // Every target's files through the output layer, all or none.
-        let mut set = out_dir.file_set()?;
+        let mut set = out_dir.file_set()?.replacing_recorded("reproject");
         let mut reports = Vec::with_capacity(results.len());
         for RenderedTarget {
             to,

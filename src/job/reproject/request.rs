@@ -232,6 +232,11 @@ impl RigPlan {
         self.from
     }
 
+    /// The target eyes, in the order rendered.
+    pub fn targets(&self) -> &[Eye] {
+        &self.targets
+    }
+
     /// How the source's depth is read.
     pub fn depth_kind(&self) -> DepthEncoding {
         self.depth_kind

@@ -38,6 +38,37 @@ fn stacked_depth(set: &FaceSet) -> DepthMap {
     }
 }
 
+/// The stitched images, colour only: `{name}.png`.
+const OUTPUT_NAMES: [&str; 3] = ["ods_top_bottom", "ods_left", "ods_right"];
+
+/// Refuses a face folder whose files an output would replace: a face file under an output's
+/// name in the out-dir, or one an output's name already is (a hard link, a symlink). Every
+/// regular file of the folder whose name is a face's counts (the files are chosen by
+/// extension when the run reads them).
+fn check_faces_against_outputs(faces: &std::path::Path, out_dir: &std::path::Path) -> Result<(), ArgError> {
+    let is_face = |name: &str| {
+        ["left_", "right_"].iter().any(|eye| {
+            name.strip_prefix(eye).is_some_and(|rest| {
+                FACE_TAGS
+                    .iter()
+                    .any(|t| rest.strip_prefix(t).is_some_and(|r| r.starts_with(['.', '_'])))
+            })
+        })
+    };
+    // An unreadable folder is reported where the run reads its faces.
+    let Ok(entries) = std::fs::read_dir(faces) else {
+        return Ok(());
+    };
+    let files: Vec<PathBuf> = entries
+        .flatten()
+        .filter(|e| e.file_name().to_str().is_some_and(is_face))
+        .map(|e| e.path())
+        .collect();
+    let inputs: Vec<io::NamedPath<'_>> = files.iter().map(|p| ("--faces", p.as_path())).collect();
+    let writes = |name: &str| OUTPUT_NAMES.iter().any(|n| io::ViewNames::named(n, "").may_write(name));
+    io::check_out_dir(out_dir, writes, &inputs).map_err(ArgError::Invalid)
+}
+
 /// What face depth files hold.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default, serde::Serialize, serde::Deserialize)]
 #[serde(rename_all = "kebab-case")]
@@ -166,6 +197,9 @@ impl StitchJob {
             return Err(ArgError::FaceDepthKindWithoutFaces);
         }
         super::cyclopean::check_scale("--depth-scale", o.depth_scale)?;
+        if let Some(dir) = &o.faces {
+            check_faces_against_outputs(dir, &o.out_dir)?;
+        }
         Ok(StitchJob {
             faces: o.faces,
             face_size: o.face_size,
@@ -254,7 +288,7 @@ impl StitchJob {
         };
         // Colour-only views through the output layer, all or none.
         let colour = io::FileFormats::of(io::OutputSet::RGB);
-        let mut set = out_dir.file_set()?;
+        let mut set = out_dir.file_set()?.replacing_recorded("stitch");
         let mut whole = ViewOutput::color_only(img, None);
         io::write_view(&mut set, &io::ViewNames::named("ods_top_bottom", ""), &whole, &colour)?;
         if let Some([l, r]) = eyes {

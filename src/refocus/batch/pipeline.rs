@@ -82,7 +82,9 @@ struct WriteJob {
 /// leaves the previous run's files of this frame untouched.
 fn write_frame(job: WriteJob, files: &FileFormats) -> Result<()> {
     let dir = job.root.subdir(&job.name)?;
-    let mut set = dir.file_set()?;
+    // A frame redone (other settings: fewer scales, other outputs) leaves only its new set.
+    let previous = manifest::previous_files(dir.real_path());
+    let mut set = dir.file_set()?.replacing_listed(previous);
     let mut record = job.manifest;
     for (tag, scale, out) in job.outputs {
         let entry = manifest::write_target(&mut set, &tag, scale, out, files)?;
