@@ -54,6 +54,9 @@ pub(crate) fn files_in(dir: &Path) -> Vec<String> {
         .map(|r| {
             r.filter_map(|e| e.ok())
                 .map(|e| e.file_name().to_string_lossy().into_owned())
+                // The hidden record of the run's set (`.viewsynth.<command>.set`, by which the
+                // next run replaces it) is bookkeeping, not an output.
+                .filter(|name| !(name.starts_with(".viewsynth.") && name.ends_with(".set")))
                 .collect()
         })
         .unwrap_or_default();

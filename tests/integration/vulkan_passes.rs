@@ -414,11 +414,8 @@ fn cyclopean_gather_renders_on_one_shared_device_for_every_convention() {
 
 /// Every file `gl` holds is in `vk` with the same shape, within the agreement rule.
 fn compare_folders(tag: &str, gl: &Path, vk: &Path) {
-    let mut names: Vec<_> = std::fs::read_dir(gl)
-        .unwrap()
-        .map(|e| e.unwrap().file_name().into_string().unwrap())
-        .collect();
-    names.sort();
+    // The outputs (files_in leaves out the hidden record of the set); sorted.
+    let names = super::cli::files_in(gl);
     assert!(!names.is_empty(), "{tag}: the GL run wrote nothing");
     for name in names {
         let (a, b) = (gl.join(&name), vk.join(&name));
