@@ -10,8 +10,8 @@ use viewsynth::job::ArgError;
 pub(crate) const EXAMPLES: &str = "\
 Examples:
   viewsynth bench --sizes 640x480 --repeats 3
-  viewsynth bench --batch 8 --jobs 2           # the pipelined refocus batch on 8 frames
-  viewsynth bench --sizes 640x480 --json";
+  viewsynth bench --batch 4 --jobs 2           # the pipelined refocus batch on 4 frames
+  viewsynth bench --sizes 320x240 --repeats 1 --json";
 
 #[derive(Args)]
 pub(crate) struct BenchArgs {
