@@ -35,13 +35,23 @@ void main() {
     int radius = max(u_size.x, u_size.y);
     // The row (directions 0 and 8: +x, -x): off the image with no rendered pixel either way is a
     // border strip; inside, candidates count up to u_reach times its span.
-    ivec2 q;
-    int r_right = first_along(p, DIRECTIONS[0], u_size, radius, q);
-    int r_left = first_along(p, DIRECTIONS[8], u_size, radius, q);
+    // The row's two walks are the loop's directions 0 and 8: walked once, their hits reused.
+    ivec2 q_right, q_left, q;
+    int r_right = first_along(p, DIRECTIONS[0], u_size, radius, q_right);
+    int r_left = first_along(p, DIRECTIONS[8], u_size, radius, q_left);
     bool border_strip = r_right == 0 || r_left == 0;
     int reach = border_strip ? radius : u_reach * max(r_right, r_left);
     for (int i = 0; i < DIRECTION_COUNT; ++i) {
-        int r_q = first_along(p, DIRECTIONS[i], u_size, radius, q);
+        int r_q;
+        if (i == 0) {
+            r_q = r_right;
+            q = q_right;
+        } else if (i == 8) {
+            r_q = r_left;
+            q = q_left;
+        } else {
+            r_q = first_along(p, DIRECTIONS[i], u_size, radius, q);
+        }
         if (r_q == 0 || r_q > reach) {
             continue;
         }

@@ -14,6 +14,7 @@ const int CENSUS_HALF_W = 3;
 const int CENSUS_HALF_H = 2;
 const int BOX_RADIUS = 4;
 const uint MEAN_SHIFT = 8u;
+const uint UNIQUENESS_PERCENT = 5u;
 const float LR_TOLERANCE_PX = 1.0;
 // A 16-bit cost lane holding no cost: the disparity cannot exist at the pixel, or none was
 // offered yet (means are at most 34 << MEAN_SHIFT, well below).

@@ -47,9 +47,14 @@ float quotient(int a, int b) {
     return a < 0 ? -v : v;
 }
 
-float disparity(uint w0, uint w1) {
+// The twin's `unique`: the winner's cost below the second-best's by more than the margin.
+bool unique(uint c, uint second) {
+    return second == NO_LANE || c * (100u + UNIQUENESS_PERCENT) < second * 100u;
+}
+
+float disparity(uint w0, uint w1, uint w3) {
     uint c = w0 & 0xffffu;
-    if (c == NO_LANE) {
+    if (c == NO_LANE || !unique(c, w3)) {
         return 0.0;
     }
     float d = float(w0 >> 16);
@@ -70,6 +75,6 @@ void main() {
         return;
     }
     int i = p.y * u_size.x + p.x;
-    raw[i] = disparity(winner_left[3 * i], winner_left[3 * i + 1]);
-    raw[pixels() + i] = disparity(winner_right[3 * i], winner_right[3 * i + 1]);
+    raw[i] = disparity(winner_left[4 * i], winner_left[4 * i + 1], winner_left[4 * i + 3]);
+    raw[pixels() + i] = disparity(winner_right[4 * i], winner_right[4 * i + 1], winner_right[4 * i + 3]);
 }

@@ -660,18 +660,23 @@ fn estimated_versus_splats(scene_prefix: &str) -> [Versus; 2] {
 #[test]
 fn default_beats_the_splat_baseline_with_estimated_disparities() {
     for (scene, min_gain_db) in [
-        // +0.156 / +0.159 dB, 87.31 % vs 87.25 % covered. Small beside ground truth's +0.59 dB:
+        // +0.127 / +0.130 dB, 85.18 % vs 85.15 % covered (+0.156 / +0.159 before the
+        // uniqueness test). Small beside ground truth's +0.59 dB:
         // Cones' im4 sits (+0.25, +0.1) px off the halfway view, which costs the sub-pixel
         // default and not the rounding baseline (see the test above).
         ("Middlebury Cones", 0.1),
-        // +0.060 / +0.063 dB, 83.00 % vs 82.92 %: the narrowest win.
-        ("Tsukuba (tsukuba2+tsukuba4", 0.03),
-        // +0.265 / +0.260 dB, 72.70 % vs 72.62 %.
+        // +0.060 / +0.063 dB, 83.00 % vs 82.92 % before the matcher's uniqueness test (issue
+        // 38); -0.027 / -0.025 dB, 76.49 % vs 76.47 % since: the test leaves unknown the
+        // pixels whose match is ambiguous, where the default's sub-pixel gather and two-eye
+        // merge had their edge, and on the clear matches left both methods draw the same
+        // colours. A tie, not a win: the bound holds it within 0.06 dB (+0.127 dB on Cones).
+        ("Tsukuba (tsukuba2+tsukuba4", -0.06),
+        // +0.247 / +0.242 dB, 65.21 % vs 65.20 % (+0.265 / +0.260 before).
         ("Tsukuba (tsukuba1+tsukuba5", 0.2),
-        // +1.073 / +1.075 dB, 84.99 % vs 82.93 % (one eye: the splat has no second eye to fill
+        // +1.135 / +1.136 dB, 80.21 % vs 78.30 % (+1.073 / +1.075 before; one eye: the splat has no second eye to fill
         // its cracks).
         ("Middlebury Teddy", 1.0),
-        // +0.729 / +0.727 dB, 87.07 % vs 85.82 %.
+        // +0.826 / +0.823 dB, 84.75 % vs 83.63 % (+0.729 / +0.727 before).
         ("Middlebury 2014 Motorcycle", 0.65),
     ] {
         for (baseline, v) in ["half away", "half to even"].iter().zip(estimated_versus_splats(scene)) {

@@ -296,7 +296,10 @@ fn a_steady_state_frame_creates_nothing_on_either_api() {
         let mut tracer = SceneRenderer::new(d, &scene).unwrap();
         let mut matcher = viewsynth::cyclopean::matcher::Matcher::new(d, 64, 48, 8).unwrap();
         // The first pair uploads the matcher's images; the frames below rewrite them.
-        drop(matcher.estimate(&frame.left.color, &frame.right.color).unwrap());
+        let (matched, _) = matcher.estimate(&frame.left.color, &frame.right.color).unwrap();
+        // The densify pass (issue 38) on those disparities: its first eye uploads the inputs.
+        let mut densifier = viewsynth::cyclopean::densify::Densifier::new(d).unwrap();
+        drop(densifier.densify(&matched, &frame.left.color).unwrap());
         let source = crate::common::synthetic(64, 48);
         let targets = viewsynth::refocus::manifest::TargetSpec {
             scales: vec![0.5, 1.0, 2.0],
@@ -366,6 +369,10 @@ fn a_steady_state_frame_creates_nothing_on_either_api() {
                             .unwrap(),
                     );
                 }),
+            ),
+            (
+                "densify",
+                Box::new(|| drop(densifier.densify(&matched, &frame.left.color).unwrap())),
             ),
             (
                 // The batch's frame: a new source of the same size, every target in flight at once.

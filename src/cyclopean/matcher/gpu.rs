@@ -63,7 +63,7 @@ pub struct Matcher {
     means: Buffer,
     /// A chunk's row sums.
     rows: Buffer,
-    /// Each eye's winner so far, 3 words a pixel.
+    /// Each eye's winner so far, 4 words a pixel.
     winners: [Buffer; 2],
     /// Sub-pixel disparities, then the checked ones, both eyes (f32 bits).
     raw: Buffer,
@@ -94,8 +94,8 @@ impl Matcher {
             means: buffer(chunk_pairs * n, "matcher means")?,
             rows: buffer(chunk_pairs * n, "matcher row sums")?,
             winners: [
-                buffer(3 * n, "matcher left winners")?,
-                buffer(3 * n, "matcher right winners")?,
+                buffer(4 * n, "matcher left winners")?,
+                buffer(4 * n, "matcher right winners")?,
             ],
             raw: buffer(2 * n, "matcher sub-pixel disparities")?,
             checked: buffer(2 * n, "matcher checked disparities")?,

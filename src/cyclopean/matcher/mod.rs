@@ -14,6 +14,11 @@
 //! - Winner takes all, ties to the smaller disparity, for both eyes from the same costs (the
 //!   right eye's cost at (x, d) is the left eye's at (x + d, d)); sub-pixel by the parabola
 //!   through the winner's cost and its two neighbours' (offset clamped to half a pixel).
+//! - Uniqueness: a winner whose cost is not below every cost two or more disparities away by
+//!   more than [`UNIQUENESS_PERCENT`] % is unknown (a repeated texture that matches one period
+//!   off as well as at its own disparity; both eyes would agree on the wrong one). The second
+//!   best is kept while streaming the disparities: a new winner takes the running minimum of
+//!   the costs up to two disparities before it, later costs two or more past it lower it.
 //! - Left-right consistency: a disparity is kept only if the other eye's, read at the pixel it
 //!   points to, is within 1 px; occlusions and most mismatches become 0 (unknown).
 //! - A 3 x 3 median over the known values of each known pixel (unknown pixels stay unknown).
@@ -63,6 +68,9 @@ pub const CENSUS_HALF_H: usize = 2;
 pub const BOX_RADIUS: usize = 4;
 /// Largest disagreement (px) between the eyes the left-right check accepts.
 pub const LR_TOLERANCE_PX: f32 = 1.0;
+/// The uniqueness margin: a winner whose cost is not below every cost two or more disparities
+/// away by more than this share (in %) is unknown.
+pub const UNIQUENESS_PERCENT: u32 = 5;
 /// Aggregated costs are means in fixed point with this many fractional bits.
 pub const MEAN_SHIFT: u32 = 8;
 
@@ -101,6 +109,7 @@ mod tests {
             format!("const int CENSUS_HALF_H = {};", super::CENSUS_HALF_H),
             format!("const int BOX_RADIUS = {};", super::BOX_RADIUS),
             format!("const uint MEAN_SHIFT = {}u;", super::MEAN_SHIFT),
+            format!("const uint UNIQUENESS_PERCENT = {}u;", super::UNIQUENESS_PERCENT),
             format!("const float LR_TOLERANCE_PX = {:?};", super::LR_TOLERANCE_PX),
         ] {
             assert!(glsl.contains(&line), "matcher_params.glsl lacks `{line}`");
