@@ -1,11 +1,12 @@
 #!/usr/bin/env bash
 # Builds the Docker image and tries it: `info`, a refocus into a mounted folder as a non-root
-# uid, the no-argument run (demo, and where its outputs went), and the VIEWSYNTH_REQUIRE_GPU=1
-# refusal of a software renderer. Prints the build time and the image size.
+# uid, the Python package (a numpy frame refocused from `python3` in the container), the
+# no-argument run (demo, and where its outputs went), and the VIEWSYNTH_REQUIRE_GPU=1 refusal of
+# a software renderer. Prints the build time and the image size.
 #
-# Not part of .ci/run (it compiles the whole crate, about 10 minutes on 2 cores): run it after
-# changing the Dockerfile, docker/, .dockerignore or the build. Needs root (or a docker group
-# member) and the test data (../shared/data or VIEWSYNTH_DATA_DIR).
+# Not part of .ci/run (it compiles the whole crate and the Python extension, 10 to 40 minutes on
+# 2 cores): run it after changing the Dockerfile, docker/, python/, .dockerignore or the build.
+# Needs root (or a docker group member) and the test data (../shared/data or VIEWSYNTH_DATA_DIR).
 #
 # Where no image registry is reachable, it makes the base images itself: a Debian bookworm root
 # from debootstrap, imported as debian:bookworm-slim, and rust:1-bookworm built on it from this
@@ -73,7 +74,8 @@ if ! have rust:1-bookworm && ! docker pull -q rust:1-bookworm >/dev/null 2>&1; t
   command -v rustc >/dev/null || die "rust:1-bookworm cannot be pulled and this machine has no Rust toolchain to build it from"
   SYSROOT=$(rustc --print sysroot)
   say "no registry: rust:1-bookworm from this machine's toolchain ($("$SYSROOT/bin/rustc" --version))"
-  # The official image's layout: the toolchain under /usr/local, a C toolchain for linking.
+  # The official image's layout: the toolchain under /usr/local, a C and C++ toolchain (linking,
+  # and nv-flip-sys's C++).
   mkdir -p "$WORK/rust/ca"
   tar -C "$SYSROOT" -c bin/cargo bin/rustc bin/rustdoc lib libexec | tar -C "$WORK/rust" -x
   # This machine's own CA certificates (a TLS-intercepting proxy's, say): cargo in the image
@@ -83,7 +85,7 @@ if ! have rust:1-bookworm && ! docker pull -q rust:1-bookworm >/dev/null 2>&1; t
 FROM debian:bookworm-slim
 RUN apt-get update -qq \
  && DEBIAN_FRONTEND=noninteractive apt-get install -y -qq --no-install-recommends \
-      ca-certificates gcc libc6-dev pkg-config \
+      ca-certificates gcc g++ libc6-dev pkg-config \
  && rm -rf /var/lib/apt/lists/*
 COPY ca /usr/local/share/ca-certificates
 RUN update-ca-certificates
@@ -129,6 +131,37 @@ done
 [ "$(stat -c %u "$WORK/mnt/out/tum/manifest.json")" = 1234 ] || die "the outputs are not owned by the container's uid"
 grep -q "not a mounted folder" "$WORK/refocus.log" && die "the entry point warned although /work is mounted"
 say "refocus as uid 1234 into a mounted folder: $(ls "$WORK/mnt/out/tum" | wc -l) files"
+
+# The Python package: TUM's depth read by viewsynth.read_depth, a colour frame made in numpy and
+# passed as a strided view (BGR reversed to RGB), refocused at s = 1 and 2. At s = 1 the output
+# colour equals the input wherever the mask says the geometry is valid.
+cat >"$WORK/smoke.py" <<'EOF'
+import numpy as np
+import viewsynth as vs
+
+depth = vs.read_depth("/data/rgbd_open3d_testdata/TUM_depth.png", depth_scale=5000)
+h, w = depth.shape
+yy, xx = np.mgrid[0:h, 0:w]
+bgr = np.stack([xx * 255 // (w - 1), yy * 255 // (h - 1), (3 * xx + 5 * yy) % 256], axis=-1).astype(np.uint8)
+rgb = bgr[..., ::-1]
+K = np.array([[525.0, 0, 319.5], [0, 525.0, 239.5], [0, 0, 1]])
+one, two = vs.Renderer().refocus(rgb, depth, K, scales=[1.0, 2.0])
+assert one["rgb"].shape == (h, w, 3) and two["rgb"].shape == (h, w, 3), (one["rgb"].shape, two["rgb"].shape)
+valid = np.asarray(one["mask"]).astype(bool)
+assert valid.sum() > 0.5 * h * w, f"only {valid.sum()} valid pixels at s = 1"
+diff = np.abs(one["rgb"].astype(int) - rgb.astype(int)).max(axis=-1)[valid]
+assert diff.max() <= 1, f"s = 1 colour differs from the input by up to {diff.max()} levels"
+print(
+    f"python: viewsynth {vs.__version__}, numpy {np.__version__}: refocused a {w}x{h} numpy frame "
+    f"(strided RGB view, depth from read_depth) at s = 1, 2; at s = 1 the colour equals the input "
+    f"on all {valid.sum()} valid pixels (max diff {diff.max()} levels)"
+)
+EOF
+chmod 644 "$WORK/smoke.py"
+out=$(run -v "$DATA:/data:ro" -v "$WORK/smoke.py:/smoke.py:ro" "$IMAGE" python3 /smoke.py 2>&1) ||
+  die "the Python step failed: $out"
+line=$(grep '^python: viewsynth' <<<"$out") || die "the Python step printed no result: $out"
+say "$line"
 
 # No arguments, no mount: info, the demo, and the note that its outputs are not kept.
 run "$IMAGE" >"$WORK/demo.log" 2>&1 || die "the no-argument run failed: $(tail -20 "$WORK/demo.log")"

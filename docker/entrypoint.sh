@@ -2,7 +2,8 @@
 # The image's entry point. With no arguments: show what this container renders with
 # (`viewsynth info`: renderer, every EGL device, which one `auto` picks), run the demo into
 # /work/out/demo, and say where that is. With arguments: run `viewsynth` with them
-# (`docker run IMAGE refocus ...`).
+# (`docker run IMAGE refocus ...`), or, when the first is python, python3 or pip, that program
+# (the image's venv with the Python package: `docker run IMAGE python3 augment.py`).
 #
 # Outputs go under the working directory /work. Unless a host folder is mounted there (or at
 # /work/out), they stay inside the container and are lost with it: say so, and how to mount.
@@ -30,7 +31,10 @@ if [ "$#" -eq 0 ]; then
     exit 0
 fi
 case "$1" in
-    info | bench | help | -h | --help | -V | --version) ;;
+    info | bench | help | -h | --help | -V | --version | pip) ;;
     *) mounted || mount_hint ;;
+esac
+case "$1" in
+    python | python3 | pip) exec "$@" ;;
 esac
 exec viewsynth "$@"

@@ -781,7 +781,8 @@ impl Renderer {
     /// and seed (--zoom-random, log-uniform draws). progress: f(done, total) per frame, or True.
     /// index: write out_dir/index.jsonl (the CLI's, joined over shards); pass False when frames
     /// is a share of a manifest you split yourself (Ray, Dask), then call viewsynth.write_index
-    /// once over the whole manifest.
+    /// once over the whole manifest. Either way a call that rewrites frames first removes the
+    /// index (and the parts that could list them), so an interrupted call leaves none stale.
     ///
     /// Returns the batch summary: "rendered", "skipped", "other_shards", "failed" (a list of
     /// [frame name, error message]: a failed frame leaves no folder and does not stop the

@@ -1,7 +1,7 @@
 //! `refocus --batch` for augmentation, through the binary: `--zoom-random` draws the same scales
 //! for a frame under a rerun and under shards, and `index.jsonl` lists one row per target after
 //! a run, after two shards (the last joins; `viewsynth index` joins by hand) and after a killed
-//! and resumed run.
+//! and resumed run, and a run killed after an earlier complete one leaves no stale index.
 
 use crate::cli::bin;
 use crate::cli_batch::setup;
@@ -151,4 +151,100 @@ fn index_has_one_row_per_target_after_a_killed_and_resumed_run() {
     let o = run(&manifest, &out, &heavy);
     assert!(String::from_utf8_lossy(&o.stdout).contains("already done"));
     check_index(&out, 12, 2);
+}
+
+/// Every row of `index.jsonl` and of each part still there names files that are on disk, and
+/// the frame's manifest records the row's scale for its target: no row from before a redo.
+fn assert_index_true_to_disk(out: &Path) {
+    let mut lists: Vec<_> = std::fs::read_dir(out)
+        .unwrap()
+        .flatten()
+        .map(|e| e.file_name().to_string_lossy().to_string())
+        .filter(|n| n.starts_with("index") && n.ends_with(".jsonl"))
+        .collect();
+    lists.sort();
+    for list in lists {
+        for r in read_index(&out.join(&list)).unwrap() {
+            for f in [&r.rgb, &r.depth, &r.mask].into_iter().flatten() {
+                assert!(out.join(f).is_file(), "{list} lists {f}, which is not on disk");
+            }
+            let text = std::fs::read_to_string(out.join(&r.manifest)).unwrap();
+            let m: serde_json::Value = serde_json::from_str(&text).unwrap();
+            let scale = m["outputs"][r.target]["scale"].as_f64();
+            assert_eq!(
+                scale,
+                Some(r.scale),
+                "{list}: {} target {} is not as on disk",
+                r.frame,
+                r.target
+            );
+        }
+    }
+}
+
+/// A complete run wrote its index; a run with other settings (other scales: each frame it redoes
+/// loses the previous files) is killed mid-run. Neither the joined index nor a part may then name
+/// the files it removed, nor may `viewsynth index` join such a part; the resumed run lists every
+/// frame with the new settings. Before the fix the first run's `index.jsonl` and part stayed
+/// until the end of a run, naming f0/s0.5_rgb.png and the like after the kill.
+#[test]
+fn a_run_killed_after_an_earlier_complete_run_leaves_no_stale_index() {
+    use std::os::unix::process::ExitStatusExt;
+    let (dir, manifest) = setup("augment-kill-stale", 12);
+    let out = dir.join("out");
+    let size = ["--width-out", "800", "--height-out", "600"];
+    let first = [&size[..], &["--zoom-range", "0.5,1.5"]].concat();
+    let second = [&size[..], &["--zoom-range", "0.75"]].concat();
+    run(&manifest, &out, &first);
+    check_index(&out, 12, 2);
+
+    let mut child = bin()
+        .args(["refocus", "--jobs", "1", "--batch"])
+        .arg(&manifest)
+        .arg("--out-dir")
+        .arg(&out)
+        .args(&second)
+        .stdout(Stdio::null())
+        .stderr(Stdio::null())
+        .spawn()
+        .unwrap();
+    // Until the third frame is redone: its manifest records the second run's one scale.
+    let redone = |f: usize| {
+        std::fs::read_to_string(out.join(format!("f{f}/manifest.json")))
+            .ok()
+            .and_then(|t| serde_json::from_str::<serde_json::Value>(&t).ok())
+            .is_some_and(|m| m["outputs"].as_array().is_some_and(|o| o.len() == 1))
+    };
+    let t0 = std::time::Instant::now();
+    while !redone(2) {
+        assert!(t0.elapsed().as_secs() < 120, "no frame redone in 120 s");
+        if child.try_wait().unwrap().is_some() {
+            break;
+        }
+        std::thread::sleep(std::time::Duration::from_millis(1));
+    }
+    child.kill().unwrap();
+    assert_eq!(
+        child.wait().unwrap().signal(),
+        Some(9),
+        "the batch ended before the kill"
+    );
+    assert!(!redone(11), "the last frame was redone before the kill");
+    assert!(
+        !out.join("f0/s0.5_rgb.png").exists(),
+        "the redone frame kept its old set"
+    );
+    assert_index_true_to_disk(&out);
+    // Joining by hand what the killed run left: an error (no part), never a stale index.
+    let o = bin().arg("index").arg(&out).output().unwrap();
+    assert_index_true_to_disk(&out);
+    if o.status.success() {
+        check_index(&out, 12, 1);
+    }
+
+    let o = run(&manifest, &out, &second);
+    assert!(String::from_utf8_lossy(&o.stdout).contains("already done"));
+    let rows = check_index(&out, 12, 1);
+    assert!(rows.iter().all(|r| r.scale == 0.75), "{rows:?}");
+    assert_index_true_to_disk(&out);
 }

@@ -133,8 +133,13 @@ fn a_full_stdout_is_exit_1_with_a_message() {
     let out = d.join("out");
     let mut refocus = refocus_args(&rgb, &depth, &out);
     refocus.extend(["--zoom-range", "2"]);
+    // `viewsynth index` over a batch folder holding one (empty) part: it joins, then prints.
+    let batch = d.join("batch");
+    std::fs::create_dir_all(&batch).unwrap();
+    std::fs::write(batch.join("index.part-0-of-1.jsonl"), "").unwrap();
     let mut cases: Vec<Vec<&str>> = vec![
         vec!["info"],
+        vec!["index", s(&batch)],
         vec!["compare", "--a-rgb", &a, "--b-rgb", s(&b), "--json", "-"],
         vec!["compare", "--a-rgb", &a, "--b-rgb", s(&b)],
         refocus,

@@ -7,8 +7,13 @@
 //! (K/N its shard, 0/1 unsharded): the rows of every frame of its share whose manifest records
 //! this run's settings. Then, when all N parts of that N are there, it joins them into
 //! `index.jsonl` (so the last shard to finish joins; `viewsynth index OUT` joins by hand). Parts
-//! and the index are written atomically: a killed run leaves the previous ones, and the resumed
-//! run writes them whole again.
+//! and the index are written atomically.
+//!
+//! A run that rewrites frames first removes what could list them ([`invalidate`]): the joined
+//! index, its own part and the parts of other shard counts. A frame redone with other settings
+//! loses its previous files, so an index kept from an earlier run would name files that are gone
+//! once such a run is killed. The parts of the other shards of its own count stay: they list
+//! frames this run does not touch. The resumed run writes its part again and joins.
 
 use super::resume::frame_settings;
 use super::{BatchFrame, BatchOptions};
@@ -141,6 +146,35 @@ pub fn write_part(root: &Path, frames: &[BatchFrame], opts: &BatchOptions) -> Re
         return join_parts(root, n).map(Some);
     }
     Ok(None)
+}
+
+/// Before a run rewrites any frame: remove `index.jsonl`, this run's part (K/N its shard, 0/1
+/// unsharded) and every part of another shard count, which may list the frames it rewrites. Done
+/// before the first frame is written, so a run killed at any point leaves no row naming a file
+/// it replaced; the parts of the other shards of N list only their own frames and stay.
+pub fn invalidate(root: &Path, opts: &BatchOptions) -> Result<()> {
+    let (k, n) = opts.shard.map_or((0, 1), |s| (s.index, s.count));
+    let entries = std::fs::read_dir(root).map_err(|e| Error::io(root, e))?;
+    for e in entries {
+        let e = e.map_err(|e| Error::io(root, e))?;
+        let name = e.file_name().to_string_lossy().to_string();
+        let stale = match parse_part_name(&name) {
+            Some((j, m)) => m != n || j == k,
+            None => name == INDEX_NAME,
+        };
+        if stale {
+            remove(&e.path())?;
+        }
+    }
+    Ok(())
+}
+
+/// Remove one index file (gone already is fine: another shard may have removed it).
+fn remove(path: &Path) -> Result<()> {
+    match std::fs::remove_file(path) {
+        Err(e) if e.kind() != std::io::ErrorKind::NotFound => Err(Error::io(path, e)),
+        _ => Ok(()),
+    }
 }
 
 /// Write `index.jsonl` over the whole of `frames` (the full manifest, shards ignored) as they

@@ -263,6 +263,11 @@ pub fn run_batch(
         }
         todo.push(frame);
     }
+    // Whatever could list a frame this run rewrites goes before the first frame is written (the
+    // end of the run writes the index again).
+    if !todo.is_empty() {
+        super::index::invalidate(root.real_path(), opts)?;
+    }
     let mut refocuser = Refocuser::with_settings(device, &opts.rule, opts.method, opts.files.outputs, opts.conv)?;
     refocuser.set_rgb_everywhere(opts.rgb_everywhere);
     let files = opts.files;

@@ -5,6 +5,6 @@ use anyhow::Result;
 
 pub(crate) fn index(a: &IndexArgs) -> Result<()> {
     let (path, rows) = viewsynth::refocus::batch::join_index(&a.out_dir)?;
-    println!("{}: {rows} targets", path.display());
+    outln!("{}: {rows} targets", path.display());
     Ok(())
 }
