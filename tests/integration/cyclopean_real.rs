@@ -1,20 +1,16 @@
 //! The splat-gather middle view on real stereo (Middlebury 2003 Cones), on thin structures, and
 //! against its f64 twin; the rectified-stereo CLI.
 //!
-//! GPU vs twin tolerance, from the numerics: the GPU computes positions in f32 (relative error
-//! ~1e-7, ~1e-4 px at these sizes after the matrix chain), the twin in f64. A pixel's answer can
-//! only differ where a decision sits within that of its threshold: a splat within 1e-4 px of a
-//! pixel border, a middle ray within 1e-4 px of the half-texel that decides the nearest eye texel,
-//! or two disparities within 1e-5 px of the same-surface tolerance (1.1 px, off every dyadic
-//! quantisation step, so never exactly). On generic geometry (the built-in scene) that is a
-//! handful of pixels (none when written): at most 0.1 % may differ. Where the bits agree the
-//! colour is the same weighted sum of the same texels, so it may differ by one quantisation
-//! level (rounding of a value within 1e-4 of a half level), and the middle depth by the f32
-//! error of the chain (~1e-6 relative; bound 2e-5, as for the gather method). Cones has
-//! quarter-pixel disparities: half a disparity puts a splat or a ray exactly on a pixel or
-//! texel border for many pixels at once, where f32 and f64 may round to different sides and
-//! so pick the other surface at an object edge: the bound there is 1.5 % of the pixels
-//! (1.2 % measured when written, all along object edges).
+//! GPU vs twin tolerance, from the numerics: the GPU computes positions in f32, the twin in f64.
+//! A pixel's answer can only differ where a decision sits within f32 reach of its threshold: a
+//! splat near a pixel border that may change a neighbourhood's nearest distance, a middle ray
+//! near the half-texel that decides the nearest eye texel, or two disparities near the
+//! same-surface tolerance. `splat_reference::ambiguity` marks those pixels from the twin's own
+//! geometry (bounds derived in src/cyclopean/ambiguity.rs); only they are excused. Every other
+//! pixel must carry the twin's source bits, its colour within one level (the same weighted sum of
+//! the same texels; rounding of a value near a half level) and its middle depth within 2e-5
+//! relative (the f32 error of the chain, ~1e-6; as for the gather method). So one pixel 40 levels
+//! off fails. The marked share is bounded per case (see `splat_gather_twin`).
 
 use crate::common::{data_dir, gpu};
 use std::path::{Path, PathBuf};
@@ -27,7 +23,7 @@ use viewsynth::cyclopean::reference::CyclopeanReference;
 use viewsynth::cyclopean::render::CyclopeanRenderer;
 use viewsynth::cyclopean::scene_frame::{scene_frame, StereoRig};
 use viewsynth::cyclopean::splat::{SplatParams, SplatRenderer};
-use viewsynth::cyclopean::splat_reference::splat_reference;
+use viewsynth::cyclopean::splat_reference::{self, splat_reference};
 use viewsynth::cyclopean::{CyclopeanOutput, CyclopeanOutputs, CyclopeanParams, FrameDepth, Method, StereoFrame};
 use viewsynth::eval::cyclopean::{estimated_cases, estimated_eyes};
 use viewsynth::io::{self, DepthDecode, DepthMap, RgbImage};
@@ -68,15 +64,16 @@ fn out_dir(name: &str) -> PathBuf {
     dir
 }
 
-/// Pixels whose source bits differ; pixels (same bits) whose colour differs by more than one
-/// level; pixels (same bits) whose depth differs by more than 2e-5 relative.
-fn compare(out: &CyclopeanOutput, r: &CyclopeanReference) -> (usize, usize, usize) {
-    let (mut src, mut col, mut z) = (0, 0, 0);
+/// Among the pixels the twin does not mark `ambiguous`: those whose source bits differ; those
+/// (same bits) whose colour differs by more than one level; those (same bits) whose depth
+/// differs by more than 2e-5 relative.
+fn compare(out: &CyclopeanOutput, r: &CyclopeanReference, ambiguous: &[bool]) -> (Vec<usize>, usize, usize) {
+    let (mut src, mut col, mut z) = (Vec::new(), 0, 0);
     let color = out.color().unwrap();
     let depth = out.depth().unwrap();
-    for i in 0..r.depth.len() {
+    for i in (0..r.depth.len()).filter(|&i| !ambiguous[i]) {
         if out.sources[i] != r.sources[i] {
-            src += 1;
+            src.push(i);
             continue;
         }
         let e = (0..3)
@@ -108,21 +105,29 @@ fn dump(tag: &str, out: &CyclopeanOutput, r: &CyclopeanReference, w: u32, h: u32
     dir.display().to_string()
 }
 
-/// At most `max_fraction` of the pixels may differ (in source bits, colour beyond one level or
-/// depth beyond 2e-5 relative).
+/// No pixel outside those the twin marks ambiguous may differ (in source bits, colour beyond one
+/// level or depth beyond 2e-5 relative), and at most `max_ambiguous` of the pixels are marked.
 fn check_twin(
     device: &viewsynth::pass::Device,
     tag: &str,
     frame: &StereoFrame,
     mid: &viewsynth::cyclopean::MiddleCamera,
-    max_fraction: f64,
+    max_ambiguous: f64,
 ) {
     let out = splat_on(device, frame, mid);
     let r = splat_reference(frame, mid, &SplatParams::default()).unwrap();
-    let (src, col, z) = compare(&out, &r);
+    let ambiguous = splat_reference::ambiguity(frame, mid, &SplatParams::default()).unwrap();
+    let (src, col, z) = compare(&out, &r, &ambiguous);
     let n = r.depth.len();
-    let msg = format!("{tag}: of {n} pixels, {src} differ in source bits, {col} in colour, {z} in depth");
-    if (src + col + z) as f64 > max_fraction * n as f64 {
+    let marked = ambiguous.iter().filter(|a| **a).count();
+    let w = mid.width as usize;
+    let msg = format!(
+        "{tag}: of {n} pixels, {marked} ({:.2} %) ambiguous; of the others {} differ in source bits (first {:?}), {col} in colour, {z} in depth",
+        marked as f64 * 100.0 / n as f64,
+        src.len(),
+        src.first().map(|i| (i % w, i / w))
+    );
+    if !src.is_empty() || col + z > 0 || marked as f64 > max_ambiguous * n as f64 {
         let dir = dump(tag, &out, &r, mid.width, mid.height);
         panic!("{msg}; images in {dir}");
     }
@@ -141,6 +146,14 @@ fn vulkan_splat_gather_matches_its_f64_twin() {
     splat_gather_twin(&viewsynth::vulkan::VkExecutor::device(&crate::vulkan_refocus::vulkan()).unwrap());
 }
 
+/// The share of Cones the twin may mark ambiguous. Its quarter-pixel disparities put a
+/// splat, or a middle ray's nearest eye texel, exactly on a pixel or texel border for whole
+/// surfaces at once (one disparity value in eight does), where f32 may land either side.
+/// Measured when written: 22.22 % (23.97 % before nearest-texel choices were tested for their
+/// effect, see `splat_reference::ambiguity`); 30 % is the bound. Every other pixel must match. On the built-in scene (generic
+/// geometry) 0.01 % (one pixel) is marked; the bound there is 0.5 %.
+const CONES_MAX_AMBIGUOUS: f64 = 0.30;
+
 fn splat_gather_twin(device: &viewsynth::pass::Device) {
     eprintln!("splat-gather twin check on {:?}", device.api());
     let mut rig = StereoRig::demo(160, 120);
@@ -148,12 +161,12 @@ fn splat_gather_twin(device: &viewsynth::pass::Device) {
     for conv in Conventions::all() {
         for kind in [FrameDepth::Device, FrameDepth::ViewZ] {
             let (frame, mid, _) = scene_frame(&rig, conv, kind);
-            check_twin(device, &format!("scene-{}-{kind:?}", conv.label()), &frame, &mid, 0.001);
+            check_twin(device, &format!("scene-{}-{kind:?}", conv.label()), &frame, &mid, 0.005);
         }
     }
     let (l, r, _) = cones();
     let (frame, mid) = disparity_frame(l, r, &DisparityRig::middle(400.0, 0.1), Conventions::default()).unwrap();
-    check_twin(device, "cones", &frame, &mid, 0.015);
+    check_twin(device, "cones", &frame, &mid, CONES_MAX_AMBIGUOUS);
 }
 
 type Eye = (RgbImage, DepthMap);
