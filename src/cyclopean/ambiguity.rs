@@ -87,7 +87,8 @@ impl Reach {
     }
     /// A comparison whose quantity lies `margin` from its threshold, with error up to `bound`.
     pub fn threshold(&self, margin: f64, bound: f64) {
-        if self.on && !(margin.abs() > bound) {
+        // NaN margins count as within reach.
+        if self.on && margin.abs().partial_cmp(&bound) != Some(std::cmp::Ordering::Greater) {
             self.hit.set(true);
         }
     }

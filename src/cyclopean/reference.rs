@@ -164,7 +164,7 @@ fn window(clip: [f64; 4], size: [f64; 2]) -> [f64; 2] {
 /// infinity lands.
 fn parallax(view_proj: &Mat4, dir: [f64; 3], px: [f64; 2], size: [f64; 2]) -> f64 {
     let c = mat4::transform(view_proj, [dir[0], dir[1], dir[2], 0.0]);
-    if !(c[3] > 0.0) {
+    if c[3].partial_cmp(&0.0) != Some(std::cmp::Ordering::Greater) {
         return size[0].max(size[1]);
     }
     let inf = window(c, size);
