@@ -129,7 +129,7 @@ pub fn run_with_progress(gpu: &Gpu, out_dir: &Path, progress: &dyn crate::progre
     reproject_outputs(gpu, &reproject_dir)?;
     stages.start("demo: stitched stereo panoramas");
     stitch_outputs(gpu, &stitch_dir)?;
-    let mut written = crate::eval::report_stages(gpu, out_dir, None, &[], 3, &stages)?;
+    let mut written = crate::eval::report_stages(gpu, out_dir, None, &[], None, 3, &stages)?;
     written.files.push(path);
     Ok(written)
 }

@@ -5,9 +5,13 @@ by half its flow (bilinear, borders replicated), and the average of the two warp
     python python/peers/flow_interpolation.py LEFT.png RIGHT.png OUT.png [--truth MIDDLE.png]
 
 Writes the interpolated middle view to OUT.png and, with --truth, prints its PSNR over all
-pixels (8-bit peak) as JSON on stdout: {"psnr_db": ...}. `viewsynth report --flow-peer DIR`
-scores images written this way beside viewsynth's own rows. Needs opencv-python(-headless) and
-numpy; neither is a dependency of viewsynth.
+pixels (8-bit peak) as JSON on stdout: {"psnr_db": ...}. `viewsynth report --data-dir DATA
+--flow-peer DIR` scores images written this way beside viewsynth's own rows, one per real pair
+with a true middle view, each named after its pair: DIR/cones_2_6_4.png (Middlebury 2003 Cones
+im2 + im6 -> im4), DIR/tsukuba_2_4_3.png and DIR/tsukuba_1_5_3.png (Tsukuba views 2 + 4 and
+1 + 5 -> 3); a pair whose set DATA holds and whose file is missing fails the report.
+docs/report.md ("The optical-flow peer") has the shell loop that writes them all. Needs
+opencv-python(-headless) and numpy; neither is a dependency of viewsynth.
 """
 
 import argparse

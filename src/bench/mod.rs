@@ -211,6 +211,48 @@ pub fn cyclopean_bench(
         |r| r.render(&mid),
     )?;
     record(crate::eval::cyclopean::SPLAT_NAME, splat);
+    // Dense disparities before rendering (what `--left-rgb/--right-rgb` runs between the matcher
+    // and the render): both eyes of the synthetic pair, on the GPU matcher's disparities (its
+    // occlusions and left-right misses unknown) and with a quarter of each eye cleared in 32 px
+    // blocks (the 13-27 % a real pair leaves unknown, in regions as wide as a real pair's).
+    let (left, right, _) = matcher::synthetic_pair(width, height)?;
+    let (matched_left, matched_right) =
+        crate::cyclopean::matcher::Matcher::new(gpu, width, height, MATCHER_BENCH_MAX_DISPARITY)?
+            .estimate(&left, &right)?;
+    let unknown = |maps: [&crate::io::DepthMap; 2]| {
+        let n: usize = maps.iter().map(|m| m.data.iter().filter(|d| **d <= 0.0).count()).sum();
+        100.0 * n as f64 / (2 * width as usize * height as usize) as f64
+    };
+    let cleared = |m: &crate::io::DepthMap| {
+        let mut m = m.clone();
+        for (i, d) in m.data.iter_mut().enumerate() {
+            let (bx, by) = ((i % width as usize) / 32, (i / width as usize) / 32);
+            // One block in four, in a pattern that shifts per block row (no full columns).
+            if (bx + 2 * by) % 4 == 0 {
+                *d = 0.0;
+            }
+        }
+        m
+    };
+    let blocks = [cleared(&matched_left), cleared(&matched_right)];
+    for (what, maps) in [
+        ("the matcher's disparities", [&matched_left, &matched_right]),
+        ("a quarter cleared in 32 px blocks", [&blocks[0], &blocks[1]]),
+    ] {
+        let share = unknown(maps);
+        let timing = setup_and_median(
+            repeats,
+            || crate::cyclopean::densify::Densifier::new(gpu),
+            |d| {
+                d.densify(maps[0], &left)?;
+                d.densify(maps[1], &right)
+            },
+        )?;
+        record(
+            &format!("densify, GPU pass (both eyes, {what}: {share:.1} % unknown)"),
+            timing,
+        );
+    }
     // --fill on the default method's view: what a complete spectator frame adds to it.
     let (view, _) = crate::cyclopean::splat::SplatRenderer::new(
         gpu,
@@ -269,7 +311,6 @@ pub fn cyclopean_bench(
     record("temporal accumulation, f64 twin (CPU, 1 thread)", twin);
     // The census matcher on a pair of this size: what a user without disparities pays before
     // any of the methods above (GPU pass, then its CPU twin as the baseline).
-    let (left, right, _) = matcher::synthetic_pair(width, height)?;
     let max_d = MATCHER_BENCH_MAX_DISPARITY;
     for (stages, confidence) in [(", GPU pass", false), (" + confidence stage, GPU pass", true)] {
         let timing = setup_and_median(

@@ -17,6 +17,7 @@
 //! - [`scene_frame`]: a stereo frame of the built-in scene under any conventions, for tests,
 //!   the demo and the report.
 
+pub mod ambiguity;
 pub mod baseline;
 pub mod camera_file;
 pub mod camera_spec;

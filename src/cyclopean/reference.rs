@@ -2,6 +2,7 @@
 //! texel choices. Images are handled in memory order (row 0 = framebuffer row 0 under the
 //! frame's row order) exactly as the GPU sees its textures, and converted at the end.
 
+use super::ambiguity::{distance_bound, position_bound, row_condition, Reach, EPS32};
 use super::{Blend, CyclopeanOutput, CyclopeanParams, EyeInput, FrameDepth, MiddleCamera, StereoFrame};
 use crate::camera::mat4::{self, Mat4};
 use crate::convention::{Conventions, RowOrder};
@@ -44,7 +45,14 @@ impl Eye64<'_> {
     /// With `edge_aware = Some((z, tolerance))`, texels whose view distance differs from z by
     /// more than the tolerance get no weight (no colour bleeding across depth edges); the
     /// texel holding uv always qualifies, so the weights never all vanish.
-    fn bilinear(&self, uv: [f64; 2], edge_aware: Option<(f64, f64, FrameDepth, &Conventions)>) -> [f64; 3] {
+    /// `reach` records the edge-aware choices that f32 could take otherwise (`z` of relative error
+    /// `rel_z`).
+    fn bilinear(
+        &self,
+        uv: [f64; 2],
+        edge_aware: Option<(f64, f64, FrameDepth, &Conventions)>,
+        reach: Option<(&Reach, f64)>,
+    ) -> [f64; 3] {
         let (w, h) = self.size();
         let t = [uv[0] * w as f64 - 0.5, uv[1] * h as f64 - 0.5];
         let (x0, y0) = (t[0].floor(), t[1].floor());
@@ -62,9 +70,13 @@ impl Eye64<'_> {
             let (x, y) = ((x0 + dx).clamp(0, w - 1), (y0 + dy).clamp(0, h - 1));
             let keep = match edge_aware {
                 None => true,
-                Some((z, tol, kind, conv)) => self
-                    .view_distance(x, y, kind, conv)
-                    .is_some_and(|zt| (zt - z).abs() <= tol),
+                Some((z, tol, kind, conv)) => self.view_distance(x, y, kind, conv).is_some_and(|zt| {
+                    if let Some((reach, rel_z)) = reach {
+                        let rel_t = distance_bound(self.condition(x, y, kind, conv));
+                        reach.threshold((zt - z).abs() - tol, rel_t * zt + rel_z * z);
+                    }
+                    (zt - z).abs() <= tol
+                }),
             };
             if keep {
                 let c = self.color_at(x, y);
@@ -83,12 +95,18 @@ impl Eye64<'_> {
 
     /// View-space distance stored at texel (x, y) (memory order), None for background.
     fn view_distance(&self, x: i64, y: i64, kind: FrameDepth, conv: &Conventions) -> Option<f64> {
+        stored_view_point(self.depth_at(x, y), self.texel_ndc(x, y), kind, conv, &self.inv_proj).map(|p| -p[2])
+    }
+    fn texel_ndc(&self, x: i64, y: i64) -> [f64; 2] {
         let (w, h) = self.size();
-        let ndc = [
+        [
             (x as f64 + 0.5) / w as f64 * 2.0 - 1.0,
             (y as f64 + 0.5) / h as f64 * 2.0 - 1.0,
-        ];
-        stored_view_point(self.depth_at(x, y), ndc, kind, conv, &self.inv_proj).map(|p| -p[2])
+        ]
+    }
+    /// The condition of reconstructing texel (x, y)'s distance (see [`unprojection_condition`]).
+    fn condition(&self, x: i64, y: i64, kind: FrameDepth, conv: &Conventions) -> f64 {
+        unprojection_condition(self.depth_at(x, y), self.texel_ndc(x, y), kind, conv, &self.inv_proj)
     }
 }
 
@@ -123,6 +141,36 @@ pub(crate) fn stored_view_point(
     }
 }
 
+/// How much f32 roundings grow in the distance [`stored_view_point`] reconstructs from `d` at
+/// `ndc`: 1 for a view distance (a scaled ray); for device depth the condition of the inverse
+/// projection's w row (~ z / near under standard Z, where depth precision is spent near).
+fn unprojection_condition(d: f64, ndc: [f64; 2], kind: FrameDepth, conv: &Conventions, inv_proj: &Mat4) -> f64 {
+    match kind {
+        FrameDepth::Device => row_condition(inv_proj, 3, [ndc[0], ndc[1], ndc_z_of_window_depth(d, conv), 1.0]),
+        FrameDepth::ViewZ => 1.0,
+    }
+}
+
+/// Window position (px, `size` wide and high) where `clip` lands.
+fn window(clip: [f64; 4], size: [f64; 2]) -> [f64; 2] {
+    [
+        (clip[0] / clip[3] * 0.5 + 0.5) * size[0],
+        (clip[1] / clip[3] * 0.5 + 0.5) * size[1],
+    ]
+}
+
+/// The parallax |d px / d ln z| (px) of window position `px` of a point at distance z along
+/// world direction `dir` seen through `view_proj`: its shift from where the direction's point at
+/// infinity lands.
+fn parallax(view_proj: &Mat4, dir: [f64; 3], px: [f64; 2], size: [f64; 2]) -> f64 {
+    let c = mat4::transform(view_proj, [dir[0], dir[1], dir[2], 0.0]);
+    if c[3].partial_cmp(&0.0) != Some(std::cmp::Ordering::Greater) {
+        return size[0].max(size[1]);
+    }
+    let inf = window(c, size);
+    (px[0] - inf[0]).hypot(px[1] - inf[1])
+}
+
 /// NDC z where rays are unprojected: inside the depth range under every convention.
 pub const RAY_NDC_Z: f64 = 0.5;
 
@@ -149,15 +197,25 @@ struct Ctx<'a> {
     mid: &'a MiddleCamera,
     inv_view_m: Mat4,
     params: &'a CyclopeanParams,
+    reach: Reach,
 }
 
 impl Ctx<'_> {
-    fn walk(&self, eye: &Eye64, ray_m: [f64; 3], pixel: [f64; 2]) -> EyeSample {
-        let invalid = EyeSample {
-            valid: false,
-            color: [0.0; 3],
-            z_middle: 0.0,
-        };
+    /// The eye's sample, and the relative f32 error bound of its middle distance.
+    fn walk(&self, eye: &Eye64, ray_m: [f64; 3], pixel: [f64; 2]) -> (EyeSample, f64) {
+        let invalid = (
+            EyeSample {
+                valid: false,
+                color: [0.0; 3],
+                z_middle: 0.0,
+            },
+            0.0,
+        );
+        let reach = &self.reach;
+        let eye_size = [eye.size().0 as f64, eye.size().1 as f64];
+        let view_proj = mat4::mul(&eye.input.proj, &eye.input.view);
+        // The fixation distance, rounded to f32.
+        let mut rel_z = EPS32;
         let (w, h) = eye.size();
         let mut z = self.params.fixation_distance;
         let mut uv = [0.0; 2];
@@ -165,16 +223,22 @@ impl Ctx<'_> {
         let mut texel = (0, 0);
         for _ in 0..self.params.steps() {
             let guess = mat4::transform_point(&self.inv_view_m, [ray_m[0] * z, ray_m[1] * z, ray_m[2] * z]);
-            let clip = mat4::transform(
-                &mat4::mul(&eye.input.proj, &eye.input.view),
-                [guess[0], guess[1], guess[2], 1.0],
-            );
+            let clip = mat4::transform(&view_proj, [guess[0], guess[1], guess[2], 1.0]);
             // Behind the eye (or NaN): w <= 0 fails `w > 0`.
             if clip[3].partial_cmp(&0.0) != Some(std::cmp::Ordering::Greater) {
                 return invalid;
             }
             let ndc = [clip[0] / clip[3], clip[1] / clip[3]];
             uv = [ndc[0] * 0.5 + 0.5, ndc[1] * 0.5 + 0.5];
+            if reach.on() {
+                // The texel choice and the range check both cut at integers of uv * size.
+                let px = [uv[0] * eye_size[0], uv[1] * eye_size[1]];
+                let dir = mat4::transform(&self.inv_view_m, [ray_m[0], ray_m[1], ray_m[2], 0.0]);
+                let shift = parallax(&view_proj, [dir[0], dir[1], dir[2]], px, eye_size);
+                let bound = position_bound(eye_size[0].max(eye_size[1]), rel_z, shift);
+                reach.floor(px[0], bound);
+                reach.floor(px[1], bound);
+            }
             if !(uv[0] >= 0.0 && uv[0] <= 1.0 && uv[1] >= 0.0 && uv[1] <= 1.0) {
                 return invalid;
             }
@@ -187,6 +251,13 @@ impl Ctx<'_> {
             };
             world = mat4::transform_point(&eye.inv_view, view);
             z = -mat4::transform_point(&self.mid.view, world)[2];
+            rel_z = distance_bound(unprojection_condition(
+                d,
+                ndc,
+                self.frame.depth_kind,
+                &self.frame.conv,
+                &eye.inv_proj,
+            ));
             if !(z.is_finite() && z > 0.0) {
                 return invalid;
             }
@@ -208,10 +279,17 @@ impl Ctx<'_> {
                 &mat4::mul(&self.mid.proj, &self.mid.view),
                 [sample[0], sample[1], sample[2], 1.0],
             );
-            let px = [
-                (clip[0] / clip[3] * 0.5 + 0.5) * self.mid.width as f64,
-                (clip[1] / clip[3] * 0.5 + 0.5) * self.mid.height as f64,
-            ];
+            let mid_size = [self.mid.width as f64, self.mid.height as f64];
+            let px = window(clip, mid_size);
+            if reach.on() {
+                let rel_t = distance_bound(eye.condition(texel.0, texel.1, self.frame.depth_kind, &self.frame.conv));
+                let dir = mat4::transform(&eye.inv_view, [r[0], r[1], r[2], 0.0]);
+                let view_proj_m = mat4::mul(&self.mid.proj, &self.mid.view);
+                let shift = parallax(&view_proj_m, [dir[0], dir[1], dir[2]], px, mid_size);
+                let bound = position_bound(mid_size[0].max(mid_size[1]), rel_t, shift);
+                reach.threshold((px[0] - pixel[0]).abs() - REFINE_TOLERANCE_PX, bound);
+                reach.threshold((px[1] - pixel[1]).abs() - REFINE_TOLERANCE_PX, bound);
+            }
             if !((px[0] - pixel[0]).abs() <= REFINE_TOLERANCE_PX && (px[1] - pixel[1]).abs() <= REFINE_TOLERANCE_PX) {
                 return invalid;
             }
@@ -223,11 +301,12 @@ impl Ctx<'_> {
                 Some((z_eye, self.params.z_threshold, self.frame.depth_kind, &self.frame.conv))
             }
         };
-        EyeSample {
+        let sample = EyeSample {
             valid: true,
-            color: eye.bilinear(uv, edge_aware),
+            color: eye.bilinear(uv, edge_aware, reach.on().then_some((reach, rel_z))),
             z_middle: z,
-        }
+        };
+        (sample, rel_z)
     }
 }
 
@@ -277,6 +356,24 @@ pub fn cyclopean_reference(
     mid: &MiddleCamera,
     params: &CyclopeanParams,
 ) -> Result<CyclopeanReference> {
+    Ok(twin(frame, mid, params, false)?.0)
+}
+
+/// Per pixel of [`cyclopean_reference`]'s view (rows top-down): whether any of the twin's
+/// decisions (texel choices and range checks in either eye's walk, the refinement's projection
+/// check, the edge-aware colour's depth test, the blend's depth threshold) came within the f32
+/// error bound of its boundary (see [`super::ambiguity`]), so that the GPU may answer the pixel
+/// otherwise. Every other pixel the GPU must render as the twin does.
+pub fn ambiguity(frame: &StereoFrame, mid: &MiddleCamera, params: &CyclopeanParams) -> Result<Vec<bool>> {
+    Ok(twin(frame, mid, params, true)?.1)
+}
+
+fn twin(
+    frame: &StereoFrame,
+    mid: &MiddleCamera,
+    params: &CyclopeanParams,
+    track: bool,
+) -> Result<(CyclopeanReference, Vec<bool>)> {
     frame.validate()?;
     params.validate()?;
     let flip = frame.conv.row_order == RowOrder::BottomUp;
@@ -294,6 +391,7 @@ pub fn cyclopean_reference(
         mid,
         inv_view_m: mat4::inverse(&mid.view).ok_or_else(|| crate::Error::param("middle view", "singular"))?,
         params,
+        reach: Reach::new(track),
     };
     let inv_proj_m = mat4::inverse(&mid.proj).ok_or_else(|| crate::Error::param("middle projection", "singular"))?;
     let (w, h) = (mid.width as usize, mid.height as usize);
@@ -302,15 +400,25 @@ pub fn cyclopean_reference(
         depth: vec![0.0; w * h],
         sources: vec![0; w * h],
     };
+    let mut ambiguous = vec![false; if track { w * h } else { 0 }];
     for y_mem in 0..h {
         let y_img = if flip { h - 1 - y_mem } else { y_mem };
         for x in 0..w {
             let pixel = [x as f64 + 0.5, y_mem as f64 + 0.5];
             let uv = [pixel[0] / w as f64, pixel[1] / h as f64];
             let ray = view_ray(&inv_proj_m, [uv[0] * 2.0 - 1.0, uv[1] * 2.0 - 1.0]);
-            let l = ctx.walk(&left, ray, pixel);
-            let r = ctx.walk(&right, ray, pixel);
+            let (l, rel_l) = ctx.walk(&left, ray, pixel);
+            let (r, rel_r) = ctx.walk(&right, ray, pixel);
             let o = y_img * w + x;
+            if track {
+                if l.valid && r.valid {
+                    // Hard: near colour or mean; soft: whether t > 0 (the colour is continuous in dz).
+                    let dz = (l.z_middle - r.z_middle).abs();
+                    ctx.reach
+                        .threshold(dz - params.z_threshold, rel_l * l.z_middle + rel_r * r.z_middle);
+                }
+                ambiguous[o] = ctx.reach.take();
+            }
             match combine(&l, &r, params) {
                 Some((c, z, bits)) => {
                     out.color[o] = c;
@@ -319,13 +427,13 @@ pub fn cyclopean_reference(
                 }
                 None => {
                     // The seed's fallback colour: both eyes at the same uv, averaged.
-                    let (a, b) = (left.bilinear(uv, None), right.bilinear(uv, None));
+                    let (a, b) = (left.bilinear(uv, None, None), right.bilinear(uv, None, None));
                     out.color[o] = [0, 1, 2].map(|c| 0.5 * (a[c] + b[c]));
                 }
             }
         }
     }
-    Ok(out)
+    Ok((out, ambiguous))
 }
 
 impl CyclopeanReference {

@@ -146,6 +146,14 @@ pub const MIDDLEBURY_BASELINE_M: f64 = 0.1;
 
 /// Report name of the splat-gather method (the default on real stereo).
 pub const SPLAT_NAME: &str = "splat-gather (splat, sub-pixel gather, two-eye merge)";
+/// Report scene name of Cones im2 + im6 -> im4 (ground-truth and estimated rows, the flow peer's).
+pub const CONES_SCENE: &str = "Middlebury Cones (im2+im6 -> im4)";
+
+/// Report scene name of Tsukuba view `a` + view `b` -> view 3.
+pub fn tsukuba_scene(a: u32, b: u32) -> String {
+    format!("Tsukuba (tsukuba{a}+tsukuba{b} -> tsukuba3)")
+}
+
 /// Report name of the default method with `--fill` (scored over every pixel it fills too).
 pub const FILL_NAME: &str = "splat-gather + fill (holes from the background side)";
 
@@ -291,12 +299,7 @@ pub fn cyclopean_real_rows(gpu: &Gpu, data_dir: &Path, repeats: usize) -> Result
     let truth = io::load_rgb(&cones.join("im4.png"))?;
     let rig = DisparityRig::middle(MIDDLEBURY_FOCAL_PX, MIDDLEBURY_BASELINE_M);
     let runs = real_runs(gpu, &l, &r, &rig, 1.5, repeats)?;
-    rows.extend(real_rows(
-        "Middlebury Cones (im2+im6 -> im4)",
-        "GT disparity, t = 0.5",
-        &runs,
-        &truth,
-    ));
+    rows.extend(real_rows(CONES_SCENE, "GT disparity, t = 0.5", &runs, &truth));
     let teddy = data_dir.join("middlebury2003_teddy");
     let (l, mut r) = middlebury(&teddy)?;
     let truth = r.0.clone();
@@ -408,7 +411,7 @@ pub fn estimated_cases(data_dir: &Path) -> Result<(Vec<EstimatedCase>, Vec<Strin
     };
     if let Some(dir) = present("middlebury2003_cones") {
         cases.push(EstimatedCase {
-            scene: "Middlebury Cones (im2+im6 -> im4)".into(),
+            scene: CONES_SCENE.into(),
             setting: "estimated disparity, t = 0.5".into(),
             left: io::load_rgb(&dir.join("im2.png"))?,
             right: io::load_rgb(&dir.join("im6.png"))?,
@@ -422,7 +425,7 @@ pub fn estimated_cases(data_dir: &Path) -> Result<(Vec<EstimatedCase>, Vec<Strin
     if let Some(dir) = present("tsukuba_5view_no_gt") {
         for (a, b) in [(2, 4), (1, 5)] {
             cases.push(EstimatedCase {
-                scene: format!("Tsukuba (tsukuba{a}+tsukuba{b} -> tsukuba3)"),
+                scene: tsukuba_scene(a, b),
                 setting: "estimated disparity, t = 0.5".into(),
                 left: io::load_rgb(&dir.join(format!("tsukuba{a}.png")))?,
                 right: io::load_rgb(&dir.join(format!("tsukuba{b}.png")))?,

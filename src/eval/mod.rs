@@ -10,6 +10,7 @@
 
 pub mod backends;
 pub mod cyclopean;
+pub mod flow_peer;
 pub mod image_check;
 pub mod refocus;
 pub mod reproject;
@@ -87,20 +88,22 @@ pub fn run_report_with_cases(
     cases: &[PathBuf],
     repeats: usize,
 ) -> Result<WrittenReport> {
-    run_report_with_progress(gpu, out_dir, data_dir, cases, repeats, &crate::progress::Silent)
+    run_report_with_progress(gpu, out_dir, data_dir, cases, None, repeats, &crate::progress::Silent)
 }
 
-/// [`run_report_with_cases`] with each stage reported to `progress` as it starts.
+/// [`run_report_with_cases`] with each stage reported to `progress` as it starts, and the
+/// optical-flow peer's middle views read from `flow_peer` (see [`flow_peer`]; needs `data_dir`).
 pub fn run_report_with_progress(
     gpu: &Gpu,
     out_dir: &Path,
     data_dir: Option<&Path>,
     cases: &[PathBuf],
+    flow_peer: Option<&Path>,
     repeats: usize,
     progress: &dyn crate::progress::Progress,
 ) -> Result<WrittenReport> {
     let stages = crate::progress::Stages::new(progress, report_stage_count(data_dir, cases));
-    report_stages(gpu, out_dir, data_dir, cases, repeats, &stages)
+    report_stages(gpu, out_dir, data_dir, cases, flow_peer, repeats, &stages)
 }
 
 /// How many stages [`report_stages`] reports: five on the built-in scenes (the last, GL against
@@ -116,15 +119,23 @@ fn has_cyclopean_data(dir: &Path) -> bool {
         .all(|s| dir.join(s).is_dir())
 }
 
-/// The report, its stages counted in `stages` (see [`report_stage_count`]).
+/// The report, its stages counted in `stages` (see [`report_stage_count`]); with `flow_peer`
+/// (and `data_dir`), the peer's row beside viewsynth's for every real pair with a true middle view.
 pub fn report_stages(
     gpu: &Gpu,
     out_dir: &Path,
     data_dir: Option<&Path>,
     cases: &[PathBuf],
+    flow_peer: Option<&Path>,
     repeats: usize,
     stages: &crate::progress::Stages,
 ) -> Result<WrittenReport> {
+    if let Some(peer) = flow_peer {
+        let data_dir =
+            data_dir.ok_or_else(|| crate::Error::param("--flow-peer", "needs --data-dir (the pairs' truth)"))?;
+        // Before any row is measured: a missing image fails the run at once.
+        flow_peer::check_flow_peer(data_dir, peer)?;
+    }
     std::fs::create_dir_all(out_dir).map_err(|e| crate::Error::io(out_dir, e))?;
     stages.start("report: refocus rows");
     let mut rows = refocus::refocus_rows(gpu, repeats)?;
@@ -157,6 +168,15 @@ pub fn report_stages(
                 dir.display()
             ));
         }
+    }
+    if let (Some(dir), Some(peer)) = (data_dir, flow_peer) {
+        flow_peer::place_beside(&mut rows, flow_peer::flow_peer_rows(dir, peer)?);
+        notes.push(format!(
+            "{}: middle views written by python/peers/flow_interpolation.py (DIS optical flow both ways, a backward warp of each image by half its flow, the mean of the two) read from {}, scored over all pixels against the true middle view; not timed (it ran outside viewsynth). Compare with \"{}\" on estimated disparities, which also covers every pixel.",
+            flow_peer::FLOW_PEER_NAME,
+            peer.display(),
+            cyclopean::FILL_NAME
+        ));
     }
     for case in cases {
         stages.start(&format!("report: case {}", case.display()));

@@ -15,6 +15,9 @@ pub struct ReportJob {
     pub data_dir: Option<PathBuf>,
     /// User cyclopean cases laid out as `viewsynth scene` writes them.
     pub cases: Vec<PathBuf>,
+    /// Folder with the optical-flow peer's middle views, one per real pair
+    /// ([`crate::eval::flow_peer`]); needs `data_dir`.
+    pub flow_peer: Option<PathBuf>,
     /// Timed repetitions per row.
     pub repeats: usize,
     /// The GPU to render on.
@@ -48,12 +51,17 @@ impl ReportJob {
                 host.event(Event::EmptyDataDir(d));
             }
         }
+        if let (Some(data), Some(peer)) = (&self.data_dir, &self.flow_peer) {
+            // A missing peer image fails the run before the GPU opens or a row is measured.
+            crate::eval::flow_peer::check_flow_peer(data, peer)?;
+        }
         let gpu = host.open_gpu(&self.gpu)?;
         let files = crate::eval::run_report_with_progress(
             &gpu,
             &self.out_dir,
             self.data_dir.as_deref(),
             &self.cases,
+            self.flow_peer.as_deref(),
             self.repeats,
             &HostStages(host),
         );

@@ -38,7 +38,8 @@ pub struct ReportRow {
     pub coverage: Option<f64>,
     /// Only where GPU timers are meaningful.
     pub gpu_ms: Option<f64>,
-    /// Wall-clock time per run, milliseconds.
+    /// Wall-clock time per run, milliseconds; NaN where not timed (a peer that ran outside
+    /// viewsynth): "-" in the table and the summary, not plotted.
     pub wall_ms: f64,
 }
 

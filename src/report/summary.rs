@@ -23,7 +23,10 @@ pub(super) fn summary(report: &Report) -> String {
         if let Some(p) = r.psnr_db.filter(|p| !p.is_nan() && *p != f64::NEG_INFINITY) {
             groups[i].1.push(p);
         }
-        groups[i].2.push(r.wall_ms);
+        // NaN: not timed (a peer that ran outside viewsynth).
+        if !r.wall_ms.is_nan() {
+            groups[i].2.push(r.wall_ms);
+        }
     }
     let cap_w = groups.iter().map(|g| g.0 .0.chars().count()).max().unwrap_or(0).max(10);
     let method_w = groups.iter().map(|g| g.0 .1.chars().count()).max().unwrap_or(0).max(6);
@@ -34,6 +37,11 @@ pub(super) fn summary(report: &Report) -> String {
         "capability", "method", "rows", "median PSNR", "median wall"
     );
     for ((capability, method), psnr, wall) in &groups {
+        let rows = report
+            .rows
+            .iter()
+            .filter(|r| (r.capability.as_str(), r.method.as_str()) == (*capability, *method))
+            .count();
         let psnr = if psnr.is_empty() {
             "-".to_string()
         } else {
@@ -44,9 +52,13 @@ pub(super) fn summary(report: &Report) -> String {
             "{:cap_w$}  {:method_w$}  {:>4}  {:>11}  {:>11}",
             md_inline(capability),
             md_inline(method),
-            wall.len(),
+            rows,
             psnr,
-            format!("{} ms", sig(median(wall), 3))
+            if wall.is_empty() {
+                "-".to_string()
+            } else {
+                format!("{} ms", sig(median(wall), 3))
+            }
         );
     }
     s

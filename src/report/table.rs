@@ -32,7 +32,8 @@ pub(super) fn markdown(report: &Report) -> String {
                 }
             }),
             opt(r.gpu_ms, |v| sig(v, 3)),
-            sig(r.wall_ms, 3),
+            // NaN: not timed (a peer that ran outside viewsynth).
+            opt(Some(r.wall_ms).filter(|w| !w.is_nan()), |v| sig(v, 3)),
         ];
         let _ = writeln!(s, "| {} |", cells.join(" | "));
     }

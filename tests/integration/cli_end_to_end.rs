@@ -239,15 +239,31 @@ fn report_with_a_case_measures_it_beside_the_built_in_rows() {
         .unwrap();
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
     let out = d.join("report");
+    // The optical-flow peer (issue 38 item 4) rides along at no cost: a data folder holding only
+    // Tsukuba's true middle view (no Middlebury, so no real rows are measured) and the peer's
+    // images of its two pairs, written here with known errors.
+    let (data, peer) = (d.join("data"), d.join("flow_peer"));
+    let (truth_2_4, truth_1_5) = fake_flow_peer(&data, &peer);
     let o = bin()
         .args(["report", "--repeats", "1", "--case"])
         .arg(&case)
         .arg("--out-dir")
         .arg(&out)
+        .arg("--data-dir")
+        .arg(&data)
+        .arg("--flow-peer")
+        .arg(&peer)
         .output()
         .unwrap();
     let err = String::from_utf8_lossy(&o.stderr);
     assert!(o.status.success(), "{err}");
+    let stdout = String::from_utf8_lossy(&o.stdout);
+    assert!(
+        stdout
+            .lines()
+            .any(|l| l.contains("cyclopean") && l.contains("DIS flow interpolation")),
+        "the summary lacks the peer: {stdout}"
+    );
     assert_eq!(
         files_in(&out),
         ["gl_vs_vulkan.md", "report.csv", "report.md", "report.svg"]
@@ -279,4 +295,73 @@ fn report_with_a_case_measures_it_beside_the_built_in_rows() {
         assert!(r.1.ends_with("case"), "{r:?}");
         assert!(r.4.unwrap() > 24.0, "{r:?}");
     }
+    // The peer's rows, one per Tsukuba pair, scored over all pixels: the exact middle view gives
+    // inf, the one 5 levels too bright everywhere 10 log10(255^2 / 25) = 34.151 dB.
+    let peer_rows: Vec<_> = rows.iter().filter(|r| r.2 == "DIS flow interpolation").collect();
+    assert_eq!(peer_rows.len(), 2, "{peer_rows:?}");
+    for (r, scene, psnr) in [
+        (peer_rows[0], "Tsukuba (tsukuba2+tsukuba4 -> tsukuba3)", truth_2_4),
+        (peer_rows[1], "Tsukuba (tsukuba1+tsukuba5 -> tsukuba3)", truth_1_5),
+    ] {
+        assert_eq!((r.0.as_str(), r.1.as_str()), ("cyclopean", scene), "{r:?}");
+        assert!(r.3.ends_with("all pixels"), "{r:?}");
+        assert_eq!(r.5, Some(1.0), "{r:?}");
+        let got = r.4.unwrap();
+        assert!(got == psnr || (got - psnr).abs() < 1e-9, "{r:?}: expected {psnr} dB");
+    }
+    let md = std::fs::read_to_string(out.join("report.md")).unwrap();
+    let line = md
+        .lines()
+        .find(|l| l.contains("| DIS flow interpolation |") && l.contains("tsukuba1+tsukuba5"))
+        .unwrap_or_else(|| panic!("report.md lacks the peer's row: {md}"));
+    // Not timed (the peer ran outside viewsynth): "-", not a made-up time.
+    assert!(line.contains("| 34.15 |"), "{line}");
+    assert!(line.trim_end().ends_with("| 100.0% | - | - |"), "{line}");
+}
+
+/// A data folder with Tsukuba's true middle view alone (40 x 30, values 20..230) and the
+/// flow peer's images of both Tsukuba pairs: 2+4 the truth itself, 1+5 the truth 5 levels
+/// brighter everywhere. Returns the PSNRs they must score (inf, 10 log10(255^2 / 25)).
+fn fake_flow_peer(data: &Path, peer: &Path) -> (f64, f64) {
+    let set = data.join("tsukuba_5view_no_gt");
+    std::fs::create_dir_all(&set).unwrap();
+    std::fs::create_dir_all(peer).unwrap();
+    let (w, h) = (40u32, 30u32);
+    let truth: Vec<u8> = (0..w * h * 3).map(|i| (20 + (i * 37) % 211) as u8).collect();
+    let brighter: Vec<u8> = truth.iter().map(|v| v + 5).collect();
+    let image = |data: Vec<u8>| io::RgbImage::new(w, h, data).unwrap();
+    io::save_rgb(&set.join("tsukuba3.png"), &image(truth.clone())).unwrap();
+    io::save_rgb(&peer.join("tsukuba_2_4_3.png"), &image(truth)).unwrap();
+    io::save_rgb(&peer.join("tsukuba_1_5_3.png"), &image(brighter)).unwrap();
+    (f64::INFINITY, 10.0 * (255.0f64 * 255.0 / 25.0).log10())
+}
+
+#[test]
+fn report_flow_peer_refuses_a_missing_image_by_name_before_measuring() {
+    let d = scratch("e2e-report-peer-missing");
+    let (data, peer) = (d.join("data"), d.join("flow_peer"));
+    fake_flow_peer(&data, &peer);
+    std::fs::remove_file(peer.join("tsukuba_1_5_3.png")).unwrap();
+    let out = d.join("report");
+    let o = bin()
+        .args(["report", "--repeats", "1", "--out-dir"])
+        .arg(&out)
+        .arg("--data-dir")
+        .arg(&data)
+        .arg("--flow-peer")
+        .arg(&peer)
+        .output()
+        .unwrap();
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(1), "{err}");
+    assert!(
+        err.contains(&peer.join("tsukuba_1_5_3.png").display().to_string()),
+        "{err}"
+    );
+    assert!(err.contains("flow_interpolation.py"), "{err}");
+    // Refused before any row is measured or the output folder made.
+    assert!(!out.exists(), "{err}");
+    // Without --data-dir the peer has no truth to be scored against: a usage error.
+    let o = bin().args(["report", "--flow-peer"]).arg(&peer).output().unwrap();
+    assert_eq!(o.status.code(), Some(2), "{}", String::from_utf8_lossy(&o.stderr));
 }

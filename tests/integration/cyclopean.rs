@@ -1,15 +1,20 @@
 //! cyclopean on the built-in scene: GPU against its f64 twin under every convention and depth
 //! kind, convention independence, and quality against the ray-traced middle view.
 //!
-//! Tolerances: the pass is f32 on the GPU; eye depth is read at the texel holding a projected
-//! point, so a point within f32 rounding (~1e-6 texel) of a texel border may pick the other
-//! texel: allowed on at most 0.1 % of pixels (none happened on these frames when written).
-//! Middle depth then agrees to the f32 error of reconstructing from device depth: with
-//! standard Z at 6 m and near 0.05 m that is ~5e-6 relative, so 2e-5 is the bound.
+//! Tolerances: the pass is f32 on the GPU, the twin f64. A pixel may differ only where one of the
+//! twin's decisions (an eye texel chosen by floor, a range check, the refinement's projection
+//! check, the edge-aware colour's and the blend's depth thresholds) lies within the f32 error
+//! bound of its boundary: [`ambiguity`] marks those pixels from the twin's own geometry (bounds
+//! derived in src/cyclopean/ambiguity.rs), and only they are excused. Every other pixel must
+//! carry the twin's source bits, its colour within one level (the same weighted sum of the same
+//! texels; one level where f32 and f64 round a value near a half level apart) and its middle
+//! depth within the f32 error of reconstructing from device depth: with standard Z at 6 m and
+//! near 0.05 m that is ~5e-6 relative, so 2e-5 is the bound. So one pixel 40 levels off fails.
+//! The excused share is bounded (see [`MAX_AMBIGUOUS`]) so that the comparison keeps its power.
 
 use crate::common::{cyclopean_cli, gpu, write_cyclopean_files};
 use viewsynth::convention::Conventions;
-use viewsynth::cyclopean::reference::cyclopean_reference;
+use viewsynth::cyclopean::reference::{ambiguity, cyclopean_reference};
 use viewsynth::cyclopean::render::CyclopeanRenderer;
 use viewsynth::cyclopean::scene_frame::{scene_frame, MiddleTruth, StereoRig};
 use viewsynth::cyclopean::{
@@ -44,30 +49,33 @@ pub(crate) fn methods() -> Vec<(&'static str, CyclopeanParams)> {
     ]
 }
 
-/// (pixels whose source bits differ, pixels whose colour is off by > 1 level, max relative
-/// depth error): a GPU view against its f64 twin's view (unrounded values).
-fn disagreement(out: &ViewOutput, r: &ViewOutput) -> (usize, usize, f64) {
-    let (mut src, mut col, mut z) = (0, 0, 0f64);
+/// Largest share of the frame the twin may mark ambiguous. Measured when written: at most
+/// 1.49 % over the 48 cases (the marks are the twin's, the same for GL and Vulkan; they follow
+/// texel borders that the walk's rays cross on the scene's fronto-parallel walls). 3 % leaves
+/// headroom for other frames while a pass wrong on any region larger than that still fails.
+const MAX_AMBIGUOUS: f64 = 0.03;
+
+/// The pixels (indices) where a GPU view is off its f64 twin's view (unrounded values) beyond
+/// the bounds above, among those the twin does not mark `ambiguous`: other source bits, colour
+/// more than one level off, depth more than 2e-5 relative off (or not finite).
+fn off_the_twin(out: &ViewOutput, r: &ViewOutput, ambiguous: &[bool]) -> Vec<usize> {
     let exact = r.exact.as_ref().expect("an f64 twin's view");
     let (sources, ref_sources) = (&out.mask.as_ref().unwrap().data, &r.mask.as_ref().unwrap().data);
     let (color, depth) = (&out.color.as_ref().unwrap().data, &out.depth.as_ref().unwrap().data);
     let ref_depth = exact.depth.as_ref().unwrap();
-    for i in 0..ref_depth.len() {
-        if sources[i] != ref_sources[i] {
-            src += 1;
-            continue;
-        }
-        let e = (0..3)
-            .map(|c| metrics::quantization_error(color[i * 3 + c], exact.color[i][c]))
-            .max()
-            .unwrap();
-        col += (e > 1) as usize;
-        if ref_sources[i] != 0 {
-            z = z.max((depth[i] as f64 - ref_depth[i]).abs() / ref_depth[i]);
-        }
-        assert!(depth[i].is_finite(), "pixel {i}: non-finite depth");
-    }
-    (src, col, z)
+    (0..ref_depth.len())
+        .filter(|&i| {
+            if ambiguous[i] {
+                return false;
+            }
+            let e = (0..3)
+                .map(|c| metrics::quantization_error(color[i * 3 + c], exact.color[i][c]))
+                .max()
+                .unwrap();
+            let z_off = ref_sources[i] != 0 && (depth[i] as f64 - ref_depth[i]).abs() > 2e-5 * ref_depth[i];
+            sources[i] != ref_sources[i] || e > 1 || z_off || !depth[i].is_finite()
+        })
+        .collect()
 }
 
 /// Through the pass/twin contract: [`pass::gpu`] against [`pass::reference`].
@@ -88,6 +96,7 @@ fn vulkan_gather_matches_the_f64_reference_under_every_convention_and_depth_kind
 fn gather_matches_the_twin(g: &viewsynth::pass::Device) {
     let mut rig = StereoRig::demo(160, 120);
     rig.ipd = 0.2;
+    let mut worst = 0f64;
     for conv in Conventions::all() {
         for kind in [FrameDepth::Device, FrameDepth::ViewZ] {
             let (frame, mid, _) = scene_frame(&rig, conv, kind);
@@ -99,20 +108,28 @@ fn gather_matches_the_twin(g: &viewsynth::pass::Device) {
                     outputs: CyclopeanOutputs::default(),
                 };
                 let reference = pass::reference(&input).unwrap();
+                let ambiguous = ambiguity(&frame, &mid, &params).unwrap();
                 let out = pass::gpu(g, &input).unwrap();
-                let (src, col, z) = disagreement(&out, &reference);
-                let n = (mid.width * mid.height) as usize;
+                let bad = off_the_twin(&out, &reference, &ambiguous);
+                let share = ambiguous.iter().filter(|a| **a).count() as f64 / ambiguous.len() as f64;
+                worst = worst.max(share);
                 let tag = format!("{} {kind:?} {name}", conv.label());
                 image_check::ensure_views(
-                    src * 1000 <= n && col * 1000 <= n && z <= 2e-5,
+                    bad.is_empty() && share <= MAX_AMBIGUOUS,
                     &format!("cyclopean {tag}"),
                     &out,
                     &reference,
-                    format!("{tag}: sources {src}, colour {col}, depth {z:e}"),
+                    format!(
+                        "{tag}: {} pixels off the twin beyond the bounds (first {:?}), {:.2} % ambiguous",
+                        bad.len(),
+                        bad.first().map(|i| (i % mid.width as usize, i / mid.width as usize)),
+                        share * 100.0
+                    ),
                 );
             }
         }
     }
+    println!("gather: largest ambiguous share {:.3} %", worst * 100.0);
 }
 
 #[test]

@@ -230,3 +230,34 @@ fn a_complete_frame_from_two_images_beats_flow_interpolation() {
         "mean lead {mean:+.2} dB over the flow interpolation (bar +1)"
     );
 }
+
+/// `viewsynth bench`'s cyclopean table (run at 1280 x 720 there) has the densify rows beside
+/// the seed method's and the fill's, at the size it ran, in the JSON's cases. A small size here:
+/// the rows' presence is under test, not their times (never asserted).
+#[test]
+fn the_cyclopean_bench_has_densify_and_fill_rows_beside_the_seed_method() {
+    let g = gpu();
+    let mut cases = Vec::new();
+    let table = viewsynth::bench::cyclopean_bench(&g, 256, 128, 1, &mut cases).unwrap();
+    let json = serde_json::to_value(&cases).unwrap();
+    let rows = json.as_array().unwrap();
+    let named = |start: &str| -> Vec<&serde_json::Value> {
+        rows.iter()
+            .filter(|c| c["case"].as_str().unwrap().starts_with(start))
+            .collect()
+    };
+    for (start, n) in [("seed", 1), ("densify, GPU pass", 2), ("--fill alone", 1)] {
+        let found = named(start);
+        assert_eq!(found.len(), n, "{start}: {json}");
+        for c in found {
+            assert_eq!(c["capability"], "cyclopean", "{c}");
+            assert_eq!(c["size"], "256x128", "{c}");
+            assert!(c["median_ms"].as_f64().unwrap() > 0.0, "{c}");
+            assert!(table.contains(c["case"].as_str().unwrap()), "{table}");
+        }
+    }
+    assert!(
+        table.contains(&g.info().renderer),
+        "the table names its renderer: {table}"
+    );
+}

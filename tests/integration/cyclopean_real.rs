@@ -1,20 +1,16 @@
 //! The splat-gather middle view on real stereo (Middlebury 2003 Cones), on thin structures, and
 //! against its f64 twin; the rectified-stereo CLI.
 //!
-//! GPU vs twin tolerance, from the numerics: the GPU computes positions in f32 (relative error
-//! ~1e-7, ~1e-4 px at these sizes after the matrix chain), the twin in f64. A pixel's answer can
-//! only differ where a decision sits within that of its threshold: a splat within 1e-4 px of a
-//! pixel border, a middle ray within 1e-4 px of the half-texel that decides the nearest eye texel,
-//! or two disparities within 1e-5 px of the same-surface tolerance (1.1 px, off every dyadic
-//! quantisation step, so never exactly). On generic geometry (the built-in scene) that is a
-//! handful of pixels (none when written): at most 0.1 % may differ. Where the bits agree the
-//! colour is the same weighted sum of the same texels, so it may differ by one quantisation
-//! level (rounding of a value within 1e-4 of a half level), and the middle depth by the f32
-//! error of the chain (~1e-6 relative; bound 2e-5, as for the gather method). Cones has
-//! quarter-pixel disparities: half a disparity puts a splat or a ray exactly on a pixel or
-//! texel border for many pixels at once, where f32 and f64 may round to different sides and
-//! so pick the other surface at an object edge: the bound there is 1.5 % of the pixels
-//! (1.2 % measured when written, all along object edges).
+//! GPU vs twin tolerance, from the numerics: the GPU computes positions in f32, the twin in f64.
+//! A pixel's answer can only differ where a decision sits within f32 reach of its threshold: a
+//! splat near a pixel border that may change a neighbourhood's nearest distance, a middle ray
+//! near the half-texel that decides the nearest eye texel, or two disparities near the
+//! same-surface tolerance. `splat_reference::ambiguity` marks those pixels from the twin's own
+//! geometry (bounds derived in src/cyclopean/ambiguity.rs); only they are excused. Every other
+//! pixel must carry the twin's source bits, its colour within one level (the same weighted sum of
+//! the same texels; rounding of a value near a half level) and its middle depth within 2e-5
+//! relative (the f32 error of the chain, ~1e-6; as for the gather method). So one pixel 40 levels
+//! off fails. The marked share is bounded per case (see `splat_gather_twin`).
 
 use crate::common::{data_dir, gpu};
 use std::path::{Path, PathBuf};
@@ -27,7 +23,7 @@ use viewsynth::cyclopean::reference::CyclopeanReference;
 use viewsynth::cyclopean::render::CyclopeanRenderer;
 use viewsynth::cyclopean::scene_frame::{scene_frame, StereoRig};
 use viewsynth::cyclopean::splat::{SplatParams, SplatRenderer};
-use viewsynth::cyclopean::splat_reference::splat_reference;
+use viewsynth::cyclopean::splat_reference::{self, splat_reference};
 use viewsynth::cyclopean::{CyclopeanOutput, CyclopeanOutputs, CyclopeanParams, FrameDepth, Method, StereoFrame};
 use viewsynth::eval::cyclopean::{estimated_cases, estimated_eyes};
 use viewsynth::io::{self, DepthDecode, DepthMap, RgbImage};
@@ -68,15 +64,16 @@ fn out_dir(name: &str) -> PathBuf {
     dir
 }
 
-/// Pixels whose source bits differ; pixels (same bits) whose colour differs by more than one
-/// level; pixels (same bits) whose depth differs by more than 2e-5 relative.
-fn compare(out: &CyclopeanOutput, r: &CyclopeanReference) -> (usize, usize, usize) {
-    let (mut src, mut col, mut z) = (0, 0, 0);
+/// Among the pixels the twin does not mark `ambiguous`: those whose source bits differ; those
+/// (same bits) whose colour differs by more than one level; those (same bits) whose depth
+/// differs by more than 2e-5 relative.
+fn compare(out: &CyclopeanOutput, r: &CyclopeanReference, ambiguous: &[bool]) -> (Vec<usize>, usize, usize) {
+    let (mut src, mut col, mut z) = (Vec::new(), 0, 0);
     let color = out.color().unwrap();
     let depth = out.depth().unwrap();
-    for i in 0..r.depth.len() {
+    for i in (0..r.depth.len()).filter(|&i| !ambiguous[i]) {
         if out.sources[i] != r.sources[i] {
-            src += 1;
+            src.push(i);
             continue;
         }
         let e = (0..3)
@@ -108,21 +105,34 @@ fn dump(tag: &str, out: &CyclopeanOutput, r: &CyclopeanReference, w: u32, h: u32
     dir.display().to_string()
 }
 
-/// At most `max_fraction` of the pixels may differ (in source bits, colour beyond one level or
-/// depth beyond 2e-5 relative).
+/// No pixel outside those the twin marks ambiguous may differ (in source bits, colour beyond one
+/// level or depth beyond 2e-5 relative), and at most `max_ambiguous` of the pixels are marked.
 fn check_twin(
     device: &viewsynth::pass::Device,
     tag: &str,
     frame: &StereoFrame,
     mid: &viewsynth::cyclopean::MiddleCamera,
-    max_fraction: f64,
+    max_ambiguous: f64,
 ) {
     let out = splat_on(device, frame, mid);
     let r = splat_reference(frame, mid, &SplatParams::default()).unwrap();
-    let (src, col, z) = compare(&out, &r);
+    let ambiguous = splat_reference::ambiguity(frame, mid, &SplatParams::default()).unwrap();
+    let (src, col, z) = compare(&out, &r, &ambiguous);
     let n = r.depth.len();
-    let msg = format!("{tag}: of {n} pixels, {src} differ in source bits, {col} in colour, {z} in depth");
-    if (src + col + z) as f64 > max_fraction * n as f64 {
+    let marked = ambiguous.iter().filter(|a| **a).count();
+    let w = mid.width as usize;
+    // How many of the marked pixels this device answers otherwise (told, not asserted: another
+    // driver may round the other way).
+    let unmarked: Vec<bool> = ambiguous.iter().map(|a| !a).collect();
+    let (m_src, m_col, m_z) = compare(&out, &r, &unmarked);
+    let msg = format!(
+        "{tag}: of {n} pixels, {marked} ({:.2} %) ambiguous (of them, on this device, {} differ in source bits, {m_col} in colour, {m_z} in depth); of the others {} differ in source bits (first {:?}), {col} in colour, {z} in depth",
+        marked as f64 * 100.0 / n as f64,
+        m_src.len(),
+        src.len(),
+        src.first().map(|i| (i % w, i / w))
+    );
+    if !src.is_empty() || col + z > 0 || marked as f64 > max_ambiguous * n as f64 {
         let dir = dump(tag, &out, &r, mid.width, mid.height);
         panic!("{msg}; images in {dir}");
     }
@@ -141,6 +151,20 @@ fn vulkan_splat_gather_matches_its_f64_twin() {
     splat_gather_twin(&viewsynth::vulkan::VkExecutor::device(&crate::vulkan_refocus::vulkan()).unwrap());
 }
 
+/// The share of Cones the twin may mark ambiguous. Its disparities are quarter pixels (d = k/4)
+/// and the middle view sits halfway, so each eye's texels move by k/8 px: for k = 4 mod 8 (one
+/// disparity value in eight) a texel centre lands exactly on a pixel border, and a middle ray's
+/// nearest eye texel exactly on a texel border, for whole surfaces at once; f32 may land either
+/// side there. One eye in eight, either of two eyes: 1 - (7/8)^2 = 23 % of the pixels, against
+/// 22.22 % marked (measured when written; 23.97 % before nearest-texel choices were tested for
+/// their effect, see `splat_reference::ambiguity`). The marks are not too broad: on llvmpipe and
+/// lavapipe alike 1499 of the marked pixels take other source bits, 132 another colour and 500
+/// another depth (each printed by the test), none outside them; which of them go which way is
+/// the driver's rounding, so only their share is bounded: 30 %. Every other pixel must match.
+/// On the built-in scene (generic geometry) 0.01 % (one pixel) was marked when written (none
+/// now); the bound there is 0.5 %.
+const CONES_MAX_AMBIGUOUS: f64 = 0.30;
+
 fn splat_gather_twin(device: &viewsynth::pass::Device) {
     eprintln!("splat-gather twin check on {:?}", device.api());
     let mut rig = StereoRig::demo(160, 120);
@@ -148,12 +172,12 @@ fn splat_gather_twin(device: &viewsynth::pass::Device) {
     for conv in Conventions::all() {
         for kind in [FrameDepth::Device, FrameDepth::ViewZ] {
             let (frame, mid, _) = scene_frame(&rig, conv, kind);
-            check_twin(device, &format!("scene-{}-{kind:?}", conv.label()), &frame, &mid, 0.001);
+            check_twin(device, &format!("scene-{}-{kind:?}", conv.label()), &frame, &mid, 0.005);
         }
     }
     let (l, r, _) = cones();
     let (frame, mid) = disparity_frame(l, r, &DisparityRig::middle(400.0, 0.1), Conventions::default()).unwrap();
-    check_twin(device, "cones", &frame, &mid, 0.015);
+    check_twin(device, "cones", &frame, &mid, CONES_MAX_AMBIGUOUS);
 }
 
 type Eye = (RgbImage, DepthMap);

@@ -24,6 +24,12 @@ pub(crate) struct ReportArgs {
     /// Repeatable.
     #[arg(help_heading = INPUTS, long = "case")]
     cases: Vec<PathBuf>,
+    /// Folder with the DIS optical-flow peer's middle views, one PNG per real pair with a true
+    /// middle view (cones_2_6_4.png, tsukuba_2_4_3.png, tsukuba_1_5_3.png), written by
+    /// python/peers/flow_interpolation.py: scored over all pixels in a "DIS flow interpolation"
+    /// row beside viewsynth's (docs/report.md). A missing file is an error.
+    #[arg(help_heading = INPUTS, long, value_name = "DIR", requires = "data_dir")]
+    flow_peer: Option<PathBuf>,
     /// Timed repetitions per row (the median is reported).
     #[arg(help_heading = MEASURE, long, default_value_t = 3, value_parser = clap::builder::RangedU64ValueParser::<usize>::new().range(0..=1000))]
     repeats: usize,
@@ -46,6 +52,7 @@ impl TryFrom<ReportArgs> for ReportJob {
             out_dir: a.out_dir,
             data_dir: a.data_dir,
             cases: a.cases,
+            flow_peer: a.flow_peer,
             repeats: a.repeats,
             gpu: a.gpu.try_into()?,
         })
