@@ -19,6 +19,13 @@ pub const FLOW_PEER_NAME: &str = "DIS flow interpolation";
 pub const FLOW_PEER_SETTING: &str =
     "two images alone (python/peers/flow_interpolation.py, OpenCV DIS preset MEDIUM); all pixels";
 
+/// Report name of viewsynth's complete frame from the two images, beside the peer's.
+pub const FILL_TWO_IMAGES_NAME: &str = "viewsynth cyclopean --fill";
+
+/// Report setting of those rows.
+pub const FILL_TWO_IMAGES_SETTING: &str =
+    "two images alone (range estimated, census matcher, densify, render, 2-D fill; the CLI's defaults); all pixels";
+
 /// A real pair with a true middle view, as the report names it.
 #[derive(Debug, Clone, PartialEq)]
 pub struct FlowPeerPair {
@@ -97,6 +104,68 @@ fn missing(path: &Path, pair: &FlowPeerPair) -> Error {
             path.display()
         ),
     )
+}
+
+/// What the CLI's cyclopean job tells its user: nothing here (the report runs it on its own
+/// device, which `open_gpu` is never asked for).
+struct Quiet;
+
+impl crate::job::Host for Quiet {
+    fn open_gpu(&self, _: &crate::job::GpuRequest) -> Result<crate::gpu::Gpu> {
+        Err(Error::Gl(
+            "the report's cyclopean --fill row runs on the report's device".into(),
+        ))
+    }
+    fn event(&self, _: crate::job::Event<'_>) {}
+}
+
+/// One row per pair of [`flow_peer_pairs`]: `viewsynth cyclopean --left-rgb L --right-rgb R
+/// --fill` as the CLI runs it (the same job, on `gpu`), scored over all pixels against the true
+/// middle view: what the peer's row stands beside. Timed once, reading the images included.
+pub fn fill_two_images_rows(gpu: &crate::gpu::Gpu, data_dir: &Path) -> Result<Vec<ReportRow>> {
+    use crate::job::cyclopean::{CyclopeanJob, CyclopeanOptions, CyclopeanRequest};
+    let device = crate::pass::Device::gl(gpu)?;
+    let mut rows = Vec::new();
+    for pair in flow_peer_pairs(data_dir) {
+        let job = CyclopeanJob::new(CyclopeanOptions {
+            left_rgb: pair.left.clone(),
+            right_rgb: pair.right.clone(),
+            request: CyclopeanRequest {
+                fill: true,
+                ..Default::default()
+            },
+            // Never written: the job renders only.
+            out_dir: std::env::temp_dir().join("viewsynth-report-fill"),
+            ..Default::default()
+        })
+        .map_err(|e| Error::param("report", format!("{}: {e}", pair.scene)))?;
+        let t0 = std::time::Instant::now();
+        let view = job.render(&device, &Quiet, None)?.done.view;
+        let wall_ms = t0.elapsed().as_secs_f64() * 1e3;
+        let truth = io::load_rgb(&pair.truth)?;
+        let image = view
+            .color
+            .ok_or_else(|| Error::Gl(format!("{}: the --fill view has no colour", pair.scene)))?;
+        if (image.width, image.height) != (truth.width, truth.height) {
+            return Err(Error::SizeMismatch {
+                message: format!(
+                    "{}: the view is {}x{}, its truth {}x{}",
+                    pair.scene, image.width, image.height, truth.width, truth.height
+                ),
+            });
+        }
+        let mut row = ReportRow::new(
+            "cyclopean",
+            &pair.scene,
+            FILL_TWO_IMAGES_NAME,
+            FILL_TWO_IMAGES_SETTING,
+            wall_ms,
+        );
+        let all = vec![true; (truth.width * truth.height) as usize];
+        super::score(&image, None, &all, &truth, None, &mut row);
+        rows.push(row);
+    }
+    Ok(rows)
 }
 
 /// One row per pair of [`flow_peer_pairs`]: the peer's image in `peer_dir` scored over all

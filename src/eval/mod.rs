@@ -170,11 +170,14 @@ pub fn report_stages(
         }
     }
     if let (Some(dir), Some(peer)) = (data_dir, flow_peer) {
-        flow_peer::place_beside(&mut rows, flow_peer::flow_peer_rows(dir, peer)?);
+        let mut beside = flow_peer::fill_two_images_rows(gpu, dir)?;
+        beside.extend(flow_peer::flow_peer_rows(dir, peer)?);
+        flow_peer::place_beside(&mut rows, beside);
         notes.push(format!(
-            "{}: middle views written by python/peers/flow_interpolation.py (DIS optical flow both ways, a backward warp of each image by half its flow, the mean of the two) read from {}, scored over all pixels against the true middle view; not timed (it ran outside viewsynth). Compare with \"{}\" on estimated disparities, which also covers every pixel.",
+            "{}: middle views written by python/peers/flow_interpolation.py (DIS optical flow both ways, a backward warp of each image by half its flow, the mean of the two) read from {}, scored over all pixels against the true middle view; not timed (it ran outside viewsynth). Beside it \"{}\": the CLI's complete frame from the same two images (signed range estimated, census matcher, densify, render, 2-D fill), over all pixels; \"{}\" on estimated disparities has no densify step.",
             flow_peer::FLOW_PEER_NAME,
             peer.display(),
+            flow_peer::FILL_TWO_IMAGES_NAME,
             cyclopean::FILL_NAME
         ));
     }

@@ -239,9 +239,10 @@ fn report_with_a_case_measures_it_beside_the_built_in_rows() {
         .unwrap();
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
     let out = d.join("report");
-    // The optical-flow peer (issue 38 item 4) rides along at no cost: a data folder holding only
-    // Tsukuba's true middle view (no Middlebury, so no real rows are measured) and the peer's
-    // images of its two pairs, written here with known errors.
+    // The optical-flow peer (issue 38 item 4) rides along: a data folder holding only Tsukuba's
+    // five views, small (no Middlebury, so no real rows are measured but the two pairs'
+    // `cyclopean --fill`), and the peer's images of its two pairs, written here with known
+    // errors.
     let (data, peer) = (d.join("data"), d.join("flow_peer"));
     let (truth_2_4, truth_1_5) = fake_flow_peer(&data, &peer);
     let o = bin()
@@ -309,6 +310,15 @@ fn report_with_a_case_measures_it_beside_the_built_in_rows() {
         let got = r.4.unwrap();
         assert!(got == psnr || (got - psnr).abs() < 1e-9, "{r:?}: expected {psnr} dB");
     }
+    // Beside each, viewsynth's complete frame from the pair's two images (the CLI's job): every
+    // pixel, and timed.
+    let fill_rows: Vec<_> = rows.iter().filter(|r| r.2 == "viewsynth cyclopean --fill").collect();
+    assert_eq!(fill_rows.len(), 2, "{fill_rows:?}");
+    for (r, scene) in fill_rows.iter().zip(["tsukuba2+tsukuba4", "tsukuba1+tsukuba5"]) {
+        assert!(r.1.contains(scene) && r.3.ends_with("all pixels"), "{r:?}");
+        assert_eq!(r.5, Some(1.0), "a complete frame: {r:?}");
+        assert!(r.4.is_some_and(f64::is_finite), "{r:?}");
+    }
     let md = std::fs::read_to_string(out.join("report.md")).unwrap();
     let line = md
         .lines()
@@ -319,7 +329,7 @@ fn report_with_a_case_measures_it_beside_the_built_in_rows() {
     assert!(line.trim_end().ends_with("| 100.0% | - | - |"), "{line}");
 }
 
-/// A data folder with Tsukuba's true middle view alone (40 x 30, values 20..230) and the
+/// A data folder with Tsukuba's five views (40 x 30, one texture shifted 2 px a view) and the
 /// flow peer's images of both Tsukuba pairs: 2+4 the truth itself, 1+5 the truth 5 levels
 /// brighter everywhere. Returns the PSNRs they must score (inf, 10 log10(255^2 / 25)).
 fn fake_flow_peer(data: &Path, peer: &Path) -> (f64, f64) {
@@ -327,10 +337,21 @@ fn fake_flow_peer(data: &Path, peer: &Path) -> (f64, f64) {
     std::fs::create_dir_all(&set).unwrap();
     std::fs::create_dir_all(peer).unwrap();
     let (w, h) = (40u32, 30u32);
-    let truth: Vec<u8> = (0..w * h * 3).map(|i| (20 + (i * 37) % 211) as u8).collect();
+    // View k sees one texture (values 28..226) 2k px further on: the pairs' own images, for
+    // the report's `cyclopean --fill` rows beside the peer's, and view 3 their true middle.
+    let view = |k: u32| -> Vec<u8> {
+        (0..h)
+            .flat_map(|y| {
+                (0..w).flat_map(move |x| [0u32, 1, 2].map(|c| (((x + 2 * k) * 53 + y * 97 + c * 31) % 199) as u8 + 28))
+            })
+            .collect()
+    };
+    let truth = view(3);
     let brighter: Vec<u8> = truth.iter().map(|v| v + 5).collect();
     let image = |data: Vec<u8>| io::RgbImage::new(w, h, data).unwrap();
-    io::save_rgb(&set.join("tsukuba3.png"), &image(truth.clone())).unwrap();
+    for k in 1..=5 {
+        io::save_rgb(&set.join(format!("tsukuba{k}.png")), &image(view(k))).unwrap();
+    }
     io::save_rgb(&peer.join("tsukuba_2_4_3.png"), &image(truth)).unwrap();
     io::save_rgb(&peer.join("tsukuba_1_5_3.png"), &image(brighter)).unwrap();
     (f64::INFINITY, 10.0 * (255.0f64 * 255.0 / 25.0).log10())

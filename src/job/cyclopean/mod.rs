@@ -348,7 +348,7 @@ impl CyclopeanJob {
 
 /// One view rendered, before it is written.
 pub(crate) struct RenderedView {
-    done: Synthesised,
+    pub(crate) done: Synthesised,
     confidence: Option<[DepthMap; 2]>,
     size: (u32, u32),
 }
