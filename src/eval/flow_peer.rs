@@ -142,28 +142,17 @@ pub fn fill_two_images_rows(gpu: &crate::gpu::Gpu, data_dir: &Path) -> Result<Ve
         let t0 = std::time::Instant::now();
         let view = job.render(&device, &Quiet, None)?.done.view;
         let wall_ms = t0.elapsed().as_secs_f64() * 1e3;
-        let truth = io::load_rgb(&pair.truth)?;
         let image = view
             .color
             .ok_or_else(|| Error::Gl(format!("{}: the --fill view has no colour", pair.scene)))?;
-        if (image.width, image.height) != (truth.width, truth.height) {
-            return Err(Error::SizeMismatch {
-                message: format!(
-                    "{}: the view is {}x{}, its truth {}x{}",
-                    pair.scene, image.width, image.height, truth.width, truth.height
-                ),
-            });
-        }
-        let mut row = ReportRow::new(
-            "cyclopean",
+        let truth = io::load_rgb(&pair.truth)?;
+        rows.push(all_pixels_row(
             &pair.scene,
-            FILL_TWO_IMAGES_NAME,
-            FILL_TWO_IMAGES_SETTING,
-            wall_ms,
-        );
-        let all = vec![true; (truth.width * truth.height) as usize];
-        super::score(&image, None, &all, &truth, None, &mut row);
-        rows.push(row);
+            (FILL_TWO_IMAGES_NAME, FILL_TWO_IMAGES_SETTING, wall_ms),
+            &image,
+            &truth,
+            &pair.left,
+        )?);
     }
     Ok(rows)
 }
@@ -187,6 +176,18 @@ pub fn flow_peer_rows(data_dir: &Path, peer_dir: &Path) -> Result<Vec<ReportRow>
 
 /// The peer's row of one pair: `image` (read from `path`) against `truth`, over all pixels.
 pub fn flow_peer_row(scene: &str, image: &RgbImage, truth: &RgbImage, path: &Path) -> Result<ReportRow> {
+    all_pixels_row(scene, (FLOW_PEER_NAME, FLOW_PEER_SETTING, f64::NAN), image, truth, path)
+}
+
+/// A row of `scene` for `method` (name, setting, wall ms): `image` (made from `path`) against
+/// `truth`, over all pixels; an image of another size is an error naming `path`.
+fn all_pixels_row(
+    scene: &str,
+    (name, setting, wall_ms): (&str, &str, f64),
+    image: &RgbImage,
+    truth: &RgbImage,
+    path: &Path,
+) -> Result<ReportRow> {
     if (image.width, image.height) != (truth.width, truth.height) {
         return Err(Error::SizeMismatch {
             message: format!(
@@ -199,7 +200,7 @@ pub fn flow_peer_row(scene: &str, image: &RgbImage, truth: &RgbImage, path: &Pat
             ),
         });
     }
-    let mut row = ReportRow::new("cyclopean", scene, FLOW_PEER_NAME, FLOW_PEER_SETTING, f64::NAN);
+    let mut row = ReportRow::new("cyclopean", scene, name, setting, wall_ms);
     let all = vec![true; (truth.width * truth.height) as usize];
     super::score(image, None, &all, truth, None, &mut row);
     Ok(row)
