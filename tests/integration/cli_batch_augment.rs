@@ -119,23 +119,35 @@ fn zoom_random_draws_three_scales_per_frame_the_same_under_rerun_and_two_shards(
 
 #[test]
 fn index_has_one_row_per_target_after_a_killed_and_resumed_run() {
-    use std::os::unix::process::ExitStatusExt;
     let (dir, manifest) = setup("augment-kill", 12);
     let out = dir.join("out");
     let heavy = ["--width-out", "800", "--height-out", "600", "--zoom-range", "0.5,1.5"];
+    kill_batch_when(&manifest, &out, &heavy, "no frame finished", || {
+        out.join("f2/manifest.json").exists()
+    });
+    assert!(!out.join(INDEX_NAME).exists(), "a killed run wrote an index");
+    let o = run(&manifest, &out, &heavy);
+    assert!(String::from_utf8_lossy(&o.stdout).contains("already done"));
+    check_index(&out, 12, 2);
+}
+
+/// Runs `refocus --jobs 1 --batch MANIFEST --out-dir OUT ARGS` and kills it (SIGKILL) as soon
+/// as `reached()` holds (`what` within 120 s), asserting that it was still running then.
+fn kill_batch_when(manifest: &Path, out: &Path, args: &[&str], what: &str, reached: impl Fn() -> bool) {
+    use std::os::unix::process::ExitStatusExt;
     let mut child = bin()
         .args(["refocus", "--jobs", "1", "--batch"])
-        .arg(&manifest)
+        .arg(manifest)
         .arg("--out-dir")
-        .arg(&out)
-        .args(heavy)
+        .arg(out)
+        .args(args)
         .stdout(Stdio::null())
         .stderr(Stdio::null())
         .spawn()
         .unwrap();
     let t0 = std::time::Instant::now();
-    while !out.join("f2/manifest.json").exists() {
-        assert!(t0.elapsed().as_secs() < 120, "no frame finished in 120 s");
+    while !reached() {
+        assert!(t0.elapsed().as_secs() < 120, "{what} in 120 s");
         if child.try_wait().unwrap().is_some() {
             break;
         }
@@ -147,10 +159,6 @@ fn index_has_one_row_per_target_after_a_killed_and_resumed_run() {
         Some(9),
         "the batch ended before the kill"
     );
-    assert!(!out.join(INDEX_NAME).exists(), "a killed run wrote an index");
-    let o = run(&manifest, &out, &heavy);
-    assert!(String::from_utf8_lossy(&o.stdout).contains("already done"));
-    check_index(&out, 12, 2);
 }
 
 /// Every row of `index.jsonl` and of each part still there names files that are on disk, and
@@ -189,7 +197,6 @@ fn assert_index_true_to_disk(out: &Path) {
 /// until the end of a run, naming f0/s0.5_rgb.png and the like after the kill.
 #[test]
 fn a_run_killed_after_an_earlier_complete_run_leaves_no_stale_index() {
-    use std::os::unix::process::ExitStatusExt;
     let (dir, manifest) = setup("augment-kill-stale", 12);
     let out = dir.join("out");
     let size = ["--width-out", "800", "--height-out", "600"];
@@ -198,16 +205,6 @@ fn a_run_killed_after_an_earlier_complete_run_leaves_no_stale_index() {
     run(&manifest, &out, &first);
     check_index(&out, 12, 2);
 
-    let mut child = bin()
-        .args(["refocus", "--jobs", "1", "--batch"])
-        .arg(&manifest)
-        .arg("--out-dir")
-        .arg(&out)
-        .args(&second)
-        .stdout(Stdio::null())
-        .stderr(Stdio::null())
-        .spawn()
-        .unwrap();
     // Until the third frame is redone: its manifest records the second run's one scale.
     let redone = |f: usize| {
         std::fs::read_to_string(out.join(format!("f{f}/manifest.json")))
@@ -215,20 +212,7 @@ fn a_run_killed_after_an_earlier_complete_run_leaves_no_stale_index() {
             .and_then(|t| serde_json::from_str::<serde_json::Value>(&t).ok())
             .is_some_and(|m| m["outputs"].as_array().is_some_and(|o| o.len() == 1))
     };
-    let t0 = std::time::Instant::now();
-    while !redone(2) {
-        assert!(t0.elapsed().as_secs() < 120, "no frame redone in 120 s");
-        if child.try_wait().unwrap().is_some() {
-            break;
-        }
-        std::thread::sleep(std::time::Duration::from_millis(1));
-    }
-    child.kill().unwrap();
-    assert_eq!(
-        child.wait().unwrap().signal(),
-        Some(9),
-        "the batch ended before the kill"
-    );
+    kill_batch_when(&manifest, &out, &second, "no frame redone", || redone(2));
     assert!(!redone(11), "the last frame was redone before the kill");
     assert!(
         !out.join("f0/s0.5_rgb.png").exists(),
