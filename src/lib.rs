@@ -25,39 +25,32 @@
 //! - [`gpu`]: the EGL context and device choice, RAII GL objects, programs, readback, timers.
 //! - [`progress`]: the stages of long runs (demo, report) handed to the caller.
 //! - [`view`]: the output shape shared by every GPU pass and its f64 twin.
-//! - [`metrics`]: error measures of the tests, reports and benchmarks (PSNR, masks, depth).
 //! - [`ssim`]: structural similarity, f64.
+//! - [`metrics`]: error measures of the tests, reports and benchmarks (PSNR, masks, depth).
 //! - [`scene`]: ground-truth scenes as data, ray-traced in f64 and on the GPU.
 //! - [`refocus`]: same-pose re-rendering at other focal lengths, one frame or a pipelined batch.
 //! - [`cyclopean`]: the middle (spectator) view of a stereo pair, five methods.
 //! - [`reproject`]: one view of a stereo rig to another eye.
 //! - [`stitch`]: ODS 360 equirects from over-wide cube faces.
 //! - [`compare`]: two renderings compared across conventions, with CI thresholds.
-//! - [`eval`]: every method's error against ground truth next to its run time, one file per
-//!   capability, and the GPU-vs-reference image check.
-//! - [`report`]: the evaluation written as Markdown, CSV and SVG.
-//! - [`bench`](mod@bench): every benchmark: single-frame timings, the pipelined refocus batch
-//!   against its synchronous baseline (`bench::batch`) with its per-codec CPU and bytes
-//!   (`bench::codecs`), GL against Vulkan (`bench::vulkan`).
-//! - [`stress`]: stiff and extreme cases of every capability, GPU f32 against f64.
-//! - [`demo`]: the built-in scene rendered, refocused and synthesised, with its report.
 //! - [`pass`]: backend-neutral pass descriptions and the GL executor; [`vulkan`]: the Vulkan
 //!   backend (ash) with its executor, running the same GLSL.
 //! - [`job`]: one checked job per command-line command, and the code that runs it.
+//!
+//! The measuring lab (evaluation against ground truth, the report, benchmarks, stress cases and
+//! the demo) is the `viewsynth-lab` crate above this one, and the `viewsynth` command line is
+//! the `viewsynth-cli` crate above both.
 
 #![warn(missing_docs)]
 
 pub mod alloc;
-pub mod bench;
 pub mod camera;
 pub mod compare;
 pub mod convention;
 pub mod cpu_time;
 pub mod cyclopean;
-pub mod demo;
 pub mod depth;
 pub mod error;
-pub mod eval;
 pub mod gpu;
 pub mod io;
 pub mod job;
@@ -65,12 +58,10 @@ pub mod metrics;
 pub mod pass;
 pub mod progress;
 pub mod refocus;
-pub mod report;
 pub mod reproject;
 pub mod scene;
 pub mod ssim;
 pub mod stitch;
-pub mod stress;
 pub mod view;
 #[cfg(feature = "vulkan")]
 pub mod vulkan;

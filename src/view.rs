@@ -1,6 +1,6 @@
 //! [`ViewOutput`]: the one output shape shared by every capability's GPU pass and its f64 twin
 //! (colour, view-Z depth, validity mask, timings), so the two are compared by one function
-//! ([`crate::eval::image_check::ensure_views`]) and the report and tests read every capability
+//! (the lab's `eval::image_check::ensure_views`) and the report and tests read every capability
 //! alike.
 //!
 //! Each capability keeps its own richer output (cyclopean's per-eye source bits, refocus's

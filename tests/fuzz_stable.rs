@@ -278,12 +278,30 @@ fn write_seed_corpus() {
     .unwrap();
     seed("load_rgb", "mask", read(file("m.png")));
     // json_inputs: the camera file `scene` writes, a cyclopean camera file, an empty object.
-    let o = std::process::Command::new(env!("CARGO_BIN_EXE_viewsynth"))
-        .args(["scene", "--width", "16", "--height", "12", "--out-dir"])
-        .arg(tmp.path().join("scene"))
-        .output()
-        .unwrap();
-    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    struct Quiet;
+    impl viewsynth::job::Host for Quiet {
+        fn open_gpu(&self, request: &viewsynth::job::GpuRequest) -> viewsynth::Result<viewsynth::gpu::Gpu> {
+            request.open()
+        }
+        fn event(&self, _: viewsynth::job::Event<'_>) {}
+    }
+    let scene = viewsynth::job::scene::SceneJob::new(viewsynth::job::scene::SceneOptions {
+        scene: "demo".into(),
+        width: 16,
+        height: 12,
+        ipd: 0.064,
+        conventions: Default::default(),
+        cube_faces: None,
+        face_fov: 110.0,
+        frames: 1,
+        dolly: 0.02,
+        spectator_offset: 0.0,
+        out_dir: tmp.path().join("scene"),
+        gpu: viewsynth::job::GpuRequest::new("auto", false).unwrap(),
+        backend: viewsynth::job::Backend::Gl,
+    })
+    .unwrap();
+    scene.run(&Quiet).unwrap();
     seed(
         "json_inputs",
         "scene_cameras",

@@ -140,7 +140,7 @@ pub fn save_depth_exr_with(path: &Path, depth: &DepthMap, compression: super::Ex
 }
 
 /// Encodes [`save_depth_exr_with`]'s file into `out`; errors name `path`.
-pub(crate) fn encode_depth_exr(
+pub fn encode_depth_exr(
     path: &Path,
     out: &mut std::io::BufWriter<std::fs::File>,
     depth: &DepthMap,
@@ -168,7 +168,7 @@ pub fn save_depth_npy(path: &Path, depth: &DepthMap) -> Result<()> {
 }
 
 /// Encodes [`save_depth_npy`]'s file into `out`; errors name `path`.
-pub(crate) fn encode_depth_npy(
+pub fn encode_depth_npy(
     path: &Path,
     out: &mut std::io::BufWriter<std::fs::File>,
     depth: &DepthMap,

@@ -29,7 +29,7 @@ pub fn save_depth_png16(path: &Path, depth: &DepthMap, compression: PngCompressi
 
 /// Encodes [`save_depth_png16`]'s file into `out` and returns the clipped count; errors name
 /// `path`.
-pub(crate) fn encode_depth_png16(
+pub fn encode_depth_png16(
     path: &Path,
     out: &mut std::io::BufWriter<std::fs::File>,
     depth: &DepthMap,

@@ -25,7 +25,7 @@ pub fn save_mask_png_with(path: &Path, mask: &Mask, compression: super::PngCompr
 }
 
 /// Encodes [`save_mask_png_with`]'s file into `out`; errors name `path`.
-pub(crate) fn encode_mask_png(
+pub fn encode_mask_png(
     path: &Path,
     out: &mut std::io::BufWriter<std::fs::File>,
     mask: &Mask,

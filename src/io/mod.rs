@@ -60,8 +60,8 @@ pub use outputs::{
     RgbFormat, ViewFiles, ViewNames,
 };
 pub use rgb::{load_rgb, save_rgb, save_rgb_with};
-// The encoders one by one, for the per-codec benchmark (`bench::codecs`).
-pub(crate) use depth::{encode_depth_exr, encode_depth_npy};
-pub(crate) use depth_png16::encode_depth_png16;
-pub(crate) use mask::encode_mask_png;
-pub(crate) use rgb::encode_rgb;
+// The encoders one by one, for the lab's per-codec benchmark (`viewsynth_lab::bench::codecs`).
+pub use depth::{encode_depth_exr, encode_depth_npy};
+pub use depth_png16::encode_depth_png16;
+pub use mask::encode_mask_png;
+pub use rgb::encode_rgb;

@@ -58,7 +58,7 @@ pub fn save_rgb_with(path: &Path, img: &RgbImage, encoding: &super::Encoding) ->
 }
 
 /// Encodes `img` into `out` as `ext` says (png, jpg/jpeg or exr); errors name `path`.
-pub(crate) fn encode_rgb(
+pub fn encode_rgb(
     path: &Path,
     out: &mut BufWriter<File>,
     img: &RgbImage,

@@ -316,7 +316,7 @@ pub enum JobError {
 }
 
 /// Attaches what was being done to a library error (the binary prints "context: error").
-pub(crate) trait InContext<T> {
+pub trait InContext<T> {
     /// The error, if any, as [`JobError::In`].
     fn within(self, context: impl FnOnce() -> String) -> Result<T, JobError>;
 }

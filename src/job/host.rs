@@ -120,7 +120,7 @@ pub enum Event<'a> {
 
 /// A job's stages told to its host as [`Event::Stage`] (the library's
 /// [`Progress`](crate::progress::Progress) sink for long runs).
-pub(crate) struct HostStages<'h>(pub(crate) &'h dyn Host);
+pub struct HostStages<'h>(pub &'h dyn Host);
 
 impl crate::progress::Progress for HostStages<'_> {
     fn stage(&self, index: usize, total: usize, label: &str) {

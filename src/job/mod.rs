@@ -13,19 +13,16 @@ mod files;
 mod host;
 mod intrinsics;
 
-pub mod bench;
 pub mod compare;
 pub mod cyclopean;
 pub mod refocus;
-pub mod report;
 pub mod reproject;
 pub mod scene;
 pub mod stitch;
-pub mod stress;
 
-pub use error::{ArgError, JobError, PerFrameOption};
-pub use files::{depth_formats, file_formats, FileOptions};
-pub use host::{Backend, Event, GpuRequest, Host};
+pub use error::{ArgError, InContext, JobError, PerFrameOption};
+pub use files::{depth_formats, file_formats, png_compression, FileOptions};
+pub use host::{Backend, Event, GpuRequest, Host, HostStages};
 pub use intrinsics::SourceIntrinsics;
 
 /// Largest magnitude of a real-valued option (pixels, metres, degrees, scales): far beyond any

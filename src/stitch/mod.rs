@@ -74,7 +74,7 @@
 //!
 //! - [`faces`]: faces from the ray-traced scene, or from images; [`truth`]: the ODS ground
 //!   truth; [`reference`](mod@reference): the f64 stitch; [`render`]: the GPU pass (shaders/stitch/stitch.frag);
-//!   report rows and the benchmark are in [`crate::eval::stitch`]; [`pass`]: the pass/twin
+//!   [`score`]: an equirect scored against that truth (the lab's report rows and benchmark build on it); [`pass`]: the pass/twin
 //!   contract, [`pass::gpu`] and [`pass::reference`] over one [`StitchInput`], both returning a
 //!   [`crate::view::ViewOutput`].
 
@@ -82,6 +82,7 @@ pub mod faces;
 pub mod pass;
 pub mod reference;
 pub mod render;
+pub mod score;
 pub mod truth;
 
 pub use pass::StitchInput;

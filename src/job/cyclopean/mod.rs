@@ -291,6 +291,12 @@ impl CyclopeanJob {
         })
     }
 
+    /// Reads the pair and renders its view on `device`, writing nothing: the view the job would
+    /// write, as the lab's report scores it beside its peers.
+    pub fn render_only(&self, device: &Device, host: &dyn Host) -> crate::Result<Synthesised> {
+        Ok(self.render(device, host, None)?.done)
+    }
+
     /// Reads the pair and renders its view on `device` (with a sequence's renderers, if any).
     pub(crate) fn render(
         &self,

@@ -11,7 +11,7 @@ use super::error::InContext;
 use super::{ArgError, Backend, Event, GpuRequest, Host, JobError};
 use crate::convention::Conventions;
 use crate::depth::DepthEncoding;
-use crate::eval::stitch::{score_eyes, split_top_bottom, StitchScore};
+use crate::stitch::score::{score_eyes, split_top_bottom, StitchScore};
 use crate::gpu::Timing;
 use crate::io::{self, DepthDecode, DepthMap, DepthSummary, RgbImage};
 use crate::stitch::faces::{load_face_dir, scene_faces, FaceDepthFiles, FACE_TAGS};
