@@ -2,6 +2,9 @@
 //! at five focal scales with both GPU paths, writes every output, and reports each against the
 //! exact ray-traced target view and against the f64 reference, next to its run time.
 
+use crate::report::WrittenReport;
+use std::fmt::Write as _;
+use std::path::Path;
 use viewsynth::convention::Conventions;
 use viewsynth::error::{Error, Result};
 use viewsynth::gpu::Gpu;
@@ -9,10 +12,7 @@ use viewsynth::io::FileFormats;
 use viewsynth::metrics;
 use viewsynth::refocus::manifest as job;
 use viewsynth::refocus::{reference, BreakRule, Method, OutputSet, RefocusSource, Refocuser};
-use crate::report::WrittenReport;
 use viewsynth::{io, scene};
-use std::fmt::Write as _;
-use std::path::Path;
 
 /// The focal scales the demo refocuses at.
 pub const DEMO_SCALES: [f64; 5] = viewsynth::refocus::manifest::DEFAULT_SCALES;
@@ -24,7 +24,11 @@ pub fn run(gpu: &Gpu, out_dir: &Path) -> Result<WrittenReport> {
 
 /// [`run`] with each stage reported to `progress` as it starts: the two refocus methods, the
 /// cyclopean, reprojection and stitching outputs, then the report's stages.
-pub fn run_with_progress(gpu: &Gpu, out_dir: &Path, progress: &dyn viewsynth::progress::Progress) -> Result<WrittenReport> {
+pub fn run_with_progress(
+    gpu: &Gpu,
+    out_dir: &Path,
+    progress: &dyn viewsynth::progress::Progress,
+) -> Result<WrittenReport> {
     let stages = viewsynth::progress::Stages::new(progress, 5 + crate::eval::report_stage_count(None, &[]));
     // Subfolders through OutDir::subdir: a symlinked one is refused, never written through.
     // All of them first, so a refused one fails the run before any rendering.
@@ -151,7 +155,8 @@ fn cyclopean_outputs(gpu: &Gpu, dir: &Path) -> Result<()> {
     for (name, params) in crate::eval::cyclopean::cyclopean_methods(3.0) {
         outputs.push((name, CyclopeanRenderer::new(gpu, &frame, params)?.render(&mid)?.0));
     }
-    let mut warp = viewsynth::cyclopean::forward::ForwardWarp::new(gpu, &frame, &viewsynth::refocus::BreakRule::default())?;
+    let mut warp =
+        viewsynth::cyclopean::forward::ForwardWarp::new(gpu, &frame, &viewsynth::refocus::BreakRule::default())?;
     outputs.push((crate::eval::cyclopean::FORWARD_NAME, warp.render(&mid)?.0));
     for (name, out) in outputs {
         let stem: String = name

@@ -13,7 +13,9 @@
 //! - [`report`]: the evaluation written as Markdown, CSV and SVG.
 //! - [`bench`](mod@bench): every benchmark: single-frame timings, the pipelined refocus batch
 //!   against its synchronous baseline (`bench::batch`) with its per-codec CPU and bytes
-//!   (`bench::codecs`), GL against Vulkan (`bench::vulkan`).
+//!   (`bench::codecs`), every pass on each device (`bench::passes`).
+//! - [`passes`]: every pass of the library described once and run on any device: the rows of
+//!   the GL-against-Vulkan agreement table and of the per-pass benchmark.
 //! - [`stress`]: stiff and extreme cases of every capability, GPU f32 against f64.
 //! - [`demo`]: the built-in scene rendered, refocused and synthesised, with its report.
 //! - [`job`]: the checked jobs of `viewsynth bench`, `report` and `stress`, run through the
@@ -25,5 +27,6 @@ pub mod bench;
 pub mod demo;
 pub mod eval;
 pub mod job;
+pub mod passes;
 pub mod report;
 pub mod stress;

@@ -168,11 +168,7 @@ pub fn save_depth_npy(path: &Path, depth: &DepthMap) -> Result<()> {
 }
 
 /// Encodes [`save_depth_npy`]'s file into `out`; errors name `path`.
-pub fn encode_depth_npy(
-    path: &Path,
-    out: &mut std::io::BufWriter<std::fs::File>,
-    depth: &DepthMap,
-) -> Result<()> {
+pub fn encode_depth_npy(path: &Path, out: &mut std::io::BufWriter<std::fs::File>, depth: &DepthMap) -> Result<()> {
     encode_dims(path, depth.width, depth.height, 1, depth.data.len())?;
     super::npy::encode_npy_f32(path, out, &[depth.height as usize, depth.width as usize], &depth.data)
 }

@@ -130,4 +130,3 @@ pub fn split_top_bottom(tb: &RgbImage) -> [Vec<[f64; 3]>; 2] {
         .collect();
     [px[..half].to_vec(), px[half..].to_vec()]
 }
-

@@ -4,8 +4,8 @@ use crate::options::GpuArgs;
 use crate::options::OUTPUTS;
 use clap::Args;
 use std::path::PathBuf;
-use viewsynth_lab::job::report::DemoJob;
 use viewsynth::job::ArgError;
+use viewsynth_lab::job::report::DemoJob;
 
 /// The example under `viewsynth demo --help` (paths from the repository root, as in the README).
 pub(crate) const EXAMPLES: &str = "\

@@ -4,8 +4,8 @@ use crate::options::GpuArgs;
 use crate::options::{INPUTS, MEASURE, OUTPUTS};
 use clap::Args;
 use std::path::PathBuf;
-use viewsynth_lab::job::report::ReportJob;
 use viewsynth::job::ArgError;
+use viewsynth_lab::job::report::ReportJob;
 
 /// The example under `viewsynth report --help` (paths from the repository root, as in the README).
 pub(crate) const EXAMPLES: &str = "\

@@ -9,13 +9,13 @@ use std::process::Output;
 use viewsynth::camera::stereo::{Eye, StereoParams};
 use viewsynth::convention::Conventions;
 use viewsynth::cyclopean::FrameDepth;
-use viewsynth_lab::eval::reproject::{scene_cases, Case};
 use viewsynth::io::{self, DepthMap};
 use viewsynth::reproject::render::Reprojector;
 use viewsynth::reproject::{Geometry, Method, ReprojectOutput, ReprojectParams};
 use viewsynth::stitch::faces::scene_faces;
 use viewsynth::stitch::render::StitchRenderer;
 use viewsynth::stitch::{Method as StitchMethod, OdsRig, Side, StitchParams};
+use viewsynth_lab::eval::reproject::{scene_cases, Case};
 
 const W: u32 = 64;
 const H: u32 = 48;

@@ -21,9 +21,9 @@ use viewsynth::cyclopean::{
     pass, Blend, CyclopeanInput, CyclopeanOutput, CyclopeanOutputs, CyclopeanParams, CyclopeanPass, Eye, FrameDepth,
     Method,
 };
-use viewsynth_lab::eval::image_check;
 use viewsynth::metrics;
 use viewsynth::view::ViewOutput;
+use viewsynth_lab::eval::image_check;
 
 /// The gather methods every GL and Vulkan cyclopean comparison sweeps.
 pub(crate) fn methods() -> Vec<(&'static str, CyclopeanParams)> {

@@ -25,9 +25,9 @@ use viewsynth::cyclopean::scene_frame::{scene_frame, StereoRig};
 use viewsynth::cyclopean::splat::{SplatParams, SplatRenderer};
 use viewsynth::cyclopean::splat_reference::{self, splat_reference};
 use viewsynth::cyclopean::{CyclopeanOutput, CyclopeanOutputs, CyclopeanParams, FrameDepth, Method, StereoFrame};
-use viewsynth_lab::eval::cyclopean::{estimated_cases, estimated_eyes};
 use viewsynth::io::{self, DepthDecode, DepthMap, RgbImage};
 use viewsynth::metrics;
+use viewsynth_lab::eval::cyclopean::{estimated_cases, estimated_eyes};
 
 fn splat_gpu(frame: &StereoFrame, mid: &viewsynth::cyclopean::MiddleCamera) -> CyclopeanOutput {
     splat_on(&viewsynth::pass::Device::gl(&gpu()).unwrap(), frame, mid)

@@ -22,8 +22,8 @@ use viewsynth::cyclopean::render::CyclopeanRenderer;
 use viewsynth::cyclopean::scene_frame::{scene_frame, StereoRig};
 use viewsynth::cyclopean::temporal::{carried, Accumulator, TemporalAccumulator, FROM_HISTORY};
 use viewsynth::cyclopean::{CyclopeanOutput, CyclopeanParams, FrameDepth, Method, MiddleCamera};
-use viewsynth_lab::eval::image_check::{self, Plane};
 use viewsynth::pass::Device;
+use viewsynth_lab::eval::image_check::{self, Plane};
 
 /// Middle views of the scene from a head at `at` (right eye's depth emptied: holes), rendered
 /// on GL whatever device accumulates them.

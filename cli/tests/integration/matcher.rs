@@ -17,9 +17,9 @@
 
 use crate::common::{data_dir, gpu, max_abs_difference};
 use viewsynth::cyclopean::matcher::{confidence_reference, estimate_disparities, Matcher};
-use viewsynth_lab::eval::image_check::{ensure, Plane};
 use viewsynth::io::{load_rgb, DepthMap, RgbImage};
 use viewsynth::pass::Device;
+use viewsynth_lab::eval::image_check::{ensure, Plane};
 
 /// The GPU's maps against the twin's, both eyes: the same pixels known, the same values.
 fn check(what: &str, gpu: (DepthMap, DepthMap), twin: &(DepthMap, DepthMap)) {

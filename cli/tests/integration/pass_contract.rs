@@ -11,7 +11,6 @@ use viewsynth::cyclopean::scene_frame::{scene_frame, StereoRig};
 use viewsynth::cyclopean::splat::{SplatParams, SplatRenderer};
 use viewsynth::cyclopean::splat_reference::splat_reference;
 use viewsynth::cyclopean::{self, CyclopeanInput, CyclopeanOutputs, CyclopeanParams, CyclopeanPass, FrameDepth};
-use viewsynth_lab::eval::reproject::scene_cases;
 use viewsynth::refocus::reference::refocus_reference;
 use viewsynth::refocus::{self, BreakRule, Method, OutputSet, RefocusInput, Refocuser};
 use viewsynth::reproject::reference::reproject_reference;
@@ -22,6 +21,7 @@ use viewsynth::stitch::reference::stitch_reference;
 use viewsynth::stitch::render::StitchRenderer;
 use viewsynth::stitch::{self, OdsRig, Side, StitchInput, StitchParams};
 use viewsynth::view::ViewOutput;
+use viewsynth_lab::eval::reproject::scene_cases;
 
 /// A convention other than the default, so the input's conventions reach the GPU side.
 fn other_conventions() -> Conventions {

@@ -16,10 +16,10 @@
 use crate::common::*;
 use viewsynth::camera::PinholeCamera;
 use viewsynth::convention::Conventions;
-use viewsynth_lab::eval::image_check;
 use viewsynth::pass::Device;
 use viewsynth::refocus::manifest::TargetSpec;
 use viewsynth::refocus::{pass, BreakRule, Method, OutputSet, RefocusInput, RefocusSource, Refocuser};
+use viewsynth_lab::eval::image_check;
 
 const SCALES: [f64; 7] = [0.25, 0.5, 0.75, 1.0, 1.5, 2.0, 4.0];
 

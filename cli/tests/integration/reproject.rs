@@ -21,8 +21,6 @@ use viewsynth::camera::{Intrinsics, PinholeCamera};
 use viewsynth::convention::Conventions;
 use viewsynth::cyclopean::{FrameDepth, MiddleCamera};
 use viewsynth::depth::DepthEncoding;
-use viewsynth_lab::eval::image_check;
-use viewsynth_lab::eval::reproject::{methods, motorcycle_case, run_timed, scene_cases, score, teddy_case, Case};
 use viewsynth::io::{DepthMap, RgbImage};
 use viewsynth::metrics;
 use viewsynth::pass::{Device, ToDevice};
@@ -33,6 +31,8 @@ use viewsynth::reproject::{
     ShiftModel,
 };
 use viewsynth::view::ViewOutput;
+use viewsynth_lab::eval::image_check;
+use viewsynth_lab::eval::reproject::{methods, motorcycle_case, run_timed, scene_cases, score, teddy_case, Case};
 
 const DEPTH_REL_TOL: f64 = 3e-5;
 

@@ -11,15 +11,15 @@
 
 use crate::common::gpu;
 use viewsynth::convention::Conventions;
-use viewsynth_lab::eval::image_check;
-use viewsynth::stitch::score::{score_eyes, split_top_bottom, StitchScore};
 use viewsynth::pass::Device;
 use viewsynth::stitch::faces::{faces_from_images, scene_faces};
 use viewsynth::stitch::reference::stitch_reference;
 use viewsynth::stitch::render::StitchRenderer;
+use viewsynth::stitch::score::{score_eyes, split_top_bottom, StitchScore};
 use viewsynth::stitch::truth::ods_truth;
 use viewsynth::stitch::{pass, seam_band_mask, top_bottom, FaceSet, Method, OdsRig, Side, StitchInput, StitchParams};
 use viewsynth::{metrics, Error};
+use viewsynth_lab::eval::image_check;
 
 const N: u32 = 128;
 const W: u32 = 512;

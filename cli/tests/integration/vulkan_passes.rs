@@ -26,8 +26,6 @@ use viewsynth::cyclopean::render::{CyclopeanRenderer, GatherParams};
 use viewsynth::cyclopean::scene_frame::{scene_frame, StereoRig};
 use viewsynth::cyclopean::splat::{EdgeSnapBlock, SplatBlock, SplatGatherBlock, SplatParams, SplatRenderer};
 use viewsynth::cyclopean::{CyclopeanOutputs, CyclopeanParams, FrameDepth, Method};
-use viewsynth_lab::eval::backends::{backend_diff, BackendDiff};
-use viewsynth_lab::eval::reproject::{methods, scene_cases};
 use viewsynth::gpu::shaders::{ShiftDepth, StitchBlend};
 use viewsynth::gpu::{ProgramKind, ShaderProgram};
 use viewsynth::pass::{Device, ParamBlock};
@@ -40,6 +38,8 @@ use viewsynth::stitch::render::StitchBlock;
 use viewsynth::stitch::{self, Method as StitchMethod, OdsRig, Side, StitchInput, StitchParams};
 use viewsynth::view::ViewOutput;
 use viewsynth::vulkan::VkExecutor;
+use viewsynth_lab::eval::backends::{backend_diff, BackendDiff};
+use viewsynth_lab::eval::reproject::{methods, scene_cases};
 
 /// Rust offsets and size against what the GL compiler reports for `P`'s block in `program`.
 fn check_block<P: ParamBlock>(program: ProgramKind) {

@@ -3,15 +3,15 @@
 //! per-stage medians and the stage that bounds the throughput. Nothing here asserts a time.
 
 use super::codecs::{codec_rows, CodecRow};
+use serde::Serialize;
+use std::fmt::Write as _;
+use std::path::{Path, PathBuf};
 use viewsynth::error::{Error, Result};
 use viewsynth::gpu::Gpu;
 use viewsynth::io::FileFormats;
 use viewsynth::refocus::batch::{load_manifest, run_batch, BatchFrame, BatchOptions, BatchSummary, StageTimes};
 use viewsynth::refocus::{BreakRule, Method};
 use viewsynth::{convention::Conventions, io, scene};
-use serde::Serialize;
-use std::fmt::Write as _;
-use std::path::{Path, PathBuf};
 
 /// Where the frames come from.
 #[derive(Debug, Clone)]

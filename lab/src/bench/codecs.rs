@@ -5,15 +5,15 @@
 //! Timed on a one-thread pool, so a codec that splits its work (EXR ZIP blocks) is charged all
 //! of it; medians over the repeats. Nothing here asserts a time.
 
+use serde::Serialize;
+use std::fs::File;
+use std::io::{BufWriter, Write};
+use std::path::Path;
 use viewsynth::convention::Conventions;
 use viewsynth::error::{Error, Result};
 use viewsynth::io::{self, DepthDecode, DepthMap, Encoding, ExrCompression, OutputSet, PngCompression, RgbImage};
 use viewsynth::refocus::manifest::TargetSpec;
 use viewsynth::refocus::{BreakRule, Method, RefocusOutput, RefocusSource, Refocuser};
-use serde::Serialize;
-use std::fs::File;
-use std::io::{BufWriter, Write};
-use std::path::Path;
 
 /// One codec measured.
 #[derive(Debug, Clone, Serialize)]

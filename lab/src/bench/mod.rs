@@ -6,8 +6,10 @@
 pub mod batch;
 pub mod codecs;
 pub mod matcher;
-pub mod vulkan;
+pub mod passes;
 
+use std::fmt::Write as _;
+use std::time::Instant;
 use viewsynth::convention::Conventions;
 use viewsynth::error::Result;
 use viewsynth::gpu::Gpu;
@@ -15,8 +17,6 @@ use viewsynth::io::FileFormats;
 use viewsynth::refocus::manifest::{self as job, TargetSpec};
 use viewsynth::refocus::{reference, BreakRule, Method, OutputSet, RefocusSource, Refocuser};
 use viewsynth::scene;
-use std::fmt::Write as _;
-use std::time::Instant;
 
 use crate::bench::batch::median;
 

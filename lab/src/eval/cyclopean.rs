@@ -3,6 +3,8 @@
 //! pairs with disparities estimated by [`viewsynth::cyclopean::matcher`] and on user cases, with run times.
 
 use super::{score, timed};
+use crate::report::ReportRow;
+use std::path::Path;
 use viewsynth::convention::{Conventions, NdcDepthRange, RowOrder};
 use viewsynth::cyclopean::baseline::{self, BaselineView};
 use viewsynth::cyclopean::disparity_frame::{disparity_frame, DisparityRig};
@@ -18,8 +20,6 @@ use viewsynth::error::Result;
 use viewsynth::gpu::{Gpu, Timing};
 use viewsynth::io::{self, DepthDecode, DepthMap, RgbImage};
 use viewsynth::refocus::BreakRule;
-use crate::report::ReportRow;
-use std::path::Path;
 
 /// Report name of the forward-warp method.
 pub const FORWARD_NAME: &str = "forward warp (mesh, depth-tested merge)";
@@ -477,7 +477,8 @@ pub type Eye = (RgbImage, DepthMap);
 /// rig, on the nominal Middlebury focal length and baseline: disparities are estimated between
 /// these very images, so there is no principal-point offset (doffs 0) and only t d matters.
 pub fn estimated_eyes(case: &EstimatedCase) -> Result<(Eye, Eye, DisparityRig)> {
-    let (dl, mut dr) = viewsynth::cyclopean::matcher::estimate_disparities(&case.left, &case.right, case.max_disparity)?;
+    let (dl, mut dr) =
+        viewsynth::cyclopean::matcher::estimate_disparities(&case.left, &case.right, case.max_disparity)?;
     if case.left_eye_only {
         dr.data.iter_mut().for_each(|d| *d = 0.0);
     }

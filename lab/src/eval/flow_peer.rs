@@ -7,10 +7,10 @@
 //! viewsynth's rows, in a row beside them. A pair whose data the data folder holds must have its
 //! file: a missing one is an error naming it, never a silent gap in the comparison.
 
-use viewsynth::error::{Error, Result};
-use viewsynth::io::{self, RgbImage};
 use crate::report::ReportRow;
 use std::path::{Path, PathBuf};
+use viewsynth::error::{Error, Result};
+use viewsynth::io::{self, RgbImage};
 
 /// Report name of the peer's rows.
 pub const FLOW_PEER_NAME: &str = "DIS flow interpolation";

@@ -86,7 +86,12 @@ pub fn ensure_views(ok: bool, name: &str, gpu: &ViewOutput, reference: &ViewOutp
     ensure(ok, name, gpu.width, gpu.height, &planes, message);
 }
 
-fn write_planes(dir: &std::path::Path, width: u32, height: u32, planes: &[(&str, Plane, Plane)]) -> viewsynth::Result<()> {
+fn write_planes(
+    dir: &std::path::Path,
+    width: u32,
+    height: u32,
+    planes: &[(&str, Plane, Plane)],
+) -> viewsynth::Result<()> {
     std::fs::create_dir_all(dir).map_err(|e| viewsynth::Error::io(dir, e))?;
     for (label, gpu, reference) in planes {
         let [g, r, d] = render(width, height, gpu, reference);

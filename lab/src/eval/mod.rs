@@ -15,15 +15,14 @@ pub mod image_check;
 pub mod refocus;
 pub mod reproject;
 pub mod stitch;
-pub mod vulkan;
 
+use crate::report::{Report, ReportRow, WrittenReport};
+use std::path::{Path, PathBuf};
 use viewsynth::error::Result;
 use viewsynth::gpu::{Gpu, Timing};
 use viewsynth::io::{DepthMap, RgbImage};
-use crate::report::{Report, ReportRow, WrittenReport};
-use viewsynth::ssim;
 use viewsynth::metrics;
-use std::path::{Path, PathBuf};
+use viewsynth::ssim;
 
 /// Median of `repeats` timings after one warm-up run (shader JIT, allocations).
 pub(crate) fn timed<T>(repeats: usize, mut run: impl FnMut() -> Result<(T, Timing)>) -> Result<(T, Timing)> {
@@ -89,7 +88,15 @@ pub fn run_report_with_cases(
     cases: &[PathBuf],
     repeats: usize,
 ) -> Result<WrittenReport> {
-    run_report_with_progress(gpu, out_dir, data_dir, cases, None, repeats, &viewsynth::progress::Silent)
+    run_report_with_progress(
+        gpu,
+        out_dir,
+        data_dir,
+        cases,
+        None,
+        repeats,
+        &viewsynth::progress::Silent,
+    )
 }
 
 /// [`run_report_with_cases`] with each stage reported to `progress` as it starts, and the
@@ -194,6 +201,6 @@ pub fn report_stages(
     };
     let mut files = report.write(out_dir, "report")?;
     stages.start("report: every pass, GL against Vulkan");
-    files.push(vulkan::write_section(gpu, out_dir)?);
+    files.push(backends::write_section(&viewsynth::pass::Device::gl(gpu)?, out_dir)?);
     Ok(WrittenReport { report, files })
 }

@@ -2,12 +2,12 @@
 //! each target camera.
 
 use super::{score, timed};
+use crate::report::ReportRow;
 use viewsynth::convention::Conventions;
 use viewsynth::error::Result;
 use viewsynth::gpu::Gpu;
 use viewsynth::refocus::manifest::TargetSpec;
 use viewsynth::refocus::{BreakRule, Method as RefocusMethod, OutputSet, RefocusSource, Refocuser};
-use crate::report::ReportRow;
 use viewsynth::scene;
 
 /// Refocus of the built-in scene against the scene ray-traced from each target camera.

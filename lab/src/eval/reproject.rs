@@ -1,6 +1,8 @@
 //! Report rows for `viewsynth report` and the data set-ups the tests share: the built-in scene
 //! (left eye or ray-traced centre view -> right eye, exact truth) and the Middlebury pairs.
 
+use crate::report::ReportRow;
+use std::path::Path;
 use viewsynth::camera::stereo::Eye;
 use viewsynth::camera::{Intrinsics, PinholeCamera};
 use viewsynth::convention::Conventions;
@@ -10,12 +12,10 @@ use viewsynth::depth::DepthEncoding;
 use viewsynth::error::Result;
 use viewsynth::gpu::{Gpu, Timing};
 use viewsynth::io::{self, DepthDecode, DepthMap, RgbImage};
-use crate::report::ReportRow;
+use viewsynth::metrics;
 use viewsynth::reproject::render::Reprojector;
 use viewsynth::reproject::{Geometry, Method, ReprojectOutput, ReprojectParams, ReprojectSource, ShiftModel};
 use viewsynth::ssim;
-use viewsynth::metrics;
-use std::path::Path;
 
 /// The methods compared.
 pub fn methods() -> Vec<ReprojectParams> {
@@ -100,7 +100,8 @@ fn seed_case(rig: &StereoRig, conv: Conventions) -> Result<Case> {
     let (color, depth) = viewsynth::scene::render_posed(&cam, &rig.head);
     let mut target = cam;
     target.k.cx += shift.a_px;
-    let right = viewsynth::scene::render_posed(&target, &viewsynth::camera::Pose::at([shift.b_px / cam.k.fx, 0.0, 0.0]));
+    let right =
+        viewsynth::scene::render_posed(&target, &viewsynth::camera::Pose::at([shift.b_px / cam.k.fx, 0.0, 0.0]));
     Ok(Case {
         name: format!("centre -> right (seed S = {separation:.4}, c = {convergence} m)"),
         source: ReprojectSource {
@@ -304,7 +305,8 @@ fn row(
 /// only eye and the target as the middle camera), for comparison with the shift methods.
 pub fn mesh_warp_timed(gpu: &Gpu, case: &Case, repeats: usize) -> Result<(ReprojectOutput, Timing)> {
     let (frame, target) = viewsynth::reproject::one_eye_frame(&case.source, &case.geometry)?;
-    let mut warp = viewsynth::cyclopean::forward::ForwardWarp::new(gpu, &frame, &viewsynth::refocus::BreakRule::default())?;
+    let mut warp =
+        viewsynth::cyclopean::forward::ForwardWarp::new(gpu, &frame, &viewsynth::refocus::BreakRule::default())?;
     warp.render(&target)?; // warm-up
     let mut runs = Vec::new();
     for _ in 0..repeats.max(1) {

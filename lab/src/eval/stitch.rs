@@ -1,15 +1,15 @@
 //! Report rows of the stitch: error against the ray-traced ODS truth over the
 //! seam band and the whole image, per method and overlap, with run times.
 
+use crate::report::ReportRow;
+use std::fmt::Write as _;
 use viewsynth::error::Result;
 use viewsynth::gpu::Gpu;
-use crate::report::ReportRow;
 use viewsynth::stitch::faces::scene_faces;
 use viewsynth::stitch::render::StitchRenderer;
-use viewsynth::stitch::truth::ods_truth;
 use viewsynth::stitch::score::{score_eyes, split_top_bottom};
+use viewsynth::stitch::truth::ods_truth;
 use viewsynth::stitch::{seam_band_mask, Method, OdsRig, Side, StitchParams};
-use std::fmt::Write as _;
 
 /// Overlap widths (deg) evaluated; faces have FOV = 90 + 2 overlap.
 pub const OVERLAPS_DEG: [f64; 3] = [5.0, 10.0, 20.0];

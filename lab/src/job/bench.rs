@@ -2,14 +2,14 @@
 //! `--batch` the pipelined refocus batch against its synchronous baseline. The options become a
 //! [`BenchJob`]; running it returns the tables and the cases measured.
 
-use viewsynth::job::HostStages;
-use viewsynth::job::{ArgError, Event, GpuRequest, Host, JobError};
 use crate::bench::batch::{batch_bench, BatchBench, BatchInput};
 use crate::bench::{cyclopean_bench, refocus_bench, BenchCase};
+use std::path::PathBuf;
 use viewsynth::io;
 use viewsynth::io::FileFormats;
+use viewsynth::job::HostStages;
+use viewsynth::job::{ArgError, Event, GpuRequest, Host, JobError};
 use viewsynth::progress::Progress as _;
-use std::path::PathBuf;
 
 /// The bench options as given.
 #[derive(Debug, Clone)]
@@ -171,12 +171,17 @@ impl BenchJob {
                         return Ok((tables, None));
                     }
                     stages.stage(4, total, "bench: every pass, GL against Vulkan");
-                    let vk = host.open_vulkan(&self.vulkan_request())?;
-                    tables.push(crate::bench::vulkan::refocus_bench(&vk, sizes, *repeats, &mut cases)?);
-                    tables.push(crate::bench::vulkan::passes_bench(
-                        &gpu, &vk, 640, 480, *repeats, &mut cases,
+                    let vk = host.open_device(&self.vulkan_request(), viewsynth::job::Backend::Vulkan)?;
+                    let gl = viewsynth::pass::Device::gl(&gpu)?;
+                    let name = vk.renderer();
+                    tables.push(crate::bench::passes::passes_bench(
+                        &[("gl", gl), ("vulkan", vk)],
+                        640,
+                        480,
+                        *repeats,
+                        &mut cases,
                     )?);
-                    Ok((tables, Some(vk.info().name.clone())))
+                    Ok((tables, Some(name)))
                 })();
                 host.event(Event::Finished);
                 let (tables, vulkan_device) = measured?;

@@ -1,10 +1,10 @@
 //! `report` and `demo`: every method's error against ground truth next to its run time
 //! (report.{md,csv,svg}), and the demo that renders, refocuses and reports in one go.
 
-use viewsynth::job::HostStages;
-use viewsynth::job::{ArgError, Event, GpuRequest, Host, JobError};
 use crate::report::WrittenReport;
 use std::path::{Path, PathBuf};
+use viewsynth::job::HostStages;
+use viewsynth::job::{ArgError, Event, GpuRequest, Host, JobError};
 
 /// A checked report run.
 #[derive(Debug, Clone)]

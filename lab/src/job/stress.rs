@@ -2,12 +2,12 @@
 //! The options become a [`StressJob`]; a failing case fails the job after the table is
 //! written.
 
-use viewsynth::job::InContext;
-use viewsynth::job::HostStages;
-use viewsynth::job::{ArgError, Event, GpuRequest, Host, JobError};
-use viewsynth::progress::Progress as _;
 use crate::stress::{first_failure, run_stress, StressOptions, StressRow, CAPABILITIES};
 use std::path::PathBuf;
+use viewsynth::job::HostStages;
+use viewsynth::job::InContext;
+use viewsynth::job::{ArgError, Event, GpuRequest, Host, JobError};
+use viewsynth::progress::Progress as _;
 
 /// A checked stress sweep.
 #[derive(Debug, Clone)]
@@ -66,7 +66,8 @@ impl StressJob {
     pub fn write_json(&self, rows: &[StressRow]) -> Result<(), JobError> {
         if let Some(path) = &self.json {
             // The file layer every output goes through (a FIFO or device at the path is refused).
-            let text = serde_json::to_string_pretty(rows).map_err(|e| viewsynth::Error::param("json", e.to_string()))?;
+            let text =
+                serde_json::to_string_pretty(rows).map_err(|e| viewsynth::Error::param("json", e.to_string()))?;
             let write: viewsynth::io::PathWriter<'_> =
                 Box::new(|staged| std::fs::write(staged, text.as_bytes()).map_err(|e| viewsynth::Error::io(staged, e)));
             viewsynth::io::write_paths_all_or_none(vec![(path.clone(), write)])

@@ -25,10 +25,10 @@ pub mod reproject;
 pub mod stitch;
 pub mod values;
 
+use serde::Serialize;
 use viewsynth::error::Result;
 use viewsynth::gpu::Gpu;
 use viewsynth::metrics;
-use serde::Serialize;
 
 /// f32 unit roundoff (2^-24).
 pub const EPS32: f64 = 5.960464477539063e-8;

@@ -15,6 +15,7 @@
 
 use super::refocus::refused;
 use super::{test_texture, GpuPixels, RefPixels, StressOptions, StressRow, Tally, Tolerance, EPS32};
+use crate::eval::reproject::methods;
 use viewsynth::camera::stereo::{Eye, StereoParams};
 use viewsynth::camera::{Intrinsics, PinholeCamera};
 use viewsynth::convention::{Conventions, DepthPlanes};
@@ -22,7 +23,6 @@ use viewsynth::cyclopean::scene_frame::{scene_frame, StereoRig};
 use viewsynth::cyclopean::FrameDepth;
 use viewsynth::depth::DepthEncoding;
 use viewsynth::error::Result;
-use crate::eval::reproject::methods;
 use viewsynth::gpu::Gpu;
 use viewsynth::io::{DepthMap, RgbImage};
 use viewsynth::reproject::reference::reproject_reference;
