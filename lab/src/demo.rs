@@ -7,9 +7,9 @@ use std::fmt::Write as _;
 use std::path::Path;
 use viewsynth::convention::Conventions;
 use viewsynth::error::{Error, Result};
-use viewsynth::gpu::Gpu;
 use viewsynth::io::FileFormats;
 use viewsynth::metrics;
+use viewsynth::pass::Device;
 use viewsynth::refocus::manifest as job;
 use viewsynth::refocus::{reference, BreakRule, Method, OutputSet, RefocusSource, Refocuser};
 use viewsynth::{io, scene};
@@ -18,14 +18,14 @@ use viewsynth::{io, scene};
 pub const DEMO_SCALES: [f64; 5] = viewsynth::refocus::manifest::DEFAULT_SCALES;
 
 /// Run the demo into `out_dir`; returns the report, its files and, last, refocus_check.md.
-pub fn run(gpu: &Gpu, out_dir: &Path) -> Result<WrittenReport> {
+pub fn run(gpu: &Device, out_dir: &Path) -> Result<WrittenReport> {
     run_with_progress(gpu, out_dir, &viewsynth::progress::Silent)
 }
 
 /// [`run`] with each stage reported to `progress` as it starts: the two refocus methods, the
 /// cyclopean, reprojection and stitching outputs, then the report's stages.
 pub fn run_with_progress(
-    gpu: &Gpu,
+    gpu: &Device,
     out_dir: &Path,
     progress: &dyn viewsynth::progress::Progress,
 ) -> Result<WrittenReport> {
@@ -120,7 +120,7 @@ pub fn run_with_progress(
         "# viewsynth demo: refocus of the built-in scene\n\nRenderer: {}\n\n{table}\n\
          PSNR vs scene measures the method (resampling a 640x480 source cannot recreate detail a \
          longer lens would see); PSNR/IoU vs the f64 reference measure the GPU implementation.\n",
-        gpu.info().renderer
+        gpu.renderer()
     ) + "\nGL against Vulkan on these passes and every other: gl_vs_vulkan.md.\n";
     let path = out_dir.join("refocus_check.md");
     io::atomic_write(&path, |w| {
@@ -140,7 +140,7 @@ pub fn run_with_progress(
 
 /// The built-in stereo pair (64 mm IPD, device depth, GL conventions), its ray-traced middle
 /// view, and the middle view of each cyclopean method.
-fn cyclopean_outputs(gpu: &Gpu, dir: &Path) -> Result<()> {
+fn cyclopean_outputs(gpu: &Device, dir: &Path) -> Result<()> {
     use viewsynth::cyclopean::render::CyclopeanRenderer;
     use viewsynth::cyclopean::scene_frame::{scene_frame, StereoRig};
     use viewsynth::cyclopean::FrameDepth;
@@ -178,7 +178,7 @@ fn cyclopean_outputs(gpu: &Gpu, dir: &Path) -> Result<()> {
 
 /// Left eye -> right eye of the built-in stereo pair with each reprojection method, beside the
 /// ray-traced right eye.
-fn reproject_outputs(gpu: &Gpu, dir: &Path) -> Result<()> {
+fn reproject_outputs(gpu: &Device, dir: &Path) -> Result<()> {
     use crate::eval::reproject::scene_cases;
     use viewsynth::reproject::render::Reprojector;
     use viewsynth::reproject::{Method, ReprojectParams};
@@ -217,7 +217,7 @@ fn reproject_outputs(gpu: &Gpu, dir: &Path) -> Result<()> {
 
 /// Top-bottom stereo equirect (left eye on top) of the built-in scene from 6 over-wide faces
 /// per eye, with each stitching method.
-fn stitch_outputs(gpu: &Gpu, dir: &Path) -> Result<()> {
+fn stitch_outputs(gpu: &Device, dir: &Path) -> Result<()> {
     use viewsynth::stitch::faces::scene_faces;
     use viewsynth::stitch::render::StitchRenderer;
     use viewsynth::stitch::{Method, OdsRig, Side, StitchParams};

@@ -94,10 +94,10 @@ impl RefocusSource {
     }
 }
 
-/// Largest source side refocus takes on `gpu`: the grid has a cell per pixel plus a border
+/// Largest source side refocus takes on `device`: the grid has a cell per pixel plus a border
 /// ring, and its (w + 1) x (h + 1) cells are texels of one texture.
-pub fn max_source_side(gpu: &crate::gpu::Gpu) -> u32 {
-    gpu.max_image_side().saturating_sub(1)
+pub fn max_source_side(device: &crate::pass::Device) -> u32 {
+    device.max_image_side().saturating_sub(1)
 }
 
 /// Source pixel coordinate seen by target pixel (x, y) under the same pose:

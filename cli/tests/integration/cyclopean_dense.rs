@@ -238,7 +238,9 @@ fn a_complete_frame_from_two_images_beats_flow_interpolation() {
 fn the_cyclopean_bench_has_densify_and_fill_rows_beside_the_seed_method() {
     let g = gpu();
     let mut cases = Vec::new();
-    let table = viewsynth_lab::bench::cyclopean_bench(&g, 256, 128, 1, &mut cases).unwrap();
+    let table =
+        viewsynth_lab::bench::cyclopean_bench(&viewsynth::pass::Device::gl(&g).unwrap(), 256, 128, 1, &mut cases)
+            .unwrap();
     let json = serde_json::to_value(&cases).unwrap();
     let rows = json.as_array().unwrap();
     let named = |start: &str| -> Vec<&serde_json::Value> {

@@ -82,7 +82,7 @@ fn refocus_output_one_past_the_limit_is_refused() {
 #[test]
 fn refocus_source_limit_is_the_context_limit_less_the_grid_ring() {
     let g = gpu();
-    let max = viewsynth::refocus::max_source_side(&g);
+    let max = viewsynth::refocus::max_source_side(&viewsynth::pass::Device::gl(&g).unwrap());
     assert_eq!(max, g.max_image_side() - 1);
     let w = max + 1;
     let src = RefocusSource::new(

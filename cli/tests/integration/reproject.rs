@@ -172,7 +172,7 @@ fn scene_left_and_centre_to_right_against_the_ray_traced_right_eye() {
         for case in scene_cases(640, 480, ipd, Conventions::default(), FrameDepth::Device).unwrap() {
             let (mut scan_psnr, mut walk_psnr) = (None, None);
             for params in methods() {
-                let (out, t) = run_timed(&g, &case, params, 3).unwrap();
+                let (out, t) = run_timed(&viewsynth::pass::Device::gl(&g).unwrap(), &case, params, 3).unwrap();
                 let s = score(&out, &case).unwrap();
                 println!(
                     "scene 640x480 ipd {:.0} mm, {}, {}: PSNR {:.2} dB on {:.1} % scored, coverage {:.2} %, depth rel {:.2e}, {:.1} ms",
@@ -223,7 +223,7 @@ fn middlebury_motorcycle_and_teddy_left_to_right() {
         (teddy_case(&dir, Conventions::default()).unwrap(), 28.0, 0.85),
     ] {
         for params in methods() {
-            let (out, t) = run_timed(&g, &case, params, 1).unwrap();
+            let (out, t) = run_timed(&viewsynth::pass::Device::gl(&g).unwrap(), &case, params, 1).unwrap();
             let s = score(&out, &case).unwrap();
             println!(
                 "{}, {}: PSNR {:.2} dB on valid pixels, coverage {:.2} %, {:.1} ms",
@@ -475,7 +475,9 @@ fn bad_inputs_are_errors_not_panics() {
 #[test]
 fn report_rows_cover_every_method_case_and_dataset() {
     let g = gpu();
-    let (rows, notes) = viewsynth_lab::eval::reproject::reproject_rows(&g, Some(&data_dir()), 3).unwrap();
+    let (rows, notes) =
+        viewsynth_lab::eval::reproject::reproject_rows(&viewsynth::pass::Device::gl(&g).unwrap(), Some(&data_dir()), 3)
+            .unwrap();
     // 2 baselines x 3 scene cases x (3 methods + the mesh warp), then 2 real pairs x 4.
     assert_eq!(rows.len(), 2 * 3 * 4 + 2 * 4);
     for r in &rows {
@@ -565,7 +567,7 @@ fn mesh_warp_comparison_matches_the_ray_traced_right_eye_under_every_convention(
             .into_iter()
             .next()
             .unwrap();
-        let (out, _) = mesh_warp_timed(&g, &case, 1).unwrap();
+        let (out, _) = mesh_warp_timed(&viewsynth::pass::Device::gl(&g).unwrap(), &case, 1).unwrap();
         let s = score(&out, &case).unwrap();
         assert!(
             s.psnr_db > 35.0 && s.coverage > 0.85,

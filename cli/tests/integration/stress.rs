@@ -8,7 +8,12 @@ use viewsynth_lab::stress::{first_failure, run_stress, table, StressOptions, CAP
 #[test]
 fn quick_sweep_of_every_capability_passes_with_no_nan_or_inf() {
     let g = gpu();
-    let rows = run_stress(&g, &CAPABILITIES, StressOptions { quick: true }).unwrap();
+    let rows = run_stress(
+        &viewsynth::pass::Device::gl(&g).unwrap(),
+        &CAPABILITIES,
+        StressOptions { quick: true },
+    )
+    .unwrap();
     println!("{}", table(&rows));
     for cap in CAPABILITIES {
         assert!(rows.iter().any(|r| r.capability == cap), "no rows for {cap}");

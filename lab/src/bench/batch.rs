@@ -7,8 +7,8 @@ use serde::Serialize;
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 use viewsynth::error::{Error, Result};
-use viewsynth::gpu::Gpu;
 use viewsynth::io::FileFormats;
+use viewsynth::pass::Device;
 use viewsynth::refocus::batch::{load_manifest, run_batch, BatchFrame, BatchOptions, BatchSummary, StageTimes};
 use viewsynth::refocus::{BreakRule, Method};
 use viewsynth::{convention::Conventions, io, scene};
@@ -218,7 +218,7 @@ fn scene_manifest(dir: &Path, n: usize) -> Result<PathBuf> {
 /// pool), and a third time pipelined on `vulkan` when given, into scratch folders that are
 /// removed afterwards.
 pub fn batch_bench(
-    gpu: &Gpu,
+    gpu: &Device,
     input: &BatchInput,
     jobs: usize,
     files: FileFormats,
@@ -273,7 +273,7 @@ pub fn batch_bench(
         }
         Ok(summarise(jobs, &s))
     };
-    let gl = viewsynth::pass::Device::gl(gpu)?;
+    let gl = gpu.clone();
     let synchronous = run(gl.clone(), 0, "sync")?;
     let pipelined = run(gl.clone(), jobs.max(1), "pipelined")?;
     let vulkan = match vulkan {
@@ -310,7 +310,7 @@ pub fn batch_bench(
     let bytes_per_frame = px * (3 + 4)
         + out_px * (3 * files.outputs.rgb as usize + 4 * files.outputs.depth as usize + files.outputs.mask as usize);
     Ok(BatchBench {
-        renderer: gpu.info().renderer.clone(),
+        renderer: gpu.renderer(),
         input: label,
         frame_size: (w, h),
         scales,

@@ -12,8 +12,8 @@ use std::fmt::Write as _;
 use std::time::Instant;
 use viewsynth::convention::Conventions;
 use viewsynth::error::Result;
-use viewsynth::gpu::Gpu;
 use viewsynth::io::FileFormats;
+use viewsynth::pass::Device;
 use viewsynth::refocus::manifest::{self as job, TargetSpec};
 use viewsynth::refocus::{reference, BreakRule, Method, OutputSet, RefocusSource, Refocuser};
 use viewsynth::scene;
@@ -53,12 +53,12 @@ const SCALES: [f64; 5] = viewsynth::refocus::manifest::DEFAULT_SCALES;
 
 /// Times both refocus paths at each size over the five focal scales (`repeats` runs, medians);
 /// returns a Markdown table and appends each case to `cases`.
-pub fn refocus_bench(gpu: &Gpu, sizes: &[(u32, u32)], repeats: usize, cases: &mut Vec<BenchCase>) -> Result<String> {
+pub fn refocus_bench(gpu: &Device, sizes: &[(u32, u32)], repeats: usize, cases: &mut Vec<BenchCase>) -> Result<String> {
     let mut t = format!(
         "refocus benchmark on {} ({} repeats, medians)\n\n\
          | size | path | setup ms | ms / frame (5 scales) | ms / scale | job ms / frame incl. PNG+EXR+mask writes |\n\
          |---|---|---|---|---|---|\n",
-        gpu.info().renderer,
+        gpu.renderer(),
         repeats
     );
     let tmp = std::env::temp_dir().join(format!("viewsynth-bench-{}", std::process::id()));
@@ -157,7 +157,7 @@ pub fn refocus_bench(gpu: &Gpu, sizes: &[(u32, u32)], repeats: usize, cases: &mu
 
 /// Median ms per middle frame from two eyes of `width` x `height` for each cyclopean method.
 pub fn cyclopean_bench(
-    gpu: &Gpu,
+    gpu: &Device,
     width: u32,
     height: u32,
     repeats: usize,
@@ -171,7 +171,7 @@ pub fn cyclopean_bench(
     let mut t = format!(
         "cyclopean benchmark on {}: 2 eyes {width}x{height} -> middle {width}x{height} ({repeats} repeats, medians)\n\n\
          | method | setup ms | ms / middle frame (draw + readback) |\n|---|---|---|\n",
-        gpu.info().renderer
+        gpu.renderer()
     );
     let mut record = |name: &str, (setup, m): (f64, f64)| {
         cases.push(BenchCase::new(
@@ -374,7 +374,7 @@ fn setup_and_median<R, T>(
 /// Benchmark: ms per 4096 x 2048 stereo equirect (both eyes, readback included) from 6 faces
 /// of 1024 x 1024 per eye, overlap 10 deg, per method (median of `repeats`, at least 1, after a
 /// warm-up). Not asserted.
-pub fn stitch_bench(gpu: &Gpu, repeats: usize, cases: &mut Vec<BenchCase>) -> Result<String> {
+pub fn stitch_bench(gpu: &Device, repeats: usize, cases: &mut Vec<BenchCase>) -> Result<String> {
     use viewsynth::stitch::faces::scene_faces;
     use viewsynth::stitch::render::StitchRenderer;
     use viewsynth::stitch::{Method, OdsRig, Side, StitchParams};
@@ -388,7 +388,7 @@ pub fn stitch_bench(gpu: &Gpu, repeats: usize, cases: &mut Vec<BenchCase>) -> Re
     let mut r = StitchRenderer::new(gpu, &left, &right)?;
     let setup_ms = t0.elapsed().as_secs_f64() * 1e3;
     let repeats = repeats.max(1);
-    let mut t = stitch_table_head(&gpu.info().renderer, trace_ms, setup_ms, repeats);
+    let mut t = stitch_table_head(&gpu.renderer(), trace_ms, setup_ms, repeats);
     for method in Method::ALL {
         let params = StitchParams {
             method,

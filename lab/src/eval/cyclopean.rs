@@ -17,8 +17,9 @@ use viewsynth::cyclopean::{
     StereoFrame,
 };
 use viewsynth::error::Result;
-use viewsynth::gpu::{Gpu, Timing};
+use viewsynth::gpu::Timing;
 use viewsynth::io::{self, DepthDecode, DepthMap, RgbImage};
+use viewsynth::pass::Device;
 use viewsynth::refocus::BreakRule;
 
 /// Report name of the forward-warp method.
@@ -55,7 +56,7 @@ pub fn cyclopean_methods(fixation: f64) -> Vec<(&'static str, CyclopeanParams)> 
 }
 
 fn render_cyclopean(
-    gpu: &Gpu,
+    gpu: &Device,
     frame: &StereoFrame,
     mid: &MiddleCamera,
     params: CyclopeanParams,
@@ -74,7 +75,7 @@ pub fn depth_conventions() -> Vec<Conventions> {
 }
 
 /// Report rows of every cyclopean method and the forward warp on the built-in scene (640x480), two IPDs x the four depth conventions, against the ray-traced middle view.
-pub fn cyclopean_scene_rows(gpu: &Gpu, repeats: usize) -> Result<Vec<ReportRow>> {
+pub fn cyclopean_scene_rows(gpu: &Device, repeats: usize) -> Result<Vec<ReportRow>> {
     let mut rows = Vec::new();
     for ipd in [0.064, 0.2] {
         let mut rig = StereoRig::demo(640, 480);
@@ -163,7 +164,7 @@ pub const FILL_NAME: &str = "splat-gather + fill (holes from the background side
 type RealRun = (&'static str, RgbImage, Vec<bool>, Timing);
 
 fn real_runs(
-    gpu: &Gpu,
+    gpu: &Device,
     l: &(RgbImage, DepthMap),
     r: &(RgbImage, DepthMap),
     rig: &DisparityRig,
@@ -291,7 +292,7 @@ fn real_rows(scene: &str, setting: &str, runs: &[RealRun], truth: &RgbImage) -> 
 /// reprojected to the right eye against im6, right disparity emptied), every method beside the
 /// forward-splat and no-warp baselines; then the same on estimated disparities
 /// ([`cyclopean_estimated_rows`]).
-pub fn cyclopean_real_rows(gpu: &Gpu, data_dir: &Path, repeats: usize) -> Result<(Vec<ReportRow>, Vec<String>)> {
+pub fn cyclopean_real_rows(gpu: &Device, data_dir: &Path, repeats: usize) -> Result<(Vec<ReportRow>, Vec<String>)> {
     let mut rows = Vec::new();
     let mut notes = Vec::new();
     let cones = data_dir.join("middlebury2003_cones");
@@ -494,7 +495,11 @@ pub fn estimated_eyes(case: &EstimatedCase) -> Result<(Eye, Eye, DisparityRig)> 
 /// method's. Notes: how the disparities were made, and per case the matcher's time (GPU pass
 /// and CPU twin) against the default method's render, how much of the left eye it kept and,
 /// where published, its bad-pixel rate at 1 px against the ground truth.
-pub fn cyclopean_estimated_rows(gpu: &Gpu, data_dir: &Path, repeats: usize) -> Result<(Vec<ReportRow>, Vec<String>)> {
+pub fn cyclopean_estimated_rows(
+    gpu: &Device,
+    data_dir: &Path,
+    repeats: usize,
+) -> Result<(Vec<ReportRow>, Vec<String>)> {
     let (cases, mut notes) = estimated_cases(data_dir)?;
     let mut rows = Vec::new();
     notes.push(format!(
@@ -574,7 +579,7 @@ fn describe_estimate(estimate: &DepthMap, truth: Option<&DepthMap>) -> String {
 /// Cyclopean methods on a user case: a folder laid out like `viewsynth scene` writes it:
 /// `cameras.json`, `{left,right}_rgb.png`, `{left,right}_device_depth.exr` (or `_view_z.exr` when
 /// the camera file says `view-z`) and the reference middle view `middle_rgb.png`.
-pub fn cyclopean_case_rows(gpu: &Gpu, dir: &Path, repeats: usize) -> Result<Vec<ReportRow>> {
+pub fn cyclopean_case_rows(gpu: &Device, dir: &Path, repeats: usize) -> Result<Vec<ReportRow>> {
     use viewsynth::cyclopean::camera_file::CameraFile;
     use viewsynth::cyclopean::EyeInput;
     let cams = CameraFile::load(&dir.join("cameras.json"))?;

@@ -122,9 +122,9 @@ impl viewsynth::job::Host for Quiet {
 /// One row per pair of [`flow_peer_pairs`]: `viewsynth cyclopean --left-rgb L --right-rgb R
 /// --fill` as the CLI runs it (the same job, on `gpu`), scored over all pixels against the true
 /// middle view: what the peer's row stands beside. Timed once, reading the images included.
-pub fn fill_two_images_rows(gpu: &viewsynth::gpu::Gpu, data_dir: &Path) -> Result<Vec<ReportRow>> {
+pub fn fill_two_images_rows(gpu: &viewsynth::pass::Device, data_dir: &Path) -> Result<Vec<ReportRow>> {
     use viewsynth::job::cyclopean::{CyclopeanJob, CyclopeanOptions, CyclopeanRequest};
-    let device = viewsynth::pass::Device::gl(gpu)?;
+    let device = gpu.clone();
     let mut rows = Vec::new();
     for pair in flow_peer_pairs(data_dir) {
         let job = CyclopeanJob::new(CyclopeanOptions {

@@ -19,9 +19,10 @@ pub mod stitch;
 use crate::report::{Report, ReportRow, WrittenReport};
 use std::path::{Path, PathBuf};
 use viewsynth::error::Result;
-use viewsynth::gpu::{Gpu, Timing};
+use viewsynth::gpu::Timing;
 use viewsynth::io::{DepthMap, RgbImage};
 use viewsynth::metrics;
+use viewsynth::pass::Device;
 use viewsynth::ssim;
 
 /// Median of `repeats` timings after one warm-up run (shader JIT, allocations).
@@ -76,13 +77,13 @@ pub(crate) fn score(
 }
 
 /// Run everything and write report.{md,csv,svg} into `out_dir`.
-pub fn run_report(gpu: &Gpu, out_dir: &Path, data_dir: Option<&Path>, repeats: usize) -> Result<WrittenReport> {
+pub fn run_report(gpu: &Device, out_dir: &Path, data_dir: Option<&Path>, repeats: usize) -> Result<WrittenReport> {
     run_report_with_cases(gpu, out_dir, data_dir, &[], repeats)
 }
 
 /// [`run_report`] plus user cases (see [`cyclopean::cyclopean_case_rows`]).
 pub fn run_report_with_cases(
-    gpu: &Gpu,
+    gpu: &Device,
     out_dir: &Path,
     data_dir: Option<&Path>,
     cases: &[PathBuf],
@@ -102,7 +103,7 @@ pub fn run_report_with_cases(
 /// [`run_report_with_cases`] with each stage reported to `progress` as it starts, and the
 /// optical-flow peer's middle views read from `flow_peer` (see [`flow_peer`]; needs `data_dir`).
 pub fn run_report_with_progress(
-    gpu: &Gpu,
+    gpu: &Device,
     out_dir: &Path,
     data_dir: Option<&Path>,
     cases: &[PathBuf],
@@ -130,7 +131,7 @@ fn has_cyclopean_data(dir: &Path) -> bool {
 /// The report, its stages counted in `stages` (see [`report_stage_count`]); with `flow_peer`
 /// (and `data_dir`), the peer's row beside viewsynth's for every real pair with a true middle view.
 pub fn report_stages(
-    gpu: &Gpu,
+    gpu: &Device,
     out_dir: &Path,
     data_dir: Option<&Path>,
     cases: &[PathBuf],
@@ -195,12 +196,12 @@ pub fn report_stages(
     }
     let report = Report {
         title: "viewsynth: error against run time".into(),
-        renderer: gpu.info().renderer.clone(),
+        renderer: gpu.renderer(),
         rows,
         notes,
     };
     let mut files = report.write(out_dir, "report")?;
     stages.start("report: every pass, GL against Vulkan");
-    files.push(backends::write_section(&viewsynth::pass::Device::gl(gpu)?, out_dir)?);
+    files.push(backends::write_section(gpu, out_dir)?);
     Ok(WrittenReport { report, files })
 }

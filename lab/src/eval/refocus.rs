@@ -5,13 +5,13 @@ use super::{score, timed};
 use crate::report::ReportRow;
 use viewsynth::convention::Conventions;
 use viewsynth::error::Result;
-use viewsynth::gpu::Gpu;
+use viewsynth::pass::Device;
 use viewsynth::refocus::manifest::TargetSpec;
 use viewsynth::refocus::{BreakRule, Method as RefocusMethod, OutputSet, RefocusSource, Refocuser};
 use viewsynth::scene;
 
 /// Refocus of the built-in scene against the scene ray-traced from each target camera.
-pub fn refocus_rows(gpu: &Gpu, repeats: usize) -> Result<Vec<ReportRow>> {
+pub fn refocus_rows(gpu: &Device, repeats: usize) -> Result<Vec<ReportRow>> {
     let cam = scene::demo_camera(640, 480);
     let (rgb, depth) = scene::render(&cam);
     let src = RefocusSource::new(rgb, depth, cam.k)?;

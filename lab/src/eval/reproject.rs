@@ -10,9 +10,10 @@ use viewsynth::cyclopean::scene_frame::{scene_frame, StereoRig};
 use viewsynth::cyclopean::FrameDepth;
 use viewsynth::depth::DepthEncoding;
 use viewsynth::error::Result;
-use viewsynth::gpu::{Gpu, Timing};
+use viewsynth::gpu::Timing;
 use viewsynth::io::{self, DepthDecode, DepthMap, RgbImage};
 use viewsynth::metrics;
+use viewsynth::pass::Device;
 use viewsynth::reproject::render::Reprojector;
 use viewsynth::reproject::{Geometry, Method, ReprojectOutput, ReprojectParams, ReprojectSource, ShiftModel};
 use viewsynth::ssim;
@@ -273,7 +274,12 @@ pub fn score(out: &ReprojectOutput, case: &Case) -> Result<Score> {
 }
 
 /// Median of `repeats` runs after one warm-up (shader JIT, allocations).
-pub fn run_timed(gpu: &Gpu, case: &Case, params: ReprojectParams, repeats: usize) -> Result<(ReprojectOutput, Timing)> {
+pub fn run_timed(
+    gpu: &Device,
+    case: &Case,
+    params: ReprojectParams,
+    repeats: usize,
+) -> Result<(ReprojectOutput, Timing)> {
     let mut r = Reprojector::new(gpu, &case.source, &case.geometry, params)?;
     r.render()?;
     let mut runs = Vec::new();
@@ -303,7 +309,7 @@ fn row(
 
 /// The general mesh warp of the foundation (the cyclopean forward warp with the source as the
 /// only eye and the target as the middle camera), for comparison with the shift methods.
-pub fn mesh_warp_timed(gpu: &Gpu, case: &Case, repeats: usize) -> Result<(ReprojectOutput, Timing)> {
+pub fn mesh_warp_timed(gpu: &Device, case: &Case, repeats: usize) -> Result<(ReprojectOutput, Timing)> {
     let (frame, target) = viewsynth::reproject::one_eye_frame(&case.source, &case.geometry)?;
     let mut warp =
         viewsynth::cyclopean::forward::ForwardWarp::new(gpu, &frame, &viewsynth::refocus::BreakRule::default())?;
@@ -345,7 +351,7 @@ fn mesh_row(case: &Case, scene: &str, out: &ReprojectOutput, t: Timing) -> Resul
 /// Rows for `viewsynth report`: the built-in scene at 640x480 (64 mm and 200 mm baselines, left
 /// eye with device depth and centre view -> right eye, against the ray-traced right eye), and,
 /// with `data_dir`, Middlebury 2014 Motorcycle and 2003 Teddy against their real right views.
-pub fn reproject_rows(gpu: &Gpu, data_dir: Option<&Path>, repeats: usize) -> Result<(Vec<ReportRow>, Vec<String>)> {
+pub fn reproject_rows(gpu: &Device, data_dir: Option<&Path>, repeats: usize) -> Result<(Vec<ReportRow>, Vec<String>)> {
     let mut rows = Vec::new();
     let mut notes = vec![
         "reproject: shift walk k = k fixed-point steps along the row from the zero-parallax guess and from the near bound, verified by segment coverage; shift scan = every segment the depth range allows, nearest wins; 3-D gather k = the cyclopean k-step walk with one eye. Disocclusions stay invalid; PSNR on pixels valid in the output (and with a surface in the truth for the built-in scene).".to_string(),

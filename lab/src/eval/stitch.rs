@@ -4,7 +4,7 @@
 use crate::report::ReportRow;
 use std::fmt::Write as _;
 use viewsynth::error::Result;
-use viewsynth::gpu::Gpu;
+use viewsynth::pass::Device;
 use viewsynth::stitch::faces::scene_faces;
 use viewsynth::stitch::render::StitchRenderer;
 use viewsynth::stitch::score::{score_eyes, split_top_bottom};
@@ -25,7 +25,7 @@ fn median(mut v: Vec<f64>) -> f64 {
 /// and SSIM over the same region. Faces 256 x 256, equirect 1024 x 512 per eye. Notes carry a
 /// Markdown table with MAE, the seam band's edge error and sharpness ([`StitchScore`]) and its
 /// PSNR split by truth distance.
-pub fn stitch_rows(gpu: &Gpu, repeats: usize) -> Result<(Vec<ReportRow>, Vec<String>)> {
+pub fn stitch_rows(gpu: &Device, repeats: usize) -> Result<(Vec<ReportRow>, Vec<String>)> {
     let rig = OdsRig::demo();
     let (n, w, h) = (256, 1024, 512);
     let truth = [ods_truth(&rig, Side::Left, w, h)?, ods_truth(&rig, Side::Right, w, h)?];

@@ -131,7 +131,7 @@ impl BenchJob {
 
     /// Measures.
     pub fn run(&self, host: &dyn Host) -> Result<BenchReport, JobError> {
-        let gpu = host.open_gpu(&self.gpu)?;
+        let gpu = host.open_device(&self.gpu, viewsynth::job::Backend::Gl)?;
         match &self.bench {
             Bench::Batch {
                 input,
@@ -172,7 +172,7 @@ impl BenchJob {
                     }
                     stages.stage(4, total, "bench: every pass, GL against Vulkan");
                     let vk = host.open_device(&self.vulkan_request(), viewsynth::job::Backend::Vulkan)?;
-                    let gl = viewsynth::pass::Device::gl(&gpu)?;
+                    let gl = gpu.clone();
                     let name = vk.renderer();
                     tables.push(crate::bench::passes::passes_bench(
                         &[("gl", gl), ("vulkan", vk)],
@@ -186,7 +186,7 @@ impl BenchJob {
                 host.event(Event::Finished);
                 let (tables, vulkan_device) = measured?;
                 Ok(BenchReport::Frames {
-                    renderer: gpu.info().renderer.clone(),
+                    renderer: gpu.renderer(),
                     tables,
                     cases,
                     vulkan_device,

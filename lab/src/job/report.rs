@@ -55,7 +55,7 @@ impl ReportJob {
             // A missing peer image fails the run before the GPU opens or a row is measured.
             crate::eval::flow_peer::check_flow_peer(data, peer)?;
         }
-        let gpu = host.open_gpu(&self.gpu)?;
+        let gpu = host.open_device(&self.gpu, viewsynth::job::Backend::Gl)?;
         let files = crate::eval::run_report_with_progress(
             &gpu,
             &self.out_dir,
@@ -83,7 +83,7 @@ pub struct DemoJob {
 impl DemoJob {
     /// Renders everything; returns the report, its files and, last, refocus_check.md.
     pub fn run(&self, host: &dyn Host) -> Result<WrittenReport, JobError> {
-        let gpu = host.open_gpu(&self.gpu)?;
+        let gpu = host.open_device(&self.gpu, viewsynth::job::Backend::Gl)?;
         let report = crate::demo::run_with_progress(&gpu, Path::new(&self.out_dir), &HostStages(host));
         host.event(Event::Finished);
         Ok(report?)

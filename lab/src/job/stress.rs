@@ -46,7 +46,7 @@ impl StressJob {
 
     /// Sweeps the cases: one row each.
     pub fn run(&self, host: &dyn Host) -> Result<Vec<StressRow>, JobError> {
-        let gpu = host.open_gpu(&self.gpu)?;
+        let gpu = host.open_device(&self.gpu, viewsynth::job::Backend::Gl)?;
         // One capability at a time, each a stage of the progress shown.
         let (stages, mut rows) = (HostStages(host), Vec::new());
         let total = self.capabilities.len();

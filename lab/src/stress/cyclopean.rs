@@ -27,8 +27,8 @@ use viewsynth::cyclopean::render::CyclopeanRenderer;
 use viewsynth::cyclopean::scene_frame::{scene_frame, StereoRig};
 use viewsynth::cyclopean::{CyclopeanParams, FrameDepth, Method, MiddleCamera, StereoFrame};
 use viewsynth::error::Result;
-use viewsynth::gpu::Gpu;
 use viewsynth::io::RgbImage;
+use viewsynth::pass::Device;
 
 /// Eye separation of the stress rig (metres) and the fixation distance of most cases.
 const IPD: f64 = 0.2011;
@@ -62,7 +62,7 @@ struct Case {
     mid: MiddleCamera,
 }
 
-fn sweep(gpu: &Gpu, case: &str, cases: &[Case], fixation: f64, tol: Tolerance, note: &str) -> Result<StressRow> {
+fn sweep(gpu: &Device, case: &str, cases: &[Case], fixation: f64, tol: Tolerance, note: &str) -> Result<StressRow> {
     let mut tally = Tally::default();
     for c in cases {
         for (name, params) in methods(fixation) {
@@ -108,7 +108,7 @@ fn scene_cases(rig: &StereoRig, convs: &[Conventions], kind: FrameDepth) -> Vec<
 const SCENE_Z_MAX: f64 = 8.0;
 
 /// The stress rows of cyclopean: each case's GPU output against the f64 reference.
-pub fn rows(gpu: &Gpu, opts: StressOptions) -> Result<Vec<StressRow>> {
+pub fn rows(gpu: &Device, opts: StressOptions) -> Result<Vec<StressRow>> {
     let (w, h) = if opts.quick { (96, 72) } else { (256, 192) };
     let all = Conventions::all();
     let (fine, lossy): (Vec<Conventions>, Vec<Conventions>) =

@@ -27,8 +27,8 @@ pub mod values;
 
 use serde::Serialize;
 use viewsynth::error::Result;
-use viewsynth::gpu::Gpu;
 use viewsynth::metrics;
+use viewsynth::pass::Device;
 
 /// f32 unit roundoff (2^-24).
 pub const EPS32: f64 = 5.960464477539063e-8;
@@ -283,7 +283,7 @@ pub struct StressOptions {
 pub const CAPABILITIES: [&str; 5] = ["camera", "refocus", "cyclopean", "reproject", "stitch"];
 
 /// Run the sweep over `capabilities` (names of [`CAPABILITIES`]).
-pub fn run_stress(gpu: &Gpu, capabilities: &[&str], opts: StressOptions) -> Result<Vec<StressRow>> {
+pub fn run_stress(gpu: &Device, capabilities: &[&str], opts: StressOptions) -> Result<Vec<StressRow>> {
     let mut rows = Vec::new();
     for cap in capabilities {
         match *cap {

@@ -15,8 +15,8 @@ use super::{test_texture, GpuPixels, RefPixels, StressOptions, StressRow, Tally,
 use viewsynth::camera::{Intrinsics, PinholeCamera};
 use viewsynth::convention::Conventions;
 use viewsynth::error::Result;
-use viewsynth::gpu::Gpu;
 use viewsynth::io::{DepthMap, RgbImage};
+use viewsynth::pass::Device;
 use viewsynth::refocus::manifest::TargetSpec;
 use viewsynth::refocus::reference::refocus_reference;
 use viewsynth::refocus::{BreakRule, Method, OutputSet, RefocusSource, Refocuser};
@@ -38,7 +38,7 @@ fn source(w: u32, h: u32, depth: impl Fn(u32, u32) -> f32) -> Result<RefocusSour
 }
 
 /// Run `src` at `scales` through both paths under two opposite conventions, pooled into a row.
-fn sweep(gpu: &Gpu, case: &str, src: &RefocusSource, scales: &[f64], note: &str) -> Result<StressRow> {
+fn sweep(gpu: &Device, case: &str, src: &RefocusSource, scales: &[f64], note: &str) -> Result<StressRow> {
     let rule = BreakRule::default();
     let targets = TargetSpec {
         scales: scales.to_vec(),
@@ -99,7 +99,7 @@ fn ties(src: &RefocusSource, t: &PinholeCamera) -> Vec<bool> {
 }
 
 /// The stress rows of refocus: each case's GPU output against the f64 reference.
-pub fn rows(gpu: &Gpu, opts: StressOptions) -> Result<Vec<StressRow>> {
+pub fn rows(gpu: &Device, opts: StressOptions) -> Result<Vec<StressRow>> {
     let (w, h) = if opts.quick { (96, 72) } else { (320, 240) };
     let mut rows = Vec::new();
 

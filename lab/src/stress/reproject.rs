@@ -23,8 +23,8 @@ use viewsynth::cyclopean::scene_frame::{scene_frame, StereoRig};
 use viewsynth::cyclopean::FrameDepth;
 use viewsynth::depth::DepthEncoding;
 use viewsynth::error::Result;
-use viewsynth::gpu::Gpu;
 use viewsynth::io::{DepthMap, RgbImage};
+use viewsynth::pass::Device;
 use viewsynth::reproject::reference::reproject_reference;
 use viewsynth::reproject::render::Reprojector;
 use viewsynth::reproject::{Geometry, ReprojectSource, ShiftModel};
@@ -43,7 +43,7 @@ struct Case {
     geometry: Geometry,
 }
 
-fn sweep(gpu: &Gpu, case: &str, cases: &[Case], tol: Tolerance, note: &str) -> Result<StressRow> {
+fn sweep(gpu: &Device, case: &str, cases: &[Case], tol: Tolerance, note: &str) -> Result<StressRow> {
     let mut tally = Tally::default();
     for c in cases {
         for params in methods() {
@@ -158,7 +158,7 @@ fn seed_shift(w: u32, separation: f64, convergence: f64) -> Result<ShiftModel> {
 }
 
 /// The stress rows of reproject: each case's GPU output against the f64 reference.
-pub fn rows(gpu: &Gpu, opts: StressOptions) -> Result<Vec<StressRow>> {
+pub fn rows(gpu: &Device, opts: StressOptions) -> Result<Vec<StressRow>> {
     let (w, h) = if opts.quick { (96, 72) } else { (256, 192) };
     let all = Conventions::all();
     let two = [Conventions::default(), all[7]];

@@ -8,7 +8,7 @@
 use super::{GpuPixels, RefPixels, StressOptions, StressRow, Tally, Tolerance};
 use viewsynth::convention::Conventions;
 use viewsynth::error::Result;
-use viewsynth::gpu::Gpu;
+use viewsynth::pass::Device;
 use viewsynth::stitch::faces::scene_faces;
 use viewsynth::stitch::reference::stitch_reference;
 use viewsynth::stitch::render::StitchRenderer;
@@ -33,7 +33,7 @@ fn faces(rig: &OdsRig, n: u32, overlap_deg: f64) -> Result<(FaceSet, FaceSet)> {
     ))
 }
 
-fn sweep(gpu: &Gpu, case: &str, cases: &[Case], note: &str) -> Result<StressRow> {
+fn sweep(gpu: &Device, case: &str, cases: &[Case], note: &str) -> Result<StressRow> {
     let mut tally = Tally::default();
     for c in cases {
         for conv in [Conventions::default(), Conventions::all()[7]] {
@@ -75,7 +75,7 @@ fn sweep(gpu: &Gpu, case: &str, cases: &[Case], note: &str) -> Result<StressRow>
 }
 
 /// The stress rows of stitch: each case's GPU output against the f64 reference.
-pub fn rows(gpu: &Gpu, opts: StressOptions) -> Result<Vec<StressRow>> {
+pub fn rows(gpu: &Device, opts: StressOptions) -> Result<Vec<StressRow>> {
     let (n, w, h) = if opts.quick { (48, 128, 64) } else { (128, 512, 256) };
     let rig = OdsRig::demo();
     let mut rows = Vec::new();

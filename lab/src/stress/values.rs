@@ -20,8 +20,8 @@ use viewsynth::cyclopean::splat::SplatParams;
 use viewsynth::cyclopean::{self, CyclopeanInput, CyclopeanOutputs, CyclopeanParams, CyclopeanPass, FrameDepth};
 use viewsynth::depth::clear_unusable_depth;
 use viewsynth::error::Result;
-use viewsynth::gpu::Gpu;
 use viewsynth::io::DepthMap;
+use viewsynth::pass::Device;
 use viewsynth::refocus::{self, BreakRule, Method, OutputSet, RefocusInput, RefocusSource};
 use viewsynth::reproject::{self, ReprojectInput};
 use viewsynth::stitch::{self, faces::scene_faces, OdsRig, Side, StitchInput, StitchParams};
@@ -188,7 +188,7 @@ fn values<T: Copy>(all: &[T], quick: bool) -> Vec<T> {
         .collect()
 }
 
-fn refocus_rows(gpu: &Gpu, opts: StressOptions) -> Result<Vec<StressRow>> {
+fn refocus_rows(gpu: &Device, opts: StressOptions) -> Result<Vec<StressRow>> {
     let cam = viewsynth::scene::demo_camera(32, 24);
     let (rgb, depth) = viewsynth::scene::render(&cam);
     let conv = Conventions::default();
@@ -274,7 +274,7 @@ fn pass_label(pass: &CyclopeanPass) -> &'static str {
     }
 }
 
-fn cyclopean_rows(gpu: &Gpu, opts: StressOptions) -> Result<Vec<StressRow>> {
+fn cyclopean_rows(gpu: &Device, opts: StressOptions) -> Result<Vec<StressRow>> {
     let conv = Conventions::default();
     let mut rows = Vec::new();
     for kind in [FrameDepth::ViewZ, FrameDepth::Device] {
@@ -342,7 +342,7 @@ fn cyclopean_rows(gpu: &Gpu, opts: StressOptions) -> Result<Vec<StressRow>> {
     Ok(rows)
 }
 
-fn reproject_rows(gpu: &Gpu, opts: StressOptions) -> Result<Vec<StressRow>> {
+fn reproject_rows(gpu: &Device, opts: StressOptions) -> Result<Vec<StressRow>> {
     let conv = Conventions::default();
     let mut rows = Vec::new();
     for kind in [FrameDepth::ViewZ, FrameDepth::Device] {
@@ -377,7 +377,7 @@ fn reproject_rows(gpu: &Gpu, opts: StressOptions) -> Result<Vec<StressRow>> {
     Ok(rows)
 }
 
-fn stitch_rows(gpu: &Gpu, opts: StressOptions) -> Result<Vec<StressRow>> {
+fn stitch_rows(gpu: &Device, opts: StressOptions) -> Result<Vec<StressRow>> {
     let rig = OdsRig::demo();
     let (l0, r0) = (
         scene_faces(&rig, Side::Left, 8, 100.0)?,
@@ -419,7 +419,7 @@ fn stitch_rows(gpu: &Gpu, opts: StressOptions) -> Result<Vec<StressRow>> {
 }
 
 /// The value-sweep rows of `capability` (none for `camera`, whose sweeps are its own rows).
-pub fn rows(gpu: &Gpu, capability: &str, opts: StressOptions) -> Result<Vec<StressRow>> {
+pub fn rows(gpu: &Device, capability: &str, opts: StressOptions) -> Result<Vec<StressRow>> {
     match capability {
         "refocus" => refocus_rows(gpu, opts),
         "cyclopean" => cyclopean_rows(gpu, opts),
