@@ -37,25 +37,31 @@ WORKDIR /src
 # library and the dependencies the binary's build made (same profile, same versions).
 ENV CARGO_TARGET_DIR=/src/target PYO3_PYTHON=python3
 # Dependencies first, in their own layer: placeholder crates with the real manifests and lock
-# files build every dependency, so editing src/, shaders/ or python/ rebuilds only viewsynth and
-# the extension. The root placeholder has a stand-in build.rs too, so that the build script's own
-# dependencies (gl_generator and the Khronos registries) are built in this layer; the real
-# build.rs reads shaders/ and comes with the sources. The placeholders' outputs are removed: the
-# real crates are never taken as built.
+# files build every dependency, so editing src/, lab/, cli/, shaders/ or python/ rebuilds only
+# the workspace's crates and the extension. The root placeholder has a stand-in build.rs too, so
+# that the build script's own dependencies (gl_generator and the Khronos registries) are built in
+# this layer; the real build.rs reads shaders/ and comes with the sources. The placeholders'
+# outputs are removed: the real crates are never taken as built.
 COPY Cargo.toml Cargo.lock ./
+COPY lab/Cargo.toml lab/
+COPY cli/Cargo.toml cli/
 COPY python/Cargo.toml python/Cargo.lock python/
-RUN mkdir -p src/bin/viewsynth python/src \
+RUN mkdir -p src lab/src cli/src python/src \
  && echo '' > src/lib.rs \
- && echo 'fn main() {}' > src/bin/viewsynth/main.rs \
+ && echo '' > lab/src/lib.rs \
+ && echo 'fn main() {}' > cli/src/main.rs \
  && echo 'fn main() {}' > build.rs \
  && echo '' > python/src/lib.rs \
  && cargo build --release --locked --bin viewsynth \
  && cargo build --release --locked --manifest-path python/Cargo.toml \
- && rm -rf src build.rs python/src target/release/.fingerprint/viewsynth-* target/release/build/viewsynth-* \
-      target/release/deps/viewsynth-* target/release/deps/libviewsynth-* target/release/viewsynth \
+ && rm -rf src lab/src cli/src build.rs python/src target/release/.fingerprint/viewsynth-* \
+      target/release/build/viewsynth-* target/release/deps/viewsynth-* target/release/deps/viewsynth_* \
+      target/release/deps/libviewsynth-* target/release/deps/libviewsynth_* target/release/viewsynth \
       target/release/deps/_viewsynth* target/release/deps/lib_viewsynth* target/release/lib_viewsynth*
 COPY build.rs ./
 COPY src src
+COPY lab/src lab/src
+COPY cli/src cli/src
 COPY shaders shaders
 RUN cargo build --release --locked --bin viewsynth
 # The wheel (abi3: any CPython >= 3.9), stripped, then installed with numpy into the venv the

@@ -10,7 +10,7 @@ between. So a stale figure in the README fails here.
 
 A few commands stand for work .ci/run has already done, or cannot do here; each is replaced by
 a check, or skipped, and said so (never silently):
-  - `cargo install ... --path .`: the `viewsynth` on PATH is .ci/run's target/release/viewsynth;
+  - `cargo install ... --path cli`: the `viewsynth` on PATH is .ci/run's target/release/viewsynth;
   - `cargo test --release`: .ci/run ran it before this script;
   - `pip install ... ./python[EXTRAS]`: ci/python-tests.sh installed the package into its venv,
     whose python is the one on PATH here; checked by importing the package and each extra;
@@ -27,7 +27,7 @@ import time
 # (pattern of a whole logical line, replacement or None to skip, why)
 SUBSTITUTIONS = [
     (
-        re.compile(r"cargo install (--locked )?--path \.(\s+#.*)?"),
+        re.compile(r"cargo install (--locked )?--path cli(\s+#.*)?"),
         '"$VIEWSYNTH_BIN" --version',
         "the `viewsynth` on PATH is the one .ci/run's `cargo test --release` built (target/release)",
     ),

@@ -212,7 +212,7 @@ def test_vulkan_renderer_matches_gl(renderer, pair):
 
         rgb, depth, K = make_frame()
         for ra, rb in zip(renderer.refocus(rgb, depth, K, scales=[0.5, 1.5]), vk.refocus(rgb, depth, K, scales=[0.5, 1.5])):
-            # The refocus bound of tests/integration/vulkan_refocus.rs: masks identical, colour
+            # The refocus bound of cli/tests/integration/vulkan_refocus.rs: masks identical, colour
             # within one level.
             assert np.array_equal(ra["mask"], rb["mask"])
             assert np.abs(ra["rgb"].astype(int) - rb["rgb"].astype(int)).max() <= 1

@@ -1,4 +1,4 @@
-"""The Python half of the front-end mapping test (the CLI half: src/bin/viewsynth/front_ends.rs).
+"""The Python half of the front-end mapping test (the CLI half: cli/src/front_ends.rs).
 
 Both read tests/data/front_ends.json: for each command with a library request, the option and
 keyword argument that fill each request field, and everything on one side only, with its reason.

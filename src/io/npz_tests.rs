@@ -1,5 +1,5 @@
 //! `.npz` archives built here as numpy writes them (stored, deflated, zip64 local headers),
-//! (the real Middlebury 2014 Motorcycle disparity: tests/integration/reproject.rs).
+//! (the real Middlebury 2014 Motorcycle disparity: cli/tests/integration/reproject.rs).
 
 use super::*;
 use crate::io::npy::build_npy;

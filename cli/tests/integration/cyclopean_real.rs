@@ -780,7 +780,7 @@ fn edge_pass_mixes_more_edge_pixels_than_the_work_group_limit() {
 
 /// Two images alone: the CLI estimates the disparities with the census matcher (its GPU pass)
 /// and renders as if they had been given. Oracle: the matcher's twin's disparities (the GPU
-/// pass is bit-exact with it, tests/integration/matcher.rs) written to files and given
+/// pass is bit-exact with it, cli/tests/integration/matcher.rs) written to files and given
 /// with --left-disparity/--right-disparity must give the same files, byte for byte. Options
 /// that decode disparity files, and a search range with disparities given, are usage errors.
 #[test]
@@ -803,7 +803,7 @@ fn cli_two_images_alone_render_the_matchers_disparities() {
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
     // Each eye's confidence file holds the matcher's confidence stage: its twin on the twin's
     // disparities, within the stage's GPU-vs-twin bound (CONFIDENCE_BOUND, derived beside it in
-    // tests/integration/matcher.rs), and exactly 0 where the disparity is unknown.
+    // cli/tests/integration/matcher.rs), and exactly 0 where the disparity is unknown.
     let twin = viewsynth::cyclopean::matcher::confidence_reference(&dl, &dr).unwrap();
     for (name, want, d) in [
         ("left_confidence.exr", &twin.0, &dl),

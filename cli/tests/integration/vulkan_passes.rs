@@ -10,7 +10,7 @@
 //! the same GLSL on the same f32 inputs (images in the same memory rows, parameter blocks of
 //! identical bytes), so the outputs differ only where the two compilers (Mesa's GLSL front end
 //! against glslang + SPIR-V to NIR) order or fuse f32 arithmetic differently. Each pass's own
-//! GPU-vs-f64 derivation (tests/integration/{reproject,scene,stitch,cyclopean}.rs) bounds either
+//! GPU-vs-f64 derivation (cli/tests/integration/{reproject,scene,stitch,cyclopean}.rs) bounds either
 //! backend's distance to the twin by e (depth: 3e-5 reproject, 2e-5 scene and gather), so two
 //! backends are within 2e of each other, inside 1e-4; a decision (mask, surface, rounding tie)
 //! flips only for values within a few ulp of a threshold, which the twin tests put at under
@@ -201,7 +201,7 @@ fn stitch_methods_agree_between_gl_and_vulkan_under_every_convention() {
 /// The splat-gather method (edge snap, splat with atomics, gather listing edge pixels, indirect
 /// edge pass rewriting the colour) on both executors, under every convention and both depth
 /// kinds, with and without colour (no colour: no edge pass). Its twin check on Vulkan is in
-/// tests/integration/cyclopean_real.rs.
+/// cli/tests/integration/cyclopean_real.rs.
 #[test]
 fn splat_gather_agrees_between_gl_and_vulkan_under_every_convention() {
     let (gl, vk) = devices();
