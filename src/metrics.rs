@@ -24,6 +24,12 @@ pub fn mask_iou(a: &[bool], b: &[bool]) -> f64 {
     }
 }
 
+/// Coverage: the fraction of `values` that `valid` accepts (0 for none at all). The one formula
+/// behind every "coverage" the library, the CLI's manifests and the Python package report.
+pub fn valid_fraction<T>(values: &[T], valid: impl Fn(&T) -> bool) -> f64 {
+    values.iter().filter(|v| valid(v)).count() as f64 / values.len().max(1) as f64
+}
+
 /// Rounds a 0..=255 f64 colour channel the way a UNORM8 render target stores it.
 pub fn quantize_u8(v: f64) -> u8 {
     v.round().clamp(0.0, 255.0) as u8
@@ -111,6 +117,14 @@ pub fn agreement(
 
 #[cfg(test)]
 mod tests {
+    #[test]
+    fn valid_fraction_counts_the_valid_share() {
+        assert_eq!(super::valid_fraction(&[0u8, 255, 1, 0], |m| *m != 0), 0.5);
+        assert_eq!(super::valid_fraction(&[true, true, true], |m| *m), 1.0);
+        // An empty image covers nothing (never NaN).
+        assert_eq!(super::valid_fraction::<f32>(&[], |z| *z > 0.0), 0.0);
+    }
+
     use super::*;
 
     #[test]

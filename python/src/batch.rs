@@ -13,7 +13,9 @@ use pyo3::types::{PyDict, PyList, PyMapping, PyString};
 use std::path::PathBuf;
 use viewsynth::convention::Conventions;
 use viewsynth::job::refocus::RefocusRequest;
-use viewsynth::refocus::batch::{load_manifest as read_manifest, run_batch, BatchFrame, BatchOptions};
+use viewsynth::refocus::batch::{
+    is_frame_folder_name, load_manifest as read_manifest, run_batch, BatchFrame, BatchOptions,
+};
 
 /// The keys a frame may have (a manifest's columns).
 const FRAME_KEYS: [&str; 9] = [
@@ -59,13 +61,13 @@ pub fn load_manifest<'py>(py: Python<'py>, path: PathBuf) -> PyResult<Bound<'py,
     Ok(list)
 }
 
-/// A frame name as the batch writes it: one safe folder name inside out_dir.
+/// A frame name as the batch writes it (the library's rule): one safe folder name inside out_dir.
+/// Refused, not renamed as a manifest's names are: the caller chose it and looks for it there.
 fn check_name(name: &str, at: &str) -> PyResult<()> {
-    let safe = name.chars().all(|c| c.is_ascii_alphanumeric() || "-_.".contains(c));
-    if name.is_empty() || name.starts_with('.') || !safe {
+    if !is_frame_folder_name(name) {
         return Err(errors::invalid(
             at,
-            format!("name '{name}': a frame's folder name must be non-empty, not start with '.', and hold only ASCII letters, digits, '-', '_', '.'"),
+            format!("name '{name}': a frame's folder name must be non-empty, not start with '.', be at most 255 bytes and hold only ASCII letters, digits, '-', '_', '.'"),
         ));
     }
     Ok(())

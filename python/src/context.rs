@@ -39,18 +39,9 @@ thread_local! {
     static OPEN: RefCell<Slot> = const { RefCell::new(Slot(None)) };
 }
 
-/// Parse "auto", "surfaceless" or an EGL device index (as the CLI's --device).
+/// The library's parse of "auto", "surfaceless" or an EGL device index (as the CLI's --device).
 pub fn parse_device(device: &str) -> PyResult<DeviceChoice> {
-    match device {
-        "auto" => Ok(DeviceChoice::Auto),
-        "surfaceless" => Ok(DeviceChoice::Surfaceless),
-        n => n.parse().map(DeviceChoice::Index).map_err(|_| {
-            errors::invalid(
-                "device",
-                format!("'{n}': expected \"auto\", \"surfaceless\" or an index"),
-            )
-        }),
-    }
+    device.parse().map_err(|e| errors::invalid("device", e))
 }
 
 /// This thread's context for `device`, opened on first use; each call counts one user.

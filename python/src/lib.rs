@@ -1,6 +1,6 @@
 //! Python bindings of the viewsynth library (not the CLI): numpy arrays in, numpy arrays out.
 //! The package `viewsynth` (python/viewsynth/) re-exports this module `viewsynth._viewsynth`.
-//! Arrays in memory: `renderer`, `cyclopean`, `reproject`, `stitch`; files in and out (the CLI
+//! Arrays in memory: `renderer` (the class), `refocus`, `cyclopean`, `reproject`, `stitch`; files in and out (the CLI
 //! batch's writers): `batch`.
 
 mod arrays;
@@ -12,11 +12,13 @@ mod cyclopean;
 mod errors;
 mod index;
 mod ints;
+mod refocus;
 mod renderer;
 mod reproject;
 mod shared;
 mod stack;
 mod stitch;
+mod thread_bound;
 
 use pyo3::prelude::*;
 use viewsynth::gpu::GpuInfo;

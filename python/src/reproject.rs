@@ -50,15 +50,8 @@ pub fn reproject<'py>(py: Python<'py>, gpu: Backend, a: ReprojectArgs<'_, 'py>) 
     }
     src.validate().map_err(errors::from_library)?;
     gpu.check_image_size("rgb", w, h).map_err(errors::from_library)?;
-    if src.inverse_depth_range().is_none() {
-        return Err(errors::invalid(
-            "depth",
-            format!(
-                "no pixel holds valid depth as depth_kind=\"{}\"",
-                request.depth_kind.option_value()
-            ),
-        ));
-    }
+    src.require_valid_depth(&format!("depth_kind=\"{}\"", request.depth_kind.option_value()))
+        .map_err(|e| errors::invalid("depth", e))?;
 
     // The inputs were copied out of numpy above; see SameThread for why the move is sound.
     let work = SameThread((gpu, src, plan));

@@ -27,6 +27,34 @@ pub enum DeviceChoice {
     Surfaceless,
 }
 
+/// A device string that is neither `auto`, `surfaceless` nor an EGL device index.
+#[derive(Debug, thiserror::Error)]
+#[error("'{value}': expected \"auto\", \"surfaceless\" or an index")]
+pub struct DeviceChoiceError {
+    /// The string given.
+    pub value: String,
+    /// Why it is no index.
+    #[source]
+    pub source: std::num::ParseIntError,
+}
+
+/// The one spelling of a device choice, shared by the CLI's `--device` and Python's `device=`:
+/// `auto`, `surfaceless` or an index as `viewsynth info` lists them.
+impl std::str::FromStr for DeviceChoice {
+    type Err = DeviceChoiceError;
+
+    fn from_str(s: &str) -> std::result::Result<Self, Self::Err> {
+        match s {
+            "auto" => Ok(DeviceChoice::Auto),
+            "surfaceless" => Ok(DeviceChoice::Surfaceless),
+            n => n.parse().map(DeviceChoice::Index).map_err(|source| DeviceChoiceError {
+                value: n.to_string(),
+                source,
+            }),
+        }
+    }
+}
+
 /// What the context runs on, for `viewsynth info` and reports.
 #[derive(Debug, Clone, serde::Serialize)]
 pub struct GpuInfo {
@@ -383,6 +411,29 @@ fn gl_info(
             auto_device: None,
             software: false,
             software_warning: None,
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::DeviceChoice;
+
+    #[test]
+    fn device_choice_parses_auto_surfaceless_or_an_index() {
+        assert_eq!("auto".parse::<DeviceChoice>().unwrap(), DeviceChoice::Auto);
+        assert_eq!(
+            "surfaceless".parse::<DeviceChoice>().unwrap(),
+            DeviceChoice::Surfaceless
+        );
+        assert_eq!("3".parse::<DeviceChoice>().unwrap(), DeviceChoice::Index(3));
+        for bad in ["gpu0", "-1", "", "Auto"] {
+            let e = bad.parse::<DeviceChoice>().unwrap_err();
+            assert_eq!(e.value, bad);
+            assert_eq!(
+                e.to_string(),
+                format!("'{bad}': expected \"auto\", \"surfaceless\" or an index")
+            );
         }
     }
 }

@@ -30,7 +30,7 @@ mod vertex_array;
 pub use buffer::{IndexBuffer, StorageBuffer, UniformBuffer};
 pub use census::LiveObjects;
 pub use devices::EglDevice;
-pub use egl::{DeviceChoice, EglContext, GpuInfo};
+pub use egl::{DeviceChoice, DeviceChoiceError, EglContext, GpuInfo};
 pub use framebuffer::{Attachment, Framebuffer};
 pub use limits::check_image_size;
 pub use policy::GpuPolicy;

@@ -69,6 +69,12 @@ impl DepthMap {
     pub fn get(&self, x: u32, y: u32) -> Option<f32> {
         self.data.get(pixel_index(self.width, self.height, x, y)?).copied()
     }
+
+    /// Fraction of pixels holding depth (Z > 0; NaN counts as none): an output's coverage
+    /// when no mask was rendered.
+    pub fn coverage(&self) -> f64 {
+        crate::metrics::valid_fraction(&self.data, |z| *z > 0.0)
+    }
 }
 
 impl Mask {
@@ -76,6 +82,11 @@ impl Mask {
     pub fn new(width: u32, height: u32, data: Vec<u8>) -> Result<Self> {
         check_len("Mask", width, height, 1, data.len())?;
         Ok(Self { width, height, data })
+    }
+
+    /// Fraction of pixels the mask marks valid (non-zero): an output's coverage.
+    pub fn coverage(&self) -> f64 {
+        crate::metrics::valid_fraction(&self.data, |m| *m != 0)
     }
 
     /// Value at column `x`, row `y` (top-down); `None` outside the mask.
@@ -142,6 +153,14 @@ pub(crate) fn encode_dims(path: &Path, width: u32, height: u32, channels: usize,
 
 #[cfg(test)]
 mod tests {
+    #[test]
+    fn coverage_of_masks_and_depth() {
+        let mask = super::Mask::new(2, 2, vec![0, 255, 1, 0]).unwrap();
+        assert_eq!(mask.coverage(), 0.5);
+        let depth = super::DepthMap::new(2, 2, vec![1.5, 0.0, f32::NAN, -1.0]).unwrap();
+        assert_eq!(depth.coverage(), 0.25);
+    }
+
     use super::*;
 
     #[test]

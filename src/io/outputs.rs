@@ -442,8 +442,7 @@ fn write_view_in(set: &mut FileSet, names: &ViewNames, view: &ViewOutput, format
         }
         // With a mask, coverage is the mask's (below): the depth is not counted again.
         if !outputs.mask {
-            let valid = depth.data.iter().filter(|z| **z > 0.0).count();
-            entry.coverage = Some(valid as f64 / depth.data.len().max(1) as f64);
+            entry.coverage = Some(depth.coverage());
         }
     }
     if outputs.mask {
@@ -453,8 +452,7 @@ fn write_view_in(set: &mut FileSet, names: &ViewNames, view: &ViewOutput, format
             super::mask::encode_mask_png(p, out, mask, enc.png)
         }));
         entry.mask = Some(name);
-        let valid = mask.data.iter().filter(|m| **m != 0).count();
-        entry.coverage = Some(valid as f64 / mask.data.len().max(1) as f64);
+        entry.coverage = Some(mask.coverage());
     }
     set.write_all(jobs)?;
     entry.depth_png16_clipped = clipped;

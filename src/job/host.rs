@@ -19,14 +19,12 @@ pub struct GpuRequest {
 impl GpuRequest {
     /// `device` as `--device` takes it: `auto`, `surfaceless` or an index from `viewsynth info`.
     pub fn new(device: &str, require_hardware: bool) -> Result<Self, ArgError> {
-        let device = match device {
-            "auto" => DeviceChoice::Auto,
-            "surfaceless" => DeviceChoice::Surfaceless,
-            n => DeviceChoice::Index(n.parse().map_err(|source| ArgError::Device {
-                value: n.to_string(),
-                source,
-            })?),
-        };
+        let device = device
+            .parse()
+            .map_err(|e: crate::gpu::DeviceChoiceError| ArgError::Device {
+                value: e.value,
+                source: e.source,
+            })?;
         Ok(GpuRequest {
             device,
             policy: GpuPolicy { require_hardware },

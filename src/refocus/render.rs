@@ -59,6 +59,18 @@ pub struct RefocusOutput {
     pub readback_ms: f64,
 }
 
+impl RefocusOutput {
+    /// Fraction of pixels that hold a value, as the manifest reports it: the mask's when one was
+    /// rendered, else the depth's (Z > 0); None with colour alone (colour has no "invalid").
+    pub fn coverage(&self) -> Option<f64> {
+        match (&self.mask, &self.depth) {
+            (Some(mask), _) => Some(mask.coverage()),
+            (None, Some(depth)) => Some(depth.coverage()),
+            (None, None) => None,
+        }
+    }
+}
+
 /// The uploaded source: its camera and the images that hold it (in [`SourceImages`]).
 struct Source {
     camera: PinholeCamera,
@@ -435,5 +447,43 @@ impl Refocuser {
             outputs: o,
             run,
         })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::camera::Intrinsics;
+
+    fn output(depth: Option<Vec<f32>>, mask: Option<Vec<u8>>) -> RefocusOutput {
+        RefocusOutput {
+            camera: PinholeCamera {
+                k: Intrinsics {
+                    fx: 2.0,
+                    fy: 2.0,
+                    cx: 1.0,
+                    cy: 1.0,
+                },
+                width: 2,
+                height: 2,
+            },
+            rgb: None,
+            depth: depth.map(|d| DepthMap::new(2, 2, d).unwrap()),
+            mask: mask.map(|m| Mask::new(2, 2, m).unwrap()),
+            render: Timing {
+                gpu_ms: None,
+                wall_ms: 0.0,
+            },
+            readback_ms: 0.0,
+        }
+    }
+
+    #[test]
+    fn coverage_is_the_masks_else_the_depths() {
+        // The mask decides when both are there (here it disagrees with the depth on purpose).
+        let both = output(Some(vec![1.0, 1.0, 1.0, 0.0]), Some(vec![1, 0, 0, 0]));
+        assert_eq!(both.coverage(), Some(0.25));
+        assert_eq!(output(Some(vec![1.0, 1.0, 1.0, 0.0]), None).coverage(), Some(0.75));
+        assert_eq!(output(None, None).coverage(), None);
     }
 }

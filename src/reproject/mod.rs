@@ -107,6 +107,22 @@ impl ReprojectSource {
                 Some((lo, hi)) => Some((f64::min(lo, q), f64::max(hi, q))),
             })
     }
+
+    /// Refuse a source with no valid depth at all (nothing to reproject: every target pixel
+    /// would be invalid); `read_as` names the encoding the depth was read as, for the message.
+    pub fn require_valid_depth(&self, read_as: &str) -> std::result::Result<(f64, f64), NoValidDepth> {
+        self.inverse_depth_range().ok_or_else(|| NoValidDepth {
+            read_as: read_as.to_string(),
+        })
+    }
+}
+
+/// A reprojection source whose depth holds no valid pixel as it was read.
+#[derive(Debug, thiserror::Error)]
+#[error("no pixel holds valid depth as {read_as}")]
+pub struct NoValidDepth {
+    /// The encoding the depth was read as (e.g. `depth_kind="device"`).
+    pub read_as: String,
 }
 
 /// The shift between two views of a parallel rig in pixels: source column s at inverse depth q
@@ -293,7 +309,7 @@ pub struct ReprojectOutput {
 impl ReprojectOutput {
     /// Fraction of target pixels the mask marks valid.
     pub fn coverage(&self) -> f64 {
-        self.mask.iter().filter(|m| **m != 0).count() as f64 / self.mask.len().max(1) as f64
+        crate::metrics::valid_fraction(&self.mask, |m| *m != 0)
     }
 }
 
@@ -459,6 +475,20 @@ pub(crate) fn check(
 mod tests {
     use super::*;
     use crate::camera::stereo::reproject_texture_x;
+
+    #[test]
+    fn a_source_without_valid_depth_is_refused_by_name() {
+        let source = |z: Vec<f32>| ReprojectSource {
+            color: RgbImage::new(2, 1, vec![0; 6]).unwrap(),
+            depth: DepthMap::new(2, 1, z).unwrap(),
+            depth_kind: DepthEncoding::ViewZ,
+            conv: Conventions::default(),
+        };
+        let e = source(vec![0.0, f32::NAN]).require_valid_depth("view Z").unwrap_err();
+        assert_eq!(e.to_string(), "no pixel holds valid depth as view Z");
+        let (lo, hi) = source(vec![2.0, 4.0]).require_valid_depth("view Z").unwrap();
+        assert_eq!((lo, hi), (0.25, 0.5));
+    }
 
     #[test]
     fn seed_model_matches_reproject_texture_x_in_pixels() {

@@ -325,9 +325,8 @@ impl ReprojectJob {
             summary: &src.depth_kind.summary(&src.conv, &src.depth),
             hint: &format!("read as {what}"),
         });
-        if src.inverse_depth_range().is_none() {
-            return Err(crate::Error::decode(&self.depth, format!("no pixel holds valid depth as {what}")).into());
-        }
+        src.require_valid_depth(what)
+            .map_err(|e| crate::Error::decode(&self.depth, e.to_string()))?;
         Ok(src)
     }
 

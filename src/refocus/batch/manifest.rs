@@ -105,18 +105,8 @@ pub fn load_manifest(path: &Path) -> Result<Vec<BatchFrame>> {
             .map(|s| s.to_string_lossy().into_owned())
             .unwrap_or_default();
         let name = f.name.clone().unwrap_or_else(|| format!("{i:05}_{stem}"));
-        let safe: String = name
-            .chars()
-            .map(|c| {
-                if c.is_ascii_alphanumeric() || "-_.".contains(c) {
-                    c
-                } else {
-                    '_'
-                }
-            })
-            .collect();
-        // A folder name: at most 255 bytes (NAME_MAX), so a huge cell is refused here, quoted short.
-        if safe.is_empty() || safe.starts_with('.') || safe.len() > 255 || !seen.insert(safe.clone()) {
+        let safe = frame_folder_name(&name);
+        if !is_frame_folder_name(&safe) || !seen.insert(safe.clone()) {
             return Err(Error::decode(
                 path,
                 format!(
@@ -128,6 +118,24 @@ pub fn load_manifest(path: &Path) -> Result<Vec<BatchFrame>> {
         f.name = Some(safe);
     }
     Ok(frames)
+}
+
+/// `name` with every character a frame's folder name may not hold (all but ASCII letters,
+/// digits, '-', '_', '.') replaced by '_': what [`load_manifest`] makes of a manifest's names.
+pub fn frame_folder_name(name: &str) -> String {
+    name.chars().map(|c| if folder_char(c) { c } else { '_' }).collect()
+}
+
+/// Whether `name` is one safe folder inside the output folder as it stands: non-empty, not
+/// hidden (no leading '.', so never `.` or `..`), at most 255 bytes (NAME_MAX, so a huge name is
+/// refused before any write) and only ASCII letters, digits, '-', '_', '.'. A manifest's names
+/// are made so ([`frame_folder_name`]); frames named by a caller (Python's refocus_batch) must be.
+pub fn is_frame_folder_name(name: &str) -> bool {
+    !name.is_empty() && !name.starts_with('.') && name.len() <= 255 && name.chars().all(folder_char)
+}
+
+fn folder_char(c: char) -> bool {
+    c.is_ascii_alphanumeric() || "-_.".contains(c)
 }
 
 /// One manifest row as the CSV gives it: columns found by header name (others ignored),
@@ -273,6 +281,24 @@ fn csv_error(path: &Path, header: &csv::StringRecord, record: Option<&csv::Strin
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn frame_folder_names_are_safe_or_made_so() {
+        for ok in ["00003_left", "a.b-c_d", "x"] {
+            assert!(is_frame_folder_name(ok), "{ok}");
+            assert_eq!(frame_folder_name(ok), ok);
+        }
+        for bad in ["", ".hidden", "..", "a/b", "../up", "ü", "a b"] {
+            assert!(!is_frame_folder_name(bad), "{bad:?}");
+        }
+        assert!(!is_frame_folder_name(&"a".repeat(256)));
+        assert!(is_frame_folder_name(&"a".repeat(255)));
+        // Renaming keeps what is safe and replaces the rest, one '_' per character.
+        assert_eq!(frame_folder_name("a/b ü"), "a_b__");
+        assert!(is_frame_folder_name(&frame_folder_name("a/b ü")));
+        // A leading '.' survives renaming: such a name stays refused, never made visible.
+        assert!(!is_frame_folder_name(&frame_folder_name("../x")));
+    }
 
     #[test]
     fn csv_manifest_resolves_paths_and_names_frames() {

@@ -26,7 +26,8 @@ mod zoom;
 
 pub use index::{join_index, read_index, write_index, IndexRow, INDEX_NAME};
 pub use manifest::{
-    load_manifest, BatchFrame, MAX_JSON_MANIFEST_BYTES, MAX_MANIFEST_BYTES, MAX_MANIFEST_ROWS, MAX_MANIFEST_ROW_BYTES,
+    frame_folder_name, is_frame_folder_name, load_manifest, BatchFrame, MAX_JSON_MANIFEST_BYTES, MAX_MANIFEST_BYTES,
+    MAX_MANIFEST_ROWS, MAX_MANIFEST_ROW_BYTES,
 };
 pub use pipeline::{run_batch, BatchSummary, StageTimes};
 pub use zoom::{ZoomRandom, MAX_SAMPLES};
