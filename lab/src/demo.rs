@@ -101,7 +101,7 @@ pub fn run_with_progress(
                 &reference.depth,
                 &reference.mask,
             );
-            let coverage = mask.iter().filter(|m| **m).count() as f64 / mask.len() as f64;
+            let coverage = viewsynth::metrics::valid_fraction(&mask, |m| *m);
             writeln!(
                 table,
                 "| {name} | {scale} | {:.1} | {:.2} | {:.2} | {:.1} | {:.2e} | {:.5} | {:.1} |",

@@ -73,7 +73,7 @@ pub(crate) fn score(
         row.depth_abs_mean = Some(dabs / nz as f64);
         row.depth_rel_mean = Some(drel / nz as f64);
     }
-    row.coverage = Some(mask.iter().filter(|m| **m).count() as f64 / mask.len().max(1) as f64);
+    row.coverage = Some(viewsynth::metrics::valid_fraction(&mask, |m| *m));
 }
 
 /// Run everything and write report.{md,csv,svg} into `out_dir`.

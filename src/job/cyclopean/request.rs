@@ -753,11 +753,8 @@ impl CyclopeanPlan {
                 })
                 .collect(),
         )?;
-        let rendered = out
-            .sources
-            .iter()
-            .filter(|s| ![0, FILLED, FROM_HISTORY].contains(*s))
-            .count();
+        // Seen by an eye in this frame: neither unseen, filled nor carried from history.
+        let coverage = crate::metrics::valid_fraction(&out.sources, |s| ![0, FILLED, FROM_HISTORY].contains(s));
         // Some methods render planes that were not asked for: keep only those that were.
         let view = ViewOutput {
             width: mid.width,
@@ -770,7 +767,7 @@ impl CyclopeanPlan {
         };
         Ok(Synthesised {
             view,
-            coverage: rendered as f64 / out.sources.len().max(1) as f64,
+            coverage,
             setup_ms,
         })
     }
