@@ -25,6 +25,7 @@
 //! - [`gpu`]: the EGL context and device choice, RAII GL objects, programs, readback, timers.
 //! - [`progress`]: the stages of long runs (demo, report) handed to the caller.
 //! - [`view`]: the output shape shared by every GPU pass and its f64 twin.
+//! - [`output`]: the output layer, a view's files written into an all-or-none file set.
 //! - [`metrics`]: error measures of the tests, reports and benchmarks (PSNR, masks, depth).
 //! - [`ssim`]: structural similarity, f64.
 //! - [`scene`]: ground-truth scenes as data, ray-traced in f64 and on the GPU.
@@ -62,6 +63,7 @@ pub mod gpu;
 pub mod io;
 pub mod job;
 pub mod metrics;
+pub mod output;
 pub mod pass;
 pub mod progress;
 pub mod refocus;

@@ -24,15 +24,18 @@ use std::path::{Path, PathBuf};
 /// ARCHITECTURE.md's picture.
 const LAYERS: &[(&str, &[&str])] = &[
     ("error", &["error.rs", "lib.rs"]),
+    ("conventions", &["convention.rs"]),
     ("files", &["io/", "alloc.rs", "cpu_time.rs"]),
-    ("maths", &["camera/", "convention.rs", "test_rng.rs"]),
+    ("maths", &["camera/", "test_rng.rs"]),
     ("data", &["depth/", "metrics.rs"]),
-    ("GPU layer", &["gpu/"]),
     ("pass descriptions", &["pass/"]),
-    ("executors", &["gpu/executor.rs", "vulkan/", "vulkan_off.rs"]),
+    ("backends", &["gpu/", "vulkan/", "vulkan_off.rs"]),
     ("view", &["view.rs", "progress.rs"]),
     ("output", &["output.rs", "output/"]),
-    ("capabilities", &["refocus/", "cyclopean/", "reproject/", "stitch/", "scene/"]),
+    (
+        "capabilities",
+        &["refocus/", "cyclopean/", "reproject/", "stitch/", "scene/"],
+    ),
     ("checking", &["compare/"]),
     ("jobs", &["job/"]),
 ];
@@ -40,14 +43,26 @@ const LAYERS: &[(&str, &[&str])] = &[
 /// Files leaving the library for the lab crate (issue 37): not scanned here; the lab's own
 /// imports are its crate's business (it sits above the library).
 const LEAVING: &[&str] = &[
-    "eval/", "report/", "bench/", "stress/", "demo.rs", "ssim.rs", "job/bench.rs", "job/report.rs", "job/stress.rs",
+    "eval/",
+    "report/",
+    "bench/",
+    "stress/",
+    "demo.rs",
+    "ssim.rs",
+    "job/bench.rs",
+    "job/report.rs",
+    "job/stress.rs",
 ];
 
 fn layer_of(file: &str) -> Option<usize> {
     let mut best: Option<(usize, usize)> = None;
     for (i, (_, prefixes)) in LAYERS.iter().enumerate() {
         for p in prefixes.iter() {
-            let hit = if p.ends_with('/') { file.starts_with(p) } else { file == *p };
+            let hit = if p.ends_with('/') {
+                file.starts_with(p)
+            } else {
+                file == *p
+            };
             if hit && best.is_none_or(|(len, _)| p.len() > len) {
                 best = Some((p.len(), i));
             }
@@ -86,7 +101,8 @@ fn strip(src: &str) -> String {
                     i += 1;
                 }
             }
-        } else if b[i] == b'r' && (b[i..].starts_with(b"r\"") || b[i..].starts_with(b"r#")) && !ident_byte_before(b, i) {
+        } else if b[i] == b'r' && (b[i..].starts_with(b"r\"") || b[i..].starts_with(b"r#")) && !ident_byte_before(b, i)
+        {
             let mut j = i + 1;
             let mut hashes = 0;
             while j < b.len() && b[j] == b'#' {
@@ -321,7 +337,12 @@ fn parse(rel: &str, text: &str) -> File {
         }
         k += 1;
     }
-    File { rel: rel.to_string(), module, paths, uses }
+    File {
+        rel: rel.to_string(),
+        module,
+        paths,
+        uses,
+    }
 }
 
 /// `crate::a::b` / `super::x` / `self::y` written in module `m` -> absolute segments.
@@ -409,13 +430,24 @@ fn import_graph() -> BTreeMap<String, BTreeSet<String>> {
     let mut files = Vec::new();
     for p in found {
         let rel = p.strip_prefix(&root).unwrap().to_string_lossy().replace('\\', "/");
-        if rel.starts_with("bin/") || LEAVING.iter().any(|l| if l.ends_with('/') { rel.starts_with(l) } else { rel == *l }) {
+        if rel.starts_with("bin/")
+            || LEAVING.iter().any(|l| {
+                if l.ends_with('/') {
+                    rel.starts_with(l)
+                } else {
+                    rel == *l
+                }
+            })
+        {
             continue;
         }
         let text = fs::read_to_string(&p).unwrap();
         files.push(parse(&rel, &text));
     }
-    let mut krate = Crate { modules: BTreeMap::new(), uses: BTreeMap::new() };
+    let mut krate = Crate {
+        modules: BTreeMap::new(),
+        uses: BTreeMap::new(),
+    };
     // Files that `#[path]` brings in under another name are their own modules only through
     // that attribute; the others are where their path says.
     for f in &files {
@@ -423,7 +455,10 @@ fn import_graph() -> BTreeMap<String, BTreeSet<String>> {
     }
     for f in &files {
         for (m, name, abs) in &f.uses {
-            krate.uses.entry((m.clone(), name.clone())).or_insert_with(|| abs.clone());
+            krate
+                .uses
+                .entry((m.clone(), name.clone()))
+                .or_insert_with(|| abs.clone());
         }
     }
     let mut graph: BTreeMap<String, BTreeSet<String>> = BTreeMap::new();
@@ -517,12 +552,22 @@ fn no_circle_between_the_library_s_files() {
         .map(|c| {
             let edges: Vec<String> = c
                 .iter()
-                .flat_map(|a| graph[a].iter().filter(|b| c.contains(b)).map(move |b| format!("{a} -> {b}")))
+                .flat_map(|a| {
+                    graph[a]
+                        .iter()
+                        .filter(|b| c.contains(b))
+                        .map(move |b| format!("{a} -> {b}"))
+                })
                 .collect();
             format!("[{}]", edges.join(", "))
         })
         .collect();
-    assert!(found.is_empty(), "{} circle(s) between files under src/:\n{}", found.len(), shown.join("\n"));
+    assert!(
+        found.is_empty(),
+        "{} circle(s) between files under src/:\n{}",
+        found.len(),
+        shown.join("\n")
+    );
 }
 
 #[test]
@@ -542,8 +587,53 @@ fn no_import_runs_from_a_lower_layer_to_a_higher_one() {
             }
         }
     }
-    assert!(unplaced.is_empty(), "files under src/ in no layer of the table: {unplaced:?}");
-    assert!(upward.is_empty(), "{} import(s) run up the layers:\n{}", upward.len(), upward.join("\n"));
+    assert!(
+        unplaced.is_empty(),
+        "files under src/ in no layer of the table: {unplaced:?}"
+    );
+    assert!(
+        upward.is_empty(),
+        "{} import(s) run up the layers:\n{}",
+        upward.len(),
+        upward.join("\n")
+    );
+}
+
+/// The two backends are mirror images over `pass/`: each holds its API and its executor,
+/// neither imports the other, and `pass/` (below both) imports neither.
+#[test]
+fn the_backends_are_mirror_images_over_the_pass_layer() {
+    let graph = import_graph();
+    let backend = |f: &str| {
+        if f.starts_with("gpu/") {
+            Some("gpu")
+        } else if f.starts_with("vulkan/") || f == "vulkan_off.rs" {
+            Some("vulkan")
+        } else {
+            None
+        }
+    };
+    let mut crossing = Vec::new();
+    for (from, tos) in &graph {
+        for to in tos {
+            let (bf, bt) = (backend(from), backend(to));
+            let across = bf.is_some() && bt.is_some() && bf != bt;
+            if across || (from.starts_with("pass/") && bt.is_some()) {
+                crossing.push(format!("{from} -> {to}"));
+            }
+        }
+    }
+    assert!(
+        crossing.is_empty(),
+        "imports across the backends:\n{}",
+        crossing.join("\n")
+    );
+    for executor in ["gpu/executor.rs", "vulkan/executor.rs"] {
+        assert!(
+            graph.contains_key(executor),
+            "{executor} is gone: the executors sit beside their APIs"
+        );
+    }
 }
 
 /// The scan itself: a use tree, a re-export followed to its file, a test module left out.
@@ -566,11 +656,23 @@ fn the_scan_resolves_use_trees_and_re_exports() {
             s(&["depth", "g"]),
         ]
     );
-    let mut krate = Crate { modules: BTreeMap::new(), uses: BTreeMap::new() };
-    for (m, file) in [(vec![], "lib.rs"), (s(&["io"]), "io/mod.rs"), (s(&["io", "encoding"]), "io/encoding.rs")] {
+    let mut krate = Crate {
+        modules: BTreeMap::new(),
+        uses: BTreeMap::new(),
+    };
+    for (m, file) in [
+        (vec![], "lib.rs"),
+        (s(&["io"]), "io/mod.rs"),
+        (s(&["io", "encoding"]), "io/encoding.rs"),
+    ] {
         krate.modules.insert(m, file.to_string());
     }
-    krate.uses.insert((s(&["io"]), "Encoding".into()), s(&["io", "encoding", "Encoding"]));
-    assert_eq!(krate.resolve(&s(&["io", "Encoding"]), 0).as_deref(), Some("io/encoding.rs"));
+    krate
+        .uses
+        .insert((s(&["io"]), "Encoding".into()), s(&["io", "encoding", "Encoding"]));
+    assert_eq!(
+        krate.resolve(&s(&["io", "Encoding"]), 0).as_deref(),
+        Some("io/encoding.rs")
+    );
     assert_eq!(krate.resolve(&s(&["io", "load"]), 0).as_deref(), Some("io/mod.rs"));
 }

@@ -1,6 +1,6 @@
 //! Refocus targets and their manifest: which targets to render (focal list or zoom scales,
 //! output size, principal point), the file-name tags, and `manifest.json` describing what was
-//! written (the files themselves are written by the output layer, [`io::write_view`]).
+//! written (the files themselves are written by the output layer, [`crate::output::write_view`]).
 
 use super::RefocusOutput;
 use crate::camera::{Intrinsics, PinholeCamera};
@@ -210,7 +210,7 @@ pub fn write_target(
         timing: Some(render),
         exact: None,
     };
-    let written = io::write_view(set, &ViewNames::tagged(tag), &view, files)?;
+    let written = crate::output::write_view(set, &ViewNames::tagged(tag), &view, files)?;
     Ok(ManifestEntry {
         scale,
         intrinsics: camera.k,
