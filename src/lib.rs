@@ -42,8 +42,10 @@
 //!   (`bench::codecs`), GL against Vulkan (`bench::vulkan`).
 //! - [`stress`]: stiff and extreme cases of every capability, GPU f32 against f64.
 //! - [`demo`]: the built-in scene rendered, refocused and synthesised, with its report.
-//! - [`pass`]: backend-neutral pass descriptions and the GL executor; [`vulkan`]: the Vulkan
-//!   backend (ash) with its executor, running the same GLSL.
+//! - [`pass`]: backend-neutral pass descriptions and the vocabulary both executors share (the
+//!   shader library, timing, the GPU policy, the image-size rule); it knows no backend. [`gpu`]
+//!   holds the GL executor beside the GL layer, [`vulkan`] the Vulkan backend (ash) with its
+//!   executor, running the same GLSL: mirror images.
 //! - [`job`]: one checked job per command-line command, and the code that runs it.
 
 #![warn(missing_docs)]
