@@ -25,6 +25,7 @@
 //! - [`gpu`]: the EGL context and device choice, RAII GL objects, programs, readback, timers.
 //! - [`progress`]: the stages of long runs (demo, report) handed to the caller.
 //! - [`view`]: the output shape shared by every GPU pass and its f64 twin.
+//! - [`output`]: the output layer, a view's files written into an all-or-none file set.
 //! - [`ssim`]: structural similarity, f64.
 //! - [`metrics`]: error measures of the tests, reports and benchmarks (PSNR, masks, depth).
 //! - [`scene`]: ground-truth scenes as data, ray-traced in f64 and on the GPU.
@@ -33,8 +34,10 @@
 //! - [`reproject`]: one view of a stereo rig to another eye.
 //! - [`stitch`]: ODS 360 equirects from over-wide cube faces.
 //! - [`compare`]: two renderings compared across conventions, with CI thresholds.
-//! - [`pass`]: backend-neutral pass descriptions and the GL executor; [`vulkan`]: the Vulkan
-//!   backend (ash) with its executor, running the same GLSL.
+//! - [`pass`]: backend-neutral pass descriptions and the vocabulary both executors share (the
+//!   shader library, timing, the GPU policy, the image-size rule); it knows no backend. [`gpu`]
+//!   holds the GL executor beside the GL layer, [`vulkan`] the Vulkan backend (ash) with its
+//!   executor, running the same GLSL: mirror images.
 //! - [`job`]: one checked job per command-line command, and the code that runs it.
 //!
 //! The measuring lab (evaluation against ground truth, the report, benchmarks, stress cases and
@@ -55,6 +58,7 @@ pub mod gpu;
 pub mod io;
 pub mod job;
 pub mod metrics;
+pub mod output;
 pub mod pass;
 pub mod progress;
 pub mod refocus;

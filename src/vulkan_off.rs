@@ -10,7 +10,7 @@ mod devices;
 pub use devices::{auto_pick, check_policy, VulkanDeviceChoice, VulkanDeviceInfo};
 
 use crate::error::{Error, Result};
-use crate::gpu::GpuPolicy;
+use crate::pass::GpuPolicy;
 use std::convert::Infallible;
 use std::rc::Rc;
 

@@ -5,7 +5,8 @@
 //! holding an `Rc` of the context ([`Texture`], [`Framebuffer`], [`Program`], [`IndexBuffer`],
 //! [`VertexArray`], [`ImageBinding`], the pooled readback buffers and timer queries), labelled
 //! for debuggers (RenderDoc, apitrace) where KHR_debug exists. Programs come only from the
-//! shader library ([`shaders`]), which renders every `#define`. Fixed-function state is a
+//! shader library ([`shaders`], the pass layer's), which renders every `#define`. The GL
+//! executor of the passes (`executor.rs`) sits here too, mirroring `crate::vulkan`. Fixed-function state is a
 //! [`DrawState`] value applied for one [`RenderPass`] and restored after it (`state.rs`).
 //! Reads go through the one streaming readback (`readback.rs`, [`Framebuffer::read_async`]).
 //! The raw context (`Gpu::gl`) is private to this folder.
@@ -14,32 +15,35 @@ mod buffer;
 mod census;
 pub mod devices;
 mod egl;
+mod executor;
 mod framebuffer;
 mod khronos;
-mod limits;
 pub mod pixels;
 mod policy;
 mod program;
 mod readback;
-pub mod shaders;
 mod state;
 mod texture;
 mod timer;
 mod vertex_array;
 
-pub use buffer::{IndexBuffer, StorageBuffer, UniformBuffer};
+pub use buffer::IndexBuffer;
 pub use census::LiveObjects;
 pub use devices::EglDevice;
-pub use egl::{DeviceChoice, DeviceChoiceError, EglContext, GpuInfo};
+pub use egl::{DeviceChoice, DeviceChoiceError, GpuInfo};
 pub use framebuffer::{Attachment, Framebuffer};
-pub use limits::check_image_size;
-pub use policy::GpuPolicy;
-pub use program::Program;
-pub use readback::{PendingRead, ReadFormat};
-pub use shaders::{ProgramKind, ShaderProgram};
-pub use state::{DepthTest, DrawState, RenderPass};
-pub use texture::{ImageBinding, Texture, TextureFormat};
-pub use timer::{DeferredTimer, GpuTimer, Timing};
+pub use readback::ReadFormat;
+pub use texture::TextureFormat;
+// Sealed: the wrappers only the GL code (its executor included) uses.
+pub(crate) use buffer::{StorageBuffer, UniformBuffer};
+pub(crate) use egl::EglContext;
+pub(crate) use program::Program;
+pub(crate) use readback::PendingRead;
+pub(crate) use state::DrawState;
+pub(crate) use texture::Texture;
+pub(crate) use timer::DeferredTimer;
+// The shared vocabulary of both executors (the pass layer below), under its old names here.
+pub use crate::pass::{check_image_size, shaders, GpuPolicy, ProgramKind, ShaderProgram, Timing};
 pub use vertex_array::VertexArray;
 
 use crate::error::{Error, Result};
@@ -159,33 +163,11 @@ impl Gpu {
         }
     }
 
-    /// Order shader image writes before what `barrier` names reads them.
-    pub fn memory_barrier(&self, barrier: Barrier) {
-        let bits = match barrier {
-            Barrier::ImageAccess => glow::SHADER_IMAGE_ACCESS_BARRIER_BIT,
-            Barrier::TextureFetch => glow::TEXTURE_FETCH_BARRIER_BIT,
-            Barrier::StorageAndCommand => glow::SHADER_STORAGE_BARRIER_BIT | glow::COMMAND_BARRIER_BIT,
-            Barrier::Framebuffer => glow::FRAMEBUFFER_BARRIER_BIT,
-            Barrier::All => glow::ALL_BARRIER_BITS,
-        };
+    /// Orders every earlier shader write (images, storage buffers, attachments) before every
+    /// later read, indirect arguments included: the pass executor puts one between steps it
+    /// cannot tell apart.
+    pub(crate) fn memory_barrier(&self) {
         // SAFETY: plain synchronisation command.
-        unsafe { self.gl().memory_barrier(bits) }
+        unsafe { self.gl().memory_barrier(glow::ALL_BARRIER_BITS) }
     }
-}
-
-/// What must see earlier shader image writes ([`Gpu::memory_barrier`]).
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum Barrier {
-    /// Later image loads, stores and atomics (a compute pass after another).
-    ImageAccess,
-    /// Later texel fetches (a draw sampling what a compute pass wrote).
-    TextureFetch,
-    /// Later storage-buffer reads and indirect dispatch arguments (a compute pass over a list
-    /// an earlier draw appended to a [`StorageBuffer`], sized by the count it kept there).
-    StorageAndCommand,
-    /// Later reads of framebuffer attachments, readback included (a compute pass rewrote some
-    /// texels of a colour attachment through an image).
-    Framebuffer,
-    /// Every kind above (the pass executor between steps it cannot tell apart).
-    All,
 }

@@ -3,7 +3,7 @@
 //! with numbered source so the line in the message can be found.
 
 use super::census::GlObject;
-use super::shaders::{ShaderFile, ShaderProgram};
+use super::shaders::{ShaderFile, ShaderProgram, Stage};
 use super::{Gpu, StorageBuffer};
 use crate::error::{Error, Result};
 use glow::HasContext;
@@ -44,6 +44,24 @@ fn stage_source(preamble: &str, files: &[ShaderFile]) -> String {
     source
 }
 
+/// The GL shader type of `stage`.
+fn gl_stage(stage: Stage) -> u32 {
+    match stage {
+        Stage::Vertex => glow::VERTEX_SHADER,
+        Stage::Fragment => glow::FRAGMENT_SHADER,
+        Stage::Compute => glow::COMPUTE_SHADER,
+    }
+}
+
+// The shader library's build step sits here, beside the program it makes, so the library
+// (`shaders.rs`, the programs as data) never names the GL program.
+impl ShaderProgram {
+    /// Compile and link on `gpu`.
+    pub fn build(&self, gpu: &Gpu) -> Result<Program> {
+        Program::from_library(gpu, self)
+    }
+}
+
 impl Program {
     /// Compile and link a program of the library.
     pub(super) fn from_library(gpu: &Gpu, spec: &ShaderProgram) -> Result<Self> {
@@ -58,7 +76,7 @@ impl Program {
             gpu.created(GlObject::Program);
             let mut shaders = Vec::new();
             for (stage, files) in &stages {
-                let shader = gl.create_shader(stage.gl()).map_err(Error::Gl)?;
+                let shader = gl.create_shader(gl_stage(*stage)).map_err(Error::Gl)?;
                 gl.shader_source(shader, &stage_source(&preamble, files));
                 gl.compile_shader(shader);
                 if !gl.get_shader_compile_status(shader) {
@@ -112,7 +130,7 @@ impl Program {
 
     /// Dispatch as many work groups as the 3 words at `offset_words` of `args` say (x, y, z),
     /// which an earlier pass wrote; the writes must be made visible first
-    /// ([`crate::gpu::Barrier::StorageAndCommand`]).
+    /// (`Gpu::memory_barrier`).
     pub fn dispatch_indirect(&self, args: &StorageBuffer, offset_words: usize) {
         self.bind();
         args.bind_dispatch_indirect();

@@ -4,7 +4,8 @@
 //! name opened with `O_CREAT | O_EXCL` (a planted symlink or file under that name makes the
 //! open fail, it is never followed or truncated), named `.viewsynth-<pid>-<random>`. Each is
 //! held under an exclusive `flock(2)` while its writer lives (a staging folder through the
-//! lock file inside it), so [`remove_orphan_temporaries`] tells a killed run's leftovers from a
+//! lock file inside it), so the file set's `remove_orphan_temporaries` (which sits above
+//! this file: it also rolls staging folders forward) tells a killed run's leftovers from a
 //! live run's by trying the lock: unlike a pid, a lock means the same in every PID namespace
 //! and container sharing the volume, and it is released by the kernel when its holder dies.
 //!
@@ -206,40 +207,10 @@ pub fn probe_writable(dir: &Path) -> Result<()> {
     temp.close().map_err(|e| Error::io(dir, e))
 }
 
-/// Removes the temporaries (files or staging folders named `.viewsynth-…`) that a run killed
-/// before it could clean up left in `dir`; returns how many were removed. A temporary whose
-/// lock another process holds is a live run's and is never touched, whatever its pid says (a
-/// pid is meaningless across PID namespaces); an unlocked one goes at once, however young
-/// (its maker, if alive, makes another: see the module notes). A staging folder killed after
-/// its journal was written is first rolled forward (its remaining files renamed into `dir`,
-/// the manifest last), so a set is always either the old one or the new one, complete.
-pub fn remove_orphan_temporaries(dir: &Path) -> usize {
-    let Ok(entries) = fs::read_dir(dir) else { return 0 };
-    let mut removed = 0;
-    for e in entries.flatten() {
-        let name = e.file_name();
-        if !name.to_str().is_some_and(|n| n.starts_with(TEMP_PREFIX)) {
-            continue;
-        }
-        // file_type does not follow symlinks: a planted link is removed, not its target.
-        let ok = match e.file_type() {
-            Ok(t) if t.is_dir() => super::file_set::recover_staging(dir, &e.path()),
-            Ok(t) if t.is_file() => match open_for_lock(&e.path()) {
-                // Removed while locked, so its maker's late lock finds the name gone.
-                Ok(f) => lock_if_current(&f, &e.path()).unwrap_or(false) && fs::remove_file(e.path()).is_ok(),
-                Err(_) => false,
-            },
-            // Never ours (we make none) and harmless: left alone.
-            _ => false,
-        };
-        removed += usize::from(ok);
-    }
-    removed
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::io::file_set::remove_orphan_temporaries;
     use crate::io::test_util::{list_dir, scratch_dir};
 
     #[test]

@@ -283,7 +283,7 @@ fn to_metres(path: &Path, raw: RawDepth, decode: &DepthDecode) -> Result<DepthMa
         RawSamples::F64(v) => v.into_iter().map(|x| (x / scale.unwrap_or(1.0)) as f32).collect(),
     };
     let mut data = data;
-    crate::depth::clear_unusable_depth(&mut data);
+    super::clear_unusable_depth(&mut data);
     DepthMap::new(raw.width, raw.height, data).map_err(|e| Error::decode(path, e.to_string()))
 }
 

@@ -49,8 +49,7 @@ mod parallel;
 pub use parallel::FileWriter;
 
 use super::atomic::{
-    check_replaceable, fault_point, lock_if_current, open_for_lock, own_prefix, probe_writable,
-    remove_orphan_temporaries, TEMP_PREFIX,
+    check_replaceable, fault_point, lock_if_current, open_for_lock, own_prefix, probe_writable, TEMP_PREFIX,
 };
 
 /// The lock file inside a staging folder (see the module notes).
@@ -551,6 +550,37 @@ impl FileSet {
     }
 }
 
+/// Removes the temporaries (files or staging folders named `.viewsynth-…`) that a run killed
+/// before it could clean up left in `dir`; returns how many were removed. A temporary whose
+/// lock another process holds is a live run's and is never touched, whatever its pid says (a
+/// pid is meaningless across PID namespaces); an unlocked one goes at once, however young
+/// (its maker, if alive, makes another: see the module notes). A staging folder killed after
+/// its journal was written is first rolled forward (its remaining files renamed into `dir`,
+/// the manifest last), so a set is always either the old one or the new one, complete.
+pub fn remove_orphan_temporaries(dir: &Path) -> usize {
+    let Ok(entries) = fs::read_dir(dir) else { return 0 };
+    let mut removed = 0;
+    for e in entries.flatten() {
+        let name = e.file_name();
+        if !name.to_str().is_some_and(|n| n.starts_with(TEMP_PREFIX)) {
+            continue;
+        }
+        // file_type does not follow symlinks: a planted link is removed, not its target.
+        let ok = match e.file_type() {
+            Ok(t) if t.is_dir() => recover_staging(dir, &e.path()),
+            Ok(t) if t.is_file() => match open_for_lock(&e.path()) {
+                // Removed while locked, so its maker's late lock finds the name gone.
+                Ok(f) => lock_if_current(&f, &e.path()).unwrap_or(false) && fs::remove_file(e.path()).is_ok(),
+                Err(_) => false,
+            },
+            // Never ours (we make none) and harmless: left alone.
+            _ => false,
+        };
+        removed += usize::from(ok);
+    }
+    removed
+}
+
 /// Writes `file` through a [`super::atomic::WRITE_BUFFER`]-sized buffer with `write`, flushed;
 /// errors name `shown`. Returns the file, not yet synced.
 fn write_file(file: File, shown: &Path, write: impl FnOnce(&mut BufWriter<File>) -> Result<()>) -> Result<File> {
@@ -784,7 +814,7 @@ fn remove_staging(staging: &Path) -> io::Result<()> {
 /// nothing while its lock is held; else rolled forward when journalled, removed otherwise. A
 /// folder without a lock file is claimed first (see [`claim_lock`]). True when the folder is
 /// gone.
-pub(crate) fn recover_staging(dir: &Path, staging: &Path) -> bool {
+fn recover_staging(dir: &Path, staging: &Path) -> bool {
     let path = staging.join(LOCK_NAME);
     let _lock = match open_for_lock(&path) {
         // Held only if it is still the folder's lock file once locked.

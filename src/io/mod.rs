@@ -14,6 +14,7 @@ mod depth_png16;
 mod depth_preview;
 mod depth_summary;
 mod depth_trunc;
+mod depth_values;
 mod encoding;
 mod exr_io;
 mod file_set;
@@ -34,9 +35,9 @@ mod rgb;
 #[cfg(test)]
 mod dataset_tests;
 #[cfg(test)]
-mod test_util;
+pub(crate) mod test_util;
 
-pub use atomic::{atomic_write, probe_writable, remove_orphan_temporaries, TEMP_PREFIX};
+pub use atomic::{atomic_write, probe_writable, TEMP_PREFIX};
 pub use depth::{
     check_rgbd_sizes, depth_dimensions, load_depth, load_depth_with_key, rgb_dimensions, save_depth_exr,
     save_depth_exr_with, save_depth_npy, DepthDecode,
@@ -45,8 +46,13 @@ pub use depth_png16::{save_depth_png16, PNG16_UNITS_PER_METRE};
 pub use depth_preview::{depth_preview, depth_preview_range, save_depth_preview, PreviewRange, PREVIEW_PERCENTILES};
 pub use depth_summary::{DepthSummary, DepthWarning, PLAUSIBLE_MEDIAN_M};
 pub use depth_trunc::{check_depth_trunc, truncate_depth};
+pub use depth_values::{
+    check_usable_depth, clear_unusable_depth, usable_depth_value, MAX_DEPTH_VALUE, MIN_DEPTH_VALUE,
+};
 pub use encoding::{Encoding, ExrCompression, PngCompression};
-pub use file_set::{write_paths_all_or_none, FileSet, FileWriter, OutDir, PathWriter, MANIFEST_NAME};
+pub use file_set::{
+    remove_orphan_temporaries, write_paths_all_or_none, FileSet, FileWriter, OutDir, PathWriter, MANIFEST_NAME,
+};
 pub use image_types::{DepthMap, Mask, RgbImage, MAX_DIMENSION};
 pub(crate) use input::{check_file_len, open_regular};
 pub use input::{check_output_pixels, max_pixels, set_max_pixels, DEFAULT_MAX_PIXELS};
@@ -56,8 +62,8 @@ pub use npy::{load_npy, save_npy_f32, NpyArray, NpyDtype};
 pub use npz::load_npz_array;
 pub use output_paths::{check_out_dir, check_outputs, NamedPath};
 pub use outputs::{
-    file_crc32, file_records, write_float_exrs, write_view, DepthFormats, FileFormats, FileRecord, OutputSet,
-    RgbFormat, ViewFiles, ViewNames,
+    file_crc32, file_records, write_float_exrs, DepthFormats, FileFormats, FileRecord, OutputSet, RgbFormat, ViewFiles,
+    ViewNames,
 };
 pub use rgb::{load_rgb, save_rgb, save_rgb_with};
 // The encoders one by one, for the lab's per-codec benchmark (`viewsynth_lab::bench::codecs`).

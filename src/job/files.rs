@@ -1,5 +1,5 @@
 //! Output files of refocus, batch and reproject (written by the output layer,
-//! [`crate::io::write_view`]): which outputs, which formats, how encoded,
+//! [`crate::output::write_view`]): which outputs, which formats, how encoded,
 //! from the options' text (`--outputs rgb,depth`, `--depth-format exr,png16`, ...).
 
 use super::ArgError;
@@ -24,7 +24,7 @@ pub struct FileOptions<'a> {
 }
 
 /// The validated file formats of refocus and reproject (a preview needs the depth output it
-/// colours); the output layer ([`crate::io::write_view`]) writes every one of them.
+/// colours); the output layer ([`crate::output::write_view`]) writes every one of them.
 pub fn file_formats(o: &FileOptions<'_>) -> Result<FileFormats, ArgError> {
     let formats = FileFormats {
         outputs: o.outputs,

@@ -223,10 +223,10 @@ impl SceneJob {
                 let mut planes = ViewOutput::color_only(img.color, None);
                 planes.depth = Some(img.view_z);
                 let names = io::ViewNames::named(&format!("{prefix}{eye}_rgb"), &format!("{prefix}{eye}_view_z"));
-                io::write_view(&mut set, &names, &planes, &rgb_depth)?;
+                crate::output::write_view(&mut set, &names, &planes, &rgb_depth)?;
                 planes.depth = Some(img.device_depth);
                 let names = io::ViewNames::named("", &format!("{prefix}{eye}_device_depth"));
-                io::write_view(&mut set, &names, &planes, &depth_only)?;
+                crate::output::write_view(&mut set, &names, &planes, &depth_only)?;
                 let entry = if eye == "middle" {
                     serde_json::json!({ "view": view, "proj": proj, "width": width, "height": height })
                 } else {
@@ -272,7 +272,12 @@ impl SceneJob {
                         let mut view = ViewOutput::color_only(face.color, None);
                         view.depth = Some(face.depth);
                         let names = io::ViewNames::named(&format!("{eye}_{tag}"), &format!("{eye}_{tag}_depth"));
-                        io::write_view(&mut set, &names, &view, &io::FileFormats::of(io::OutputSet::RGB_DEPTH))?;
+                        crate::output::write_view(
+                            &mut set,
+                            &names,
+                            &view,
+                            &io::FileFormats::of(io::OutputSet::RGB_DEPTH),
+                        )?;
                     }
                 }
                 Some((n, fov, t0.elapsed().as_secs_f64() * 1e3))

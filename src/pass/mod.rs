@@ -1,5 +1,8 @@
 //! Backend-neutral render passes: what a capability asks the GPU to do, described once and run
-//! by either executor (OpenGL: [`gl::GlExecutor`]; Vulkan: `crate::vulkan::VkExecutor`).
+//! by either executor (OpenGL: `crate::gpu`'s `GlExecutor`; Vulkan: `crate::vulkan::VkExecutor`).
+//! This folder knows no backend: it holds the vocabulary both executors share (the shader
+//! library [`shaders`], [`Timing`], [`GpuPolicy`], the image-size rule [`check_image_size`]),
+//! and each backend sits above it, mirror images.
 //!
 //! Design (after vello's recorded passes): a capability describes a pass as data and never
 //! calls a graphics API. A [`Draw`] names
@@ -22,14 +25,20 @@
 //! once ([`Device::upload`], freed when the [`Image`] drops) and render many times; executors
 //! cache programs/pipelines and targets, so a steady state creates nothing.
 
-pub mod gl;
+mod limits;
+mod policy;
+pub mod shaders;
+mod timing;
 
 pub use crate::convention::Conventions;
 use crate::convention::RowOrder;
 use crate::error::Result;
-use crate::gpu::{ShaderProgram, Timing};
+pub use limits::check_image_size;
+pub use policy::{parse_require_env, GpuPolicy, REQUIRE_GPU_ENV};
+pub use shaders::{ProgramKind, ShaderProgram};
 use std::cell::RefCell;
 use std::rc::Rc;
+pub use timing::Timing;
 
 /// Texel formats a pass samples or renders into.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
@@ -332,11 +341,6 @@ impl Device {
         Device(Rc::new(RefCell::new(Box::new(executor))))
     }
 
-    /// OpenGL on `gpu`.
-    pub fn gl(gpu: &crate::gpu::Gpu) -> Result<Self> {
-        Ok(Device::new(gl::GlExecutor::new(gpu)?))
-    }
-
     /// Which API runs the passes.
     pub fn api(&self) -> Api {
         self.0.borrow().api()
@@ -347,10 +351,10 @@ impl Device {
         self.0.borrow().max_image_side()
     }
 
-    /// [`crate::gpu::check_image_size`] against this device's limit.
+    /// [`check_image_size`] against this device's limit.
     pub fn check_image_size(&self, name: &str, width: u32, height: u32) -> Result<()> {
         let max = self.0.borrow().max_image_side();
-        crate::gpu::check_image_size(name, width.into(), height.into(), max)
+        check_image_size(name, width.into(), height.into(), max)
     }
 
     /// Upload `image` (checked against the device's size limit first).
@@ -594,12 +598,6 @@ pub trait ToDevice {
 impl ToDevice for &Device {
     fn to_device(self) -> Result<Device> {
         Ok(self.clone())
-    }
-}
-
-impl ToDevice for &crate::gpu::Gpu {
-    fn to_device(self) -> Result<Device> {
-        Device::gl(self)
     }
 }
 

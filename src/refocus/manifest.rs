@@ -1,6 +1,6 @@
 //! Refocus targets and their manifest: which targets to render (focal list or zoom scales,
 //! output size, principal point), the file-name tags, and `manifest.json` describing what was
-//! written (the files themselves are written by the output layer, [`io::write_view`]).
+//! written (the files themselves are written by the output layer, [`crate::output::write_view`]).
 
 use super::RefocusOutput;
 use crate::camera::{Intrinsics, PinholeCamera};
@@ -8,7 +8,7 @@ use crate::error::{Error, Result};
 use crate::io::{self, FileFormats, FileRecord, FileSet, ViewFiles, ViewNames};
 use crate::view::ViewOutput;
 use serde::Serialize;
-use std::path::{Path, PathBuf};
+use std::path::Path;
 
 /// The default focal scales of refocus (CLI `--zoom-range`, Python `scales=`, the demo and the
 /// benchmarks): the one list every default refers to.
@@ -167,6 +167,36 @@ pub struct Manifest {
     pub outputs: Vec<ManifestEntry>,
 }
 
+impl Manifest {
+    /// The manifest of a frame rendered by `renderer` under `method`, `break_rule` and
+    /// `conventions`, before its targets are written (the one place its fields are filled:
+    /// [`write_frame`] adds the outputs and the files).
+    #[allow(clippy::too_many_arguments)]
+    pub fn of_frame(
+        source: PinholeCamera,
+        method: super::Method,
+        break_rule: super::BreakRule,
+        conventions: crate::convention::Conventions,
+        renderer: String,
+        rgb_everywhere: bool,
+        settings: Option<serde_json::Value>,
+    ) -> Self {
+        Manifest {
+            tool: format!("viewsynth {}", env!("CARGO_PKG_VERSION")),
+            source,
+            method,
+            break_rule,
+            conventions,
+            renderer,
+            notes: manifest_notes(rgb_everywhere),
+            rgb_everywhere,
+            settings,
+            files: Vec::new(),
+            outputs: Vec::new(),
+        }
+    }
+}
+
 /// The files `entries` name, with their sizes and CRC-32 on disk (under `dir`).
 pub fn file_records(dir: &Path, entries: &[ManifestEntry]) -> Result<Vec<FileRecord>> {
     io::file_records(dir, entries.iter().flat_map(|e| e.files.names()))
@@ -210,7 +240,7 @@ pub fn write_target(
         timing: Some(render),
         exact: None,
     };
-    let written = io::write_view(set, &ViewNames::tagged(tag), &view, files)?;
+    let written = crate::output::write_view(set, &ViewNames::tagged(tag), &view, files)?;
     Ok(ManifestEntry {
         scale,
         intrinsics: camera.k,
@@ -260,15 +290,33 @@ pub fn previous_files(dir: &Path) -> Vec<String> {
         .collect()
 }
 
-/// Write `manifest.json` atomically.
-pub fn write_manifest(dir: &Path, manifest: &Manifest) -> Result<PathBuf> {
-    let path = dir.join("manifest.json");
-    let text = serde_json::to_string_pretty(manifest).map_err(|e| Error::encode(&path, e.to_string()))?;
-    io::atomic_write(&path, |w| {
+/// Writes one frame's set, the one frame path of the single-frame command and of the batch:
+/// each target's files through the output layer ([`write_target`], in the order `targets`
+/// yields them, so a caller may render each as it is asked for), then their records and
+/// `manifest.json` (written last and renamed last: its presence marks the frame finished for
+/// resume), and commits the set. `written` hears each target once its files are staged. A
+/// failure leaves the previous run's files untouched.
+pub fn write_frame(
+    mut set: FileSet,
+    mut manifest: Manifest,
+    targets: impl IntoIterator<Item = Result<(String, f64, RefocusOutput)>>,
+    files: &FileFormats,
+    mut written: impl FnMut(),
+) -> Result<Manifest> {
+    for target in targets {
+        let (tag, scale, out) = target?;
+        manifest.outputs.push(write_target(&mut set, &tag, scale, out, files)?);
+        written();
+    }
+    manifest.files = file_records(set.staging(), &manifest.outputs).map_err(|e| set.final_error(e))?;
+    let path = set.final_path(io::MANIFEST_NAME);
+    let text = serde_json::to_string_pretty(&manifest).map_err(|e| Error::encode(&path, e.to_string()))?;
+    set.write(io::MANIFEST_NAME, |w| {
         use std::io::Write;
         w.write_all(text.as_bytes()).map_err(|e| Error::io(&path, e))
     })?;
-    Ok(path)
+    set.commit()?;
+    Ok(manifest)
 }
 
 #[cfg(test)]

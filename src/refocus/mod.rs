@@ -10,7 +10,7 @@
 //! - [`pass`]: the pass/twin contract, [`pass::gpu`] and [`pass::reference`] over one
 //!   [`RefocusInput`], both returning a [`crate::view::ViewOutput`].
 //! - [`manifest`]: targets from focal lists or zoom scales, their file tags and the manifest
-//!   (the files go through the output layer, [`crate::io::write_view`]).
+//!   (the files go through the output layer, [`crate::output::write_view`]).
 
 pub mod batch;
 mod grid;

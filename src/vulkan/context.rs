@@ -7,7 +7,7 @@
 //! device; `--require-gpu` refuses a CPU device with the same `Error::SoftwareRenderer`.
 
 use crate::error::{Error, Result};
-use crate::gpu::GpuPolicy;
+use crate::pass::GpuPolicy;
 use ash::vk;
 use std::ffi::CStr;
 use std::rc::Rc;

@@ -3,7 +3,7 @@
 //! the policy read the same types either way.
 
 use crate::error::{Error, Result};
-use crate::gpu::GpuPolicy;
+use crate::pass::GpuPolicy;
 use serde::Serialize;
 
 /// What `viewsynth info --backend vulkan` prints about one physical device.

@@ -28,11 +28,11 @@ use super::pipeline::{Pipeline, PipelineDesc};
 use super::resources::{sampled_image, sampler_and_set_layout, Buffer, Image};
 use super::targets::ColorTargets;
 use crate::error::{Error, Result};
-use crate::gpu::{ShaderProgram, Timing};
 use crate::pass::{
     Api, BufferId, Dispatch, Executor, Format, Groups, ImageData, ImageId, Rendered, Slots, Step, StorageImage, Target,
     Ticket,
 };
+use crate::pass::{ShaderProgram, Timing};
 use ash::vk;
 use std::time::Instant;
 

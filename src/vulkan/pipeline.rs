@@ -188,8 +188,8 @@ mod tests {
     /// is `ShaderProgram::preamble`, and the table's switch values cover the typed ones.
     #[test]
     fn every_vulkan_program_variant_is_compiled_with_the_gl_preamble() {
-        use crate::gpu::shaders::Stage;
-        use crate::gpu::ShaderProgram;
+        use crate::pass::shaders::Stage;
+        use crate::pass::ShaderProgram;
         let mut found = 0;
         for conv in Conventions::all() {
             for program in ShaderProgram::all(conv).into_iter().filter(|p| p.kind.on_vulkan()) {

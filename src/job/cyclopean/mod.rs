@@ -213,7 +213,7 @@ impl CyclopeanJob {
         let view = self.render(&device, host, None)?;
         let out_dir = io::OutDir::prepare(&self.out_dir)?;
         let mut set = out_dir.file_set()?.replacing(owned_name);
-        io::write_view(
+        crate::output::write_view(
             &mut set,
             &io::ViewNames::tagged("middle"),
             &view.done.view,

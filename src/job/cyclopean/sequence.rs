@@ -184,7 +184,7 @@ impl CyclopeanSequenceJob {
                 ),
             };
             let names = io::ViewNames::tagged(&format!("middle_{k:05}"));
-            io::write_view(set, &names, &view.done.view, &job.formats())?;
+            crate::output::write_view(set, &names, &view.done.view, &job.formats())?;
             size = view.size;
             coverage += view.done.coverage;
             render_ms += view.done.view.timing.map_or(0.0, |t| t.wall_ms);

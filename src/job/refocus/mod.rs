@@ -11,7 +11,7 @@ use super::{ArgError, Backend, Event, GpuRequest, Host, JobError, PerFrameOption
 use crate::convention::Conventions;
 use crate::io::{self, DepthDecode, DepthSummary};
 use crate::refocus::batch::{load_manifest, run_batch, BatchOptions, BatchSummary, Shard};
-use crate::refocus::manifest::{self as job, Manifest, ManifestEntry};
+use crate::refocus::manifest::{self as job, Manifest};
 use crate::refocus::{RefocusSource, Refocuser};
 use std::path::PathBuf;
 
@@ -162,33 +162,30 @@ impl RefocusJob {
             what: "refocus targets",
             total: targets.len() as u64,
         });
-        let mut entries: Vec<ManifestEntry> = Vec::new();
         // All targets and the manifest, or (on any failure) none: earlier runs' files stay.
         // The previous run's set, as its manifest lists it, goes where this one does not
         // write the same names (fewer scales, no depth): the folder holds this run's set.
         let previous = job::previous_files(out_dir.real_path());
-        let mut set = out_dir.file_set()?.replacing_listed(previous);
-        for ((scale, target), tag) in scales.iter().zip(&targets).zip(&plan.tags) {
-            let out = refocuser.render(target)?;
-            entries.push(job::write_target(&mut set, tag, *scale, out, files)?);
-            host.event(Event::Advanced);
-        }
+        let set = out_dir.file_set()?.replacing_listed(previous);
+        let manifest = Manifest::of_frame(
+            src.camera(),
+            plan.method,
+            plan.rule,
+            conv,
+            refocuser.renderer(),
+            plan.rgb_everywhere,
+            None,
+        );
+        let targets = scales
+            .iter()
+            .zip(&targets)
+            .zip(&plan.tags)
+            .map(|((scale, target), tag)| {
+                let out = refocuser.render(target)?;
+                Ok((tag.clone(), *scale, out))
+            });
+        let manifest = job::write_frame(set, manifest, targets, files, || host.event(Event::Advanced))?;
         host.event(Event::Finished);
-        let manifest = Manifest {
-            tool: format!("viewsynth {}", env!("CARGO_PKG_VERSION")),
-            source: src.camera(),
-            method: plan.method,
-            break_rule: plan.rule,
-            conventions: conv,
-            renderer: refocuser.renderer(),
-            notes: job::manifest_notes(plan.rgb_everywhere),
-            rgb_everywhere: plan.rgb_everywhere,
-            settings: None,
-            files: job::file_records(set.staging(), &entries).map_err(|e| set.final_error(e))?,
-            outputs: entries,
-        };
-        job::write_manifest(set.staging(), &manifest).map_err(|e| set.final_error(e))?;
-        set.commit()?;
         Ok(RefocusReport {
             manifest,
             manifest_path: out_dir.path().join("manifest.json"),

@@ -277,7 +277,7 @@ impl ReprojectJob {
                 timing: Some(timing),
                 exact: None,
             };
-            io::write_view(
+            crate::output::write_view(
                 &mut set,
                 &io::ViewNames::tagged(view_name(Some(to))),
                 &view,

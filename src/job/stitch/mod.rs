@@ -290,11 +290,11 @@ impl StitchJob {
         let colour = io::FileFormats::of(io::OutputSet::RGB);
         let mut set = out_dir.file_set()?.replacing_recorded("stitch");
         let mut whole = ViewOutput::color_only(img, None);
-        io::write_view(&mut set, &io::ViewNames::named("ods_top_bottom", ""), &whole, &colour)?;
+        crate::output::write_view(&mut set, &io::ViewNames::named("ods_top_bottom", ""), &whole, &colour)?;
         if let Some([l, r]) = eyes {
             for (name, eye) in [("ods_left", l), ("ods_right", r)] {
                 let view = ViewOutput::color_only(eye, None);
-                io::write_view(&mut set, &io::ViewNames::named(name, ""), &view, &colour)?;
+                crate::output::write_view(&mut set, &io::ViewNames::named(name, ""), &view, &colour)?;
             }
         }
         let written = set.commit()?;

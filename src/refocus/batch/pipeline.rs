@@ -84,21 +84,9 @@ fn write_frame(job: WriteJob, files: &FileFormats) -> Result<()> {
     let dir = job.root.subdir(&job.name)?;
     // A frame redone (other settings: fewer scales, other outputs) leaves only its new set.
     let previous = manifest::previous_files(dir.real_path());
-    let mut set = dir.file_set()?.replacing_listed(previous);
-    let mut record = job.manifest;
-    for (tag, scale, out) in job.outputs {
-        let entry = manifest::write_target(&mut set, &tag, scale, out, files)?;
-        record.outputs.push(entry);
-    }
-    record.files = manifest::file_records(set.staging(), &record.outputs)?;
-    let path = set.final_path("manifest.json");
-    let text = serde_json::to_string_pretty(&record).map_err(|e| Error::encode(&path, e.to_string()))?;
-    // Written last and renamed last: its presence marks the frame finished for resume.
-    set.write("manifest.json", |w| {
-        use std::io::Write;
-        w.write_all(text.as_bytes()).map_err(|e| Error::io(&path, e))
-    })?;
-    set.commit()?;
+    let set = dir.file_set()?.replacing_listed(previous);
+    let targets = job.outputs.into_iter().map(Ok);
+    manifest::write_frame(set, job.manifest, targets, files, || {})?;
     Ok(())
 }
 
@@ -170,19 +158,15 @@ fn submit_frame(
         .map(|t| refocuser.submit(t))
         .collect::<Result<Vec<_>>>()?;
     stages.render.push(ms_since(t0));
-    let manifest = Manifest {
-        tool: format!("viewsynth {}", env!("CARGO_PKG_VERSION")),
-        source: src.camera(),
-        method: opts.method,
-        break_rule: opts.rule,
-        conventions: opts.conv,
-        renderer: refocuser.renderer(),
-        notes: manifest::manifest_notes(opts.rgb_everywhere),
-        rgb_everywhere: opts.rgb_everywhere,
-        settings: Some(settings),
-        files: Vec::new(),
-        outputs: Vec::new(),
-    };
+    let manifest = Manifest::of_frame(
+        src.camera(),
+        opts.method,
+        opts.rule,
+        opts.conv,
+        refocuser.renderer(),
+        opts.rgb_everywhere,
+        Some(settings),
+    );
     Ok(InFlight {
         name,
         root,

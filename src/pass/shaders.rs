@@ -2,7 +2,8 @@
 //! `#define`s typed.
 //!
 //! Design: a capability asks for a [`ShaderProgram`] (conventions + a [`ProgramKind`] whose
-//! fields are the program's compile-time switches) and gets a linked [`Program`]; it never
+//! fields are the program's compile-time switches) and a backend links it (GL: `gpu::Program`,
+//! Vulkan: the SPIR-V variant of the same defines); it never
 //! writes GLSL text or `#define` lines. The loader ([`ShaderProgram::preamble`]) renders every
 //! define here, in one place: the conventions, the program's own switches and the shared
 //! numeric constants (`shaders/common/depth.glsl` takes the background epsilon from the Rust
@@ -12,9 +13,7 @@
 //! `ShaderProgram::all` lists every program under one set of conventions, which the
 //! compile-all test (cli/tests/integration/shader_library.rs) links under all eight.
 
-use super::{Gpu, Program};
 use crate::convention::{Conventions, NdcDepthRange, RowOrder};
-use crate::error::Result;
 
 /// A GLSL source file of the library (path below `shaders/`, text).
 #[derive(Debug, Clone, Copy)]
@@ -66,16 +65,6 @@ pub enum Stage {
     Fragment,
     /// Compute shader.
     Compute,
-}
-
-impl Stage {
-    pub(super) fn gl(self) -> u32 {
-        match self {
-            Stage::Vertex => glow::VERTEX_SHADER,
-            Stage::Fragment => glow::FRAGMENT_SHADER,
-            Stage::Compute => glow::COMPUTE_SHADER,
-        }
-    }
 }
 
 /// How the reprojection shift reads its stored depth (`DEPTH_MODE` in reproject/shift.frag).
@@ -501,11 +490,6 @@ impl ShaderProgram {
     /// Per stage: the stage and its files in order (shared ones first).
     pub fn sources(&self) -> Vec<(Stage, Vec<ShaderFile>)> {
         self.kind.stages()
-    }
-
-    /// Compile and link on `gpu`.
-    pub fn build(&self, gpu: &Gpu) -> Result<Program> {
-        Program::from_library(gpu, self)
     }
 }
 

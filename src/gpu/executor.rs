@@ -1,4 +1,5 @@
-//! The GL executor: runs [`super::Draw`]s with the GPU layer's RAII objects (no raw GL here).
+//! The GL executor: runs [`crate::pass::Draw`]s with the GPU layer's RAII objects (no raw GL
+//! here), beside them as `crate::vulkan`'s executor is beside ash.
 //! Programs are built once per [`ShaderProgram`], framebuffers once per size and output set
 //! (the last few kept), the parameter blocks of a pass go into one uniform buffer at aligned
 //! offsets (one `glBufferSubData` a pass), and outputs are read through the pooled pixel-pack
@@ -9,15 +10,30 @@
 //! be in flight and nothing waits on the GPU until their outputs are wanted.
 
 use super::{
-    Api, BufferId, Executor, Format, Groups, ImageData, ImageId, Rendered, Slots, Step, StorageImage, Target, Ticket,
+    Attachment, DeferredTimer, DrawState, Framebuffer, Gpu, IndexBuffer, PendingRead, Program, ReadFormat,
+    ShaderProgram, StorageBuffer, Texture, TextureFormat, Timing, UniformBuffer, VertexArray,
 };
 use crate::convention::RowOrder;
 use crate::error::{Error, Result};
-use crate::gpu::{
-    Attachment, Barrier, DeferredTimer, DrawState, Framebuffer, Gpu, IndexBuffer, PendingRead, Program, ReadFormat,
-    ShaderProgram, StorageBuffer, Texture, TextureFormat, Timing, UniformBuffer, VertexArray,
+use crate::pass::{
+    Api, BufferId, Device, Executor, Format, Groups, ImageData, ImageId, Rendered, Slots, Step, StorageImage, Target,
+    Ticket, ToDevice,
 };
 use std::time::Instant;
+
+impl Device {
+    /// OpenGL on `gpu`.
+    pub fn gl(gpu: &Gpu) -> Result<Self> {
+        Ok(Device::new(GlExecutor::new(gpu)?))
+    }
+}
+
+/// A GL context opens a new GL executor on it, so GL callers keep passing `&Gpu`.
+impl ToDevice for &Gpu {
+    fn to_device(self) -> Result<Device> {
+        Device::gl(self)
+    }
+}
 
 /// Framebuffers kept for reuse (sizes and output sets seen most recently).
 const KEPT_TARGETS: usize = 4;
@@ -61,7 +77,7 @@ struct InFlight {
 type TargetKey = (u32, u32, Vec<Option<Format>>, bool);
 
 /// Passes on an OpenGL context.
-pub struct GlExecutor {
+pub(crate) struct GlExecutor {
     gpu: Gpu,
     vao: VertexArray,
     /// Indexed draws bind their element buffer here (a VAO's state), pulled draws use `vao`.
@@ -76,7 +92,7 @@ pub struct GlExecutor {
 
 impl GlExecutor {
     /// An executor on `gpu`.
-    pub fn new(gpu: &Gpu) -> Result<Self> {
+    pub(crate) fn new(gpu: &Gpu) -> Result<Self> {
         Ok(GlExecutor {
             gpu: gpu.clone(),
             vao: VertexArray::new(gpu)?.with_label("pass vertex array"),
@@ -244,12 +260,12 @@ impl Executor for GlExecutor {
             // No draws (no kept triangles, or compute steps storing to the outputs): the target
             // is still cleared, before the steps so that what they store survives.
             drop(fb.begin_pass(DrawState::default(), 1.0));
-            self.gpu.memory_barrier(Barrier::All);
+            self.gpu.memory_barrier();
         }
         for (k, step) in steps.iter().enumerate() {
             if k > 0 && !matches!((&steps[k - 1], step), (Step::Draw(_), Step::Draw(_))) {
                 // What earlier steps wrote, before this one reads it.
-                self.gpu.memory_barrier(Barrier::All);
+                self.gpu.memory_barrier();
             }
             if !matches!(step, Step::Draw(_)) {
                 pass = None;
@@ -309,7 +325,7 @@ impl Executor for GlExecutor {
         let reads = match (target, fb) {
             (Some(target), Some(fb)) => {
                 // What the steps wrote, before the readback.
-                self.gpu.memory_barrier(Barrier::All);
+                self.gpu.memory_barrier();
                 let flip = target.rows == RowOrder::BottomUp;
                 target
                     .outputs
