@@ -308,11 +308,6 @@ pub fn d3d_transform(p: [f64; 4], m: &[[f64; 4]; 4]) -> [f64; 4] {
     std::array::from_fn(|j| p[0] * m[0][j] + p[1] * m[1][j] + p[2] * m[2][j] + p[3] * m[3][j])
 }
 
-/// The f32 array a GL uniform upload takes.
-pub fn gl_to_f32(m: &[f64; 16]) -> [f32; 16] {
-    m.map(|v| v as f32)
-}
-
 /// Seed 004's vertex-shader form: `clip.x += side * separation * (clip.w - convergence)`.
 pub fn clip_shift(clip: [f64; 4], eye: Eye, params: &StereoParams) -> [f64; 4] {
     let [x, y, z, w] = clip;

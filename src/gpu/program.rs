@@ -7,17 +7,12 @@ use super::shaders::{ShaderFile, ShaderProgram, Stage};
 use super::{Gpu, StorageBuffer};
 use crate::error::{Error, Result};
 use glow::HasContext;
-use std::cell::RefCell;
-use std::collections::HashMap;
 
 /// A linked GL program of the shader library, owning its GL object (deleted on drop).
 pub struct Program {
     gpu: Gpu,
     raw: glow::Program,
     name: &'static str,
-    /// Uniform locations by name, looked up once: a steady stream of frames then costs no
-    /// glGetUniformLocation.
-    locations: RefCell<HashMap<String, Option<glow::UniformLocation>>>,
 }
 
 const VERSION: &str = "#version 450 core\n";
@@ -111,7 +106,6 @@ impl Program {
                 gpu: gpu.clone(),
                 raw: program,
                 name,
-                locations: RefCell::default(),
             })
         }
     }
@@ -178,71 +172,6 @@ impl Program {
     pub fn bind(&self) {
         // SAFETY: valid program handle.
         unsafe { self.gpu.gl().use_program(Some(self.raw)) }
-    }
-
-    fn location(&self, name: &str) -> Option<glow::UniformLocation> {
-        if let Some(l) = self.locations.borrow().get(name) {
-            return *l;
-        }
-        // SAFETY: valid program handle.
-        let l = unsafe { self.gpu.gl().get_uniform_location(self.raw, name) };
-        self.locations.borrow_mut().insert(name.to_string(), l);
-        l
-    }
-
-    /// Set uniforms by name on the bound program. Unknown names are ignored (the GLSL compiler
-    /// drops unused uniforms), so a convention that compiles a uniform away still works.
-    pub fn set_f32(&self, name: &str, v: f32) {
-        // SAFETY: location belongs to this program, which the caller has bound.
-        unsafe { self.gpu.gl().uniform_1_f32(self.location(name).as_ref(), v) }
-    }
-    /// Sets an `int` (or sampler unit) uniform of the bound program.
-    pub fn set_i32(&self, name: &str, v: i32) {
-        // SAFETY: as above.
-        unsafe { self.gpu.gl().uniform_1_i32(self.location(name).as_ref(), v) }
-    }
-    /// Sets an `ivec2` uniform of the bound program.
-    pub fn set_ivec2(&self, name: &str, v: [i32; 2]) {
-        // SAFETY: as above.
-        unsafe { self.gpu.gl().uniform_2_i32(self.location(name).as_ref(), v[0], v[1]) }
-    }
-    /// Sets a `vec2` uniform of the bound program.
-    pub fn set_vec2(&self, name: &str, v: [f32; 2]) {
-        // SAFETY: as above.
-        unsafe { self.gpu.gl().uniform_2_f32(self.location(name).as_ref(), v[0], v[1]) }
-    }
-    /// Sets a `vec3` uniform of the bound program.
-    pub fn set_vec3(&self, name: &str, v: [f32; 3]) {
-        // SAFETY: as above.
-        unsafe {
-            self.gpu
-                .gl()
-                .uniform_3_f32(self.location(name).as_ref(), v[0], v[1], v[2])
-        }
-    }
-    /// Sets a `vec4` uniform of the bound program.
-    pub fn set_vec4(&self, name: &str, v: [f32; 4]) {
-        // SAFETY: as above.
-        unsafe {
-            self.gpu
-                .gl()
-                .uniform_4_f32(self.location(name).as_ref(), v[0], v[1], v[2], v[3])
-        }
-    }
-    /// A 4x4 matrix given row-major (as written on paper); uploaded transposed for GLSL.
-    pub fn set_mat4_rows(&self, name: &str, rows: &[[f64; 4]; 4]) {
-        let mut cols = [0f32; 16];
-        for (r, row) in rows.iter().enumerate() {
-            for (c, v) in row.iter().enumerate() {
-                cols[c * 4 + r] = *v as f32;
-            }
-        }
-        // SAFETY: as above; 16 floats.
-        unsafe {
-            self.gpu
-                .gl()
-                .uniform_matrix_4_f32_slice(self.location(name).as_ref(), false, &cols)
-        }
     }
 }
 

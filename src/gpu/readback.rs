@@ -159,20 +159,6 @@ impl PendingRead {
         r == glow::ALREADY_SIGNALED || r == glow::CONDITION_SATISFIED
     }
 
-    /// Wait for the copy and copy the bytes into `out` (exactly `len()` long): one memcpy out of
-    /// the mapped buffer, no conversion.
-    pub fn finish_into(self, out: &mut [u8]) -> Result<()> {
-        if out.len() != self.len {
-            return Err(Error::Gl(format!(
-                "readback into {} bytes, {} expected",
-                out.len(),
-                self.len
-            )));
-        }
-        // SAFETY: `out` is `len` initialised bytes.
-        unsafe { self.copy_to(out.as_mut_ptr()) }
-    }
-
     /// Waits, then copies the `len` bytes into `dst`.
     ///
     /// # Safety

@@ -138,11 +138,6 @@ impl RenderPass<'_> {
         }
     }
 
-    /// The one full-screen triangle of shaders/common/fullscreen.vert with the bound program.
-    pub fn draw_fullscreen(&self, vao: &VertexArray) {
-        self.draw_triangles(vao, 1);
-    }
-
     /// `count` triangles whose vertices the bound program pulls itself (no vertex buffers).
     pub fn draw_triangles(&self, vao: &VertexArray, count: usize) {
         vao.bind();

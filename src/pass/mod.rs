@@ -66,16 +66,6 @@ impl Format {
             Format::Rgba32F => 16,
         }
     }
-
-    /// Bytes a pixel of a read-back output (RGBA8 comes back as RGB).
-    pub fn output_bytes(self) -> usize {
-        match self {
-            Format::Rgba8 => 3,
-            Format::R32F | Format::R32Ui => 4,
-            Format::R8 | Format::R8Ui => 1,
-            Format::Rgba32F => 16,
-        }
-    }
 }
 
 /// Host texels of an image to upload, rows in memory order.
@@ -581,11 +571,6 @@ pub fn mat4_std140(rows: &[[f64; 4]; 4]) -> [[f32; 4]; 4] {
         }
     }
     cols
-}
-
-/// The whole target as a draw's viewport.
-pub fn full_viewport(target: &Target) -> [u32; 4] {
-    [0, 0, target.width, target.height]
 }
 
 /// What a renderer can be opened on: an existing [`Device`] (shared), or a GL context (a new GL
