@@ -24,11 +24,8 @@ pub fn mask_iou(a: &[bool], b: &[bool]) -> f64 {
     }
 }
 
-/// Coverage: the fraction of `values` that `valid` accepts (0 for none at all). The one formula
-/// behind every "coverage" the library, the CLI's manifests and the Python package report.
-pub fn valid_fraction<T>(values: &[T], valid: impl Fn(&T) -> bool) -> f64 {
-    values.iter().filter(|v| valid(v)).count() as f64 / values.len().max(1) as f64
-}
+// The coverage formula lives with the image types it measures (the files layer, below this one).
+pub use crate::io::valid_fraction;
 
 /// Rounds a 0..=255 f64 colour channel the way a UNORM8 render target stores it.
 pub fn quantize_u8(v: f64) -> u8 {

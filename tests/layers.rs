@@ -532,7 +532,11 @@ fn no_circle_between_the_files_of_any_crate() {
     for dir in ["src", "lab/src", "cli/src"] {
         let shown = circles_shown(&crate_graph(dir));
         if !shown.is_empty() {
-            all.push(format!("{} circle(s) between files under {dir}/:\n{}", shown.len(), shown.join("\n")));
+            all.push(format!(
+                "{} circle(s) between files under {dir}/:\n{}",
+                shown.len(),
+                shown.join("\n")
+            ));
         }
     }
     assert!(all.is_empty(), "{}", all.join("\n"));
@@ -543,7 +547,8 @@ fn no_circle_between_the_files_of_any_crate() {
 /// up, e.g. a dev-dependency).
 #[test]
 fn no_crate_depends_on_one_above_it() {
-    let manifest = |dir: &str| fs::read_to_string(Path::new(env!("CARGO_MANIFEST_DIR")).join(dir).join("Cargo.toml")).unwrap();
+    let manifest =
+        |dir: &str| fs::read_to_string(Path::new(env!("CARGO_MANIFEST_DIR")).join(dir).join("Cargo.toml")).unwrap();
     // A dependency on a crate above is a `name = ...` line or a path to its folder.
     let names_above = |text: &str, above: &[&str]| -> Vec<String> {
         text.lines()
@@ -552,14 +557,24 @@ fn no_crate_depends_on_one_above_it() {
                 !l.starts_with('#')
                     && above.iter().any(|a| {
                         let folder = a.trim_start_matches("viewsynth-");
-                        l.starts_with(&format!("{a} =")) || l.contains(&format!("path = \"{folder}\"")) || l.contains(&format!("path = \"../{folder}\""))
+                        l.starts_with(&format!("{a} ="))
+                            || l.contains(&format!("path = \"{folder}\""))
+                            || l.contains(&format!("path = \"../{folder}\""))
                     })
             })
             .map(str::to_string)
             .collect()
     };
-    assert_eq!(names_above(&manifest("."), &["viewsynth-lab", "viewsynth-cli"]), Vec::<String>::new(), "the library's Cargo.toml");
-    assert_eq!(names_above(&manifest("lab"), &["viewsynth-cli"]), Vec::<String>::new(), "the lab's Cargo.toml");
+    assert_eq!(
+        names_above(&manifest("."), &["viewsynth-lab", "viewsynth-cli"]),
+        Vec::<String>::new(),
+        "the library's Cargo.toml"
+    );
+    assert_eq!(
+        names_above(&manifest("lab"), &["viewsynth-cli"]),
+        Vec::<String>::new(),
+        "the lab's Cargo.toml"
+    );
 }
 
 /// Each circle of `graph` as its edges, "a -> b" within the circle.

@@ -16,6 +16,7 @@
 //!   (`bench::codecs`), every pass on each device (`bench::passes`).
 //! - [`passes`]: every pass of the library described once and run on any device: the rows of
 //!   the GL-against-Vulkan agreement table and of the per-pass benchmark.
+//! - [`stats`]: the median of the timings.
 //! - [`stress`]: stiff and extreme cases of every capability, GPU f32 against f64.
 //! - [`demo`]: the built-in scene rendered, refocused and synthesised, with its report.
 //! - [`job`]: the checked jobs of `viewsynth bench`, `report` and `stress`, run through the
@@ -29,4 +30,5 @@ pub mod eval;
 pub mod job;
 pub mod passes;
 pub mod report;
+pub mod stats;
 pub mod stress;

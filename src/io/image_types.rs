@@ -73,7 +73,7 @@ impl DepthMap {
     /// Fraction of pixels holding depth (Z > 0; NaN counts as none): an output's coverage
     /// when no mask was rendered.
     pub fn coverage(&self) -> f64 {
-        crate::metrics::valid_fraction(&self.data, |z| *z > 0.0)
+        valid_fraction(&self.data, |z| *z > 0.0)
     }
 }
 
@@ -86,7 +86,7 @@ impl Mask {
 
     /// Fraction of pixels the mask marks valid (non-zero): an output's coverage.
     pub fn coverage(&self) -> f64 {
-        crate::metrics::valid_fraction(&self.data, |m| *m != 0)
+        valid_fraction(&self.data, |m| *m != 0)
     }
 
     /// Value at column `x`, row `y` (top-down); `None` outside the mask.
@@ -149,6 +149,13 @@ pub(crate) fn encode_dims(path: &Path, width: u32, height: u32, channels: usize,
         return Err(Error::encode(path, msg));
     }
     check_len(&path.display().to_string(), width, height, channels, len)
+}
+
+/// Coverage: the fraction of `values` that `valid` accepts (0 for none at all). The one formula
+/// behind every "coverage" the library, the CLI's manifests and the Python package report
+/// (also `metrics::valid_fraction`).
+pub fn valid_fraction<T>(values: &[T], valid: impl Fn(&T) -> bool) -> f64 {
+    values.iter().filter(|v| valid(v)).count() as f64 / values.len().max(1) as f64
 }
 
 #[cfg(test)]

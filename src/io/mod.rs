@@ -53,7 +53,7 @@ pub use encoding::{Encoding, ExrCompression, PngCompression};
 pub use file_set::{
     remove_orphan_temporaries, write_paths_all_or_none, FileSet, FileWriter, OutDir, PathWriter, MANIFEST_NAME,
 };
-pub use image_types::{DepthMap, Mask, RgbImage, MAX_DIMENSION};
+pub use image_types::{valid_fraction, DepthMap, Mask, RgbImage, MAX_DIMENSION};
 pub(crate) use input::{check_file_len, open_regular};
 pub use input::{check_output_pixels, max_pixels, set_max_pixels, DEFAULT_MAX_PIXELS};
 pub use json::{load_json, read_text, MAX_JSON_BYTES, MAX_JSON_MAGNITUDE};

@@ -3,6 +3,7 @@
 //! per-stage medians and the stage that bounds the throughput. Nothing here asserts a time.
 
 use super::codecs::{codec_rows, CodecRow};
+use crate::stats::median;
 use serde::Serialize;
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
@@ -121,30 +122,17 @@ pub struct BatchBench {
     pub codecs: Vec<CodecRow>,
 }
 
-pub(crate) fn median(mut v: Vec<f64>) -> f64 {
-    if v.is_empty() {
-        return 0.0;
-    }
-    v.sort_by(f64::total_cmp);
-    let n = v.len();
-    if n % 2 == 1 {
-        v[n / 2]
-    } else {
-        0.5 * (v[n / 2 - 1] + v[n / 2])
-    }
-}
-
 fn medians(s: &StageTimes) -> StageMedians {
     StageMedians {
-        decode: median(s.decode.clone()),
-        upload: median(s.upload.clone()),
-        render: median(s.render.clone()),
-        readback: median(s.readback.clone()),
-        encode: median(s.encode.clone()),
-        wait: median(s.wait.clone()),
-        gpu_render: (!s.gpu_render.is_empty()).then(|| median(s.gpu_render.clone())),
-        decode_cpu: (!s.decode_cpu.is_empty()).then(|| median(s.decode_cpu.clone())),
-        encode_cpu: (!s.encode_cpu.is_empty()).then(|| median(s.encode_cpu.clone())),
+        decode: median(&s.decode),
+        upload: median(&s.upload),
+        render: median(&s.render),
+        readback: median(&s.readback),
+        encode: median(&s.encode),
+        wait: median(&s.wait),
+        gpu_render: (!s.gpu_render.is_empty()).then(|| median(&s.gpu_render)),
+        decode_cpu: (!s.decode_cpu.is_empty()).then(|| median(&s.decode_cpu)),
+        encode_cpu: (!s.encode_cpu.is_empty()).then(|| median(&s.encode_cpu)),
     }
 }
 

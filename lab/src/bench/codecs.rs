@@ -100,7 +100,7 @@ fn cpu_median(pool: &rayon_core::ThreadPool, repeats: usize, mut f: impl FnMut()
         let c1 = viewsynth::cpu_time::process_cpu_ms();
         times.push(c0.zip(c1).map_or(0.0, |(a, b)| b - a));
     }
-    Ok(super::batch::median(times))
+    Ok(crate::stats::median(&times))
 }
 
 fn file_len(path: &Path) -> Result<u64> {

@@ -18,7 +18,7 @@ use viewsynth::refocus::manifest::{self as job, TargetSpec};
 use viewsynth::refocus::{reference, BreakRule, Method, OutputSet, RefocusSource, Refocuser};
 use viewsynth::scene;
 
-use crate::bench::batch::median;
+use crate::stats::median;
 
 /// One measured case, for `bench --json`.
 #[derive(Debug, Clone, serde::Serialize)]
@@ -103,7 +103,7 @@ pub fn refocus_bench(gpu: &Device, sizes: &[(u32, u32)], repeats: usize, cases: 
                 }
                 with_io.push(t0.elapsed().as_secs_f64() * 1e3);
             }
-            let m = median(frame);
+            let m = median(&frame);
             let name = match method {
                 Method::Mesh => format!("GPU mesh ({} triangles)", r.triangle_count().unwrap_or(0)),
                 Method::Fullscreen => "GPU full-screen".to_string(),
@@ -118,13 +118,13 @@ pub fn refocus_bench(gpu: &Device, sizes: &[(u32, u32)], repeats: usize, cases: 
                 &format!("{case}-job-with-writes"),
                 format!("{w}x{h}"),
                 None,
-                median(with_io.clone()),
+                median(&with_io),
             ));
             writeln!(
                 t,
                 "| {w}x{h} | {name} | {setup:.1} | {m:.2} | {:.2} | {:.1} |",
                 m / 5.0,
-                median(with_io)
+                median(&with_io)
             )
             .expect("write to String");
         }
@@ -136,7 +136,7 @@ pub fn refocus_bench(gpu: &Device, sizes: &[(u32, u32)], repeats: usize, cases: 
             }
             cpu.push(t0.elapsed().as_secs_f64() * 1e3);
         }
-        let m = median(cpu);
+        let m = median(&cpu);
         cases.push(BenchCase::new(
             "refocus",
             "cpu-f64-reference",
@@ -368,7 +368,7 @@ fn setup_and_median<R, T>(
         run(&mut r)?;
         runs.push(t0.elapsed().as_secs_f64() * 1e3);
     }
-    Ok((setup, median(runs)))
+    Ok((setup, median(&runs)))
 }
 
 /// Benchmark: ms per 4096 x 2048 stereo equirect (both eyes, readback included) from 6 faces
@@ -401,7 +401,7 @@ pub fn stitch_bench(gpu: &Device, repeats: usize, cases: &mut Vec<BenchCase>) ->
         for _ in 0..repeats {
             times.push(r.render(&params)?.1.wall_ms);
         }
-        let m = median(times);
+        let m = median(&times);
         cases.push(BenchCase::new(
             "stitch",
             method.label(),

@@ -3,8 +3,8 @@
 //! comparison. Nothing here knows which API a device runs.
 
 use super::BenchCase;
-use crate::bench::batch::median;
 use crate::passes::{Frame, PassCase, PassInputs};
+use crate::stats::median;
 use std::fmt::Write as _;
 use std::time::Instant;
 use viewsynth::convention::Conventions;
@@ -21,7 +21,7 @@ fn time(repeats: usize, mut frame: Frame) -> Result<f64> {
         frame()?;
         runs.push(t0.elapsed().as_secs_f64() * 1e3);
     }
-    Ok(median(runs))
+    Ok(median(&runs))
 }
 
 /// Every pass on each of `devices` (named `names`, e.g. "gl" and "vulkan"), render + readback,

@@ -2,6 +2,7 @@
 
 use super::table::{fixed, md_inline, sig};
 use super::Report;
+use crate::stats::median;
 use std::fmt::Write as _;
 
 /// One summary line's rows: (capability, method), their PSNRs and their wall times.
@@ -62,15 +63,4 @@ pub(super) fn summary(report: &Report) -> String {
         );
     }
     s
-}
-
-fn median(v: &[f64]) -> f64 {
-    let mut v = v.to_vec();
-    v.sort_by(f64::total_cmp);
-    let n = v.len();
-    if n % 2 == 1 {
-        v[n / 2]
-    } else {
-        0.5 * (v[n / 2 - 1] + v[n / 2])
-    }
 }
