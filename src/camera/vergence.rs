@@ -509,7 +509,7 @@ mod tests {
                 let d1 = scale(d1, 1.0 / norm(d1));
                 let w = sub(up, scale(d1, dot(up, d1)));
                 let w = scale(w, 1.0 / norm(w));
-                let alpha = if rng.next_u64() % 4 == 0 {
+                let alpha = if rng.next_u64().is_multiple_of(4) {
                     0.0
                 } else {
                     (2.0 * rng.range(0.0, 1e-9)).sqrt()

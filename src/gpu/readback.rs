@@ -201,7 +201,7 @@ impl PendingRead {
 
     /// Wait and return the bytes as native-endian f32 values (a cast of the copy, no conversion).
     pub fn finish_f32(self) -> Result<Vec<f32>> {
-        if self.len % 4 != 0 {
+        if !self.len.is_multiple_of(4) {
             return Err(Error::Gl(format!("readback of {} bytes is not f32 data", self.len)));
         }
         let n = self.len / 4;

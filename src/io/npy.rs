@@ -535,7 +535,7 @@ fn fortran_to_c(shape: &[usize], data: &[f64]) -> Vec<f64> {
 #[cfg(test)]
 pub(crate) fn build_npy(dict: &str, payload: &[u8]) -> Vec<u8> {
     let mut text = dict.to_string();
-    while (10 + text.len() + 1) % 64 != 0 {
+    while !(10 + text.len() + 1).is_multiple_of(64) {
         text.push(' ');
     }
     text.push('\n');

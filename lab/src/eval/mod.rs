@@ -73,7 +73,7 @@ pub(crate) fn score(
         row.depth_abs_mean = Some(dabs / nz as f64);
         row.depth_rel_mean = Some(drel / nz as f64);
     }
-    row.coverage = Some(viewsynth::metrics::valid_fraction(&mask, |m| *m));
+    row.coverage = Some(viewsynth::metrics::valid_fraction(mask, |m| *m));
 }
 
 /// Run everything and write report.{md,csv,svg} into `out_dir`.
