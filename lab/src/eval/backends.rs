@@ -43,6 +43,19 @@ impl BackendDiff {
             && frac(self.colour_beyond_one, self.pixels) <= 0.005
             && frac(self.depth_beyond, self.depth_compared) <= 0.005
     }
+
+    /// The worst of `self` and `other`, count by count (pixels: the larger).
+    pub fn worst(self, other: BackendDiff) -> BackendDiff {
+        BackendDiff {
+            pixels: self.pixels.max(other.pixels),
+            mask_mismatches: self.mask_mismatches.max(other.mask_mismatches),
+            colour_beyond_one: self.colour_beyond_one.max(other.colour_beyond_one),
+            colour_worst: self.colour_worst.max(other.colour_worst),
+            depth_compared: self.depth_compared.max(other.depth_compared),
+            depth_beyond: self.depth_beyond.max(other.depth_beyond),
+            depth_worst_rel: self.depth_worst_rel.max(other.depth_worst_rel),
+        }
+    }
 }
 
 /// Compares `gl` with `vk` plane by plane (planes only one view has are mismatches of every
@@ -107,21 +120,6 @@ pub fn backend_diff(gl: &ViewOutput, vk: &ViewOutput) -> BackendDiff {
         }
     }
     d
-}
-
-impl BackendDiff {
-    /// The worst of `self` and `other`, count by count (pixels: the larger).
-    pub fn worst(self, other: BackendDiff) -> BackendDiff {
-        BackendDiff {
-            pixels: self.pixels.max(other.pixels),
-            mask_mismatches: self.mask_mismatches.max(other.mask_mismatches),
-            colour_beyond_one: self.colour_beyond_one.max(other.colour_beyond_one),
-            colour_worst: self.colour_worst.max(other.colour_worst),
-            depth_compared: self.depth_compared.max(other.depth_compared),
-            depth_beyond: self.depth_beyond.max(other.depth_beyond),
-            depth_worst_rel: self.depth_worst_rel.max(other.depth_worst_rel),
-        }
-    }
 }
 
 /// One pass on two devices, over every convention.
