@@ -124,6 +124,17 @@ impl RowOrder {
         }
     }
 
+    /// The rows of `data` (rows of `row_bytes`, stored in this order) from the top down: what
+    /// [`Self::convert_rows`] makes, read in place without a copy.
+    pub fn top_down(self, data: &[u8], row_bytes: usize) -> impl Iterator<Item = &[u8]> {
+        let h = data.len().checked_div(row_bytes).unwrap_or(0);
+        let flip = self == RowOrder::BottomUp;
+        (0..h).map(move |y| {
+            let y = if flip { h - 1 - y } else { y };
+            &data[y * row_bytes..(y + 1) * row_bytes]
+        })
+    }
+
     /// Convert between top-down image rows and this order's memory rows (the same operation
     /// both ways: a row flip for bottom-up, nothing for top-down). `row_bytes` is one row.
     pub fn convert_rows(self, mut data: Vec<u8>, row_bytes: usize) -> Vec<u8> {
@@ -307,6 +318,10 @@ mod tests {
         let flipped = RowOrder::BottomUp.convert_rows(img.clone(), 4);
         assert_eq!(flipped, vec![8, 9, 10, 11, 4, 5, 6, 7, 0, 1, 2, 3]);
         assert_eq!(RowOrder::BottomUp.convert_rows(flipped, 4), img);
+        for rows in [RowOrder::TopDown, RowOrder::BottomUp] {
+            let read: Vec<u8> = rows.top_down(&img, 4).flatten().copied().collect();
+            assert_eq!(read, rows.convert_rows(img.clone(), 4));
+        }
     }
 
     #[test]

@@ -10,7 +10,7 @@ use crate::convention::RowOrder;
 use crate::error::{Error, Result};
 use crate::gpu::shaders::TRI_TEX_WIDTH;
 use crate::gpu::{ProgramKind, ShaderProgram, Timing};
-use crate::pass::{mat4_std140, Device, Draw, Format, Image, ImageData, Step, Target, ToDevice};
+use crate::pass::{mat4_std140, Device, Draw, Format, Image, ImageData, Step, Target, Texels, ToDevice};
 use crate::refocus::mesh::code_rows;
 use crate::refocus::{BreakRule, Grid};
 
@@ -204,7 +204,11 @@ impl ForwardWarp {
             // Neither eye kept a triangle: an empty view (a run without draws reads nothing).
             let n = w as usize * h as usize;
             crate::pass::Rendered {
-                outputs: vec![Some(vec![0; 3 * n]), Some(vec![0; 4 * n]), Some(vec![0; n])],
+                outputs: vec![
+                    Some(Texels::Bytes(vec![0; 3 * n])),
+                    Some(Texels::Floats(vec![0.0; n])),
+                    Some(Texels::Bytes(vec![0; n])),
+                ],
                 timing: Timing {
                     gpu_ms: None,
                     wall_ms: 0.0,

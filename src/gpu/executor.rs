@@ -17,7 +17,7 @@ use crate::convention::RowOrder;
 use crate::error::{Error, Result};
 use crate::pass::{
     Api, BufferId, Device, Executor, Format, Groups, ImageData, ImageId, Rendered, Slots, Step, StorageImage, Target,
-    Ticket, ToDevice,
+    Texels, Ticket, ToDevice,
 };
 use std::time::Instant;
 
@@ -208,7 +208,13 @@ impl Executor for GlExecutor {
         let outputs = run
             .reads
             .into_iter()
-            .map(|r| r.map(PendingRead::finish).transpose())
+            .map(|r| {
+                r.map(|r| match r.holds_floats() {
+                    true => r.finish_f32().map(Texels::Floats),
+                    false => r.finish().map(Texels::Bytes),
+                })
+                .transpose()
+            })
             .collect::<Result<Vec<_>>>()?;
         Ok(Rendered {
             outputs,

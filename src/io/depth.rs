@@ -259,18 +259,23 @@ fn to_metres(path: &Path, raw: RawDepth, decode: &DepthDecode) -> Result<DepthMa
         }
         RawSamples::U16(v) => {
             let s = need_scale("16-bit", "5000 for TUM, 1000 for SUN RGB-D or millimetres")?;
-            v.into_iter()
-                .map(|d| {
-                    let d = if decode.swap_bytes { d.swap_bytes() } else { d };
-                    // Same as ((d >> 3) | (d << 13)) & 0xFFFF.
-                    let d = if decode.sun_rgbd_bit_rotate {
-                        d.rotate_right(3)
-                    } else {
-                        d
-                    };
-                    int_to_metres(d.into(), s)
-                })
-                .collect()
+            // Same as ((d >> 3) | (d << 13)) & 0xFFFF.
+            let rotate = |d: u16| {
+                if decode.sun_rgbd_bit_rotate {
+                    d.rotate_right(3)
+                } else {
+                    d
+                }
+            };
+            if decode.swap_bytes {
+                v.into_iter()
+                    .map(|d| int_to_metres(rotate(d.swap_bytes()).into(), s))
+                    .collect()
+            } else if decode.sun_rgbd_bit_rotate {
+                v.into_iter().map(|d| int_to_metres(rotate(d).into(), s)).collect()
+            } else {
+                v.into_iter().map(|d| int_to_metres(d.into(), s)).collect()
+            }
         }
         RawSamples::U32(v) => {
             let s = need_scale("integer", "the number of raw units per metre")?;
@@ -287,12 +292,11 @@ fn to_metres(path: &Path, raw: RawDepth, decode: &DepthDecode) -> Result<DepthMa
     DepthMap::new(raw.width, raw.height, data).map_err(|e| Error::decode(path, e.to_string()))
 }
 
+/// `raw / scale` in f64, rounded once to f32; 0 (no reading) stays 0 because `scale` is finite
+/// and > 0. No branch, so the conversion loops vectorise (a branch per pixel cost ~2 ms a VGA
+/// frame).
 fn int_to_metres(raw: u32, scale: f64) -> f32 {
-    if raw == 0 {
-        0.0
-    } else {
-        (f64::from(raw) / scale) as f32
-    }
+    (f64::from(raw) / scale) as f32
 }
 
 #[cfg(test)]

@@ -8,6 +8,7 @@
 
 use std::fmt;
 
+use super::depth_ranks::ValidRanks;
 use super::DepthMap;
 use crate::convention::DepthPlanes;
 
@@ -94,35 +95,24 @@ const NO_SPREAD_MIN_PIXELS: usize = 4096;
 impl DepthSummary {
     /// Counts and ranks the valid (finite, > 0) values of `depth`.
     pub fn of(depth: &DepthMap) -> Self {
-        let mut valid: Vec<f32> = depth
-            .data
-            .iter()
-            .copied()
-            .filter(|v| v.is_finite() && *v > 0.0)
-            .collect();
-        let range = if valid.is_empty() {
-            None
+        let ranks = ValidRanks::of(&depth.data);
+        let n = ranks.count;
+        let (range, p05_p95, at_max) = if n == 0 {
+            (None, None, 0)
         } else {
-            let mid = valid.len() / 2;
-            let (_, median, _) = valid.select_nth_unstable_by(mid, f32::total_cmp);
-            let median = f64::from(*median);
-            let (lo, hi) = valid
-                .iter()
-                .fold((f32::MAX, f32::MIN), |(l, h), v| (l.min(*v), h.max(*v)));
-            Some((f64::from(lo), median, f64::from(hi)))
-        };
-        let p05_p95 = (!valid.is_empty()).then(|| {
-            let n = valid.len();
             let rank = |p: f64| ((p * n as f64).ceil() as usize).clamp(1, n) - 1;
-            let p05 = f64::from(*valid.select_nth_unstable_by(rank(0.05), f32::total_cmp).1);
-            let p95 = f64::from(*valid.select_nth_unstable_by(rank(0.95), f32::total_cmp).1);
-            (p05, p95)
-        });
-        let at_max = range.map_or(0, |(_, _, hi)| valid.iter().filter(|v| f64::from(**v) == hi).count());
+            // The upper median, as `select_nth_unstable(n / 2)` gives.
+            let [median, p05, p95] = ranks.values_at([n / 2, rank(0.05), rank(0.95)], &depth.data);
+            (
+                Some((f64::from(ranks.min), f64::from(median), f64::from(ranks.max))),
+                Some((f64::from(p05), f64::from(p95))),
+                ranks.at_max,
+            )
+        };
         DepthSummary {
             width: depth.width,
             height: depth.height,
-            valid: valid.len(),
+            valid: ranks.count,
             at_max,
             range,
             p05_p95,

@@ -12,6 +12,7 @@ mod decode;
 mod depth;
 mod depth_png16;
 mod depth_preview;
+mod depth_ranks;
 mod depth_summary;
 mod depth_trunc;
 mod depth_values;

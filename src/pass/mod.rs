@@ -197,11 +197,41 @@ pub struct Draw<'a> {
     pub indices: Option<BufferId>,
 }
 
-/// What a pass read back: per output location, top-down bytes where asked for.
+/// One output's texels as read back, rows top-down: bytes (RGB8 from an RGBA8 target, R8) or
+/// f32 (R32F). Each lands in a vector of its own element type, so a depth map takes the read
+/// f32s as they are (a byte vector had to be copied into an aligned one: a second pass over
+/// every depth output, ~1 ms a VGA target).
+#[derive(Debug, Clone, PartialEq)]
+pub enum Texels {
+    /// RGB8 colour (packed from RGBA8) or R8.
+    Bytes(Vec<u8>),
+    /// R32F.
+    Floats(Vec<f32>),
+}
+
+impl Texels {
+    /// The texels as bytes (f32s as their native-endian bytes, copied).
+    pub fn into_bytes(self) -> Vec<u8> {
+        match self {
+            Texels::Bytes(b) => b,
+            Texels::Floats(f) => bytemuck::cast_slice(&f).to_vec(),
+        }
+    }
+
+    /// The texels as f32s (bytes reinterpreted, copied; their length a multiple of 4).
+    pub fn into_floats(self) -> Vec<f32> {
+        match self {
+            Texels::Bytes(b) => bytemuck::pod_collect_to_vec(&b),
+            Texels::Floats(f) => f,
+        }
+    }
+}
+
+/// What a pass read back: per output location, top-down texels where asked for.
 #[derive(Debug)]
 pub struct Rendered {
     /// Per location of [`Target::outputs`].
-    pub outputs: Vec<Option<Vec<u8>>>,
+    pub outputs: Vec<Option<Texels>>,
     /// Wall time of draws and readback (and GPU time where the backend measures it).
     pub timing: Timing,
     /// The target's width and height (0 x 0 without one).
@@ -232,7 +262,7 @@ impl Rendered {
         let (w, h) = self.size;
         self.outputs[i]
             .take()
-            .map(|c| crate::io::RgbImage::new(w, h, c))
+            .map(|c| crate::io::RgbImage::new(w, h, c.into_bytes()))
             .transpose()
     }
 
@@ -241,12 +271,21 @@ impl Rendered {
         let (w, h) = self.size;
         self.outputs[i]
             .take()
-            .map(|d| crate::io::DepthMap::new(w, h, crate::alloc::try_pod_collect(&d, "depth readback")?))
+            .map(|d| crate::io::DepthMap::new(w, h, d.into_floats()))
             .transpose()
     }
 
-    /// Output `i` (asked for, so present), or an error naming the pass.
+    /// Output `i`'s bytes (asked for, so present), or an error naming the pass.
     pub fn take(&mut self, i: usize, what: &str) -> Result<Vec<u8>> {
+        self.take_texels(i, what).map(Texels::into_bytes)
+    }
+
+    /// Output `i`'s f32s (asked for, so present), or an error naming the pass.
+    pub fn take_floats(&mut self, i: usize, what: &str) -> Result<Vec<f32>> {
+        self.take_texels(i, what).map(Texels::into_floats)
+    }
+
+    fn take_texels(&mut self, i: usize, what: &str) -> Result<Texels> {
         self.outputs
             .get_mut(i)
             .and_then(Option::take)

@@ -270,10 +270,9 @@ impl SceneRenderer {
             indices: None,
         };
         let mut out = self.device.render(&target, &[draw])?;
-        let floats = |b: Vec<u8>| -> Vec<f32> { bytemuck::pod_collect_to_vec(&b) };
         let color = out.take(0, "scene ray trace")?;
-        let view_z = floats(out.take(1, "scene ray trace")?);
-        let device = floats(out.take(2, "scene ray trace")?);
+        let view_z = out.take_floats(1, "scene ray trace")?;
+        let device = out.take_floats(2, "scene ray trace")?;
         Ok((
             SceneImage {
                 color: RgbImage::new(w, h, color)?,

@@ -8,7 +8,7 @@ use super::context::{vk_err, Vk};
 use super::resources::Buffer;
 use crate::convention::RowOrder;
 use crate::error::Result;
-use crate::pass::Format;
+use crate::pass::{Format, Texels};
 use ash::vk;
 
 /// A submission's objects and what its readback holds.
@@ -117,8 +117,9 @@ impl Flight {
     }
 
     /// Output `i`'s texels after the fence, rows top-down (files are top-down: a bottom-up
-    /// memory order is flipped here, as GL does on the GPU), RGBA8 packed to RGB.
-    pub fn read_output(&self, i: usize) -> Result<Option<Vec<u8>>> {
+    /// memory order is flipped here, as GL does on the GPU), RGBA8 packed to RGB, R32F into f32s
+    /// (one copy out of the mapped buffer each).
+    pub fn read_output(&self, i: usize) -> Result<Option<Texels>> {
         let Some(f) = self.outputs.get(i).copied().flatten() else {
             return Ok(None);
         };
@@ -127,16 +128,33 @@ impl Flight {
         };
         let (w, h) = self.size;
         let row_bytes = w as usize * f.texel_bytes();
-        let copy = crate::alloc::try_copy(buffer.read(row_bytes * h as usize), "readback")?;
-        let rows = self.rows.convert_rows(copy, row_bytes);
+        let mapped = buffer.read(row_bytes * h as usize);
         Ok(Some(match f {
             // Files hold RGB; the GL executor packs on the GPU, here while copying out.
             Format::Rgba8 => {
-                let mut rgb = crate::alloc::try_with_capacity(rows.len() / 4 * 3, "colour readback")?;
-                rgb.extend(rows.chunks_exact(4).flat_map(|p| [p[0], p[1], p[2]]));
-                rgb
+                let mut rgb = crate::alloc::try_with_capacity(mapped.len() / 4 * 3, "colour readback")?;
+                for row in self.rows.top_down(mapped, row_bytes) {
+                    rgb.extend(row.chunks_exact(4).flat_map(|p| [p[0], p[1], p[2]]));
+                }
+                Texels::Bytes(rgb)
             }
-            _ => rows,
+            Format::R32F => {
+                let mut floats = crate::alloc::try_with_capacity::<f32>(mapped.len() / 4, "depth readback")?;
+                for row in self.rows.top_down(mapped, row_bytes) {
+                    floats.extend(
+                        row.chunks_exact(4)
+                            .map(|b| f32::from_ne_bytes([b[0], b[1], b[2], b[3]])),
+                    );
+                }
+                Texels::Floats(floats)
+            }
+            _ => {
+                let mut bytes = crate::alloc::try_with_capacity(mapped.len(), "readback")?;
+                for row in self.rows.top_down(mapped, row_bytes) {
+                    bytes.extend_from_slice(row);
+                }
+                Texels::Bytes(bytes)
+            }
         }))
     }
 
