@@ -18,6 +18,14 @@ cargo build --release --locked --bin viewsynth
 export PYO3_PYTHON="$VENV/bin/python"
 cargo fmt --manifest-path python/Cargo.toml --check
 cargo clippy --manifest-path python/Cargo.toml --release --locked --all-targets -- -D warnings
+# Small single-purpose files: none under python/src over 500 lines (issue 37; each capability's
+# Renderer method lives in its own file, so renderer.rs does not grow with each capability).
+too_long=$(find python/src -type f -exec awk 'END { if (NR > 500) print FILENAME ": " NR " lines" }' {} \;)
+if [ -n "$too_long" ]; then
+  echo "python/src files over 500 lines (split them):" >&2
+  echo "$too_long" >&2
+  exit 1
+fi
 
 # From the repository root, so `import viewsynth` is the installed package, not python/viewsynth.
 set +e

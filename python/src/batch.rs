@@ -1,12 +1,14 @@
-//! Files in, files out: `viewsynth.load_manifest` and `Renderer.refocus_batch`, the library's
-//! batch (`viewsynth refocus --batch`) on this Renderer's context. The same code writes the same
-//! files, so a Ray Data (or any other) pipeline that hands each worker a share of a manifest's
-//! frames gets exactly the CLI batch's output folders. Scheduling frames is the caller's part.
+//! Files in, files out: `viewsynth.load_manifest` and `Renderer.refocus_batch` (the method in its
+//! own `#[pymethods]` block), the library's batch (`viewsynth refocus --batch`) on this
+//! Renderer's context. The same code writes the same files, so a Ray Data (or any other) pipeline
+//! that hands each worker a share of a manifest's frames gets exactly the CLI batch's output
+//! folders. Scheduling frames is the caller's part.
 
+use crate::augment::Augment;
 use crate::backend::Backend;
 use crate::errors;
-use crate::shared::choice;
-use crate::shared::SameThread;
+use crate::renderer::Renderer;
+use crate::shared::{choice, SameThread};
 use pyo3::conversion::FromPyObjectOwned;
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyList, PyMapping, PyString};
@@ -196,7 +198,81 @@ pub struct BatchArgs<'a, 'py> {
     /// Write the index part (and join it); False where the caller splits the manifest itself.
     pub index: bool,
     /// rgb_everywhere, random zoom and progress (augment.rs).
-    pub augment: crate::augment::Augment<'py>,
+    pub augment: Augment<'py>,
+}
+
+#[pymethods]
+impl Renderer {
+    #[doc = include_str!("doc/refocus_batch.txt")]
+    #[allow(clippy::too_many_arguments)]
+    #[pyo3(signature = (frames, out_dir, *, scales = None, size = None, principal = None,
+                        outputs = None, tau_rel = 0.05, tau_abs = 0.2, method = "fullscreen", rgb_format = "png",
+                        depth_format = None, depth_preview = false, png_compression = "fast",
+                        exr_compression = "zip", depth_trunc = None, resume = true, jobs = None, shard = None,
+                        rgb_everywhere = false, zoom_random = None, samples = None, seed = None, progress = None,
+                        index = true))]
+    fn refocus_batch<'py>(
+        &mut self,
+        py: Python<'py>,
+        frames: &Bound<'py, PyAny>,
+        out_dir: std::path::PathBuf,
+        scales: Option<Vec<f64>>,
+        #[pyo3(from_py_with = crate::ints::size)] size: Option<(u32, u32)>,
+        principal: Option<(f64, f64)>,
+        outputs: Option<&Bound<'py, PyAny>>,
+        tau_rel: f64,
+        tau_abs: f64,
+        method: &str,
+        rgb_format: &str,
+        depth_format: Option<&Bound<'py, PyAny>>,
+        depth_preview: bool,
+        png_compression: &str,
+        exr_compression: &str,
+        depth_trunc: Option<f64>,
+        resume: bool,
+        #[pyo3(from_py_with = crate::ints::jobs)] jobs: Option<usize>,
+        shard: Option<&str>,
+        rgb_everywhere: bool,
+        zoom_random: Option<(f64, f64)>,
+        samples: Option<usize>,
+        seed: Option<u64>,
+        progress: Option<Bound<'py, PyAny>>,
+        index: bool,
+    ) -> PyResult<Bound<'py, PyAny>> {
+        let gpu = self.gpu()?.clone();
+        refocus_batch(
+            py,
+            gpu,
+            BatchArgs {
+                frames,
+                out_dir,
+                scales,
+                size,
+                principal,
+                outputs,
+                tau_rel,
+                tau_abs,
+                method,
+                rgb_format,
+                depth_format,
+                depth_preview,
+                png_compression,
+                exr_compression,
+                depth_trunc,
+                resume,
+                jobs,
+                shard,
+                index,
+                augment: Augment {
+                    rgb_everywhere,
+                    zoom_random,
+                    samples,
+                    seed,
+                    progress,
+                },
+            },
+        )
+    }
 }
 
 /// The settings as the library's request, checked by it as the CLI's `refocus --batch`.
@@ -230,7 +306,7 @@ pub fn options(a: &BatchArgs<'_, '_>) -> PyResult<BatchOptions> {
 }
 
 /// Validates `a`, runs the batch with the GIL released, and returns its summary as a dict.
-pub fn refocus_batch<'py>(py: Python<'py>, gpu: Backend, a: BatchArgs<'_, 'py>) -> PyResult<Bound<'py, PyAny>> {
+fn refocus_batch<'py>(py: Python<'py>, gpu: Backend, a: BatchArgs<'_, 'py>) -> PyResult<Bound<'py, PyAny>> {
     let opts = options(&a)?;
     let frames = frames(a.frames)?;
     let out_dir = a.out_dir;

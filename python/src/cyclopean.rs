@@ -1,14 +1,17 @@
-//! `Renderer.cyclopean`: the library calls of `viewsynth cyclopean`, numpy in and out, for both
-//! of its set-ups: a rectified pair with disparities (`--left-disparity ...`), or any pair with
-//! depth placed by a camera file (`--left-depth ... --cameras`). The cameras come as the file's
-//! path or as a dict with the file's keys, read by the library's own `CameraFile` parser (K, R, t
-//! converted to GL matrices exactly as for the CLI); see `camera_json` for the dict.
+//! `Renderer.cyclopean` (the method in its own `#[pymethods]` block, its keyword arguments
+//! filling the library's `CyclopeanRequest`): the library calls of `viewsynth cyclopean`, numpy
+//! in and out, for both of its set-ups: a rectified pair with disparities (`--left-disparity
+//! ...`), or any pair with depth placed by a camera file (`--left-depth ... --cameras`). The
+//! cameras come as the file's path or as a dict with the file's keys, read by the library's own
+//! `CameraFile` parser (K, R, t converted to GL matrices exactly as for the CLI); see
+//! `camera_json` for the dict.
 
 use crate::arrays;
 use crate::backend::Backend;
 use crate::errors;
 use crate::errors::Kind;
-use crate::shared::SameThread;
+use crate::renderer::Renderer;
+use crate::shared::{choice, outputs_given, SameThread};
 use pyo3::prelude::*;
 use pyo3::types::{PyBool, PyDict, PyFloat, PyInt, PyList, PyString, PyTuple};
 use viewsynth::cyclopean::camera_file::CameraFile;
@@ -19,7 +22,7 @@ use viewsynth::job::cyclopean::{
 use viewsynth::pass::ToDevice;
 
 /// The arguments of one call, as Python gave them.
-pub struct CyclopeanArgs<'a, 'py> {
+struct CyclopeanArgs<'a, 'py> {
     pub left_rgb: &'a Bound<'py, PyAny>,
     pub right_rgb: &'a Bound<'py, PyAny>,
     pub left_disparity: Option<&'a Bound<'py, PyAny>>,
@@ -29,6 +32,76 @@ pub struct CyclopeanArgs<'a, 'py> {
     pub cameras: Option<&'a Bound<'py, PyAny>>,
     /// Every other keyword argument, named as the library's request names it.
     pub request: CyclopeanRequest,
+}
+
+#[pymethods]
+impl Renderer {
+    #[doc = include_str!("doc/cyclopean.txt")]
+    #[allow(clippy::too_many_arguments, clippy::doc_lazy_continuation)] // the doc: Python text
+    #[pyo3(signature = (left_rgb, right_rgb, left_disparity = None, right_disparity = None, position = None, *,
+                        left_depth = None, right_depth = None, cameras = None, method = None,
+                        refine_steps = None, blend = None, z_threshold = None, dominant = None,
+                        focal = None, baseline = None, doffs = 0.0, outputs = None, fill = false,
+                        max_disparity = None, min_confidence = None, confidence = false))]
+    fn cyclopean<'py>(
+        &mut self,
+        py: Python<'py>,
+        left_rgb: &Bound<'py, PyAny>,
+        right_rgb: &Bound<'py, PyAny>,
+        left_disparity: Option<&Bound<'py, PyAny>>,
+        right_disparity: Option<&Bound<'py, PyAny>>,
+        position: Option<f64>,
+        left_depth: Option<&Bound<'py, PyAny>>,
+        right_depth: Option<&Bound<'py, PyAny>>,
+        cameras: Option<&Bound<'py, PyAny>>,
+        method: Option<&str>,
+        #[pyo3(from_py_with = crate::ints::refine_steps)] refine_steps: Option<u32>,
+        blend: Option<&str>,
+        z_threshold: Option<f64>,
+        dominant: Option<String>,
+        focal: Option<f64>,
+        baseline: Option<f64>,
+        doffs: f64,
+        outputs: Option<&Bound<'py, PyAny>>,
+        fill: bool,
+        #[pyo3(from_py_with = crate::ints::max_disparity)] max_disparity: Option<u32>,
+        min_confidence: Option<f64>,
+        confidence: bool,
+    ) -> PyResult<Bound<'py, PyDict>> {
+        let gpu = self.gpu()?.clone();
+        // The settings as the library's request: it alone decides and checks them.
+        let request = CyclopeanRequest {
+            method: method.map(|m| choice("--method", m)).transpose()?,
+            refine_steps,
+            blend: blend.map(|b| choice("--blend", b)).transpose()?,
+            z_threshold,
+            dominant,
+            position,
+            focal,
+            baseline,
+            doffs,
+            outputs: outputs_given(outputs)?,
+            fill,
+            max_disparity: max_disparity.map(|m| m.min(i32::MAX as u32) as i32),
+            min_disparity: None,
+            min_confidence,
+            confidence,
+        };
+        cyclopean(
+            py,
+            gpu,
+            CyclopeanArgs {
+                left_rgb,
+                right_rgb,
+                left_disparity,
+                right_disparity,
+                left_depth,
+                right_depth,
+                cameras,
+                request,
+            },
+        )
+    }
 }
 
 /// The work of one call once validated: render with the GIL released.
@@ -183,7 +256,7 @@ fn camera_file(obj: &Bound<'_, PyAny>) -> PyResult<CameraFile> {
 }
 
 /// Validates `a`, renders the view with the GIL released, and returns the result dict.
-pub fn cyclopean<'py>(py: Python<'py>, gpu: Backend, a: CyclopeanArgs<'_, 'py>) -> PyResult<Bound<'py, PyDict>> {
+fn cyclopean<'py>(py: Python<'py>, gpu: Backend, a: CyclopeanArgs<'_, 'py>) -> PyResult<Bound<'py, PyDict>> {
     let kind = StereoGiven {
         left_disparity: a.left_disparity.is_some(),
         right_disparity: a.right_disparity.is_some(),

@@ -13,7 +13,7 @@ use std::path::PathBuf;
 /// written with these settings (failed, not yet rendered, or made with other settings) has no
 /// rows. The settings are refocus_batch's keywords of the same names and must be the ones the
 /// frames were rendered with. Returns (path, rows).
-// The keyword list is refocus_batch's settings (python/src/renderer.rs), written again because
+// The keyword list is refocus_batch's settings (python/src/batch.rs), written again because
 // pyo3 takes a signature only as a literal; test_refocus_batch.py holds the two equal.
 #[pyfunction]
 #[allow(clippy::too_many_arguments)]

@@ -1,7 +1,9 @@
 //! Python bindings of the viewsynth library (not the CLI): numpy arrays in, numpy arrays out.
 //! The package `viewsynth` (python/viewsynth/) re-exports this module `viewsynth._viewsynth`.
-//! Arrays in memory: `renderer` (the class), `refocus`, `cyclopean`, `reproject`, `stitch`; files in and out (the CLI
-//! batch's writers): `batch`.
+//! `renderer`: the class `Renderer`, its context and lifetime. Each capability's module holds its
+//! method (a `#[pymethods]` block of its own, pyo3's `multiple-pymethods`) and its work; arrays in
+//! memory: `refocus`, `cyclopean`, `reproject`, `stitch`; files in and out (the CLI batch's
+//! writers): `batch`.
 
 mod arrays;
 mod augment;

@@ -1,11 +1,14 @@
-//! `Renderer.refocus` on one frame: the inputs checked and copied out of numpy while the GIL is
-//! held, the targets planned by the library's request, every target rendered with the GIL
-//! released, the outputs handed back as numpy arrays (a stack is split in `renderer`).
+//! `Renderer.refocus`: the method (its own `#[pymethods]` block; a stack of frames is split by
+//! `stack` into one call per frame), and its work on one frame: the inputs checked and copied out
+//! of numpy while the GIL is held, the targets planned by the library's request, every target
+//! rendered with the GIL released, the outputs handed back as numpy arrays.
 
 use crate::arrays;
 use crate::backend::Backend;
 use crate::errors;
+use crate::renderer::Renderer;
 use crate::shared::{choice, outputs_given, SameThread};
+use crate::stack;
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyList};
 use viewsynth::camera::PinholeCamera;
@@ -14,7 +17,7 @@ use viewsynth::job::refocus::RefocusRequest;
 use viewsynth::refocus::{BreakRule, Method, OutputSet, RefocusOutput, RefocusSource, Refocuser};
 
 /// The arguments of one refocus call (one frame), as Python gave them.
-pub struct RefocusArgs<'a, 'py> {
+struct RefocusArgs<'a, 'py> {
     pub rgb: &'a Bound<'py, PyAny>,
     pub depth: &'a Bound<'py, PyAny>,
     pub k: &'a Bound<'py, PyAny>,
@@ -27,6 +30,73 @@ pub struct RefocusArgs<'a, 'py> {
     pub tau_abs: f64,
     pub method: &'a str,
     pub rgb_everywhere: bool,
+}
+
+#[pymethods]
+impl Renderer {
+    #[doc = include_str!("doc/refocus.txt")]
+    #[allow(non_snake_case, clippy::too_many_arguments)]
+    #[pyo3(signature = (rgb, depth, K, *, scales = None, K_out = None, size = None, principal = None,
+                        outputs = None, tau_rel = 0.05, tau_abs = 0.2, method = "fullscreen", rgb_everywhere = false))]
+    fn refocus<'py>(
+        &mut self,
+        py: Python<'py>,
+        rgb: &Bound<'py, PyAny>,
+        depth: &Bound<'py, PyAny>,
+        K: &Bound<'py, PyAny>,
+        scales: Option<Vec<f64>>,
+        K_out: Option<&Bound<'py, PyAny>>,
+        #[pyo3(from_py_with = crate::ints::size)] size: Option<(u32, u32)>,
+        principal: Option<(f64, f64)>,
+        outputs: Option<&Bound<'py, PyAny>>,
+        tau_rel: f64,
+        tau_abs: f64,
+        method: &str,
+        rgb_everywhere: bool,
+    ) -> PyResult<Bound<'py, PyList>> {
+        if let Some(frames) = stack::frames(rgb, depth, K)? {
+            let views = PyList::empty(py);
+            for (rgb, depth, k) in frames {
+                let (s, o) = (scales.clone(), outputs);
+                let one = self.refocus(
+                    py,
+                    &rgb,
+                    &depth,
+                    &k,
+                    s,
+                    K_out,
+                    size,
+                    principal,
+                    o,
+                    tau_rel,
+                    tau_abs,
+                    method,
+                    rgb_everywhere,
+                );
+                views.append(one?)?;
+            }
+            return Ok(views);
+        }
+        let gpu = self.gpu()?.clone();
+        refocus(
+            py,
+            gpu,
+            RefocusArgs {
+                rgb,
+                depth,
+                k: K,
+                scales,
+                k_out: K_out,
+                size,
+                principal,
+                outputs,
+                tau_rel,
+                tau_abs,
+                method,
+                rgb_everywhere,
+            },
+        )
+    }
 }
 
 /// A refocus call's inputs, validated while the GIL is held.
@@ -62,7 +132,7 @@ fn render_all(gpu: &Backend, job: &RefocusJob) -> viewsynth::Result<(f64, Vec<Re
 
 /// Refocus one frame on `gpu`: one dict per target (see `Renderer.refocus`).
 #[allow(non_snake_case)]
-pub fn refocus<'py>(py: Python<'py>, gpu: Backend, a: RefocusArgs<'_, 'py>) -> PyResult<Bound<'py, PyList>> {
+fn refocus<'py>(py: Python<'py>, gpu: Backend, a: RefocusArgs<'_, 'py>) -> PyResult<Bound<'py, PyList>> {
     let RefocusArgs {
         rgb,
         depth,

@@ -1,11 +1,13 @@
-//! `Renderer.reproject` on a parallel stereo rig: the library calls of the CLI's rig mode
-//! (`viewsynth reproject --fx ... --baseline ...`), numpy in and out. The keyword arguments fill
-//! the library's `ReprojectRequest`; its checks decide the views, the depth kind and the rig.
+//! `Renderer.reproject` (the method in its own `#[pymethods]` block) on a parallel stereo rig: the
+//! library calls of the CLI's rig mode (`viewsynth reproject --fx ... --baseline ...`), numpy in
+//! and out. The keyword arguments fill the library's `ReprojectRequest`; its checks decide the
+//! views, the depth kind and the rig.
 
 use crate::arrays;
 use crate::backend::Backend;
 use crate::errors;
-use crate::shared::SameThread;
+use crate::renderer::Renderer;
+use crate::shared::{choice, outputs_given, SameThread};
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 use viewsynth::camera::stereo::Eye;
@@ -14,11 +16,70 @@ use viewsynth::job::reproject::{RenderedTarget, ReprojectRequest};
 use viewsynth::pass::ToDevice;
 
 /// The arguments of one call: the arrays, and the settings as the library's request.
-pub struct ReprojectArgs<'a, 'py> {
+struct ReprojectArgs<'a, 'py> {
     pub rgb: &'a Bound<'py, PyAny>,
     pub depth: &'a Bound<'py, PyAny>,
     pub k: &'a Bound<'py, PyAny>,
     pub request: ReprojectRequest,
+}
+
+#[pymethods]
+impl Renderer {
+    #[doc = include_str!("doc/reproject.txt")]
+    #[allow(non_snake_case, clippy::too_many_arguments)]
+    #[pyo3(signature = (rgb, depth, K, *, depth_kind = "view-z", baseline = None, focal = None, doffs = 0.0,
+                        separation = None, convergence = None, near = None, far = None, source = "left",
+                        target = "right", method = "shift-scan", steps = 3, tau_rel = 0.05, outputs = None))]
+    fn reproject<'py>(
+        &mut self,
+        py: Python<'py>,
+        rgb: &Bound<'py, PyAny>,
+        depth: &Bound<'py, PyAny>,
+        K: &Bound<'py, PyAny>,
+        depth_kind: &str,
+        baseline: Option<f64>,
+        focal: Option<f64>,
+        doffs: f64,
+        separation: Option<f64>,
+        convergence: Option<f64>,
+        near: Option<f64>,
+        far: Option<f64>,
+        source: &str,
+        target: &str,
+        method: &str,
+        #[pyo3(from_py_with = crate::ints::steps)] steps: u32,
+        tau_rel: f64,
+        outputs: Option<&Bound<'py, PyAny>>,
+    ) -> PyResult<Bound<'py, PyDict>> {
+        let gpu = self.gpu()?.clone();
+        // The settings as the library's request: it alone decides and checks them.
+        let request = ReprojectRequest {
+            depth_kind: choice("--depth-kind", depth_kind)?,
+            near,
+            far,
+            baseline,
+            focal,
+            doffs,
+            separation,
+            convergence,
+            from: choice("--from", source)?,
+            to: choice("--to", target)?,
+            method: choice("--method", method)?,
+            steps,
+            tau_rel,
+            outputs: outputs_given(outputs)?,
+        };
+        reproject(
+            py,
+            gpu,
+            ReprojectArgs {
+                rgb,
+                depth,
+                k: K,
+                request,
+            },
+        )
+    }
 }
 
 fn eye_name(eye: Eye) -> &'static str {
@@ -29,7 +90,7 @@ fn eye_name(eye: Eye) -> &'static str {
 }
 
 /// Validates `a`, renders every target with the GIL released, and returns {eye name: dict}.
-pub fn reproject<'py>(py: Python<'py>, gpu: Backend, a: ReprojectArgs<'_, 'py>) -> PyResult<Bound<'py, PyDict>> {
+fn reproject<'py>(py: Python<'py>, gpu: Backend, a: ReprojectArgs<'_, 'py>) -> PyResult<Bound<'py, PyDict>> {
     let request = a.request;
     let k = arrays::intrinsics(a.k, "K")?;
     let plan = request.rig(k.fx).map_err(errors::from_request)?;

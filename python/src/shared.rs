@@ -1,5 +1,5 @@
-//! Helpers every binding uses (the renderer's methods and the modules they call alike), kept
-//! apart from `renderer` so that no binding imports back from the module that calls it.
+//! Helpers every binding uses (the capability modules, their `Renderer` methods, `index`), kept
+//! apart from any one of them so that no binding imports from a sibling capability.
 
 use crate::errors;
 use pyo3::prelude::*;

@@ -1,12 +1,13 @@
-//! `Renderer.stitch`: an omni-directional stereo (ODS) 360 from each eye's six over-wide cube
-//! faces, numpy in and out: the library calls of `viewsynth stitch --faces DIR` with the same
-//! defaults and checks, the faces given as stacked arrays instead of a folder.
+//! `Renderer.stitch` (the method in its own `#[pymethods]` block): an omni-directional stereo
+//! (ODS) 360 from each eye's six over-wide cube faces, numpy in and out: the library calls of
+//! `viewsynth stitch --faces DIR` with the same defaults and checks, the faces given as stacked
+//! arrays instead of a folder.
 
 use crate::arrays;
 use crate::backend::Backend;
 use crate::errors;
-use crate::shared::choice;
-use crate::shared::SameThread;
+use crate::renderer::Renderer;
+use crate::shared::{choice, SameThread};
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 use viewsynth::convention::{Conventions, RowOrder};
@@ -19,7 +20,7 @@ use viewsynth::stitch::render::StitchRenderer;
 use viewsynth::stitch::{FaceSet, OdsRig, Side, StitchParams};
 
 /// The arguments of one call, as Python gave them.
-pub struct StitchArgs<'a, 'py> {
+struct StitchArgs<'a, 'py> {
     pub left_rgb: &'a Bound<'py, PyAny>,
     pub left_depth: &'a Bound<'py, PyAny>,
     pub right_rgb: &'a Bound<'py, PyAny>,
@@ -36,6 +37,59 @@ pub struct StitchArgs<'a, 'py> {
     pub far: Option<f64>,
     pub ndc: &'a str,
     pub reversed_z: bool,
+}
+
+#[pymethods]
+impl Renderer {
+    #[doc = include_str!("doc/stitch.txt")]
+    #[allow(clippy::too_many_arguments)]
+    #[pyo3(signature = (left_rgb, left_depth, right_rgb, right_depth, *, fov = None, overlap = None,
+                        method = "reproject", width = 2048, height = 1024, ipd = 0.064, pole_fade = 45.0,
+                        depth_kind = "view-z", near = None, far = None, ndc = "gl", reversed_z = false))]
+    fn stitch<'py>(
+        &mut self,
+        py: Python<'py>,
+        left_rgb: &Bound<'py, PyAny>,
+        left_depth: &Bound<'py, PyAny>,
+        right_rgb: &Bound<'py, PyAny>,
+        right_depth: &Bound<'py, PyAny>,
+        fov: Option<f64>,
+        overlap: Option<f64>,
+        method: &str,
+        #[pyo3(from_py_with = crate::ints::width)] width: u32,
+        #[pyo3(from_py_with = crate::ints::height)] height: u32,
+        ipd: f64,
+        pole_fade: f64,
+        depth_kind: &str,
+        near: Option<f64>,
+        far: Option<f64>,
+        ndc: &str,
+        reversed_z: bool,
+    ) -> PyResult<Bound<'py, PyDict>> {
+        let gpu = self.gpu()?.clone();
+        stitch(
+            py,
+            gpu,
+            StitchArgs {
+                left_rgb,
+                left_depth,
+                right_rgb,
+                right_depth,
+                fov,
+                overlap,
+                method,
+                width,
+                height,
+                ipd,
+                pole_fade,
+                depth_kind,
+                near,
+                far,
+                ndc,
+                reversed_z,
+            },
+        )
+    }
 }
 
 impl StitchArgs<'_, '_> {
@@ -104,7 +158,7 @@ fn render(
 }
 
 /// Validates `a`, stitches both eyes with the GIL released, and returns the result dict.
-pub fn stitch<'py>(py: Python<'py>, gpu: Backend, a: StitchArgs<'_, 'py>) -> PyResult<Bound<'py, PyDict>> {
+fn stitch<'py>(py: Python<'py>, gpu: Backend, a: StitchArgs<'_, 'py>) -> PyResult<Bound<'py, PyDict>> {
     // The faces' own frame: the circle centre only translates the face eyes and the ODS rays
     // together (as the CLI's --faces); arrays are top-down, as the CLI's files.
     let base = OdsRig {

@@ -86,7 +86,7 @@ def test_shares_without_index_then_write_index_equal_the_cli_index(renderer, cli
 def test_write_index_takes_refocus_batchs_settings_with_the_same_defaults():
     # write_index keeps a frame's rows only where its manifest records these settings, so its
     # keywords must be refocus_batch's settings, same names, order and defaults. pyo3 takes each
-    # signature as a literal (python/src/index.rs and renderer.rs write the list twice): this
+    # signature as a literal (python/src/index.rs and batch.rs write the list twice): this
     # holds the two together. What only steers a run (resume, jobs, shard, progress, index)
     # is not a setting.
     import inspect
