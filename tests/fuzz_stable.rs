@@ -330,45 +330,28 @@ fn write_seed_corpus() {
                 .to_vec(),
         ),
     );
-    // npz: first byte picks the key (none, arr_0, disp); members stored, deflated, zip64.
+    // npz: first byte picks the key (none, arr_0, disp); members stored, deflated, zip64, as
+    // numpy's zipfile writes them (CRCs, a central directory).
     let npy = read(file("d.npy"));
-    let member = |name: &str, deflate: bool, zip64: bool| -> Vec<u8> {
+    let npz = |members: &[(&str, bool)], zip64: bool| -> Vec<u8> {
         use std::io::Write;
-        let data = if deflate {
-            let mut e = flate2::write::DeflateEncoder::new(Vec::new(), flate2::Compression::default());
-            e.write_all(&npy).unwrap();
-            e.finish().unwrap()
-        } else {
-            npy.clone()
-        };
-        let mut m = Vec::new();
-        m.extend_from_slice(&0x0403_4b50u32.to_le_bytes());
-        m.extend_from_slice(&45u16.to_le_bytes());
-        m.extend_from_slice(&0u16.to_le_bytes());
-        m.extend_from_slice(&(if deflate { 8u16 } else { 0 }).to_le_bytes());
-        m.extend_from_slice(&[0; 8]);
-        let (packed, unpacked) = if zip64 {
-            (u32::MAX, u32::MAX)
-        } else {
-            (data.len() as u32, npy.len() as u32)
-        };
-        m.extend_from_slice(&packed.to_le_bytes());
-        m.extend_from_slice(&unpacked.to_le_bytes());
-        m.extend_from_slice(&(name.len() as u16).to_le_bytes());
-        m.extend_from_slice(&(if zip64 { 20u16 } else { 0 }).to_le_bytes());
-        m.extend_from_slice(name.as_bytes());
-        if zip64 {
-            m.extend_from_slice(&1u16.to_le_bytes());
-            m.extend_from_slice(&16u16.to_le_bytes());
-            m.extend_from_slice(&(npy.len() as u64).to_le_bytes());
-            m.extend_from_slice(&(data.len() as u64).to_le_bytes());
+        let mut w = zip::ZipWriter::new(std::io::Cursor::new(Vec::new()));
+        for &(name, deflate) in members {
+            let method = if deflate {
+                zip::CompressionMethod::Deflated
+            } else {
+                zip::CompressionMethod::Stored
+            };
+            let options = zip::write::SimpleFileOptions::default()
+                .compression_method(method)
+                .large_file(zip64);
+            w.start_file(name, options).unwrap();
+            w.write_all(&npy).unwrap();
         }
-        m.extend_from_slice(&data);
-        m
+        w.finish().unwrap().into_inner()
     };
-    seed("npz", "stored", with(0, member("arr_0.npy", false, false)));
-    seed("npz", "deflated", with(1, member("arr_0.npy", true, false)));
-    let mut two = member("disp.npy", true, true);
-    two.extend(member("arr_0.npy", false, true));
+    seed("npz", "stored", with(0, npz(&[("arr_0.npy", false)], false)));
+    seed("npz", "deflated", with(1, npz(&[("arr_0.npy", true)], false)));
+    let two = npz(&[("disp.npy", true), ("arr_0.npy", false)], true);
     seed("npz", "zip64_two_members", with(2, two));
 }

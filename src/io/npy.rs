@@ -1,10 +1,17 @@
 //! NumPy `.npy` arrays (format versions 1.0, 2.0, 3.0): strict reader, f32 writer.
+//!
+//! One reader, [`NpyStream`], for `.npy` files and `.npz` members alike: the header is read
+//! and checked (its length against 1 MiB and the input, the element count against the pixel
+//! budget, the input's length against the shape) before a byte of the payload is, and the
+//! payload is decoded in chunks, never held whole. `npyz` was weighed and kept out: it
+//! allocates the header length a file declares before reading it, accepts unknown and
+//! duplicate dict keys, and multiplies the shape without an overflow check.
 
-use std::io::Write;
+use std::io::{Read, Write};
 use std::path::Path;
 
 use super::atomic::atomic_write;
-use super::input::{max_pixels, open_regular, read_body, read_prefix};
+use super::input::{max_pixels, open_regular};
 use crate::error::{Error, Result};
 
 const MAGIC: &[u8] = b"\x93NUMPY";
@@ -45,107 +52,36 @@ pub fn load_npy(path: &Path) -> Result<NpyArray> {
 /// Largest header accepted (NumPy writes well under 1 KiB; format 2.0 allows 4 GiB).
 const MAX_HEADER: usize = 1 << 20;
 
-/// An opened `.npy` whose header was read and whose length matches it; payload unread.
-pub(crate) struct NpyFile {
-    file: std::fs::File,
-    header: Header,
-    data_offset: usize,
-    need: usize,
-}
-
-impl NpyFile {
-    pub(crate) fn shape(&self) -> &[usize] {
-        &self.header.shape
-    }
-}
-
-/// Reads and checks the header: element count against `max_values` (from the pixel budget),
-/// then the file's length against the shape.
-pub(crate) fn open_npy(path: &Path, max_values: u64) -> Result<NpyFile> {
-    let (mut file, len) = open_regular(path)?;
-    let bad = |msg: String| Error::decode(path, format!("invalid NPY: {msg}"));
-    // Magic (6), version (2), header length (2 or 4).
-    let start = read_prefix(path, &mut file, len, 12)?;
-    let (prefix_len, header_len) = header_extent(&start).map_err(bad)?;
-    if header_len > MAX_HEADER {
-        return Err(bad(format!("header length {header_len} exceeds {MAX_HEADER} bytes")));
-    }
-    let data_offset = prefix_len + header_len;
-    let head = read_prefix(path, &mut file, len, data_offset)?;
-    let (header, _) = split_header(&head).map_err(bad)?;
-    let h = parse_header(header).map_err(bad)?;
-    let have = len.saturating_sub(data_offset as u64);
-    let need = payload_extent(&h, have, max_values, "; refused before reading the values")
-        .map_err(|e| e.into_message(|m| Error::decode(path, m)))?;
-    Ok(NpyFile {
-        file,
-        header: h,
-        data_offset,
-        need,
-    })
+/// An `.npy` file whose header was read and checked against `max_values` (from the pixel
+/// budget) and the file's length; payload unread.
+pub(crate) fn open_npy(path: &Path, max_values: u64) -> Result<NpyStream<std::fs::File>> {
+    let (file, len) = open_regular(path)?;
+    NpyStream::open(file, len, max_values).map_err(|m| Error::decode(path, m))
 }
 
 /// Reads exactly the payload the header declared.
-pub(crate) fn read_npy(path: &Path, mut f: NpyFile) -> Result<NpyArray> {
-    let payload = read_body(path, &mut f.file, f.data_offset as u64, f.need)?;
-    Ok(decode_payload(f.header, &payload))
+pub(crate) fn read_npy(path: &Path, f: NpyStream<std::fs::File>) -> Result<NpyArray> {
+    f.read().map_err(|m| Error::decode(path, m))
 }
 
-/// Values of a payload whose length matches the header, in C order.
-fn decode_payload(h: Header, payload: &[u8]) -> NpyArray {
-    let data: Vec<f64> = payload.chunks_exact(h.item_size).map(h.decode).collect();
-    let data = if h.fortran_order {
-        fortran_to_c(&h.shape, &data)
-    } else {
-        data
-    };
-    NpyArray {
-        shape: h.shape,
-        dtype: h.dtype,
-        data,
-    }
-}
-
-/// A `.npy` being read from a stream of known length (an `.npz` member as it is inflated):
-/// the header is read and checked (element count against the budget, length against the
-/// shape) before a byte of the payload is, and the payload is decoded in chunks, so the
-/// stored bytes are never held whole.
+/// A `.npy` being read from a stream of known length (a file, or an `.npz` member as it is
+/// inflated), its header read and checked; errors are messages for the caller to attach to
+/// the file (and member) they name.
 pub(crate) struct NpyStream<R> {
     reader: R,
     header: Header,
     need: usize,
 }
 
-/// Reads the header of a `.npy` stream of exactly `len` bytes and checks its extent.
-pub(crate) fn open_npy_stream<R: std::io::Read>(
-    mut reader: R,
-    len: u64,
-    max_values: u64,
-) -> std::result::Result<NpyStream<R>, String> {
-    let bad = |msg: String| format!("invalid NPY: {msg}");
-    let mut head = vec![0u8; 8];
-    read_all(&mut reader, &mut head).map_err(bad)?;
-    let len_bytes = match head.get(6..8) {
-        Some([1, 0]) => 2,
-        _ => 4,
-    };
-    head.resize(8 + len_bytes, 0);
-    read_all(&mut reader, &mut head[8..]).map_err(bad)?;
-    let (prefix_len, header_len) = header_extent(&head).map_err(bad)?;
-    if header_len > MAX_HEADER {
-        return Err(bad(format!("header length {header_len} exceeds {MAX_HEADER} bytes")));
+impl<R: Read> NpyStream<R> {
+    /// Reads the header of a `.npy` of exactly `len` bytes and checks its extent: no more than
+    /// `max_values` elements, and exactly as many payload bytes as the shape needs.
+    pub(crate) fn open(mut reader: R, len: u64, max_values: u64) -> std::result::Result<Self, String> {
+        let (header, data_offset) = read_header(&mut reader, len).map_err(|m| format!("invalid NPY: {m}"))?;
+        let need = payload_extent(&header, len - data_offset as u64, max_values)?;
+        Ok(NpyStream { reader, header, need })
     }
-    head.resize(prefix_len + header_len, 0);
-    read_all(&mut reader, &mut head[prefix_len..]).map_err(bad)?;
-    let (text, _) = split_header(&head).map_err(bad)?;
-    let header = parse_header(text).map_err(bad)?;
-    let have = len.saturating_sub(head.len() as u64);
-    let need =
-        payload_extent(&header, have, max_values, "; refused before inflating").map_err(|e| e.into_message(|m| m))?;
-    Ok(NpyStream { reader, header, need })
-}
 
-impl<R: std::io::Read> NpyStream<R> {
     pub(crate) fn shape(&self) -> &[usize] {
         &self.header.shape
     }
@@ -169,6 +105,8 @@ impl<R: std::io::Read> NpyStream<R> {
             data.extend(chunk[..n].chunks_exact(item).map(self.header.decode));
             left -= n;
         }
+        // One more byte: past the declared length is an error (and an archive member's
+        // checksum is verified at its end).
         let mut extra = [0u8; 1];
         if self.reader.read(&mut extra).map_err(|e| e.to_string())? != 0 {
             return Err("invalid NPY: trailing bytes after the declared payload".into());
@@ -186,39 +124,45 @@ impl<R: std::io::Read> NpyStream<R> {
     }
 }
 
-fn read_all(r: &mut impl std::io::Read, buf: &mut [u8]) -> std::result::Result<(), String> {
+/// The parsed header of an input of `len` bytes, and where its payload starts. The header's
+/// declared length is checked against 1 MiB and the input before it is allocated.
+fn read_header(r: &mut impl Read, len: u64) -> std::result::Result<(Header, usize), String> {
+    // Magic and version (8 bytes), then the 2- or 4-byte header length they call for; a short
+    // input gets header_extent's message.
+    let mut head = Vec::with_capacity(12);
+    r.by_ref().take(8).read_to_end(&mut head).map_err(|e| e.to_string())?;
+    let len_bytes = if head.get(6..8) == Some(&[1, 0][..]) { 2 } else { 4 };
+    r.by_ref()
+        .take(len_bytes)
+        .read_to_end(&mut head)
+        .map_err(|e| e.to_string())?;
+    let (prefix_len, header_len) = header_extent(&head)?;
+    if header_len > MAX_HEADER {
+        return Err(format!("header length {header_len} exceeds {MAX_HEADER} bytes"));
+    }
+    let data_offset = prefix_len + header_len;
+    if data_offset as u64 > len {
+        return Err(format!("header length {header_len} exceeds the file"));
+    }
+    head.resize(data_offset, 0);
+    read_all(r, &mut head[prefix_len..])?;
+    let text = std::str::from_utf8(&head[prefix_len..]).map_err(|_| "header is not UTF-8")?;
+    let text = text.strip_suffix('\n').ok_or("header does not end with a newline")?;
+    Ok((parse_header(text)?, data_offset))
+}
+
+fn read_all(r: &mut impl Read, buf: &mut [u8]) -> std::result::Result<(), String> {
     r.read_exact(buf).map_err(|e| match e.kind() {
         std::io::ErrorKind::UnexpectedEof => "truncated: the data ends early".to_string(),
         _ => e.to_string(),
     })
 }
 
-/// Why a header's extent was refused: over the pixel budget, or malformed (overflow, or a
-/// payload of another length than the shape says: "invalid NPY: " is prefixed).
-enum ExtentError {
-    Budget(String),
-    Invalid(String),
-}
-
-impl ExtentError {
-    fn into_message<E>(self, wrap: impl Fn(String) -> E) -> E {
-        match self {
-            ExtentError::Budget(m) => wrap(m),
-            ExtentError::Invalid(m) => wrap(format!("invalid NPY: {m}")),
-        }
-    }
-}
-
 /// Payload bytes the header declares, checked before anything is read from it: no overflow,
-/// at most `max_values` elements (`budget_note` ends that message), and exactly `have` bytes
-/// present.
-fn payload_extent(
-    h: &Header,
-    have: u64,
-    max_values: u64,
-    budget_note: &str,
-) -> std::result::Result<usize, ExtentError> {
-    let overflow = || ExtentError::Invalid(format!("shape {:?} overflows", h.shape));
+/// at most `max_values` elements, and exactly `have` bytes present. Malformed extents are
+/// "invalid NPY"; the budget's refusal says which option raises it.
+fn payload_extent(h: &Header, have: u64, max_values: u64) -> std::result::Result<usize, String> {
+    let overflow = || format!("invalid NPY: shape {:?} overflows", h.shape);
     let count = h
         .shape
         .iter()
@@ -226,11 +170,11 @@ fn payload_extent(
         .ok_or_else(overflow)?;
     let need = count.checked_mul(h.item_size).ok_or_else(overflow)?;
     if count as u64 > max_values {
-        return Err(ExtentError::Budget(format!(
-            "shape {:?} = {count} values exceeds the pixel budget ({} pixels; --max-pixels{budget_note})",
+        return Err(format!(
+            "shape {:?} = {count} values exceeds the pixel budget ({} pixels; --max-pixels; refused before reading the values)",
             h.shape,
             max_pixels()
-        )));
+        ));
     }
     if have != need as u64 {
         let what = if have < need as u64 {
@@ -238,10 +182,10 @@ fn payload_extent(
         } else {
             "trailing bytes"
         };
-        return Err(ExtentError::Invalid(format!(
-            "{what}: header says shape {:?} of {} = {need} data bytes, file has {have}",
+        return Err(format!(
+            "invalid NPY: {what}: header says shape {:?} of {} = {need} data bytes, file has {have}",
             h.shape, h.descr,
-        )));
+        ));
     }
     Ok(need)
 }
@@ -315,17 +259,6 @@ fn format_header(descr: &str, shape: &[usize]) -> Option<Vec<u8>> {
     out.extend_from_slice(&len.to_le_bytes());
     out.extend_from_slice(dict.as_bytes());
     Some(out)
-}
-
-/// Returns (header dict text, payload).
-fn split_header(bytes: &[u8]) -> std::result::Result<(&str, &[u8]), String> {
-    let (start, len) = header_extent(bytes)?;
-    let (header, payload) = bytes[start..]
-        .split_at_checked(len)
-        .ok_or_else(|| format!("header length {len} exceeds the file"))?;
-    let header = std::str::from_utf8(header).map_err(|_| "header is not UTF-8")?;
-    let header = header.strip_suffix('\n').ok_or("header does not end with a newline")?;
-    Ok((header, payload))
 }
 
 /// Converts one stored element (exactly `item_size` bytes) to f64.

@@ -1,143 +1,41 @@
 //! NumPy `.npz` archives: the zip members `numpy.savez` / `savez_compressed` write (stored or
-//! deflated, zip64 local headers as numpy >= 1.16 writes them), each decoded by the strict
-//! `.npy` reader. Members with a trailing data descriptor (zips written to a pipe) are refused.
+//! deflated, zip64 as numpy >= 1.16 writes them), found through the `zip` crate's reading of
+//! the central directory (CRC-32 checked) and each decoded by the strict `.npy` reader.
+//!
+//! Memory stays bounded before any array is inflated:
+//! - the zip crate holds the whole central directory before we see it: at most one entry per
+//!   46 bytes of the file (a zip32 count is at most 65535 and below the directory's offset, a
+//!   zip64 count is checked against the bytes it would fill), so a small multiple of the file's
+//!   length; more than [`MAX_MEMBERS`] members are then refused;
+//! - members must tile the archive (see [`check_tiling`]);
+//! - a member's `.npy` header is read within the size the directory declares, its shape checked
+//!   against the budget and that size before its data, and inflation stops one byte past it.
 
 use std::fs::File;
-use std::io::{Read, Seek, SeekFrom};
+use std::io::{Read, Seek, SeekFrom, Take};
 use std::path::Path;
 
-use super::npy::{open_npy_stream, NpyArray, NpyDtype, NpyStream};
+use zip::read::ZipFile;
+use zip::{CompressionMethod, ZipArchive};
+
+use super::npy::{NpyArray, NpyDtype, NpyStream};
 use crate::error::{Error, Result};
 
-const LOCAL_HEADER: u32 = 0x0403_4b50;
-const ZIP64_EXTRA: u16 = 0x0001;
-/// Most members an archive may list (numpy archives hold a handful; the list is kept).
+/// Most members an archive may list (numpy archives hold a handful).
 const MAX_MEMBERS: usize = 1024;
+/// A local file header's fixed part: a gap shorter than this between members hides none (it
+/// is a data descriptor, which zips written to a pipe put after each member's data).
+const LOCAL_HEADER_LEN: u64 = 30;
 
-fn u16_at(b: &[u8], o: usize) -> Option<u16> {
-    Some(u16::from_le_bytes(b.get(o..o + 2)?.try_into().ok()?))
-}
-
-fn u32_at(b: &[u8], o: usize) -> Option<u32> {
-    Some(u32::from_le_bytes(b.get(o..o + 4)?.try_into().ok()?))
-}
-
-fn u64_at(b: &[u8], o: usize) -> Option<u64> {
-    Some(u64::from_le_bytes(b.get(o..o + 8)?.try_into().ok()?))
-}
-
-/// One archive member as its local header declares it; nothing of its data is read yet.
+/// One listed member, as the central directory describes it.
 struct Member {
     name: String,
-    method: u16,
-    unpacked: u64,
-    packed: u64,
-    /// Where its (compressed) data starts in the file.
-    offset: u64,
+    method: CompressionMethod,
 }
 
-impl Member {
-    /// The array's name as numpy gives it (`arr_0` for `arr_0.npy`).
-    fn key(&self) -> &str {
-        self.name.strip_suffix(".npy").unwrap_or(&self.name)
-    }
-
-    /// The member's `.npy`, its header read and checked against `max_values` and the member's
-    /// declared size; the data is inflated as the payload is decoded, never whole.
-    fn open<'f>(&self, file: &'f File, max_values: u64) -> std::result::Result<NpyStream<Box<dyn Read + 'f>>, String> {
-        let mut f = file;
-        f.seek(SeekFrom::Start(self.offset)).map_err(|e| e.to_string())?;
-        let raw = f.take(self.packed);
-        // One byte more than declared, so that a member inflating past its size is noticed.
-        let reader: Box<dyn Read + 'f> = match self.method {
-            0 => Box::new(raw.take(self.unpacked + 1)),
-            8 => Box::new(flate2::read::DeflateDecoder::new(raw).take(self.unpacked + 1)),
-            m => return Err(format!("{}: compression method {m} (only stored/deflate)", self.name)),
-        };
-        open_npy_stream(reader, self.unpacked, max_values).map_err(|e| format!("{}: {e}", self.key()))
-    }
-}
-
-/// (uncompressed, compressed) sizes from a zip64 extra field.
-fn zip64_sizes(extra: &[u8]) -> Option<(u64, u64)> {
-    let mut o = 0;
-    while o + 4 <= extra.len() {
-        let (id, len) = (u16_at(extra, o)?, usize::from(u16_at(extra, o + 2)?));
-        if id == ZIP64_EXTRA && len >= 16 {
-            return Some((u64_at(extra, o + 4)?, u64_at(extra, o + 12)?));
-        }
-        o += 4 + len;
-    }
-    None
-}
-
-/// Fills `buf` from `at`; false when the file ends first.
-fn read_at(file: &File, at: u64, buf: &mut [u8]) -> std::result::Result<bool, String> {
-    let mut f = file;
-    f.seek(SeekFrom::Start(at)).map_err(|e| e.to_string())?;
-    match f.read_exact(buf) {
-        Ok(()) => Ok(true),
-        Err(e) if e.kind() == std::io::ErrorKind::UnexpectedEof => Ok(false),
-        Err(e) => Err(e.to_string()),
-    }
-}
-
-/// The members in file order, walking the local headers (a few dozen bytes read per member).
-/// Two members of one name are refused: numpy would read the last, a zip walk the first.
-fn members(file: &File, len: u64) -> std::result::Result<Vec<Member>, String> {
-    let mut out: Vec<Member> = Vec::new();
-    let mut o = 0u64;
-    let mut fixed = [0u8; 30];
-    while o + 4 <= len && read_at(file, o, &mut fixed[..4])? && u32_at(&fixed, 0) == Some(LOCAL_HEADER) {
-        if !read_at(file, o, &mut fixed)? {
-            return Err(format!("truncated header at byte {o}"));
-        }
-        let flags = u16_at(&fixed, 6).unwrap_or(0);
-        let method = u16_at(&fixed, 8).unwrap_or(0);
-        let mut packed = u64::from(u32_at(&fixed, 18).unwrap_or(0));
-        let mut unpacked = u64::from(u32_at(&fixed, 22).unwrap_or(0));
-        let name_len = usize::from(u16_at(&fixed, 26).unwrap_or(0));
-        let extra_len = usize::from(u16_at(&fixed, 28).unwrap_or(0));
-        if flags & 0x8 != 0 {
-            return Err("members with a trailing data descriptor are not supported".into());
-        }
-        let mut var = vec![0u8; name_len + extra_len];
-        if !read_at(file, o + 30, &mut var)? {
-            return Err("truncated member name".into());
-        }
-        let (name, extra) = var.split_at(name_len);
-        let name = super::excerpt(&String::from_utf8_lossy(name));
-        if packed == 0xFFFF_FFFF || unpacked == 0xFFFF_FFFF {
-            (unpacked, packed) = zip64_sizes(extra).ok_or_else(|| format!("{name}: zip64 sizes missing"))?;
-        }
-        let start = o + 30 + (name_len + extra_len) as u64;
-        let end = start
-            .checked_add(packed)
-            .filter(|&end| end <= len)
-            .ok_or_else(|| format!("member {name} at byte {o} runs past the end"))?;
-        let member = Member {
-            name,
-            method,
-            unpacked,
-            packed,
-            offset: start,
-        };
-        if out.iter().any(|m| m.key() == member.key()) {
-            return Err(format!(
-                "two arrays named '{}': ambiguous (numpy reads the last, other readers the first)",
-                member.key()
-            ));
-        }
-        if out.len() == MAX_MEMBERS {
-            return Err(format!("more than {MAX_MEMBERS} members"));
-        }
-        out.push(member);
-        o = end;
-    }
-    if out.is_empty() {
-        return Err("not a zip archive (no local file header at byte 0)".into());
-    }
-    Ok(out)
+/// The array's name as numpy gives it (`arr_0` for `arr_0.npy`).
+fn key(name: &str) -> &str {
+    name.strip_suffix(".npy").unwrap_or(name)
 }
 
 /// Array `key` (e.g. `arr_0`) of an `.npz` file, or with `None` the only array, else the
@@ -151,48 +49,156 @@ pub fn load_npz_array(path: &Path, key: Option<&str>) -> Result<(String, NpyArra
 /// shape: both from the member's header, before its data is inflated.
 pub(crate) fn load_npz_array_within(
     path: &Path,
-    key: Option<&str>,
+    wanted: Option<&str>,
     max_values: u64,
     check: &dyn Fn(&[usize]) -> Result<()>,
 ) -> Result<(String, NpyArray)> {
-    let (file, len) = super::input::open_regular(path)?;
+    let (file, _) = super::input::open_regular(path)?;
     let bad = |m: String| Error::decode(path, format!("npz: {m}"));
-    let members = members(&file, len).map_err(bad)?;
-    let keys = || super::excerpt(&members.iter().map(|m| m.key()).collect::<Vec<_>>().join(", "));
-    let chosen = match key {
-        Some(key) => {
-            let m = members
-                .iter()
-                .find(|m| m.key() == key)
-                .ok_or_else(|| bad(format!("no array '{}' (arrays: {})", super::excerpt(key), keys())))?;
-            (m, m.open(&file, max_values).map_err(bad)?)
-        }
-        None if members.len() == 1 => (&members[0], members[0].open(&file, max_values).map_err(bad)?),
+    // Every read of the archive seeks first, so `unlisted` may share the file's cursor.
+    let mut zip =
+        ZipArchive::new(&file).map_err(|e| bad(format!("not a zip archive, or a truncated or corrupt one ({e})")))?;
+    if zip.len() > MAX_MEMBERS {
+        return Err(bad(format!("{} members, more than {MAX_MEMBERS}", zip.len())));
+    }
+    let members = check_tiling(&mut zip, &file).map_err(bad)?;
+    let keys = || super::excerpt(&members.iter().map(|m| key(&m.name)).collect::<Vec<_>>().join(", "));
+    let index = match wanted {
+        Some(wanted) => members
+            .iter()
+            .position(|m| key(&m.name) == wanted)
+            .ok_or_else(|| bad(format!("no array '{}' (arrays: {})", super::excerpt(wanted), keys())))?,
+        None if members.len() == 1 => 0,
         None => {
             // The first floating-point array, told from the headers alone.
             let mut found = None;
-            for m in &members {
-                let stream = m.open(&file, max_values).map_err(bad)?;
-                if matches!(stream.dtype(), NpyDtype::F32 | NpyDtype::F64) {
-                    found = Some((m, stream));
+            for (i, m) in members.iter().enumerate() {
+                if matches!(
+                    open(&mut zip, m, i, max_values).map_err(bad)?.dtype(),
+                    NpyDtype::F32 | NpyDtype::F64
+                ) {
+                    found = Some(i);
                     break;
                 }
             }
-            found.ok_or_else(|| {
-                bad(format!(
-                    "no floating-point array (arrays: {}); name one with --npz-key",
-                    keys()
-                ))
-            })?
+            let none = if members.is_empty() {
+                "the archive holds no arrays".to_string()
+            } else {
+                format!("no floating-point array (arrays: {}); name one with --npz-key", keys())
+            };
+            found.ok_or_else(|| bad(none))?
         }
     };
-    let (m, stream) = chosen;
+    let m = &members[index];
+    let stream = open(&mut zip, m, index, max_values).map_err(bad)?;
     check(stream.shape()).map_err(|e| match e {
-        Error::Decode { path, message } => Error::decode(path, format!("array '{}': {message}", m.key())),
+        Error::Decode { path, message } => {
+            Error::decode(path, format!("array '{}': {message}", super::excerpt(key(&m.name))))
+        }
         other => other,
     })?;
-    let array = stream.read().map_err(|e| bad(format!("{}: {e}", m.key())))?;
-    Ok((m.key().to_string(), array))
+    let array = stream
+        .read()
+        .map_err(|e| bad(format!("{}: {e}", super::excerpt(key(&m.name)))))?;
+    Ok((key(&m.name).to_string(), array))
+}
+
+/// Member `index`'s `.npy`, its header read and checked against `max_values` and the size the
+/// central directory declares; the data is inflated as the payload is decoded, never whole,
+/// and never past one byte more than declared.
+fn open<'z, 'f>(
+    zip: &'z mut ZipArchive<&'f File>,
+    m: &Member,
+    index: usize,
+    max_values: u64,
+) -> std::result::Result<NpyStream<Take<ZipFile<'z, &'f File>>>, String> {
+    let name = super::excerpt(key(&m.name));
+    if !matches!(m.method, CompressionMethod::Stored | CompressionMethod::Deflated) {
+        return Err(format!(
+            "{name}: compression method {} (only stored and deflate)",
+            m.method
+        ));
+    }
+    let file = zip.by_index(index).map_err(|e| format!("{name}: {e}"))?;
+    let size = file.size();
+    NpyStream::open(file.take(size.saturating_add(1)), size, max_values).map_err(|e| format!("{name}: {e}"))
+}
+
+/// The listed members, in directory order, once they are known to tile the archive: each
+/// starts where the one before ended (after at most a data descriptor), the last ends where the
+/// central directory starts, and no two share a key. So no member's bytes serve two entries,
+/// and no member hides between them (two of one name, which the directory keeps once: numpy
+/// reads the last, a reader walking the local headers the first).
+fn check_tiling(zip: &mut ZipArchive<&File>, file: &File) -> std::result::Result<Vec<Member>, String> {
+    let mut members = Vec::with_capacity(zip.len());
+    let mut spans = Vec::with_capacity(zip.len());
+    for i in 0..zip.len() {
+        // The local header is read here (its name and extra lengths give where the data starts).
+        let f = zip.by_index_raw(i).map_err(|e| e.to_string())?;
+        let name = f.name().to_string();
+        let end = f
+            .data_start()
+            .and_then(|start| start.checked_add(f.compressed_size()))
+            .ok_or_else(|| format!("member {}: its data runs past the end", super::excerpt(&name)))?;
+        if members.iter().any(|m: &Member| key(&m.name) == key(&name)) {
+            return Err(ambiguous(&name));
+        }
+        spans.push((f.header_start(), end, i));
+        members.push(Member {
+            name,
+            method: f.compression(),
+        });
+    }
+    spans.sort_unstable();
+    let directory = zip.central_directory_start();
+    let mut at = zip.offset();
+    for &(start, end, i) in &spans {
+        if start < at {
+            return Err(format!(
+                "member {} at byte {start} overlaps the one before it",
+                super::excerpt(&members[i].name)
+            ));
+        }
+        unlisted(file, at, start, &members)?;
+        at = end;
+    }
+    if at > directory {
+        let last = super::excerpt(spans.last().map_or("", |s| members[s.2].name.as_str()));
+        return Err(format!(
+            "member {last}: its data runs past the end of the members (the central directory at byte {directory})"
+        ));
+    }
+    unlisted(file, at, directory, &members)?;
+    Ok(members)
+}
+
+/// Refuses bytes `from..to` between members when they could hold one (naming it when its local
+/// header can be read).
+fn unlisted(mut file: &File, from: u64, to: u64, members: &[Member]) -> std::result::Result<(), String> {
+    if to.saturating_sub(from) < LOCAL_HEADER_LEN {
+        return Ok(());
+    }
+    file.seek(SeekFrom::Start(from)).map_err(|e| e.to_string())?;
+    // At most the header (two u16-sized fields past its fixed part) is read.
+    let mut header = file.take((to - from).min(LOCAL_HEADER_LEN + 2 * 65535));
+    let hidden = match zip::read::read_zipfile_from_stream(&mut header) {
+        Ok(Some(f)) => f.name().to_string(),
+        _ => return Err(format!("bytes {from}..{to} between members belong to none")),
+    };
+    if members.iter().any(|m| key(&m.name) == key(&hidden)) {
+        return Err(ambiguous(&hidden));
+    }
+    Err(format!(
+        "bytes {from}..{to} hold member {}, which the central directory does not list",
+        super::excerpt(&hidden)
+    ))
+}
+
+fn ambiguous(name: &str) -> String {
+    format!(
+        "two arrays named '{}': ambiguous (numpy reads the last, other readers the first)",
+        super::excerpt(key(name))
+    )
 }
 
 #[cfg(test)]

@@ -1,43 +1,40 @@
-//! `.npz` archives built here as numpy writes them (stored, deflated, zip64 local headers),
-//! (the real Middlebury 2014 Motorcycle disparity: cli/tests/integration/reproject.rs).
+//! `.npz` archives written here by the zip crate as numpy's zipfile writes them (stored or
+//! deflated, zip64 local headers, real CRCs, a central directory), then damaged byte by byte
+//! for the hostile cases (the real Middlebury 2014 Motorcycle disparity:
+//! cli/tests/integration/reproject.rs).
 
 use super::*;
 use crate::io::npy::build_npy;
 use std::io::Write;
+use zip::write::SimpleFileOptions;
 
-/// A zip local header + data as Python's zipfile writes it (numpy's savez forces zip64).
-fn member(name: &str, npy: &[u8], deflate: bool, zip64: bool) -> Vec<u8> {
-    let data = if deflate {
-        let mut e = flate2::write::DeflateEncoder::new(Vec::new(), flate2::Compression::default());
-        e.write_all(npy).unwrap();
-        e.finish().unwrap()
-    } else {
-        npy.to_vec()
-    };
-    let mut h = Vec::new();
-    h.extend_from_slice(&LOCAL_HEADER.to_le_bytes());
-    h.extend_from_slice(&45u16.to_le_bytes()); // version needed
-    h.extend_from_slice(&0u16.to_le_bytes()); // flags
-    h.extend_from_slice(&(if deflate { 8u16 } else { 0 }).to_le_bytes());
-    h.extend_from_slice(&[0; 8]); // time, date, crc (not checked)
-    let (packed, unpacked) = if zip64 {
-        (u32::MAX, u32::MAX)
-    } else {
-        (data.len() as u32, npy.len() as u32)
-    };
-    h.extend_from_slice(&packed.to_le_bytes());
-    h.extend_from_slice(&unpacked.to_le_bytes());
-    h.extend_from_slice(&(name.len() as u16).to_le_bytes());
-    h.extend_from_slice(&(if zip64 { 20u16 } else { 0 }).to_le_bytes());
-    h.extend_from_slice(name.as_bytes());
-    if zip64 {
-        h.extend_from_slice(&ZIP64_EXTRA.to_le_bytes());
-        h.extend_from_slice(&16u16.to_le_bytes());
-        h.extend_from_slice(&(npy.len() as u64).to_le_bytes());
-        h.extend_from_slice(&(data.len() as u64).to_le_bytes());
+/// An archive of `(name, .npy bytes, deflated)` members; zip64 local headers with `zip64`
+/// (numpy's savez forces them).
+fn npz(members: &[(&str, &[u8], bool)], zip64: bool) -> Vec<u8> {
+    let mut w = zip::ZipWriter::new(std::io::Cursor::new(Vec::new()));
+    for &(name, data, deflate) in members {
+        let method = if deflate {
+            CompressionMethod::Deflated
+        } else {
+            CompressionMethod::Stored
+        };
+        let options = SimpleFileOptions::default()
+            .compression_method(method)
+            .large_file(zip64);
+        w.start_file(name, options).unwrap();
+        w.write_all(data).unwrap();
     }
-    h.extend_from_slice(&data);
-    h
+    w.finish().unwrap().into_inner()
+}
+
+/// Where the `n`th central directory header starts.
+fn central(zip: &[u8], n: usize) -> usize {
+    let at = zip.windows(4).enumerate().filter(|(_, w)| *w == b"PK\x01\x02").nth(n);
+    at.expect("central directory header").0
+}
+
+fn put(zip: &mut [u8], at: usize, bytes: &[u8]) {
+    zip[at..at + bytes.len()].copy_from_slice(bytes);
 }
 
 fn f4(shape: &str, values: &[f32]) -> Vec<u8> {
@@ -66,6 +63,10 @@ fn write(name: &str, bytes: &[u8]) -> std::path::PathBuf {
     p
 }
 
+fn refusal(name: &str, bytes: &[u8]) -> String {
+    load_npz_array(&write(name, bytes), None).unwrap_err().to_string()
+}
+
 #[test]
 fn stored_deflated_and_zip64_members_read_alike() {
     let values = [1.0, 2.5, f32::INFINITY, 0.0, 7.0, 3.25];
@@ -73,7 +74,7 @@ fn stored_deflated_and_zip64_members_read_alike() {
     for (deflate, zip64) in [(false, false), (true, false), (false, true), (true, true)] {
         let p = write(
             &format!("one_{deflate}_{zip64}.npz"),
-            &member("arr_0.npy", &npy, deflate, zip64),
+            &npz(&[("arr_0.npy", &npy, deflate)], zip64),
         );
         let (key, a) = load_npz_array(&p, None).unwrap();
         assert_eq!(key, "arr_0");
@@ -84,10 +85,35 @@ fn stored_deflated_and_zip64_members_read_alike() {
 }
 
 #[test]
+fn zips_written_to_a_pipe_read_too() {
+    // A writer that cannot seek puts each member's sizes and CRC in a data descriptor after its
+    // data: a gap between members that hides none.
+    let mut w = zip::ZipWriter::new_stream(Vec::new());
+    let options = SimpleFileOptions::default().compression_method(CompressionMethod::Deflated);
+    for (name, values) in [("depth.npy", [4.0, 5.0]), ("conf.npy", [0.5, 0.25])] {
+        w.start_file(name, options).unwrap();
+        w.write_all(&f4("(1, 2)", &values)).unwrap();
+    }
+    let bytes = w.finish().unwrap().into_inner();
+    assert_ne!(bytes[6] & 0x8, 0, "the first member has a data descriptor");
+    let p = write("piped.npz", &bytes);
+    assert_eq!(load_npz_array(&p, Some("conf")).unwrap().1.data, [0.5, 0.25]);
+    assert_eq!(load_npz_array(&p, None).unwrap().1.data, [4.0, 5.0]);
+}
+
+#[test]
 fn default_key_is_the_first_float_array_and_a_key_picks_another() {
-    let mut zip = member("labels.npy", &u1(&[1, 2, 3]), true, true);
-    zip.extend(member("depth.npy", &f4("(1, 2)", &[4.0, 5.0]), true, true));
-    zip.extend(member("conf.npy", &f4("(1, 2)", &[0.5, 0.25]), false, true));
+    let labels = u1(&[1, 2, 3]);
+    let depth = f4("(1, 2)", &[4.0, 5.0]);
+    let conf = f4("(1, 2)", &[0.5, 0.25]);
+    let zip = npz(
+        &[
+            ("labels.npy", &labels, true),
+            ("depth.npy", &depth, true),
+            ("conf.npy", &conf, false),
+        ],
+        true,
+    );
     let p = write("several.npz", &zip);
     let (key, a) = load_npz_array(&p, None).unwrap();
     assert_eq!((key.as_str(), a.data.as_slice()), ("depth", [4.0, 5.0].as_slice()));
@@ -98,33 +124,113 @@ fn default_key_is_the_first_float_array_and_a_key_picks_another() {
         e.contains("several.npz") && e.contains("'disp'") && e.contains("labels, depth, conf"),
         "{e}"
     );
-    let ints = write(
-        "ints.npz",
-        &[
-            member("a.npy", &u1(&[1]), false, false),
-            member("b.npy", &u1(&[2]), false, false),
-        ]
-        .concat(),
-    );
-    let e = load_npz_array(&ints, None).unwrap_err().to_string();
+    let ints = npz(&[("a.npy", &u1(&[1]), false), ("b.npy", &u1(&[2]), false)], false);
+    let e = refusal("ints.npz", &ints);
     assert!(e.contains("no floating-point array") && e.contains("--npz-key"), "{e}");
 }
 
 #[test]
 fn broken_archives_are_refused_with_the_file_named() {
     let npy = f4("(1, 2)", &[4.0, 5.0]);
-    let whole = member("arr_0.npy", &npy, true, false);
+    let whole = npz(&[("arr_0.npy", &npy, true)], false);
+    // A method numpy never writes (bzip2), in the local and the central header.
+    let mut bzip2 = npz(&[("arr_0.npy", &npy, false)], false);
+    put(&mut bzip2, 8, &12u16.to_le_bytes());
+    let c = central(&bzip2, 0);
+    put(&mut bzip2, c + 10, &12u16.to_le_bytes());
+    // The directory says the member's data is longer than the bytes before the directory.
+    let mut long = npz(&[("arr_0.npy", &npy, false)], false);
+    let c = central(&long, 0);
+    put(&mut long, c + 20, &(npy.len() as u32 + 40).to_le_bytes());
     let cases = [
-        ("truncated.npz", whole[..whole.len() - 3].to_vec(), "runs past the end"),
+        ("truncated.npz", whole[..whole.len() - 3].to_vec(), "truncated"),
         ("not_zip.npz", b"hello".to_vec(), "not a zip archive"),
         (
             "bad_npy.npz",
-            member("arr_0.npy", b"\x93NUMPY garbage", false, false),
+            npz(&[("arr_0.npy", b"\x93NUMPY garbage", false)], false),
             "invalid NPY",
         ),
+        ("bzip2.npz", bzip2, "compression method"),
+        ("runs_past.npz", long, "runs past the end"),
+        ("empty.npz", npz(&[], false), "no arrays"),
     ];
     for (name, bytes, want) in cases {
-        let e = load_npz_array(&write(name, &bytes), None).unwrap_err().to_string();
+        let e = refusal(name, &bytes);
+        assert!(e.contains(name) && e.contains(want), "{name}: {e}");
+    }
+}
+
+#[test]
+fn a_wrong_checksum_is_refused() {
+    let values = [4.0f32, 5.0];
+    let npy = f4("(1, 2)", &values);
+    // A flipped bit in the stored payload, its CRC left as written.
+    let mut flipped = npz(&[("arr_0.npy", &npy, false)], true);
+    let at = flipped.windows(4).position(|w| w == 5.0f32.to_le_bytes()).unwrap();
+    flipped[at] ^= 1;
+    // A deflated member whose directory CRC is wrong.
+    let mut crc = npz(&[("disp.npy", &npy, true)], true);
+    let c = central(&crc, 0);
+    crc[c + 16] ^= 0xff;
+    for (name, bytes, key) in [("flipped.npz", flipped, "arr_0"), ("crc.npz", crc, "disp")] {
+        let e = refusal(name, &bytes);
+        assert!(
+            e.contains(name) && e.contains(key) && e.contains("checksum"),
+            "{name}: {e}"
+        );
+    }
+}
+
+#[test]
+fn the_budget_and_the_declared_size_bound_what_is_inflated() {
+    // Over the value budget: refused from the header.
+    let p = write(
+        "budget.npz",
+        &npz(&[("arr_0.npy", &f4("(2, 3)", &[0.0; 6]), true)], true),
+    );
+    let e = load_npz_array_within(&p, None, 5, &|_| Ok(())).unwrap_err().to_string();
+    assert!(e.contains("budget.npz") && e.contains("pixel budget"), "{e}");
+    // Declared as a (1, 2) array but inflating 1 MiB past it: inflation stops one byte past
+    // the declared size.
+    let mut big = f4("(1, 2)", &[4.0, 5.0]);
+    let declared = big.len() as u32;
+    big.resize(big.len() + (1 << 20), 0);
+    let mut zip = npz(&[("arr_0.npy", &big, true)], false);
+    let c = central(&zip, 0);
+    put(&mut zip, c + 24, &declared.to_le_bytes());
+    let e = refusal("bomb.npz", &zip);
+    assert!(e.contains("bomb.npz") && e.contains("trailing bytes"), "{e}");
+}
+
+#[test]
+fn ambiguous_overlapping_and_crowded_archives_are_refused() {
+    let (a, b) = (f4("(1, 1)", &[1.0]), f4("(1, 1)", &[2.0]));
+    // Two members of one name: the central directory keeps one, the other hides between.
+    let mut dup = npz(&[("arr_0.npy", &a, false), ("arr_1.npy", &b, false)], true);
+    while let Some(at) = dup.windows(9).position(|w| w == b"arr_1.npy") {
+        put(&mut dup, at, b"arr_0.npy");
+    }
+    // Two names of one key.
+    let alias = npz(&[("a", &a, false), ("a.npy", &b, false)], false);
+    // The second member's directory entry points at the first member.
+    let mut overlap = npz(&[("x.npy", &a, false), ("y.npy", &b, false)], false);
+    let c = central(&overlap, 1);
+    put(&mut overlap, c + 42, &0u32.to_le_bytes());
+    // An end record counting 65535 entries in a directory of one.
+    let mut count = npz(&[("x.npy", &a, false)], false);
+    let end = count.windows(4).rposition(|w| w == b"PK\x05\x06").unwrap();
+    put(&mut count, end + 8, &[0xff; 4]);
+    let names: Vec<String> = (0..=MAX_MEMBERS).map(|i| format!("m{i}.npy")).collect();
+    let crowd: Vec<(&str, &[u8], bool)> = names.iter().map(|n| (n.as_str(), &a[..], false)).collect();
+    let cases = [
+        ("dup.npz", dup, "two arrays named 'arr_0'"),
+        ("alias.npz", alias, "two arrays named 'a'"),
+        ("overlap.npz", overlap, "overlaps"),
+        ("count.npz", count, "not a zip archive"),
+        ("crowd.npz", npz(&crowd, false), "more than 1024"),
+    ];
+    for (name, bytes, want) in cases {
+        let e = refusal(name, &bytes);
         assert!(e.contains(name) && e.contains(want), "{name}: {e}");
     }
 }

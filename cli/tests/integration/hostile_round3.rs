@@ -275,40 +275,33 @@ fn npy_bytes(shape: &str, descr: &str, payload: &[u8]) -> Vec<u8> {
     out
 }
 
-/// A zip local header (zip64 sizes) and data, as numpy's savez writes a member.
-fn zip_member(name: &str, data: &[u8], unpacked: u64, deflated: bool) -> Vec<u8> {
-    let mut h = Vec::new();
-    h.extend(0x0403_4b50u32.to_le_bytes());
-    h.extend(45u16.to_le_bytes());
-    h.extend(0u16.to_le_bytes());
-    h.extend((if deflated { 8u16 } else { 0 }).to_le_bytes());
-    h.extend([0; 8]);
-    h.extend(u32::MAX.to_le_bytes());
-    h.extend(u32::MAX.to_le_bytes());
-    h.extend((name.len() as u16).to_le_bytes());
-    h.extend(20u16.to_le_bytes());
-    h.extend(name.as_bytes());
-    h.extend(1u16.to_le_bytes());
-    h.extend(16u16.to_le_bytes());
-    h.extend(unpacked.to_le_bytes());
-    h.extend((data.len() as u64).to_le_bytes());
-    h.extend(data);
-    h
-}
-
-/// A deflated stream of `header` followed by `zeros` zero bytes, compressed as it goes.
-fn deflated(header: &[u8], zeros: u64) -> Vec<u8> {
+/// An `.npz` as numpy's savez writes one (zip64 local headers, real CRCs, a central
+/// directory): each member is `bytes` and then `zeros` zero bytes (streamed, never held),
+/// deflated at the best level with `deflate`.
+fn npz(members: &[(&str, &[u8], u64)], deflate: bool) -> Vec<u8> {
     use std::io::Write;
-    let mut e = flate2::write::DeflateEncoder::new(Vec::new(), flate2::Compression::best());
-    e.write_all(header).unwrap();
+    let method = if deflate {
+        zip::CompressionMethod::Deflated
+    } else {
+        zip::CompressionMethod::Stored
+    };
+    let options = zip::write::SimpleFileOptions::default()
+        .compression_method(method)
+        .compression_level(deflate.then_some(9))
+        .large_file(true);
+    let mut w = zip::ZipWriter::new(std::io::Cursor::new(Vec::new()));
     let chunk = vec![0u8; 1 << 20];
-    let mut left = zeros;
-    while left > 0 {
-        let n = left.min(chunk.len() as u64) as usize;
-        e.write_all(&chunk[..n]).unwrap();
-        left -= n as u64;
+    for &(name, bytes, zeros) in members {
+        w.start_file(name, options).unwrap();
+        w.write_all(bytes).unwrap();
+        let mut left = zeros;
+        while left > 0 {
+            let n = left.min(chunk.len() as u64) as usize;
+            w.write_all(&chunk[..n]).unwrap();
+            left -= n as u64;
+        }
     }
-    e.finish().unwrap()
+    w.finish().unwrap().into_inner()
 }
 
 fn mkfifo(path: &Path) {
@@ -325,25 +318,20 @@ fn round3_every_input_is_bounded_before_it_is_read() {
     let header = npy_bytes("(4, 8192, 8192)", "<f8", &[]);
     let payload = 4u64 * 8192 * 8192 * 8;
     let bomb = root.join("bomb.npz");
-    std::fs::write(
-        &bomb,
-        zip_member(
-            "arr_0.npy",
-            &deflated(&header, payload),
-            header.len() as u64 + payload,
-            true,
-        ),
-    )
-    .unwrap();
+    std::fs::write(&bomb, npz(&[("arr_0.npy", &header, payload)], true)).unwrap();
     // Two members of one name.
     let one = npy_bytes(&format!("({H}, {W})"), "<f4", &vec![0u8; (W * H * 4) as usize]);
     let dup = root.join("dup.npz");
-    let m = zip_member("arr_0.npy", &one, one.len() as u64, false);
-    std::fs::write(&dup, [m.clone(), m].concat()).unwrap();
+    // The zip writer refuses a repeated name: the second is renamed in its headers after.
+    let mut two = npz(&[("arr_0.npy", &one, 0), ("arr_1.npy", &one, 0)], false);
+    while let Some(at) = two.windows(9).position(|w| w == b"arr_1.npy") {
+        two[at..at + 9].copy_from_slice(b"arr_0.npy");
+    }
+    std::fs::write(&dup, two).unwrap();
     // A 3-D member within the value budget but no depth: refused from its header.
     let cube = npy_bytes("(3, 2, 2)", "<f4", &[0u8; 48]);
     let cube_npz = root.join("cube.npz");
-    std::fs::write(&cube_npz, zip_member("arr_0.npy", &cube, cube.len() as u64, false)).unwrap();
+    std::fs::write(&cube_npz, npz(&[("arr_0.npy", &cube, 0)], false)).unwrap();
     // Intrinsics: huge sparse text file, FIFO, device, huge/subnormal values.
     let big = root.join("big.txt");
     std::fs::File::create(&big).unwrap().set_len(128 << 20).unwrap();
