@@ -3,16 +3,16 @@
 //! time, with glslangValidator (Debian/Ubuntu package `glslang-tools`, installed by
 //! ci/install-deps.sh).
 //!
-//! Each stage is assembled as src/gpu/shaders.rs + program.rs do it for GL: `#version`, the `#define`
-//! preamble, `#line 1`, the body; the Vulkan layer (shaders/common/vulkan.glsl and any layer
-//! files the table names, e.g. refocus's push constants) sits between the preamble and
+//! Each stage is assembled as src/pass/shaders.rs and src/gpu/program.rs do it for GL: `#version`,
+//! the `#define` preamble, `#line 1`, the body; the Vulkan layer (shaders/common/vulkan.glsl and
+//! any layer files the table names, e.g. refocus's push constants) sits between the preamble and
 //! `#line 1`, so compile errors keep the body's line numbers. Passes whose parameters are one
-//! std140 block (`*_params.glsl`) need no layer of their own: the same text binds under both
-//! APIs. The preamble is compiled for every convention combination and every combination of the
-//! program's switch values in the table; the Vulkan backend looks a variant up by the exact
-//! preamble text the GL backend would use, so a drift between the table and
-//! `ShaderProgram::preamble` fails loudly there (and in its unit test), never silently. Also
-//! writes OUT_DIR/shader_files.rs, every GLSL file embedded, for the GL loader.
+//! std140 block (`*_params.glsl`) need no layer of their own: the same text binds under both APIs.
+//! The preamble is compiled for every convention combination and every combination of the program's
+//! switch values in the table; the Vulkan backend looks a variant up by the exact preamble text the
+//! GL backend would use, so a drift between the table and `ShaderProgram::preamble` fails loudly
+//! there (and in its unit test), never silently. Also writes OUT_DIR/shader_files.rs, every GLSL
+//! file embedded, for the GL loader.
 //!
 //! It also generates, with gl_generator from the Khronos XML registries, the few EGL extension
 //! and GL entry points that khronos-egl and glow do not carry (see [`write_khronos_bindings`]).
@@ -22,7 +22,7 @@ use std::path::{Path, PathBuf};
 use std::process::{Command, Stdio};
 
 // The shader library's one table (program, stages, files, switch values, Vulkan layer), shared
-// with src/gpu/shaders.rs.
+// with src/pass/shaders.rs.
 include!("shaders/programs.rs");
 
 /// The Vulkan layer every pass shares (before its own layer files, if any).
@@ -140,7 +140,7 @@ fn main() {
 }
 
 /// OUT_DIR/shader_files.rs: every GLSL file below shaders/ as a `ShaderFile` (path, embedded
-/// text), sorted by path, for the GL loader (src/gpu/shaders.rs), which finds the table's files
+/// text), sorted by path, for the GL loader (src/pass/shaders.rs), which finds the table's files
 /// in it.
 fn write_shader_files(root: &Path, out: &Path) {
     let shaders = root.join("shaders");
