@@ -18,14 +18,14 @@ use viewsynth::{io, scene};
 pub const DEMO_SCALES: [f64; 5] = viewsynth::refocus::manifest::DEFAULT_SCALES;
 
 /// Run the demo into `out_dir`; returns the report, its files and, last, refocus_check.md.
-pub fn run(gpu: &Device, out_dir: &Path) -> Result<WrittenReport> {
-    run_with_progress(gpu, out_dir, &viewsynth::progress::Silent)
+pub fn run(device: &Device, out_dir: &Path) -> Result<WrittenReport> {
+    run_with_progress(device, out_dir, &viewsynth::progress::Silent)
 }
 
 /// [`run`] with each stage reported to `progress` as it starts: the two refocus methods, the
 /// cyclopean, reprojection and stitching outputs, then the report's stages.
 pub fn run_with_progress(
-    gpu: &Device,
+    device: &Device,
     out_dir: &Path,
     progress: &dyn viewsynth::progress::Progress,
 ) -> Result<WrittenReport> {
@@ -60,7 +60,7 @@ pub fn run_with_progress(
             Method::Fullscreen => "fullscreen",
         };
         stages.start(&format!("demo: refocus ({name}) at {} scales", DEMO_SCALES.len()));
-        let mut r = Refocuser::new(gpu, &src, &rule, method, outputs, Conventions::default())?;
+        let mut r = Refocuser::new(device, &src, &rule, method, outputs, Conventions::default())?;
         for (scale, target) in DEMO_SCALES.iter().zip(&targets) {
             let out = r.render(target)?;
             job::write_output(
@@ -120,7 +120,7 @@ pub fn run_with_progress(
         "# viewsynth demo: refocus of the built-in scene\n\nRenderer: {}\n\n{table}\n\
          PSNR vs scene measures the method (resampling a 640x480 source cannot recreate detail a \
          longer lens would see); PSNR/IoU vs the f64 reference measure the GPU implementation.\n",
-        gpu.renderer()
+        device.renderer()
     ) + "\nGL against Vulkan on these passes and every other: gl_vs_vulkan.md.\n";
     let path = out_dir.join("refocus_check.md");
     io::atomic_write(&path, |w| {
@@ -128,19 +128,19 @@ pub fn run_with_progress(
         w.write_all(report.as_bytes()).map_err(|e| Error::io(&path, e))
     })?;
     stages.start("demo: cyclopean middle views");
-    cyclopean_outputs(gpu, &cyclopean_dir)?;
+    cyclopean_outputs(device, &cyclopean_dir)?;
     stages.start("demo: reprojection left -> right");
-    reproject_outputs(gpu, &reproject_dir)?;
+    reproject_outputs(device, &reproject_dir)?;
     stages.start("demo: stitched stereo panoramas");
-    stitch_outputs(gpu, &stitch_dir)?;
-    let mut written = crate::eval::report_stages(gpu, out_dir, None, &[], None, 3, &stages)?;
+    stitch_outputs(device, &stitch_dir)?;
+    let mut written = crate::eval::report_stages(device, out_dir, None, &[], None, 3, &stages)?;
     written.files.push(path);
     Ok(written)
 }
 
 /// The built-in stereo pair (64 mm IPD, device depth, GL conventions), its ray-traced middle
 /// view, and the middle view of each cyclopean method.
-fn cyclopean_outputs(gpu: &Device, dir: &Path) -> Result<()> {
+fn cyclopean_outputs(device: &Device, dir: &Path) -> Result<()> {
     use viewsynth::cyclopean::render::CyclopeanRenderer;
     use viewsynth::cyclopean::scene_frame::{scene_frame, StereoRig};
     use viewsynth::cyclopean::FrameDepth;
@@ -153,10 +153,10 @@ fn cyclopean_outputs(gpu: &Device, dir: &Path) -> Result<()> {
     io::save_rgb(&dir.join("middle_truth_rgb.png"), &truth.color)?;
     let mut outputs = Vec::new();
     for (name, params) in crate::eval::cyclopean::cyclopean_methods(3.0) {
-        outputs.push((name, CyclopeanRenderer::new(gpu, &frame, params)?.render(&mid)?.0));
+        outputs.push((name, CyclopeanRenderer::new(device, &frame, params)?.render(&mid)?.0));
     }
     let mut warp =
-        viewsynth::cyclopean::forward::ForwardWarp::new(gpu, &frame, &viewsynth::refocus::BreakRule::default())?;
+        viewsynth::cyclopean::forward::ForwardWarp::new(device, &frame, &viewsynth::refocus::BreakRule::default())?;
     outputs.push((crate::eval::cyclopean::FORWARD_NAME, warp.render(&mid)?.0));
     for (name, out) in outputs {
         let stem: String = name
@@ -178,7 +178,7 @@ fn cyclopean_outputs(gpu: &Device, dir: &Path) -> Result<()> {
 
 /// Left eye -> right eye of the built-in stereo pair with each reprojection method, beside the
 /// ray-traced right eye.
-fn reproject_outputs(gpu: &Device, dir: &Path) -> Result<()> {
+fn reproject_outputs(device: &Device, dir: &Path) -> Result<()> {
     use crate::eval::reproject::scene_cases;
     use viewsynth::reproject::render::Reprojector;
     use viewsynth::reproject::{Method, ReprojectParams};
@@ -198,7 +198,8 @@ fn reproject_outputs(gpu: &Device, dir: &Path) -> Result<()> {
         ("shift_scan", Method::ShiftScan),
         ("gather3d", Method::Gather3d { steps: 3 }),
     ] {
-        let (out, _) = Reprojector::new(gpu, &case.source, &case.geometry, ReprojectParams::new(method))?.render()?;
+        let (out, _) =
+            Reprojector::new(device, &case.source, &case.geometry, ReprojectParams::new(method))?.render()?;
         let (color, depth) = (
             out.color.as_ref().expect("colour requested"),
             out.depth.as_ref().expect("depth requested"),
@@ -217,7 +218,7 @@ fn reproject_outputs(gpu: &Device, dir: &Path) -> Result<()> {
 
 /// Top-bottom stereo equirect (left eye on top) of the built-in scene from 6 over-wide faces
 /// per eye, with each stitching method.
-fn stitch_outputs(gpu: &Device, dir: &Path) -> Result<()> {
+fn stitch_outputs(device: &Device, dir: &Path) -> Result<()> {
     use viewsynth::stitch::faces::scene_faces;
     use viewsynth::stitch::render::StitchRenderer;
     use viewsynth::stitch::{Method, OdsRig, Side, StitchParams};
@@ -227,7 +228,7 @@ fn stitch_outputs(gpu: &Device, dir: &Path) -> Result<()> {
         scene_faces(&rig, Side::Left, 256, 90.0 + 2.0 * overlap)?,
         scene_faces(&rig, Side::Right, 256, 90.0 + 2.0 * overlap)?,
     );
-    let mut r = StitchRenderer::new(gpu, &left, &right)?;
+    let mut r = StitchRenderer::new(device, &left, &right)?;
     for method in Method::ALL {
         let (img, _) = r.render(&StitchParams {
             method,

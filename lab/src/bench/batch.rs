@@ -206,7 +206,7 @@ fn scene_manifest(dir: &Path, n: usize) -> Result<PathBuf> {
 /// pool), and a third time pipelined on `vulkan` when given, into scratch folders that are
 /// removed afterwards.
 pub fn batch_bench(
-    gpu: &Device,
+    device: &Device,
     input: &BatchInput,
     jobs: usize,
     files: FileFormats,
@@ -261,7 +261,7 @@ pub fn batch_bench(
         }
         Ok(summarise(jobs, &s))
     };
-    let gl = gpu.clone();
+    let gl = device.clone();
     let synchronous = run(gl.clone(), 0, "sync")?;
     let pipelined = run(gl.clone(), jobs.max(1), "pipelined")?;
     let vulkan = match vulkan {
@@ -298,7 +298,7 @@ pub fn batch_bench(
     let bytes_per_frame = px * (3 + 4)
         + out_px * (3 * files.outputs.rgb as usize + 4 * files.outputs.depth as usize + files.outputs.mask as usize);
     Ok(BatchBench {
-        renderer: gpu.renderer(),
+        renderer: device.renderer(),
         input: label,
         frame_size: (w, h),
         scales,

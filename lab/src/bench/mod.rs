@@ -53,12 +53,17 @@ const SCALES: [f64; 5] = viewsynth::refocus::manifest::DEFAULT_SCALES;
 
 /// Times both refocus paths at each size over the five focal scales (`repeats` runs, medians);
 /// returns a Markdown table and appends each case to `cases`.
-pub fn refocus_bench(gpu: &Device, sizes: &[(u32, u32)], repeats: usize, cases: &mut Vec<BenchCase>) -> Result<String> {
+pub fn refocus_bench(
+    device: &Device,
+    sizes: &[(u32, u32)],
+    repeats: usize,
+    cases: &mut Vec<BenchCase>,
+) -> Result<String> {
     let mut t = format!(
         "refocus benchmark on {} ({} repeats, medians)\n\n\
          | size | path | setup ms | ms / frame (5 scales) | ms / scale | job ms / frame incl. PNG+EXR+mask writes |\n\
          |---|---|---|---|---|---|\n",
-        gpu.renderer(),
+        device.renderer(),
         repeats
     );
     let tmp = std::env::temp_dir().join(format!("viewsynth-bench-{}", std::process::id()));
@@ -77,7 +82,7 @@ pub fn refocus_bench(gpu: &Device, sizes: &[(u32, u32)], repeats: usize, cases: 
         let outputs = OutputSet::default();
         for method in [Method::Fullscreen, Method::Mesh] {
             let t0 = Instant::now();
-            let mut r = Refocuser::new(gpu, &src, &rule, method, outputs, Conventions::default())?;
+            let mut r = Refocuser::new(device, &src, &rule, method, outputs, Conventions::default())?;
             r.render(&targets[0])?; // warm-up: shader JIT and framebuffer allocation
             let setup = t0.elapsed().as_secs_f64() * 1e3;
             let mut frame = Vec::new();
@@ -109,8 +114,8 @@ pub fn refocus_bench(gpu: &Device, sizes: &[(u32, u32)], repeats: usize, cases: 
                 Method::Fullscreen => "GPU full-screen".to_string(),
             };
             let case = match method {
-                Method::Mesh => "gpu-mesh",
-                Method::Fullscreen => "gpu-fullscreen",
+                Method::Mesh => "device-mesh",
+                Method::Fullscreen => "device-fullscreen",
             };
             cases.push(BenchCase::new("refocus", case, format!("{w}x{h}"), Some(setup), m));
             cases.push(BenchCase::new(
@@ -157,7 +162,7 @@ pub fn refocus_bench(gpu: &Device, sizes: &[(u32, u32)], repeats: usize, cases: 
 
 /// Median ms per middle frame from two eyes of `width` x `height` for each cyclopean method.
 pub fn cyclopean_bench(
-    gpu: &Device,
+    device: &Device,
     width: u32,
     height: u32,
     repeats: usize,
@@ -171,7 +176,7 @@ pub fn cyclopean_bench(
     let mut t = format!(
         "cyclopean benchmark on {}: 2 eyes {width}x{height} -> middle {width}x{height} ({repeats} repeats, medians)\n\n\
          | method | setup ms | ms / middle frame (draw + readback) |\n|---|---|---|\n",
-        gpu.renderer()
+        device.renderer()
     );
     let mut record = |name: &str, (setup, m): (f64, f64)| {
         cases.push(BenchCase::new(
@@ -186,7 +191,7 @@ pub fn cyclopean_bench(
     for (name, params) in crate::eval::cyclopean::cyclopean_methods(3.0) {
         let timing = setup_and_median(
             repeats,
-            || CyclopeanRenderer::new(gpu, &frame, params),
+            || CyclopeanRenderer::new(device, &frame, params),
             |r| r.render(&mid),
         )?;
         record(name, timing);
@@ -194,7 +199,7 @@ pub fn cyclopean_bench(
     let rule = viewsynth::refocus::BreakRule::default();
     let warp = setup_and_median(
         repeats,
-        || viewsynth::cyclopean::forward::ForwardWarp::new(gpu, &frame, &rule),
+        || viewsynth::cyclopean::forward::ForwardWarp::new(device, &frame, &rule),
         |w| w.render(&mid),
     )?;
     record(crate::eval::cyclopean::FORWARD_NAME, warp);
@@ -202,7 +207,7 @@ pub fn cyclopean_bench(
         repeats,
         || {
             viewsynth::cyclopean::splat::SplatRenderer::new(
-                gpu,
+                device,
                 &frame,
                 viewsynth::cyclopean::splat::SplatParams::default(),
                 viewsynth::cyclopean::CyclopeanOutputs::default(),
@@ -217,7 +222,7 @@ pub fn cyclopean_bench(
     // blocks (the 13-27 % a real pair leaves unknown, in regions as wide as a real pair's).
     let (left, right, _) = matcher::synthetic_pair(width, height)?;
     let (matched_left, matched_right) =
-        viewsynth::cyclopean::matcher::Matcher::new(gpu, width, height, MATCHER_BENCH_MAX_DISPARITY)?
+        viewsynth::cyclopean::matcher::Matcher::new(device, width, height, MATCHER_BENCH_MAX_DISPARITY)?
             .estimate(&left, &right)?;
     let unknown = |maps: [&viewsynth::io::DepthMap; 2]| {
         let n: usize = maps.iter().map(|m| m.data.iter().filter(|d| **d <= 0.0).count()).sum();
@@ -242,7 +247,7 @@ pub fn cyclopean_bench(
         let share = unknown(maps);
         let timing = setup_and_median(
             repeats,
-            || viewsynth::cyclopean::densify::Densifier::new(gpu),
+            || viewsynth::cyclopean::densify::Densifier::new(device),
             |d| {
                 d.densify(maps[0], &left)?;
                 d.densify(maps[1], &right)
@@ -255,7 +260,7 @@ pub fn cyclopean_bench(
     }
     // --fill on the default method's view: what a complete spectator frame adds to it.
     let (view, _) = viewsynth::cyclopean::splat::SplatRenderer::new(
-        gpu,
+        device,
         &frame,
         viewsynth::cyclopean::splat::SplatParams::default(),
         viewsynth::cyclopean::CyclopeanOutputs::default(),
@@ -263,7 +268,7 @@ pub fn cyclopean_bench(
     .render(&mid)?;
     let fill = setup_and_median(
         repeats,
-        || viewsynth::cyclopean::fill::Filler::new(gpu),
+        || viewsynth::cyclopean::fill::Filler::new(device),
         |f| f.fill(&view, mid.width, mid.height),
     )?;
     record("--fill alone (on the splat-gather view; add to its row)", fill);
@@ -273,7 +278,7 @@ pub fn cyclopean_bench(
     moved.head.position[0] += 0.03;
     let (last, last_mid, _) = scene_frame(&moved, Conventions::default(), FrameDepth::Device);
     let (last, _) = viewsynth::cyclopean::splat::SplatRenderer::new(
-        gpu,
+        device,
         &last,
         viewsynth::cyclopean::splat::SplatParams::default(),
         viewsynth::cyclopean::CyclopeanOutputs::default(),
@@ -284,7 +289,7 @@ pub fn cyclopean_bench(
     // Each timed push reprojects the other frame's view: the two alternate.
     let temporal = setup_and_median(
         repeats,
-        || Ok((Accumulator::new(gpu, FILL_ONLY, DEPTH_TOLERANCE, conv)?, false)),
+        || Ok((Accumulator::new(device, FILL_ONLY, DEPTH_TOLERANCE, conv)?, false)),
         |(a, odd)| {
             *odd = !*odd;
             match odd {
@@ -315,7 +320,7 @@ pub fn cyclopean_bench(
     for (stages, confidence) in [(", GPU pass", false), (" + confidence stage, GPU pass", true)] {
         let timing = setup_and_median(
             repeats,
-            || viewsynth::cyclopean::matcher::Matcher::new(gpu, width, height, max_d),
+            || viewsynth::cyclopean::matcher::Matcher::new(device, width, height, max_d),
             |m| match confidence {
                 false => m.estimate(&left, &right).map(drop),
                 true => m.estimate_with_confidence(&left, &right).map(drop),
@@ -374,7 +379,7 @@ fn setup_and_median<R, T>(
 /// Benchmark: ms per 4096 x 2048 stereo equirect (both eyes, readback included) from 6 faces
 /// of 1024 x 1024 per eye, overlap 10 deg, per method (median of `repeats`, at least 1, after a
 /// warm-up). Not asserted.
-pub fn stitch_bench(gpu: &Device, repeats: usize, cases: &mut Vec<BenchCase>) -> Result<String> {
+pub fn stitch_bench(device: &Device, repeats: usize, cases: &mut Vec<BenchCase>) -> Result<String> {
     use viewsynth::stitch::faces::scene_faces;
     use viewsynth::stitch::render::StitchRenderer;
     use viewsynth::stitch::{Method, OdsRig, Side, StitchParams};
@@ -385,10 +390,10 @@ pub fn stitch_bench(gpu: &Device, repeats: usize, cases: &mut Vec<BenchCase>) ->
     let right = scene_faces(&rig, Side::Right, n, 90.0 + 2.0 * overlap)?;
     let trace_ms = t0.elapsed().as_secs_f64() * 1e3;
     let t0 = Instant::now();
-    let mut r = StitchRenderer::new(gpu, &left, &right)?;
+    let mut r = StitchRenderer::new(device, &left, &right)?;
     let setup_ms = t0.elapsed().as_secs_f64() * 1e3;
     let repeats = repeats.max(1);
-    let mut t = stitch_table_head(&gpu.renderer(), trace_ms, setup_ms, repeats);
+    let mut t = stitch_table_head(&device.renderer(), trace_ms, setup_ms, repeats);
     for method in Method::ALL {
         let params = StitchParams {
             method,

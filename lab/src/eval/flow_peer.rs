@@ -120,11 +120,10 @@ impl viewsynth::job::Host for Quiet {
 }
 
 /// One row per pair of [`flow_peer_pairs`]: `viewsynth cyclopean --left-rgb L --right-rgb R
-/// --fill` as the CLI runs it (the same job, on `gpu`), scored over all pixels against the true
+/// --fill` as the CLI runs it (the same job, on `device`), scored over all pixels against the true
 /// middle view: what the peer's row stands beside. Timed once, reading the images included.
-pub fn fill_two_images_rows(gpu: &viewsynth::pass::Device, data_dir: &Path) -> Result<Vec<ReportRow>> {
+pub fn fill_two_images_rows(device: &viewsynth::pass::Device, data_dir: &Path) -> Result<Vec<ReportRow>> {
     use viewsynth::job::cyclopean::{CyclopeanJob, CyclopeanOptions, CyclopeanRequest};
-    let device = gpu.clone();
     let mut rows = Vec::new();
     for pair in flow_peer_pairs(data_dir) {
         let job = CyclopeanJob::new(CyclopeanOptions {
@@ -140,7 +139,7 @@ pub fn fill_two_images_rows(gpu: &viewsynth::pass::Device, data_dir: &Path) -> R
         })
         .map_err(|e| Error::param("report", format!("{}: {e}", pair.scene)))?;
         let t0 = std::time::Instant::now();
-        let view = job.render_only(&device, &Quiet)?.view;
+        let view = job.render_only(device, &Quiet)?.view;
         let wall_ms = t0.elapsed().as_secs_f64() * 1e3;
         let image = view
             .color

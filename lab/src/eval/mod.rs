@@ -77,20 +77,20 @@ pub(crate) fn score(
 }
 
 /// Run everything and write report.{md,csv,svg} into `out_dir`.
-pub fn run_report(gpu: &Device, out_dir: &Path, data_dir: Option<&Path>, repeats: usize) -> Result<WrittenReport> {
-    run_report_with_cases(gpu, out_dir, data_dir, &[], repeats)
+pub fn run_report(device: &Device, out_dir: &Path, data_dir: Option<&Path>, repeats: usize) -> Result<WrittenReport> {
+    run_report_with_cases(device, out_dir, data_dir, &[], repeats)
 }
 
 /// [`run_report`] plus user cases (see [`cyclopean::cyclopean_case_rows`]).
 pub fn run_report_with_cases(
-    gpu: &Device,
+    device: &Device,
     out_dir: &Path,
     data_dir: Option<&Path>,
     cases: &[PathBuf],
     repeats: usize,
 ) -> Result<WrittenReport> {
     run_report_with_progress(
-        gpu,
+        device,
         out_dir,
         data_dir,
         cases,
@@ -103,7 +103,7 @@ pub fn run_report_with_cases(
 /// [`run_report_with_cases`] with each stage reported to `progress` as it starts, and the
 /// optical-flow peer's middle views read from `flow_peer` (see [`flow_peer`]; needs `data_dir`).
 pub fn run_report_with_progress(
-    gpu: &Device,
+    device: &Device,
     out_dir: &Path,
     data_dir: Option<&Path>,
     cases: &[PathBuf],
@@ -112,7 +112,7 @@ pub fn run_report_with_progress(
     progress: &dyn viewsynth::progress::Progress,
 ) -> Result<WrittenReport> {
     let stages = viewsynth::progress::Stages::new(progress, report_stage_count(data_dir, cases));
-    report_stages(gpu, out_dir, data_dir, cases, flow_peer, repeats, &stages)
+    report_stages(device, out_dir, data_dir, cases, flow_peer, repeats, &stages)
 }
 
 /// How many stages [`report_stages`] reports: five on the built-in scenes (the last, GL against
@@ -131,7 +131,7 @@ fn has_cyclopean_data(dir: &Path) -> bool {
 /// The report, its stages counted in `stages` (see [`report_stage_count`]); with `flow_peer`
 /// (and `data_dir`), the peer's row beside viewsynth's for every real pair with a true middle view.
 pub fn report_stages(
-    gpu: &Device,
+    device: &Device,
     out_dir: &Path,
     data_dir: Option<&Path>,
     cases: &[PathBuf],
@@ -147,9 +147,9 @@ pub fn report_stages(
     }
     std::fs::create_dir_all(out_dir).map_err(|e| viewsynth::Error::io(out_dir, e))?;
     stages.start("report: refocus rows");
-    let mut rows = refocus::refocus_rows(gpu, repeats)?;
+    let mut rows = refocus::refocus_rows(device, repeats)?;
     stages.start("report: cyclopean rows (built-in scene)");
-    rows.extend(cyclopean::cyclopean_scene_rows(gpu, repeats)?);
+    rows.extend(cyclopean::cyclopean_scene_rows(device, repeats)?);
     let mut notes = vec![
         "Built-in scene: truth is the scene ray-traced in f64 from the target/middle camera; scores cover pixels the method marks valid and the scene has a surface at.".to_string(),
         "refocus cannot show detail the source did not record: its PSNR against the scene measures resampling, not the implementation (that is held to the f64 reference by the tests).".to_string(),
@@ -157,18 +157,18 @@ pub fn report_stages(
         "Wall time: median after a warm-up, glFinish included; GPU time only where timer queries are meaningful (not llvmpipe).".to_string(),
     ];
     stages.start("report: reproject rows");
-    let (reproject, reproject_notes) = reproject::reproject_rows(gpu, data_dir, repeats)?;
+    let (reproject, reproject_notes) = reproject::reproject_rows(device, data_dir, repeats)?;
     rows.extend(reproject);
     notes.extend(reproject_notes);
     stages.start("report: stitch rows");
-    let (stitch, stitch_notes) = stitch::stitch_rows(gpu, repeats)?;
+    let (stitch, stitch_notes) = stitch::stitch_rows(device, repeats)?;
     rows.extend(stitch);
     notes.extend(stitch_notes);
     if let Some(dir) = data_dir {
         // Sets absent from the folder are skipped (and said so), not failed on.
         if has_cyclopean_data(dir) {
             stages.start("report: cyclopean rows (Middlebury 2003)");
-            let (real, real_notes) = cyclopean::cyclopean_real_rows(gpu, dir, repeats)?;
+            let (real, real_notes) = cyclopean::cyclopean_real_rows(device, dir, repeats)?;
             rows.extend(real);
             notes.extend(real_notes);
         } else {
@@ -179,7 +179,7 @@ pub fn report_stages(
         }
     }
     if let (Some(dir), Some(peer)) = (data_dir, flow_peer) {
-        let mut beside = flow_peer::fill_two_images_rows(gpu, dir)?;
+        let mut beside = flow_peer::fill_two_images_rows(device, dir)?;
         beside.extend(flow_peer::flow_peer_rows(dir, peer)?);
         flow_peer::place_beside(&mut rows, beside);
         notes.push(format!(
@@ -192,16 +192,16 @@ pub fn report_stages(
     }
     for case in cases {
         stages.start(&format!("report: case {}", case.display()));
-        rows.extend(cyclopean::cyclopean_case_rows(gpu, case, repeats)?);
+        rows.extend(cyclopean::cyclopean_case_rows(device, case, repeats)?);
     }
     let report = Report {
         title: "viewsynth: error against run time".into(),
-        renderer: gpu.renderer(),
+        renderer: device.renderer(),
         rows,
         notes,
     };
     let mut files = report.write(out_dir, "report")?;
     stages.start("report: every pass, GL against Vulkan");
-    files.push(backends::write_section(gpu, out_dir)?);
+    files.push(backends::write_section(device, out_dir)?);
     Ok(WrittenReport { report, files })
 }

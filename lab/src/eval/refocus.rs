@@ -11,7 +11,7 @@ use viewsynth::refocus::{BreakRule, Method as RefocusMethod, OutputSet, RefocusS
 use viewsynth::scene;
 
 /// Refocus of the built-in scene against the scene ray-traced from each target camera.
-pub fn refocus_rows(gpu: &Device, repeats: usize) -> Result<Vec<ReportRow>> {
+pub fn refocus_rows(device: &Device, repeats: usize) -> Result<Vec<ReportRow>> {
     let cam = scene::demo_camera(640, 480);
     let (rgb, depth) = scene::render(&cam);
     let src = RefocusSource::new(rgb, depth, cam.k)?;
@@ -25,7 +25,7 @@ pub fn refocus_rows(gpu: &Device, repeats: usize) -> Result<Vec<ReportRow>> {
     let mut rows = Vec::new();
     for method in [RefocusMethod::Fullscreen, RefocusMethod::Mesh] {
         let mut r = Refocuser::new(
-            gpu,
+            device,
             &src,
             &BreakRule::default(),
             method,

@@ -275,12 +275,12 @@ pub fn score(out: &ReprojectOutput, case: &Case) -> Result<Score> {
 
 /// Median of `repeats` runs after one warm-up (shader JIT, allocations).
 pub fn run_timed(
-    gpu: &Device,
+    device: &Device,
     case: &Case,
     params: ReprojectParams,
     repeats: usize,
 ) -> Result<(ReprojectOutput, Timing)> {
-    let mut r = Reprojector::new(gpu, &case.source, &case.geometry, params)?;
+    let mut r = Reprojector::new(device, &case.source, &case.geometry, params)?;
     r.render()?;
     let mut runs = Vec::new();
     for _ in 0..repeats.max(1) {
@@ -309,10 +309,10 @@ fn row(
 
 /// The general mesh warp of the foundation (the cyclopean forward warp with the source as the
 /// only eye and the target as the middle camera), for comparison with the shift methods.
-pub fn mesh_warp_timed(gpu: &Device, case: &Case, repeats: usize) -> Result<(ReprojectOutput, Timing)> {
+pub fn mesh_warp_timed(device: &Device, case: &Case, repeats: usize) -> Result<(ReprojectOutput, Timing)> {
     let (frame, target) = viewsynth::reproject::one_eye_frame(&case.source, &case.geometry)?;
     let mut warp =
-        viewsynth::cyclopean::forward::ForwardWarp::new(gpu, &frame, &viewsynth::refocus::BreakRule::default())?;
+        viewsynth::cyclopean::forward::ForwardWarp::new(device, &frame, &viewsynth::refocus::BreakRule::default())?;
     warp.render(&target)?; // warm-up
     let mut runs = Vec::new();
     for _ in 0..repeats.max(1) {
@@ -351,7 +351,11 @@ fn mesh_row(case: &Case, scene: &str, out: &ReprojectOutput, t: Timing) -> Resul
 /// Rows for `viewsynth report`: the built-in scene at 640x480 (64 mm and 200 mm baselines, left
 /// eye with device depth and centre view -> right eye, against the ray-traced right eye), and,
 /// with `data_dir`, Middlebury 2014 Motorcycle and 2003 Teddy against their real right views.
-pub fn reproject_rows(gpu: &Device, data_dir: Option<&Path>, repeats: usize) -> Result<(Vec<ReportRow>, Vec<String>)> {
+pub fn reproject_rows(
+    device: &Device,
+    data_dir: Option<&Path>,
+    repeats: usize,
+) -> Result<(Vec<ReportRow>, Vec<String>)> {
     let mut rows = Vec::new();
     let mut notes = vec![
         "reproject: shift walk k = k fixed-point steps along the row from the zero-parallax guess and from the near bound, verified by segment coverage; shift scan = every segment the depth range allows, nearest wins; 3-D gather k = the cyclopean k-step walk with one eye. Disocclusions stay invalid; PSNR on pixels valid in the output (and with a surface in the truth for the built-in scene).".to_string(),
@@ -360,12 +364,12 @@ pub fn reproject_rows(gpu: &Device, data_dir: Option<&Path>, repeats: usize) -> 
     for ipd in [0.064, 0.2] {
         for case in scene_cases(640, 480, ipd, conv, FrameDepth::Device)? {
             for params in methods() {
-                let (out, t) = run_timed(gpu, &case, params, repeats)?;
+                let (out, t) = run_timed(device, &case, params, repeats)?;
                 let (mut r, _) = row(&case, "builtin:demo 640x480", params, &out, t)?;
                 r.setting = format!("{}, ipd {:.0} mm", case.name, ipd * 1e3);
                 rows.push(r);
             }
-            let (out, t) = mesh_warp_timed(gpu, &case, repeats)?;
+            let (out, t) = mesh_warp_timed(device, &case, repeats)?;
             let (mut r, _) = mesh_row(&case, "builtin:demo 640x480", &out, t)?;
             r.setting = format!("{}, ipd {:.0} mm", case.name, ipd * 1e3);
             rows.push(r);
@@ -385,7 +389,7 @@ pub fn reproject_rows(gpu: &Device, data_dir: Option<&Path>, repeats: usize) -> 
             }
             let case = make(dir, conv)?;
             for params in methods() {
-                let (out, t) = run_timed(gpu, &case, params, repeats)?;
+                let (out, t) = run_timed(device, &case, params, repeats)?;
                 let (mut r, s) = row(&case, &case.name, params, &out, t)?;
                 r.setting = "PSNR vs the real right view on pixels marked valid".into();
                 notes.push(format!(
@@ -398,7 +402,7 @@ pub fn reproject_rows(gpu: &Device, data_dir: Option<&Path>, repeats: usize) -> 
                 ));
                 rows.push(r);
             }
-            let (out, t) = mesh_warp_timed(gpu, &case, repeats)?;
+            let (out, t) = mesh_warp_timed(device, &case, repeats)?;
             let (mut r, s) = mesh_row(&case, &case.name, &out, t)?;
             r.setting = "PSNR vs the real right view on pixels marked valid".into();
             notes.push(format!(

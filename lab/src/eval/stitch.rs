@@ -25,7 +25,7 @@ fn median(mut v: Vec<f64>) -> f64 {
 /// and SSIM over the same region. Faces 256 x 256, equirect 1024 x 512 per eye. Notes carry a
 /// Markdown table with MAE, the seam band's edge error and sharpness ([`StitchScore`]) and its
 /// PSNR split by truth distance.
-pub fn stitch_rows(gpu: &Device, repeats: usize) -> Result<(Vec<ReportRow>, Vec<String>)> {
+pub fn stitch_rows(device: &Device, repeats: usize) -> Result<(Vec<ReportRow>, Vec<String>)> {
     let rig = OdsRig::demo();
     let (n, w, h) = (256, 1024, 512);
     let truth = [ods_truth(&rig, Side::Left, w, h)?, ods_truth(&rig, Side::Right, w, h)?];
@@ -39,7 +39,7 @@ pub fn stitch_rows(gpu: &Device, repeats: usize) -> Result<(Vec<ReportRow>, Vec<
         let fov = 90.0 + 2.0 * overlap;
         let left = scene_faces(&rig, Side::Left, n, fov)?;
         let right = scene_faces(&rig, Side::Right, n, fov)?;
-        let mut r = StitchRenderer::new(gpu, &left, &right)?;
+        let mut r = StitchRenderer::new(device, &left, &right)?;
         let band = seam_band_mask(w, h, overlap);
         for method in Method::ALL {
             let params = StitchParams {

@@ -131,7 +131,7 @@ impl BenchJob {
 
     /// Measures.
     pub fn run(&self, host: &dyn Host) -> Result<BenchReport, JobError> {
-        let gpu = host.open_device(&self.gpu, viewsynth::job::Backend::Gl)?;
+        let device = host.open_device(&self.gpu, viewsynth::job::Backend::Gl)?;
         match &self.bench {
             Bench::Batch {
                 input,
@@ -144,7 +144,7 @@ impl BenchJob {
                     false => None,
                 };
                 Ok(BenchReport::Batch(Box::new(batch_bench(
-                    &gpu,
+                    &device,
                     input,
                     *jobs,
                     *files,
@@ -162,17 +162,17 @@ impl BenchJob {
                 let total = 3 + usize::from(*with_vulkan);
                 let measured = (|| -> Result<(Vec<String>, Option<String>), JobError> {
                     stages.stage(1, total, "bench: refocus");
-                    let mut tables = vec![refocus_bench(&gpu, sizes, *repeats, &mut cases)?];
+                    let mut tables = vec![refocus_bench(&device, sizes, *repeats, &mut cases)?];
                     stages.stage(2, total, "bench: cyclopean");
-                    tables.push(cyclopean_bench(&gpu, 1280, 720, *repeats, &mut cases)?);
+                    tables.push(cyclopean_bench(&device, 1280, 720, *repeats, &mut cases)?);
                     stages.stage(3, total, "bench: stitch");
-                    tables.push(crate::bench::stitch_bench(&gpu, *repeats, &mut cases)?);
+                    tables.push(crate::bench::stitch_bench(&device, *repeats, &mut cases)?);
                     if !*with_vulkan {
                         return Ok((tables, None));
                     }
                     stages.stage(4, total, "bench: every pass, GL against Vulkan");
                     let vk = host.open_device(&self.vulkan_request(), viewsynth::job::Backend::Vulkan)?;
-                    let gl = gpu.clone();
+                    let gl = device.clone();
                     let name = vk.renderer();
                     tables.push(crate::bench::passes::passes_bench(
                         &[("gl", gl), ("vulkan", vk)],
@@ -186,7 +186,7 @@ impl BenchJob {
                 host.event(Event::Finished);
                 let (tables, vulkan_device) = measured?;
                 Ok(BenchReport::Frames {
-                    renderer: gpu.renderer(),
+                    renderer: device.renderer(),
                     tables,
                     cases,
                     vulkan_device,

@@ -55,9 +55,9 @@ impl ReportJob {
             // A missing peer image fails the run before the GPU opens or a row is measured.
             crate::eval::flow_peer::check_flow_peer(data, peer)?;
         }
-        let gpu = host.open_device(&self.gpu, viewsynth::job::Backend::Gl)?;
+        let device = host.open_device(&self.gpu, viewsynth::job::Backend::Gl)?;
         let files = crate::eval::run_report_with_progress(
-            &gpu,
+            &device,
             &self.out_dir,
             self.data_dir.as_deref(),
             &self.cases,
@@ -83,8 +83,8 @@ pub struct DemoJob {
 impl DemoJob {
     /// Renders everything; returns the report, its files and, last, refocus_check.md.
     pub fn run(&self, host: &dyn Host) -> Result<WrittenReport, JobError> {
-        let gpu = host.open_device(&self.gpu, viewsynth::job::Backend::Gl)?;
-        let report = crate::demo::run_with_progress(&gpu, Path::new(&self.out_dir), &HostStages(host));
+        let device = host.open_device(&self.gpu, viewsynth::job::Backend::Gl)?;
+        let report = crate::demo::run_with_progress(&device, Path::new(&self.out_dir), &HostStages(host));
         host.event(Event::Finished);
         Ok(report?)
     }

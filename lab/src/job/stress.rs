@@ -46,14 +46,14 @@ impl StressJob {
 
     /// Sweeps the cases: one row each.
     pub fn run(&self, host: &dyn Host) -> Result<Vec<StressRow>, JobError> {
-        let gpu = host.open_device(&self.gpu, viewsynth::job::Backend::Gl)?;
+        let device = host.open_device(&self.gpu, viewsynth::job::Backend::Gl)?;
         // One capability at a time, each a stage of the progress shown.
         let (stages, mut rows) = (HostStages(host), Vec::new());
         let total = self.capabilities.len();
         let swept = (|| -> viewsynth::Result<()> {
             for (i, cap) in self.capabilities.iter().enumerate() {
                 stages.stage(i + 1, total, &format!("stress: {cap}"));
-                rows.extend(run_stress(&gpu, &[cap], StressOptions { quick: self.quick })?);
+                rows.extend(run_stress(&device, &[cap], StressOptions { quick: self.quick })?);
             }
             Ok(())
         })();

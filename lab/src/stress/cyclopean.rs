@@ -62,12 +62,12 @@ struct Case {
     mid: MiddleCamera,
 }
 
-fn sweep(gpu: &Device, case: &str, cases: &[Case], fixation: f64, tol: Tolerance, note: &str) -> Result<StressRow> {
+fn sweep(device: &Device, case: &str, cases: &[Case], fixation: f64, tol: Tolerance, note: &str) -> Result<StressRow> {
     let mut tally = Tally::default();
     for c in cases {
         for (name, params) in methods(fixation) {
             let reference = cyclopean_reference(&c.frame, &c.mid, &params)?;
-            let (out, _) = CyclopeanRenderer::new(gpu, &c.frame, params)?.render(&c.mid)?;
+            let (out, _) = CyclopeanRenderer::new(device, &c.frame, params)?.render(&c.mid)?;
             tally.add(
                 &format!("{} {name}", c.tag),
                 &GpuPixels {
@@ -108,7 +108,7 @@ fn scene_cases(rig: &StereoRig, convs: &[Conventions], kind: FrameDepth) -> Vec<
 const SCENE_Z_MAX: f64 = 8.0;
 
 /// The stress rows of cyclopean: each case's GPU output against the f64 reference.
-pub fn rows(gpu: &Device, opts: StressOptions) -> Result<Vec<StressRow>> {
+pub fn rows(device: &Device, opts: StressOptions) -> Result<Vec<StressRow>> {
     let (w, h) = if opts.quick { (96, 72) } else { (256, 192) };
     let all = Conventions::all();
     let (fine, lossy): (Vec<Conventions>, Vec<Conventions>) =
@@ -141,7 +141,7 @@ pub fn rows(gpu: &Device, opts: StressOptions) -> Result<Vec<StressRow>> {
                 String::new()
             };
             rows.push(sweep(
-                gpu,
+                device,
                 &format!("device depth, near/far {ratio:.0e}, {label}"),
                 &scene_cases(&rig, convs, FrameDepth::Device),
                 FIXATION,
@@ -156,7 +156,7 @@ pub fn rows(gpu: &Device, opts: StressOptions) -> Result<Vec<StressRow>> {
     let mut rig = StereoRig::demo(w, h);
     rig.ipd = 0.0;
     rows.push(sweep(
-        gpu,
+        device,
         "zero IPD",
         &scene_cases(&rig, &two, FrameDepth::ViewZ),
         FIXATION,
@@ -171,7 +171,7 @@ pub fn rows(gpu: &Device, opts: StressOptions) -> Result<Vec<StressRow>> {
         (1e6, "fixation 1000 km (parallel gaze)"),
     ] {
         rows.push(sweep(
-            gpu,
+            device,
             label,
             &scene_cases(&rig, &two, FrameDepth::ViewZ),
             fixation,
@@ -195,7 +195,7 @@ pub fn rows(gpu: &Device, opts: StressOptions) -> Result<Vec<StressRow>> {
         }
     }
     rows.push(sweep(
-        gpu,
+        device,
         "NaN / +-Inf / negative / zero eye depth patches",
         &cases,
         FIXATION,
@@ -215,7 +215,7 @@ pub fn rows(gpu: &Device, opts: StressOptions) -> Result<Vec<StressRow>> {
         .gl_view();
     }
     rows.push(sweep(
-        gpu,
+        device,
         "middle camera 1.5 m ahead (surfaces behind it)",
         &cases,
         FIXATION,
@@ -253,7 +253,7 @@ pub fn rows(gpu: &Device, opts: StressOptions) -> Result<Vec<StressRow>> {
         });
     }
     rows.push(sweep(
-        gpu,
+        device,
         "depth 1 mm and 100 km in one frame",
         &cases,
         1.0,
@@ -262,7 +262,7 @@ pub fn rows(gpu: &Device, opts: StressOptions) -> Result<Vec<StressRow>> {
     )?);
 
     // Output size extremes: 1x1 and the largest side (x 2 rows), then one past it.
-    let max = gpu.max_image_side();
+    let max = device.max_image_side();
     let rig = StereoRig::demo(64, 48);
     let mut cases = Vec::new();
     for (mw, mh) in [(1, 1), (max, 2)] {
@@ -276,7 +276,7 @@ pub fn rows(gpu: &Device, opts: StressOptions) -> Result<Vec<StressRow>> {
         });
     }
     rows.push(sweep(
-        gpu,
+        device,
         &format!("middle view 1x1 and {max}x2"),
         &cases,
         FIXATION,
@@ -286,7 +286,7 @@ pub fn rows(gpu: &Device, opts: StressOptions) -> Result<Vec<StressRow>> {
     let (frame, mut mid, _) = scene_frame(&rig, all[7], FrameDepth::ViewZ);
     mid.width = max + 1;
     mid.height = 1;
-    let r = CyclopeanRenderer::new(gpu, &frame, CyclopeanParams::seed(FIXATION))
+    let r = CyclopeanRenderer::new(device, &frame, CyclopeanParams::seed(FIXATION))
         .and_then(|mut r| r.render(&mid).map(|_| ()));
     rows.push(refused("cyclopean", max + 1, max, r));
     Ok(rows)

@@ -283,15 +283,15 @@ pub struct StressOptions {
 pub const CAPABILITIES: [&str; 5] = ["camera", "refocus", "cyclopean", "reproject", "stitch"];
 
 /// Run the sweep over `capabilities` (names of [`CAPABILITIES`]).
-pub fn run_stress(gpu: &Device, capabilities: &[&str], opts: StressOptions) -> Result<Vec<StressRow>> {
+pub fn run_stress(device: &Device, capabilities: &[&str], opts: StressOptions) -> Result<Vec<StressRow>> {
     let mut rows = Vec::new();
     for cap in capabilities {
         match *cap {
             "camera" => rows.extend(camera::rows(opts)?),
-            "refocus" => rows.extend(refocus::rows(gpu, opts)?),
-            "cyclopean" => rows.extend(cyclopean::rows(gpu, opts)?),
-            "reproject" => rows.extend(reproject::rows(gpu, opts)?),
-            "stitch" => rows.extend(stitch::rows(gpu, opts)?),
+            "refocus" => rows.extend(refocus::rows(device, opts)?),
+            "cyclopean" => rows.extend(cyclopean::rows(device, opts)?),
+            "reproject" => rows.extend(reproject::rows(device, opts)?),
+            "stitch" => rows.extend(stitch::rows(device, opts)?),
             other => {
                 return Err(viewsynth::Error::param(
                     "capability",
@@ -299,7 +299,7 @@ pub fn run_stress(gpu: &Device, capabilities: &[&str], opts: StressOptions) -> R
                 ))
             }
         }
-        rows.extend(values::rows(gpu, cap, opts)?);
+        rows.extend(values::rows(device, cap, opts)?);
     }
     Ok(rows)
 }

@@ -38,7 +38,7 @@ fn source(w: u32, h: u32, depth: impl Fn(u32, u32) -> f32) -> Result<RefocusSour
 }
 
 /// Run `src` at `scales` through both paths under two opposite conventions, pooled into a row.
-fn sweep(gpu: &Device, case: &str, src: &RefocusSource, scales: &[f64], note: &str) -> Result<StressRow> {
+fn sweep(device: &Device, case: &str, src: &RefocusSource, scales: &[f64], note: &str) -> Result<StressRow> {
     let rule = BreakRule::default();
     let targets = TargetSpec {
         scales: scales.to_vec(),
@@ -50,7 +50,7 @@ fn sweep(gpu: &Device, case: &str, src: &RefocusSource, scales: &[f64], note: &s
     let references: Vec<_> = targets.iter().map(|t| refocus_reference(src, &rule, t)).collect();
     for method in [Method::Fullscreen, Method::Mesh] {
         for conv in [Conventions::default(), Conventions::all()[7]] {
-            let mut r = Refocuser::new(gpu, src, &rule, method, OutputSet::default(), conv)?;
+            let mut r = Refocuser::new(device, src, &rule, method, OutputSet::default(), conv)?;
             for ((t, reference), s) in targets.iter().zip(&references).zip(scales) {
                 let out = r.render(t)?;
                 let (rgb, depth, mask) = (
@@ -99,7 +99,7 @@ fn ties(src: &RefocusSource, t: &PinholeCamera) -> Vec<bool> {
 }
 
 /// The stress rows of refocus: each case's GPU output against the f64 reference.
-pub fn rows(gpu: &Device, opts: StressOptions) -> Result<Vec<StressRow>> {
+pub fn rows(device: &Device, opts: StressOptions) -> Result<Vec<StressRow>> {
     let (w, h) = if opts.quick { (96, 72) } else { (320, 240) };
     let mut rows = Vec::new();
 
@@ -107,7 +107,7 @@ pub fn rows(gpu: &Device, opts: StressOptions) -> Result<Vec<StressRow>> {
     let (rgb, depth) = viewsynth::scene::render(&cam);
     let demo = RefocusSource::new(rgb, depth, cam.k)?;
     rows.push(sweep(
-        gpu,
+        device,
         "focal scales 0.05 .. 20 (built-in scene)",
         &demo,
         &[0.05, 0.1, 0.25, 0.5, 1.0, 2.0, 4.0, 10.0, 20.0],
@@ -122,7 +122,7 @@ pub fn rows(gpu: &Device, opts: StressOptions) -> Result<Vec<StressRow>> {
         }
     })?;
     rows.push(sweep(
-        gpu,
+        device,
         "depth 1 mm and 100 km in one frame",
         &src,
         &[0.05, 0.5, 1.0, 2.0, 20.0],
@@ -139,7 +139,7 @@ pub fn rows(gpu: &Device, opts: StressOptions) -> Result<Vec<StressRow>> {
         }
     })?;
     rows.push(sweep(
-        gpu,
+        device,
         "NaN / +-Inf / negative / zero depth patches (and points behind the camera)",
         &src,
         &[0.7, 1.0, 1.9],
@@ -153,7 +153,7 @@ pub fn rows(gpu: &Device, opts: StressOptions) -> Result<Vec<StressRow>> {
         (1.0 / (1.0 - 0.999 * t)) as f32
     })?;
     rows.push(sweep(
-        gpu,
+        device,
         "grazing slanted plane (1 m .. 1 km)",
         &src,
         &[0.5, 1.0, 2.0],
@@ -162,7 +162,7 @@ pub fn rows(gpu: &Device, opts: StressOptions) -> Result<Vec<StressRow>> {
 
     let src = source(w, h, |x, y| if x % 5 == 2 && y % 5 == 2 { 0.5 } else { 10.0 })?;
     rows.push(sweep(
-        gpu,
+        device,
         "single-pixel foreground objects",
         &src,
         &[0.5, 1.0, 3.0],
@@ -171,7 +171,7 @@ pub fn rows(gpu: &Device, opts: StressOptions) -> Result<Vec<StressRow>> {
 
     let src = source(w, h, |_, _| 2.0)?;
     rows.push(sweep(
-        gpu,
+        device,
         "constant depth (near plane = far plane)",
         &src,
         &[0.5, 1.0, 2.0],
@@ -179,13 +179,13 @@ pub fn rows(gpu: &Device, opts: StressOptions) -> Result<Vec<StressRow>> {
     )?);
 
     let src = source(1, 1, |_, _| 2.5)?;
-    rows.push(sweep(gpu, "1x1 image", &src, &[0.5, 1.0, 2.0], "")?);
+    rows.push(sweep(device, "1x1 image", &src, &[0.5, 1.0, 2.0], "")?);
 
     // The context's limit, less one: the grid's border ring (refocus::max_source_side).
-    let max = viewsynth::refocus::max_source_side(gpu);
+    let max = viewsynth::refocus::max_source_side(device);
     let src = source(max, 2, |x, _| 1.0 + 1e-4 * x as f32)?;
     rows.push(sweep(
-        gpu,
+        device,
         &format!("{max}x2 image (largest side)"),
         &src,
         &[0.5, 1.0],
@@ -194,7 +194,7 @@ pub fn rows(gpu: &Device, opts: StressOptions) -> Result<Vec<StressRow>> {
 
     let too_big = source(max + 1, 1, |_, _| 1.0).and_then(|src| {
         Refocuser::new(
-            gpu,
+            device,
             &src,
             &BreakRule::default(),
             Method::Fullscreen,
@@ -206,12 +206,12 @@ pub fn rows(gpu: &Device, opts: StressOptions) -> Result<Vec<StressRow>> {
     rows.push(refused("refocus", max + 1, max, too_big));
 
     // The output side: the context's limit itself is allowed, one past it refused.
-    let limit = gpu.max_image_side();
+    let limit = device.max_image_side();
     let too_big = source(4, 3, |_, _| 1.0).and_then(|src| {
         let mut target = src.camera();
         (target.width, target.height) = (limit + 1, 1);
         Refocuser::new(
-            gpu,
+            device,
             &src,
             &BreakRule::default(),
             Method::Fullscreen,

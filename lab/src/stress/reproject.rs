@@ -43,12 +43,12 @@ struct Case {
     geometry: Geometry,
 }
 
-fn sweep(gpu: &Device, case: &str, cases: &[Case], tol: Tolerance, note: &str) -> Result<StressRow> {
+fn sweep(device: &Device, case: &str, cases: &[Case], tol: Tolerance, note: &str) -> Result<StressRow> {
     let mut tally = Tally::default();
     for c in cases {
         for params in methods() {
             let reference = reproject_reference(&c.source, &c.geometry, &params)?;
-            let (out, _) = Reprojector::new(gpu, &c.source, &c.geometry, params)?.render()?;
+            let (out, _) = Reprojector::new(device, &c.source, &c.geometry, params)?.render()?;
             tally.add(
                 &format!("{} {}", c.tag, params.method.label()),
                 &GpuPixels {
@@ -158,7 +158,7 @@ fn seed_shift(w: u32, separation: f64, convergence: f64) -> Result<ShiftModel> {
 }
 
 /// The stress rows of reproject: each case's GPU output against the f64 reference.
-pub fn rows(gpu: &Device, opts: StressOptions) -> Result<Vec<StressRow>> {
+pub fn rows(device: &Device, opts: StressOptions) -> Result<Vec<StressRow>> {
     let (w, h) = if opts.quick { (96, 72) } else { (256, 192) };
     let all = Conventions::all();
     let two = [Conventions::default(), all[7]];
@@ -198,7 +198,7 @@ pub fn rows(gpu: &Device, opts: StressOptions) -> Result<Vec<StressRow>> {
                 String::new()
             };
             rows.push(sweep(
-                gpu,
+                device,
                 &format!(
                     "device depth, near/far {:.0e}, {}",
                     near / 100.0,
@@ -236,7 +236,7 @@ pub fn rows(gpu: &Device, opts: StressOptions) -> Result<Vec<StressRow>> {
         }
     }
     rows.push(sweep(
-        gpu,
+        device,
         "zero separation / zero IPD",
         &cases,
         view_z,
@@ -257,7 +257,7 @@ pub fn rows(gpu: &Device, opts: StressOptions) -> Result<Vec<StressRow>> {
         }
     }
     rows.push(sweep(
-        gpu,
+        device,
         "convergence 1e-9 m and 1000 km",
         &cases,
         view_z,
@@ -282,7 +282,7 @@ pub fn rows(gpu: &Device, opts: StressOptions) -> Result<Vec<StressRow>> {
         });
     }
     rows.push(sweep(
-        gpu,
+        device,
         "depth 1 mm and 100 km in one frame",
         &cases,
         view_z,
@@ -330,14 +330,14 @@ pub fn rows(gpu: &Device, opts: StressOptions) -> Result<Vec<StressRow>> {
         });
     }
     rows.push(sweep(
-        gpu,
+        device,
         "NaN / +-Inf / negative / zero depth and disparity (points behind the camera)",
         &cases,
         view_z,
         "invalid source depth is never drawn: a hole in the mask",
     )?);
 
-    let max = gpu.max_image_side();
+    let max = device.max_image_side();
     let mut cases = Vec::new();
     for (sw, sh) in [(2, 1), (max, 2)] {
         cases.push(Case {
@@ -350,7 +350,7 @@ pub fn rows(gpu: &Device, opts: StressOptions) -> Result<Vec<StressRow>> {
         });
     }
     rows.push(sweep(
-        gpu,
+        device,
         &format!("2x1 and {max}x2 images"),
         &cases,
         Tolerance::new(view_z_bound(max), 1e-3, 1e-3),
@@ -361,7 +361,7 @@ pub fn rows(gpu: &Device, opts: StressOptions) -> Result<Vec<StressRow>> {
             camera: rig_camera(max + 1, 1),
             shift: ShiftModel::rectified(1.0, 0.01, 0.0, Some(Eye::Left), Some(Eye::Right))?,
         };
-        Reprojector::new(gpu, &src, &geometry, methods()[0]).map(|_| ())
+        Reprojector::new(device, &src, &geometry, methods()[0]).map(|_| ())
     });
     rows.push(refused("reproject", max + 1, max, r));
     Ok(rows)

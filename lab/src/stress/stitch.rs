@@ -33,11 +33,11 @@ fn faces(rig: &OdsRig, n: u32, overlap_deg: f64) -> Result<(FaceSet, FaceSet)> {
     ))
 }
 
-fn sweep(gpu: &Device, case: &str, cases: &[Case], note: &str) -> Result<StressRow> {
+fn sweep(device: &Device, case: &str, cases: &[Case], note: &str) -> Result<StressRow> {
     let mut tally = Tally::default();
     for c in cases {
         for conv in [Conventions::default(), Conventions::all()[7]] {
-            let mut renderer = StitchRenderer::with_conventions(gpu, &c.left, &c.right, conv)?;
+            let mut renderer = StitchRenderer::with_conventions(device, &c.left, &c.right, conv)?;
             for method in Method::ALL {
                 let params = StitchParams {
                     method,
@@ -75,7 +75,7 @@ fn sweep(gpu: &Device, case: &str, cases: &[Case], note: &str) -> Result<StressR
 }
 
 /// The stress rows of stitch: each case's GPU output against the f64 reference.
-pub fn rows(gpu: &Device, opts: StressOptions) -> Result<Vec<StressRow>> {
+pub fn rows(device: &Device, opts: StressOptions) -> Result<Vec<StressRow>> {
     let (n, w, h) = if opts.quick { (48, 128, 64) } else { (128, 512, 256) };
     let rig = OdsRig::demo();
     let mut rows = Vec::new();
@@ -92,7 +92,7 @@ pub fn rows(gpu: &Device, opts: StressOptions) -> Result<Vec<StressRow>> {
     };
 
     rows.push(sweep(
-        gpu,
+        device,
         "overlap 0.25 and 40 deg (FOV 90.5 and 170)",
         &[case("0.25deg", &rig, 0.25, w, h)?, case("40deg", &rig, 40.0, w, h)?],
         "",
@@ -100,7 +100,7 @@ pub fn rows(gpu: &Device, opts: StressOptions) -> Result<Vec<StressRow>> {
 
     let zero = OdsRig { ipd: 0.0, ..rig };
     rows.push(sweep(
-        gpu,
+        device,
         "zero IPD",
         &[case("ipd0", &zero, 10.0, w, h)?],
         "all face eyes at the centre: the seed's dd = 0",
@@ -120,14 +120,14 @@ pub fn rows(gpu: &Device, opts: StressOptions) -> Result<Vec<StressRow>> {
         }
     }
     rows.push(sweep(
-        gpu,
+        device,
         "NaN / +-Inf / negative / zero face depth patches",
         &[c],
         "invalid depth is background (the seed's far guess)",
     )?);
 
     rows.push(sweep(
-        gpu,
+        device,
         "equirect 1x1 and 3x2, faces 2x2",
         &[case("1x1", &rig, 10.0, 1, 1)?, case("3x2", &rig, 10.0, 3, 2)?, {
             let (left, right) = (
@@ -146,9 +146,9 @@ pub fn rows(gpu: &Device, opts: StressOptions) -> Result<Vec<StressRow>> {
         "",
     )?);
 
-    let max = gpu.max_image_side();
+    let max = device.max_image_side();
     let c = case("big", &rig, 10.0, 2, 2)?;
-    let r = StitchRenderer::new(gpu, &c.left, &c.right).and_then(|mut r| {
+    let r = StitchRenderer::new(device, &c.left, &c.right).and_then(|mut r| {
         r.render(&StitchParams {
             method: Method::Blend,
             overlap_deg: 10.0,

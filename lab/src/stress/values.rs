@@ -188,7 +188,7 @@ fn values<T: Copy>(all: &[T], quick: bool) -> Vec<T> {
         .collect()
 }
 
-fn refocus_rows(gpu: &Device, opts: StressOptions) -> Result<Vec<StressRow>> {
+fn refocus_rows(device: &Device, opts: StressOptions) -> Result<Vec<StressRow>> {
     let cam = viewsynth::scene::demo_camera(32, 24);
     let (rgb, depth) = viewsynth::scene::render(&cam);
     let conv = Conventions::default();
@@ -206,7 +206,7 @@ fn refocus_rows(gpu: &Device, opts: StressOptions) -> Result<Vec<StressRow>> {
                 conv,
             };
             let tag = format!("{tag} {method:?}");
-            let (g, t) = (refocus::pass::gpu(gpu, &input), refocus::pass::reference(&input));
+            let (g, t) = (refocus::pass::gpu(device, &input), refocus::pass::reference(&input));
             if raw {
                 s.refuse(&tag, g, t);
             } else {
@@ -274,7 +274,7 @@ fn pass_label(pass: &CyclopeanPass) -> &'static str {
     }
 }
 
-fn cyclopean_rows(gpu: &Device, opts: StressOptions) -> Result<Vec<StressRow>> {
+fn cyclopean_rows(device: &Device, opts: StressOptions) -> Result<Vec<StressRow>> {
     let conv = Conventions::default();
     let mut rows = Vec::new();
     for kind in [FrameDepth::ViewZ, FrameDepth::Device] {
@@ -301,7 +301,7 @@ fn cyclopean_rows(gpu: &Device, opts: StressOptions) -> Result<Vec<StressRow>> {
                         outputs: CyclopeanOutputs::default(),
                     };
                     let tag = format!("{kind:?} depth {v:e} {}", pass_label(&pass));
-                    let (g, t) = (cyclopean::pass::gpu(gpu, &input), cyclopean::pass::reference(&input));
+                    let (g, t) = (cyclopean::pass::gpu(device, &input), cyclopean::pass::reference(&input));
                     if cleared {
                         s.compare(&tag, g, t);
                     } else {
@@ -309,7 +309,7 @@ fn cyclopean_rows(gpu: &Device, opts: StressOptions) -> Result<Vec<StressRow>> {
                     }
                 }
                 // The forward warp has no f64 twin: its own output is held to the rule.
-                let fwd = ForwardWarp::new(gpu, &frame, &BreakRule::default())
+                let fwd = ForwardWarp::new(device, &frame, &BreakRule::default())
                     .and_then(|mut f| f.render(&mid))
                     .map(|(o, _)| ViewOutput::from_cyclopean(&o, mid.width, mid.height, None));
                 let tag = format!("{kind:?} depth {v:e} forward");
@@ -342,7 +342,7 @@ fn cyclopean_rows(gpu: &Device, opts: StressOptions) -> Result<Vec<StressRow>> {
     Ok(rows)
 }
 
-fn reproject_rows(gpu: &Device, opts: StressOptions) -> Result<Vec<StressRow>> {
+fn reproject_rows(device: &Device, opts: StressOptions) -> Result<Vec<StressRow>> {
     let conv = Conventions::default();
     let mut rows = Vec::new();
     for kind in [FrameDepth::ViewZ, FrameDepth::Device] {
@@ -360,7 +360,7 @@ fn reproject_rows(gpu: &Device, opts: StressOptions) -> Result<Vec<StressRow>> {
                         params,
                     };
                     let tag = format!("{kind:?} depth {v:e} {}", params.method.label());
-                    let (g, t) = (reproject::pass::gpu(gpu, &input), reproject::pass::reference(&input));
+                    let (g, t) = (reproject::pass::gpu(device, &input), reproject::pass::reference(&input));
                     if cleared {
                         s.compare(&tag, g, t);
                     } else {
@@ -377,7 +377,7 @@ fn reproject_rows(gpu: &Device, opts: StressOptions) -> Result<Vec<StressRow>> {
     Ok(rows)
 }
 
-fn stitch_rows(gpu: &Device, opts: StressOptions) -> Result<Vec<StressRow>> {
+fn stitch_rows(device: &Device, opts: StressOptions) -> Result<Vec<StressRow>> {
     let rig = OdsRig::demo();
     let (l0, r0) = (
         scene_faces(&rig, Side::Left, 8, 100.0)?,
@@ -403,7 +403,7 @@ fn stitch_rows(gpu: &Device, opts: StressOptions) -> Result<Vec<StressRow>> {
                     conv: Conventions::default(),
                 };
                 let tag = format!("depth {v:e} {}", method.label());
-                let (g, t) = (stitch::pass::gpu(gpu, &input), stitch::pass::reference(&input));
+                let (g, t) = (stitch::pass::gpu(device, &input), stitch::pass::reference(&input));
                 if cleared {
                     s.compare(&tag, g, t);
                 } else {
@@ -419,12 +419,12 @@ fn stitch_rows(gpu: &Device, opts: StressOptions) -> Result<Vec<StressRow>> {
 }
 
 /// The value-sweep rows of `capability` (none for `camera`, whose sweeps are its own rows).
-pub fn rows(gpu: &Device, capability: &str, opts: StressOptions) -> Result<Vec<StressRow>> {
+pub fn rows(device: &Device, capability: &str, opts: StressOptions) -> Result<Vec<StressRow>> {
     match capability {
-        "refocus" => refocus_rows(gpu, opts),
-        "cyclopean" => cyclopean_rows(gpu, opts),
-        "reproject" => reproject_rows(gpu, opts),
-        "stitch" => stitch_rows(gpu, opts),
+        "refocus" => refocus_rows(device, opts),
+        "cyclopean" => cyclopean_rows(device, opts),
+        "reproject" => reproject_rows(device, opts),
+        "stitch" => stitch_rows(device, opts),
         _ => Ok(Vec::new()),
     }
 }
