@@ -66,9 +66,9 @@ enum GlBuffer {
     Index(IndexBuffer),
 }
 
-/// A submitted run: its queued reads and timer.
+/// A submitted run: its queued reads (each with whether its format reads as f32s) and timer.
 struct InFlight {
-    reads: Vec<Option<PendingRead>>,
+    reads: Vec<Option<(PendingRead, bool)>>,
     timer: DeferredTimer,
     submit_ms: f64,
 }
@@ -197,7 +197,7 @@ impl Executor for GlExecutor {
     fn is_ready(&mut self, ticket: Ticket) -> bool {
         self.runs
             .get(ticket.0)
-            .is_none_or(|r| r.reads.iter().flatten().all(PendingRead::is_ready))
+            .is_none_or(|r| r.reads.iter().flatten().all(|(read, _)| read.is_ready()))
     }
 
     fn wait(&mut self, ticket: Ticket) -> Result<Rendered> {
@@ -209,7 +209,7 @@ impl Executor for GlExecutor {
             .reads
             .into_iter()
             .map(|r| {
-                r.map(|r| match r.holds_floats() {
+                r.map(|(r, floats)| match floats {
                     true => r.finish_f32().map(Texels::Floats),
                     false => r.finish().map(Texels::Bytes),
                 })
@@ -338,7 +338,9 @@ impl Executor for GlExecutor {
                     .iter()
                     .enumerate()
                     .map(|(i, f)| match f {
-                        Some(f) => fb.read_async(i, read_format(*f), flip),
+                        Some(f) => Ok(fb
+                            .read_async(i, read_format(*f), flip)?
+                            .map(|read| (read, f.reads_as_floats()))),
                         None => Ok(None),
                     })
                     .collect::<Result<Vec<_>>>()?

@@ -103,7 +103,6 @@ pub struct PendingRead {
     buffer: Option<glow::Buffer>,
     fence: Option<glow::Fence>,
     len: usize,
-    floats: bool,
 }
 
 impl PendingRead {
@@ -135,7 +134,6 @@ impl PendingRead {
             buffer: Some(buffer),
             fence: None,
             len,
-            floats: format.ty == glow::FLOAT,
         };
         pending.fence = Some(fence.map_err(|e| Error::Gl(format!("readback fence: {e}")))?);
         gpu.created(GlObject::Sync);
@@ -185,11 +183,6 @@ impl PendingRead {
             }
         }
         self.gpu.check("readback map")
-    }
-
-    /// Whether the texels are f32 (read them with [`Self::finish_f32`]).
-    pub fn holds_floats(&self) -> bool {
-        self.floats
     }
 
     /// Wait and return the bytes as a new vector.

@@ -259,22 +259,22 @@ fn to_metres(path: &Path, raw: RawDepth, decode: &DepthDecode) -> Result<DepthMa
         }
         RawSamples::U16(v) => {
             let s = need_scale("16-bit", "5000 for TUM, 1000 for SUN RGB-D or millimetres")?;
-            // Same as ((d >> 3) | (d << 13)) & 0xFFFF.
-            let rotate = |d: u16| {
-                if decode.sun_rgbd_bit_rotate {
-                    d.rotate_right(3)
-                } else {
-                    d
-                }
-            };
-            if decode.swap_bytes {
-                v.into_iter()
-                    .map(|d| int_to_metres(rotate(d.swap_bytes()).into(), s))
-                    .collect()
-            } else if decode.sun_rgbd_bit_rotate {
-                v.into_iter().map(|d| int_to_metres(rotate(d).into(), s)).collect()
-            } else {
+            if !(decode.swap_bytes || decode.sun_rgbd_bit_rotate) {
+                // The common case as its own loop, so it vectorises.
                 v.into_iter().map(|d| int_to_metres(d.into(), s)).collect()
+            } else {
+                v.into_iter()
+                    .map(|d| {
+                        let d = if decode.swap_bytes { d.swap_bytes() } else { d };
+                        // Same as ((d >> 3) | (d << 13)) & 0xFFFF.
+                        let d = if decode.sun_rgbd_bit_rotate {
+                            d.rotate_right(3)
+                        } else {
+                            d
+                        };
+                        int_to_metres(d.into(), s)
+                    })
+                    .collect()
             }
         }
         RawSamples::U32(v) => {

@@ -1,9 +1,8 @@
 //! Order statistics of a depth map's valid values (finite, > 0) without copying or sorting
 //! them: positive finite f32s order as their bit patterns, so a histogram of the top 16 bits
 //! finds the bucket holding each rank, and a selection among that bucket's values the exact
-//! value. Two linear passes give what `select_nth_unstable` gives on a
-//! copy of the valid values; the copy and three selections cost ~3 ms of every VGA batch
-//! frame's decode.
+//! value. Two linear passes give what `select_nth_unstable` gives on a copy of the valid values;
+//! the copy and three selections cost ~3 ms of every VGA batch frame's decode.
 
 const BUCKETS: usize = 1 << 16;
 
@@ -65,6 +64,7 @@ impl ValidRanks {
                 }
                 below += n;
             }
+            // `ranks` are below `count`, the histogram's total, so the loop returned.
             unreachable!("rank {r} of {} valid values", self.count)
         });
         let mut buckets: Vec<usize> = located.iter().map(|l| l.0).collect();
@@ -82,6 +82,7 @@ impl ValidRanks {
             }
         }
         located.map(|(bucket, r)| {
+            // `buckets` is the set of the located buckets.
             let k = buckets.iter().position(|&b| b == bucket).expect("bucket listed");
             *members[k].select_nth_unstable_by(r as usize, f32::total_cmp).1
         })

@@ -66,6 +66,12 @@ impl Format {
             Format::Rgba32F => 16,
         }
     }
+
+    /// Whether this format's read-back texels come as f32s ([`Texels::Floats`]) rather than
+    /// bytes: the one rule both executors follow.
+    pub fn reads_as_floats(self) -> bool {
+        matches!(self, Format::R32F | Format::Rgba32F)
+    }
 }
 
 /// Host texels of an image to upload, rows in memory order.
@@ -197,32 +203,32 @@ pub struct Draw<'a> {
     pub indices: Option<BufferId>,
 }
 
-/// One output's texels as read back, rows top-down: bytes (RGB8 from an RGBA8 target, R8) or
-/// f32 (R32F). Each lands in a vector of its own element type, so a depth map takes the read
+/// One output's texels as read back, rows top-down: bytes (RGB8 from an RGBA8 target, R8, the
+/// integer formats) or f32s (R32F, RGBA32F; [`Format::reads_as_floats`]). Each lands in a vector of its own element type, so a depth map takes the read
 /// f32s as they are (a byte vector had to be copied into an aligned one: a second pass over
 /// every depth output, ~1 ms a VGA target).
 #[derive(Debug, Clone, PartialEq)]
 pub enum Texels {
-    /// RGB8 colour (packed from RGBA8) or R8.
+    /// RGB8 colour (packed from RGBA8), R8 and the integer formats.
     Bytes(Vec<u8>),
-    /// R32F.
+    /// R32F and RGBA32F.
     Floats(Vec<f32>),
 }
 
 impl Texels {
     /// The texels as bytes (f32s as their native-endian bytes, copied).
-    pub fn into_bytes(self) -> Vec<u8> {
+    pub fn into_bytes(self) -> Result<Vec<u8>> {
         match self {
-            Texels::Bytes(b) => b,
-            Texels::Floats(f) => bytemuck::cast_slice(&f).to_vec(),
+            Texels::Bytes(b) => Ok(b),
+            Texels::Floats(f) => crate::alloc::try_copy(bytemuck::cast_slice(&f), "readback"),
         }
     }
 
     /// The texels as f32s (bytes reinterpreted, copied; their length a multiple of 4).
-    pub fn into_floats(self) -> Vec<f32> {
+    pub fn into_floats(self) -> Result<Vec<f32>> {
         match self {
-            Texels::Bytes(b) => bytemuck::pod_collect_to_vec(&b),
-            Texels::Floats(f) => f,
+            Texels::Bytes(b) => crate::alloc::try_pod_collect(&b, "depth readback"),
+            Texels::Floats(f) => Ok(f),
         }
     }
 }
@@ -262,7 +268,7 @@ impl Rendered {
         let (w, h) = self.size;
         self.outputs[i]
             .take()
-            .map(|c| crate::io::RgbImage::new(w, h, c.into_bytes()))
+            .map(|c| crate::io::RgbImage::new(w, h, c.into_bytes()?))
             .transpose()
     }
 
@@ -271,18 +277,18 @@ impl Rendered {
         let (w, h) = self.size;
         self.outputs[i]
             .take()
-            .map(|d| crate::io::DepthMap::new(w, h, d.into_floats()))
+            .map(|d| crate::io::DepthMap::new(w, h, d.into_floats()?))
             .transpose()
     }
 
     /// Output `i`'s bytes (asked for, so present), or an error naming the pass.
     pub fn take(&mut self, i: usize, what: &str) -> Result<Vec<u8>> {
-        self.take_texels(i, what).map(Texels::into_bytes)
+        self.take_texels(i, what)?.into_bytes()
     }
 
     /// Output `i`'s f32s (asked for, so present), or an error naming the pass.
     pub fn take_floats(&mut self, i: usize, what: &str) -> Result<Vec<f32>> {
-        self.take_texels(i, what).map(Texels::into_floats)
+        self.take_texels(i, what)?.into_floats()
     }
 
     fn take_texels(&mut self, i: usize, what: &str) -> Result<Texels> {

@@ -117,8 +117,8 @@ impl Flight {
     }
 
     /// Output `i`'s texels after the fence, rows top-down (files are top-down: a bottom-up
-    /// memory order is flipped here, as GL does on the GPU), RGBA8 packed to RGB, R32F into f32s
-    /// (one copy out of the mapped buffer each).
+    /// memory order is flipped here, as GL does on the GPU), RGBA8 packed to RGB, the float
+    /// formats into f32s (one copy out of the mapped buffer each).
     pub fn read_output(&self, i: usize) -> Result<Option<Texels>> {
         let Some(f) = self.outputs.get(i).copied().flatten() else {
             return Ok(None);
@@ -138,7 +138,7 @@ impl Flight {
                 }
                 Texels::Bytes(rgb)
             }
-            Format::R32F => {
+            f if f.reads_as_floats() => {
                 let mut floats = crate::alloc::try_with_capacity::<f32>(mapped.len() / 4, "depth readback")?;
                 for row in self.rows.top_down(mapped, row_bytes) {
                     floats.extend(
