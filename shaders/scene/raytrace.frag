@@ -1,5 +1,6 @@
 // Ray tracer of a scene description (src/scene/shapes.rs; f64 twin: src/scene/gpu.rs
-// `trace_gl_reference`). One ray per pixel centre from the camera's inverse view-projection.
+// `trace_gl_reference`). One ray per pixel centre from the camera's ray basis (the inverse of
+// the view-projection's clip x, y, w rows), the same under every convention.
 // Outputs colour, view distance (GL: -z_eye; 0 on a miss) and window depth under the
 // conventions (the far value on a miss).
 
@@ -10,6 +11,7 @@ layout(location = 1) out float o_view_z;
 layout(location = 2) out float o_device;
 
 const float NONE = 3.0e38;
+const float EDGE_SLACK = 1e-5;
 
 bool ok(float t) {
     return t > 1e-9 && t < NONE;
@@ -25,7 +27,11 @@ float intersect(int i, vec3 o, vec3 d) {
         }
         float t = dot(n, u_a[i].xyz - o) / den;
         vec3 p = o + d * t;
-        bool inside = all(greaterThan(p, u_c[i].xyz)) && all(lessThan(p, u_d[i].xyz));
+        // Closed bounds widened by EDGE_SLACK (src/scene/shapes.rs): planes sharing an edge
+        // leave no crack where rounding puts a hit just outside both.
+        vec3 ap = abs(p);
+        float slack = EDGE_SLACK * (1.0 + max(ap.x, max(ap.y, ap.z)));
+        bool inside = all(greaterThanEqual(p, u_c[i].xyz - slack)) && all(lessThanEqual(p, u_d[i].xyz + slack));
         return ok(t) && inside ? t : NONE;
     }
     if (kind == 1) {
@@ -92,9 +98,10 @@ void main() {
         float lat = 0.5 * PI - PI * gl_FragCoord.y / u_size.y;
         ods_ray(lon, lat, u_ods_centre, u_ods_radius, u_ods_fade_start, eye, dir);
     } else {
-        vec2 ndc = gl_FragCoord.xy / u_size * 2.0 - 1.0;
-        vec4 q = u_inv_view_proj * vec4(ndc, RAY_NDC_Z, 1.0);
-        dir = q.xyz / q.w - eye;
+        // (2 p + 1 - n) / n with gl_FragCoord = p + 0.5: exact numerator, so mirrored rows get
+        // exactly negated NDC and both row orders the same ray (src/scene/gpu.rs pixel_ndc).
+        vec2 ndc = (2.0 * gl_FragCoord.xy - u_size) / u_size;
+        dir = (u_ray_basis * vec4(ndc, 1.0, 0.0)).xyz;
     }
     float best = NONE;
     int hit = -1;

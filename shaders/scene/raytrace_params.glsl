@@ -2,7 +2,9 @@
 // (binding 0) mirrored by `RaytraceParams` in src/scene/gpu.rs. No images.
 const int MAX_OBJECTS = 32;
 layout(std140, binding = 0) uniform RaytraceParams {
-    mat4 u_inv_view_proj;
+    // Pixel NDC (x, y, 1, 0) -> ray direction (src/scene/gpu.rs ray_basis): the same rays under
+    // every convention.
+    mat4 u_ray_basis;
     mat4 u_view_proj;
     mat4 u_view;
     vec3 u_eye;

@@ -13,7 +13,7 @@ use crate::pass::{mat4_std140, Device, Draw, Format, Target, ToDevice};
 crate::param_block! {
     /// The ray tracer's parameters: shaders/scene/raytrace_params.glsl, member for member.
     pub struct RaytraceParams("RaytraceParams") {
-        u_inv_view_proj: [[f32; 4]; 4],
+        u_ray_basis: [[f32; 4]; 4],
         u_view_proj: [[f32; 4]; 4],
         u_view: [[f32; 4]; 4],
         u_eye: [f32; 3],
@@ -31,8 +31,27 @@ crate::param_block! {
     }
 }
 
-/// NDC z of the point each pixel's ray is built through (inside the range of every convention).
-pub const RAY_NDC_Z: f64 = 0.5;
+/// The ray basis of a perspective view-projection `vp`: the inverse of the 3x3 that takes a
+/// direction to its clip (x, y, w), so a pixel's ray is `basis (ndc_x, ndc_y, 1)`, in the upper
+/// left 3x3 of a 4x4 (the rest identity). The depth conventions change only clip z and the row
+/// order only the sign of clip y (the pixel's NDC y flips with it, exactly), so every convention
+/// gives the same rays bit for bit. The ray through an unprojected NDC point (inv(vp) at some
+/// NDC z, minus the eye) rounds differently under each convention: at 320 x 240 the demo's
+/// floor-wall edge row cracked under Vulkan NDC and reversed-Z only (issue 47).
+pub fn ray_basis(vp: &Mat4) -> Option<Mat4> {
+    let mut m = mat4::IDENTITY;
+    for (r, src) in [0, 1, 3].into_iter().enumerate() {
+        m[r][..3].copy_from_slice(&vp[src][..3]);
+    }
+    mat4::inverse(&m)
+}
+
+/// NDC of pixel centre `p` (counted from 0) along an axis of `n` pixels, as `(2 p + 1 - n) / n`:
+/// the numerator is exact, so the mirrored pixel `n - 1 - p` gets exactly the negated value
+/// (`(p + 0.5) / n * 2 - 1` does not), and both row orders give the same ray.
+pub fn pixel_ndc(p: f64, n: f64) -> f64 {
+    (2.0 * p + 1.0 - n) / n
+}
 
 /// A GL camera: world -> eye `view`, eye -> clip `proj` (matching `conv`), image size.
 #[derive(Debug, Clone, Copy)]
@@ -77,9 +96,10 @@ pub fn projection_centre(vp: &Mat4) -> Option<[f64; 3]> {
 impl GlCamera {
     fn matrices(&self) -> Result<(Mat4, Mat4, [f64; 3])> {
         let vp = mat4::mul(&self.proj, &self.view);
-        let inv_vp = mat4::inverse(&vp).ok_or_else(|| Error::param("camera view-projection", "singular"))?;
+        mat4::inverse(&vp).ok_or_else(|| Error::param("camera view-projection", "singular"))?;
+        let basis = ray_basis(&vp).ok_or_else(|| Error::param("camera projection", "not perspective"))?;
         let eye = projection_centre(&vp).ok_or_else(|| Error::param("camera projection", "not perspective"))?;
-        Ok((vp, inv_vp, eye))
+        Ok((vp, basis, eye))
     }
 
     /// Image row of framebuffer row `y`.
@@ -93,7 +113,7 @@ impl GlCamera {
 
 /// f64 twin of the shader: same rays, same rounding of colour to 8 bits.
 pub fn trace_gl_reference(scene: &Scene, cam: &GlCamera) -> Result<SceneImage> {
-    let (vp, inv_vp, eye) = cam.matrices()?;
+    let (vp, basis, eye) = cam.matrices()?;
     let (w, h) = (cam.width as usize, cam.height as usize);
     let mut color = vec![0u8; w * h * 3];
     let mut view_z = vec![0f32; w * h];
@@ -101,12 +121,9 @@ pub fn trace_gl_reference(scene: &Scene, cam: &GlCamera) -> Result<SceneImage> {
     let mut device = vec![far; w * h];
     for y in 0..cam.height {
         for x in 0..cam.width {
-            let ndc = [
-                (x as f64 + 0.5) / w as f64 * 2.0 - 1.0,
-                (y as f64 + 0.5) / h as f64 * 2.0 - 1.0,
-            ];
-            let q = mat4::transform_point(&inv_vp, [ndc[0], ndc[1], RAY_NDC_Z]);
-            let dir = [q[0] - eye[0], q[1] - eye[1], q[2] - eye[2]];
+            let ndc = [pixel_ndc(x as f64, w as f64), pixel_ndc(y as f64, h as f64), 1.0, 0.0];
+            let d = mat4::transform(&basis, ndc);
+            let dir = [d[0], d[1], d[2]];
             let Some(hit) = scene.trace(eye, dir) else { continue };
             let o = cam.image_row(y) as usize * w + x as usize;
             let c = pattern_color(&hit);
@@ -216,7 +233,7 @@ impl SceneRenderer {
                 (&gl_default, Some((centre, radius, fade_start)))
             }
         };
-        let (vp, inv_vp, eye) = cam.matrices()?;
+        let (vp, basis, eye) = cam.matrices()?;
         let (w, h) = (cam.width, cam.height);
         self.device.check_image_size("camera size", w, h)?;
         let mut block: RaytraceParams = bytemuck::Zeroable::zeroed();
@@ -242,7 +259,7 @@ impl SceneRenderer {
             block.u_kind[i] = [kind, o.pattern as i32, 0, 0];
             (block.u_a[i], block.u_b[i], block.u_c[i], block.u_d[i]) = (a, b, c, d);
         }
-        block.u_inv_view_proj = mat4_std140(&inv_vp);
+        block.u_ray_basis = mat4_std140(&basis);
         block.u_view_proj = mat4_std140(&vp);
         block.u_view = mat4_std140(&cam.view);
         block.u_eye = eye.map(|v| v as f32);

@@ -9,7 +9,7 @@
 pub mod gpu;
 mod shapes;
 
-pub use shapes::{boxes_scene, builtin, demo_scene, Hit, Object, Scene, Shape, MAX_OBJECTS};
+pub use shapes::{boxes_scene, builtin, demo_scene, Hit, Object, Scene, Shape, EDGE_SLACK, MAX_OBJECTS};
 
 use crate::camera::{PinholeCamera, Pose};
 use crate::io::{DepthMap, RgbImage};

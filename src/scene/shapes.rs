@@ -7,12 +7,21 @@ use serde::{Deserialize, Serialize};
 /// Largest number of objects the GPU tracer takes (uniform arrays).
 pub const MAX_OBJECTS: usize = 32;
 
+/// How far past its bounds a plane still counts as hit, relative to the hit's largest coordinate
+/// (plus 1e-5 m). Planes that share an edge (the demo's floor meets its wall at y = 1.2, z = 6)
+/// would otherwise both miss a ray through the edge: each hit lies on the other's bound, and
+/// rounding puts it just outside either. At 320 x 240 and 64 x 48 a whole row of pixel centres
+/// lies on that edge (issue 47). f32 puts a hit within a few 1e-7 of its magnitude, f64 far
+/// closer, so 1e-5 closes the crack on both tracers and widens a plane by under 0.1 mm at 6 m.
+pub const EDGE_SLACK: f64 = 1e-5;
+
 /// A primitive of a ground-truth scene, world coordinates (GL axes: y up, -z forward).
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 #[serde(tag = "type", rename_all = "kebab-case")]
 pub enum Shape {
     /// Plane through `point` with `normal`, kept where the hit lies inside the world-space box
-    /// [`bounds_min`, `bounds_max`] (use +-1e30 for unbounded axes).
+    /// [`bounds_min`, `bounds_max`] (use +-1e30 for unbounded axes), closed and widened by
+    /// [`EDGE_SLACK`] of the hit's magnitude.
     Plane {
         /// A point on the plane.
         point: [f64; 3],
@@ -90,7 +99,8 @@ impl Shape {
                 }
                 let t = dot(normal, [point[0] - o[0], point[1] - o[1], point[2] - o[2]]) / den;
                 let p = at(t);
-                let inside = (0..3).all(|i| p[i] > bounds_min[i] && p[i] < bounds_max[i]);
+                let slack = EDGE_SLACK * (1.0 + p.iter().fold(0f64, |m, v| m.max(v.abs())));
+                let inside = (0..3).all(|i| p[i] >= bounds_min[i] - slack && p[i] <= bounds_max[i] + slack);
                 (ok(t) && inside).then_some(t)
             }
             Shape::Sphere { center, radius } => {

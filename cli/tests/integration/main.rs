@@ -19,6 +19,7 @@ mod cli_sequence;
 mod common;
 mod compare;
 mod compare_robust;
+mod conventions_sweep;
 mod cyclopean;
 mod cyclopean_dense;
 mod cyclopean_fill;

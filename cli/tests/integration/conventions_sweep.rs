@@ -1,0 +1,239 @@
+//! Outputs must not depend on the conventions (NDC depth range, reversed-Z, row order): every
+//! pass of the library ([`PassCase::all`] but the matcher, which takes no conventions) under all
+//! eight combinations, at sizes where pixel centres fall on scene edges (320 x 240, 64 x 48: the
+//! demo floor meets the wall exactly on row 172 / 34), odd sizes and wide ones, against the same
+//! pass under the GL defaults on the same device.
+//!
+//! The rule: coverage identical on every pixel (mask, or depth > 0 where a view has no mask),
+//! colour within 1 level on every pixel, depth within [`depth_bound`]. Where a pass reads
+//! device depth (the stereo frame is encoded under each convention), the inputs themselves differ
+//! by the f32 rounding of window depth: a relative depth error of about
+//! 2^-24 * z / near * (f - n) / f per rounding for standard Z (dz/z = dd * z (f - n) / (f n)), far
+//! less for reversed-Z. With near 0.05 m, z <= 8 m that is 1.0e-5 per rounding; encode, decode
+//! and interpolation make 4 roundings: 4e-5. Where depth is never encoded (scene, refocus, stitch)
+//! the same f32 arithmetic in another order: 1e-6.
+//!
+//! Coverage identical is the strict part: a pixel kept under one convention and dropped under
+//! another is the crack this test was written for (issue 47). A pass whose validity test reads
+//! device depth near a threshold could flip a pixel by rounding; none does at these sizes, and
+//! such a flip is to be fixed at its cause, not allowed here.
+
+use crate::common::gpu;
+use viewsynth::convention::Conventions;
+use viewsynth::pass::Device;
+use viewsynth::view::ViewOutput;
+use viewsynth_lab::passes::{PassCase, PassInputs};
+
+/// Relative depth agreement: 4 f32 roundings of window depth at z / near = 160 under standard Z
+/// where the pass reads device depth, 1e-6 (reordered f32 arithmetic) otherwise.
+fn depth_bound(case: &PassCase) -> f64 {
+    match case {
+        PassCase::Refocus(_) | PassCase::Scene | PassCase::Stitch(_) => 1e-6,
+        _ => 4.0 * 2f64.powi(-24) * 160.0,
+    }
+}
+
+/// Sizes: the two where the demo floor/wall edge lands on a pixel centre, odd and prime ones,
+/// portrait, and the two common large ones.
+const SIZES: [(u32, u32); 12] = [
+    (63, 47),
+    (64, 48),
+    (65, 49),
+    (97, 131),
+    (127, 95),
+    (160, 120),
+    (320, 240),
+    (321, 239),
+    (640, 480),
+    (641, 479),
+    (1280, 720),
+    (1919, 1079),
+];
+
+#[derive(Default, Debug)]
+struct Diff {
+    coverage: usize,
+    colour: usize,
+    colour_worst: i32,
+    depth: usize,
+    depth_worst: f64,
+    first: Option<(usize, &'static str)>,
+}
+
+fn coverage(v: &ViewOutput) -> Option<Vec<bool>> {
+    v.valid()
+        .or_else(|| v.depth.as_ref().map(|d| d.data.iter().map(|z| *z > 0.0).collect()))
+}
+
+fn diff(a: &ViewOutput, b: &ViewOutput, bound: f64) -> Diff {
+    let mut d = Diff::default();
+    assert_eq!((a.width, a.height), (b.width, b.height));
+    let n = a.width as usize * a.height as usize;
+    let (ca, cb) = (coverage(a), coverage(b));
+    assert_eq!(ca.is_some(), cb.is_some(), "the same planes");
+    if let (Some(ca), Some(cb)) = (&ca, &cb) {
+        for i in 0..n {
+            if ca[i] != cb[i] {
+                d.coverage += 1;
+                d.first.get_or_insert((i, "coverage"));
+            }
+        }
+    }
+    if let (Some(x), Some(y)) = (&a.color, &b.color) {
+        for (i, (p, q)) in x.data.chunks_exact(3).zip(y.data.chunks_exact(3)).enumerate() {
+            let worst = p
+                .iter()
+                .zip(q)
+                .map(|(u, v)| (*u as i32 - *v as i32).abs())
+                .max()
+                .unwrap();
+            d.colour_worst = d.colour_worst.max(worst);
+            if worst > 1 {
+                d.colour += 1;
+                d.first.get_or_insert((i, "colour"));
+            }
+        }
+    }
+    if let (Some(x), Some(y)) = (&a.depth, &b.depth) {
+        for i in 0..n {
+            let both = match (&ca, &cb) {
+                (Some(p), Some(q)) => p[i] && q[i],
+                _ => true,
+            };
+            if !both {
+                continue;
+            }
+            let (za, zb) = (x.data[i] as f64, y.data[i] as f64);
+            let rel = if za == zb {
+                0.0
+            } else {
+                (za - zb).abs() / za.abs().max(zb.abs())
+            };
+            if rel.is_nan() || rel > bound {
+                d.depth += 1;
+                d.first.get_or_insert((i, "depth"));
+            }
+            d.depth_worst = d.depth_worst.max(if rel.is_nan() { f64::INFINITY } else { rel });
+        }
+    }
+    d
+}
+
+/// Pixels of the scene view with no surface whose neighbours above and below (or left and right)
+/// both have one. The built-in demo scene has no gap narrower than a pixel at these sizes (its
+/// misses are the regions past the wall's edges), so each such pixel is a crack between surfaces
+/// that share an edge, like the floor meeting the wall.
+fn cracks(v: &ViewOutput) -> Vec<(usize, usize)> {
+    let (w, h) = (v.width as usize, v.height as usize);
+    let z = &v.depth.as_ref().expect("the scene writes view Z").data;
+    let hit = |x: usize, y: usize| z[y * w + x] > 0.0;
+    let mut out = Vec::new();
+    for y in 1..h.saturating_sub(1) {
+        for x in 1..w.saturating_sub(1) {
+            if !hit(x, y) && ((hit(x, y - 1) && hit(x, y + 1)) || (hit(x - 1, y) && hit(x + 1, y))) {
+                out.push((x, y));
+            }
+        }
+    }
+    out
+}
+
+/// Every pass at `sizes` under every convention against the GL defaults; a list of failures.
+fn sweep(device: &Device, sizes: &[(u32, u32)], cases: &[PassCase]) -> Vec<String> {
+    let mut failures = Vec::new();
+    for &(w, h) in sizes {
+        let inputs: Vec<PassInputs> = Conventions::all()
+            .into_iter()
+            .map(|c| PassInputs::new(w, h, c).unwrap())
+            .collect();
+        for case in cases {
+            let mut base: Option<Vec<ViewOutput>> = None;
+            for inp in &inputs {
+                let views = case.frame(device, inp).unwrap()().unwrap();
+                if *case == PassCase::Scene {
+                    let cracks = cracks(&views[0]);
+                    if !cracks.is_empty() {
+                        failures.push(format!(
+                            "{w}x{h} scene {}: {} pixels without a surface between two with one, first {:?}",
+                            inp.conv.label(),
+                            cracks.len(),
+                            cracks[0]
+                        ));
+                    }
+                }
+                let Some(b) = &base else {
+                    base = Some(views);
+                    continue;
+                };
+                for (k, (v, bv)) in views.iter().zip(b).enumerate() {
+                    let d = diff(v, bv, depth_bound(case));
+                    if d.coverage + d.colour + d.depth > 0 {
+                        let (i, what) = d.first.unwrap();
+                        failures.push(format!(
+                            "{w}x{h} {} view {k} {}: {} coverage, {} colour > 1 (worst {}), {} depth beyond \
+                             {:.1e} (worst {:.1e}); first {what} at ({}, {})",
+                            case.name(),
+                            inp.conv.label(),
+                            d.coverage,
+                            d.colour,
+                            d.colour_worst,
+                            d.depth,
+                            depth_bound(case),
+                            d.depth_worst,
+                            i % v.width as usize,
+                            i / v.width as usize
+                        ));
+                    }
+                }
+            }
+        }
+    }
+    failures
+}
+
+/// Every pass but the matcher; `VIEWSYNTH_SWEEP_PASS=<substring of the row name>` narrows the
+/// sweep while investigating one pass.
+fn cases() -> Vec<PassCase> {
+    let only = std::env::var("VIEWSYNTH_SWEEP_PASS").unwrap_or_default();
+    PassCase::all()
+        .into_iter()
+        .filter(|c| *c != PassCase::Matcher && c.name().contains(&only))
+        .collect()
+}
+
+fn run_sweep(device: &Device, what: &str) {
+    let t0 = std::time::Instant::now();
+    // The two largest sizes run the passes whose cost is per output pixel and cheap on llvmpipe
+    // (scene, refocus fullscreen, reproject, cyclopean seed); the rest run at every other size.
+    let (small, large) = SIZES.split_at(SIZES.len() - 2);
+    let mut failures = sweep(device, small, &cases());
+    let cheap: Vec<PassCase> = cases()
+        .into_iter()
+        .filter(|c| {
+            matches!(
+                c,
+                PassCase::Scene | PassCase::Refocus(viewsynth::refocus::Method::Fullscreen) | PassCase::Reproject(_)
+            ) || *c == (PassCase::Cyclopean { steps: 0 })
+        })
+        .collect();
+    failures.extend(sweep(device, large, &cheap));
+    println!("{what}: convention sweep in {:.1} s", t0.elapsed().as_secs_f64());
+    assert!(
+        failures.is_empty(),
+        "{what}: {} views depend on the conventions:\n{}",
+        failures.len(),
+        failures.join("\n")
+    );
+}
+
+#[test]
+fn every_pass_gives_the_same_view_under_every_convention_at_every_size_on_gl() {
+    run_sweep(&Device::gl(&gpu()).unwrap(), "GL");
+}
+
+#[test]
+#[cfg(feature = "vulkan")]
+fn every_pass_gives_the_same_view_under_every_convention_at_every_size_on_vulkan() {
+    let v = crate::vulkan_refocus::vulkan();
+    run_sweep(&viewsynth::vulkan::VkExecutor::device(&v).unwrap(), "Vulkan");
+}
