@@ -225,8 +225,14 @@ pub struct PassInputs {
 }
 
 impl PassInputs {
-    /// The inputs at `width` x `height` under `conv`.
+    /// The inputs at `width` x `height` under `conv`, the eyes' depth as device depth under it.
     pub fn new(width: u32, height: u32, conv: Conventions) -> Result<Self> {
+        Self::with_depth(width, height, conv, FrameDepth::Device)
+    }
+
+    /// [`PassInputs::new`] with the eyes' depth (stereo frame and reprojection source) as `kind`:
+    /// view Z gives every convention the same input bits.
+    pub fn with_depth(width: u32, height: u32, conv: Conventions, kind: FrameDepth) -> Result<Self> {
         let cam = viewsynth::scene::demo_camera(width, height);
         let (rgb, depth) = viewsynth::scene::render(&cam);
         let refocus = RefocusSource::new(rgb, depth, cam.k)?;
@@ -236,9 +242,9 @@ impl PassInputs {
             principal: None,
         }
         .targets(&cam)?;
-        let (frame, mid, _) = scene_frame(&StereoRig::demo(width, height), conv, FrameDepth::Device);
+        let (frame, mid, _) = scene_frame(&StereoRig::demo(width, height), conv, kind);
         let (l, r, _) = crate::bench::matcher::synthetic_pair(width.max(128), height.max(64))?;
-        let reproject = crate::eval::reproject::scene_cases(width, height, 0.064, conv, FrameDepth::Device)?
+        let reproject = crate::eval::reproject::scene_cases(width, height, 0.064, conv, kind)?
             .into_iter()
             .next()
             .ok_or_else(|| viewsynth::Error::param("passes", "no reprojection case"))?;
