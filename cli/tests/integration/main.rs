@@ -2,6 +2,7 @@
 //! missing EGL fails them with the library's error, never a skip.
 
 mod batch;
+mod bounds;
 mod cli;
 mod cli_batch;
 mod cli_batch_augment;
