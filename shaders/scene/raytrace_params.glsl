@@ -1,7 +1,7 @@
 // scene/raytrace's interface, the same text for GL and Vulkan: the std140 parameter block
 // (binding 0) mirrored by `RaytraceParams` in src/scene/gpu.rs. No images.
 const int MAX_OBJECTS = 32;
-layout(std140, binding = 0) uniform RaytraceParams {
+layout(std140, binding = 0) PARAM_BLOCK RaytraceParams {
     mat4 u_inv_view_proj;
     mat4 u_view_proj;
     mat4 u_view;

@@ -34,6 +34,7 @@ mod hostile_round4;
 mod hostile_round4_outputs;
 mod limits;
 mod matcher;
+mod memory_flat;
 mod messages;
 mod pass_contract;
 mod readback;
