@@ -181,6 +181,8 @@ fn the_matchers_search_is_bounded_before_the_images_are_read() {
 
 /// The peak resident memory of `cmd` run to its end (wait4's ru_maxrss, of this child alone),
 /// in bytes, and its output status.
+// The child is reaped by wait4 (which also gives its rusage), not by `Child::wait`.
+#[allow(clippy::zombie_processes)]
 pub(crate) fn peak_memory(mut cmd: Command) -> (u64, std::process::ExitStatus, String) {
     use std::os::unix::process::ExitStatusExt;
     let child = cmd

@@ -1,7 +1,7 @@
 //! Refusals name the option or file and the exact reason, and exit as the rest do: 2 for a
 //! command line that contradicts itself, 1 for what is found while running, never a panic.
 
-use super::cli::{bin, scratch, RUN_ERROR, USAGE};
+use super::cli::{bin, scratch, RUN_ERROR};
 use std::path::Path;
 use std::process::{Command, Output, Stdio};
 use viewsynth::io::{self, RgbImage};
@@ -78,7 +78,7 @@ fn surfaceless_with_vulkan_is_a_usage_error_on_every_command() {
             .output()
             .unwrap();
         let err = text(&o);
-        assert_eq!(o.status.code(), Some(USAGE), "{args:?}: {err}");
+        assert_eq!(o.status.code(), Some(super::cli::USAGE), "{args:?}: {err}");
         assert!(
             err.contains("--device") && err.contains("surfaceless is an EGL choice"),
             "{args:?}: {err}"
