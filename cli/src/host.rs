@@ -19,10 +19,10 @@ impl Host for CliHost {
         let gpu = request.open()?;
         let info = gpu.info();
         if let Some(w) = &info.software_warning {
-            eprintln!("\n*** WARNING: {w} ***\n");
+            errln!("\n*** WARNING: {w} ***\n");
         } else if info.software {
             // No hardware visible: not alarming, but never silent (as for Vulkan below).
-            eprintln!("note: OpenGL renders in software ({}): no GPU in use", info.renderer);
+            errln!("note: OpenGL renders in software ({}): no GPU in use", info.renderer);
         }
         Ok(gpu)
     }
@@ -30,7 +30,7 @@ impl Host for CliHost {
     fn open_vulkan(&self, request: &GpuRequest) -> viewsynth::Result<viewsynth::vulkan::Vk> {
         let vk = request.open_vulkan()?;
         if vk.info().software {
-            eprintln!(
+            errln!(
                 "note: Vulkan device '{}' renders in software (CPU device)",
                 vk.info().name
             );
@@ -41,13 +41,13 @@ impl Host for CliHost {
     fn event(&self, event: Event<'_>) {
         match event {
             Event::InputDepth { path, summary, hint } => {
-                eprintln!("input depth {}: {summary}", path.display());
+                errln!("input depth {}: {summary}", path.display());
                 for w in summary.warnings() {
-                    eprintln!("warning: {}: {w}; {hint}", path.display());
+                    errln!("warning: {}: {w}; {hint}", path.display());
                 }
             }
             Event::DepthTruncated { limit_m, pixels } => {
-                eprintln!("--depth-trunc {limit_m}: {pixels} pixels beyond {limit_m} m set invalid");
+                errln!("--depth-trunc {limit_m}: {pixels} pixels beyond {limit_m} m set invalid");
             }
             Event::DisparityRange { min, max, estimated } => {
                 let how = if estimated {
@@ -55,10 +55,10 @@ impl Host for CliHost {
                 } else {
                     "as given"
                 };
-                eprintln!("disparity range {min}..{max} px ({how}; --min-disparity/--max-disparity override it)");
+                errln!("disparity range {min}..{max} px ({how}; --min-disparity/--max-disparity override it)");
             }
             Event::EmptyDataDir(d) => {
-                eprintln!(
+                errln!(
                     "note: --data-dir {} is empty: the real-data rows are skipped",
                     d.display()
                 );

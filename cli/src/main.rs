@@ -33,11 +33,19 @@ macro_rules! out {
     };
 }
 
+/// `eprintln!` through [`stderr::write`]: never panics; a refused write makes the run exit 1.
+macro_rules! errln {
+    ($($arg:tt)*) => {
+        $crate::stderr::write(format_args!($($arg)*))
+    };
+}
+
 #[cfg(test)]
 mod front_ends;
 mod host;
 mod options;
 mod progress;
+mod stderr;
 mod stdout;
 mod text;
 
@@ -195,14 +203,15 @@ fn main() -> ExitCode {
     let result = io::set_max_pixels(cli.max_pixels)
         .map_err(anyhow::Error::from)
         .and_then(|()| run(cli.command))
-        .and_then(|code| stdout::flush().map(|()| code).map_err(anyhow::Error::from));
+        .and_then(|code| stdout::flush().map(|()| code).map_err(anyhow::Error::from))
+        .and_then(|code| stderr::failure().map_or(Ok(code), |e| Err(e.into())));
     match result {
         Ok(code) => code,
         Err(e) => {
-            eprintln!("error: {}", error_chain(&e));
+            errln!("error: {}", error_chain(&e));
             if e.is::<Usage>() {
                 // As clap ends its own usage errors: both kinds read alike.
-                eprintln!("\nFor more information, try '--help'.");
+                errln!("\nFor more information, try '--help'.");
                 return ExitCode::from(USAGE_ERROR);
             }
             ExitCode::from(RUN_ERROR)

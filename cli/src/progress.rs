@@ -50,7 +50,7 @@ impl Progress {
         }
         if self.last_log.get().elapsed() >= LOG_EVERY || done == self.total {
             self.last_log.set(Instant::now());
-            eprintln!("{}", log_line(self.what, done, self.total, self.start.elapsed()));
+            errln!("{}", log_line(self.what, done, self.total, self.start.elapsed()));
         }
     }
 
@@ -114,7 +114,7 @@ impl StageProgress {
                 let now = Instant::now();
                 if now >= due {
                     if let Some((i, n, label)) = &st.stage {
-                        eprintln!("{}, still running", stage_line(*i, *n, label, start.elapsed()));
+                        errln!("{}, still running", stage_line(*i, *n, label, start.elapsed()));
                     }
                     st.last_line = now;
                     continue;
@@ -168,7 +168,7 @@ impl viewsynth::progress::Progress for StageProgress {
             if let Ok(mut st) = log.state.0.lock() {
                 st.stage = Some((index, total, label.to_string()));
                 st.last_line = Instant::now();
-                eprintln!("{}", stage_line(index, total, label, self.start.elapsed()));
+                errln!("{}", stage_line(index, total, label, self.start.elapsed()));
             }
         }
     }

@@ -120,6 +120,8 @@ def test_refocus_batch_bad_inputs(renderer, tmp_path):
     batch_error(renderer, tmp_path, [frame], "rgb_format", ["'bmp'"], rgb_format="bmp")
     batch_error(renderer, tmp_path, [frame], "invalid png_compression", ["'huge'"], png_compression="huge")
     batch_error(renderer, tmp_path, [frame], "shard", ["'3/2'"], shard="3/2")
+    # One file tag in the range, two samples asked for: refused (it drew forever).
+    batch_error(renderer, tmp_path, [frame], "zoom_random/samples", ["1 distinct scale"], zoom_random=(1.0, 1.0000001), samples=2)
     batch_error(renderer, tmp_path, [frame], "depth_preview", ["outputs"], depth_preview=True, outputs=["rgb"])
     batch_error(renderer, tmp_path, [frame], "scales", ["no target given"], scales=[])
     batch_error(renderer, tmp_path, [frame], "tau", [], tau_rel=-1.0)

@@ -2,7 +2,7 @@
 // (binding 0) mirrored by `DensifyParams` in src/cyclopean/densify.rs, the constants of its rule
 // (held against the Rust ones by a test), and one eye's disparity and colour (bindings 1, 2),
 // rows in memory order.
-layout(std140, binding = 0) uniform DensifyParams {
+layout(std140, binding = 0) PARAM_BLOCK DensifyParams {
     ivec2 u_size;     // W, H of the eye
     int u_radius;     // farthest a walk goes, pixels (Chebyshev)
     uint u_filled;    // the flag filled disparities carry

@@ -10,7 +10,7 @@
 
 layout(local_size_x = 8, local_size_y = 8) in;
 // Parameters (`EdgeSnapParams` in src/cyclopean/splat.rs), one block for GL and Vulkan.
-layout(std140, binding = 0) uniform EdgeSnapParams {
+layout(std140, binding = 0) PARAM_BLOCK EdgeSnapParams {
     float u_parallax_px;  // full-baseline disparity = this / distance
     float u_tolerance_px;
     int u_margin;

@@ -1,7 +1,7 @@
 // cyclopean/fill's interface, the same text for GL and Vulkan: the std140 parameter block
 // (binding 0) mirrored by `FillParams` in src/cyclopean/fill.rs, and the middle view it fills
 // (bindings 1..3), rows in memory order.
-layout(std140, binding = 0) uniform FillParams {
+layout(std140, binding = 0) PARAM_BLOCK FillParams {
     ivec2 u_size;     // W, H of the middle view
     uint u_filled;    // the source bit filled pixels carry (fill.rs FILLED)
     float u_same_surface;  // relative depth difference below which both sides are one surface

@@ -1,7 +1,7 @@
 // cyclopean/forward's interface, the same text for GL and Vulkan and for both stages: the
 // std140 parameter block (binding 0) mirrored by `ForwardParams` in src/cyclopean/forward.rs,
 // one per eye's draw, and the eye's images (bindings 1..3).
-layout(std140, binding = 0) uniform ForwardParams {
+layout(std140, binding = 0) PARAM_BLOCK ForwardParams {
     mat4 u_inv_view_e;
     mat4 u_inv_proj_e;
     mat4 u_view_proj_e;

@@ -1,7 +1,7 @@
 // cyclopean/gather's interface, the same text for GL and Vulkan: the std140 parameter block
 // (binding 0) mirrored by `GatherParams` in src/cyclopean/render.rs, and the eyes' images
 // (bindings 1..4).
-layout(std140, binding = 0) uniform GatherParams {
+layout(std140, binding = 0) PARAM_BLOCK GatherParams {
     mat4 u_view_proj_l;
     mat4 u_inv_view_l;
     mat4 u_inv_proj_l;

@@ -3,7 +3,7 @@
 // values, which a unit test holds this file to; reference.rs is the CPU twin). One invocation
 // per pixel, rows in memory order = the images' top-down rows (the rule is symmetric in y).
 layout(local_size_x = 8, local_size_y = 8) in;
-layout(std140, binding = 0) uniform MatcherParams {
+layout(std140, binding = 0) PARAM_BLOCK MatcherParams {
     ivec2 u_size;         // W, H of both images
     int u_max_disparity;  // disparities 0..=u_max_disparity are searched
     int u_first_d;        // the chunk's first disparity (even)

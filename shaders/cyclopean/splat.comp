@@ -6,7 +6,7 @@
 
 layout(local_size_x = 8, local_size_y = 8) in;
 // Parameters (`SplatParams` in src/cyclopean/splat.rs), one block for GL and Vulkan.
-layout(std140, binding = 0) uniform SplatParams {
+layout(std140, binding = 0) PARAM_BLOCK SplatParams {
     mat4 u_inv_view_e;
     mat4 u_inv_proj_e;
     mat4 u_view_proj_m;

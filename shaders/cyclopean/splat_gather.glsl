@@ -4,7 +4,7 @@
 
 // Parameters (`SplatGatherParams` in src/cyclopean/splat.rs), one block for GL and Vulkan,
 // shared by the gather draw and the edge pass.
-layout(std140, binding = 0) uniform SplatGatherParams {
+layout(std140, binding = 0) PARAM_BLOCK SplatGatherParams {
     mat4 u_view_proj_l;
     mat4 u_view_l;
     mat4 u_inv_view_l;

@@ -1,7 +1,7 @@
 // cyclopean/temporal_*'s parameter block, the same text for GL and Vulkan, mirrored by
 // `TemporalParams` in src/cyclopean/temporal.rs: the previous middle view's camera (h) and the
 // current one (m), and the accumulation's rule.
-layout(std140, binding = 0) uniform TemporalParams {
+layout(std140, binding = 0) PARAM_BLOCK TemporalParams {
     mat4 u_inv_view_h;
     mat4 u_inv_proj_h;
     mat4 u_view_proj_m;

@@ -2,7 +2,7 @@
 // three programs: the std140 parameter block (binding 0) mirrored by `RefocusParams` in
 // src/refocus/render.rs, and the images every pass samples (bindings 1..4). The full-screen
 // pass adds its coverage flags and the boundary pass its triangle codes, both at binding 5.
-layout(std140, binding = 0) uniform RefocusParams {
+layout(std140, binding = 0) PARAM_BLOCK RefocusParams {
     mat4 u_clip_from_target;  // target projection (OpenCV view space, see projection.rs)
     vec4 u_src_k;             // fx, fy, cx, cy of the source
     ivec2 u_src_size;         // W, H

@@ -1,7 +1,7 @@
 // stitch/stitch's interface, the same text for GL and Vulkan: the std140 parameter block
 // (binding 0) mirrored by `StitchParamsBlock` in src/stitch/render.rs, one per eye's draw, and
 // the eye's face atlases (bindings 1, 2).
-layout(std140, binding = 0) uniform StitchParams {
+layout(std140, binding = 0) PARAM_BLOCK StitchParams {
     mat4 u_rot[6];      // world from face rotation (upper 3x3)
     vec4 u_eye[6];      // face eyes (xyz)
     vec4 u_centre;      // ODS circle centre (xyz)

@@ -15,7 +15,9 @@ pub struct Program {
     name: &'static str,
 }
 
-const VERSION: &str = "#version 450 core\n";
+/// `#version`, and the parameter block's kind: a uniform block under GL (Vulkan's layer,
+/// shaders/common/vulkan.glsl, makes it a read-only storage buffer and says why).
+const VERSION: &str = "#version 450 core\n#define PARAM_BLOCK uniform\n";
 
 /// The files of one stage, each numbered by its own lines, for compile errors.
 fn numbered(files: &[ShaderFile]) -> String {

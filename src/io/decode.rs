@@ -37,6 +37,9 @@ fn reader(path: &Path, format: Option<ImageFormat>) -> Result<ImageReader<BufRea
     if reader.format().is_none() {
         return Err(Error::decode(path, "unrecognised image format"));
     }
+    if reader.format() == Some(ImageFormat::OpenExr) {
+        super::exr_io::check_exr_sampling(path)?;
+    }
     let mut limits = Limits::default();
     limits.max_image_width = Some(MAX_DIMENSION);
     limits.max_image_height = Some(MAX_DIMENSION);

@@ -19,12 +19,45 @@ pub(crate) fn exr_dimensions(path: &Path) -> Result<(u32, u32)> {
     let (file, _) = open_regular(path)?;
     let meta = MetaData::read_from_buffered(BufReader::new(file), false).map_err(|e| exr_error(path, e))?;
     match meta.headers.as_slice() {
-        [h] => decode_dims(path, h.layer_size.width() as u64, h.layer_size.height() as u64),
+        [h] => {
+            check_sampling(path, h)?;
+            decode_dims(path, h.layer_size.width() as u64, h.layer_size.height() as u64)
+        }
         hs => Err(Error::decode(
             path,
             format!("EXR has {} layers; expected exactly one", hs.len()),
         )),
     }
+}
+
+/// Refuses a header with a subsampled channel (x or y sampling other than 1, e.g. chroma
+/// subsampling), naming the channel: its sample counts and offset table differ from a flat
+/// image's, which would otherwise read as a corrupt file.
+fn check_sampling(path: &Path, header: &exr::meta::header::Header) -> Result<()> {
+    match header
+        .channels
+        .list
+        .iter()
+        .find(|c| c.sampling != exr::math::Vec2(1, 1))
+    {
+        Some(c) => Err(Error::decode(
+            path,
+            format!(
+                "EXR channel {} is subsampled ({} x {}): subsampled channels are not supported; \
+                 write every channel at full resolution",
+                c.name, c.sampling.0, c.sampling.1
+            ),
+        )),
+        None => Ok(()),
+    }
+}
+
+/// Refuses an EXR with a subsampled channel, from its headers alone (colour inputs, which the
+/// `image` crate decodes).
+pub(crate) fn check_exr_sampling(path: &Path) -> Result<()> {
+    let (file, _) = open_regular(path)?;
+    let meta = MetaData::read_from_buffered(BufReader::new(file), false).map_err(|e| exr_error(path, e))?;
+    meta.headers.iter().try_for_each(|h| check_sampling(path, h))
 }
 
 /// Reads the depth channel of a single-layer, flat EXR: "Z", else "depth" (any case), else
@@ -49,6 +82,7 @@ pub(crate) fn read_depth_channel(path: &Path) -> Result<RawDepth> {
     if header.deep {
         return Err(Error::decode(path, "deep EXR data is not supported"));
     }
+    check_sampling(path, header)?;
     let (width, height) = decode_dims(
         path,
         header.layer_size.width() as u64,
@@ -427,6 +461,33 @@ mod tests {
 
     fn names(v: &[&str]) -> Vec<String> {
         v.iter().map(|s| s.to_string()).collect()
+    }
+
+    /// A subsampled channel (x and y sampling 2, as chroma subsampling writes) is named as
+    /// unsupported subsampling, for depth and colour alike (it read as a corrupt offset table).
+    #[test]
+    fn a_subsampled_channel_is_named_as_unsupported() {
+        let dir = crate::io::test_util::scratch_dir("exr-subsampled");
+        let (depth, rgb) = (dir.join("depth.exr"), dir.join("rgb.exr"));
+        crate::io::save_depth_exr(&depth, &crate::io::DepthMap::new(4, 4, vec![1.5; 16]).unwrap()).unwrap();
+        crate::io::save_rgb(&rgb, &crate::io::RgbImage::new(4, 4, vec![9; 48]).unwrap()).unwrap();
+        for path in [&depth, &rgb] {
+            // The channel list: "chlist", its size, then per channel a name, the pixel type (4),
+            // pLinear and 3 reserved bytes, then x and y sampling (4 each): the first set to 2.
+            let mut bytes = std::fs::read(path).unwrap();
+            let at = bytes.windows(7).position(|w| w == b"chlist\0").unwrap() + 7 + 4;
+            let name_end = at + bytes[at..].iter().position(|&b| b == 0).unwrap() + 1;
+            let sampling = name_end + 4 + 4;
+            bytes[sampling..sampling + 8].copy_from_slice(&[2, 0, 0, 0, 2, 0, 0, 0]);
+            std::fs::write(path, &bytes).unwrap();
+        }
+        let e = read_depth_channel(&depth).unwrap_err().to_string();
+        assert!(
+            e.contains("depth.exr") && e.contains("is subsampled (2 x 2)") && !e.contains("corrupt"),
+            "{e}"
+        );
+        let e = crate::io::load_rgb(&rgb).unwrap_err().to_string();
+        assert!(e.contains("rgb.exr") && e.contains("is subsampled (2 x 2)"), "{e}");
     }
 
     #[test]

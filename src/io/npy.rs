@@ -86,10 +86,6 @@ impl<R: Read> NpyStream<R> {
         &self.header.shape
     }
 
-    pub(crate) fn dtype(&self) -> NpyDtype {
-        self.header.dtype
-    }
-
     /// Decodes the payload chunk by chunk; the stream must end exactly where it does.
     pub(crate) fn read(mut self) -> std::result::Result<NpyArray, String> {
         let item = self.header.item_size;
@@ -124,9 +120,9 @@ impl<R: Read> NpyStream<R> {
     }
 }
 
-/// The parsed header of an input of `len` bytes, and where its payload starts. The header's
-/// declared length is checked against 1 MiB and the input before it is allocated.
-fn read_header(r: &mut impl Read, len: u64) -> std::result::Result<(Header, usize), String> {
+/// The header dict's text of an input of `len` bytes, and where its payload starts. The
+/// header's declared length is checked against 1 MiB and the input before it is allocated.
+fn read_header_text(r: &mut impl Read, len: u64) -> std::result::Result<(String, usize), String> {
     // Magic and version (8 bytes), then the 2- or 4-byte header length they call for; a short
     // input gets header_extent's message.
     let mut head = Vec::with_capacity(12);
@@ -148,7 +144,23 @@ fn read_header(r: &mut impl Read, len: u64) -> std::result::Result<(Header, usiz
     read_all(r, &mut head[prefix_len..])?;
     let text = std::str::from_utf8(&head[prefix_len..]).map_err(|_| "header is not UTF-8")?;
     let text = text.strip_suffix('\n').ok_or("header does not end with a newline")?;
-    Ok((parse_header(text)?, data_offset))
+    Ok((text.to_string(), data_offset))
+}
+
+/// The parsed header of an input of `len` bytes, and where its payload starts. The header's
+/// declared length is checked against 1 MiB and the input before it is allocated.
+fn read_header(r: &mut impl Read, len: u64) -> std::result::Result<(Header, usize), String> {
+    let (text, data_offset) = read_header_text(r, len)?;
+    Ok((parse_header(&text)?, data_offset))
+}
+
+/// The element type a `.npy` of `len` bytes declares, from its header alone: `None` for a
+/// well-formed header of a type this reader does not decode (`|b1`, `<i8`, ...), which a
+/// search for the first floating-point array passes over.
+pub(crate) fn read_dtype(r: &mut impl Read, len: u64) -> std::result::Result<Option<NpyDtype>, String> {
+    let (text, _) = read_header_text(r, len).map_err(|m| format!("invalid NPY: {m}"))?;
+    let (descr, _, _) = parse_dict(&text).map_err(|m| format!("invalid NPY: {m}"))?;
+    Ok(dtype_of(&descr).map(|(dtype, _, _)| dtype))
 }
 
 fn read_all(r: &mut impl Read, buf: &mut [u8]) -> std::result::Result<(), String> {
@@ -273,7 +285,8 @@ struct Header {
     shape: Vec<usize>,
 }
 
-fn parse_header(text: &str) -> std::result::Result<Header, String> {
+/// The header dict's `descr`, `fortran_order` and `shape`, each present once.
+fn parse_dict(text: &str) -> std::result::Result<(String, bool, Vec<usize>), String> {
     let mut p = Parser {
         s: text.as_bytes(),
         i: 0,
@@ -306,8 +319,16 @@ fn parse_header(text: &str) -> std::result::Result<Header, String> {
     if p.i != p.s.len() {
         return Err("unexpected text after the header dict".into());
     }
-    let descr: String = descr.ok_or("header lacks 'descr'")?;
-    let (dtype, item_size, decode): (NpyDtype, usize, DecodeFn) = match descr.as_str() {
+    Ok((
+        descr.ok_or("header lacks 'descr'")?,
+        fortran.ok_or("header lacks 'fortran_order'")?,
+        shape.ok_or("header lacks 'shape'")?,
+    ))
+}
+
+/// The element type, size and decoder of a supported `descr`.
+fn dtype_of(descr: &str) -> Option<(NpyDtype, usize, DecodeFn)> {
+    let known: (NpyDtype, usize, DecodeFn) = match descr {
         "|u1" => (NpyDtype::U8, 1, |b| f64::from(b[0])),
         "<u2" => (NpyDtype::U16, 2, |b| f64::from(u16::from_le_bytes([b[0], b[1]]))),
         ">u2" => (NpyDtype::U16, 2, |b| f64::from(u16::from_be_bytes([b[0], b[1]]))),
@@ -319,19 +340,22 @@ fn parse_header(text: &str) -> std::result::Result<Header, String> {
         }),
         "<f8" => (NpyDtype::F64, 8, |b| f64::from_le_bytes(array8(b))),
         ">f8" => (NpyDtype::F64, 8, |b| f64::from_be_bytes(array8(b))),
-        other => {
-            return Err(format!(
-                "unsupported dtype '{other}' (supported: |u1 <u2 >u2 <f4 >f4 <f8 >f8)"
-            ))
-        }
+        _ => return None,
     };
+    Some(known)
+}
+
+fn parse_header(text: &str) -> std::result::Result<Header, String> {
+    let (descr, fortran_order, shape) = parse_dict(text)?;
+    let (dtype, item_size, decode) = dtype_of(&descr)
+        .ok_or_else(|| format!("unsupported dtype '{descr}' (supported: |u1 <u2 >u2 <f4 >f4 <f8 >f8)"))?;
     Ok(Header {
         descr,
         dtype,
         item_size,
         decode,
-        fortran_order: fortran.ok_or("header lacks 'fortran_order'")?,
-        shape: shape.ok_or("header lacks 'shape'")?,
+        fortran_order,
+        shape,
     })
 }
 

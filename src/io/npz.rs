@@ -70,13 +70,11 @@ pub(crate) fn load_npz_array_within(
             .ok_or_else(|| bad(format!("no array '{}' (arrays: {})", super::excerpt(wanted), keys())))?,
         None if members.len() == 1 => 0,
         None => {
-            // The first floating-point array, told from the headers alone.
+            // The first floating-point array, told from the headers alone: an array of a type
+            // this reader does not decode (a boolean mask, int64 ids) is not one, and is passed.
             let mut found = None;
             for (i, m) in members.iter().enumerate() {
-                if matches!(
-                    open(&mut zip, m, i, max_values).map_err(bad)?.dtype(),
-                    NpyDtype::F32 | NpyDtype::F64
-                ) {
+                if matches!(dtype(&mut zip, m, i).map_err(bad)?, Some(NpyDtype::F32 | NpyDtype::F64)) {
                     found = Some(i);
                     break;
                 }
@@ -113,15 +111,34 @@ fn open<'z, 'f>(
     max_values: u64,
 ) -> std::result::Result<NpyStream<Take<ZipFile<'z, &'f File>>>, String> {
     let name = super::excerpt(key(&m.name));
+    let file = member(zip, m, index)?;
+    let size = file.size();
+    NpyStream::open(file.take(size.saturating_add(1)), size, max_values).map_err(|e| format!("{name}: {e}"))
+}
+
+/// Member `index`, opened for reading (stored or deflated only).
+fn member<'z, 'f>(
+    zip: &'z mut ZipArchive<&'f File>,
+    m: &Member,
+    index: usize,
+) -> std::result::Result<ZipFile<'z, &'f File>, String> {
+    let name = super::excerpt(key(&m.name));
     if !matches!(m.method, CompressionMethod::Stored | CompressionMethod::Deflated) {
         return Err(format!(
             "{name}: compression method {} (only stored and deflate)",
             m.method
         ));
     }
-    let file = zip.by_index(index).map_err(|e| format!("{name}: {e}"))?;
+    zip.by_index(index).map_err(|e| format!("{name}: {e}"))
+}
+
+/// Member `index`'s element type from its `.npy` header (`None`: a type the reader does not
+/// decode), read within the size the central directory declares.
+fn dtype(zip: &mut ZipArchive<&File>, m: &Member, index: usize) -> std::result::Result<Option<NpyDtype>, String> {
+    let name = super::excerpt(key(&m.name));
+    let file = member(zip, m, index)?;
     let size = file.size();
-    NpyStream::open(file.take(size.saturating_add(1)), size, max_values).map_err(|e| format!("{name}: {e}"))
+    super::npy::read_dtype(&mut file.take(size), size).map_err(|e| format!("{name}: {e}"))
 }
 
 /// The listed members, in directory order, once they are known to tile the archive: each

@@ -234,3 +234,20 @@ fn ambiguous_overlapping_and_crowded_archives_are_refused() {
         assert!(e.contains(name) && e.contains(want), "{name}: {e}");
     }
 }
+
+/// Without a key the first floating-point array is read, whatever comes before it: a boolean
+/// mask (a dtype the reader does not decode) is passed over (it refused the archive).
+#[test]
+fn a_boolean_array_before_the_depth_is_passed_over() {
+    let mask = build_npy("{'descr': '|b1', 'fortran_order': False, 'shape': (3,), }", &[1, 0, 1]);
+    let depth = f4("(1, 3)", &[1.0, 2.0, 3.0]);
+    let p = write(
+        "bool_first.npz",
+        &npz(&[("valid.npy", &mask, false), ("depth.npy", &depth, true)], false),
+    );
+    let (key, a) = load_npz_array(&p, None).unwrap();
+    assert_eq!((key.as_str(), a.data), ("depth", vec![1.0, 2.0, 3.0]));
+    // Named, the boolean array is still refused for its type.
+    let e = load_npz_array(&p, Some("valid")).unwrap_err().to_string();
+    assert!(e.contains("unsupported dtype '|b1'"), "{e}");
+}

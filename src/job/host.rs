@@ -31,6 +31,19 @@ impl GpuRequest {
         })
     }
 
+    /// Refuses a `--device` that `backend` has no such device for (surfaceless is an EGL
+    /// platform): the command line contradicts itself, found before any work.
+    pub fn check_backend(&self, backend: Backend) -> Result<(), ArgError> {
+        if backend == Backend::Vulkan && self.device == DeviceChoice::Surfaceless {
+            return Err(ArgError::Invalid(crate::Error::param(
+                "--device",
+                "surfaceless is an EGL choice: with --backend vulkan give auto or an index of \
+                 `viewsynth info --backend vulkan`",
+            )));
+        }
+        Ok(())
+    }
+
     /// Opens the context (EGL display, GL 4.5+ core), refusing software under the policy.
     pub fn open(&self) -> crate::Result<Gpu> {
         Gpu::open(self.device, self.policy)

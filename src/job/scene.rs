@@ -94,6 +94,7 @@ pub struct SceneReport {
 impl SceneJob {
     /// Checks the scene name, the interocular distance and the image size.
     pub fn new(o: SceneOptions) -> Result<Self, ArgError> {
+        o.gpu.check_backend(o.backend)?;
         let scene = if Path::new(&o.scene).extension().is_some_and(|e| e == "json") {
             SceneSource::File(PathBuf::from(&o.scene))
         } else {

@@ -9,7 +9,8 @@
 //! - the program (a [`ShaderProgram`]: the registry's `ProgramKind` and its typed switches under
 //!   the conventions), which both backends build from the same GLSL (SPIR-V by build.rs);
 //! - one parameter block: the bytes of a `#[repr(C)]` bytemuck `Pod` struct made with
-//!   [`param_block!`], mirrored field for field by a std140 uniform block (binding 0) in one
+//!   [`param_block!`], mirrored field for field by a std140 block (binding 0: a uniform block
+//!   under GL, a read-only storage buffer under Vulkan, shaders/common/vulkan.glsl) in one
 //!   `*_params.glsl` file that both backends include, so there are no loose uniforms and no
 //!   hand-packed byte offsets (the layout test holds every block against the offsets the GL
 //!   compiler reports);

@@ -2,11 +2,12 @@
 //! same GLSL compiled to SPIR-V by build.rs, looked up by the GL preamble.
 //!
 //! Interface (every `*_params.glsl`): descriptor set 0 holds the parameter block at binding 0
-//! (a uniform buffer), the sampled images at bindings 1..=7 (combined image samplers, nearest,
-//! clamp to edge), exactly the GL bindings, then the storage images at 8 + k and the storage
-//! buffers at 12 + k (GL's image unit and buffer binding k: shaders/common/bindings.glsl). One
-//! host-visible uniform buffer carries every step's block at 256-byte offsets (the largest
-//! `minUniformBufferOffsetAlignment` the spec allows). Pipelines are cached per program, output
+//! (a read-only storage buffer: shaders/common/vulkan.glsl says why), the sampled images at
+//! bindings 1..=7 (combined image samplers, nearest, clamp to edge), exactly the GL bindings,
+//! then the storage images at 8 + k and the storage buffers at 12 + k (GL's image unit and
+//! buffer binding k: shaders/common/bindings.glsl). One host-visible buffer carries every
+//! step's block at 256-byte offsets (the largest `minStorageBufferOffsetAlignment` the spec
+//! allows). Pipelines are cached per program, output
 //! set and binding counts; targets per size and output set (the last few). Each run is one
 //! submission of a [`Flight`] (flight.rs: command buffer, fence, parameter buffer, descriptor
 //! pool, staging arena, host readback buffers), reused once waited for, so several runs can be
@@ -145,7 +146,8 @@ fn bindings((samplers, images, buffers): Counts) -> Vec<vk::DescriptorSetLayoutB
             .descriptor_count(1)
             .stage_flags(stages)
     };
-    let mut b = vec![one(0, vk::DescriptorType::UNIFORM_BUFFER)];
+    // The parameter block is a storage buffer (see PARAM_BLOCK in shaders/common/vulkan.glsl).
+    let mut b = vec![one(0, vk::DescriptorType::STORAGE_BUFFER)];
     b.extend((1..=samplers as u32).map(|i| one(i, vk::DescriptorType::COMBINED_IMAGE_SAMPLER)));
     b.extend((0..images as u32).map(|i| one(STORAGE_IMAGE_BASE + i, vk::DescriptorType::STORAGE_IMAGE)));
     b.extend((0..buffers as u32).map(|i| one(STORAGE_BUFFER_BASE + i, vk::DescriptorType::STORAGE_BUFFER)));
@@ -452,7 +454,7 @@ impl VkExecutor {
             let mut writes = vec![vk::WriteDescriptorSet::default()
                 .dst_set(set)
                 .dst_binding(0)
-                .descriptor_type(vk::DescriptorType::UNIFORM_BUFFER)
+                .descriptor_type(vk::DescriptorType::STORAGE_BUFFER)
                 .buffer_info(&buffer_info)];
             for (i, info) in sampled.iter().enumerate() {
                 writes.push(

@@ -90,7 +90,7 @@ impl Flight {
     pub fn params(&mut self, bytes: usize) -> Result<&Buffer> {
         if self.params.as_ref().is_none_or(|b| b.size < bytes) {
             self.params = None;
-            self.params = Some(Buffer::new(&self.vk, bytes, vk::BufferUsageFlags::UNIFORM_BUFFER)?);
+            self.params = Some(Buffer::new(&self.vk, bytes, vk::BufferUsageFlags::STORAGE_BUFFER)?);
         }
         Ok(self.params.as_ref().expect("allocated above"))
     }
@@ -178,9 +178,6 @@ impl Flight {
             let n = sets.next_power_of_two().max(MIN_SETS) as u32;
             let sizes = [
                 vk::DescriptorPoolSize::default()
-                    .ty(vk::DescriptorType::UNIFORM_BUFFER)
-                    .descriptor_count(n),
-                vk::DescriptorPoolSize::default()
                     .ty(vk::DescriptorType::COMBINED_IMAGE_SAMPLER)
                     .descriptor_count(MAX_SAMPLED as u32 * n),
                 vk::DescriptorPoolSize::default()
@@ -188,7 +185,8 @@ impl Flight {
                     .descriptor_count(4 * n),
                 vk::DescriptorPoolSize::default()
                     .ty(vk::DescriptorType::STORAGE_BUFFER)
-                    .descriptor_count(4 * n),
+                    // Four storage buffers a step and its parameter block.
+                    .descriptor_count(5 * n),
             ];
             self.pool = d
                 .create_descriptor_pool(

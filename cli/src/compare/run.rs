@@ -69,7 +69,7 @@ pub(crate) fn compare(job: &CompareJob) -> Result<ExitCode> {
         return Ok(ExitCode::SUCCESS);
     }
     for b in &r.broken {
-        eprintln!("threshold broken: {b}");
+        errln!("threshold broken: {b}");
     }
     // Exit 1 means "A and B differ beyond the limits" for CI, whatever other errors map to.
     Ok(ExitCode::FAILURE)

@@ -144,7 +144,8 @@ pub(crate) struct CyclopeanArgs {
     /// searches, pixels.
     ///
     /// Default: estimated from the images by a coarse pass, with a margin; the range used is
-    /// printed.
+    /// printed. The search is bounded: at most 1024 disparities past 0 (max - min when the
+    /// minimum is negative).
     #[arg(help_heading = INPUTS, long, value_name = "N", allow_hyphen_values = true, value_parser = clap::value_parser!(i32).range(-i64::from(viewsynth::io::MAX_DIMENSION)..=i64::from(viewsynth::io::MAX_DIMENSION)))]
     max_disparity: Option<i32>,
     /// Two images alone: the smallest disparity searched, pixels; negative for pairs whose

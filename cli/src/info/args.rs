@@ -37,9 +37,11 @@ pub(crate) struct InfoRequest {
 impl TryFrom<InfoArgs> for InfoRequest {
     type Error = ArgError;
     fn try_from(a: InfoArgs) -> Result<Self, ArgError> {
+        let gpu: GpuRequest = a.gpu.clone().try_into()?;
+        gpu.check_backend(a.backend.into())?;
         Ok(InfoRequest {
             open_vulkan: a.gpu.is_explicit(),
-            gpu: a.gpu.try_into()?,
+            gpu,
             json: a.json,
             backend: a.backend,
         })

@@ -67,7 +67,8 @@ pub(crate) struct RefocusArgs {
     /// sharded runs draw the same; files z{k}_s{s}_*, scales recorded in each frame's manifest.
     #[arg(help_heading = TARGETS, long, value_name = "LO,HI", value_delimiter = ',', conflicts_with_all = ["zoom_range", "focal_list"], value_parser = finite_value)]
     zoom_random: Option<Vec<f64>>,
-    /// With --zoom-random: scales drawn per frame [default: 1].
+    /// With --zoom-random: scales drawn per frame [default: 1]; at most the distinct file tags
+    /// (6 decimals) the range holds.
     #[arg(help_heading = TARGETS, long, value_name = "K", requires = "zoom_random", value_parser = clap::builder::RangedU64ValueParser::<usize>::new().range(1..=viewsynth::refocus::batch::MAX_SAMPLES as u64))]
     samples: Option<usize>,
     /// With --zoom-random: the seed [default: 0].

@@ -56,19 +56,19 @@ fn batch(job: &RefocusBatchJob) -> Result<()> {
         None => println!("index: this shard's part written; the last shard (or `viewsynth index`) joins them"),
     }
     for (name, w) in &summary.depth_warnings {
-        eprintln!("warning: frame {name}: depth {w}; check its depth_scale (or --depth-scale) and sun_bit_rotate");
+        errln!("warning: frame {name}: depth {w}; check its depth_scale (or --depth-scale) and sun_bit_rotate");
     }
     let warned: std::collections::BTreeSet<&str> =
         summary.depth_warnings.iter().map(|(name, _)| name.as_str()).collect();
     if !warned.is_empty() {
-        eprintln!(
+        errln!(
             "warning: {} of {} frames rendered or tried have depth that looks wrongly decoded (listed above)",
             warned.len(),
             summary.rendered + summary.failed.len()
         );
     }
     for (name, e) in &summary.failed {
-        eprintln!("failed: {name}: {e}");
+        errln!("failed: {name}: {e}");
     }
     Ok(report.outcome()?)
 }

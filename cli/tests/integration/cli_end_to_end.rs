@@ -330,7 +330,7 @@ fn report_with_a_case_measures_it_beside_the_built_in_rows() {
 /// A data folder with Tsukuba's five views (40 x 30, one texture shifted 2 px a view) and the
 /// flow peer's images of both Tsukuba pairs: 2+4 the truth itself, 1+5 the truth 5 levels
 /// brighter everywhere. Returns the PSNRs they must score (inf, 10 log10(255^2 / 25)).
-fn fake_flow_peer(data: &Path, peer: &Path) -> (f64, f64) {
+pub(crate) fn fake_flow_peer(data: &Path, peer: &Path) -> (f64, f64) {
     let set = data.join("tsukuba_5view_no_gt");
     std::fs::create_dir_all(&set).unwrap();
     std::fs::create_dir_all(peer).unwrap();

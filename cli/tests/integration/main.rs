@@ -2,6 +2,7 @@
 //! missing EGL fails them with the library's error, never a skip.
 
 mod batch;
+mod bounds;
 mod cli;
 mod cli_batch;
 mod cli_batch_augment;
@@ -34,6 +35,8 @@ mod hostile_round4;
 mod hostile_round4_outputs;
 mod limits;
 mod matcher;
+mod memory_flat;
+mod messages;
 mod pass_contract;
 mod readback;
 mod refocus_accuracy;

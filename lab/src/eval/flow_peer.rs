@@ -70,8 +70,9 @@ pub fn flow_peer_pairs(data_dir: &Path) -> Vec<FlowPeerPair> {
     pairs
 }
 
-/// Every pair's peer image in `peer_dir` exists: else an error naming the first missing file
-/// (checked before any row is measured).
+/// Every pair's peer image in `peer_dir` exists, is a regular image file and has its true
+/// middle view's size, all from the headers: else an error naming the first file at fault and
+/// why (checked before any row is measured).
 pub fn check_flow_peer(data_dir: &Path, peer_dir: &Path) -> Result<()> {
     if !peer_dir.is_dir() {
         return Err(Error::param(
@@ -84,9 +85,31 @@ pub fn check_flow_peer(data_dir: &Path, peer_dir: &Path) -> Result<()> {
     }
     for pair in flow_peer_pairs(data_dir) {
         let path = peer_dir.join(pair.file);
-        if !path.is_file() {
+        // Missing only when nothing is there: a FIFO, a device or a folder is named as such.
+        if std::fs::symlink_metadata(&path).is_err() {
             return Err(missing(&path, &pair));
         }
+        let (w, h) = io::rgb_dimensions(&path)
+            .map_err(|e| Error::param("--flow-peer", format!("{e} (the peer's middle view of {})", pair.scene)))?;
+        let (tw, th) = io::rgb_dimensions(&pair.truth)?;
+        check_size(&path, (w, h), (tw, th), &pair.scene)?;
+    }
+    Ok(())
+}
+
+/// An image of `size` made from `path` has the true middle view's size `truth`.
+fn check_size(path: &Path, size: (u32, u32), truth: (u32, u32), scene: &str) -> Result<()> {
+    if size != truth {
+        return Err(Error::SizeMismatch {
+            message: format!(
+                "{} is {}x{}, the true middle view of {scene} {}x{}",
+                path.display(),
+                size.0,
+                size.1,
+                truth.0,
+                truth.1
+            ),
+        });
     }
     Ok(())
 }
@@ -187,18 +210,7 @@ fn all_pixels_row(
     truth: &RgbImage,
     path: &Path,
 ) -> Result<ReportRow> {
-    if (image.width, image.height) != (truth.width, truth.height) {
-        return Err(Error::SizeMismatch {
-            message: format!(
-                "{} is {}x{}, the true middle view of {scene} {}x{}",
-                path.display(),
-                image.width,
-                image.height,
-                truth.width,
-                truth.height
-            ),
-        });
-    }
+    check_size(path, (image.width, image.height), (truth.width, truth.height), scene)?;
     let mut row = ReportRow::new("cyclopean", scene, name, setting, wall_ms);
     let all = vec![true; (truth.width * truth.height) as usize];
     super::score(image, None, &all, truth, None, &mut row);

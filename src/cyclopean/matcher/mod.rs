@@ -87,12 +87,16 @@ fn check_pair(left: &RgbImage, right: &RgbImage) -> Result<()> {
     Ok(())
 }
 
-/// The search range 0..=`max_disparity` fits the image: at least 1 px, less than its width.
+/// The search range 0..=`max_disparity` fits the image (at least 1 px, less than its width)
+/// and the matcher's bound ([`range::MAX_SEARCH`]).
 fn check_range(width: u32, max_disparity: u32) -> Result<()> {
-    if max_disparity == 0 || max_disparity >= width {
+    if max_disparity == 0 || max_disparity >= width || i64::from(max_disparity) > range::MAX_SEARCH {
         return Err(Error::param(
             "max_disparity",
-            format!("{max_disparity} px: must be at least 1 and less than the image width ({width} px)"),
+            format!(
+                "{max_disparity} px: must be at least 1, less than the image width ({width} px) and at most {}",
+                range::MAX_SEARCH
+            ),
         ));
     }
     Ok(())

@@ -35,6 +35,12 @@ pub const COARSE_WIDTH: u32 = 128;
 /// the range (mismatches the left-right check let through).
 const TAIL: f64 = 0.01;
 
+/// Most disparities the matcher searches past 0 (its `max_disparity`, the signed range moved
+/// up by its offset): its work grows with each one (a 16384-wide pair searched to its width
+/// did not finish in 45 s), so the search is bounded by this, not by the image width. Four
+/// times the largest default search (256).
+pub const MAX_SEARCH: i64 = 1024;
+
 /// A disparity search range, pixels (left: x_right = x_left - d), both ends included.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
 pub struct DisparityRange {
@@ -45,7 +51,30 @@ pub struct DisparityRange {
 }
 
 impl DisparityRange {
-    /// Refuses an empty range or one at least as wide as the image.
+    /// How far the matcher searches for this range: 0..=max - min(min, 0) ([`SignedSearch`]).
+    pub fn searched(&self) -> i64 {
+        self.max as i64 - (self.min as i64).min(0)
+    }
+
+    /// Refuses a range whose search passes [`MAX_SEARCH`] disparities, naming both options.
+    pub fn check_search(&self) -> Result<()> {
+        if self.searched() > MAX_SEARCH {
+            return Err(Error::param(
+                "--min-disparity/--max-disparity",
+                format!(
+                    "{}..{} px: the matcher would search {} disparities, more than its {MAX_SEARCH} \
+                     (its work grows with each); give a narrower range",
+                    self.min,
+                    self.max,
+                    self.searched() + 1
+                ),
+            ));
+        }
+        Ok(())
+    }
+
+    /// Refuses an empty range, one at least as wide as the image and one searched past
+    /// [`MAX_SEARCH`].
     pub fn validate(&self, width: u32) -> Result<()> {
         let span = self.max as i64 - self.min as i64;
         if span < 1 || self.max as i64 >= width as i64 || -(self.min as i64) >= width as i64 {
@@ -59,7 +88,7 @@ impl DisparityRange {
                 ),
             ));
         }
-        Ok(())
+        self.check_search()
     }
 }
 

@@ -129,6 +129,7 @@ impl CyclopeanJob {
     /// Checks the options: one input set-up, the files' decoding options for it, and the
     /// request ([`CyclopeanRequest::plan`]).
     pub fn new(o: CyclopeanOptions) -> Result<Self, ArgError> {
+        o.gpu.check_backend(o.backend)?;
         let kind = StereoGiven {
             left_disparity: o.left_disparity.is_some(),
             right_disparity: o.right_disparity.is_some(),

@@ -244,6 +244,12 @@ impl CyclopeanRequest {
                 )));
             }
         }
+        // The search the given ends imply at least (a lone maximum searches from 0 or below),
+        // bounded before any image is read.
+        if let Some(max) = self.max_disparity {
+            let min = self.min_disparity.unwrap_or(0);
+            DisparityRange { min, max }.check_search().map_err(ArgError::Invalid)?;
+        }
         let metric = match kind {
             StereoKind::Disparity | StereoKind::Images => {
                 self.check_rig()?;
@@ -593,6 +599,16 @@ impl CyclopeanPlan {
     ) -> crate::Result<Estimate> {
         let (range, estimated) = self.range(left, right, left_rgb)?;
         let search = SignedSearch::new(range);
+        // A negative minimum widens both images by its size: the widened pair must fit the GPU.
+        device
+            .check_image_size("widened pair", search.width(left.width), left.height)
+            .map_err(|e| {
+                left_rgb.error(format!(
+                    "{} px wide, widened by {} columns for the search {}..{} px \
+                     (--min-disparity/--max-disparity): {e}",
+                    left.width, search.offset, range.min, range.max
+                ))
+            })?;
         let widened;
         let (l, r) = match search.offset {
             0 => (left, right),

@@ -110,6 +110,7 @@ impl CyclopeanSequenceJob {
     /// set-up when the file is read.
     pub fn new(file: PathBuf, template: CyclopeanOptions) -> std::result::Result<Self, ArgError> {
         let t = &template;
+        t.gpu.check_backend(t.backend)?;
         for (flag, given) in [
             ("--left-rgb", !t.left_rgb.as_os_str().is_empty()),
             ("--right-rgb", !t.right_rgb.as_os_str().is_empty()),

@@ -88,6 +88,7 @@ pub struct RefocusBatchJob {
 impl RefocusCommand {
     /// Checks the options against each other and the library's rules.
     pub fn new(o: RefocusOptions) -> Result<Self, ArgError> {
+        o.gpu.check_backend(o.backend)?;
         super::cyclopean::check_scale("--depth-scale", o.decode.scale)?;
         if let Some(manifest) = o.manifest.clone() {
             return RefocusBatchJob::new(manifest, o).map(RefocusCommand::Batch);

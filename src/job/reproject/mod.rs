@@ -192,6 +192,7 @@ pub(crate) fn device_depth(near: Option<f64>, far: Option<f64>, what: &'static s
 impl ReprojectJob {
     /// Checks the options against each other and the library's rules.
     pub fn new(mut o: ReprojectOptions) -> Result<Self, ArgError> {
+        o.gpu.check_backend(o.backend)?;
         super::check_npz_key(o.npz_key.as_deref(), &[&o.depth])?;
         o.files.outputs = o.request.outputs();
         // The mask is always rendered: the coverage reported is measured on it.

@@ -165,6 +165,7 @@ pub struct StitchReport {
 impl StitchJob {
     /// Checks the options against each other and the library's rules.
     pub fn new(o: StitchOptions) -> Result<Self, ArgError> {
+        o.gpu.check_backend(o.backend)?;
         // Face files are named by the folder, found while running; an empty key, or a key with
         // the built-in scene (no depth files at all), is wrong on the command line.
         super::check_npz_key(o.npz_key.as_deref(), &[])?;

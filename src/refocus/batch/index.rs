@@ -22,6 +22,9 @@ use crate::error::{Error, Result};
 use serde::{Deserialize, Serialize};
 use std::path::{Path, PathBuf};
 
+/// Missing parts named at most in `viewsynth index`'s refusal (the rest are counted).
+const MISSING_NAMED: usize = 8;
+
 /// The joined index's file name, at the out-dir's root.
 pub const INDEX_NAME: &str = "index.jsonl";
 
@@ -63,7 +66,9 @@ fn part_name(index: usize, count: usize) -> String {
 fn parse_part_name(name: &str) -> Option<(usize, usize)> {
     let rest = name.strip_prefix("index.part-")?.strip_suffix(".jsonl")?;
     let (k, n) = rest.split_once("-of-")?;
-    Some((k.parse().ok()?, n.parse().ok()?))
+    let (k, n): (usize, usize) = (k.parse().ok()?, n.parse().ok()?);
+    // A part K >= N is no shard's (a stray file): not counted.
+    (k < n).then_some((k, n))
 }
 
 /// The rows of one finished frame: its manifest, when it records `settings`.
@@ -223,14 +228,26 @@ pub fn join_index(root: &Path) -> Result<(PathBuf, usize)> {
             ),
         ));
     };
-    let missing: Vec<String> = (0..n).filter(|j| !found.contains(j)).map(|j| part_name(j, n)).collect();
-    if !missing.is_empty() {
+    // N comes from a file name: the missing parts are counted, and only the first few named,
+    // so that `--shard 0/100000000` costs no list of a hundred million names.
+    let found: std::collections::BTreeSet<usize> = found.iter().copied().collect();
+    let missing = n - found.len();
+    if missing > 0 {
+        let first: Vec<String> = (0..n)
+            .filter(|j| !found.contains(j))
+            .take(MISSING_NAMED)
+            .map(|j| part_name(j, n))
+            .collect();
+        let more = match missing - first.len() {
+            0 => String::new(),
+            rest => format!(" and {rest} more"),
+        };
         return Err(Error::param(
             "index",
             format!(
-                "{}: shards still to run: {} missing",
+                "{}: shards still to run: {missing} of {n} parts missing ({}{more})",
                 root.display(),
-                missing.join(", ")
+                first.join(", ")
             ),
         ));
     }

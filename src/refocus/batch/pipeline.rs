@@ -226,6 +226,22 @@ pub fn run_batch(
         ));
     }
     opts.rule.validate()?;
+    if let Some(s) = opts.shard.filter(|s| s.count > frames.len().max(1)) {
+        // Shards K >= the frame count would have nothing to do, yet the index waits for every
+        // part of N: refused before any folder or part is written.
+        return Err(Error::param(
+            "shard",
+            format!(
+                "{}/{}: the manifest lists {} frames, so shards {}..{} would have none; give N <= {}",
+                s.index,
+                s.count,
+                frames.len(),
+                frames.len(),
+                s.count - 1,
+                frames.len().max(1)
+            ),
+        ));
+    }
     // Creates and checks --out-dir and clears temporaries that killed runs left in it.
     let root = io::OutDir::prepare(out_dir)?;
     let t_start = Instant::now();

@@ -43,6 +43,19 @@ impl ZoomRandom {
                 format!("{samples}: expected 1 to {MAX_SAMPLES} scales per frame"),
             ));
         }
+        // A frame's scales have distinct file tags (6 decimals): the range must hold as many.
+        let tags = tag_number(hi) - tag_number(lo) + 1;
+        if tags < samples as u64 {
+            return Err(Error::param(
+                "--zoom-random/--samples",
+                format!(
+                    "{lo},{hi} holds {tags} distinct scale{} at the 6 decimals of the file tags, \
+                     fewer than the {samples} samples asked for per frame; widen the range or \
+                     lower --samples",
+                    if tags == 1 { "" } else { "s" }
+                ),
+            ));
+        }
         Ok(ZoomRandom { lo, hi, samples, seed })
     }
 
@@ -52,14 +65,27 @@ impl ZoomRandom {
         let mut rng = SplitMix64(fnv1a64(frame.as_bytes()) ^ splitmix(self.seed));
         let (ln_lo, ln_hi) = (self.lo.ln(), self.hi.ln());
         let mut out: Vec<f64> = Vec::with_capacity(self.samples);
-        while out.len() < self.samples {
+        let taken = |out: &[f64], s: f64| out.iter().any(|&o| tag_number(o) == tag_number(s));
+        // `new` checked that the range holds enough tags, but a tag at an end may cover almost
+        // none of it: past this many draws the rest are taken in order (a bounded loop).
+        let mut draws = MAX_DRAWS_PER_SAMPLE * self.samples;
+        while out.len() < self.samples && draws > 0 {
+            draws -= 1;
             // 53 random bits -> [0, 1); clamped because exp(ln x) may round past the ends.
             let t = (rng.next() >> 11) as f64 / (1u64 << 53) as f64;
             let s = (ln_lo + t * (ln_hi - ln_lo)).exp().clamp(self.lo, self.hi);
-            let tag = super::super::manifest::scale_tag(s);
-            if !out.iter().any(|&o| super::super::manifest::scale_tag(o) == tag) {
+            if !taken(&out, s) {
                 out.push(s);
             }
+        }
+        let mut tag = tag_number(self.lo);
+        while out.len() < self.samples && tag <= tag_number(self.hi) {
+            // The tag's own value, or the range's end where the tag's value lies outside it.
+            let s = (tag as f64 / 1e6).clamp(self.lo, self.hi);
+            if !taken(&out, s) {
+                out.push(s);
+            }
+            tag += 1;
         }
         out
     }
@@ -72,6 +98,15 @@ impl ZoomRandom {
             .map(|(k, &s)| format!("z{k}_{}", super::super::manifest::scale_tag(s)))
             .collect()
     }
+}
+
+/// Draws per sample before the remaining scales are taken in tag order.
+const MAX_DRAWS_PER_SAMPLE: usize = 64;
+
+/// A scale's file tag as a whole number: its value in millionths, rounded as the tag's text
+/// (`manifest::scale_tag`, 6 decimals) rounds it.
+fn tag_number(scale: f64) -> u64 {
+    format!("{scale:.6}").replace('.', "").parse().unwrap_or(0)
 }
 
 /// FNV-1a, 64 bits.
@@ -138,6 +173,25 @@ mod tests {
         let z = ZoomRandom::new(0.5, 2.0, 1, 1).unwrap();
         let below = (0..4000).filter(|i| z.scales(&format!("f{i}"))[0] < 1.0).count();
         assert!((1800..=2200).contains(&below), "{below} of 4000 below 1");
+    }
+
+    #[test]
+    fn a_range_with_fewer_tags_than_samples_is_refused_and_a_tight_one_ends() {
+        // 1..1.0000001 rounds to one tag (s1): two samples cannot be distinct (this looped).
+        let e = ZoomRandom::new(1.0, 1.0000001, 2, 0).unwrap_err().to_string();
+        assert!(
+            e.contains("--zoom-random/--samples") && e.contains("1 distinct scale"),
+            "{e}"
+        );
+        // Exactly as many tags as samples, the end tags covering a sliver of the range
+        // (1.0000004999 rounds to s1, 1.0000035001 to s1.000004): every tag is taken, each
+        // once, in a bounded number of draws.
+        let z = ZoomRandom::new(1.0000004999, 1.0000035001, 5, 3).unwrap();
+        let scales = z.scales("f");
+        assert!(scales.iter().all(|s| (z.lo..=z.hi).contains(s)), "{scales:?}");
+        let mut tags: Vec<u64> = scales.iter().map(|&s| tag_number(s)).collect();
+        tags.sort_unstable();
+        assert_eq!(tags, (1_000_000..=1_000_004).collect::<Vec<u64>>());
     }
 
     #[test]
