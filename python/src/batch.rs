@@ -212,7 +212,7 @@ impl Renderer {
                         rgb_everywhere = false, zoom_random = None, samples = None, seed = None, progress = None,
                         index = true))]
     fn refocus_batch<'py>(
-        &mut self,
+        &self,
         py: Python<'py>,
         frames: &Bound<'py, PyAny>,
         out_dir: std::path::PathBuf,
@@ -239,7 +239,7 @@ impl Renderer {
         progress: Option<Bound<'py, PyAny>>,
         index: bool,
     ) -> PyResult<Bound<'py, PyAny>> {
-        let gpu = self.gpu()?.clone();
+        let (gpu, _busy) = self.enter()?;
         refocus_batch(
             py,
             gpu,

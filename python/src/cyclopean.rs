@@ -44,7 +44,7 @@ impl Renderer {
                         focal = None, baseline = None, doffs = 0.0, outputs = None, fill = false,
                         max_disparity = None, min_confidence = None, confidence = false))]
     fn cyclopean<'py>(
-        &mut self,
+        &self,
         py: Python<'py>,
         left_rgb: &Bound<'py, PyAny>,
         right_rgb: &Bound<'py, PyAny>,
@@ -68,7 +68,7 @@ impl Renderer {
         min_confidence: Option<f64>,
         confidence: bool,
     ) -> PyResult<Bound<'py, PyDict>> {
-        let gpu = self.gpu()?.clone();
+        let (gpu, _busy) = self.enter()?;
         // The settings as the library's request: it alone decides and checks them.
         let request = CyclopeanRequest {
             method: method.map(|m| choice("--method", m)).transpose()?,

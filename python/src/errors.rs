@@ -22,6 +22,8 @@ pub enum Kind {
     Closed,
     /// A Renderer used on a thread other than its creator's.
     WrongThread,
+    /// A Renderer used (to render or close) from inside one of its own calls.
+    Busy,
 }
 
 impl Kind {
@@ -34,6 +36,7 @@ impl Kind {
             Kind::Forked => "RendererForkedError",
             Kind::Closed => "RendererClosedError",
             Kind::WrongThread => "WrongThreadError",
+            Kind::Busy => "RendererBusyError",
         }
     }
 }

@@ -1,7 +1,8 @@
 //! `viewsynth.write_index`: the dataset index over a whole manifest, for pipelines that hand
 //! each worker a share of it (`Renderer.refocus_batch(..., index=False)` per share), so
 //! `out_dir/index.jsonl` equals the CLI batch's. No GPU: the rows come from the frames' own
-//! manifests on disk, kept only where they record these settings.
+//! manifests on disk, kept only where they record these settings. `viewsynth.read_index` reads
+//! the index through the library's reader (`_index_rows`).
 
 use crate::batch::{options, BatchArgs};
 use crate::errors;
@@ -79,4 +80,20 @@ pub fn write_index<'py>(
         .detach(|| viewsynth::refocus::batch::write_index(&root, &frames, &opts))
         .map_err(errors::from_library)?;
     Ok((path.to_string_lossy().into_owned(), rows))
+}
+
+/// The rows of out_dir/index.jsonl, each as its JSON text, for `viewsynth.read_index`: read by
+/// the library's rules (a regular file, never a FIFO or device, of bounded size, UTF-8, each
+/// line a row), so its errors are the library's (FileError).
+#[pyfunction]
+pub fn _index_rows(py: Python<'_>, out_dir: PathBuf) -> PyResult<Vec<String>> {
+    let path = out_dir.join(viewsynth::refocus::batch::INDEX_NAME);
+    let rows = py
+        .detach(|| viewsynth::refocus::batch::read_index(&path))
+        .map_err(errors::from_library)?;
+    rows.iter()
+        .map(|row| {
+            serde_json::to_string(row).map_err(|e| errors::from_library(viewsynth::Error::decode(&path, e.to_string())))
+        })
+        .collect()
 }

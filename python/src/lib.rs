@@ -66,6 +66,7 @@ fn _viewsynth(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(batch::load_manifest, m)?)?;
     m.add_function(wrap_pyfunction!(augment::read_depth, m)?)?;
     m.add_function(wrap_pyfunction!(index::write_index, m)?)?;
+    m.add_function(wrap_pyfunction!(index::_index_rows, m)?)?;
     m.add_function(wrap_pyfunction!(_request_defaults, m)?)?;
     m.add_function(wrap_pyfunction!(_keyword, m)?)?;
     m.add("_REQUEST_COMMANDS", viewsynth::job::REQUEST_COMMANDS.to_vec())?;

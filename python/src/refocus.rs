@@ -39,7 +39,7 @@ impl Renderer {
     #[pyo3(signature = (rgb, depth, K, *, scales = None, K_out = None, size = None, principal = None,
                         outputs = None, tau_rel = 0.05, tau_abs = 0.2, method = "fullscreen", rgb_everywhere = false))]
     fn refocus<'py>(
-        &mut self,
+        &self,
         py: Python<'py>,
         rgb: &Bound<'py, PyAny>,
         depth: &Bound<'py, PyAny>,
@@ -54,48 +54,31 @@ impl Renderer {
         method: &str,
         rgb_everywhere: bool,
     ) -> PyResult<Bound<'py, PyList>> {
-        if let Some(frames) = stack::frames(rgb, depth, K)? {
-            let views = PyList::empty(py);
-            for (rgb, depth, k) in frames {
-                let (s, o) = (scales.clone(), outputs);
-                let one = self.refocus(
-                    py,
-                    &rgb,
-                    &depth,
-                    &k,
-                    s,
-                    K_out,
-                    size,
-                    principal,
-                    o,
-                    tau_rel,
-                    tau_abs,
-                    method,
-                    rgb_everywhere,
-                );
-                views.append(one?)?;
-            }
-            return Ok(views);
+        let args = |rgb, depth, k, scales| RefocusArgs {
+            rgb,
+            depth,
+            k,
+            scales,
+            k_out: K_out,
+            size,
+            principal,
+            outputs,
+            tau_rel,
+            tau_abs,
+            method,
+            rgb_everywhere,
+        };
+        let stacked = stack::frames(rgb, depth, K)?;
+        let (gpu, _busy) = self.enter()?;
+        let Some(frames) = stacked else {
+            return refocus(py, gpu, args(rgb, depth, K, scales));
+        };
+        // One call over a stack: each frame as a call of its own, the Renderer busy throughout.
+        let views = PyList::empty(py);
+        for (rgb, depth, k) in &frames {
+            views.append(refocus(py, gpu.clone(), args(rgb, depth, k, scales.clone()))?)?;
         }
-        let gpu = self.gpu()?.clone();
-        refocus(
-            py,
-            gpu,
-            RefocusArgs {
-                rgb,
-                depth,
-                k: K,
-                scales,
-                k_out: K_out,
-                size,
-                principal,
-                outputs,
-                tau_rel,
-                tau_abs,
-                method,
-                rgb_everywhere,
-            },
-        )
+        Ok(views)
     }
 }
 

@@ -10,6 +10,8 @@ use crate::context;
 use crate::errors::{self, Kind};
 use crate::thread_bound::ThreadBound;
 use pyo3::prelude::*;
+use std::cell::RefCell;
+use std::sync::atomic::{AtomicBool, Ordering};
 
 /// An OpenGL 4.5 context over EGL (a GPU, or Mesa's llvmpipe on the CPU), or a Vulkan 1.3
 /// device running the same shaders (backend="vulkan"), for refocusing numpy
@@ -38,17 +40,44 @@ use pyo3::prelude::*;
 /// A Renderer does not pickle: pass frames to workers, not the Renderer.
 ///
 /// Release the context with close() or a with-block; garbage collection also releases it.
-#[pyclass(module = "viewsynth")]
+///
+/// Re-entrant use: while a call renders (e.g. from refocus_batch's progress callback), rendering
+/// or closing with the same Renderer raises RendererBusyError; its properties stay readable.
+// Frozen: every method takes &self, so pyo3 never borrow-checks the object (its refusal was a
+// bare RuntimeError("Already borrowed")); `busy` refuses re-entrant calls with our own class.
+#[pyclass(module = "viewsynth", frozen)]
 pub struct Renderer {
-    gpu: ThreadBound<Option<Backend>>,
+    gpu: ThreadBound<RefCell<Option<Backend>>>,
+    /// A rendering call of this Renderer is running (see `Renderer::enter`).
+    busy: AtomicBool,
     /// Process that opened the context: a forked child must not use (or free) it.
     pid: u32,
     device: String,
 }
 
+/// A rendering call in progress: the Renderer is busy until it is dropped.
+pub(crate) struct Busy<'a>(&'a AtomicBool);
+
+impl Drop for Busy<'_> {
+    fn drop(&mut self) {
+        self.0.store(false, Ordering::Release);
+    }
+}
+
 impl Renderer {
-    /// This thread's and this process's backend, for every method that renders.
-    pub(crate) fn gpu(&self) -> PyResult<&Backend> {
+    /// The backend for a rendering call, and the mark that the Renderer is busy until the call
+    /// ends: a call made meanwhile (from a callback of this one) is refused.
+    pub(crate) fn enter(&self) -> PyResult<(Backend, Busy<'_>)> {
+        // Thread, process and closed first: those refusals say more than "busy".
+        let backend = self.gpu()?;
+        if self.busy.swap(true, Ordering::AcqRel) {
+            return Err(busy("render with it"));
+        }
+        Ok((backend, Busy(&self.busy)))
+    }
+
+    /// This thread's and this process's backend.
+    fn gpu(&self) -> PyResult<Backend> {
         if self.pid != std::process::id() {
             return Err(errors::raise(
                 Kind::Forked,
@@ -64,13 +93,15 @@ impl Renderer {
         }
         self.gpu
             .get()?
-            .as_ref()
+            .borrow()
+            .clone()
             .ok_or_else(|| errors::raise(Kind::Closed, "this Renderer is closed", None))
     }
 
-    fn close_inner(&mut self) -> PyResult<()> {
+    fn close_inner(&self) -> PyResult<()> {
         let forked = self.pid != std::process::id();
-        if let Some(backend) = self.gpu.get_mut()?.take() {
+        let taken = self.gpu.get()?.borrow_mut().take();
+        if let Some(backend) = taken {
             match (backend, forked) {
                 // The parent's context or device: never to be freed (or used) in the child.
                 (backend, true) => std::mem::forget(backend),
@@ -80,6 +111,27 @@ impl Renderer {
         }
         Ok(())
     }
+
+    /// close(), refused while one of this Renderer's calls runs (its context is in use).
+    fn close_busy_checked(&self) -> PyResult<()> {
+        self.gpu.get()?; // another thread's call is refused as such first
+        if self.busy.load(Ordering::Acquire) {
+            return Err(busy("close it"));
+        }
+        self.close_inner()
+    }
+}
+
+/// The refusal of a call made while another call of the same Renderer runs.
+fn busy(what: &str) -> PyErr {
+    errors::raise(
+        Kind::Busy,
+        format!(
+            "this Renderer is busy: one of its calls is running (this call came from inside it, e.g. \
+             from a progress callback); {what} after that call returns, or use another Renderer"
+        ),
+        None,
+    )
 }
 
 impl Drop for Renderer {
@@ -96,7 +148,8 @@ impl Renderer {
     fn new(device: &str, require_gpu: bool, backend: &str) -> PyResult<Self> {
         let gpu = Backend::open(device, require_gpu, backend)?;
         let renderer = Renderer {
-            gpu: ThreadBound::new(Some(gpu)),
+            gpu: ThreadBound::new(RefCell::new(Some(gpu))),
+            busy: AtomicBool::new(false),
             pid: std::process::id(),
             device: device.to_string(),
         };
@@ -115,7 +168,7 @@ impl Renderer {
     /// What the context runs on (vendor, renderer, GL version, EGL platform and device, limits).
     #[getter]
     fn info<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
-        match self.gpu()? {
+        match &self.gpu()? {
             Backend::Gl(gpu) => crate::info_dict(py, gpu.info()),
             Backend::Vulkan(_, info) => {
                 let text = serde_json::to_string(info)
@@ -131,7 +184,7 @@ impl Renderer {
     /// same-sized calls leaves the counts unchanged; growth is a leak. Renderers on one thread
     /// share a context, hence these counts.
     fn gl_objects<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
-        let Backend::Gl(gpu) = self.gpu()? else {
+        let Backend::Gl(gpu) = &self.gpu()? else {
             return Err(errors::invalid(
                 "backend",
                 "gl_objects() counts GL objects; this Renderer runs on Vulkan",
@@ -146,12 +199,12 @@ impl Renderer {
     /// True after close().
     #[getter]
     fn closed(&self) -> PyResult<bool> {
-        Ok(self.gpu.get()?.is_none())
+        Ok(self.gpu.get()?.borrow().is_none())
     }
 
     /// Release the context now (it is also released when the Renderer is garbage-collected).
-    fn close(&mut self) -> PyResult<()> {
-        self.close_inner()
+    fn close(&self) -> PyResult<()> {
+        self.close_busy_checked()
     }
 
     fn __enter__(slf: Py<Self>) -> Py<Self> {
@@ -159,8 +212,8 @@ impl Renderer {
     }
 
     #[pyo3(signature = (*_exc))]
-    fn __exit__(&mut self, _exc: &Bound<'_, pyo3::types::PyTuple>) -> PyResult<bool> {
-        self.close_inner()?;
+    fn __exit__(&self, _exc: &Bound<'_, pyo3::types::PyTuple>) -> PyResult<bool> {
+        self.close_busy_checked()?;
         Ok(false)
     }
 
@@ -176,7 +229,7 @@ impl Renderer {
         if !self.gpu.on_owner() {
             return format!("Renderer(device={:?}, owned by another thread)", self.device);
         }
-        match (&*self.gpu.value, self.pid == std::process::id()) {
+        match (&*self.gpu.value.borrow(), self.pid == std::process::id()) {
             (Some(Backend::Gl(gpu)), true) => {
                 format!("Renderer(device={:?}, renderer={:?})", self.device, gpu.info().renderer)
             }

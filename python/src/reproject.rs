@@ -31,7 +31,7 @@ impl Renderer {
                         separation = None, convergence = None, near = None, far = None, source = "left",
                         target = "right", method = "shift-scan", steps = 3, tau_rel = 0.05, outputs = None))]
     fn reproject<'py>(
-        &mut self,
+        &self,
         py: Python<'py>,
         rgb: &Bound<'py, PyAny>,
         depth: &Bound<'py, PyAny>,
@@ -51,7 +51,7 @@ impl Renderer {
         tau_rel: f64,
         outputs: Option<&Bound<'py, PyAny>>,
     ) -> PyResult<Bound<'py, PyDict>> {
-        let gpu = self.gpu()?.clone();
+        let (gpu, _busy) = self.enter()?;
         // The settings as the library's request: it alone decides and checks them.
         let request = ReprojectRequest {
             depth_kind: choice("--depth-kind", depth_kind)?,

@@ -47,7 +47,7 @@ impl Renderer {
                         method = "reproject", width = 2048, height = 1024, ipd = 0.064, pole_fade = 45.0,
                         depth_kind = "view-z", near = None, far = None, ndc = "gl", reversed_z = false))]
     fn stitch<'py>(
-        &mut self,
+        &self,
         py: Python<'py>,
         left_rgb: &Bound<'py, PyAny>,
         left_depth: &Bound<'py, PyAny>,
@@ -66,7 +66,7 @@ impl Renderer {
         ndc: &str,
         reversed_z: bool,
     ) -> PyResult<Bound<'py, PyDict>> {
-        let gpu = self.gpu()?.clone();
+        let (gpu, _busy) = self.enter()?;
         stitch(
             py,
             gpu,

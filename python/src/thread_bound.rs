@@ -46,11 +46,6 @@ impl<T> ThreadBound<T> {
         self.check()?;
         Ok(&self.value)
     }
-
-    pub fn get_mut(&mut self) -> PyResult<&mut T> {
-        self.check()?;
-        Ok(&mut self.value)
-    }
 }
 
 impl<T> Drop for ThreadBound<T> {

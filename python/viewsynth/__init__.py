@@ -22,6 +22,7 @@ from .errors import (
     GpuError,
     GpuUnavailableError,
     InvalidInputError,
+    RendererBusyError,
     RendererClosedError,
     RendererForkedError,
     ViewsynthError,
@@ -44,5 +45,6 @@ __all__ = [
     "FileError",
     "RendererForkedError",
     "RendererClosedError",
+    "RendererBusyError",
     "WrongThreadError",
 ]

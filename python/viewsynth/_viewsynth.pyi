@@ -343,6 +343,11 @@ def info(device: str = "auto") -> Dict[str, Any]:
     """Describe the EGL/OpenGL context viewsynth renders with."""
     ...
 
+def _index_rows(out_dir: Union[str, "os.PathLike[str]"]) -> List[str]:
+    """The rows of out_dir/index.jsonl as JSON text, read by the library's rules: the reader
+    behind viewsynth.read_index."""
+    ...
+
 def load_manifest(path: Union[str, "os.PathLike[str]"]) -> List[ManifestFrame]:
     """Read a refocus manifest (CSV or JSON) as `viewsynth refocus --batch` does: paths resolved
     against its folder, every frame named."""

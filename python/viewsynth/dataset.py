@@ -5,6 +5,8 @@ frame folder."""
 import json
 import os
 
+from ._viewsynth import _index_rows
+
 INDEX_NAME = "index.jsonl"
 
 
@@ -19,17 +21,15 @@ def read_index(out_dir, absolute=True):
     separately, ``viewsynth index OUT`` joins their parts. Where a scheduler hands workers shares
     of a manifest (Ray, Dask), each calls ``refocus_batch(..., index=False)`` and the driver
     calls ``viewsynth.write_index`` once over the whole manifest.
+
+    Raises FileError (a ViewsynthError and an OSError) when the index is missing, not a regular
+    file (a folder, FIFO or device), too large, not UTF-8 or not rows of the index.
     """
-    path = os.path.join(os.fspath(out_dir), INDEX_NAME)
-    rows = []
-    with open(path, encoding="utf-8") as f:
-        for line in f:
-            if not line.strip():
-                continue
-            row = json.loads(line)
-            if absolute:
-                for key in ("rgb", "depth", "mask", "manifest"):
-                    if row.get(key) is not None:
-                        row[key] = os.path.join(os.fspath(out_dir), row[key])
-            rows.append(row)
+    # The library reads the file, by its rules for every input; rows come back as JSON text.
+    rows = [json.loads(text) for text in _index_rows(os.fspath(out_dir))]
+    if absolute:
+        for row in rows:
+            for key in ("rgb", "depth", "mask", "manifest"):
+                if row.get(key) is not None:
+                    row[key] = os.path.join(os.fspath(out_dir), row[key])
     return rows

@@ -38,6 +38,11 @@ class RendererClosedError(ViewsynthError, RuntimeError):
     """A Renderer was used after close()."""
 
 
+class RendererBusyError(ViewsynthError, RuntimeError):
+    """A Renderer was used to render or close while one of its own calls was running (from a
+    callback of that call, such as refocus_batch's progress): wait for the call to return."""
+
+
 class WrongThreadError(ViewsynthError, RuntimeError):
     """A Renderer was used on a thread other than the one that created it: one per thread."""
 
@@ -50,5 +55,6 @@ __all__ = [
     "FileError",
     "RendererForkedError",
     "RendererClosedError",
+    "RendererBusyError",
     "WrongThreadError",
 ]

@@ -46,7 +46,10 @@ use std::io::{self, BufWriter, Write};
 use std::path::{Component, Path, PathBuf};
 
 mod parallel;
+mod replaces;
 pub use parallel::FileWriter;
+pub(crate) use replaces::remove_own_file;
+pub use replaces::Replaces;
 
 use super::atomic::{
     check_replaceable, fault_point, lock_if_current, open_for_lock, own_prefix, probe_writable, TEMP_PREFIX,
@@ -228,26 +231,9 @@ pub struct FileSet {
     unsynced: Vec<String>,
     /// The background syncs of [`FileSet::write_all`]'s files, joined at commit.
     syncing: Vec<std::thread::JoinHandle<Result<()>>>,
-    /// The names the command owns in the folder ([`FileSet::replacing`]): those of a previous
-    /// set that this one does not write are removed at commit.
-    owned: Option<fn(&str) -> bool>,
-    /// Where the previous run of the command listed its set ([`FileSet::replacing_listed`],
-    /// [`FileSet::replacing_recorded`]).
-    previous: Option<Previous>,
+    /// Which of the previous run's files this set replaces ([`FileSet::replacing`]).
+    replaces: Option<Replaces>,
 }
-
-/// The previous set of a command's run, as it was written down.
-#[derive(Debug)]
-enum Previous {
-    /// Its names, read by the command from its manifest.
-    Listed(Vec<String>),
-    /// Its names in the folder's record file of this name, rewritten by every commit.
-    Recorded(String),
-}
-
-/// The largest set record read (a 10 000-frame scene's is about 3 MB): a larger file is not
-/// one this program wrote, and nothing is removed on its word.
-const MAX_RECORD_BYTES: u64 = 64 << 20;
 
 impl FileSet {
     /// A set whose files go into `dir` (an existing folder) on commit. The staging folder is
@@ -262,36 +248,20 @@ impl FileSet {
             written: Vec::new(),
             unsynced: Vec::new(),
             syncing: Vec::new(),
-            owned: None,
-            previous: None,
+            replaces: None,
         })
     }
 
-    /// This set replaces the previous one of its command: at commit, a regular file of the
-    /// folder named as the command names its outputs (`owned`) that this set does not write
-    /// is removed, in the same journalled commit (a 3-frame sequence rerun as 2 frames leaves
-    /// no third frame; a run without depth leaves no old depth file).
-    pub fn replacing(mut self, owned: fn(&str) -> bool) -> Self {
-        self.owned = Some(owned);
-        self
-    }
-
-    /// This set replaces the previous run's, whose names `previous` lists (as its manifest
-    /// recorded them): at commit, a regular file of that list that this set does not write is
-    /// removed, in the same journalled commit. A file the list does not name stays, whatever
-    /// its name (the user's own files in the folder).
-    pub fn replacing_listed(mut self, previous: impl IntoIterator<Item = String>) -> Self {
-        self.previous = Some(Previous::Listed(previous.into_iter().collect()));
-        self
-    }
-
-    /// As [`FileSet::replacing_listed`], for commands that write no manifest: the set's names
-    /// are recorded in the folder's hidden file `.viewsynth.{command}.set` (one name a line,
-    /// renamed with the set, not among the paths [`FileSet::commit`] returns), and the previous
-    /// run's record lists the names to replace. A folder with no record (first run, or written
-    /// by an older version) loses nothing.
-    pub fn replacing_recorded(mut self, command: &str) -> Self {
-        self.previous = Some(Previous::Recorded(record_name(command)));
+    /// This set replaces the previous one of its command: at commit, in the same journalled
+    /// commit as its renames, a file of the previous set (as [`Replaces`] finds it: listed by a
+    /// regular file this program wrote, or for [`Replaces::Owned`] exactly named as the command
+    /// names its files) that this set does not write is removed. A file the list does not name stays,
+    /// whatever its name (the user's own files in the folder). With [`Replaces::Recorded`] the
+    /// set's names are recorded in that hidden file (one name a line, renamed with the set, not
+    /// among the paths [`FileSet::commit`] returns); a folder with no record (first run, or
+    /// written by an older version) loses nothing.
+    pub fn replacing(mut self, replaces: Replaces) -> Self {
+        self.replaces = Some(replaces);
         self
     }
 
@@ -408,7 +378,7 @@ impl FileSet {
         for name in &order {
             check_replaceable(&self.dir.join(name)).map_err(|e| self.final_error_for(name, e))?;
         }
-        let stale = self.stale(&order)?;
+        let stale = self.stale(&order);
         self.sync_written()?;
         let FileSet {
             dir,
@@ -445,7 +415,7 @@ impl FileSet {
                 }
             }
             for name in &stale {
-                remove_stale(&dir.join(name)).map_err(|e| Error::io(final_path(name), e))?;
+                remove_own_file(&dir.join(name)).map_err(|e| Error::io(final_path(name), e))?;
             }
             // Make the renames durable; failure to sync the folder is not worth failing the run.
             sync_dir(&dir);
@@ -487,10 +457,10 @@ impl FileSet {
         })
     }
 
-    /// Stages the set's record ([`FileSet::replacing_recorded`]): the names of `order`, which
+    /// Stages the set's record ([`Replaces::Recorded`]): the names of `order`, which
     /// then renames it just before the manifest (if any). Returns its name.
     fn write_record(&mut self, order: &mut Vec<String>) -> Result<Option<String>> {
-        let Some(Previous::Recorded(record)) = &self.previous else {
+        let Some(Replaces::Recorded(record)) = &self.replaces else {
             return Ok(None);
         };
         let record = record.clone();
@@ -503,43 +473,15 @@ impl FileSet {
         Ok(Some(record))
     }
 
-    /// The names the previous run's record or manifest lists (none when unreadable).
-    fn previous_names(&self) -> Vec<String> {
-        match &self.previous {
-            None => Vec::new(),
-            Some(Previous::Listed(names)) => names.clone(),
-            Some(Previous::Recorded(record)) => read_record(&self.dir.join(record)),
-        }
-    }
-
-    /// The regular files of the previous set (see [`FileSet::replacing`],
-    /// [`FileSet::replacing_listed`]) that `order` does not replace, sorted.
-    fn stale(&self, order: &[String]) -> Result<Vec<String>> {
-        let mut stale: Vec<String> = self
-            .previous_names()
-            .into_iter()
-            .filter(|name| {
-                !order.contains(name)
-                    && check_plain_name(name, &self.shown).is_ok()
-                    && fs::symlink_metadata(self.dir.join(name)).is_ok_and(|m| m.is_file())
-            })
-            .collect();
-        stale.sort();
-        stale.dedup();
-        let Some(owned) = self.owned else { return Ok(stale) };
-        for e in fs::read_dir(&self.dir).map_err(|e| Error::io(&self.shown, e))? {
-            let e = e.map_err(|e| Error::io(&self.shown, e))?;
-            let Some(name) = e.file_name().to_str().map(str::to_string) else {
-                continue;
-            };
-            let regular = e.file_type().is_ok_and(|t| t.is_file());
-            if regular && owned(&name) && !order.contains(&name) && check_plain_name(&name, &self.shown).is_ok() {
-                stale.push(name);
-            }
-        }
-        stale.sort();
-        stale.dedup();
-        Ok(stale)
+    /// The files of the previous set (see [`FileSet::replacing`]) that `order` does not
+    /// replace, sorted.
+    fn stale(&self, order: &[String]) -> Vec<String> {
+        let Some(replaces) = &self.replaces else {
+            return Vec::new();
+        };
+        let mut stale = replaces.may_remove(&self.dir);
+        stale.retain(|name| !order.contains(name));
+        stale
     }
 
     fn final_error_for(&self, name: &str, e: Error) -> Error {
@@ -615,7 +557,7 @@ fn roll_forward(dir: &Path, staging: &Path) -> bool {
     };
     for name in journal.lines() {
         if let Some(stale) = name.strip_prefix('/') {
-            if check_plain_name(stale, dir).is_err() || remove_stale(&dir.join(stale)).is_err() {
+            if check_plain_name(stale, dir).is_err() || remove_own_file(&dir.join(stale)).is_err() {
                 return false;
             }
             continue;
@@ -637,39 +579,6 @@ fn roll_forward(dir: &Path, staging: &Path) -> bool {
     }
     sync_dir(dir);
     fs::remove_dir_all(staging).is_ok()
-}
-
-/// The hidden record of a command's set in its folder ([`FileSet::replacing_recorded`]); not
-/// under [`TEMP_PREFIX`], which marks temporaries.
-fn record_name(command: &str) -> String {
-    format!(".viewsynth.{command}.set")
-}
-
-/// The names a set record lists: none when it is missing, not a regular file, too large or not
-/// text (nothing is removed on the word of a file this program did not write).
-fn read_record(path: &Path) -> Vec<String> {
-    let Ok(m) = fs::symlink_metadata(path) else {
-        return Vec::new();
-    };
-    if !m.is_file() || m.len() > MAX_RECORD_BYTES {
-        return Vec::new();
-    }
-    fs::read_to_string(path)
-        .map(|text| text.lines().filter(|l| !l.is_empty()).map(str::to_string).collect())
-        .unwrap_or_default()
-}
-
-/// Removes a previous set's file: gone already is fine, anything but a regular file stays.
-fn remove_stale(path: &Path) -> io::Result<()> {
-    match fs::symlink_metadata(path) {
-        Ok(m) if m.is_file() => match fs::remove_file(path) {
-            Err(e) if e.kind() == io::ErrorKind::NotFound => Ok(()),
-            r => r,
-        },
-        Ok(_) => Ok(()),
-        Err(e) if e.kind() == io::ErrorKind::NotFound => Ok(()),
-        Err(e) => Err(e),
-    }
 }
 
 /// Makes a staging folder in `dir` and takes its lock. A cleaner of another run may take the
@@ -947,7 +856,7 @@ mod tests {
         let dir = scratch_dir("set-record");
         fs::write(dir.join("right_notes.txt"), "the user's").unwrap();
         let run = |names: &[&'static str]| {
-            let mut set = FileSet::new(&dir).unwrap().replacing_recorded("test");
+            let mut set = FileSet::new(&dir).unwrap().replacing(Replaces::recorded("test"));
             for &n in names {
                 set.write(n, text("x")).unwrap();
             }
@@ -969,7 +878,7 @@ mod tests {
         // A file the user made after the first run, under a name the command could write.
         fs::write(dir.join("left_depth.exr"), "the user's").unwrap();
         // A failed rerun removes nothing.
-        let mut set = FileSet::new(&dir).unwrap().replacing_recorded("test");
+        let mut set = FileSet::new(&dir).unwrap().replacing(Replaces::recorded("test"));
         set.write("left_rgb.png", text("y")).unwrap();
         drop(set);
         assert_eq!(list_dir(&dir).len(), 6);
@@ -987,12 +896,10 @@ mod tests {
             fs::read_to_string(dir.join(".viewsynth.test.set")).unwrap(),
             "left_rgb.png\n"
         );
-        // A listed set: its names go, unless written again; others stay.
-        let mut set = FileSet::new(&dir).unwrap().replacing_listed([
-            "left_rgb.png".to_string(),
-            "../x".to_string(),
-            "gone.png".to_string(),
-        ]);
+        // A set its manifest lists: its names go, unless written again; others stay.
+        fs::write(dir.join("manifest.json"), "left_rgb.png\n../x\ngone.png").unwrap();
+        let lines = |text: &str| text.lines().map(str::to_string).collect();
+        let mut set = FileSet::new(&dir).unwrap().replacing(Replaces::Manifest(lines));
         set.write("manifest.json", text("{}")).unwrap();
         set.commit().unwrap();
         assert_eq!(

@@ -51,8 +51,10 @@ pub use depth_values::{
     check_usable_depth, clear_unusable_depth, usable_depth_value, MAX_DEPTH_VALUE, MIN_DEPTH_VALUE,
 };
 pub use encoding::{Encoding, ExrCompression, PngCompression};
+pub(crate) use file_set::remove_own_file;
 pub use file_set::{
-    remove_orphan_temporaries, write_paths_all_or_none, FileSet, FileWriter, OutDir, PathWriter, MANIFEST_NAME,
+    remove_orphan_temporaries, write_paths_all_or_none, FileSet, FileWriter, OutDir, PathWriter, Replaces,
+    MANIFEST_NAME,
 };
 pub use image_types::{valid_fraction, DepthMap, Mask, RgbImage, MAX_DIMENSION};
 pub(crate) use input::{check_file_len, open_regular};

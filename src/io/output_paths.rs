@@ -6,6 +6,7 @@
 //! device or FIFO (`/dev/null`, `/dev/stdout`) is written in place, never replaced, and two
 //! outputs may share one. Refusals name both options and the path.
 
+use super::file_set::Replaces;
 use crate::error::{Error, Result};
 use std::fs;
 use std::os::unix::fs::{FileTypeExt, MetadataExt};
@@ -76,14 +77,22 @@ pub fn check_outputs(inputs: &[NamedPath<'_>], outputs: &[NamedPath<'_>]) -> Res
     Ok(())
 }
 
-/// Refuses an `--out-dir` run whose files would replace one of `inputs`: an input directly in
-/// the folder under a name the run writes (`writes(name)`), or a name the run writes that is
-/// already the input's file under another name (a hard link, a symlink).
-pub fn check_out_dir(out_dir: &Path, writes: impl Fn(&str) -> bool, inputs: &[NamedPath<'_>]) -> Result<()> {
+/// Refuses an `--out-dir` run whose files would replace or remove one of `inputs`: an input
+/// directly in the folder under a name the run writes (`writes(name)`) or may remove as a file
+/// of the previous run's set (`replaces`, the one deletion rule), or such a name that is already
+/// the input's file under another name (a hard link, a symlink).
+pub fn check_out_dir(
+    out_dir: &Path,
+    writes: impl Fn(&str) -> bool,
+    replaces: &Replaces,
+    inputs: &[NamedPath<'_>],
+) -> Result<()> {
     // A folder not made yet holds no input.
     let Ok(dir) = fs::canonicalize(out_dir) else {
         return Ok(());
     };
+    let removes = replaces.may_remove(&dir);
+    let writes = |name: &str| writes(name) || removes.iter().any(|n| n == name);
     let ins: Vec<_> = inputs
         .iter()
         .filter_map(|&(o, p)| input_key(p).map(|k| (o, p, k)))
@@ -146,6 +155,7 @@ mod tests {
         fs::hard_link(&a, dir.join("hard.png")).unwrap();
         let x = dir.join("x.png");
         let inputs = [("--a-rgb", a.as_path())];
+        let none = Replaces::recorded("none");
         // The same name twice, even spelled differently.
         let e = check_outputs(&inputs, &[("--diff", &x), ("--json", &dir.join("./x.png"))]).unwrap_err();
         assert!(
@@ -164,17 +174,25 @@ mod tests {
         let null = Path::new("/dev/null");
         assert!(check_outputs(&inputs, &[("--diff", null), ("--json", null)]).is_ok());
         // An out-dir that would write one of its inputs' names.
-        let e = check_out_dir(&dir, |n| n.starts_with("a."), &inputs)
+        let e = check_out_dir(&dir, |n| n.starts_with("a."), &none, &inputs)
             .unwrap_err()
             .to_string();
         assert!(e.contains("--out-dir") && e.contains("--a-rgb"), "{e}");
-        assert!(check_out_dir(&dir, |n| n.starts_with("s2_"), &inputs).is_ok());
-        assert!(check_out_dir(&dir.join("missing"), |_| true, &inputs).is_ok());
+        assert!(check_out_dir(&dir, |n| n.starts_with("s2_"), &none, &inputs).is_ok());
+        assert!(check_out_dir(&dir.join("missing"), |_| true, &none, &inputs).is_ok());
         // A name the run writes that is the input under another name: a hard link, a symlink.
         for alias in ["hard.png", "link.png"] {
-            let e = check_out_dir(&dir, |n| n == alias, &inputs).unwrap_err().to_string();
+            let e = check_out_dir(&dir, |n| n == alias, &none, &inputs)
+                .unwrap_err()
+                .to_string();
             assert!(e.contains(alias) && e.contains("--a-rgb"), "{alias}: {e}");
         }
-        assert!(check_out_dir(&dir, |n| n == "x.png", &inputs).is_ok());
+        assert!(check_out_dir(&dir, |n| n == "x.png", &none, &inputs).is_ok());
+        // An input the previous run's set lists: removed at commit if not written again.
+        std::fs::write(dir.join(".viewsynth.t.set"), "a.png\n").unwrap();
+        let e = check_out_dir(&dir, |n| n == "x.png", &Replaces::recorded("t"), &inputs)
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("--out-dir") && e.contains("--a-rgb"), "{e}");
     }
 }

@@ -129,7 +129,7 @@ impl SceneJob {
             )));
         }
         if let SceneSource::File(path) = &scene {
-            io::check_out_dir(&o.out_dir, writes, &[("--scene", path)]).map_err(ArgError::Invalid)?;
+            io::check_out_dir(&o.out_dir, writes, &replaced(), &[("--scene", path)]).map_err(ArgError::Invalid)?;
         }
         let mut rig = StereoRig::demo(o.width, o.height);
         rig.camera.validate("scene camera")?;
@@ -184,7 +184,7 @@ impl SceneJob {
         let (rig, conv) = (&self.rig, self.conventions);
         let (width, height) = (rig.camera.width, rig.camera.height);
         let out = io::OutDir::prepare(&self.out_dir)?;
-        let mut set = out.file_set()?.replacing_recorded("scene");
+        let mut set = out.file_set()?.replacing(replaced());
         let gpu = host.open_device(&self.gpu, self.backend)?;
         let mut renderer = SceneRenderer::new(&gpu, scene)?;
         let proj = gl_projection(&rig.camera, &rig.planes, &conv);
@@ -324,6 +324,12 @@ fn write_json(set: &mut io::FileSet, name: &str, path: &Path, value: &serde_json
         w.write_all(text.as_bytes()).map_err(|e| crate::Error::io(path, e))
     })?;
     Ok(())
+}
+
+/// What a run's set replaces: the files the previous run's record lists (the one deletion rule,
+/// [`io::Replaces`]).
+fn replaced() -> io::Replaces {
+    io::Replaces::recorded("scene")
 }
 
 #[cfg(test)]

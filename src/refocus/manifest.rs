@@ -270,16 +270,15 @@ pub fn write_output(dir: &Path, scale: f64, out: &RefocusOutput, files: &FileFor
     Ok(entry)
 }
 
-/// The files the previous run's `manifest.json` in `dir` lists (its `files`), for the set that
-/// replaces it ([`FileSet::replacing_listed`]): none when there is no manifest, or one this
-/// program did not write (not a regular file, far too large, not JSON with `files`).
-pub fn previous_files(dir: &Path) -> Vec<String> {
-    let path = dir.join(io::MANIFEST_NAME);
-    // A manifest is a few kB (a few MB for thousands of targets).
-    let Ok(text) = io::read_text(&path, 16 << 20) else {
-        return Vec::new();
-    };
-    let Ok(m) = serde_json::from_str::<serde_json::Value>(&text) else {
+/// What a frame's set replaces: the files its folder's previous `manifest.json` lists, read by
+/// the library's one deletion rule ([`io::Replaces`]: a regular file, never a symlink).
+pub fn replaced() -> io::Replaces {
+    io::Replaces::Manifest(listed_files)
+}
+
+/// The files a manifest's text lists (its `files`): none when it is not JSON with `files`.
+fn listed_files(text: &str) -> Vec<String> {
+    let Ok(m) = serde_json::from_str::<serde_json::Value>(text) else {
         return Vec::new();
     };
     m.get("files")
@@ -294,14 +293,16 @@ pub fn previous_files(dir: &Path) -> Vec<String> {
 /// each target's files through the output layer ([`write_target`], in the order `targets`
 /// yields them, so a caller may render each as it is asked for), then their records and
 /// `manifest.json` (written last and renamed last: its presence marks the frame finished for
-/// resume), and commits the set. `written` hears each target once its files are staged. A
-/// failure leaves the previous run's files untouched.
+/// resume), and commits the set. `written` hears each target once its files are staged,
+/// `before_commit` runs once all are (the batch removes its index then). A failure leaves the
+/// previous run's files untouched.
 pub fn write_frame(
     mut set: FileSet,
     mut manifest: Manifest,
     targets: impl IntoIterator<Item = Result<(String, f64, RefocusOutput)>>,
     files: &FileFormats,
     mut written: impl FnMut(),
+    before_commit: impl FnOnce() -> Result<()>,
 ) -> Result<Manifest> {
     for target in targets {
         let (tag, scale, out) = target?;
@@ -315,6 +316,7 @@ pub fn write_frame(
         use std::io::Write;
         w.write_all(text.as_bytes()).map_err(|e| Error::io(&path, e))
     })?;
+    before_commit()?;
     set.commit()?;
     Ok(manifest)
 }

@@ -33,7 +33,7 @@ fn ok(args: &[&str]) {
 }
 
 /// A `w` x `h` colour PNG and NPY depth map named `{stem}_rgb.png`, `{stem}_depth.npy`.
-fn frame(dir: &Path, stem: &str, w: u32, h: u32) -> (PathBuf, PathBuf) {
+pub(crate) fn frame(dir: &Path, stem: &str, w: u32, h: u32) -> (PathBuf, PathBuf) {
     let rgb: Vec<u8> = (0..w * h * 3).map(|i| (i % 251) as u8).collect();
     let (r, d) = (
         dir.join(format!("{stem}_rgb.png")),
@@ -46,7 +46,7 @@ fn frame(dir: &Path, stem: &str, w: u32, h: u32) -> (PathBuf, PathBuf) {
 }
 
 /// The 16 x 12 rig every frame of these tests is seen with.
-const K: [&str; 8] = ["--fx", "16", "--fy", "16", "--cx", "7.5", "--cy", "5.5"];
+pub(crate) const K: [&str; 8] = ["--fx", "16", "--fy", "16", "--cx", "7.5", "--cy", "5.5"];
 
 /// One hostile command line: `args` writes over the input its option `input` names (so the
 /// refusal must name `input` and `output`); `keep` must be unchanged after.

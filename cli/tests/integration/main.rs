@@ -26,6 +26,7 @@ mod cyclopean_dense;
 mod cyclopean_fill;
 mod cyclopean_real;
 mod cyclopean_temporal;
+mod deletion;
 mod device_choice;
 mod gl_objects;
 mod gpu_context;

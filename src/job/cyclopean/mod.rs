@@ -26,11 +26,17 @@ pub use sequence::{load_sequence, CyclopeanSequenceJob, SequenceFrame, MAX_SEQUE
 /// The files of each eye's matcher confidence (`--confidence`), left then right.
 pub const CONFIDENCE_FILES: [&str; 2] = ["left_confidence.exr", "right_confidence.exr"];
 
-/// Whether `name` is one this command writes into its folder: a pair's files and a
-/// sequence's frames all start with `middle_`, beside the confidence files. A run's set replaces
-/// the previous run's files of these names ([`io::FileSet::replacing`]).
+/// Whether `name` is one this command may write into its folder: a pair's files and a
+/// sequence's frames all start with `middle_`, beside the confidence files. No input may have
+/// such a name there.
 pub(crate) fn owned_name(name: &str) -> bool {
     name.starts_with("middle_") || CONFIDENCE_FILES.contains(&name)
+}
+
+/// What a run's set replaces: the files the previous run's record lists (the one deletion rule,
+/// [`io::Replaces`]), never a file merely named as this command names its outputs.
+pub(crate) fn replaced() -> io::Replaces {
+    io::Replaces::recorded("cyclopean")
 }
 
 /// How the middle view is synthesised.
@@ -183,7 +189,7 @@ impl CyclopeanJob {
             ]);
         }
         inputs.extend(o.cameras.as_deref().map(|c| ("--cameras", c)));
-        io::check_out_dir(&o.out_dir, owned_name, &inputs).map_err(ArgError::Invalid)?;
+        io::check_out_dir(&o.out_dir, owned_name, &replaced(), &inputs).map_err(ArgError::Invalid)?;
         Ok(CyclopeanJob {
             left_rgb: o.left_rgb,
             right_rgb: o.right_rgb,
@@ -213,7 +219,7 @@ impl CyclopeanJob {
         let device = host.open_device(&self.gpu, self.backend)?;
         let view = self.render(&device, host, None)?;
         let out_dir = io::OutDir::prepare(&self.out_dir)?;
-        let mut set = out_dir.file_set()?.replacing(owned_name);
+        let mut set = out_dir.file_set()?.replacing(replaced());
         crate::output::write_view(
             &mut set,
             &io::ViewNames::tagged("middle"),

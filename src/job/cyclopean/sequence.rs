@@ -181,7 +181,7 @@ impl CyclopeanSequenceJob {
                 None => set.insert(
                     io::OutDir::prepare(self.out_dir())?
                         .file_set()?
-                        .replacing(super::owned_name),
+                        .replacing(super::replaced()),
                 ),
             };
             let names = io::ViewNames::tagged(&format!("middle_{k:05}"));

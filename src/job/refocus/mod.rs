@@ -10,7 +10,7 @@ use super::error::InContext;
 use super::{ArgError, Backend, Event, GpuRequest, Host, JobError, PerFrameOption, SourceIntrinsics};
 use crate::convention::Conventions;
 use crate::io::{self, DepthDecode, DepthSummary};
-use crate::refocus::batch::{load_manifest, run_batch, BatchOptions, BatchSummary, Shard};
+use crate::refocus::batch::{is_index_name, load_manifest, run_batch, BatchOptions, BatchSummary, Shard};
 use crate::refocus::manifest::{self as job, Manifest};
 use crate::refocus::{RefocusSource, Refocuser};
 use std::path::PathBuf;
@@ -105,7 +105,7 @@ impl RefocusCommand {
             |name: &str| name == io::MANIFEST_NAME || plan.tags.iter().any(|t| name.starts_with(&format!("{t}_")));
         let mut inputs = vec![("--rgb", rgb.as_path()), ("--depth", depth.as_path())];
         inputs.extend(o.intrinsics_file.as_deref().map(|p| ("--intrinsics", p)));
-        io::check_out_dir(&o.out_dir, writes, &inputs).map_err(ArgError::Invalid)?;
+        io::check_out_dir(&o.out_dir, writes, &job::replaced(), &inputs).map_err(ArgError::Invalid)?;
         Ok(RefocusCommand::Frame(RefocusJob {
             rgb,
             depth,
@@ -166,8 +166,7 @@ impl RefocusJob {
         // All targets and the manifest, or (on any failure) none: earlier runs' files stay.
         // The previous run's set, as its manifest lists it, goes where this one does not
         // write the same names (fewer scales, no depth): the folder holds this run's set.
-        let previous = job::previous_files(out_dir.real_path());
-        let set = out_dir.file_set()?.replacing_listed(previous);
+        let set = out_dir.file_set()?.replacing(job::replaced());
         let manifest = Manifest::of_frame(
             src.camera(),
             plan.method,
@@ -185,7 +184,7 @@ impl RefocusJob {
                 let out = refocuser.render(target)?;
                 Ok((tag.clone(), *scale, out))
             });
-        let manifest = job::write_frame(set, manifest, targets, files, || host.event(Event::Advanced))?;
+        let manifest = job::write_frame(set, manifest, targets, files, || host.event(Event::Advanced), || Ok(()))?;
         host.event(Event::Finished);
         Ok(RefocusReport {
             manifest,
@@ -244,8 +243,15 @@ impl RefocusBatchJob {
     /// inputs: the manifest under an index name in --out-dir, or a frame's colour or depth
     /// under a name its folder `<out-dir>/<name>/` gets (by identity, as for one frame).
     fn check_outputs(&self, frames: &[crate::refocus::batch::BatchFrame]) -> Result<(), JobError> {
-        let index = |n: &str| n.starts_with("index.") && n.ends_with(".jsonl");
-        io::check_out_dir(&self.out_dir, index, &[("--batch", self.manifest.as_path())]).map_err(ArgError::Invalid)?;
+        // The index's own names are written and (those of other runs) removed at the root.
+        let index = is_index_name;
+        io::check_out_dir(
+            &self.out_dir,
+            index,
+            &io::Replaces::Owned(index),
+            &[("--batch", self.manifest.as_path())],
+        )
+        .map_err(ArgError::Invalid)?;
         for frame in frames {
             let name = frame.name.as_deref().unwrap_or_default();
             let (_, tags) = self.options.frame_targets(name);
@@ -254,7 +260,8 @@ impl RefocusBatchJob {
                 ("--batch rgb", frame.rgb.as_path()),
                 ("--batch depth", frame.depth.as_path()),
             ];
-            io::check_out_dir(&self.out_dir.join(name), writes, &inputs).map_err(ArgError::Invalid)?;
+            io::check_out_dir(&self.out_dir.join(name), writes, &job::replaced(), &inputs)
+                .map_err(ArgError::Invalid)?;
         }
         Ok(())
     }

@@ -213,7 +213,7 @@ impl ReprojectJob {
         let mut inputs = vec![("--color", o.color.as_path()), ("--depth", o.depth.as_path())];
         inputs.extend(o.intrinsics_file.as_deref().map(|p| ("--intrinsics", p)));
         inputs.extend(o.cameras.as_deref().map(|p| ("--cameras", p)));
-        io::check_out_dir(&o.out_dir, writes, &inputs).map_err(ArgError::Invalid)?;
+        io::check_out_dir(&o.out_dir, writes, &replaced(), &inputs).map_err(ArgError::Invalid)?;
         Ok(ReprojectJob {
             decode: DepthDecode {
                 scale: o.depth_scale,
@@ -259,7 +259,7 @@ impl ReprojectJob {
         let results = request::render_targets(&gpu, &src, &targets, self.params)?;
         let (width, height) = (src.color.width, src.color.height);
         // Every target's files through the output layer, all or none.
-        let mut set = out_dir.file_set()?.replacing_recorded("reproject");
+        let mut set = out_dir.file_set()?.replacing(replaced());
         let mut reports = Vec::with_capacity(results.len());
         for RenderedTarget {
             to,
@@ -425,6 +425,12 @@ fn camera_file_views(o: &ReprojectOptions, path: &Path) -> Result<Views, ArgErro
         from,
         to,
     })
+}
+
+/// What a run's set replaces: the files the previous run's record lists (the one deletion rule,
+/// [`io::Replaces`]).
+fn replaced() -> io::Replaces {
+    io::Replaces::recorded("reproject")
 }
 
 #[cfg(test)]

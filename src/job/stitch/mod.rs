@@ -66,7 +66,7 @@ fn check_faces_against_outputs(faces: &std::path::Path, out_dir: &std::path::Pat
         .collect();
     let inputs: Vec<io::NamedPath<'_>> = files.iter().map(|p| ("--faces", p.as_path())).collect();
     let writes = |name: &str| OUTPUT_NAMES.iter().any(|n| io::ViewNames::named(n, "").may_write(name));
-    io::check_out_dir(out_dir, writes, &inputs).map_err(ArgError::Invalid)
+    io::check_out_dir(out_dir, writes, &replaced(), &inputs).map_err(ArgError::Invalid)
 }
 
 /// What face depth files hold.
@@ -289,7 +289,7 @@ impl StitchJob {
         };
         // Colour-only views through the output layer, all or none.
         let colour = io::FileFormats::of(io::OutputSet::RGB);
-        let mut set = out_dir.file_set()?.replacing_recorded("stitch");
+        let mut set = out_dir.file_set()?.replacing(replaced());
         let mut whole = ViewOutput::color_only(img, None);
         crate::output::write_view(&mut set, &io::ViewNames::named("ods_top_bottom", ""), &whole, &colour)?;
         if let Some([l, r]) = eyes {
@@ -335,6 +335,12 @@ impl StitchJob {
             score: score_eyes([&el, &er], [&tl, &tr], &band),
         })
     }
+}
+
+/// What a run's set replaces: the files the previous run's record lists (the one deletion rule,
+/// [`io::Replaces`]).
+fn replaced() -> io::Replaces {
+    io::Replaces::recorded("stitch")
 }
 
 #[cfg(test)]

@@ -9,12 +9,16 @@
 //! `index.jsonl` (so the last shard to finish joins; `viewsynth index OUT` joins by hand). Parts
 //! and the index are written atomically.
 //!
-//! A run that rewrites frames first removes what could list them ([`invalidate`]): the joined
-//! index, its own part and the parts of other shard counts. A frame redone with other settings
-//! loses its previous files, so an index kept from an earlier run would name files that are gone
-//! once such a run is killed. The parts of the other shards of its own count stay: they list
-//! frames this run does not touch. The resumed run writes its part again and joins.
+//! A run that rewrites frames removes what could list them ([`Invalidation`]): the joined
+//! index, its own part and the parts of other shard counts, just before its first frame's set
+//! is committed (never earlier: a run whose every frame fails leaves the index as it was). A
+//! frame redone with other settings loses its previous files, so an index kept from an earlier
+//! run would name files that are gone once such a run is killed. The parts of the other shards
+//! of its own count stay: they list frames this run does not touch. The resumed run writes its
+//! part again and joins. Only the index's exact names ([`super::index_names`]) are touched, and
+//! only regular files.
 
+use super::index_names::{parse_part_name, part_name, INDEX_NAME};
 use super::resume::frame_settings;
 use super::{BatchFrame, BatchOptions};
 use crate::camera::Intrinsics;
@@ -24,9 +28,6 @@ use std::path::{Path, PathBuf};
 
 /// Missing parts named at most in `viewsynth index`'s refusal (the rest are counted).
 const MISSING_NAMED: usize = 8;
-
-/// The joined index's file name, at the out-dir's root.
-pub const INDEX_NAME: &str = "index.jsonl";
 
 /// One target of one frame.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -55,20 +56,6 @@ pub struct IndexRow {
     pub mask: Option<String>,
     /// The frame's manifest, relative to the out-dir.
     pub manifest: String,
-}
-
-/// A part's file name.
-fn part_name(index: usize, count: usize) -> String {
-    format!("index.part-{index}-of-{count}.jsonl")
-}
-
-/// (K, N) of a part's file name.
-fn parse_part_name(name: &str) -> Option<(usize, usize)> {
-    let rest = name.strip_prefix("index.part-")?.strip_suffix(".jsonl")?;
-    let (k, n) = rest.split_once("-of-")?;
-    let (k, n): (usize, usize) = (k.parse().ok()?, n.parse().ok()?);
-    // A part K >= N is no shard's (a stray file): not counted.
-    (k < n).then_some((k, n))
 }
 
 /// The rows of one finished frame: its manifest, when it records `settings`.
@@ -153,11 +140,44 @@ pub fn write_part(root: &Path, frames: &[BatchFrame], opts: &BatchOptions) -> Re
     Ok(None)
 }
 
-/// Before a run rewrites any frame: remove `index.jsonl`, this run's part (K/N its shard, 0/1
+/// The removal of the index files that could list a frame this run rewrites ([`invalidate`]),
+/// done once, by whichever frame is committed first (encoders commit on several threads).
+pub(super) struct Invalidation<'a> {
+    root: &'a Path,
+    opts: &'a BatchOptions,
+    done: std::sync::Mutex<bool>,
+}
+
+impl<'a> Invalidation<'a> {
+    pub(super) fn new(root: &'a Path, opts: &'a BatchOptions) -> Self {
+        Invalidation {
+            root,
+            opts,
+            done: std::sync::Mutex::new(false),
+        }
+    }
+
+    /// Called with a frame's set staged, before its commit: the first call removes the files.
+    pub(super) fn before_commit(&self) -> Result<()> {
+        let mut done = self.done.lock().unwrap_or_else(|e| e.into_inner());
+        if !*done {
+            invalidate(self.root, self.opts)?;
+            *done = true;
+        }
+        Ok(())
+    }
+
+    /// Whether the index files were removed (a frame was committed, or about to be).
+    pub(super) fn happened(&self) -> bool {
+        *self.done.lock().unwrap_or_else(|e| e.into_inner())
+    }
+}
+
+/// Before a run replaces any frame: remove `index.jsonl`, this run's part (K/N its shard, 0/1
 /// unsharded) and every part of another shard count, which may list the frames it rewrites. Done
-/// before the first frame is written, so a run killed at any point leaves no row naming a file
+/// before the first frame is committed, so a run killed at any point leaves no row naming a file
 /// it replaced; the parts of the other shards of N list only their own frames and stay.
-pub fn invalidate(root: &Path, opts: &BatchOptions) -> Result<()> {
+fn invalidate(root: &Path, opts: &BatchOptions) -> Result<()> {
     let (k, n) = opts.shard.map_or((0, 1), |s| (s.index, s.count));
     let entries = std::fs::read_dir(root).map_err(|e| Error::io(root, e))?;
     for e in entries {
@@ -174,12 +194,10 @@ pub fn invalidate(root: &Path, opts: &BatchOptions) -> Result<()> {
     Ok(())
 }
 
-/// Remove one index file (gone already is fine: another shard may have removed it).
+/// Remove one index file, if a regular file (gone already is fine: another shard may have
+/// removed it).
 fn remove(path: &Path) -> Result<()> {
-    match std::fs::remove_file(path) {
-        Err(e) if e.kind() != std::io::ErrorKind::NotFound => Err(Error::io(path, e)),
-        _ => Ok(()),
-    }
+    crate::io::remove_own_file(path).map_err(|e| Error::io(path, e))
 }
 
 /// Write `index.jsonl` over the whole of `frames` (the full manifest, shards ignored) as they
@@ -259,16 +277,4 @@ pub fn join_index(root: &Path) -> Result<(PathBuf, usize)> {
 /// Read `index.jsonl` (or a part).
 pub fn read_index(path: &Path) -> Result<Vec<IndexRow>> {
     read_rows(path)
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn part_names_round_trip() {
-        assert_eq!(parse_part_name(&part_name(3, 8)), Some((3, 8)));
-        assert_eq!(parse_part_name("index.jsonl"), None);
-        assert_eq!(parse_part_name("index.part-x-of-2.jsonl"), None);
-    }
 }

@@ -1,6 +1,7 @@
 //! The batch manifest: a CSV or JSON list of frames, streamed from the file (see the
 //! module notes of [`super`]).
 
+use super::index_names::is_index_name;
 use crate::camera::Intrinsics;
 use crate::error::{Error, Result};
 use serde::Deserialize;
@@ -110,7 +111,8 @@ pub fn load_manifest(path: &Path) -> Result<Vec<BatchFrame>> {
             return Err(Error::decode(
                 path,
                 format!(
-                    "frame {i}: name '{}' is empty, hidden, longer than 255 bytes or repeated",
+                    "frame {i}: name '{}' is empty, hidden, longer than 255 bytes, one of the index's names \
+                     (index.jsonl, index.part-K-of-N.jsonl) or repeated",
                     crate::error::excerpt(&name)
                 ),
             ));
@@ -128,10 +130,16 @@ pub fn frame_folder_name(name: &str) -> String {
 
 /// Whether `name` is one safe folder inside the output folder as it stands: non-empty, not
 /// hidden (no leading '.', so never `.` or `..`), at most 255 bytes (NAME_MAX, so a huge name is
-/// refused before any write) and only ASCII letters, digits, '-', '_', '.'. A manifest's names
-/// are made so ([`frame_folder_name`]); frames named by a caller (Python's refocus_batch) must be.
+/// refused before any write), only ASCII letters, digits, '-', '_', '.', and not one of the
+/// index's names at the out-dir root ([`is_index_name`]: a folder there would break every
+/// later index write). A manifest's names are made so ([`frame_folder_name`]) or refused;
+/// frames named by a caller (Python's refocus_batch) must be.
 pub fn is_frame_folder_name(name: &str) -> bool {
-    !name.is_empty() && !name.starts_with('.') && name.len() <= 255 && name.chars().all(folder_char)
+    !name.is_empty()
+        && !name.starts_with('.')
+        && name.len() <= 255
+        && name.chars().all(folder_char)
+        && !is_index_name(name)
 }
 
 fn folder_char(c: char) -> bool {
@@ -288,7 +296,17 @@ mod tests {
             assert!(is_frame_folder_name(ok), "{ok}");
             assert_eq!(frame_folder_name(ok), ok);
         }
-        for bad in ["", ".hidden", "..", "a/b", "../up", "ü", "a b"] {
+        for bad in [
+            "",
+            ".hidden",
+            "..",
+            "a/b",
+            "../up",
+            "ü",
+            "a b",
+            "index.jsonl",
+            "index.part-0-of-2.jsonl",
+        ] {
             assert!(!is_frame_folder_name(bad), "{bad:?}");
         }
         assert!(!is_frame_folder_name(&"a".repeat(256)));

@@ -19,12 +19,14 @@
 //! [`pipeline`] runs the stages.
 
 mod index;
+mod index_names;
 mod manifest;
 mod pipeline;
 mod resume;
 mod zoom;
 
-pub use index::{join_index, read_index, write_index, IndexRow, INDEX_NAME};
+pub use index::{join_index, read_index, write_index, IndexRow};
+pub use index_names::{is_index_name, INDEX_NAME};
 pub use manifest::{
     frame_folder_name, is_frame_folder_name, load_manifest, BatchFrame, MAX_JSON_MANIFEST_BYTES, MAX_MANIFEST_BYTES,
     MAX_MANIFEST_ROWS, MAX_MANIFEST_ROW_BYTES,

@@ -2,6 +2,7 @@
 //! frame's outputs) -> encode pool, with bounded queues; or every stage in turn on one thread
 //! (`jobs` = 0, the synchronous baseline).
 
+use super::index::Invalidation;
 use super::resume::{frame_finished, frame_settings};
 use super::{BatchFrame, BatchOptions, MAX_JOBS};
 use crate::error::{Error, Result};
@@ -80,13 +81,12 @@ struct WriteJob {
 /// Write a frame's files as one all-or-none set: staged, then renamed into the frame's folder
 /// (a plain folder inside --out-dir, never a symlink) with `manifest.json` last. A failure
 /// leaves the previous run's files of this frame untouched.
-fn write_frame(job: WriteJob, files: &FileFormats) -> Result<()> {
+fn write_frame(job: WriteJob, files: &FileFormats, index: &Invalidation<'_>) -> Result<()> {
     let dir = job.root.subdir(&job.name)?;
     // A frame redone (other settings: fewer scales, other outputs) leaves only its new set.
-    let previous = manifest::previous_files(dir.real_path());
-    let set = dir.file_set()?.replacing_listed(previous);
+    let set = dir.file_set()?.replacing(manifest::replaced());
     let targets = job.outputs.into_iter().map(Ok);
-    manifest::write_frame(set, job.manifest, targets, files, || {})?;
+    manifest::write_frame(set, job.manifest, targets, files, || {}, || index.before_commit())?;
     Ok(())
 }
 
@@ -263,11 +263,13 @@ pub fn run_batch(
         }
         todo.push(frame);
     }
-    // Whatever could list a frame this run rewrites goes before the first frame is written (the
-    // end of the run writes the index again).
-    if !todo.is_empty() {
-        super::index::invalidate(root.real_path(), opts)?;
-    }
+    // Whatever could list a frame this run rewrites goes just before the first frame is
+    // committed (the end of the run writes the index again); a run whose frames all fail
+    // removes nothing.
+    let invalidation = Invalidation::new(root.real_path(), opts);
+    // The index is written again unless every frame this run tried failed before its commit:
+    // then the folder stays as it was, index included.
+    let index_again = |summary: &BatchSummary| opts.index && (summary.failed.is_empty() || invalidation.happened());
     let mut refocuser = Refocuser::with_settings(device, &opts.rule, opts.method, opts.files.outputs, opts.conv)?;
     refocuser.set_rgb_everywhere(opts.rgb_everywhere);
     let files = opts.files;
@@ -302,7 +304,7 @@ pub fn run_batch(
                 .and_then(|f| collect_frame(f, &mut stages));
             match result.and_then(|job| {
                 let (t0, c0) = (Instant::now(), crate::cpu_time::process_cpu_ms());
-                let r = write_frame(job, &files).map_err(|e| (name.clone(), e));
+                let r = write_frame(job, &files, &invalidation).map_err(|e| (name.clone(), e));
                 stages.encode.push(ms_since(t0));
                 stages.encode_cpu.extend(cpu_ms_since(c0));
                 r
@@ -314,7 +316,7 @@ pub fn run_batch(
         }
         summary.frames_in_flight = 1;
         summary.stages = stages;
-        if opts.index {
+        if index_again(&summary) {
             summary.index = super::index::write_part(root.real_path(), frames, opts)?;
         }
         warned(&mut summary, warnings);
@@ -346,13 +348,13 @@ pub fn run_batch(
         let (job_tx, job_rx) = mpsc::sync_channel::<WriteJob>(jobs);
         let job_rx = Arc::new(Mutex::new(job_rx));
         for _ in 0..jobs {
-            let (rx, tx) = (job_rx.clone(), result_tx.clone());
+            let (rx, tx, invalidation) = (job_rx.clone(), result_tx.clone(), &invalidation);
             scope.spawn(move || loop {
                 let next = rx.lock().map(|r| r.recv());
                 let Ok(Ok(job)) = next else { break };
                 let name = job.name.clone();
                 let t0 = Instant::now();
-                let r = write_frame(job, &files);
+                let r = write_frame(job, &files, invalidation);
                 let _ = tx.send((name, r, ms_since(t0)));
             });
         }
@@ -425,7 +427,7 @@ pub fn run_batch(
         }
     });
     summary.stages = stages;
-    if opts.index {
+    if index_again(&summary) {
         summary.index = super::index::write_part(root.real_path(), frames, opts)?;
     }
     warned(&mut summary, warnings);
