@@ -279,3 +279,20 @@ fn gl_against_vulkan_at_640x480_one_stray_pixel_and_the_missing_conventions() {
     assert!(j["flip_mean"].as_f64().is_some_and(|m| (0.0..0.01).contains(&m)), "{j}");
     assert_eq!(viewsynth::io::load_rgb(&flip).unwrap().width, 640);
 }
+
+/// Gates never pass on nothing: B's depth all NaN leaves no pixel valid in both, so the share
+/// gate fails naming why (it once passed, gating colour alone).
+#[test]
+fn the_share_gate_fails_when_no_depth_was_compared() {
+    let d = scratch("cmp-nan");
+    let a = side(&d, "a", 100, 2.0);
+    let b_nan = d.join("b_nan.exr");
+    io::save_depth_exr(&b_nan, &DepthMap::new(8, 2, vec![f32::NAN; 16]).unwrap()).unwrap();
+    let o = compare(&a, &(a.0.clone(), b_nan), &["--max-bad-share", "0.01"]);
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(1), "{err}");
+    assert!(
+        err.contains("threshold broken") && err.contains("no pixel holds valid depth on both sides"),
+        "{err}"
+    );
+}
