@@ -139,3 +139,8 @@ pub fn percent(share: f64) -> String {
         format!("{p:.1e} %")
     }
 }
+
+/// A relative tolerance as a percentage ("1 %", "0.1 %").
+pub(super) fn relative(tolerance: f64) -> String {
+    format!("{} %", (tolerance * 100.0 * 1e6).round() / 1e6)
+}
