@@ -223,8 +223,9 @@ impl CompareJob {
             if let (Some(path), Some(depth)) = (&opts.depth, &side.depth) {
                 let s = name.to_lowercase();
                 let hint = format!(
-                    "check what {name}'s file holds: --{s}-depth-kind view-z (metres) or device (window \
-                     depth, with --{s}-near and --{s}-far; --{s}-reversed-z if reversed), and that it is \
+                    "check what {name}'s file holds: metres (`--{s}-depth-kind view-z`), window depth \
+                     (`--{s}-depth-kind device --{s}-near N --{s}-far F`, far may be inf; reversed: \
+                     `--{s}-depth-kind device --{s}-near N --{s}-far F --{s}-reversed-z`), and that it is \
                      depth, not disparity"
                 );
                 host.event(Event::InputDepth {
