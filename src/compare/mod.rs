@@ -67,12 +67,6 @@ impl Side {
     }
 }
 
-impl From<RgbImage> for ColourImage {
-    fn from(img: RgbImage) -> Self {
-        ColourImage::from(&img)
-    }
-}
-
 /// The differences between two renderings, as printed and written to JSON by `compare`.
 #[derive(Debug, Clone, serde::Serialize)]
 pub struct Comparison {

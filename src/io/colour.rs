@@ -35,6 +35,12 @@ impl From<&RgbImage> for ColourImage {
     }
 }
 
+impl From<RgbImage> for ColourImage {
+    fn from(img: RgbImage) -> Self {
+        ColourImage::from(&img)
+    }
+}
+
 /// Loads PNG, JPEG, PPM/PNM or EXR (sniffed from the content) at its own precision: gray is
 /// replicated to RGB, alpha kept apart.
 pub fn load_colour(path: &Path) -> Result<ColourImage> {
