@@ -198,3 +198,62 @@ fn suspicion_names_row_orders_as_the_cli_spells_them() {
         "{s}"
     );
 }
+
+/// The colour check's other readings: premultiplied alpha taken for straight, and sRGB values
+/// declared linear (the reverse of the linear-for-sRGB mistake), each named with its option;
+/// declared right, nothing is named.
+#[test]
+fn premultiplied_alpha_and_srgb_declared_linear_are_named() {
+    use viewsynth::compare::{Alpha, Transfer};
+    use viewsynth::io::ColourImage;
+    let (w, h) = (32u32, 24u32);
+    let rgb: Vec<f32> = (0..w * h)
+        .flat_map(|i| {
+            [
+                (40 + (i % w) * 6) as f32 / 255.0,
+                0.6,
+                (30 + (i / w) * 8) as f32 / 255.0,
+            ]
+        })
+        .collect();
+    let alpha: Vec<f32> = (0..w * h).map(|i| 0.3 + 0.7 * (i % 7) as f32 / 6.0).collect();
+    let side = |rgb: Vec<f32>, alpha: Option<Vec<f32>>| {
+        let color = ColourImage {
+            width: w,
+            height: h,
+            rgb,
+            alpha,
+            bits: 32,
+        };
+        let conv = Conventions {
+            row_order: RowOrder::TopDown,
+            ..Conventions::default()
+        };
+        Side::new(color, None, DepthEncoding::ViewZ, conv)
+    };
+    let a = side(rgb.clone(), None);
+    let premultiplied: Vec<f32> = rgb
+        .chunks_exact(3)
+        .zip(&alpha)
+        .flat_map(|(p, a)| p.iter().map(move |v| v * a))
+        .collect();
+    let mut b = side(premultiplied, Some(alpha));
+    let (c, _) = compare(&a, &b).unwrap();
+    assert!(
+        matches!(&c.suspicions[..], [s] if s.contains("premultiplied alpha") && s.contains("(--b-alpha premultiplied)")),
+        "{:?}",
+        c.suspicions
+    );
+    b.colour.alpha = Alpha::Premultiplied;
+    let (c, _) = compare(&a, &b).unwrap();
+    assert!(c.suspicions.is_empty() && c.max_color_diff < 1e-3, "{c:?}");
+    // sRGB values declared linear: encoded once more than A.
+    let mut b = side(rgb, None);
+    b.colour.transfer = Transfer::Linear;
+    let (c, _) = compare(&a, &b).unwrap();
+    assert!(
+        matches!(&c.suspicions[..], [s] if s.contains("sRGB values where linear is expected") && s.contains("(--b-transfer srgb)")),
+        "{:?}",
+        c.suspicions
+    );
+}
