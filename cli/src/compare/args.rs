@@ -91,7 +91,8 @@ pub(crate) struct CompareArgs {
     ///
     /// Checked for colour (a pixel is bad when a channel differs by more than --bad-colour
     /// levels) and, with depth, for depth (relative error over --bad-depth-rel, pixels valid in
-    /// both). The share over each threshold is in the JSON either way.
+    /// both; with depth files on both sides and no such pixel, it fails: a gate never passes on
+    /// nothing). The share over each threshold is in the JSON either way.
     #[arg(help_heading = THRESHOLDS, long, value_name = "SHARE")]
     max_bad_share: Option<f64>,
     /// Per-pixel colour threshold of --max-bad-share: largest channel difference, 8-bit levels.
