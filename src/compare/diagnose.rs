@@ -1,81 +1,80 @@
-//! Which reading of B's conventions fits A: flipped rows (colour PSNR over all pixels), then
-//! B's depth read every wrong way a renderer's depth is commonly read: reversed-Z toggled, GL NDC
-//! z stored as window depth, linear depth declared device or device depth declared linear, and
-//! (by fits over all pixels) depth in other units, window depth under unknown planes, and
-//! disparity (a line in 1 / Z) in place of depth.
+//! Which reading of B's depth fits A (B's colour is checked in `colour_check.rs`): B's depth
+//! read every wrong way a renderer's depth is commonly read: reversed-Z toggled, GL NDC z stored
+//! as window depth (and the reverse), an infinite far plane read as finite, other planes than
+//! A's, linear depth declared device or device depth declared linear, and (by fits over all
+//! pixels) depth in other units, window depth under unknown planes, and disparity (a line in
+//! 1 / Z) in place of depth.
 //!
 //! Every reading is scored by its agreement: the share of the compared pixels holding depth on
-//! either side where both hold it and agree within 1 %. A share over all pixels does not move
-//! with one pixel, nor with the image size: the maxima this check once used named reversed-Z at
-//! 320x240 and said nothing at 640x480, where one pixel at an edge decided.
+//! either side where both hold it and agree within the tolerance (1 %, or the share gate's
+//! per-pixel threshold when that is tighter: a reading that passes the check must not fail
+//! the gate on every pixel, as an infinite far plane read with far 1000 did). A share over all
+//! pixels does not move with one pixel, nor with the image size: the maxima this check once
+//! used named reversed-Z at 320x240 and said nothing at 640x480, where one pixel at an edge
+//! decided.
 
-use super::{color_error, stored_top_down, to_top_down, view_z, Comparison, Side};
-use crate::convention::{Conventions, RowOrder};
+use super::{stored_top_down, view_z, Side};
+use crate::convention::{DepthPlanes, NdcDepthRange};
 use crate::depth::DepthEncoding;
-use crate::io::{DepthMap, RgbImage};
 
-/// Two readings agree at a pixel within this relative difference.
-const AGREE_REL: f64 = 1e-2;
+/// Two readings agree at a pixel within this relative difference, at most.
+pub(super) const AGREE_REL: f64 = 1e-2;
 /// A reading is named when it agrees on at least this share of the pixels ...
 const NAMED_AGREEMENT: f64 = 0.5;
 /// ... and on this much more of them than the declared reading.
 const NAMED_GAIN: f64 = 0.25;
 
-/// The share of the selected pixels with depth on either side where both agree within 1 %.
-fn agreement(za: &[f64], zb: &[f64], selected: &[bool]) -> f64 {
+/// The share of the selected pixels with depth on either side where both agree within
+/// `tolerance` (relative).
+fn agreement(za: &[f64], zb: &[f64], selected: &[bool], tolerance: f64) -> f64 {
     let (mut either, mut agree) = (0usize, 0usize);
     for ((a, b), _) in za.iter().zip(zb).zip(selected).filter(|(_, s)| **s) {
         if a.is_nan() && b.is_nan() {
             continue;
         }
         either += 1;
-        if (a - b).abs() <= AGREE_REL * a.abs() {
+        if (a - b).abs() <= tolerance * a.abs() {
             agree += 1;
         }
     }
     agree as f64 / either.max(1) as f64
 }
 
-/// Name a reading of B's conventions that fits much better than the declared one.
-pub(super) fn diagnose(
-    a: &Side,
-    b: &Side,
-    ca: &RgbImage,
-    za: Option<&[f64]>,
-    selected: &[bool],
-    declared: &Comparison,
-) -> Option<String> {
-    let other_rows = match b.conv.row_order {
-        RowOrder::BottomUp => RowOrder::TopDown,
-        RowOrder::TopDown => RowOrder::BottomUp,
-    };
-    let (flipped_psnr, _, _) = color_error(ca, &to_top_down(&b.color, other_rows), selected);
-    if flipped_psnr > declared.psnr_db + 10.0 {
-        return Some(format!(
-            "B's rows look flipped: read as {} it matches at {flipped_psnr:.1} dB (declared {}: {:.1} dB)",
-            other_rows.name(),
-            b.conv.row_order.name(),
-            declared.psnr_db
-        ));
+/// A plane as the CLI takes it.
+fn plane(v: f64) -> String {
+    if v.is_infinite() {
+        "inf".into()
+    } else {
+        format!("{v}")
     }
+}
+
+/// Name a reading of B's depth that fits much better than the declared one.
+pub(super) fn diagnose(a: &Side, b: &Side, za: Option<&[f64]>, selected: &[bool], tolerance: f64) -> Option<String> {
     let (za, db) = (za?, b.depth.as_ref()?);
-    let declared_agreement = agreement(za, &view_z(db, b.storage, &b.conv), selected);
+    let declared_agreement = agreement(za, &view_z(db, b.storage, &b.conv, b.ndc_z), selected, tolerance);
     if declared_agreement >= 1.0 - NAMED_GAIN {
         return None;
     }
-    let score = |zb: Vec<f64>| agreement(za, &zb, selected);
+    let score = |zb: Vec<f64>| agreement(za, &zb, selected, tolerance);
     let named = |what: String, share: f64| {
         (share >= NAMED_AGREEMENT && share >= declared_agreement + NAMED_GAIN).then(|| {
             format!(
-                "B's depth fits {what}: {:.1} % of the pixels agree with A within 1 %, {:.1} % as declared",
+                "B's depth fits {what}: {:.1} % of the pixels agree with A within {}, {:.1} % as declared",
                 share * 100.0,
+                super::thresholds::relative(tolerance),
                 declared_agreement * 100.0
             )
         })
     };
-    let best = exact_readings(a, b, db)
+    let best = exact_readings(a, b)
         .into_iter()
-        .map(|(what, storage, conv, depth)| (what, score(view_z(&depth, storage, &conv))))
+        .map(|(what, r)| {
+            (
+                what,
+                score(view_z(db, r.storage, &b.conv_with(r.reversed_z, r.ndc), r.ndc_z)),
+            )
+        })
         .max_by(|x, y| x.1.total_cmp(&y.1));
     if let Some(found) = best.and_then(|(what, share)| named(what, share)) {
         return Some(found);
@@ -89,43 +88,103 @@ pub(super) fn diagnose(
         .and_then(|(what, share)| named(what, share))
 }
 
-/// The wrong readings with a known conversion: (what, storage, conventions, depth as stored).
-fn exact_readings(a: &Side, b: &Side, db: &DepthMap) -> Vec<(String, DepthEncoding, Conventions, DepthMap)> {
+/// One way to read B's depth file.
+struct Reading {
+    storage: DepthEncoding,
+    reversed_z: bool,
+    ndc: NdcDepthRange,
+    ndc_z: bool,
+}
+
+impl Side {
+    fn conv_with(&self, reversed_z: bool, ndc_depth: NdcDepthRange) -> crate::convention::Conventions {
+        crate::convention::Conventions {
+            reversed_z,
+            ndc_depth,
+            ..self.conv
+        }
+    }
+}
+
+/// The wrong readings with a known conversion: (what, with the options that declare it).
+fn exact_readings(a: &Side, b: &Side) -> Vec<(String, Reading)> {
     let mut out = Vec::new();
+    let same = |storage| Reading {
+        storage,
+        reversed_z: b.conv.reversed_z,
+        ndc: b.conv.ndc_depth,
+        ndc_z: b.ndc_z,
+    };
     match b.storage {
-        DepthEncoding::Device { .. } => {
-            let toggled = Conventions {
-                reversed_z: !b.conv.reversed_z,
-                ..b.conv
-            };
+        DepthEncoding::Device { planes } => {
+            let reversed_z = !b.conv.reversed_z;
             out.push((
                 format!(
-                    "reversed-Z {} (declared {}; --b-reversed-z)",
-                    toggled.reversed_z, b.conv.reversed_z
+                    "reversed-Z {reversed_z} (declared {}; {})",
+                    b.conv.reversed_z,
+                    if reversed_z {
+                        "add --b-reversed-z"
+                    } else {
+                        "drop --b-reversed-z"
+                    }
                 ),
-                b.storage,
-                toggled,
-                db.clone(),
+                Reading {
+                    reversed_z,
+                    ..same(b.storage)
+                },
             ));
-            // GL NDC z in [-1, 1] stored where window depth is declared: window = (z + 1) / 2.
-            // (GL and Vulkan NDC ranges give the same window depth for the same planes, so
-            // stored window depth cannot tell --b-ndc apart; NDC z stored in its place can.)
-            let as_window = DepthMap {
-                width: db.width,
-                height: db.height,
-                data: db.data.iter().map(|v| 0.5 * (v + 1.0)).collect(),
-            };
-            out.push((
-                "GL NDC z in [-1, 1] stored instead of window depth (--b-ndc)".to_string(),
-                b.storage,
-                b.conv,
-                as_window,
-            ));
+            if b.ndc_z {
+                out.push((
+                    "window depth, not NDC z (--b-depth-kind device, without --b-ndc)".to_string(),
+                    Reading {
+                        ndc_z: false,
+                        ..same(b.storage)
+                    },
+                ));
+            } else {
+                // GL NDC z in [-1, 1] stored where window depth is declared. (Window depth is
+                // the same function of Z under either NDC range: only stored NDC z tells them
+                // apart.)
+                out.push((
+                    "GL NDC z in [-1, 1] stored instead of window depth (--b-depth-kind ndc --b-ndc gl)".to_string(),
+                    Reading {
+                        ndc_z: true,
+                        ndc: NdcDepthRange::MinusOneToOne,
+                        ..same(b.storage)
+                    },
+                ));
+            }
+            if planes.far.is_finite() {
+                out.push((
+                    format!("an infinite far plane (--b-far inf; declared {})", planes.far),
+                    same(DepthEncoding::Device {
+                        planes: DepthPlanes {
+                            far: f64::INFINITY,
+                            ..planes
+                        },
+                    }),
+                ));
+            }
+            if let DepthEncoding::Device { planes: pa } = a.storage {
+                if pa != planes {
+                    out.push((
+                        format!(
+                            "A's planes (--b-near {} --b-far {}; declared {} / {})",
+                            plane(pa.near),
+                            plane(pa.far),
+                            plane(planes.near),
+                            plane(planes.far)
+                        ),
+                        same(a.storage),
+                    ));
+                }
+            }
             out.push((
                 "view distance in metres, not device depth (--b-depth-kind view-z)".to_string(),
-                DepthEncoding::ViewZ,
-                b.conv,
-                db.clone(),
+                Reading {
+                    ndc_z: false,
+                    ..same(DepthEncoding::ViewZ)
+                },
             ));
         }
         DepthEncoding::ViewZ => {
@@ -133,12 +192,16 @@ fn exact_readings(a: &Side, b: &Side, db: &DepthMap) -> Vec<(String, DepthEncodi
                 for reversed_z in [false, true] {
                     out.push((
                         format!(
-                            "device depth under --near {} --far {}, reversed-Z {reversed_z} (--b-depth-kind device)",
-                            planes.near, planes.far
+                            "device depth under A's planes, reversed-Z {reversed_z} (--b-depth-kind device \
+                             --b-near {} --b-far {}{})",
+                            plane(planes.near),
+                            plane(planes.far),
+                            if reversed_z { " --b-reversed-z" } else { "" }
                         ),
-                        a.storage,
-                        Conventions { reversed_z, ..b.conv },
-                        db.clone(),
+                        Reading {
+                            reversed_z,
+                            ..same(a.storage)
+                        },
                     ));
                 }
             }
@@ -172,15 +235,22 @@ fn fitted_readings(za: &[f64], stored: &[f64], selected: &[bool]) -> Vec<(String
         let zb = stored.iter().map(|v| positive(k / (v - c))).collect();
         let in_unit_range = vs.iter().all(|v| (-1e-6..=1.0 + 1e-6).contains(v));
         let what = if in_unit_range {
-            // w = c + k / Z: standard Z has k < 0 and w(near) = 0, reversed-Z k > 0, w(near) = 1.
-            let (reversed, near) = if k < 0.0 {
-                (false, -k / c)
+            // w = c + k / Z: standard Z has k < 0, w(near) = 0 and w(far) = 1; reversed-Z has
+            // k > 0, w(near) = 1 and w(far) = 0. A far plane past 1e6 near is infinite.
+            let (reversed, near, far) = if k < 0.0 {
+                (false, -k / c, k / (1.0 - c))
             } else {
-                (true, k / (1.0 - c))
+                (true, k / (1.0 - c), -k / c)
+            };
+            let far = if far > 0.0 && far < 1e6 * near {
+                format!("{far:.4}")
+            } else {
+                "inf".into()
             };
             format!(
-                "window depth written with other planes: reversed-Z {reversed}, near ~{near:.4} m \
-                 (--b-depth-kind device, --near/--far, --b-reversed-z)"
+                "window depth written with other planes: reversed-Z {reversed}, near ~{near:.4} m, far ~{far} \
+                 (--b-depth-kind device --b-near {near:.4} --b-far {far}{})",
+                if reversed { " --b-reversed-z" } else { "" }
             )
         } else {
             format!("disparity, not depth: stored = {k:.4} / Z + {c:.3} (a line in 1 / Z)")

@@ -5,11 +5,14 @@
 //! (`flip.rs`), mask agreement, a diff image, and names a reading of B's conventions that fits
 //! far better than the declared one (`diagnose.rs`). CI limits: `thresholds.rs`.
 
+mod colour;
+mod colour_check;
 mod diagnose;
 pub mod distribution;
 pub mod flip;
 mod thresholds;
 
+pub use colour::{srgb_decode, srgb_encode, Alpha, ChannelOrder, ColourReading, Transfer};
 pub use distribution::{ErrorDistribution, ShareOver};
 pub use flip::Flip;
 pub use thresholds::{percent, BadPixel, Thresholds};
@@ -17,7 +20,7 @@ pub use thresholds::{percent, BadPixel, Thresholds};
 use crate::convention::{Conventions, RowOrder};
 use crate::depth::{DepthEncoding, DepthKind};
 use crate::error::{Error, Result};
-use crate::io::{DepthMap, Mask, RgbImage};
+use crate::io::{ColourImage, DepthMap, Mask, RgbImage};
 use crate::metrics;
 
 /// Per-pixel colour thresholds (largest channel difference, 8-bit levels) whose shares are
@@ -28,29 +31,63 @@ pub const DEPTH_REL_REPORTED: [f64; 5] = [1e-5, 1e-4, 1e-3, 1e-2, 1e-1];
 
 /// One side: colour and optional depth as stored in its files (rows in `conv.row_order`).
 pub struct Side {
-    /// Colour, 8-bit RGB.
-    pub color: RgbImage,
+    /// Colour at its file's precision.
+    pub color: ColourImage,
+    /// How the colour is stored (channel order, transfer, alpha).
+    pub colour: ColourReading,
     /// Depth as stored in the file, decoded per `storage`; None compares colour only.
     pub depth: Option<DepthMap>,
     /// What the depth holds (view distance is refused: no rays here).
     pub storage: DepthEncoding,
+    /// Device depth only: the file holds NDC z in `conv.ndc_depth`'s range (what a shader
+    /// writes as clip z / w), not window depth; the only case where the NDC range matters, as
+    /// window depth is the same function of Z under either range.
+    pub ndc_z: bool,
     /// NDC depth range, reversed-Z and row order the side was rendered under.
     pub conv: Conventions,
+}
+
+impl Side {
+    /// A side whose colour is stored as RGB, sRGB, straight alpha, and whose device depth (if
+    /// any) is window depth.
+    pub fn new(
+        color: impl Into<ColourImage>,
+        depth: Option<DepthMap>,
+        storage: DepthEncoding,
+        conv: Conventions,
+    ) -> Self {
+        Side {
+            color: color.into(),
+            colour: ColourReading::default(),
+            depth,
+            storage,
+            ndc_z: false,
+            conv,
+        }
+    }
 }
 
 /// The differences between two renderings, as printed and written to JSON by `compare`.
 #[derive(Debug, Clone, serde::Serialize)]
 pub struct Comparison {
-    /// Colour PSNR over the compared pixels; infinite (written "inf") when identical.
+    /// Colour PSNR over the compared pixels (peak 1 on colour in [0, 1], the same as peak 255
+    /// on 8-bit levels); infinite (written "inf") when identical.
     #[serde(serialize_with = "infinite_as_string")]
     pub psnr_db: f64,
-    /// Colour RMSE in 8-bit levels over the compared pixels' samples.
+    /// Colour RMSE in 8-bit levels (1/255 of the range: fractional for 16-bit and float
+    /// colour) over the compared pixels' samples.
     pub color_rmse: f64,
     /// Largest per-sample colour difference, 8-bit levels.
-    pub max_color_diff: u8,
+    pub max_color_diff: f64,
     /// Per pixel, the largest channel difference in 8-bit levels: its distribution over the
     /// compared pixels.
     pub color_error: ErrorDistribution,
+    /// Bits per colour sample of A's and B's files (8, 16, or 32 for float): colour is
+    /// compared at this precision, not quantised to 8 bits.
+    pub color_bits: [u8; 2],
+    /// Mean SSIM (Wang et al. 2004) on BT.601 luma over the compared pixels; None when the
+    /// images are under 11x11 (no whole window).
+    pub ssim: Option<f64>,
     /// Over pixels valid in both (after conversion to view Z).
     pub depth_max_abs: Option<f64>,
     /// Largest relative view-Z difference |A - B| / A, over pixels valid in both.
@@ -63,10 +100,11 @@ pub struct Comparison {
     pub pixels: usize,
     /// FLIP mean over the compared pixels (B the reference), when measured.
     pub flip_mean: Option<f64>,
-    /// A reading of B's conventions that fits far better than the declared one, if any.
-    pub suspicion: Option<String>,
-    /// The diff image is |A - B| times this, so the largest difference is white (255) and none
-    /// saturates: 255 / max_color_diff, or 1 when A and B are identical.
+    /// Readings of B's conventions that fit far better than the declared ones (colour first,
+    /// then depth), each naming the option that declares it.
+    pub suspicions: Vec<String>,
+    /// The diff image is |A - B| (8-bit levels) times this, so the largest difference is white
+    /// (255) and none saturates: 255 / max_color_diff, or 1 when A and B are identical.
     pub diff_scale: f64,
 }
 
@@ -106,46 +144,65 @@ fn optional_infinite_as_string<S: serde::Serializer>(v: &Option<f64>, s: S) -> s
     }
 }
 
-fn to_top_down(color: &RgbImage, rows: RowOrder) -> RgbImage {
-    let data = rows.convert_rows(color.data.clone(), color.width as usize * 3);
-    RgbImage {
-        width: color.width,
-        height: color.height,
-        data,
+/// The stored depth values, rows top-down.
+fn stored_top_down(depth: &DepthMap, rows: RowOrder) -> Vec<f64> {
+    let rows = match rows {
+        RowOrder::TopDown => depth.data.clone(),
+        RowOrder::BottomUp => colour::flip_rows(&depth.data, depth.width as usize),
+    };
+    rows.into_iter().map(f64::from).collect()
+}
+
+/// View distance per pixel (top-down), NaN where invalid. NDC z stored (`ndc_z`) is first
+/// turned into window depth under `conv`'s range.
+fn view_z(depth: &DepthMap, storage: DepthEncoding, conv: &Conventions, ndc_z: bool) -> Vec<f64> {
+    stored_top_down(depth, conv.row_order)
+        .into_iter()
+        .map(|d| {
+            let d = if ndc_z {
+                crate::depth::window_depth_of_ndc_z(d, conv)
+            } else {
+                d
+            };
+            storage.view_z(conv, d, 1.0).unwrap_or(f64::NAN)
+        })
+        .collect()
+}
+
+/// The largest channel difference of each selected pixel, 8-bit levels (NaN against a number
+/// counts as the whole range).
+fn color_pixel_errors(a: &[f64], b: &[f64], selected: &[bool]) -> Vec<f64> {
+    a.chunks_exact(3)
+        .zip(b.chunks_exact(3))
+        .zip(selected)
+        .filter(|(_, s)| **s)
+        .map(|((x, y), _)| x.iter().zip(y).map(|(x, y)| level_diff(*x, *y)).fold(0.0, f64::max))
+        .collect()
+}
+
+/// |x - y| in 8-bit levels, rounded to 1e-4 levels: f32 samples hold v / 255 to ~1e-5 levels,
+/// so 8-bit colour differs by whole levels and a 16-bit level (1/257 of one) stays visible;
+/// 255 where one is NaN and the other not.
+fn level_diff(x: f64, y: f64) -> f64 {
+    match (x.is_nan(), y.is_nan()) {
+        (false, false) => ((x - y).abs() * 255.0 * 1e4).round() / 1e4,
+        (true, true) => 0.0,
+        _ => 255.0,
     }
 }
 
-/// The stored depth values, rows top-down.
-fn stored_top_down(depth: &DepthMap, rows: RowOrder) -> Vec<f64> {
-    let bytes: Vec<u8> = crate::gpu::pixels::f32_to_bytes(&depth.data);
-    let rows = rows.convert_rows(bytes, depth.width as usize * 4);
-    crate::gpu::pixels::bytes_to_f32(&rows)
-        .into_iter()
-        .map(f64::from)
-        .collect()
-}
-
-/// View distance per pixel (top-down), NaN where invalid.
-fn view_z(depth: &DepthMap, storage: DepthEncoding, conv: &Conventions) -> Vec<f64> {
-    stored_top_down(depth, conv.row_order)
-        .into_iter()
-        .map(|d| storage.view_z(conv, d, 1.0).unwrap_or(f64::NAN))
-        .collect()
-}
-
-/// (PSNR, RMSE in levels, max difference) over the selected pixels.
-fn color_error(a: &RgbImage, b: &RgbImage, selected: &[bool]) -> (f64, f64, u8) {
-    let (mut sq, mut max, mut n) = (0.0, 0u8, 0usize);
+/// (PSNR, RMSE in levels, max difference in levels) over the selected pixels.
+fn color_error(a: &[f64], b: &[f64], selected: &[bool]) -> (f64, f64, f64) {
+    let (mut sq, mut max, mut n) = (0.0, 0.0f64, 0usize);
     for ((x, y), _) in a
-        .data
         .chunks_exact(3)
-        .zip(b.data.chunks_exact(3))
+        .zip(b.chunks_exact(3))
         .zip(selected)
         .filter(|(_, s)| **s)
     {
         for (x, y) in x.iter().zip(y) {
-            let d = x.abs_diff(*y);
-            sq += f64::from(d) * f64::from(d);
+            let d = level_diff(*x, *y);
+            sq += d * d;
             max = max.max(d);
             n += 1;
         }
@@ -154,15 +211,14 @@ fn color_error(a: &RgbImage, b: &RgbImage, selected: &[bool]) -> (f64, f64, u8) 
     (metrics::psnr_from_mse(mse), mse.sqrt(), max)
 }
 
-/// The largest channel difference of each selected pixel, levels.
-fn color_pixel_errors(a: &RgbImage, b: &RgbImage, selected: &[bool]) -> Vec<f64> {
-    a.data
-        .chunks_exact(3)
-        .zip(b.data.chunks_exact(3))
-        .zip(selected)
-        .filter(|(_, s)| **s)
-        .map(|((x, y), _)| f64::from(x.iter().zip(y).map(|(x, y)| x.abs_diff(*y)).max().unwrap_or(0)))
-        .collect()
+/// Mean SSIM on BT.601 luma (0..255 scale) of the compared forms over the selected pixels.
+fn ssim(a: &[f64], b: &[f64], width: u32, height: u32, selected: &[bool]) -> Option<f64> {
+    let luma = |c: &[f64]| -> Vec<f64> {
+        c.chunks_exact(3)
+            .map(|p| 255.0 * (0.299 * p[0] + 0.587 * p[1] + 0.114 * p[2]))
+            .collect()
+    };
+    crate::ssim::ssim_luma_planes(&luma(a), &luma(b), width as usize, height as usize, Some(selected))
 }
 
 /// Depth errors over the selected pixels valid in both.
@@ -219,6 +275,12 @@ fn check_sides(a: &Side, b: &Side, mask: Option<&Mask>) -> Result<Vec<bool>> {
             &format!("{name} depth kind"),
             &[DepthKind::ViewZ, DepthKind::Device, DepthKind::Disparity],
         )?;
+        if s.colour.alpha == Alpha::Premultiplied && s.color.alpha.is_none() {
+            return Err(Error::param(
+                format!("{name} alpha"),
+                "premultiplied declared, but its colour file has no alpha channel",
+            ));
+        }
         if let Some(d) = &s.depth {
             if (d.width, d.height) != (s.color.width, s.color.height) {
                 return Err(Error::SizeMismatch {
@@ -250,15 +312,14 @@ fn check_sides(a: &Side, b: &Side, mask: Option<&Mask>) -> Result<Vec<bool>> {
 pub fn compare_with(a: &Side, b: &Side, mask: Option<&Mask>, measures: Measures) -> Result<Compared> {
     let selected = check_sides(a, b, mask)?;
     let pixels = selected.iter().filter(|s| **s).count();
-    let (ca, cb) = (
-        to_top_down(&a.color, a.conv.row_order),
-        to_top_down(&b.color, b.conv.row_order),
-    );
+    let (w, h) = (a.color.width, a.color.height);
+    let ca = colour::compared_form(&a.color, a.colour, a.conv.row_order);
+    let cb = colour::compared_form(&b.color, b.colour, b.conv.row_order);
     let (psnr_db, color_rmse, max_color_diff) = color_error(&ca, &cb, &selected);
-    let diff_scale = if max_color_diff == 0 {
+    let diff_scale = if max_color_diff == 0.0 {
         1.0
     } else {
-        255.0 / f64::from(max_color_diff)
+        255.0 / max_color_diff
     };
     let mut levels = COLOR_LEVELS_REPORTED.to_vec();
     levels.push(measures.bad.color_levels);
@@ -269,18 +330,20 @@ pub fn compare_with(a: &Side, b: &Side, mask: Option<&Mask>, measures: Measures)
         color_rmse,
         max_color_diff,
         color_error,
+        color_bits: [a.color.bits, b.color.bits],
+        ssim: ssim(&ca, &cb, w, h, &selected),
         depth_max_abs: None,
         depth_max_rel: None,
         depth_rel_error: None,
         mask_disagreement: None,
         pixels,
         flip_mean: None,
-        suspicion: None,
+        suspicions: Vec::new(),
         diff_scale,
     };
-    let za = a.depth.as_ref().map(|d| view_z(d, a.storage, &a.conv));
+    let za = a.depth.as_ref().map(|d| view_z(d, a.storage, &a.conv, a.ndc_z));
     if let (Some(za), Some(db)) = (&za, &b.depth) {
-        let e = depth_error(za, &view_z(db, b.storage, &b.conv), &selected);
+        let e = depth_error(za, &view_z(db, b.storage, &b.conv, b.ndc_z), &selected);
         let mut rels = DEPTH_REL_REPORTED.to_vec();
         rels.push(measures.bad.depth_rel);
         // No pixel with depth on both sides (all NaN, say) compares nothing: no error is
@@ -290,16 +353,23 @@ pub fn compare_with(a: &Side, b: &Side, mask: Option<&Mask>, measures: Measures)
         cmp.depth_rel_error = ErrorDistribution::of(e.rel, &rels);
         cmp.mask_disagreement = Some(e.disagree);
     }
-    cmp.suspicion = diagnose::diagnose(a, b, &ca, za.as_deref(), &selected, &cmp);
+    let colour = colour_check::suspicion(a, b, &ca, &cb, &selected);
+    // Flipped rows misplace depth too: the depth check would only name the same mistake.
+    let rows_named = colour.as_ref().is_some_and(|c| c.rows);
+    cmp.suspicions.extend(colour.map(|c| c.line));
+    if !rows_named {
+        let tolerance = diagnose::AGREE_REL.min(measures.bad.depth_rel);
+        cmp.suspicions
+            .extend(diagnose::diagnose(a, b, za.as_deref(), &selected, tolerance));
+    }
     let data = ca
-        .data
         .chunks_exact(3)
-        .zip(cb.data.chunks_exact(3))
+        .zip(cb.chunks_exact(3))
         .zip(&selected)
         .flat_map(|((x, y), s)| {
             let d = |i: usize| {
                 if *s {
-                    (f64::from(x[i].abs_diff(y[i])) * diff_scale).round() as u8
+                    (level_diff(x[i], y[i]) * diff_scale).round().min(255.0) as u8
                 } else {
                     0
                 }
@@ -308,12 +378,13 @@ pub fn compare_with(a: &Side, b: &Side, mask: Option<&Mask>, measures: Measures)
         })
         .collect();
     let diff = RgbImage {
-        width: ca.width,
-        height: ca.height,
+        width: w,
+        height: h,
         data,
     };
+    // FLIP is LDR FLIP: it reads 8-bit sRGB, so deeper colour is rounded for it alone.
     let flip_map = measures.flip.then(|| {
-        let flip = Flip::of(&cb, &ca);
+        let flip = Flip::of(&colour::to_rgb8(&cb, w, h), &colour::to_rgb8(&ca, w, h));
         cmp.flip_mean = Some(flip.mean(&selected));
         flip.magma_map(&selected)
     });

@@ -99,9 +99,16 @@ impl Thresholds {
                 None => out.push(format!("share over {level} levels: not measured")),
             }
             // Depth only where both sides have it: a colour-only comparison is gated on colour.
-            if let Some(d) = &c.depth_rel_error {
-                let rel = self.bad.depth_rel;
-                match d.share_over(rel) {
+            // Both sides with depth files but no pixel valid in both compared nothing: a share
+            // of nothing is no pass.
+            let rel = self.bad.depth_rel;
+            match (&c.depth_rel_error, c.mask_disagreement) {
+                (None, Some(_)) => out.push(format!(
+                    "share over relative depth error {rel:e}: no pixel holds valid depth on both sides, \
+                     nothing was compared"
+                )),
+                (None, None) => {}
+                (Some(d), _) => match d.share_over(rel) {
                     Some(s) if s > max => out.push(format!(
                         "{} of the pixels have a relative depth error over {rel:e} > {}",
                         percent(s),
@@ -109,7 +116,7 @@ impl Thresholds {
                     )),
                     Some(_) => {}
                     None => out.push(format!("share over relative depth error {rel:e}: not measured")),
-                }
+                },
             }
         }
         if let Some(max) = self.max_flip_mean {
@@ -131,4 +138,9 @@ pub fn percent(share: f64) -> String {
     } else {
         format!("{p:.1e} %")
     }
+}
+
+/// A relative tolerance as a percentage ("1 %", "0.1 %").
+pub(super) fn relative(tolerance: f64) -> String {
+    format!("{} %", (tolerance * 100.0 * 1e6).round() / 1e6)
 }

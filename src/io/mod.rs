@@ -8,6 +8,7 @@
 pub(crate) use crate::error::excerpt;
 
 mod atomic;
+mod colour;
 mod decode;
 mod depth;
 mod depth_png16;
@@ -39,6 +40,7 @@ mod dataset_tests;
 pub(crate) mod test_util;
 
 pub use atomic::{atomic_write, probe_writable, TEMP_PREFIX};
+pub use colour::{load_colour, ColourImage};
 pub use depth::{
     check_rgbd_sizes, depth_dimensions, load_depth, load_depth_with_key, rgb_dimensions, save_depth_exr,
     save_depth_exr_with, save_depth_npy, DepthDecode,

@@ -4,8 +4,8 @@
 
 use super::error::InContext;
 use super::{ArgError, Event, Host, JobError};
-use crate::compare::{compare_with, Comparison, Measures, Side, Thresholds};
-use crate::convention::{Conventions, DepthPlanes};
+use crate::compare::{compare_with, ColourReading, Comparison, Measures, Side, Thresholds};
+use crate::convention::{Conventions, DepthPlanes, NdcDepthRange, RowOrder};
 use crate::depth::DepthEncoding;
 use crate::io::{self, DepthDecode};
 use std::path::{Path, PathBuf};
@@ -13,11 +13,25 @@ use std::path::{Path, PathBuf};
 /// What a side's depth file holds.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
 pub enum SideDepth {
-    /// Window depth under the side's conventions, written with the job's planes.
+    /// Window depth in [0, 1] from a depth buffer, written with the side's planes (the same
+    /// function of Z under either NDC range).
     Device,
+    /// NDC z after the perspective divide (clip z / w) in the side's NDC range, written with
+    /// the side's planes.
+    Ndc,
     /// View distance in metres.
     #[default]
     ViewZ,
+}
+
+impl SideDepth {
+    fn name(self) -> &'static str {
+        match self {
+            SideDepth::Device => "device",
+            SideDepth::Ndc => "ndc",
+            SideDepth::ViewZ => "view-z",
+        }
+    }
 }
 
 /// One side's files as given.
@@ -25,12 +39,20 @@ pub enum SideDepth {
 pub struct SideOptions {
     /// Colour.
     pub rgb: PathBuf,
+    /// How the colour is stored.
+    pub colour: ColourReading,
     /// Depth, if compared.
     pub depth: Option<PathBuf>,
     /// What the depth holds.
     pub depth_kind: SideDepth,
-    /// How the side was stored.
-    pub conventions: Conventions,
+    /// Planes its device or NDC depth was written with (else [`CompareOptions::planes`]).
+    pub planes: Option<DepthPlanes>,
+    /// NDC range of stored NDC z ([`SideDepth::Ndc`] only: window depth is the same under both).
+    pub ndc: Option<NdcDepthRange>,
+    /// Its device or NDC depth was written with reversed-Z.
+    pub reversed_z: bool,
+    /// Row order of its files.
+    pub row_order: RowOrder,
 }
 
 /// Where the JSON summary goes.
@@ -51,10 +73,8 @@ pub struct CompareOptions {
     pub b: SideOptions,
     /// The `.npz` array to read (both sides).
     pub npz_key: Option<String>,
-    /// Near plane of device depth.
-    pub near: f64,
-    /// Far plane of device depth.
-    pub far: f64,
+    /// Planes of both sides' device or NDC depth (a side's own planes take precedence).
+    pub planes: Option<DepthPlanes>,
     /// Where to write the colour difference.
     pub diff: Option<PathBuf>,
     /// Where to write FLIP's magma error map.
@@ -73,7 +93,8 @@ pub struct CompareJob {
     a: SideOptions,
     b: SideOptions,
     npz_key: Option<String>,
-    planes: DepthPlanes,
+    /// Each side's encoding, decided from its options.
+    storage: [DepthEncoding; 2],
     diff: Option<PathBuf>,
     flip_map: Option<PathBuf>,
     mask: Option<PathBuf>,
@@ -112,10 +133,11 @@ impl CompareJob {
             .map(|p| p.as_path())
             .collect();
         super::check_npz_key(o.npz_key.as_deref(), &depths)?;
-        if !(o.near.is_finite() && o.near > 0.0 && o.far > o.near) {
-            return Err(ArgError::ComparePlanes {
-                near: o.near,
-                far: o.far,
+        let storage = [side_storage('A', &o.a, o.planes)?, side_storage('B', &o.b, o.planes)?];
+        if o.planes.is_some() && storage.iter().all(|s| !matches!(s, DepthEncoding::Device { .. })) {
+            return Err(ArgError::CompareNotApplicable {
+                option: "--near/--far".into(),
+                why: "neither side's depth is device or ndc depth (view-z is metres: no planes)".into(),
             });
         }
         let inputs: Vec<io::NamedPath<'_>> = [
@@ -138,10 +160,7 @@ impl CompareJob {
             a: o.a,
             b: o.b,
             npz_key: o.npz_key,
-            planes: DepthPlanes {
-                near: o.near,
-                far: o.far,
-            },
+            storage,
             diff: o.diff,
             flip_map: o.flip_map,
             mask: o.mask,
@@ -175,19 +194,22 @@ impl CompareJob {
         self.mask.is_some()
     }
 
-    fn side(&self, s: &SideOptions) -> crate::Result<Side> {
+    fn side(&self, s: &SideOptions, storage: DepthEncoding) -> crate::Result<Side> {
         Ok(Side {
-            color: io::load_rgb(&s.rgb)?,
+            color: io::load_colour(&s.rgb)?,
+            colour: s.colour,
             depth: s
                 .depth
                 .as_deref()
                 .map(|d| io::load_depth_with_key(d, self.npz_key.as_deref(), &DepthDecode::default()))
                 .transpose()?,
-            storage: match s.depth_kind {
-                SideDepth::Device => DepthEncoding::Device { planes: self.planes },
-                SideDepth::ViewZ => DepthEncoding::ViewZ,
+            storage,
+            ndc_z: s.depth_kind == SideDepth::Ndc,
+            conv: Conventions {
+                ndc_depth: s.ndc.unwrap_or_default(),
+                reversed_z: s.reversed_z,
+                row_order: s.row_order,
             },
-            conv: s.conventions,
         })
     }
 
@@ -195,18 +217,20 @@ impl CompareJob {
     /// atomically: they name files anywhere, not an output folder). Each depth input is
     /// summarised to `host` in metres (device depth converted with the planes).
     pub fn run(&self, host: &dyn Host) -> Result<CompareReport, JobError> {
-        let sa = self.side(&self.a)?;
-        let sb = self.side(&self.b)?;
+        let sa = self.side(&self.a, self.storage[0])?;
+        let sb = self.side(&self.b, self.storage[1])?;
         for (opts, side, name) in [(&self.a, &sa, "A"), (&self.b, &sb, "B")] {
             if let (Some(path), Some(depth)) = (&opts.depth, &side.depth) {
+                let s = name.to_lowercase();
                 let hint = format!(
-                    "check --{side}-depth-kind (view-z: metres; device: window depth written with \
-                     --near/--far) and that {name}'s file holds depth, not disparity",
-                    side = name.to_lowercase()
+                    "check what {name}'s file holds: metres (`--{s}-depth-kind view-z`), window depth \
+                     (`--{s}-depth-kind device --{s}-near N --{s}-far F`, far may be inf; reversed: \
+                     `--{s}-depth-kind device --{s}-near N --{s}-far F --{s}-reversed-z`), and that it is \
+                     depth, not disparity"
                 );
                 host.event(Event::InputDepth {
                     path,
-                    summary: &side.storage.summary(&side.conv, depth),
+                    summary: &side.storage.summary(&side.conv, &side_window_depth(side, depth)),
                     hint: &hint,
                 });
             }
@@ -260,24 +284,188 @@ impl CompareJob {
     }
 }
 
+/// The side's depth as window depth (NDC z converted), for its summary.
+fn side_window_depth(side: &Side, depth: &io::DepthMap) -> io::DepthMap {
+    if !side.ndc_z {
+        return depth.clone();
+    }
+    io::DepthMap {
+        width: depth.width,
+        height: depth.height,
+        data: depth
+            .data
+            .iter()
+            .map(|v| crate::depth::window_depth_of_ndc_z(f64::from(*v), &side.conv) as f32)
+            .collect(),
+    }
+}
+
+/// A side's depth encoding from its options, refusing every convention option that cannot
+/// change its reading: planes, `ndc` and reversed-Z on metric depth (or none), the NDC range on
+/// window depth (the same function of Z under either range), premultiplied alpha nowhere to
+/// apply is checked on reading (the file decides).
+fn side_storage(name: char, o: &SideOptions, both: Option<DepthPlanes>) -> Result<DepthEncoding, ArgError> {
+    let s = name.to_ascii_lowercase();
+    let not_applicable = |option: String, why: String| Err(ArgError::CompareNotApplicable { option, why });
+    let kind = o.depth_kind;
+    if o.depth.is_none() {
+        if o.planes.is_some() || o.reversed_z || o.ndc.is_some() || kind != SideDepth::ViewZ {
+            return not_applicable(
+                format!("--{s}-depth-kind/--{s}-near/--{s}-far/--{s}-reversed-z/--{s}-ndc"),
+                format!("{name} has no depth file (--{s}-depth)"),
+            );
+        }
+        return Ok(DepthEncoding::ViewZ);
+    }
+    match kind {
+        SideDepth::ViewZ => {
+            let metric = format!("{name}'s depth is view-z, metres (--{s}-depth-kind device or ndc for device depth)");
+            if o.planes.is_some() {
+                return not_applicable(format!("--{s}-near/--{s}-far"), metric);
+            }
+            if o.reversed_z {
+                return not_applicable(format!("--{s}-reversed-z"), metric);
+            }
+            if o.ndc.is_some() {
+                return not_applicable(format!("--{s}-ndc"), metric);
+            }
+            Ok(DepthEncoding::ViewZ)
+        }
+        SideDepth::Device | SideDepth::Ndc => {
+            if kind == SideDepth::Device && o.ndc.is_some() {
+                return not_applicable(
+                    format!("--{s}-ndc"),
+                    format!(
+                        "window depth in [0, 1] is the same function of Z under gl and vulkan NDC for the \
+                         same planes, so it cannot change {name}'s reading; it applies to NDC z stored \
+                         (--{s}-depth-kind ndc)"
+                    ),
+                );
+            }
+            if kind == SideDepth::Ndc && o.ndc.is_none() {
+                return Err(ArgError::CompareNotApplicable {
+                    option: format!("--{s}-depth-kind ndc"),
+                    why: format!("needs the NDC range the z was written in: --{s}-ndc gl or --{s}-ndc vulkan"),
+                });
+            }
+            let planes = o.planes.or(both).ok_or(ArgError::ComparePlanesMissing {
+                side: name,
+                kind: kind.name(),
+            })?;
+            if !(planes.near.is_finite() && planes.near > 0.0 && planes.far > planes.near) {
+                let options = if o.planes.is_some() {
+                    format!("--{s}-near/--{s}-far")
+                } else {
+                    "--near/--far".into()
+                };
+                return Err(ArgError::ComparePlanes {
+                    options,
+                    near: planes.near,
+                    far: planes.far,
+                });
+            }
+            Ok(DepthEncoding::Device { planes })
+        }
+    }
+}
+
 #[cfg(test)]
 mod tests {
-    use super::{ArgError, CompareJob, CompareOptions};
+    use super::{ArgError, CompareJob, CompareOptions, SideDepth, SideOptions};
+    use crate::convention::{DepthPlanes, NdcDepthRange};
+
+    fn device(planes: Option<DepthPlanes>) -> SideOptions {
+        SideOptions {
+            depth: Some("d.exr".into()),
+            depth_kind: SideDepth::Device,
+            planes,
+            ..Default::default()
+        }
+    }
+
+    fn job(a: SideOptions, b: SideOptions, planes: Option<DepthPlanes>) -> Result<CompareJob, ArgError> {
+        CompareJob::new(CompareOptions {
+            a: SideOptions {
+                rgb: "a.png".into(),
+                ..a
+            },
+            b: SideOptions {
+                rgb: "b.png".into(),
+                ..b
+            },
+            planes,
+            ..Default::default()
+        })
+    }
 
     #[test]
-    fn planes_must_be_ordered_and_positive() {
-        let options = |near, far| CompareOptions {
-            near,
-            far,
-            ..Default::default()
-        };
-        assert!(CompareJob::new(options(0.1, 1000.0)).is_ok());
-        assert!(CompareJob::new(options(0.1, f64::INFINITY)).is_ok());
+    fn planes_must_be_ordered_and_positive_and_far_may_be_infinite() {
+        let p = |near, far| Some(DepthPlanes { near, far });
+        assert!(job(device(p(0.1, 1000.0)), device(p(0.05, f64::INFINITY)), None).is_ok());
+        assert!(job(device(None), device(None), p(0.1, f64::INFINITY)).is_ok());
         for (near, far) in [(0.0, 10.0), (10.0, 1.0), (f64::NAN, 1.0)] {
             assert!(matches!(
-                CompareJob::new(options(near, far)),
+                job(device(p(near, far)), device(p(0.1, 1.0)), None),
                 Err(ArgError::ComparePlanes { .. })
             ));
         }
+    }
+
+    #[test]
+    fn device_depth_needs_planes_and_each_option_must_apply() {
+        let p = Some(DepthPlanes { near: 0.1, far: 10.0 });
+        // No silent default planes.
+        let e = job(device(p), device(None), None).unwrap_err();
+        assert!(matches!(e, ArgError::ComparePlanesMissing { side: 'B', .. }), "{e}");
+        assert!(e.to_string().contains("--b-near N --b-far F"), "{e}");
+        let metric = SideOptions {
+            depth: Some("d.exr".into()),
+            ..Default::default()
+        };
+        // Planes, reversed-Z and the NDC range on metric depth; the NDC range on window depth.
+        for (b, option) in [
+            (
+                SideOptions {
+                    planes: p,
+                    ..metric.clone()
+                },
+                "--b-near/--b-far",
+            ),
+            (
+                SideOptions {
+                    reversed_z: true,
+                    ..metric.clone()
+                },
+                "--b-reversed-z",
+            ),
+            (
+                SideOptions {
+                    ndc: Some(NdcDepthRange::ZeroToOne),
+                    ..device(p)
+                },
+                "--b-ndc",
+            ),
+        ] {
+            let e = job(metric.clone(), b, None).unwrap_err();
+            assert!(
+                matches!(&e, ArgError::CompareNotApplicable { option: o, .. } if o == option) && e.is_usage(),
+                "{option}: {e}"
+            );
+        }
+        assert!(
+            job(metric.clone(), metric.clone(), p).is_err(),
+            "--near/--far with no device side"
+        );
+        // Stored NDC z needs its range, and takes it.
+        let ndc = SideOptions {
+            depth_kind: SideDepth::Ndc,
+            ..device(p)
+        };
+        assert!(job(metric.clone(), ndc.clone(), None).is_err());
+        let gl = SideOptions {
+            ndc: Some(NdcDepthRange::MinusOneToOne),
+            ..ndc
+        };
+        assert!(job(metric, gl, None).is_ok());
     }
 }

@@ -217,12 +217,34 @@ pub enum ArgError {
     #[error("invalid ipd {0}: must be finite and >= 0")]
     Ipd(f64),
     /// Compare's planes out of order.
-    #[error("invalid --near {near} / --far {far}: need 0 < near < far")]
+    #[error("invalid {options} {near} / {far}: need 0 < near < far (far may be inf)")]
     ComparePlanes {
-        /// `--near`.
+        /// The options, e.g. `--b-near/--b-far`.
+        options: String,
+        /// The near plane given.
         near: f64,
-        /// `--far`.
+        /// The far plane given.
         far: f64,
+    },
+    /// A compare side's device or NDC depth without the planes it was written with.
+    #[error(
+        "{side}'s depth is {kind} depth: give the planes it was written with, --{s}-near N --{s}-far F \
+         (far may be inf; --near/--far set both sides)",
+        s = side.to_ascii_lowercase()
+    )]
+    ComparePlanesMissing {
+        /// `A` or `B`.
+        side: char,
+        /// `device` or `ndc`.
+        kind: &'static str,
+    },
+    /// A compare convention option that cannot change the reading of the side it names.
+    #[error("{option} does not apply: {why}")]
+    CompareNotApplicable {
+        /// The option, e.g. `--b-ndc`.
+        option: String,
+        /// Why it changes nothing there.
+        why: String,
     },
 }
 

@@ -4,16 +4,43 @@ use crate::options::{conventions, NdcArg, RowsArg};
 use crate::options::{CONVENTIONS, INPUTS, OUTPUTS, THRESHOLDS};
 use clap::{Args, ValueEnum};
 use std::path::{Path, PathBuf};
-use viewsynth::compare::{BadPixel, Thresholds};
+use viewsynth::compare::{Alpha, BadPixel, ChannelOrder, ColourReading, Thresholds, Transfer};
+use viewsynth::convention::{DepthPlanes, NdcDepthRange};
 use viewsynth::job::compare::{CompareJob, CompareOptions, JsonOutput, SideDepth, SideOptions};
 use viewsynth::job::ArgError;
 
 #[derive(Clone, Copy, ValueEnum, PartialEq)]
 pub(crate) enum DepthKindArg {
-    /// Window depth in [0, 1] from a depth buffer, under the side's conventions.
+    /// Window depth in [0, 1] from a depth buffer (the same under gl and vulkan NDC).
     Device,
+    /// NDC z after the divide (clip z / w): gl [-1, 1] or vulkan [0, 1], as --X-ndc says.
+    Ndc,
     /// Linear view distance in metres.
     ViewZ,
+}
+
+#[derive(Clone, Copy, ValueEnum)]
+pub(crate) enum ChannelsArg {
+    /// Red first.
+    Rgb,
+    /// Blue first (a BGRA swapchain read back as RGBA).
+    Bgr,
+}
+
+#[derive(Clone, Copy, ValueEnum)]
+pub(crate) enum TransferArg {
+    /// sRGB-encoded values (image viewers, our PNG outputs).
+    Srgb,
+    /// Linear values (e.g. a UNORM target read back where an SRGB one was expected).
+    Linear,
+}
+
+#[derive(Clone, Copy, ValueEnum)]
+pub(crate) enum AlphaArg {
+    /// Colour independent of alpha.
+    Straight,
+    /// Colour multiplied by alpha (the file must have alpha).
+    Premultiplied,
 }
 
 /// The example under `viewsynth compare --help` (paths from the repository root, as in the README).
@@ -26,7 +53,7 @@ Examples:
   viewsynth scene --width 320 --height 240 --ndc vulkan --reversed-z --out-dir out/scene_vk
   viewsynth compare --a-rgb out/scene/middle_rgb.png --a-depth out/scene/middle_device_depth.exr --a-depth-kind device \\
       --b-rgb out/scene_vk/middle_rgb.png --b-depth out/scene_vk/middle_device_depth.exr --b-depth-kind device \\
-      --b-ndc vulkan --b-reversed-z --near 0.05 --far 100 --max-bad-share 0.002 --max-flip 0.01";
+      --b-reversed-z --near 0.05 --far 100 --max-bad-share 0.002 --max-flip 0.01";
 
 #[derive(Args)]
 pub(crate) struct CompareArgs {
@@ -64,7 +91,8 @@ pub(crate) struct CompareArgs {
     ///
     /// Checked for colour (a pixel is bad when a channel differs by more than --bad-colour
     /// levels) and, with depth, for depth (relative error over --bad-depth-rel, pixels valid in
-    /// both). The share over each threshold is in the JSON either way.
+    /// both; with depth files on both sides and no such pixel, it fails: a gate never passes on
+    /// nothing). The share over each threshold is in the JSON either way.
     #[arg(help_heading = THRESHOLDS, long, value_name = "SHARE")]
     max_bad_share: Option<f64>,
     /// Per-pixel colour threshold of --max-bad-share: largest channel difference, 8-bit levels.
@@ -90,19 +118,20 @@ pub(crate) struct CompareArgs {
     /// An infinite PSNR is written as the string "inf".
     #[arg(help_heading = OUTPUTS, long, value_name = "FILE", num_args = 0..=1, default_missing_value = "-")]
     json: Option<PathBuf>,
-    /// What A's depth holds: view-z (metres) or device (window depth under --a-ndc and
-    /// --a-reversed-z, with --near/--far).
-    #[arg(help_heading = CONVENTIONS, long, value_enum, default_value = "view-z")]
+    /// What A's depth holds: view-z (metres), device (window depth in [0, 1], with
+    /// --a-near/--a-far) or ndc (NDC z, with --a-ndc and the planes).
+    #[arg(help_heading = CONVENTIONS, long, value_enum, default_value = "view-z", requires = "a_depth")]
     a_depth_kind: DepthKindArg,
-    /// What B's depth holds: view-z (metres) or device (under --b-ndc and --b-reversed-z).
-    #[arg(help_heading = CONVENTIONS, long, value_enum, default_value = "view-z")]
+    /// What B's depth holds (see --a-depth-kind).
+    #[arg(help_heading = CONVENTIONS, long, value_enum, default_value = "view-z", requires = "b_depth")]
     b_depth_kind: DepthKindArg,
-    /// NDC depth range A's device depth was written under: gl [-1, 1] or vulkan [0, 1].
-    #[arg(help_heading = CONVENTIONS, long, value_enum, default_value = "gl")]
-    a_ndc: NdcArg,
-    /// NDC depth range B's device depth was written under: gl [-1, 1] or vulkan [0, 1].
-    #[arg(help_heading = CONVENTIONS, long, value_enum, default_value = "gl")]
-    b_ndc: NdcArg,
+    /// NDC range of A's stored NDC z (--a-depth-kind ndc only: window depth reads the same
+    /// under both): gl [-1, 1] or vulkan [0, 1].
+    #[arg(help_heading = CONVENTIONS, long, value_enum)]
+    a_ndc: Option<NdcArg>,
+    /// NDC range of B's stored NDC z (--b-depth-kind ndc only).
+    #[arg(help_heading = CONVENTIONS, long, value_enum)]
+    b_ndc: Option<NdcArg>,
     /// A's device depth was written with reversed-Z (near at the top of the range).
     #[arg(help_heading = CONVENTIONS, long)]
     a_reversed_z: bool,
@@ -115,19 +144,82 @@ pub(crate) struct CompareArgs {
     /// Row order B's files are stored in (see --a-rows).
     #[arg(help_heading = CONVENTIONS, long, value_enum, default_value = "top-down")]
     b_rows: RowsArg,
-    /// Near plane of the device depth (metres), with --far.
-    #[arg(help_heading = CONVENTIONS, long, default_value_t = 0.1)]
-    near: f64,
-    /// Far plane of the device depth (metres; may be inf), with --near.
-    #[arg(help_heading = CONVENTIONS, long, default_value_t = 1000.0)]
-    far: f64,
+    /// Channel order of A's colour file.
+    #[arg(help_heading = CONVENTIONS, long, value_enum, default_value = "rgb")]
+    a_channels: ChannelsArg,
+    /// Channel order of B's colour file.
+    #[arg(help_heading = CONVENTIONS, long, value_enum, default_value = "rgb")]
+    b_channels: ChannelsArg,
+    /// What A's colour values are: srgb (encoded) or linear (encoded to sRGB before comparing).
+    #[arg(help_heading = CONVENTIONS, long, value_enum, default_value = "srgb")]
+    a_transfer: TransferArg,
+    /// What B's colour values are (see --a-transfer).
+    #[arg(help_heading = CONVENTIONS, long, value_enum, default_value = "srgb")]
+    b_transfer: TransferArg,
+    /// A's colour against its alpha: straight or premultiplied (divided out before comparing).
+    #[arg(help_heading = CONVENTIONS, long, value_enum, default_value = "straight")]
+    a_alpha: AlphaArg,
+    /// B's colour against its alpha (see --a-alpha).
+    #[arg(help_heading = CONVENTIONS, long, value_enum, default_value = "straight")]
+    b_alpha: AlphaArg,
+    /// Near plane of both sides' device or NDC depth (metres), with --far.
+    #[arg(help_heading = CONVENTIONS, long, requires = "far", conflicts_with_all = ["a_near", "b_near"])]
+    near: Option<f64>,
+    /// Far plane of both sides' device or NDC depth (metres; may be inf), with --near.
+    #[arg(help_heading = CONVENTIONS, long, requires = "near", conflicts_with_all = ["a_far", "b_far"])]
+    far: Option<f64>,
+    /// Near plane A's device or NDC depth was written with (metres), with --a-far.
+    #[arg(help_heading = CONVENTIONS, long, requires = "a_far")]
+    a_near: Option<f64>,
+    /// Far plane A's depth was written with (metres; inf for an infinite far plane).
+    #[arg(help_heading = CONVENTIONS, long, requires = "a_near")]
+    a_far: Option<f64>,
+    /// Near plane B's device or NDC depth was written with (metres), with --b-far.
+    #[arg(help_heading = CONVENTIONS, long, requires = "b_far")]
+    b_near: Option<f64>,
+    /// Far plane B's depth was written with (metres; inf for an infinite far plane).
+    #[arg(help_heading = CONVENTIONS, long, requires = "b_near")]
+    b_far: Option<f64>,
 }
 
 fn side_depth(kind: DepthKindArg) -> SideDepth {
     match kind {
         DepthKindArg::Device => SideDepth::Device,
+        DepthKindArg::Ndc => SideDepth::Ndc,
         DepthKindArg::ViewZ => SideDepth::ViewZ,
     }
+}
+
+fn rows(arg: RowsArg) -> viewsynth::convention::RowOrder {
+    conventions(NdcArg::Gl, false, arg).row_order
+}
+
+fn planes(near: Option<f64>, far: Option<f64>) -> Option<DepthPlanes> {
+    Some(DepthPlanes { near: near?, far: far? })
+}
+
+fn colour(channels: ChannelsArg, transfer: TransferArg, alpha: AlphaArg) -> ColourReading {
+    ColourReading {
+        channels: match channels {
+            ChannelsArg::Rgb => ChannelOrder::Rgb,
+            ChannelsArg::Bgr => ChannelOrder::Bgr,
+        },
+        transfer: match transfer {
+            TransferArg::Srgb => Transfer::Srgb,
+            TransferArg::Linear => Transfer::Linear,
+        },
+        alpha: match alpha {
+            AlphaArg::Straight => Alpha::Straight,
+            AlphaArg::Premultiplied => Alpha::Premultiplied,
+        },
+    }
+}
+
+fn ndc(arg: Option<NdcArg>) -> Option<NdcDepthRange> {
+    arg.map(|n| match n {
+        NdcArg::Gl => NdcDepthRange::MinusOneToOne,
+        NdcArg::Vulkan => NdcDepthRange::ZeroToOne,
+    })
 }
 
 impl TryFrom<CompareArgs> for CompareJob {
@@ -136,19 +228,26 @@ impl TryFrom<CompareArgs> for CompareJob {
         CompareJob::new(CompareOptions {
             a: SideOptions {
                 rgb: a.a_rgb,
+                colour: colour(a.a_channels, a.a_transfer, a.a_alpha),
                 depth: a.a_depth,
                 depth_kind: side_depth(a.a_depth_kind),
-                conventions: conventions(a.a_ndc, a.a_reversed_z, a.a_rows),
+                planes: planes(a.a_near, a.a_far),
+                ndc: ndc(a.a_ndc),
+                reversed_z: a.a_reversed_z,
+                row_order: rows(a.a_rows),
             },
             b: SideOptions {
                 rgb: a.b_rgb,
+                colour: colour(a.b_channels, a.b_transfer, a.b_alpha),
                 depth: a.b_depth,
                 depth_kind: side_depth(a.b_depth_kind),
-                conventions: conventions(a.b_ndc, a.b_reversed_z, a.b_rows),
+                planes: planes(a.b_near, a.b_far),
+                ndc: ndc(a.b_ndc),
+                reversed_z: a.b_reversed_z,
+                row_order: rows(a.b_rows),
             },
             npz_key: a.npz_key,
-            near: a.near,
-            far: a.far,
+            planes: planes(a.near, a.far),
             diff: a.diff,
             flip_map: a.flip_map,
             mask: a.mask,

@@ -20,6 +20,15 @@ fn distribution(d: &ErrorDistribution, threshold: f64, fmt: impl Fn(f64) -> Stri
     )
 }
 
+/// A level count: whole for 8-bit colour, with the digits deeper colour needs otherwise.
+fn levels(v: f64) -> String {
+    if v.fract() == 0.0 {
+        format!("{v}")
+    } else {
+        format!("{v:.4}")
+    }
+}
+
 pub(crate) fn compare(job: &CompareJob) -> Result<ExitCode> {
     let r = job.run(&CliHost::default())?;
     let cmp = &r.comparison;
@@ -28,22 +37,27 @@ pub(crate) fn compare(job: &CompareJob) -> Result<ExitCode> {
     } else {
         let over = if job.masked() { " (in the mask)" } else { "" };
         let bad = job.thresholds().bad;
+        let bits = match cmp.color_bits {
+            [8, 8] => String::new(),
+            [a, b] => format!(" (compared at A {a}, B {b} bits per sample)"),
+        };
         outln!(
-            "colour: PSNR {:.2} dB, RMSE {:.4} levels, max difference {} levels over {} pixels{over}",
+            "colour: PSNR {:.2} dB, RMSE {:.4} levels, max difference {} levels over {} pixels{over}{bits}",
             cmp.psnr_db,
             cmp.color_rmse,
-            cmp.max_color_diff,
+            levels(cmp.max_color_diff),
             cmp.pixels
         );
         outln!(
             "colour error (levels): {}",
-            distribution(&cmp.color_error, bad.color_levels, |v| format!("{v}"))
+            distribution(&cmp.color_error, bad.color_levels, levels)
         );
         if let Some(m) = cmp.flip_mean {
             let map = job
                 .flip_map()
                 .map_or(String::new(), |p| format!(" (map: {})", p.display()));
-            outln!("FLIP: mean {m:.4}{map}");
+            let ssim = cmp.ssim.map_or("- (images under 11x11)".into(), |s| format!("{s:.4}"));
+            outln!("FLIP: mean {m:.4}{map}; SSIM: {ssim}");
         }
         if let Some(p) = job.diff() {
             outln!(
@@ -61,7 +75,7 @@ pub(crate) fn compare(job: &CompareJob) -> Result<ExitCode> {
                 distribution(d, bad.depth_rel, |v| format!("{v:.2e}"))
             );
         }
-        if let Some(s) = &cmp.suspicion {
+        for s in &cmp.suspicions {
             outln!("suspicion: {s}");
         }
     }

@@ -142,3 +142,22 @@ fn cameras_in_k_r_t_form_give_the_outputs_of_the_gl_matrices() {
         .unwrap();
     assert_clean_failure(RUN_ERROR, &o, "is 96x72, its camera in the camera file 128x96", &out);
 }
+
+/// docs/formats.md's cameras.json example, as a Vulkan renderer would write it, parses under the
+/// conventions it states (the schema there is the file's, key by key).
+#[test]
+fn the_documented_vulkan_cameras_json_parses() {
+    let doc = std::fs::read_to_string(Path::new(env!("CARGO_MANIFEST_DIR")).join("../docs/formats.md")).unwrap();
+    let section = &doc[doc.find("## cameras.json").unwrap()..];
+    let start = section.find("```json").unwrap() + "```json".len();
+    let block = &section[start..start + section[start..].find("```").unwrap()];
+    let d = scratch("cameras-doc");
+    let path = d.join("cameras.json");
+    std::fs::write(&path, block).unwrap();
+    let f = CameraFile::load(&path).unwrap();
+    assert!(f.conventions.reversed_z, "{:?}", f.conventions);
+    assert_eq!((f.middle.width, f.middle.height), (640, 480));
+    assert_eq!(f.left.size, Some([640, 480]));
+    let (_, fixation) = f.middle_and_fixation().unwrap();
+    assert_eq!(fixation, 3.0);
+}

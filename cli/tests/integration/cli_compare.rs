@@ -166,7 +166,8 @@ fn depth_inputs_are_summarised_and_an_implausible_range_warns() {
     let window = DepthPlanes::window_depth_of_ndc_z(&conv, planes.ndc_z_of_view_z(&conv, 2.0)) as f32;
     let b_device = d.join("b_device.exr");
     io::save_depth_exr(&b_device, &DepthMap::new(8, 2, vec![window; 16]).unwrap()).unwrap();
-    let o = compare(&a, &(a.0.clone(), b_device), &["--b-depth-kind", "device"]);
+    let device = ["--b-depth-kind", "device", "--b-near", "0.1", "--b-far", "1000"];
+    let o = compare(&a, &(a.0.clone(), b_device), &device);
     assert_eq!(o.status.code(), Some(0), "{}", String::from_utf8_lossy(&o.stderr));
     let log = String::from_utf8_lossy(&o.stderr);
     for file in ["a_z.exr", "b_device.exr"] {
@@ -244,7 +245,7 @@ fn gl_against_vulkan_at_640x480_one_stray_pixel_and_the_missing_conventions() {
             .output()
             .unwrap()
     };
-    let vk = ["--b-ndc", "vulkan", "--b-reversed-z"];
+    let vk = ["--b-reversed-z"];
     // The share gate passes; the maximum fails on the one pixel.
     let o = run(&[&vk[..], &["--max-bad-share", "0.001"]].concat());
     let out = String::from_utf8_lossy(&o.stdout);
@@ -260,7 +261,7 @@ fn gl_against_vulkan_at_640x480_one_stray_pixel_and_the_missing_conventions() {
     let o = run(&["--json"]);
     let j: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
     assert!(
-        j["suspicion"]
+        j["suspicions"][0]
             .as_str()
             .unwrap_or_default()
             .contains("reversed-Z true (declared false"),
@@ -278,4 +279,250 @@ fn gl_against_vulkan_at_640x480_one_stray_pixel_and_the_missing_conventions() {
     }
     assert!(j["flip_mean"].as_f64().is_some_and(|m| (0.0..0.01).contains(&m)), "{j}");
     assert_eq!(viewsynth::io::load_rgb(&flip).unwrap().width, 640);
+}
+
+/// Gates never pass on nothing: B's depth all NaN leaves no pixel valid in both, so the share
+/// gate fails naming why (it once passed, gating colour alone).
+#[test]
+fn the_share_gate_fails_when_no_depth_was_compared() {
+    let d = scratch("cmp-nan");
+    let a = side(&d, "a", 100, 2.0);
+    let b_nan = d.join("b_nan.exr");
+    io::save_depth_exr(&b_nan, &DepthMap::new(8, 2, vec![f32::NAN; 16]).unwrap()).unwrap();
+    let o = compare(&a, &(a.0.clone(), b_nan), &["--max-bad-share", "0.01"]);
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(1), "{err}");
+    assert!(
+        err.contains("threshold broken") && err.contains("no pixel holds valid depth on both sides"),
+        "{err}"
+    );
+}
+
+/// 32x24 colour with red along x, blue along y and green at `g` (no pixel grey: red and blue
+/// differ almost everywhere), top-down; B takes it through `b`.
+fn colourful(dir: &Path, b: impl Fn(f64) -> f64, swap: bool) -> (PathBuf, PathBuf) {
+    let (w, h) = (32u32, 24u32);
+    let (mut ca, mut cb) = (Vec::new(), Vec::new());
+    for y in 0..h {
+        for x in 0..w {
+            let px = [40 + x * 6, 150, 30 + y * 8].map(|v| v as u8);
+            ca.extend(px);
+            let q = px.map(|v| (b(f64::from(v) / 255.0) * 255.0).round() as u8);
+            cb.extend(if swap { [q[2], q[1], q[0]] } else { q });
+        }
+    }
+    let (pa, pb) = (dir.join("a.png"), dir.join("b.png"));
+    io::save_rgb(&pa, &RgbImage::new(w, h, ca).unwrap()).unwrap();
+    io::save_rgb(&pb, &RgbImage::new(w, h, cb).unwrap()).unwrap();
+    (pa, pb)
+}
+
+fn colour_only(a: &Path, b: &Path, extra: &[&str]) -> Output {
+    bin()
+        .args(["compare", "--a-rgb", s(a), "--b-rgb", s(b)])
+        .args(extra)
+        .output()
+        .unwrap()
+}
+
+/// The two commonest Vulkan readback mistakes are named, one line each, with the option that
+/// reads them; given that option, B matches. (Both scored 11-13 dB with no suspicion before.)
+#[test]
+fn compare_names_bgr_and_linear_for_srgb_and_ssim_is_reported() {
+    use viewsynth::compare::srgb_decode;
+    let d = scratch("cmp-colour");
+    for (name, b, swap, fix) in [
+        ("bgr", (|v| v) as fn(f64) -> f64, true, ["--b-channels", "bgr"]),
+        (
+            "linear",
+            srgb_decode as fn(f64) -> f64,
+            false,
+            ["--b-transfer", "linear"],
+        ),
+    ] {
+        let dir = d.join(name);
+        std::fs::create_dir_all(&dir).unwrap();
+        let (a, b) = colourful(&dir, b, swap);
+        let o = colour_only(&a, &b, &[]);
+        let out = String::from_utf8_lossy(&o.stdout);
+        let lines: Vec<&str> = out.lines().filter(|l| l.starts_with("suspicion")).collect();
+        let named = format!("({})", fix.join(" "));
+        assert!(
+            matches!(&lines[..], [l] if l.contains("B's colour fits") && l.contains(&named)),
+            "{name}: {out}"
+        );
+        assert!(out.contains("SSIM: 0."), "{name}: {out}");
+        // Read as the suspicion says: within a level or two (8-bit linear is coarse in the
+        // darks), no suspicion.
+        let o = colour_only(&a, &b, &[&fix[..], &["--json"]].concat());
+        let j: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+        assert!(j["suspicions"].as_array().is_some_and(Vec::is_empty), "{name}: {j}");
+        assert!(
+            j["color_error"]["p99"].as_f64().is_some_and(|p| p <= 2.0),
+            "{name}: {j}"
+        );
+        assert!(j["ssim"].as_f64().is_some_and(|s| s > 0.99), "{name}: {j}");
+    }
+}
+
+/// 16-bit colour is compared at 16 bits: one 16-bit level is not 0 error (8-bit loading kept the
+/// high byte: both 117, PSNR inf).
+#[test]
+fn sixteen_bit_colour_is_compared_at_sixteen_bits() {
+    let d = scratch("cmp-16");
+    let save = |name: &str, last: u16| {
+        let p = d.join(name);
+        let mut px = vec![30000u16; 16 * 16 * 3];
+        px[0] = last;
+        image::ImageBuffer::<image::Rgb<u16>, _>::from_raw(16, 16, px)
+            .unwrap()
+            .save(&p)
+            .unwrap();
+        p
+    };
+    let (a, b) = (save("a.png", 30000), save("b.png", 30001));
+    let summary = d.join("s.json");
+    let o = colour_only(&a, &b, &["--max-colour-rmse", "0", "--json", s(&summary)]);
+    assert_eq!(o.status.code(), Some(1), "{}", String::from_utf8_lossy(&o.stderr));
+    let j = json(&summary);
+    // One level of 65535 is 255 / 65535 = 0.0039 8-bit levels.
+    assert_eq!(j["max_color_diff"].as_f64(), Some(0.0039), "{j}");
+    assert!(j["psnr_db"].as_f64().is_some_and(|p| p > 100.0), "{j}");
+    assert_eq!(j["color_bits"], serde_json::json!([16, 16]));
+    let o = colour_only(&a, &a, &["--max-colour-rmse", "0"]);
+    assert_eq!(o.status.code(), Some(0));
+}
+
+/// Window depth of view Z `z` under reversed-Z with an infinite far plane: near / Z.
+fn reversed_infinite(z: f32, near: f32) -> f32 {
+    near / z
+}
+
+/// Each side's planes, an infinite far plane, and no silent default: the case (an
+/// infinite-far reversed-Z buffer read with a finite far failed on every pixel, silently).
+#[test]
+fn per_side_and_infinite_planes_and_no_default_planes() {
+    use viewsynth::convention::{Conventions, DepthPlanes};
+    let d = scratch("cmp-planes");
+    // A: GL standard-Z window depth with (0.1, 100); B: reversed-Z, infinite far, near 0.05.
+    let z: Vec<f32> = (0..16 * 12)
+        .map(|i| 2.0 + (i % 16) as f32 * 0.25 + (i / 16) as f32 * 0.1)
+        .collect();
+    let (conv, pa) = (Conventions::default(), DepthPlanes { near: 0.1, far: 100.0 });
+    let wa: Vec<f32> = z
+        .iter()
+        .map(|z| DepthPlanes::window_depth_of_ndc_z(&conv, pa.ndc_z_of_view_z(&conv, f64::from(*z))) as f32)
+        .collect();
+    let wb: Vec<f32> = z.iter().map(|z| reversed_infinite(*z, 0.05)).collect();
+    let rgb = d.join("c.png");
+    io::save_rgb(&rgb, &RgbImage::new(16, 12, vec![90; 16 * 12 * 3]).unwrap()).unwrap();
+    let (da, db) = (d.join("a.exr"), d.join("b.exr"));
+    io::save_depth_exr(&da, &DepthMap::new(16, 12, wa).unwrap()).unwrap();
+    io::save_depth_exr(&db, &DepthMap::new(16, 12, wb).unwrap()).unwrap();
+    let run = |extra: &[&str]| {
+        compare(
+            &(rgb.clone(), da.clone()),
+            &(rgb.clone(), db.clone()),
+            &[
+                &[
+                    "--a-depth-kind",
+                    "device",
+                    "--b-depth-kind",
+                    "device",
+                    "--a-near",
+                    "0.1",
+                    "--a-far",
+                    "100",
+                    "--max-bad-share",
+                    "0.001",
+                ][..],
+                extra,
+            ]
+            .concat(),
+        )
+    };
+    let o = run(&["--b-near", "0.05", "--b-far", "inf", "--b-reversed-z"]);
+    let out = String::from_utf8_lossy(&o.stdout);
+    assert_eq!(o.status.code(), Some(0), "{out}{}", String::from_utf8_lossy(&o.stderr));
+    assert!(!out.contains("suspicion"), "{out}");
+    // Read with far 1000 (the old silent default): every pixel bad, and the reading named.
+    let o = run(&["--b-near", "0.05", "--b-far", "1000", "--b-reversed-z"]);
+    let out = String::from_utf8_lossy(&o.stdout);
+    assert_eq!(o.status.code(), Some(1), "{out}");
+    assert!(
+        out.contains("suspicion: B's depth fits an infinite far plane (--b-far inf; declared 1000)"),
+        "{out}"
+    );
+    // No planes for B's device depth: a usage error naming the options, no silent default.
+    let o = run(&["--b-reversed-z"]);
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(
+        o.status.code() == Some(2) && err.contains("--b-near N --b-far F"),
+        "{err}"
+    );
+}
+
+/// Every convention option changes the reading or is refused (exit 2, saying why): --b-ndc on
+/// window depth changed nothing (the same function of Z under either range); it now reads
+/// stored NDC z, where the range matters.
+#[test]
+fn convention_options_change_the_reading_or_are_refused() {
+    use viewsynth::convention::{Conventions, DepthPlanes};
+    let d = scratch("cmp-ndc");
+    let a = side(&d, "a", 100, 2.0);
+    // B: GL NDC z of the same 2 m, near 0.1, far 10.
+    let (conv, planes) = (Conventions::default(), DepthPlanes { near: 0.1, far: 10.0 });
+    let ndc = d.join("b_ndc.exr");
+    let v = planes.ndc_z_of_view_z(&conv, 2.0) as f32;
+    io::save_depth_exr(&ndc, &DepthMap::new(8, 2, vec![v; 16]).unwrap()).unwrap();
+    let b = (a.0.clone(), ndc);
+    let as_ndc = |range: &str| {
+        compare(
+            &a,
+            &b,
+            &[
+                "--b-depth-kind",
+                "ndc",
+                "--b-ndc",
+                range,
+                "--b-near",
+                "0.1",
+                "--b-far",
+                "10",
+                "--max-depth-rel",
+                "1e-4",
+            ],
+        )
+    };
+    assert_eq!(as_ndc("gl").status.code(), Some(0));
+    assert_eq!(as_ndc("vulkan").status.code(), Some(1), "the range changes the reading");
+    for (flags, why) in [
+        (
+            &[
+                "--b-depth-kind",
+                "device",
+                "--b-near",
+                "0.1",
+                "--b-far",
+                "10",
+                "--b-ndc",
+                "vulkan",
+            ][..],
+            "same function of Z",
+        ),
+        (&["--b-reversed-z"][..], "view-z"),
+        (&["--near", "0.1", "--far", "10"][..], "neither side"),
+        (
+            &["--b-depth-kind", "ndc", "--b-near", "0.1", "--b-far", "10"][..],
+            "--b-ndc gl",
+        ),
+    ] {
+        let o = compare(&a, &b, flags);
+        let err = String::from_utf8_lossy(&o.stderr);
+        assert!(o.status.code() == Some(2) && err.contains(why), "{flags:?}: {err}");
+    }
+    // Premultiplied alpha where the file has none: refused, naming the side.
+    let o = compare(&a, &a, &["--b-alpha", "premultiplied"]);
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(o.status.code() != Some(0) && err.contains("B alpha"), "{err}");
 }

@@ -336,9 +336,13 @@ impl CyclopeanJob {
         }
         if let (Some(cameras), Some((left_map, right_map))) = (&self.cameras, &self.maps) {
             for (path, eye) in [(left_map, &frame.left), (right_map, &frame.right)] {
+                // cyclopean takes the conventions and planes from the file alone (--ndc and
+                // the like are refused with --cameras): the hint names the file's keys.
                 let hint = format!(
-                    "read as {:?} depth (check depth_kind and the projections in {}, and --depth-scale)",
-                    frame.depth_kind,
+                    "read as {} depth under {}: check its depth_kind, conventions (ndc_depth, reversed_z) \
+                     and each eye's proj or near/far (docs/formats.md); for integer depth files, \
+                     `--depth-scale S` (raw units per metre)",
+                    frame.depth_kind.name(),
                     cameras.display()
                 );
                 host.event(Event::InputDepth {
