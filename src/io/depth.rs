@@ -258,7 +258,11 @@ fn to_metres(path: &Path, raw: RawDepth, decode: &DepthDecode) -> Result<DepthMa
             v.into_iter().map(|d| int_to_metres(d.into(), s)).collect()
         }
         RawSamples::U16(v) => {
-            let s = need_scale("16-bit", "5000 for TUM, 1000 for SUN RGB-D or millimetres")?;
+            let s = need_scale(
+                "16-bit",
+                "5000 for TUM, 1000 for SUN RGB-D, NYU, ScanNet or millimetres; \
+                 viewsynth's png16 output records its scale in manifest.json",
+            )?;
             if !(decode.swap_bytes || decode.sun_rgbd_bit_rotate) {
                 // The common case as its own loop, so it vectorises.
                 v.into_iter().map(|d| int_to_metres(d.into(), s)).collect()

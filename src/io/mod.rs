@@ -43,7 +43,7 @@ pub use depth::{
     check_rgbd_sizes, depth_dimensions, load_depth, load_depth_with_key, rgb_dimensions, save_depth_exr,
     save_depth_exr_with, save_depth_npy, DepthDecode,
 };
-pub use depth_png16::{save_depth_png16, PNG16_UNITS_PER_METRE};
+pub use depth_png16::{save_depth_png16, Png16Units, PNG16_UNITS_PER_METRE};
 pub use depth_preview::{depth_preview, depth_preview_range, save_depth_preview, PreviewRange, PREVIEW_PERCENTILES};
 pub use depth_summary::{DepthSummary, DepthWarning, PLAUSIBLE_MEDIAN_M};
 pub use depth_trunc::{check_depth_trunc, truncate_depth};

@@ -16,6 +16,7 @@ mod cli_outputs_table;
 mod cli_plausibility;
 mod cli_reproject_stitch;
 mod cli_sequence;
+mod cli_units;
 mod common;
 mod compare;
 mod compare_robust;
