@@ -16,9 +16,12 @@ mod depth_ranks;
 mod depth_summary;
 mod depth_trunc;
 mod depth_values;
+mod disparity_fit;
+mod disparity_summary;
 mod encoding;
 mod exr_io;
 mod file_set;
+mod grey_png;
 mod image_types;
 mod input;
 mod json;
@@ -50,6 +53,8 @@ pub use depth_trunc::{check_depth_trunc, truncate_depth};
 pub use depth_values::{
     check_usable_depth, clear_unusable_depth, usable_depth_value, MAX_DEPTH_VALUE, MIN_DEPTH_VALUE,
 };
+pub use disparity_fit::{fit_disparity_scale, ScaleFit, CANDIDATE_SCALES, CLEARLY_BETTER};
+pub use disparity_summary::{DisparitySummary, DisparityWarning, PLAUSIBLE_P95_WIDTH_SHARE};
 pub use encoding::{Encoding, ExrCompression, PngCompression};
 pub use file_set::{
     remove_orphan_temporaries, write_paths_all_or_none, FileSet, FileWriter, OutDir, PathWriter, MANIFEST_NAME,

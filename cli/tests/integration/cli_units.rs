@@ -1,8 +1,13 @@
-//! Units are never assumed (issue 47): png16 depth is written in the units asked for
-//! (`--depth-png-scale`), recorded, and depth beyond what the PNG holds is said.
+//! Units are never assumed (issue 47). png16 depth is written in the units asked for
+//! (`--depth-png-scale`), recorded, and depth beyond what the PNG holds is said. Disparity inputs
+//! are checked as depth inputs are: a summary per map, a warning naming `--disparity-scale` and
+//! the value the views agree with when another scale fits far better (Middlebury Cones read at 1
+//! instead of 4 rendered a doubled view at exit 0, silently), and grey maps stored as palette or
+//! RGB PNGs read as the grey they hold.
 
 use crate::cli::{bin, scratch};
-use std::path::Path;
+use crate::common::data_dir;
+use std::path::{Path, PathBuf};
 use viewsynth::io::{self, DepthMap, RgbImage};
 
 fn s(p: &Path) -> &str {
@@ -15,6 +20,109 @@ fn text(o: &std::process::Output) -> String {
         String::from_utf8_lossy(&o.stdout),
         String::from_utf8_lossy(&o.stderr)
     )
+}
+
+fn cones(file: &str) -> PathBuf {
+    data_dir().join("middlebury2003_cones").join(file)
+}
+
+/// `cyclopean` of Cones with the given disparity files and extra options into `out`.
+fn run(left: &Path, right: &Path, extra: &[&str], out: &Path) -> std::process::Output {
+    bin()
+        .args([
+            "cyclopean",
+            "--left-rgb",
+            s(&cones("im2.png")),
+            "--right-rgb",
+            s(&cones("im6.png")),
+        ])
+        .args(["--left-disparity", s(left), "--right-disparity", s(right)])
+        .args(["--out-dir", s(out)])
+        .args(extra)
+        .output()
+        .unwrap()
+}
+
+/// The PGM's grey values (the 2003 maps: 4 units a pixel).
+fn grey(pgm: &Path) -> (u32, u32, Vec<u8>) {
+    let img = image::open(pgm).unwrap().into_luma8();
+    (img.width(), img.height(), img.into_raw())
+}
+
+/// `values` as an 8-bit palette PNG whose entry i is (i, i, i).
+fn write_palette_png(path: &Path, (w, h, values): &(u32, u32, Vec<u8>)) {
+    let file = std::io::BufWriter::new(std::fs::File::create(path).unwrap());
+    let mut e = png::Encoder::new(file, *w, *h);
+    e.set_color(png::ColorType::Indexed);
+    e.set_depth(png::BitDepth::Eight);
+    e.set_palette((0..=255u8).flat_map(|i| [i, i, i]).collect::<Vec<u8>>());
+    e.write_header().unwrap().write_image_data(values).unwrap();
+}
+
+/// `values` as an RGB PNG with each channel equal to the grey value.
+fn write_rgb_png(path: &Path, (w, h, values): &(u32, u32, Vec<u8>)) -> Vec<u8> {
+    let rgb: Vec<u8> = values.iter().flat_map(|&v| [v, v, v]).collect();
+    image::RgbImage::from_raw(*w, *h, rgb.clone())
+        .unwrap()
+        .save(path)
+        .unwrap();
+    rgb
+}
+
+#[test]
+fn cones_without_its_disparity_scale_warns_naming_the_value_that_fits() {
+    let d = scratch("disp-units-scale");
+    let (left, right) = (cones("disp2.pgm"), cones("disp6.pgm"));
+    let o = run(&left, &right, &[], &d.join("unscaled"));
+    let t = text(&o);
+    // Still rendered (a warning, not a refusal), but said, with the fix.
+    assert!(o.status.success(), "{t}");
+    assert!(
+        t.contains("input disparity") && t.contains("at --disparity-scale 1"),
+        "{t}"
+    );
+    let warnings: Vec<&str> = t.lines().filter(|l| l.starts_with("warning:")).collect();
+    assert!(
+        warnings
+            .iter()
+            .any(|w| w.contains("disp2.pgm") && w.contains("--disparity-scale 4 ")),
+        "{t}"
+    );
+    let o = run(&left, &right, &["--disparity-scale", "4"], &d.join("scaled"));
+    let t = text(&o);
+    assert!(o.status.success() && !t.contains("warning"), "{t}");
+    assert!(t.contains("at --disparity-scale 4"), "{t}");
+}
+
+#[test]
+fn palette_and_rgb_copies_of_grey_disparities_render_as_the_pgms_and_unequal_channels_are_refused() {
+    let d = scratch("disp-units-png");
+    let (left, right) = (cones("disp2.pgm"), cones("disp6.pgm"));
+    let (left_png, right_png, bad_png) = (d.join("disp2.png"), d.join("disp6.png"), d.join("bad.png"));
+    write_palette_png(&left_png, &grey(&left));
+    let mut rgb = write_rgb_png(&right_png, &grey(&right));
+    let scale = ["--disparity-scale", "4"];
+    let pgm = run(&left, &right, &scale, &d.join("pgm"));
+    assert!(pgm.status.success(), "{}", text(&pgm));
+    let png = run(&left_png, &right_png, &scale, &d.join("png"));
+    assert!(png.status.success(), "{}", text(&png));
+    for file in ["middle_rgb.png", "middle_mask.png"] {
+        let (a, b) = (d.join("pgm").join(file), d.join("png").join(file));
+        assert!(
+            std::fs::read(&a).unwrap() == std::fs::read(&b).unwrap(),
+            "{file} differs"
+        );
+    }
+    // Green of pixel (5, 3) one level off: a colour picture, refused naming the pixel.
+    let (w, h, _) = grey(&right);
+    rgb[3 * (3 * w as usize + 5) + 1] ^= 1;
+    image::RgbImage::from_raw(w, h, rgb).unwrap().save(&bad_png).unwrap();
+    let out = d.join("bad");
+    let o = run(&left_png, &bad_png, &scale, &out);
+    let t = text(&o);
+    assert_eq!(o.status.code(), Some(1), "{t}");
+    assert!(t.contains("bad.png") && t.contains("differ at pixel (5, 3)"), "{t}");
+    assert!(!t.contains("panicked") && !out.exists(), "{t}");
 }
 
 #[test]
