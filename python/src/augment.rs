@@ -131,7 +131,8 @@ pub fn read_depth<'py>(
         // A missing scale is a bad argument, worded with the keyword (the library names the
         // field, `depth-scale`; as an option it becomes `depth_scale`).
         viewsynth::Error::InvalidParameter { name, message } if !name.starts_with("--") => {
-            errors::from_request(ArgError::Invalid(viewsynth::Error::param(&format!("--{name}"), message)))
+            let option = viewsynth::Error::param(format!("--{name}"), message);
+            errors::from_request(ArgError::Invalid(option))
         }
         e => errors::from_library(e),
     })?;
