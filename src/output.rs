@@ -60,11 +60,13 @@ fn write_view_in(set: &mut FileSet, names: &ViewNames, view: &ViewOutput, format
         if formats.depth.png16 {
             let name = format!("{}.png", names.depth);
             let count = &mut clipped;
+            let units = formats.depth.png16_units;
             jobs.push(job(set, &name, move |p, out| {
-                *count = Some(io::encode_depth_png16(p, out, depth, enc.png)?);
+                *count = Some(io::encode_depth_png16(p, out, depth, units, enc.png)?);
                 Ok(())
             }));
             entry.depth_png16 = Some(name);
+            entry.depth_png16_units_per_metre = Some(units.get());
         }
         if formats.depth_preview {
             let range = io::depth_preview_range(depth);
@@ -133,6 +135,7 @@ mod tests {
                 exr: false,
                 npy: true,
                 png16: true,
+                png16_units: Default::default(),
             },
             depth_preview: true,
             ..Default::default()

@@ -248,7 +248,7 @@ fn write_seed_corpus() {
     seed("load_depth", "npy", with(0, read(file("d.npy"))));
     io::save_depth_exr(&file("d.exr"), &depth).unwrap();
     seed("load_depth", "exr", with(1, read(file("d.exr"))));
-    io::save_depth_png16(&file("d.png"), &depth, PngCompression::Fast).unwrap();
+    io::save_depth_png16(&file("d.png"), &depth, io::Png16Units::default(), PngCompression::Fast).unwrap();
     seed("load_depth", "png16", with(2 | 8, read(file("d.png"))));
     let mut pgm = format!("P5\n{w} {h}\n65535\n").into_bytes();
     pgm.extend(depth.data.iter().flat_map(|z| ((z * 1000.0) as u16).to_be_bytes()));

@@ -181,7 +181,7 @@ proptest! {
         }
         let d = scratch();
         let p = d.path().join("z.png");
-        let clipped = io::save_depth_png16(&p, &depth, PngCompression::Fast).unwrap();
+        let clipped = io::save_depth_png16(&p, &depth, io::Png16Units::default(), PngCompression::Fast).unwrap();
         let back = io::load_depth(&p, &DepthDecode { scale: Some(io::PNG16_UNITS_PER_METRE), ..Default::default() }).unwrap();
         prop_assert_eq!((back.width, back.height), (depth.width, depth.height));
         let mut over = 0u64;

@@ -46,6 +46,12 @@ impl Host for CliHost {
                     errln!("warning: {}: {w}; {hint}", path.display());
                 }
             }
+            Event::InputDisparity { path, summary } => {
+                eprintln!("input disparity {}: {summary}", path.display());
+                for w in summary.warnings() {
+                    eprintln!("warning: {}: {w}", path.display());
+                }
+            }
             Event::DepthTruncated { limit_m, pixels } => {
                 errln!("--depth-trunc {limit_m}: {pixels} pixels beyond {limit_m} m set invalid");
             }

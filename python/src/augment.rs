@@ -1,14 +1,14 @@
 //! Dataset augmentation around `Renderer.refocus_batch`: `rgb_everywhere`, random zoom
 //! (`zoom_random`, `samples`, `seed`: the CLI's `--zoom-random LO,HI --samples K --seed S`) and
 //! `progress` (a callable, or True for a line on stderr), and `viewsynth.read_depth`: the depth
-//! files the CLI writes (EXR, NPY, 16-bit PNG in millimetres) read back as float32 metres.
+//! files the CLI writes or reads, as float32 metres under the library's rules.
 
 use crate::errors;
 use pyo3::prelude::*;
 use pyo3::types::PyBool;
 use std::cell::{Cell, RefCell};
 use std::path::PathBuf;
-use viewsynth::io::DepthDecode;
+use viewsynth::job::{ArgError, DepthFileRequest};
 use viewsynth::refocus::batch::BatchOptions;
 
 /// The augmentation keyword arguments of one `refocus_batch` call.
@@ -101,23 +101,40 @@ impl Progress {
     }
 }
 
-/// Read a depth file as the CLI writes it (or reads it): EXR, NPY, 16-bit PNG (millimetres,
-/// or `depth_scale` raw units per metre), PFM, NPZ. Returns float32[H, W] view-space Z in
-/// metres, 0 where invalid.
+/// Read a depth file as the CLI writes it (or reads it): EXR, NPY, NPZ, PFM, 16-bit PNG/PGM.
+/// Returns float32[H, W] view-space Z in metres, 0 where invalid. The library's rule, as the
+/// CLI's inputs: integer samples need `depth_scale` (raw units per metre; the CLI's png16
+/// output records its own in manifest.json and index.jsonl), device depth needs the `near` and
+/// `far` planes it was written with.
 ///
-/// Raises FileError for a missing or unreadable file, InvalidInputError for a bad depth_scale.
+/// Raises FileError for a missing or unreadable file, InvalidInputError for integer depth
+/// without depth_scale, a bad depth_scale, or device depth without its planes.
 #[pyfunction]
-#[pyo3(signature = (path, *, depth_scale = None))]
-pub fn read_depth<'py>(py: Python<'py>, path: PathBuf, depth_scale: Option<f64>) -> PyResult<Bound<'py, PyAny>> {
-    let png16 = path.extension().is_some_and(|e| e.eq_ignore_ascii_case("png"));
-    // The CLI's png16 output holds millimetres.
-    let scale = depth_scale.or(png16.then_some(1000.0));
-    let decode = DepthDecode {
-        scale,
-        ..Default::default()
-    };
-    let depth = py
-        .detach(|| viewsynth::io::load_depth(&path, &decode))
-        .map_err(errors::from_library)?;
+#[pyo3(signature = (path, *, depth_scale = None, depth_kind = "view-z", near = None, far = None))]
+pub fn read_depth<'py>(
+    py: Python<'py>,
+    path: PathBuf,
+    depth_scale: Option<f64>,
+    depth_kind: &str,
+    near: Option<f64>,
+    far: Option<f64>,
+) -> PyResult<Bound<'py, PyAny>> {
+    let reading = DepthFileRequest {
+        depth_scale,
+        depth_kind: crate::shared::choice("--depth-kind", depth_kind)?,
+        near,
+        far,
+    }
+    .check()
+    .map_err(errors::from_request)?;
+    let depth = py.detach(|| reading.read(&path)).map_err(|e| match e {
+        // A missing scale is a bad argument, worded with the keyword (the library names the
+        // field, `depth-scale`; as an option it becomes `depth_scale`).
+        viewsynth::Error::InvalidParameter { name, message } if !name.starts_with("--") => {
+            let option = viewsynth::Error::param(format!("--{name}"), message);
+            errors::from_request(ArgError::Invalid(option))
+        }
+        e => errors::from_library(e),
+    })?;
     Ok(crate::arrays::depth_array(py, depth))
 }

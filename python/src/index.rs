@@ -20,7 +20,7 @@ use std::path::PathBuf;
 #[allow(clippy::too_many_arguments)]
 #[pyo3(signature = (frames, out_dir, *, scales = None, size = None, principal = None,
                     outputs = None, tau_rel = 0.05, tau_abs = 0.2, method = "fullscreen", rgb_format = "png",
-                    depth_format = None, depth_preview = false, png_compression = "fast",
+                    depth_format = None, depth_png_scale = None, depth_preview = false, png_compression = "fast",
                     exr_compression = "zip", depth_trunc = None, rgb_everywhere = false, zoom_random = None,
                     samples = None, seed = None))]
 pub fn write_index<'py>(
@@ -36,6 +36,7 @@ pub fn write_index<'py>(
     method: &str,
     rgb_format: &str,
     depth_format: Option<&Bound<'py, PyAny>>,
+    depth_png_scale: Option<f64>,
     depth_preview: bool,
     png_compression: &str,
     exr_compression: &str,
@@ -57,6 +58,7 @@ pub fn write_index<'py>(
         method,
         rgb_format,
         depth_format,
+        depth_png_scale,
         depth_preview,
         png_compression,
         exr_compression,

@@ -76,7 +76,10 @@ def test_read_depth_reads_every_format_the_cli_writes(renderer, tmp_path):
     renderer.refocus_batch(manifest, tmp_path / "out", scales=[1.0], depth_format="exr,npy,png16")
     [row] = vs.read_index(tmp_path / "out")
     folder = tmp_path / "out" / "f"
-    exr, npy, png = (vs.read_depth(folder / f"s1_depth.{ext}") for ext in ("exr", "npy", "png"))
+    exr, npy = (vs.read_depth(folder / f"s1_depth.{ext}") for ext in ("exr", "npy"))
+    # The png16 file's units come from its row, never assumed.
+    assert row["depth"].endswith("s1_depth.exr") and "depth_scale" not in row
+    png = vs.read_depth(folder / "s1_depth.png", depth_scale=1000)
     assert np.array_equal(exr, npy)
     valid = npy > 0
     assert np.abs(png[valid] - npy[valid]).max() <= 0.0005 + 1e-6  # millimetres, rounded

@@ -8,7 +8,8 @@
     right = r.reproject(rgb, depth, K, baseline=0.1)["right"]
     ods = r.stitch(left_rgb, left_depth, right_rgb, right_depth, width=2048, height=1024)["rgb"]
     r.refocus_batch(vs.load_manifest("frames.csv"), "out/")   # files, as `viewsynth refocus --batch`
-    rows = vs.read_index("out/")             # one dict per target; vs.read_depth(rows[0]["depth"])
+    rows = vs.read_index("out/")             # one dict per target; vs.read_depth(rows[0]["depth"],
+                                             #   depth_scale=rows[0].get("depth_scale"))
     vs.write_index(frames, "out/")           # after shares rendered with refocus_batch(index=False)
 
 A Renderer belongs to the thread that created it, and to the process that created it:

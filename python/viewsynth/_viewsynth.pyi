@@ -289,6 +289,7 @@ class Renderer:
         method: Literal["fullscreen", "mesh"] = "fullscreen",
         rgb_format: Literal["png", "jpeg", "jpg", "exr"] = "png",
         depth_format: Optional[Union[str, Sequence[Literal["exr", "npy", "png16"]]]] = None,
+        depth_png_scale: Optional[float] = None,
         depth_preview: bool = False,
         png_compression: Literal["fast", "default", "best"] = "fast",
         exr_compression: Literal["none", "rle", "zip", "piz"] = "zip",
@@ -321,6 +322,7 @@ def write_index(
     method: Literal["fullscreen", "mesh"] = "fullscreen",
     rgb_format: Literal["png", "jpeg", "jpg", "exr"] = "png",
     depth_format: Optional[Union[str, Sequence[Literal["exr", "npy", "png16"]]]] = None,
+    depth_png_scale: Optional[float] = None,
     depth_preview: bool = False,
     png_compression: Literal["fast", "default", "best"] = "fast",
     exr_compression: Literal["none", "rle", "zip", "piz"] = "zip",
@@ -334,9 +336,19 @@ def write_index(
     Renderer.refocus_batch(..., index=False) under the same settings; no GPU. Returns (path, rows)."""
     ...
 
-def read_depth(path: Union[str, "os.PathLike[str]"], *, depth_scale: Optional[float] = None) -> npt.NDArray[np.float32]:
-    """A depth file the CLI writes (EXR, NPY, 16-bit PNG in millimetres) or reads, as float32[H, W]
-    view-space Z in metres, 0 where invalid."""
+def read_depth(
+    path: Union[str, "os.PathLike[str]"],
+    *,
+    depth_scale: Optional[float] = None,
+    depth_kind: Literal["view-z", "metric", "device"] = "view-z",
+    near: Optional[float] = None,
+    far: Optional[float] = None,
+) -> npt.NDArray[np.float32]:
+    """A depth file the CLI writes or reads, as float32[H, W] view-space Z in metres, 0 where
+    invalid, under the CLI's rules: integer files (16-bit PNG/PGM, uint16 NPY) need depth_scale,
+    raw units per metre (5000 for TUM; the CLI's png16 output records its own as the index row's
+    "depth_scale"); device depth (depth_kind="device") needs the near and far planes it was
+    written with. Raises InvalidInputError when one is missing."""
     ...
 
 def info(device: str = "auto") -> Dict[str, Any]:

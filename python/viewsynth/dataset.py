@@ -13,8 +13,9 @@ INDEX_NAME = "index.jsonl"
 def read_index(out_dir, absolute=True):
     """The rows of ``out_dir/index.jsonl``, in manifest order: dicts with "frame",
     "frame_index", "target", "scale", "intrinsics" (fx, fy, cx, cy of K'), "width", "height",
-    "coverage", and the files "rgb", "depth", "mask" (None when not written) and "manifest".
-    With ``absolute`` (the default) the file paths are joined to ``out_dir``; otherwise they
+    "coverage", and the files "rgb", "depth", "mask" (None when not written) and "manifest";
+    a row whose "depth" is the 16-bit PNG also has "depth_scale", its raw units per metre
+    (``read_depth(row["depth"], depth_scale=row.get("depth_scale"))``). With ``absolute`` (the default) the file paths are joined to ``out_dir``; otherwise they
     stay relative to it, as stored.
 
     The index is written when a run (or the last of its shards) ends; after shards ran

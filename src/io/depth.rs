@@ -7,6 +7,7 @@ use image::ImageFormat;
 use super::atomic::atomic_write;
 use super::decode::{decode_image, image_dimensions, Samples};
 use super::exr_io::{exr_dimensions, read_depth_channel, write_f32_planes};
+use super::grey_png::grey_of;
 use super::image_types::{decode_dims, encode_dims, DepthMap};
 use super::input::max_pixels;
 use super::netpbm::netpbm_dimensions;
@@ -38,8 +39,10 @@ pub struct DepthDecode {
 
 /// Loads a depth (or disparity) map by extension, case-insensitive: `.exr` (one channel,
 /// see below), `.npy` (shape (H, W) or (H, W, 1); `<f4 >f4 <f8 >f8 <u2 >u2`, either
-/// order), `.npz` (the only array, else the first floating-point one, as `.npy`), `.png` (single-channel 16-bit, or 8-bit when `scale` is given), `.pgm` (P5/P2,
-/// big-endian per Netpbm unless `swap_bytes`), `.pfm` (grayscale `Pf`).
+/// order), `.npz` (the only array, else the first floating-point one, as `.npy`), `.png`
+/// (16-bit, or 8-bit when `scale` is given; gray, or palette/RGB/RGBA with equal colour
+/// channels and opaque alpha), `.pgm` (P5/P2, big-endian per Netpbm unless `swap_bytes`),
+/// `.pfm` (grayscale `Pf`).
 ///
 /// The EXR channel is "Z", else "depth" (any case), else "Y", else "R", else the only one.
 pub fn load_depth(path: &Path, decode: &DepthDecode) -> Result<DepthMap> {
@@ -173,18 +176,15 @@ pub fn encode_depth_npy(path: &Path, out: &mut std::io::BufWriter<std::fs::File>
     super::npy::encode_npy_f32(path, out, &[depth.height as usize, depth.width as usize], &depth.data)
 }
 
+/// A single-channel PNG, or a palette, RGB or RGBA one holding a grey map
+/// ([`grey_of`]: equal colour channels, opaque alpha).
 fn read_png(path: &Path) -> Result<RawDepth> {
     let img = decode_image(path, Some(ImageFormat::Png))?;
-    if img.channels != 1 {
-        return Err(Error::decode(
-            path,
-            format!("depth PNG must be single-channel gray, found {} channels", img.channels),
-        ));
-    }
+    let (channels, width) = (img.channels, img.width);
     let samples = match img.samples {
-        Samples::U8(v) => RawSamples::U8(v),
-        Samples::U16(v) => RawSamples::U16(v),
-        Samples::F32(v) => RawSamples::F32(v),
+        Samples::U8(v) => RawSamples::U8(grey_of(path, v, channels, width, u8::MAX)?),
+        Samples::U16(v) => RawSamples::U16(grey_of(path, v, channels, width, u16::MAX)?),
+        Samples::F32(v) => RawSamples::F32(grey_of(path, v, channels, width, 1.0)?),
     };
     Ok(RawDepth {
         width: img.width,
@@ -258,7 +258,11 @@ fn to_metres(path: &Path, raw: RawDepth, decode: &DepthDecode) -> Result<DepthMa
             v.into_iter().map(|d| int_to_metres(d.into(), s)).collect()
         }
         RawSamples::U16(v) => {
-            let s = need_scale("16-bit", "5000 for TUM, 1000 for SUN RGB-D or millimetres")?;
+            let s = need_scale(
+                "16-bit",
+                "5000 for TUM, 1000 for SUN RGB-D, NYU, ScanNet or millimetres; \
+                 viewsynth's png16 output records its scale in manifest.json",
+            )?;
             if !(decode.swap_bytes || decode.sun_rgbd_bit_rotate) {
                 // The common case as its own loop, so it vectorises.
                 v.into_iter().map(|d| int_to_metres(d.into(), s)).collect()

@@ -17,9 +17,12 @@ mod depth_ranks;
 mod depth_summary;
 mod depth_trunc;
 mod depth_values;
+mod disparity_fit;
+mod disparity_summary;
 mod encoding;
 mod exr_io;
 mod file_set;
+mod grey_png;
 mod image_types;
 mod input;
 mod json;
@@ -45,13 +48,15 @@ pub use depth::{
     check_rgbd_sizes, depth_dimensions, load_depth, load_depth_with_key, rgb_dimensions, save_depth_exr,
     save_depth_exr_with, save_depth_npy, DepthDecode,
 };
-pub use depth_png16::{save_depth_png16, PNG16_UNITS_PER_METRE};
+pub use depth_png16::{save_depth_png16, Png16Units, PNG16_UNITS_PER_METRE};
 pub use depth_preview::{depth_preview, depth_preview_range, save_depth_preview, PreviewRange, PREVIEW_PERCENTILES};
 pub use depth_summary::{DepthSummary, DepthWarning, PLAUSIBLE_MEDIAN_M};
 pub use depth_trunc::{check_depth_trunc, truncate_depth};
 pub use depth_values::{
     check_usable_depth, clear_unusable_depth, usable_depth_value, MAX_DEPTH_VALUE, MIN_DEPTH_VALUE,
 };
+pub use disparity_fit::{fit_disparity_scale, ScaleFit, CANDIDATE_SCALES, CLEARLY_BETTER};
+pub use disparity_summary::{DisparitySummary, DisparityWarning, PLAUSIBLE_P95_WIDTH_SHARE};
 pub use encoding::{Encoding, ExrCompression, PngCompression};
 pub(crate) use file_set::remove_own_file;
 pub use file_set::{

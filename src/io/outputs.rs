@@ -8,7 +8,7 @@
 //! [`ViewNames`] lets a command keep other names it has always written (stitch's
 //! `ods_left.png`, scene's `left_view_z.exr`).
 
-use super::{Encoding, FileSet, FileWriter, PreviewRange};
+use super::{Encoding, FileSet, FileWriter, Png16Units, PreviewRange};
 use crate::error::{Error, Result};
 use serde::{Deserialize, Serialize};
 use std::path::Path;
@@ -104,10 +104,14 @@ pub struct DepthFormats {
     pub exr: bool,
     /// float32 metres in a NumPy `.npy` file.
     pub npy: bool,
-    /// uint16 millimetres in a 16-bit gray PNG (0 = invalid). Left out of the settings JSON
-    /// when off, so batches made before it resume.
+    /// uint16 `metres * png16_units` in a 16-bit gray PNG (0 = invalid). Left out of the
+    /// settings JSON when off, so batches made before it resume.
     #[serde(skip_serializing_if = "std::ops::Not::not")]
     pub png16: bool,
+    /// Raw units per metre of the png16 file (default 1000, millimetres; left out of the
+    /// settings JSON at the default, so batches made before it resume).
+    #[serde(skip_serializing_if = "Png16Units::is_default")]
+    pub png16_units: Png16Units,
 }
 
 impl DepthFormats {
@@ -119,6 +123,7 @@ impl DepthFormats {
             exr: false,
             npy: false,
             png16: false,
+            png16_units: Png16Units::default(),
         };
         for name in names {
             match name.trim() {
@@ -141,6 +146,7 @@ impl Default for DepthFormats {
             exr: true,
             npy: false,
             png16: false,
+            png16_units: Png16Units::default(),
         }
     }
 }
@@ -275,10 +281,14 @@ pub struct ViewFiles {
     pub depth_exr: Option<String>,
     /// Depth NPY file name; None when not written.
     pub depth_npy: Option<String>,
-    /// Depth 16-bit PNG file name (millimetres); None when not written.
+    /// Depth 16-bit PNG file name; None when not written.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub depth_png16: Option<String>,
-    /// Valid pixels written as 0 in the PNG because they lie beyond 65.535 m.
+    /// Raw units per metre of the 16-bit PNG (metres = raw / this), when written.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub depth_png16_units_per_metre: Option<f64>,
+    /// Valid pixels written as 0 in the PNG because they lie beyond 65535 units
+    /// (65.535 m in millimetres).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub depth_png16_clipped: Option<u64>,
     /// Depth preview PNG file name; None when not written.

@@ -15,6 +15,8 @@ pub struct FileOptions<'a> {
     pub rgb: RgbFormat,
     /// `--depth-format`: any of exr, npy, png16.
     pub depth: &'a str,
+    /// `--depth-png-scale`: raw units per metre of png16 depth (none: 1000, millimetres).
+    pub depth_png_scale: Option<f64>,
     /// `--depth-preview`.
     pub depth_preview: bool,
     /// `--png-compression`: fast, default or best.
@@ -26,10 +28,21 @@ pub struct FileOptions<'a> {
 /// The validated file formats of refocus and reproject (a preview needs the depth output it
 /// colours); the output layer ([`crate::output::write_view`]) writes every one of them.
 pub fn file_formats(o: &FileOptions<'_>) -> Result<FileFormats, ArgError> {
+    let mut depth = depth_formats(o.depth)?;
+    if let Some(units) = o.depth_png_scale {
+        // A unit that changes nothing would be silently ignored: name it instead.
+        if !depth.png16 {
+            return Err(ArgError::Invalid(crate::Error::param(
+                "--depth-png-scale",
+                "sets the units of png16 depth: add png16 to --depth-format",
+            )));
+        }
+        depth.png16_units = io::Png16Units::new(units).map_err(|e| e.renamed("--depth-png-scale"))?;
+    }
     let formats = FileFormats {
         outputs: o.outputs,
         rgb: o.rgb,
-        depth: depth_formats(o.depth)?,
+        depth,
         encoding: io::Encoding {
             png: png_compression(o.png_compression)?,
             exr: o
@@ -65,6 +78,7 @@ mod tests {
             outputs: OutputSet::parse(outputs).unwrap(),
             rgb: RgbFormat::Png,
             depth,
+            depth_png_scale: None,
             depth_preview: preview,
             png_compression: "fast",
             exr_compression: "zip",
@@ -77,6 +91,23 @@ mod tests {
         assert!(f.exr && f.png16 && !f.npy);
         let e = depth_formats("exr,tiff").unwrap_err().to_string();
         assert!(e.contains("'tiff'") && e.contains("exr, npy, png16"), "{e}");
+    }
+
+    #[test]
+    fn png16_units_are_checked_and_need_png16() {
+        let mut o = options("rgb,depth", "exr,png16", false);
+        assert_eq!(file_formats(&o).unwrap().depth.png16_units.get(), 1000.0);
+        o.depth_png_scale = Some(5000.0);
+        assert_eq!(file_formats(&o).unwrap().depth.png16_units.get(), 5000.0);
+        for bad in [0.0, -5000.0, f64::NAN, f64::INFINITY] {
+            o.depth_png_scale = Some(bad);
+            let e = file_formats(&o).unwrap_err().to_string();
+            assert!(e.starts_with("invalid --depth-png-scale"), "{e}");
+        }
+        let mut exr_only = options("rgb,depth", "exr", false);
+        exr_only.depth_png_scale = Some(5000.0);
+        let e = file_formats(&exr_only).unwrap_err().to_string();
+        assert!(e.contains("--depth-png-scale") && e.contains("png16"), "{e}");
     }
 
     #[test]

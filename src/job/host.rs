@@ -3,7 +3,7 @@
 
 use super::ArgError;
 use crate::gpu::{DeviceChoice, Gpu, GpuPolicy};
-use crate::io::DepthSummary;
+use crate::io::{DepthSummary, DisparitySummary};
 use crate::vulkan::{Vk, VulkanContext, VulkanDeviceChoice};
 use std::path::Path;
 
@@ -88,6 +88,14 @@ pub enum Event<'a> {
         summary: &'a DepthSummary,
         /// What to check when the summary looks wrong.
         hint: &'a str,
+    },
+    /// An input disparity map as decoded, in pixels, with the pair's scale check (before
+    /// rendering; the warnings name `--disparity-scale`).
+    InputDisparity {
+        /// The file.
+        path: &'a Path,
+        /// Size, valid fraction, min / median / max, the scale that fits the views.
+        summary: &'a DisparitySummary,
     },
     /// `--depth-trunc` set this many pixels invalid.
     DepthTruncated {

@@ -8,6 +8,7 @@
 //! has to tell a person (input-depth summaries, progress, the result) goes through the host as
 //! an [`Event`] or comes back as a typed report, so the library prints nothing.
 
+mod depth_file;
 mod error;
 mod files;
 mod host;
@@ -20,6 +21,7 @@ pub mod reproject;
 pub mod scene;
 pub mod stitch;
 
+pub use depth_file::{DepthFileReading, DepthFileRequest};
 pub use error::{ArgError, InContext, JobError, PerFrameOption};
 pub use files::{depth_formats, file_formats, png_compression, FileOptions};
 pub use host::{Backend, Event, GpuRequest, Host, HostStages};

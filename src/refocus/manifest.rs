@@ -441,6 +441,7 @@ mod tests {
                 exr: false,
                 npy: false,
                 png16: true,
+                png16_units: Default::default(),
             },
             ..Default::default()
         };
@@ -467,12 +468,15 @@ mod tests {
         assert!(names.contains(&"s1_depth.png".to_string()), "{names:?}");
         let json = serde_json::to_value(&e).unwrap();
         assert_eq!(json["depth_png16_clipped"], 2);
+        // The units travel with the file, so no loader has to guess them.
+        assert_eq!(json["depth_png16_units_per_metre"], 1000.0);
         // Off by default: neither the file nor the keys appear (older manifests stay as they were).
         let plain = write(dir.path(), "s2", 2.0, out, &FileFormats::default()).unwrap();
         let json = serde_json::to_value(&plain).unwrap();
         assert!(json.get("depth_png16").is_none() && json.get("depth_png16_clipped").is_none());
         let settings = serde_json::to_value(FileFormats::default()).unwrap();
         assert!(settings["depth"].get("png16").is_none(), "{settings}");
+        assert!(settings["depth"].get("png16_units").is_none(), "{settings}");
         assert!(settings.get("depth_preview").is_none(), "{settings}");
     }
 

@@ -76,7 +76,9 @@ pub(crate) struct CyclopeanArgs {
     /// Right disparity, pixels (x_left = x_right + d).
     #[arg(help_heading = INPUTS, long, conflicts_with_all = ["right_depth", "cameras"])]
     right_disparity: Option<PathBuf>,
-    /// Raw disparity units per pixel (4 for Middlebury 2003 PGMs; default 1).
+    /// Raw disparity units per pixel (4 for Middlebury 2003 PGMs; default 1). Each map's
+    /// summary is printed, with a warning naming the scale the two views agree with when it
+    /// fits far better than this one.
     #[arg(help_heading = INPUTS, long)]
     disparity_scale: Option<f64>,
     /// Left depth: device (window) depth or view distance, as `depth_kind` in the camera file.

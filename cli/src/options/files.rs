@@ -21,10 +21,15 @@ pub(crate) struct FileOutputArgs {
     #[arg(long, value_enum, default_value = "png")]
     rgb_format: RgbFormatArg,
     /// Depth file formats, any of: exr (float32 metres), npy (float32 metres), png16 (uint16
-    /// millimetres, 0 = invalid; beyond 65.535 m written as 0 and counted in the manifest)
-    /// [default: exr].
+    /// metres x --depth-png-scale, 0 = invalid; beyond 65535 units written as 0 and counted in
+    /// the manifest) [default: exr].
     #[arg(long)]
     depth_format: Option<String>,
+    /// Raw units per metre of png16 depth (recorded in the manifest): 1000 (millimetres: NYU
+    /// toolbox, Open3D's default, ScanNet, SUN RGB-D) or 5000 (TUM); holds up to 65535 / this
+    /// metres [default: 1000].
+    #[arg(long, value_parser = viewsynth::job::finite_value)]
+    depth_png_scale: Option<f64>,
     /// Also write a <view>_depth_preview.png beside each depth output (named as the command's
     /// --out-dir lists): the depth colour-mapped (turbo: near red, far blue, invalid black) over
     /// its 2nd-98th percentile (the range is recorded in the manifest where the command writes one).
@@ -57,6 +62,7 @@ impl FileOutputArgs {
         r.outputs = self.outputs_given()?;
         r.rgb_format = self.rgb_format();
         r.depth_format = self.depth_format.clone();
+        r.depth_png_scale = self.depth_png_scale;
         r.depth_preview = self.depth_preview;
         r.png_compression = self.png_compression.clone();
         r.exr_compression = self.exr_compression.clone();
@@ -81,6 +87,7 @@ impl FileOutputArgs {
                 .depth_format
                 .as_deref()
                 .unwrap_or(viewsynth::job::refocus::DEFAULT_DEPTH_FORMAT),
+            depth_png_scale: self.depth_png_scale,
             depth_preview: self.depth_preview,
             png_compression: &self.png_compression,
             exr_compression: &self.exr_compression,

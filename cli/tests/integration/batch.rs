@@ -48,6 +48,7 @@ fn options(jobs: usize) -> BatchOptions {
                 exr: true,
                 npy: true,
                 png16: true,
+                png16_units: Default::default(),
             },
             ..Default::default()
         },
@@ -303,6 +304,7 @@ fn every_output_kind_reads_back_as_rendered() {
                 exr: true,
                 npy: true,
                 png16: true,
+                png16_units: Default::default(),
             },
             ..Default::default()
         };

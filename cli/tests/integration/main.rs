@@ -17,6 +17,7 @@ mod cli_outputs_table;
 mod cli_plausibility;
 mod cli_reproject_stitch;
 mod cli_sequence;
+mod cli_units;
 mod cli_warning_flags;
 mod common;
 mod compare;

@@ -86,7 +86,9 @@ fn encoders() -> Vec<(&'static str, &'static str, bool, Encoder)> {
             "depth",
             "PNG16 mm (fast)",
             false,
-            Box::new(move |p, out, o| io::encode_depth_png16(p, out, depth(o)?, PngCompression::Fast).map(|_| ())),
+            Box::new(move |p, out, o| {
+                io::encode_depth_png16(p, out, depth(o)?, io::Png16Units::default(), PngCompression::Fast).map(|_| ())
+            }),
         ),
     ]
 }
@@ -181,7 +183,7 @@ fn decode_rows(
             "in_rgb.png" | "in_rgb.jpg" => io::save_rgb(&path, rgb)?,
             "in_depth.exr" => io::save_depth_exr(&path, depth)?,
             "in_depth.png" => {
-                io::save_depth_png16(&path, depth, PngCompression::Fast)?;
+                io::save_depth_png16(&path, depth, io::Png16Units::default(), PngCompression::Fast)?;
             }
             _ => io::save_depth_npy(&path, depth)?,
         }

@@ -312,6 +312,14 @@ impl CyclopeanJob {
         mut reuse: Option<&mut Reused>,
     ) -> crate::Result<RenderedView> {
         let input = self.input()?;
+        if let (StereoInput::Disparity { left, right }, Some((left_map, right_map))) = (&input, &self.maps) {
+            tell_disparities(
+                host,
+                [left_map, right_map],
+                (left, right),
+                self.decode.scale.unwrap_or(1.0),
+            );
+        }
         let left_map = self.maps.as_ref().map_or(self.left_rgb.as_path(), |m| m.0.as_path());
         let names = [
             InputName::File(&self.left_rgb),
@@ -368,6 +376,23 @@ pub(crate) struct RenderedView {
     pub(crate) done: Synthesised,
     confidence: Option<[DepthMap; 2]>,
     size: (u32, u32),
+}
+
+/// Each disparity map's summary, with the pair's photometric scale check (cheap: a subsample),
+/// told to the host: a wrong `--disparity-scale` renders a plausible wrong view at exit 0.
+fn tell_disparities(
+    host: &dyn Host,
+    paths: [&PathBuf; 2],
+    (left, right): (&(RgbImage, DepthMap), &(RgbImage, DepthMap)),
+    scale: f64,
+) {
+    let fit = io::fit_disparity_scale((&left.0, &left.1), (&right.0, &right.1), scale);
+    for (path, (_, map)) in paths.into_iter().zip([left, right]) {
+        host.event(Event::InputDisparity {
+            path,
+            summary: &io::DisparitySummary::of(map, scale, fit),
+        });
+    }
 }
 
 /// An eye's depth as view Z in metres, summarised (device depth checked for a degenerate decoding).

@@ -42,6 +42,8 @@ pub struct RefocusRequest {
     pub rgb_format: RgbFormat,
     /// Depth file formats, comma-separated; none: [`DEFAULT_DEPTH_FORMAT`].
     pub depth_format: Option<String>,
+    /// Raw units per metre of png16 depth; none: 1000 (millimetres).
+    pub depth_png_scale: Option<f64>,
     /// Also write the depth preview.
     pub depth_preview: bool,
     /// PNG compression.
@@ -79,6 +81,7 @@ impl Default for RefocusRequest {
             outputs: None,
             rgb_format: RgbFormat::Png,
             depth_format: None,
+            depth_png_scale: None,
             depth_preview: false,
             png_compression: "fast".into(),
             exr_compression: "zip".into(),
@@ -166,6 +169,7 @@ impl RefocusRequest {
             outputs: self.outputs.unwrap_or_default(),
             rgb: self.rgb_format,
             depth: self.depth_format.as_deref().unwrap_or(DEFAULT_DEPTH_FORMAT),
+            depth_png_scale: self.depth_png_scale,
             depth_preview: self.depth_preview,
             png_compression: &self.png_compression,
             exr_compression: &self.exr_compression,

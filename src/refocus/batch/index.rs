@@ -52,6 +52,10 @@ pub struct IndexRow {
     pub rgb: Option<String>,
     /// Depth file (the first of EXR, NPY, 16-bit PNG written), relative to the out-dir.
     pub depth: Option<String>,
+    /// Raw units per metre of `depth` when it is the 16-bit PNG (metres = raw / this; pass it
+    /// as `read_depth(..., depth_scale=)`); absent for float files.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub depth_scale: Option<f64>,
     /// Mask file, relative to the out-dir.
     pub mask: Option<String>,
     /// The frame's manifest, relative to the out-dir.
@@ -75,9 +79,16 @@ fn frame_rows(root: &Path, name: &str, frame_index: usize, settings: &serde_json
         .iter()
         .enumerate()
         .map(|(target, o)| {
-            let depth = ["depth_exr", "depth_npy", "depth_png16"]
-                .iter()
-                .find_map(|k| o.get(*k).and_then(rel));
+            let depth_key = ["depth_exr", "depth_npy", "depth_png16"]
+                .into_iter()
+                .find(|k| o.get(*k).and_then(rel).is_some());
+            let depth = depth_key.and_then(|k| o.get(k).and_then(rel));
+            // Manifests from before the units were recorded wrote millimetres.
+            let depth_scale = (depth_key == Some("depth_png16")).then(|| {
+                o.get("depth_png16_units_per_metre")
+                    .and_then(|u| u.as_f64())
+                    .unwrap_or(crate::io::PNG16_UNITS_PER_METRE)
+            });
             Some(IndexRow {
                 frame: name.to_string(),
                 frame_index,
@@ -89,6 +100,7 @@ fn frame_rows(root: &Path, name: &str, frame_index: usize, settings: &serde_json
                 coverage: o.get("coverage").and_then(|c| c.as_f64()),
                 rgb: o.get("rgb").and_then(rel),
                 depth,
+                depth_scale,
                 mask: o.get("mask").and_then(rel),
                 manifest: format!("{name}/{}", crate::io::MANIFEST_NAME),
             })
