@@ -47,9 +47,9 @@ impl Host for CliHost {
                 }
             }
             Event::InputDisparity { path, summary } => {
-                eprintln!("input disparity {}: {summary}", path.display());
+                errln!("input disparity {}: {summary}", path.display());
                 for w in summary.warnings() {
-                    eprintln!("warning: {}: {w}", path.display());
+                    errln!("warning: {}: {w}", path.display());
                 }
             }
             Event::DepthTruncated { limit_m, pixels } => {

@@ -100,30 +100,40 @@ pub fn srgb_decode(v: f64) -> f64 {
 /// Top-down interleaved RGB of `img` stored in `rows`, in the compared form (see the module).
 /// Premultiplied colour is divided by its alpha in the stored transfer (where alpha is 0 the
 /// colour is kept: nothing to recover).
-pub fn compared_form(img: &ColourImage, reading: ColourReading, rows: RowOrder) -> Vec<f64> {
-    let row = img.width as usize * 3;
-    let mut out: Vec<f64> = img.rgb.iter().map(|v| f64::from(*v)).collect();
+pub fn compared_form(img: &ColourImage, reading: ColourReading, rows: RowOrder) -> Vec<f32> {
+    // f32 holds 16-bit and half-float colour exactly and keeps `compare` at a few bytes a
+    // pixel (issue 46); the arithmetic below runs in f64.
+    let (w, h) = (img.width as usize, img.height as usize);
+    let mut out = img.rgb.clone();
+    // Pixel i of the output (top-down) is stored pixel `src(i)`.
+    let src = |i: usize| match rows {
+        RowOrder::BottomUp => (h - 1 - i / w.max(1)) * w + i % w.max(1),
+        RowOrder::TopDown => i,
+    };
     if rows == RowOrder::BottomUp {
-        out = flip_rows(&out, row);
-    }
-    let alpha: Option<Vec<f64>> = img.alpha.as_ref().map(|a| {
-        let mut a: Vec<f64> = a.iter().map(|v| f64::from(*v)).collect();
-        if rows == RowOrder::BottomUp {
-            a = flip_rows(&a, img.width as usize);
+        let row = w * 3;
+        for y in 0..h / 2 {
+            let (top, bottom) = out.split_at_mut((h - 1 - y) * row);
+            top[y * row..(y + 1) * row].swap_with_slice(&mut bottom[..row]);
         }
-        a
-    });
+    }
     for (i, px) in out.chunks_exact_mut(3).enumerate() {
         if reading.channels == ChannelOrder::Bgr {
             px.swap(0, 2);
         }
-        if let (Alpha::Premultiplied, Some(a)) = (reading.alpha, &alpha) {
-            if a[i] > 0.0 {
-                px.iter_mut().for_each(|v| *v /= a[i]);
+        let mut v = [px[0], px[1], px[2]].map(f64::from);
+        if let (Alpha::Premultiplied, Some(a)) = (reading.alpha, &img.alpha) {
+            let a = f64::from(a[src(i)]);
+            if a > 0.0 {
+                v.iter_mut().for_each(|v| *v /= a);
             }
         }
         if reading.transfer == Transfer::Linear {
-            px.iter_mut().for_each(|v| *v = srgb_encode(*v));
+            v.iter_mut().for_each(|v| *v = srgb_encode(*v));
+        }
+        // Through f64 only when a reading changed the value: 8-bit v / 255 keeps its f32.
+        if reading.transfer == Transfer::Linear || reading.alpha == Alpha::Premultiplied {
+            px.copy_from_slice(&v.map(|v| v as f32));
         }
     }
     out
@@ -135,7 +145,7 @@ pub(super) fn flip_rows<T: Copy>(data: &[T], row: usize) -> Vec<T> {
 }
 
 /// The compared form quantised to 8 bits (FLIP reads 8-bit sRGB).
-pub(super) fn to_rgb8(values: &[f64], width: u32, height: u32) -> crate::io::RgbImage {
+pub(super) fn to_rgb8(values: &[f32], width: u32, height: u32) -> crate::io::RgbImage {
     crate::io::RgbImage {
         width,
         height,

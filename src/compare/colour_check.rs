@@ -9,7 +9,7 @@
 //! space keeps B's own quantisation out of the score: dark linear values stored in 8 bits are
 //! many sRGB levels apart.
 
-use super::colour::{flip_rows, srgb_decode, srgb_encode, Alpha, ChannelOrder, Transfer};
+use super::colour::{srgb_decode, srgb_encode, Alpha, ChannelOrder, Transfer};
 use super::Side;
 use crate::convention::RowOrder;
 
@@ -29,32 +29,95 @@ pub(super) struct ColourSuspicion {
     pub rows: bool,
 }
 
-/// The share of the selected pixels whose largest channel difference is within
-/// [`AGREE_LEVELS`].
-fn agreement(model: &[f64], cb: &[f64], selected: &[bool]) -> f64 {
+/// How a reading turns A's compared form into what B would hold under it, pixel by pixel (no
+/// reading is materialised: each would be another image of f64s, and `compare` keeps its
+/// memory per pixel bounded, issue 46).
+enum Model<'a> {
+    /// The declared reading: A as it is.
+    Declared,
+    /// Rows in the other order.
+    Rows,
+    /// Red and blue swapped.
+    Swapped,
+    /// Each value sRGB-decoded (B one encoding short).
+    Decoded,
+    /// Each value sRGB-encoded (B one encoding over).
+    Encoded,
+    /// Alpha applied the other way: B's alpha in its file's rows (`flipped`: bottom-up), each
+    /// value premultiplied (or divided) by it, in linear light when `linear`.
+    Alpha {
+        alpha: &'a [f32],
+        flipped: bool,
+        premultiply: bool,
+        linear: bool,
+    },
+}
+
+impl Model<'_> {
+    /// Pixel `i` (top-down) of the model over `ca`, an image `w` pixels wide and `h` high.
+    fn pixel(&self, ca: &[f32], i: usize, w: usize, h: usize) -> [f64; 3] {
+        let at = |j: usize| [0, 1, 2].map(|c| f64::from(ca[j * 3 + c]));
+        let mirrored = |j: usize| (h - 1 - j / w) * w + j % w;
+        match *self {
+            Model::Declared => at(i),
+            Model::Rows => at(mirrored(i)),
+            Model::Swapped => {
+                let [r, g, b] = at(i);
+                [b, g, r]
+            }
+            Model::Decoded => at(i).map(srgb_decode),
+            Model::Encoded => at(i).map(srgb_encode),
+            Model::Alpha {
+                alpha,
+                flipped,
+                premultiply,
+                linear,
+            } => {
+                let a = f64::from(alpha[if flipped { mirrored(i) } else { i }]);
+                let scale = |v: f64| {
+                    if premultiply {
+                        v * a
+                    } else if a > 0.0 {
+                        v / a
+                    } else {
+                        v
+                    }
+                };
+                // Premultiplication happens on the stored values: in linear light when B is
+                // declared linear (its compared form is encoded afterwards).
+                at(i).map(|v| {
+                    if linear {
+                        srgb_encode(scale(srgb_decode(v)))
+                    } else {
+                        scale(v)
+                    }
+                })
+            }
+        }
+    }
+}
+
+/// The share of the selected pixels whose largest channel difference between `model` (over
+/// A's compared form `ca`) and B's `cb` is within [`AGREE_LEVELS`].
+fn agreement(model: &Model, ca: &[f32], cb: &[f32], width: usize, selected: &[bool]) -> f64 {
+    let h = selected.len() / width.max(1);
     let (mut n, mut agree) = (0usize, 0usize);
-    for ((x, y), _) in model
-        .chunks_exact(3)
-        .zip(cb.chunks_exact(3))
-        .zip(selected)
-        .filter(|(_, s)| **s)
-    {
+    for (i, (y, _)) in cb.chunks_exact(3).zip(selected).enumerate().filter(|(_, (_, s))| **s) {
         n += 1;
-        if x.iter().zip(y).all(|(x, y)| (x - y).abs() * 255.0 <= AGREE_LEVELS) {
+        let x = model.pixel(ca, i, width, h);
+        if x.iter()
+            .zip(y)
+            .all(|(x, y)| (x - f64::from(*y)).abs() * 255.0 <= AGREE_LEVELS)
+        {
             agree += 1;
         }
     }
     agree as f64 / n.max(1) as f64
 }
 
-/// `ca` with `f` applied to every channel value.
-fn per_value(ca: &[f64], f: impl Fn(f64) -> f64) -> Vec<f64> {
-    ca.iter().map(|v| f(*v)).collect()
-}
-
 /// The readings of B's colour besides the declared one: (what, the option that declares it,
-/// is it the rows, A's colour as B would hold it under that reading).
-fn readings(a: &Side, b: &Side, ca: &[f64]) -> Vec<(String, String, bool, Vec<f64>)> {
+/// is it the rows, the model of B under it).
+fn readings<'a>(a: &Side, b: &'a Side) -> Vec<(String, String, bool, Model<'a>)> {
     let mut out = Vec::new();
     let other_rows = match b.conv.row_order {
         RowOrder::BottomUp => RowOrder::TopDown,
@@ -68,14 +131,12 @@ fn readings(a: &Side, b: &Side, ca: &[f64]) -> Vec<(String, String, bool, Vec<f6
         ),
         format!("--b-rows {}", other_rows.name()),
         true,
-        flip_rows(ca, a.color.width as usize * 3),
+        Model::Rows,
     ));
     let other_channels = match b.colour.channels {
         ChannelOrder::Rgb => ChannelOrder::Bgr,
         ChannelOrder::Bgr => ChannelOrder::Rgb,
     };
-    let mut swapped = ca.to_vec();
-    swapped.chunks_exact_mut(3).for_each(|p| p.swap(0, 2));
     out.push((
         format!(
             "red and blue swapped: channels {} (declared {}; a BGRA swapchain read back as RGBA)",
@@ -84,7 +145,7 @@ fn readings(a: &Side, b: &Side, ca: &[f64]) -> Vec<(String, String, bool, Vec<f6
         ),
         format!("--b-channels {}", other_channels.name()),
         false,
-        swapped,
+        Model::Swapped,
     ));
     // One sRGB encoding short of A: B stored linear values where sRGB-encoded ones belong
     // (declared sRGB), or A holds sRGB values declared linear. B declared linear and still
@@ -99,7 +160,7 @@ fn readings(a: &Side, b: &Side, ca: &[f64]) -> Vec<(String, String, bool, Vec<f6
             "linear values stored where sRGB is expected (a UNORM target where an SRGB one belongs)".to_string(),
             fix.to_string(),
             false,
-            per_value(ca, srgb_decode),
+            Model::Decoded,
         ));
     }
     // One encoding over A: B holds sRGB values declared linear, or A holds linear values
@@ -114,55 +175,39 @@ fn readings(a: &Side, b: &Side, ca: &[f64]) -> Vec<(String, String, bool, Vec<f6
             "sRGB values where linear is expected (one sRGB encoding more than A)".to_string(),
             fix.to_string(),
             false,
-            per_value(ca, srgb_encode),
+            Model::Encoded,
         ));
     }
-    if let Some(alpha) = alpha_top_down(b) {
-        let (other, scale): (Alpha, fn(f64, f64) -> f64) = match b.colour.alpha {
-            Alpha::Straight => (Alpha::Premultiplied, |v, a| v * a),
-            Alpha::Premultiplied => (Alpha::Straight, |v, a| if a > 0.0 { v / a } else { v }),
+    if let Some(alpha) = b.color.alpha.as_deref() {
+        let other = match b.colour.alpha {
+            Alpha::Straight => Alpha::Premultiplied,
+            Alpha::Premultiplied => Alpha::Straight,
         };
-        // Premultiplication happens on the stored values: in linear light when B is declared
-        // linear (its compared form is encoded afterwards).
-        let linear = b.colour.transfer == Transfer::Linear;
-        let mut model = ca.to_vec();
-        for (p, a) in model.chunks_exact_mut(3).zip(&alpha) {
-            for v in p.iter_mut() {
-                *v = if linear {
-                    srgb_encode(scale(srgb_decode(*v), *a))
-                } else {
-                    scale(*v, *a)
-                };
-            }
-        }
         out.push((
             format!("{} alpha (declared {})", other.name(), b.colour.alpha.name()),
             format!("--b-alpha {}", other.name()),
             false,
-            model,
+            Model::Alpha {
+                alpha,
+                flipped: b.conv.row_order == RowOrder::BottomUp,
+                premultiply: b.colour.alpha == Alpha::Straight,
+                linear: b.colour.transfer == Transfer::Linear,
+            },
         ));
     }
     out
 }
 
-/// B's alpha, rows top-down, when its file has alpha.
-fn alpha_top_down(b: &Side) -> Option<Vec<f64>> {
-    let a: Vec<f64> = b.color.alpha.as_ref()?.iter().map(|v| f64::from(*v)).collect();
-    Some(match b.conv.row_order {
-        RowOrder::TopDown => a,
-        RowOrder::BottomUp => flip_rows(&a, b.color.width as usize),
-    })
-}
-
 /// The reading of B's colour that fits A far better than the declared one, if any.
-pub(super) fn suspicion(a: &Side, b: &Side, ca: &[f64], cb: &[f64], selected: &[bool]) -> Option<ColourSuspicion> {
-    let declared = agreement(ca, cb, selected);
+pub(super) fn suspicion(a: &Side, b: &Side, ca: &[f32], cb: &[f32], selected: &[bool]) -> Option<ColourSuspicion> {
+    let width = a.color.width as usize;
+    let declared = agreement(&Model::Declared, ca, cb, width, selected);
     if declared >= 1.0 - NAMED_GAIN {
         return None;
     }
-    let (what, fix, rows, share) = readings(a, b, ca)
+    let (what, fix, rows, share) = readings(a, b)
         .into_iter()
-        .map(|(what, fix, rows, model)| (what, fix, rows, agreement(&model, cb, selected)))
+        .map(|(what, fix, rows, model)| (what, fix, rows, agreement(&model, ca, cb, width, selected)))
         .max_by(|x, y| x.3.total_cmp(&y.3))?;
     (share >= NAMED_AGREEMENT && share >= declared + NAMED_GAIN).then(|| ColourSuspicion {
         line: format!(

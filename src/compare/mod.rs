@@ -171,7 +171,7 @@ fn view_z(depth: &DepthMap, storage: DepthEncoding, conv: &Conventions, ndc_z: b
 
 /// The largest channel difference of each selected pixel, 8-bit levels (NaN against a number
 /// counts as the whole range).
-fn color_pixel_errors(a: &[f64], b: &[f64], selected: &[bool]) -> Vec<f64> {
+fn color_pixel_errors(a: &[f32], b: &[f32], selected: &[bool]) -> Vec<f64> {
     a.chunks_exact(3)
         .zip(b.chunks_exact(3))
         .zip(selected)
@@ -183,7 +183,8 @@ fn color_pixel_errors(a: &[f64], b: &[f64], selected: &[bool]) -> Vec<f64> {
 /// |x - y| in 8-bit levels, rounded to 1e-4 levels: f32 samples hold v / 255 to ~1e-5 levels,
 /// so 8-bit colour differs by whole levels and a 16-bit level (1/257 of one) stays visible;
 /// 255 where one is NaN and the other not.
-fn level_diff(x: f64, y: f64) -> f64 {
+fn level_diff(x: f32, y: f32) -> f64 {
+    let (x, y) = (f64::from(x), f64::from(y));
     match (x.is_nan(), y.is_nan()) {
         (false, false) => ((x - y).abs() * 255.0 * 1e4).round() / 1e4,
         (true, true) => 0.0,
@@ -192,7 +193,7 @@ fn level_diff(x: f64, y: f64) -> f64 {
 }
 
 /// (PSNR, RMSE in levels, max difference in levels) over the selected pixels.
-fn color_error(a: &[f64], b: &[f64], selected: &[bool]) -> (f64, f64, f64) {
+fn color_error(a: &[f32], b: &[f32], selected: &[bool]) -> (f64, f64, f64) {
     let (mut sq, mut max, mut n) = (0.0, 0.0f64, 0usize);
     for ((x, y), _) in a
         .chunks_exact(3)
@@ -212,10 +213,10 @@ fn color_error(a: &[f64], b: &[f64], selected: &[bool]) -> (f64, f64, f64) {
 }
 
 /// Mean SSIM on BT.601 luma (0..255 scale) of the compared forms over the selected pixels.
-fn ssim(a: &[f64], b: &[f64], width: u32, height: u32, selected: &[bool]) -> Option<f64> {
-    let luma = |c: &[f64]| -> Vec<f64> {
+fn ssim(a: &[f32], b: &[f32], width: u32, height: u32, selected: &[bool]) -> Option<f64> {
+    let luma = |c: &[f32]| -> Vec<f64> {
         c.chunks_exact(3)
-            .map(|p| 255.0 * (0.299 * p[0] + 0.587 * p[1] + 0.114 * p[2]))
+            .map(|p| 255.0 * (0.299 * f64::from(p[0]) + 0.587 * f64::from(p[1]) + 0.114 * f64::from(p[2])))
             .collect()
     };
     crate::ssim::ssim_luma_planes(&luma(a), &luma(b), width as usize, height as usize, Some(selected))
@@ -382,9 +383,14 @@ pub fn compare_with(a: &Side, b: &Side, mask: Option<&Mask>, measures: Measures)
         height: h,
         data,
     };
-    // FLIP is LDR FLIP: it reads 8-bit sRGB, so deeper colour is rounded for it alone.
-    let flip_map = measures.flip.then(|| {
-        let flip = Flip::of(&colour::to_rgb8(&cb, w, h), &colour::to_rgb8(&ca, w, h));
+    // FLIP is LDR FLIP: it reads 8-bit sRGB, so deeper colour is rounded for it alone. The
+    // compared forms go before FLIP's working memory is taken (the peak of `compare`).
+    let rgb8 = measures
+        .flip
+        .then(|| (colour::to_rgb8(&cb, w, h), colour::to_rgb8(&ca, w, h)));
+    drop((ca, cb));
+    let flip_map = rgb8.map(|(rb, ra)| {
+        let flip = Flip::of(&rb, &ra);
         cmp.flip_mean = Some(flip.mean(&selected));
         flip.magma_map(&selected)
     });

@@ -25,7 +25,7 @@ fn frame(job: &RefocusJob) -> Result<()> {
         );
         if let (Some(n @ 1..), Some(units)) = (e.files.depth_png16_clipped, e.files.depth_png16_units_per_metre) {
             // Written as invalid (0), never as a wrong depth; said here so it is not only in the manifest.
-            eprintln!(
+            errln!(
                 "warning: s={}: {n} valid pixels lie beyond {:.3} m, the most png16 holds at --depth-png-scale {units}: \
                  written as 0 (invalid); a smaller --depth-png-scale keeps them",
                 e.scale,

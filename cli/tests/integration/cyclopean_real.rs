@@ -559,12 +559,7 @@ fn cli_rectified_pair_matches_the_library_and_refuses_bad_input_cleanly() {
     paths.push(("--out-dir", &left));
     let o = viewsynth(&["--disparity-scale", "4", "--position", "0"], &paths);
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
-    let mut names: Vec<_> = std::fs::read_dir(&left)
-        .unwrap()
-        .map(|e| e.unwrap().file_name().into_string().unwrap())
-        .collect();
-    names.sort();
-    assert_eq!(names, ["middle_mask.png", "middle_rgb.png"]);
+    assert_eq!(crate::cli::files_in(&left), ["middle_mask.png", "middle_rgb.png"]);
     let im2 = io::load_rgb(&dir.join("im2.png")).unwrap();
     let mask = io::load_mask_png(&left.join("middle_mask.png")).unwrap();
     let rgb = io::load_rgb(&left.join("middle_rgb.png")).unwrap();

@@ -324,7 +324,13 @@ impl ReprojectJob {
         host.event(Event::InputDepth {
             path: &self.depth,
             summary: &src.depth_kind.summary(&src.conv, &src.depth),
-            hint: &format!("read as {what}"),
+            // reproject decodes device depth under its own options (cyclopean and compare name
+            // theirs): the hint names them, runnable as written.
+            hint: &if matches!(src.depth_kind, DepthEncoding::Device { .. }) {
+                format!("read as {what}: set `--ndc`, `--reversed-z` and `--near/--far` as the renderer wrote it")
+            } else {
+                format!("read as {what}")
+            },
         });
         src.require_valid_depth(what)
             .map_err(|e| crate::Error::decode(&self.depth, e.to_string()))?;
