@@ -248,6 +248,11 @@ def test_two_images_alone_equal_cli(renderer, cli, pair, tmp_path):
     assert err.value.parameter == "confidence" and "two images alone" in str(err.value)
     assert np.array_equal(view["mask"], np.asarray(Image.open(out / "middle_mask.png")) == 255)
     assert view["coverage"] > 0.5
+    # A search past the matcher's bound is refused before any image is read; one within it
+    # but as wide as the image, by the image.
     with pytest.raises(vs.InvalidInputError) as err:
         renderer.cyclopean(pair[0], pair[1], max_disparity=10_000)
+    assert err.value.parameter == "max_disparity" and "more than its 1024" in str(err.value)
+    with pytest.raises(vs.InvalidInputError) as err:
+        renderer.cyclopean(pair[0], pair[1], max_disparity=pair[0].shape[1])
     assert err.value.parameter == "left_rgb" and "less than the width" in str(err.value)

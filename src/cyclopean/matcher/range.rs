@@ -56,11 +56,16 @@ impl DisparityRange {
         self.max as i64 - (self.min as i64).min(0)
     }
 
-    /// Refuses a range whose search passes [`MAX_SEARCH`] disparities, naming both options.
+    /// Refuses a range whose search passes [`MAX_SEARCH`] disparities, naming the option that
+    /// sets it (both when the range reaches below 0).
     pub fn check_search(&self) -> Result<()> {
         if self.searched() > MAX_SEARCH {
             return Err(Error::param(
-                "--min-disparity/--max-disparity",
+                if self.min < 0 {
+                    "--min-disparity/--max-disparity"
+                } else {
+                    "--max-disparity"
+                },
                 format!(
                     "{}..{} px: the matcher would search {} disparities, more than its {MAX_SEARCH} \
                      (its work grows with each); give a narrower range",
