@@ -38,7 +38,7 @@ cleanup() {
   fi
 }
 trap cleanup EXIT
-[ -d "$DATA" ] || die "test data missing: $DATA (set VIEWSYNTH_DATA_DIR)"
+[ -d "$DATA" ] || die "test data missing: $DATA (fetch it with python3 ci/fetch-data.py, or set VIEWSYNTH_DATA_DIR)"
 DATA=$(cd "$DATA" && pwd)
 command -v docker >/dev/null || die "no docker client (Debian: apt-get install docker.io)"
 

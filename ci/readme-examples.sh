@@ -20,7 +20,7 @@ die() {
 }
 [ -x "$BIN" ] || die "$BIN missing: run \`cargo build --release\` (or .ci/run) first"
 [ -x "$VENV/bin/python" ] || die "$VENV missing: run ci/python-tests.sh first (it installs the package there)"
-[ -d "$DATA" ] || die "test data missing: $DATA (set VIEWSYNTH_DATA_DIR)"
+[ -d "$DATA" ] || die "test data missing: $DATA (fetch it with python3 ci/fetch-data.py, or set VIEWSYNTH_DATA_DIR)"
 DATA=$(cd "$DATA" && pwd)
 
 SCRATCH=$(mktemp -d "${TMPDIR:-/tmp}/viewsynth-readme.XXXXXX")

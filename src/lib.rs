@@ -74,6 +74,8 @@ pub mod vulkan;
 pub mod vulkan;
 
 #[cfg(test)]
+mod test_data;
+#[cfg(test)]
 mod test_rng;
 
 pub use error::{Error, Result};

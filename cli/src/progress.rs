@@ -2,21 +2,18 @@
 //! every few seconds otherwise (Docker, Slurm and CI logs have no terminal), so no long run is
 //! silent.
 
-use std::cell::Cell;
+use std::cell::{Cell, RefCell};
 use std::io::IsTerminal;
 use std::sync::{Arc, Condvar, Mutex};
 use std::time::{Duration, Instant};
 
-/// How often the log line is written when stderr is not a terminal.
-const LOG_EVERY: Duration = Duration::from_secs(10);
+use viewsynth::progress::{CountLog, LOG_EVERY};
 
 pub(crate) struct Progress {
-    what: &'static str,
-    total: u64,
     bar: Option<indicatif::ProgressBar>,
+    /// The library's log lines where stderr is not a terminal (the Python package writes the same).
+    log: RefCell<CountLog>,
     done: Cell<u64>,
-    start: Instant,
-    last_log: Cell<Instant>,
 }
 
 impl Progress {
@@ -29,14 +26,10 @@ impl Progress {
             bar.set_message(what);
             bar
         });
-        let now = Instant::now();
         Progress {
-            what,
-            total,
             bar,
+            log: RefCell::new(CountLog::new(what, total)),
             done: Cell::new(0),
-            start: now,
-            last_log: Cell::new(now),
         }
     }
 
@@ -48,9 +41,8 @@ impl Progress {
             bar.inc(1);
             return;
         }
-        if self.last_log.get().elapsed() >= LOG_EVERY || done == self.total {
-            self.last_log.set(Instant::now());
-            errln!("{}", log_line(self.what, done, self.total, self.start.elapsed()));
+        if let Some(line) = self.log.borrow_mut().line(done) {
+            errln!("{line}");
         }
     }
 
@@ -179,35 +171,10 @@ fn stage_line(index: usize, total: usize, label: &str, elapsed: Duration) -> Str
     format!("[{index}/{total}] {label} ({} s so far)", elapsed.as_secs())
 }
 
-/// "batch: 120/800 frames (15.0 %), 4.02 /s, ETA 2m49s".
-fn log_line(what: &str, done: u64, total: u64, elapsed: Duration) -> String {
-    let secs = elapsed.as_secs_f64().max(1e-9);
-    let rate = done as f64 / secs;
-    let eta = if done > 0 && total >= done {
-        let left = ((total - done) as f64 / rate).round() as u64;
-        format!("{}m{:02}s", left / 60, left % 60)
-    } else {
-        "?".to_string()
-    };
-    let pct = if total > 0 {
-        100.0 * done as f64 / total as f64
-    } else {
-        100.0
-    };
-    format!("{what}: {done}/{total} ({pct:.1} %), {rate:.2} /s, ETA {eta}")
-}
-
 #[cfg(test)]
 mod tests {
-    use super::{log_line, stage_line};
+    use super::stage_line;
     use std::time::Duration;
-
-    #[test]
-    fn log_line_gives_rate_and_eta() {
-        let l = log_line("batch frames", 30, 120, Duration::from_secs(10));
-        assert_eq!(l, "batch frames: 30/120 (25.0 %), 3.00 /s, ETA 0m30s");
-        assert!(log_line("x", 0, 5, Duration::from_secs(1)).ends_with("ETA ?"));
-    }
 
     #[test]
     fn stage_line_names_the_stage_and_the_time() {

@@ -1,12 +1,10 @@
 //! Dataset augmentation around `Renderer.refocus_batch`: `rgb_everywhere`, random zoom
 //! (`zoom_random`, `samples`, `seed`: the CLI's `--zoom-random LO,HI --samples K --seed S`) and
-//! `progress` (a callable, or True for a line on stderr), and `viewsynth.read_depth`: the depth
-//! files the CLI writes or reads, as float32 metres under the library's rules.
+//! `progress` (progress.rs), and `viewsynth.read_depth`: the depth files the CLI writes or
+//! reads, as float32 metres under the library's rules.
 
 use crate::errors;
 use pyo3::prelude::*;
-use pyo3::types::PyBool;
-use std::cell::{Cell, RefCell};
 use std::path::PathBuf;
 use viewsynth::job::{ArgError, DepthFileRequest};
 use viewsynth::refocus::batch::BatchOptions;
@@ -26,78 +24,6 @@ pub fn frames_in_share(total: usize, opts: &BatchOptions) -> usize {
     match opts.shard {
         Some(s) => (0..total).filter(|i| i % s.count == s.index).count(),
         None => total,
-    }
-}
-
-enum Report {
-    None,
-    Stderr,
-    Call(Py<PyAny>),
-}
-
-/// Progress of a batch: called once per frame on the thread that runs it (with the GIL
-/// released, so a callable call takes it back for the call). The first exception a callable
-/// raises is kept, later calls are skipped, and `finish` raises it once the batch is over (the
-/// frames already written stay).
-pub struct Progress {
-    report: Report,
-    total: usize,
-    done: Cell<usize>,
-    error: RefCell<Option<PyErr>>,
-}
-
-impl Progress {
-    /// `progress=`: None or False (silent), True (stderr), or a callable `f(done, total)`.
-    pub fn new(progress: Option<Bound<'_, PyAny>>, total: usize) -> PyResult<Self> {
-        let report = match progress {
-            None => Report::None,
-            Some(p) if p.is_instance_of::<PyBool>() => match p.extract::<bool>()? {
-                true => Report::Stderr,
-                false => Report::None,
-            },
-            Some(p) if p.is_callable() => Report::Call(p.unbind()),
-            Some(_) => {
-                return Err(errors::invalid(
-                    "progress",
-                    "expected a callable f(done, total), True or None",
-                ))
-            }
-        };
-        Ok(Progress {
-            report,
-            total,
-            done: Cell::new(0),
-            error: RefCell::new(None),
-        })
-    }
-
-    /// One more frame finished.
-    pub fn advance(&self) {
-        let done = self.done.get() + 1;
-        self.done.set(done);
-        match &self.report {
-            Report::None => {}
-            Report::Stderr => eprint!("\rrefocus_batch: {done}/{} frames", self.total),
-            Report::Call(f) => {
-                if self.error.borrow().is_some() {
-                    return;
-                }
-                if let Err(e) = Python::attach(|py| f.call1(py, (done, self.total)).map(drop)) {
-                    *self.error.borrow_mut() = Some(e);
-                }
-            }
-        }
-    }
-
-    /// End the stderr line; raise what a callable raised.
-    pub fn finish(self) -> PyResult<()> {
-        if let Report::Stderr = self.report {
-            eprintln!();
-        }
-        match self.error.into_inner() {
-            Some(e) => Err(e),
-            None => Ok(()),
-        }
     }
 }
 

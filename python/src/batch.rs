@@ -315,7 +315,7 @@ fn refocus_batch<'py>(py: Python<'py>, gpu: Backend, a: BatchArgs<'_, 'py>) -> P
     let frames = frames(a.frames)?;
     let out_dir = a.out_dir;
     let progress =
-        crate::augment::Progress::new(a.augment.progress, crate::augment::frames_in_share(frames.len(), &opts))?;
+        crate::progress::Progress::new(a.augment.progress, crate::augment::frames_in_share(frames.len(), &opts))?;
     // Paths and options were copied out of Python above; see SameThread for why the move is sound.
     let work = SameThread((gpu, frames, out_dir, opts, progress));
     let result = py.detach(move || {

@@ -14,6 +14,7 @@ mod cyclopean;
 mod errors;
 mod index;
 mod ints;
+mod progress;
 mod refocus;
 mod renderer;
 mod reproject;

@@ -4,6 +4,7 @@ depth, depth_scale 5000) and two synthetic frames (PNG colour, .npy depth), one 
 import csv
 import filecmp
 import json
+import os
 from pathlib import Path
 
 import numpy as np
@@ -11,7 +12,7 @@ from PIL import Image
 
 from conftest import REPO, make_frame
 
-TUM = REPO.parent / "shared" / "data" / "rgbd_open3d_testdata"
+TUM = Path(os.environ.get("VIEWSYNTH_DATA_DIR") or REPO.parent / "shared" / "data") / "rgbd_open3d_testdata"
 SCALES = [0.5, 1.0, 2.0]
 # Timings differ between runs; everything else in a frame's manifest.json must not.
 TIMING_KEYS = ("render_ms", "readback_ms", "write_ms")
@@ -22,7 +23,7 @@ def write_manifest(folder, broken=False):
     file is missing. Returns the manifest's path."""
     folder.mkdir(parents=True, exist_ok=True)
     rows = []
-    assert (TUM / "TUM_color.png").is_file(), f"shared test data missing under {TUM}"
+    assert (TUM / "TUM_color.png").is_file(), f"test data missing under {TUM} (fetch it with `python3 ci/fetch-data.py`, or set VIEWSYNTH_DATA_DIR)"
     rows.append({"rgb": str(TUM / "TUM_color.png"), "depth": str(TUM / "TUM_depth.png"),
                  "fx": 525.0, "fy": 525.0, "cx": 319.5, "cy": 239.5, "depth_scale": 5000, "name": ""})
     for i, (w, h) in enumerate([(96, 72), (80, 60)]):

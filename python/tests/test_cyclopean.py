@@ -19,7 +19,7 @@ from conftest import REPO
 def data_dir():
     """../shared/data beside the repository, or VIEWSYNTH_DATA_DIR (as the Rust tests)."""
     path = Path(os.environ.get("VIEWSYNTH_DATA_DIR", REPO.parent / "shared" / "data"))
-    assert path.is_dir(), f"test data missing: {path} (set VIEWSYNTH_DATA_DIR)"
+    assert path.is_dir(), f"test data missing: {path} (fetch it with `python3 ci/fetch-data.py`, or set VIEWSYNTH_DATA_DIR)"
     return path
 
 

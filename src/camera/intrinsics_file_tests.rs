@@ -77,10 +77,7 @@ fn middlebury_motorcycle_calib_matches_the_downsampled_pair() {
     let close = |a: f64, b: f64| (a - b).abs() < 1e-3;
     assert!(close(f.k.fx / 4.0, 994.978) && close(f.k.cx / 4.0, 311.193) && close(f.k.cy / 4.0, 254.877));
     assert!(close(stereo.doffs / 4.0, 31.086));
-    let data = Path::new(concat!(
-        env!("CARGO_MANIFEST_DIR"),
-        "/../shared/data/middlebury2014_motorcycle_skimage"
-    ));
+    let data = crate::test_data::dir().join("middlebury2014_motorcycle_skimage");
     let left = crate::io::load_rgb(&data.join("motorcycle_left.png")).unwrap();
     assert_eq!((w / 4, h / 4), (left.width, left.height));
     // The full-resolution file does not fit the downsampled image: refused, naming both sizes.

@@ -1,13 +1,9 @@
 //! Loads the real RGB-D frames in `../shared/data` (see its README, section 4).
 
-use std::path::Path;
-
 use super::{load_depth, load_rgb, DepthDecode, DepthMap};
 
-const DATA: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/../shared/data/");
-
 fn data(rel: &str) -> std::path::PathBuf {
-    Path::new(DATA).join(rel)
+    crate::test_data::dir().join(rel)
 }
 
 /// (fraction of pixels equal to `invalid`, min and max of the others).

@@ -124,7 +124,8 @@ pub struct ManifestEntry {
 /// What the output files hold, repeated in every manifest.
 pub const MANIFEST_NOTES: &str = "rgb: 8-bit sRGB as sampled from the source (no hole filling, 0 where invalid); \
 depth: view-space Z in metres (distance along the optical axis), float32, 0 where invalid; \
-mask: 255 where a kept triangle covers the pixel centre, 0 elsewhere; rows top-down; \
+mask: 255 where a kept triangle covers the pixel centre, 0 elsewhere; every file's rows run top-down \
+(conventions.row_order is the GPU framebuffers' order while rendering; the files do not depend on it); \
 K' follows OpenCV: pixel (u, v) has its centre at (u, v).";
 
 /// [`MANIFEST_NOTES`], amended under `--rgb-everywhere`.
@@ -136,6 +137,19 @@ pub fn manifest_notes(rgb_everywhere: bool) -> String {
              covered or not (0 only outside it); depth and mask still mark valid geometry only."
         ),
     }
+}
+
+/// A single frame's sources as given, and the decoding of its depth.
+#[derive(Debug, Clone, Serialize)]
+pub struct FrameInputs {
+    /// The colour file.
+    pub rgb: String,
+    /// The depth file.
+    pub depth: String,
+    /// Raw depth units per metre (`--depth-scale`), when given.
+    pub depth_scale: Option<f64>,
+    /// SUN RGB-D's bit rotation was undone (`--sun-bit-rotate`).
+    pub sun_bit_rotate: bool,
 }
 
 /// The manifest written as `manifest.json` beside the outputs.
@@ -161,6 +175,10 @@ pub struct Manifest {
     /// The settings a batch frame was made with; resume redoes the frame when they differ.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub settings: Option<serde_json::Value>,
+    /// The source files of a single frame and how its depth was decoded (a batch frame's
+    /// `settings` record them).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub inputs: Option<FrameInputs>,
     /// Every file written, with its size: resume checks they are all still there.
     pub files: Vec<FileRecord>,
     /// One entry per target, in the order rendered.
@@ -191,6 +209,7 @@ impl Manifest {
             notes: manifest_notes(rgb_everywhere),
             rgb_everywhere,
             settings,
+            inputs: None,
             files: Vec::new(),
             outputs: Vec::new(),
         }
@@ -206,6 +225,15 @@ pub fn file_records(dir: &Path, entries: &[ManifestEntry]) -> Result<Vec<FileRec
 /// sortable enough, unambiguous).
 pub fn scale_tag(scale: f64) -> String {
     format!("s{}", trim_decimals(scale))
+}
+
+/// A zoom scale as printed for people: at most 3 decimals, trailing zeros dropped (0.5 -> "0.5",
+/// 400 / 525 -> "0.762"); the manifest keeps the exact value.
+pub fn scale_label(scale: f64) -> String {
+    let text = format!("{scale:.3}");
+    let text = text.trim_end_matches('0').trim_end_matches('.');
+    // -0.0004 rounds to "-0": print it as 0.
+    if text == "-0" { "0" } else { text }.to_string()
 }
 
 /// The file-name prefix of a target focal length fx' in pixels: 571.4 -> "f571.4".
@@ -324,6 +352,15 @@ pub fn write_frame(
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn scale_labels_are_short() {
+        let got: Vec<String> = [0.5, 2.0, 400.0 / 525.0, 1.25, 0.0004, -0.0004, 1.9996]
+            .into_iter()
+            .map(scale_label)
+            .collect();
+        assert_eq!(got, ["0.5", "2", "0.762", "1.25", "0", "0", "2"]);
+    }
 
     #[test]
     fn targets_keep_the_principal_point_offset_when_the_size_changes() {

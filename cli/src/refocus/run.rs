@@ -3,6 +3,7 @@
 use crate::host::CliHost;
 use anyhow::Result;
 use viewsynth::job::refocus::{RefocusBatchJob, RefocusCommand, RefocusJob};
+use viewsynth::refocus::manifest::scale_label;
 
 pub(crate) fn refocus(command: RefocusCommand) -> Result<()> {
     match command {
@@ -16,7 +17,7 @@ fn frame(job: &RefocusJob) -> Result<()> {
     for e in &report.manifest.outputs {
         outln!(
             "s={:<6} fx'={:<9.3} {}x{} coverage {:>6.2}%  render {:>7.2} ms",
-            e.scale,
+            scale_label(e.scale),
             e.intrinsics.fx,
             e.width,
             e.height,
@@ -28,7 +29,7 @@ fn frame(job: &RefocusJob) -> Result<()> {
             errln!(
                 "warning: s={}: {n} valid pixels lie beyond {:.3} m, the most png16 holds at --depth-png-scale {units}: \
                  written as 0 (invalid); a smaller --depth-png-scale keeps them",
-                e.scale,
+                scale_label(e.scale),
                 f64::from(u16::MAX) / units
             );
         }

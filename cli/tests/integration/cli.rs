@@ -103,6 +103,48 @@ fn refocus_writes_requested_files_and_a_manifest() {
     assert_eq!(files_in(&only_depth), ["manifest.json", "s1_depth.exr"]);
 }
 
+/// A single frame's manifest records its sources and depth scale (as a batch frame's settings
+/// do), its notes agree with its row order, and the printed scales are short (the manifest keeps
+/// the exact value).
+#[test]
+fn single_frame_manifest_records_its_inputs_and_scales_print_short() {
+    let d = scratch("inputs");
+    let (rgb, depth) = inputs(&d, 32, 24);
+    let out = d.join("out");
+    // fx' = 100/3 against fx = 40: s = 0.8333...
+    let o = refocus(&rgb, &depth, &out, &["--focal-list", "33.333333333333336,80"]);
+    let stdout = String::from_utf8_lossy(&o.stdout);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let lines: Vec<&str> = stdout.lines().filter(|l| l.starts_with("s=")).collect();
+    assert_eq!(lines.len(), 2, "{stdout}");
+    assert!(
+        lines[0].starts_with("s=0.833 ") && lines[1].starts_with("s=2 "),
+        "{stdout}"
+    );
+    let m: serde_json::Value = serde_json::from_slice(&std::fs::read(out.join("manifest.json")).unwrap()).unwrap();
+    assert_eq!(m["inputs"]["rgb"], rgb.to_str().unwrap());
+    assert_eq!(m["inputs"]["depth"], depth.to_str().unwrap());
+    assert!(m["inputs"]["depth_scale"].is_null(), "{}", m["inputs"]);
+    assert!((m["outputs"][0]["scale"].as_f64().unwrap() - 5.0 / 6.0).abs() < 1e-12);
+    // The framebuffers' row order is not the files': the notes say which one they mean.
+    let notes = m["notes"].as_str().unwrap();
+    assert_eq!(m["conventions"]["row_order"], "bottom-up");
+    assert!(
+        notes.contains("every file's rows run top-down") && notes.contains("conventions.row_order"),
+        "{notes}"
+    );
+
+    // A depth scale given is recorded.
+    let raw: Vec<u16> = (0..32 * 24).map(|i| 1000 + (i % 32) as u16).collect();
+    let png = d.join("depth16.png");
+    image::save_buffer(&png, bytemuck::cast_slice(&raw), 32, 24, image::ExtendedColorType::L16).unwrap();
+    let scaled = d.join("scaled");
+    let o = refocus(&rgb, &png, &scaled, &["--zoom-range", "1", "--depth-scale", "1000"]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let m: serde_json::Value = serde_json::from_slice(&std::fs::read(scaled.join("manifest.json")).unwrap()).unwrap();
+    assert_eq!(m["inputs"]["depth_scale"], 1000.0);
+}
+
 /// Exit status of a command-line problem (clap's refusals and the job's option checks); its
 /// message ends "try '--help'".
 pub(crate) const USAGE: i32 = 2;

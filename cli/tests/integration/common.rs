@@ -22,7 +22,7 @@ pub fn data_dir() -> PathBuf {
         .unwrap_or_else(|| PathBuf::from(concat!(env!("CARGO_MANIFEST_DIR"), "/../../shared/data")));
     assert!(
         dir.is_dir(),
-        "test data missing: {} (set VIEWSYNTH_DATA_DIR)",
+        "test data missing: {} (fetch it with `python3 ci/fetch-data.py`, or set VIEWSYNTH_DATA_DIR)",
         dir.display()
     );
     dir

@@ -1183,11 +1183,8 @@ fn csv_manifest_with_a_byte_order_mark_is_read() {
         .output()
         .unwrap();
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
-    // The frame's folder, beside the index and its one part.
-    assert_eq!(
-        files_in(&sb.out),
-        ["00000_rgb", "index.jsonl", "index.part-0-of-1.jsonl"]
-    );
+    // The frame's folder beside the index: no `index.part-0-of-1.jsonl` without --shard.
+    assert_eq!(files_in(&sb.out), ["00000_rgb", "index.jsonl"]);
 }
 
 #[test]

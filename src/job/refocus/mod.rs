@@ -167,7 +167,7 @@ impl RefocusJob {
         // The previous run's set, as its manifest lists it, goes where this one does not
         // write the same names (fewer scales, no depth): the folder holds this run's set.
         let set = out_dir.file_set()?.replacing(job::replaced());
-        let manifest = Manifest::of_frame(
+        let mut manifest = Manifest::of_frame(
             src.camera(),
             plan.method,
             plan.rule,
@@ -176,6 +176,12 @@ impl RefocusJob {
             plan.rgb_everywhere,
             None,
         );
+        manifest.inputs = Some(job::FrameInputs {
+            rgb: self.rgb.to_string_lossy().into_owned(),
+            depth: self.depth.to_string_lossy().into_owned(),
+            depth_scale: self.decode.scale,
+            sun_bit_rotate: self.decode.sun_rgbd_bit_rotate,
+        });
         let targets = scales
             .iter()
             .zip(&targets)

@@ -3,11 +3,12 @@
 //! file instead of walking every frame folder.
 //!
 //! Rows are made from the frames' own `manifest.json` files (the frames as they are on disk),
-//! never from what a run meant to write. Each run writes its part, `index.part-K-of-N.jsonl`
-//! (K/N its shard, 0/1 unsharded): the rows of every frame of its share whose manifest records
-//! this run's settings. Then, when all N parts of that N are there, it joins them into
-//! `index.jsonl` (so the last shard to finish joins; `viewsynth index OUT` joins by hand). Parts
-//! and the index are written atomically.
+//! never from what a run meant to write. Each sharded run writes its part,
+//! `index.part-K-of-N.jsonl` (K/N its shard): the rows of every frame of its share whose
+//! manifest records this run's settings. Then, when all N parts of that N are there, it joins
+//! them into `index.jsonl` (so the last shard to finish joins; `viewsynth index OUT` joins by
+//! hand). A run without a shard writes `index.jsonl` alone: its part would be the whole index.
+//! Parts and the index are written atomically.
 //!
 //! A run that rewrites frames removes what could list them ([`Invalidation`]): the joined
 //! index, its own part and the parts of other shard counts, just before its first frame's set
@@ -141,9 +142,15 @@ fn read_rows(path: &Path) -> Result<Vec<IndexRow>> {
 }
 
 /// Write this run's part (its share of `frames` as they are on disk under `root`) and, when
-/// every part of its N is there, join them; returns the joined index's path if it joined.
+/// every part of its N is there, join them; returns the joined index's path if it joined. A
+/// run without a shard writes the index itself, leaving no part.
 pub fn write_part(root: &Path, frames: &[BatchFrame], opts: &BatchOptions) -> Result<Option<PathBuf>> {
-    let (k, n) = opts.shard.map_or((0, 1), |s| (s.index, s.count));
+    let Some(shard) = opts.shard else {
+        let path = root.join(INDEX_NAME);
+        write_rows(&path, &rows_of(root, frames, opts, |_| true))?;
+        return Ok(Some(path));
+    };
+    let (k, n) = (shard.index, shard.count);
     let rows = rows_of(root, frames, opts, |i| i % n == k);
     write_rows(&root.join(part_name(k, n)), &rows)?;
     if (0..n).all(|j| root.join(part_name(j, n)).is_file()) {
@@ -250,6 +257,12 @@ pub fn join_index(root: &Path) -> Result<(PathBuf, usize)> {
         entry.1 = entry.1.max(modified);
     }
     let Some((&n, (found, _))) = counts.iter().max_by_key(|(_, (_, t))| *t) else {
+        // An unsharded run writes the index itself, with no part: nothing to join.
+        let index = root.join(INDEX_NAME);
+        if index.is_file() {
+            let rows = read_rows(&index)?.len();
+            return Ok((index, rows));
+        }
         return Err(Error::param(
             "index",
             format!(
