@@ -86,12 +86,6 @@ pub enum ArgError {
     /// `report --data-dir` is no folder.
     #[error("--data-dir {}: not a directory", .0.display())]
     DataDirMissing(PathBuf),
-    /// A cyclopean disparity pair with one eye missing.
-    #[error("--left-disparity needs --right-disparity (a file of zeros if the right eye has none)")]
-    RightDisparityMissing,
-    /// A cyclopean disparity pair given by its right eye only.
-    #[error("--right-disparity needs --left-disparity")]
-    LeftDisparityMissing,
     /// Cyclopean disparities and depth input both given.
     #[error(
         "give disparities (--left-disparity, --right-disparity) or depth (--left-depth, --right-depth, --cameras), not both"
