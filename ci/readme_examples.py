@@ -130,7 +130,7 @@ def found(expected, output):
 
 # The docs/ pages in the order their examples run (after README.md): a page that reads another
 # page's outputs (out/scene, out/cones, ...) comes after it. Every page must be listed.
-DOCS_ORDER = ["scene", "refocus", "cyclopean", "compare", "reproject", "stitch", "demo", "report",
+DOCS_ORDER = ["scene", "refocus", "cyclopean", "compare", "reproject", "stereo", "stitch", "demo", "report",
               "bench", "stress", "info", "python", "docker", "formats", "internals"]
 
 # The order of the commands whose `--help` examples run last, and the files the examples name

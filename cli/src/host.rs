@@ -52,6 +52,19 @@ impl Host for CliHost {
                     errln!("warning: {}: {w}", path.display());
                 }
             }
+            Event::DisparityDerived { eye, known_fraction } => {
+                let (this, other) = match eye {
+                    viewsynth::cyclopean::Eye::Left => ("left", "right"),
+                    viewsynth::cyclopean::Eye::Right => ("right", "left"),
+                };
+                errln!(
+                    "note: no --{this}-disparity: the {this} eye's disparity is the {other} one forward-warped \
+                     (the nearer surface wins), known at {:.1}% of its pixels; the {this} eye adds colour only \
+                     where the {other} eye's geometry says it sees the surface, and what only the {this} eye \
+                     sees stays a hole (--fill fills it)",
+                    100.0 * known_fraction
+                );
+            }
             Event::DepthTruncated { limit_m, pixels } => {
                 errln!("--depth-trunc {limit_m}: {pixels} pixels beyond {limit_m} m set invalid");
             }

@@ -15,6 +15,8 @@ use crate::shared::{choice, outputs_given, SameThread};
 use pyo3::prelude::*;
 use pyo3::types::{PyBool, PyDict, PyFloat, PyInt, PyList, PyString, PyTuple};
 use viewsynth::cyclopean::camera_file::CameraFile;
+use viewsynth::cyclopean::one_eye::other_eye_disparity;
+use viewsynth::cyclopean::Eye;
 use viewsynth::io::{DepthMap, RgbImage, MASK_FILLED};
 use viewsynth::job::cyclopean::{
     CyclopeanPlan, CyclopeanRequest, Framed, InputName, StereoGiven, StereoInput, StereoKind, Synthesised,
@@ -277,6 +279,17 @@ fn cyclopean<'py>(py: Python<'py>, gpu: Backend, a: CyclopeanArgs<'_, 'py>) -> P
     ) {
         (StereoKind::Disparity, Some(ld), Some(rd), ..) => {
             let (left, right) = eyes(&a, [(ld, "left_disparity"), (rd, "right_disparity")])?;
+            StereoInput::Disparity { left, right }
+        }
+        // One eye's disparity: the other eye's is derived by the library's rule (one_eye).
+        (StereoKind::Disparity, Some(ld), None, ..) => {
+            let (left, mut right) = eyes(&a, [(ld, "left_disparity"), (ld, "left_disparity")])?;
+            right.1 = other_eye_disparity(&left.1, Eye::Left);
+            StereoInput::Disparity { left, right }
+        }
+        (StereoKind::Disparity, None, Some(rd), ..) => {
+            let (mut left, right) = eyes(&a, [(rd, "right_disparity"), (rd, "right_disparity")])?;
+            left.1 = other_eye_disparity(&right.1, Eye::Right);
             StereoInput::Disparity { left, right }
         }
         (StereoKind::Images, ..) => {

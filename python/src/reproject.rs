@@ -64,7 +64,7 @@ impl Renderer {
             convergence,
             from: choice("--from", source)?,
             to: choice("--to", target)?,
-            method: choice("--method", method)?,
+            method: Some(choice("--method", method)?),
             steps,
             tau_rel,
             outputs: outputs_given(outputs)?,
@@ -149,7 +149,8 @@ fn reproject<'py>(py: Python<'py>, gpu: Backend, a: ReprojectArgs<'_, 'py>) -> P
             let mask = viewsynth::io::Mask::new(w, h, bits).map_err(errors::from_library)?;
             d.set_item("mask", arrays::mask_array(py, mask))?;
         }
-        views.set_item(eye_name(to), d)?;
+        // A rig's targets are eyes; the middle camera is a camera file's (not given here).
+        views.set_item(to.map_or("centre", eye_name), d)?;
     }
     Ok(views)
 }

@@ -28,6 +28,7 @@ pub mod fill;
 pub mod forward;
 pub mod frame_depth;
 pub mod matcher;
+pub mod one_eye;
 pub mod pass;
 pub mod reference;
 pub mod render;

@@ -86,12 +86,6 @@ pub enum ArgError {
     /// `report --data-dir` is no folder.
     #[error("--data-dir {}: not a directory", .0.display())]
     DataDirMissing(PathBuf),
-    /// A cyclopean disparity pair with one eye missing.
-    #[error("--left-disparity needs --right-disparity (a file of zeros if the right eye has none)")]
-    RightDisparityMissing,
-    /// A cyclopean disparity pair given by its right eye only.
-    #[error("--right-disparity needs --left-disparity")]
-    LeftDisparityMissing,
     /// Cyclopean disparities and depth input both given.
     #[error(
         "give disparities (--left-disparity, --right-disparity) or depth (--left-depth, --right-depth, --cameras), not both"
@@ -168,12 +162,14 @@ pub enum ArgError {
     /// A camera file's source must be an eye.
     #[error("--cameras holds the two eyes: --from left or right")]
     CameraFileFromCentre,
-    /// A camera file's target must be the other eye.
-    #[error("--cameras: the target is the other eye (--to {0})")]
-    CameraFileTarget(&'static str),
     /// Full eye matrices with a shift method.
-    #[error("--cameras (full eye matrices) needs --method gather3d: the shift methods need a parallel rig")]
+    #[error(
+        "--cameras (full eye matrices) renders by --method gather3d (its default): the shift methods need a parallel rig"
+    )]
     CameraFileNeedsGather,
+    /// The middle camera is a camera file's.
+    #[error("--to centre (middle) needs --cameras: a rig's centre is a source (--from centre), not a target")]
+    CentreTargetNeedsCameras,
     /// Depth kind or conventions given with a camera file that carries its own.
     #[error(
         "--cameras: the depth kind and the conventions come from the file; drop --depth-kind/--ndc/--reversed-z/--rows"

@@ -97,6 +97,14 @@ pub enum Event<'a> {
         /// Size, valid fraction, min / median / max, the scale that fits the views.
         summary: &'a DisparitySummary,
     },
+    /// A rectified pair given one eye's disparity: `eye`'s map was derived from the other's
+    /// ([`crate::cyclopean::one_eye`]), known at this fraction of its pixels.
+    DisparityDerived {
+        /// The eye without a file.
+        eye: crate::cyclopean::Eye,
+        /// Fraction of its pixels the given eye's geometry reaches.
+        known_fraction: f64,
+    },
     /// `--depth-trunc` set this many pixels invalid.
     DepthTruncated {
         /// The limit in metres.

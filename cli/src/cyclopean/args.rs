@@ -24,7 +24,8 @@ pub(crate) enum MethodArg {
     /// Splat each eye's surfaces into the view (nearest first), then refine each pixel sub-pixel
     /// on the surface it sees and merge the eyes (the best on real stereo).
     SplatGather,
-    /// Seed 000 as written: one reconstruction step from the fixation depth.
+    /// One step per eye: the middle ray at the fixation depth is projected into the eye, the
+    /// eye's depth read there gives the surface point; the eyes' colours merge by --blend.
     Seed,
     /// The seed's step, --refine-steps refinement steps and a projection check.
     Refine,

@@ -36,6 +36,9 @@ pub(crate) enum ToArg {
     Right,
     /// Both eyes (from the centre view only).
     Both,
+    /// The middle camera of --cameras (writes centre_*).
+    #[value(alias = "middle")]
+    Centre,
 }
 
 #[derive(Clone, Copy, ValueEnum)]
@@ -85,7 +88,9 @@ pub(crate) struct ReprojectArgs {
     /// Full eye matrices instead of a rig: a cameras.json as `viewsynth scene` writes it (left and
     /// right GL view and projection, conventions, depth kind: those of the file apply).
     ///
-    /// The source is --from's eye, the target the other eye; --method gather3d only.
+    /// The source is --from's eye; the target (--to) the other eye or the file's middle camera
+    /// (--to centre, alias middle). Renders by the 3-D gather (--method gather3d, the default
+    /// here; a shift method is refused).
     #[arg(help_heading = INPUTS, long, conflicts_with_all = ["intrinsics", "fx", "fy", "cx", "cy", "baseline", "separation", "near", "far", "focal"])]
     cameras: Option<PathBuf>,
     /// Source intrinsics (with a rig).
@@ -112,13 +117,15 @@ pub(crate) struct ReprojectArgs {
     /// The source view.
     #[arg(help_heading = TARGETS, long, value_enum, default_value = "left")]
     from: FromArg,
-    /// The target view(s).
+    /// The target view(s): an eye, both eyes (from centre), or centre (middle): --cameras' middle
+    /// camera.
     #[arg(help_heading = TARGETS, long, value_enum, default_value = "right")]
     to: ToArg,
-    /// How each target pixel finds its source: shift-scan (exact, default), shift (fixed-point
-    /// walk, --steps) or gather3d (the cyclopean 3-D walk, --steps).
-    #[arg(help_heading = METHOD, long, value_enum, default_value = "shift-scan")]
-    method: ReprojectMethodArg,
+    /// How each target pixel finds its source: shift-scan (exact; the default on a rig), shift
+    /// (fixed-point walk, --steps) or gather3d (the cyclopean 3-D walk, --steps; the default and
+    /// only method with --cameras).
+    #[arg(help_heading = METHOD, long, value_enum)]
+    method: Option<ReprojectMethodArg>,
     /// Steps of the shift walk / 3-D gather (1..=16).
     #[arg(help_heading = METHOD, long, default_value_t = ReprojectRequest::default().steps, value_parser = clap::value_parser!(u32).range(1..=16))]
     steps: u32,
@@ -169,12 +176,13 @@ impl ReprojectArgs {
                 ToArg::Left => Target::Left,
                 ToArg::Right => Target::Right,
                 ToArg::Both => Target::Both,
+                ToArg::Centre => Target::Centre,
             },
-            method: match self.method {
+            method: self.method.map(|m| match m {
                 ReprojectMethodArg::Shift => MethodChoice::Shift,
                 ReprojectMethodArg::ShiftScan => MethodChoice::ShiftScan,
                 ReprojectMethodArg::Gather3d => MethodChoice::Gather3d,
-            },
+            }),
             steps: self.steps,
             tau_rel: self.tau_rel,
             outputs,

@@ -11,7 +11,7 @@ pub(crate) fn reproject(job: &ReprojectJob) -> Result<()> {
         outln!(
             "{} -> {} ({}): {}x{}, coverage {:.2} %, render {} (setup + shader compile {:.1} ms)",
             view_name(r.from),
-            view_name(Some(t.to)),
+            view_name(t.to),
             r.method,
             r.width,
             r.height,

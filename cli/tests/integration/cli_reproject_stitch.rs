@@ -917,3 +917,91 @@ fn scene_cube_faces_feed_stitch_faces() {
     ]);
     assert_clean_failure(USAGE, &o, "--face-fov 90", &bad);
 }
+
+/// `reproject --cameras` renders by the 3-D gather without being told, to any camera of the
+/// file (`--to centre`, alias middle: the file's middle camera); a contradictory method or
+/// target is a usage error that writes nothing.
+#[test]
+fn reproject_cameras_default_to_gather3d_and_reach_the_middle_camera() {
+    let dir = scratch("reproject_cameras_targets");
+    let scene = dir.join("scene");
+    ok(&run(&[
+        "scene",
+        "--width",
+        "96",
+        "--height",
+        "72",
+        "--out-dir",
+        s(&scene),
+    ]));
+    let cams = scene.join("cameras.json");
+    let (color, depth) = (scene.join("left_rgb.png"), scene.join("left_device_depth.exr"));
+    let common = [
+        "reproject",
+        "--cameras",
+        s(&cams),
+        "--color",
+        s(&color),
+        "--depth",
+        s(&depth),
+    ];
+    // No --method: gather3d (before, exit 2 "needs --method gather3d").
+    let right = dir.join("right");
+    let stdout = ok(&run(&[&common[..], &["--out-dir", s(&right)]].concat()));
+    assert!(stdout.contains("left -> right (3-D gather 3)"), "{stdout}");
+    // The middle camera, against the scene's ray-traced middle view on the valid pixels.
+    let middle = dir.join("middle");
+    let stdout = ok(&run(
+        &[&common[..], &["--to", "middle", "--out-dir", s(&middle)]].concat()
+    ));
+    assert!(stdout.contains("left -> centre (3-D gather 3)"), "{stdout}");
+    assert_eq!(
+        files_in(&middle),
+        ["centre_depth.exr", "centre_mask.png", "centre_rgb.png"]
+    );
+    let (rgb, truth) = (
+        io::load_rgb(&middle.join("centre_rgb.png")).unwrap(),
+        io::load_rgb(&scene.join("middle_rgb.png")).unwrap(),
+    );
+    let mask = io::load_rgb(&middle.join("centre_mask.png")).unwrap();
+    let valid: Vec<usize> = (0..mask.data.len() / 3).filter(|&i| mask.data[3 * i] > 0).collect();
+    let sq: f64 = valid
+        .iter()
+        .flat_map(|&i| (0..3).map(move |c| 3 * i + c))
+        .map(|j| (rgb.data[j] as f64 - truth.data[j] as f64).powi(2))
+        .sum();
+    let psnr = viewsynth::metrics::psnr_from_mse(sq / (3 * valid.len()) as f64);
+    let coverage = valid.len() as f64 / (96.0 * 72.0);
+    println!("cameras.json left -> middle: coverage {coverage:.4}, {psnr:.2} dB");
+    assert!(coverage > 0.9 && psnr > 30.0, "coverage {coverage} psnr {psnr}");
+
+    let bad = dir.join("bad");
+    let o = run(&[&common[..], &["--method", "shift", "--out-dir", s(&bad)]].concat());
+    assert_clean_failure(USAGE, &o, "--method gather3d", &bad);
+    let o = run(&[&common[..], &["--to", "left", "--out-dir", s(&bad)]].concat());
+    assert_clean_failure(USAGE, &o, "the source view itself", &bad);
+    let o = run(&[&common[..], &["--to", "both", "--out-dir", s(&bad)]].concat());
+    assert_clean_failure(USAGE, &o, "--to both", &bad);
+    let rig = [
+        "reproject",
+        "--color",
+        s(&color),
+        "--depth",
+        s(&color),
+        "--fx",
+        "80",
+        "--fy",
+        "80",
+        "--cx",
+        "48",
+        "--cy",
+        "36",
+        "--baseline",
+        "0.1",
+        "--to",
+        "centre",
+        "--out-dir",
+        s(&bad),
+    ];
+    assert_clean_failure(USAGE, &run(&rig), "--to centre (middle) needs --cameras", &bad);
+}

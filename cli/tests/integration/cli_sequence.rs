@@ -265,12 +265,13 @@ fn sequence_refusals_name_the_file_or_flag_and_leave_the_folder_as_it_was() {
     check(&["cyclopean", "--sequence", &bad], 1, &["bad.json", "right_rgb"]);
     let half = write(
         "half.json",
-        r#"{"frames": [{"left_rgb": "00000_left_rgb.png", "right_rgb": "00000_right_rgb.png", "left_disparity": "d.pfm"}]}"#,
+        r#"{"frames": [{"left_rgb": "00000_left_rgb.png", "right_rgb": "00000_right_rgb.png", "left_disparity": "d.pfm", "right_depth": "r.exr"}]}"#,
     );
+    // A frame mixing set-ups (one eye's disparity alone is a set-up of its own).
     check(
         &["cyclopean", "--sequence", &half],
         1,
-        &["half.json", "frame 0", "--right-disparity"],
+        &["half.json", "frame 0", "not both"],
     );
     // The second frame's left depth is missing: the first frame rendered, nothing is written.
     let text = std::fs::read_to_string(&seq)

@@ -6,7 +6,8 @@
 use super::{ArgError, Backend, Event, GpuRequest, Host, JobError};
 use crate::convention::{Conventions, DepthPlanes};
 use crate::cyclopean::camera_file::CameraFile;
-use crate::cyclopean::{EyeInput, FrameDepth};
+use crate::cyclopean::one_eye::other_eye_disparity;
+use crate::cyclopean::{Eye, EyeInput, FrameDepth};
 use crate::depth::DepthEncoding;
 use crate::io::{self, DepthDecode, DepthMap, DepthSummary, RgbImage};
 use crate::pass::Device;
@@ -103,8 +104,9 @@ pub struct CyclopeanOptions {
 pub struct CyclopeanJob {
     left_rgb: PathBuf,
     right_rgb: PathBuf,
-    /// Left and right disparity or depth files (none: two images alone).
-    maps: Option<(PathBuf, PathBuf)>,
+    /// Left and right disparity or depth files (none: two images alone). Disparities may give
+    /// one eye only: the other's is derived ([`crate::cyclopean::one_eye`]).
+    maps: Option<(Option<PathBuf>, Option<PathBuf>)>,
     cameras: Option<PathBuf>,
     decode: DepthDecode,
     npz_key: Option<String>,
@@ -155,7 +157,7 @@ impl CyclopeanJob {
                         return Err(ArgError::DecodeWithoutMaps(flag));
                     }
                 }
-                ((None, None), None)
+                (None, None)
             }
             StereoKind::Disparity => {
                 if o.depth_scale.is_some() {
@@ -163,31 +165,31 @@ impl CyclopeanJob {
                 }
                 check_scale("--disparity-scale", o.disparity_scale)?;
                 let maps = (o.left_disparity.clone(), o.right_disparity.clone());
-                (maps, Some(o.disparity_scale.unwrap_or(1.0)))
+                (Some(maps), Some(o.disparity_scale.unwrap_or(1.0)))
             }
             StereoKind::Cameras => {
                 if o.disparity_scale.is_some() {
                     return Err(ArgError::RigOptionWithCameraFile("--disparity-scale"));
                 }
                 check_scale("--depth-scale", o.depth_scale)?;
-                ((o.left_depth.clone(), o.right_depth.clone()), o.depth_scale)
+                (Some((o.left_depth.clone(), o.right_depth.clone())), o.depth_scale)
             }
         };
-        let maps = maps.0.zip(maps.1);
-        if let Some((left, right)) = &maps {
-            super::check_npz_key(o.npz_key.as_deref(), &[left, right])?;
+        let map_files: Vec<(&'static str, &Path)> = maps
+            .iter()
+            .flat_map(|(l, r)| [("--left-depth/disparity", l), ("--right-depth/disparity", r)])
+            .filter_map(|(flag, p)| Some((flag, p.as_deref()?)))
+            .collect();
+        if !map_files.is_empty() {
+            let files: Vec<&Path> = map_files.iter().map(|f| f.1).collect();
+            super::check_npz_key(o.npz_key.as_deref(), &files)?;
         }
         let plan = o.request.plan(kind)?;
         let mut inputs = vec![
             ("--left-rgb", o.left_rgb.as_path()),
             ("--right-rgb", o.right_rgb.as_path()),
         ];
-        if let Some((l, r)) = &maps {
-            inputs.extend([
-                ("--left-depth/disparity", l.as_path()),
-                ("--right-depth/disparity", r.as_path()),
-            ]);
-        }
+        inputs.extend(map_files);
         inputs.extend(o.cameras.as_deref().map(|c| ("--cameras", c)));
         io::check_out_dir(&o.out_dir, owned_name, &replaced(), &inputs).map_err(ArgError::Invalid)?;
         Ok(CyclopeanJob {
@@ -277,15 +279,29 @@ impl CyclopeanJob {
                 }
             }
             Some((left_map, right_map)) => {
-                let eye = |rgb: &Path, map: &Path| -> crate::Result<(RgbImage, DepthMap)> {
-                    io::check_rgbd_sizes(rgb, map)?;
-                    Ok((
-                        io::load_rgb(rgb)?,
-                        io::load_depth_with_key(map, self.npz_key.as_deref(), &self.decode)?,
-                    ))
+                // An eye without a map is checked against the other eye's map (one pair size).
+                let given = left_map.as_ref().or(right_map.as_ref()).ok_or_else(|| {
+                    crate::Error::param("--left-disparity", "neither eye's disparity or depth is given")
+                })?;
+                let eye = |rgb: &Path, map: Option<&PathBuf>| -> crate::Result<(RgbImage, Option<DepthMap>)> {
+                    io::check_rgbd_sizes(rgb, map.unwrap_or(given))?;
+                    let depth = map
+                        .map(|m| io::load_depth_with_key(m, self.npz_key.as_deref(), &self.decode))
+                        .transpose()?;
+                    Ok((io::load_rgb(rgb)?, depth))
                 };
-                let left = eye(&self.left_rgb, left_map)?;
-                let right = eye(&self.right_rgb, right_map)?;
+                let (left_rgb, left_d) = eye(&self.left_rgb, left_map.as_ref())?;
+                let (right_rgb, right_d) = eye(&self.right_rgb, right_map.as_ref())?;
+                let (left_d, right_d) = match (left_d, right_d) {
+                    (Some(l), Some(r)) => (l, r),
+                    (Some(l), None) => {
+                        let r = other_eye_disparity(&l, Eye::Left);
+                        (l, r)
+                    }
+                    (None, Some(r)) => (other_eye_disparity(&r, Eye::Right), r),
+                    (None, None) => unreachable!("`given` is one of the two maps"),
+                };
+                let (left, right) = ((left_rgb, left_d), (right_rgb, right_d));
                 match &self.cameras {
                     None => StereoInput::Disparity { left, right },
                     Some(path) => StereoInput::Cameras {
@@ -315,12 +331,16 @@ impl CyclopeanJob {
         if let (StereoInput::Disparity { left, right }, Some((left_map, right_map))) = (&input, &self.maps) {
             tell_disparities(
                 host,
-                [left_map, right_map],
+                [left_map.as_deref(), right_map.as_deref()],
                 (left, right),
                 self.decode.scale.unwrap_or(1.0),
             );
         }
-        let left_map = self.maps.as_ref().map_or(self.left_rgb.as_path(), |m| m.0.as_path());
+        let left_map = self
+            .maps
+            .as_ref()
+            .and_then(|m| m.0.as_deref().or(m.1.as_deref()))
+            .unwrap_or(self.left_rgb.as_path());
         let names = [
             InputName::File(&self.left_rgb),
             InputName::File(&self.right_rgb),
@@ -342,7 +362,7 @@ impl CyclopeanJob {
                 estimated,
             });
         }
-        if let (Some(cameras), Some((left_map, right_map))) = (&self.cameras, &self.maps) {
+        if let (Some(cameras), Some((Some(left_map), Some(right_map)))) = (&self.cameras, &self.maps) {
             for (path, eye) in [(left_map, &frame.left), (right_map, &frame.right)] {
                 // cyclopean takes the conventions and planes from the file alone (--ndc and
                 // the like are refused with --cameras): the hint names the file's keys.
@@ -378,20 +398,41 @@ pub(crate) struct RenderedView {
     size: (u32, u32),
 }
 
-/// Each disparity map's summary, with the pair's photometric scale check (cheap: a subsample),
-/// told to the host: a wrong `--disparity-scale` renders a plausible wrong view at exit 0.
+/// Each given disparity map's summary, with the pair's photometric scale check (cheap: a
+/// subsample), told to the host: a wrong `--disparity-scale` renders a plausible wrong view at
+/// exit 0. An eye without a file (`None`) had its map derived: the host is told so, and the
+/// scale check uses the given map alone (the derived one would only repeat it).
 fn tell_disparities(
     host: &dyn Host,
-    paths: [&PathBuf; 2],
+    paths: [Option<&Path>; 2],
     (left, right): (&(RgbImage, DepthMap), &(RgbImage, DepthMap)),
     scale: f64,
 ) {
-    let fit = io::fit_disparity_scale((&left.0, &left.1), (&right.0, &right.1), scale);
-    for (path, (_, map)) in paths.into_iter().zip([left, right]) {
-        host.event(Event::InputDisparity {
-            path,
-            summary: &io::DisparitySummary::of(map, scale, fit),
-        });
+    let unknown = |m: &DepthMap| DepthMap {
+        data: vec![0.0; m.data.len()],
+        ..m.clone()
+    };
+    let fit_map = |path: Option<&Path>, m: &DepthMap| if path.is_some() { m.clone() } else { unknown(m) };
+    let fit = io::fit_disparity_scale(
+        (&left.0, &fit_map(paths[0], &left.1)),
+        (&right.0, &fit_map(paths[1], &right.1)),
+        scale,
+    );
+    let eyes = [(Eye::Left, left), (Eye::Right, right)];
+    for (path, (eye, (_, map))) in paths.into_iter().zip(eyes) {
+        match path {
+            Some(path) => host.event(Event::InputDisparity {
+                path,
+                summary: &io::DisparitySummary::of(map, scale, fit),
+            }),
+            None => {
+                let known = map.data.iter().filter(|d| d.is_finite() && **d != 0.0).count();
+                host.event(Event::DisparityDerived {
+                    eye,
+                    known_fraction: known as f64 / map.data.len().max(1) as f64,
+                });
+            }
+        }
     }
 }
 
@@ -513,13 +554,14 @@ mod tests {
             ..disparity_options(CyclopeanRequest::default())
         };
         assert!(matches!(CyclopeanJob::new(both), Err(ArgError::DisparityAndDepth)));
-        let no_right = CyclopeanOptions {
-            right_disparity: None,
-            ..disparity_options(CyclopeanRequest::default())
-        };
-        assert!(matches!(
-            CyclopeanJob::new(no_right),
-            Err(ArgError::RightDisparityMissing)
-        ));
+        // One eye's disparity is a set-up of its own (the other eye's is derived).
+        for (left, right) in [(true, false), (false, true)] {
+            let one = CyclopeanOptions {
+                left_disparity: left.then(|| "ld.pgm".into()),
+                right_disparity: right.then(|| "rd.pgm".into()),
+                ..disparity_options(CyclopeanRequest::default())
+            };
+            assert!(CyclopeanJob::new(one).is_ok());
+        }
     }
 }

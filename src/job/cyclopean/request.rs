@@ -113,11 +113,8 @@ impl StereoGiven {
         match (disparity, depth) {
             (true, true) => Err(ArgError::DisparityAndDepth),
             (false, false) => Ok(StereoKind::Images),
-            (true, false) => match (self.left_disparity, self.right_disparity) {
-                (true, true) => Ok(StereoKind::Disparity),
-                (true, false) => Err(ArgError::RightDisparityMissing),
-                _ => Err(ArgError::LeftDisparityMissing),
-            },
+            // One eye's disparity is enough: the other's is derived (cyclopean::one_eye).
+            (true, false) => Ok(StereoKind::Disparity),
             (false, true) => {
                 for (flag, given) in [
                     ("--left-depth", self.left_depth),

@@ -57,6 +57,8 @@ pub enum Target {
     Right,
     /// Both eyes (from the centre view).
     Both,
+    /// The middle camera of a camera file (`--cameras`).
+    Centre,
 }
 
 /// The reprojection method as chosen.
@@ -110,8 +112,9 @@ pub struct ReprojectOptions {
 enum Views {
     /// A parallel rig from intrinsics.
     Rig(RigViews),
-    /// Full eye matrices from a camera file: the source eye to the other.
-    Cameras { path: PathBuf, from: Eye, to: Eye },
+    /// Full eye matrices from a camera file: the source eye to the other eye or the middle
+    /// camera (`to` None).
+    Cameras { path: PathBuf, from: Eye, to: Option<Eye> },
 }
 
 /// [`Views::Rig`]: the checked rig, the source intrinsics and the conventions.
@@ -141,8 +144,8 @@ pub struct ReprojectJob {
 /// One target rendered.
 #[derive(Debug)]
 pub struct TargetReport {
-    /// The target eye.
-    pub to: Eye,
+    /// The target eye (None: the camera file's middle camera).
+    pub to: Option<Eye>,
     /// Its valid fraction.
     pub coverage: f64,
     /// Render time.
@@ -195,6 +198,10 @@ impl ReprojectJob {
         o.gpu.check_backend(o.backend)?;
         super::check_npz_key(o.npz_key.as_deref(), &[&o.depth])?;
         o.files.outputs = o.request.outputs();
+        if o.cameras.is_some() {
+            // Full matrices leave one method; a different one given is refused below.
+            o.request.method.get_or_insert(MethodChoice::Gather3d);
+        }
         // The mask is always rendered: the coverage reported is measured on it.
         let params = o.request.params()?;
         let views = match &o.cameras {
@@ -203,12 +210,12 @@ impl ReprojectJob {
         };
         super::cyclopean::check_scale("--depth-scale", o.depth_scale)?;
         let eyes = match &views {
-            Views::Rig(rig) => rig.plan.targets().to_vec(),
+            Views::Rig(rig) => rig.plan.targets().iter().map(|&e| Some(e)).collect(),
             Views::Cameras { to, .. } => vec![*to],
         };
         let writes = |name: &str| {
             eyes.iter()
-                .any(|&e| io::ViewNames::tagged(view_name(Some(e))).may_write(name))
+                .any(|&e| io::ViewNames::tagged(view_name(e)).may_write(name))
         };
         let mut inputs = vec![("--color", o.color.as_path()), ("--depth", o.depth.as_path())];
         inputs.extend(o.intrinsics_file.as_deref().map(|p| ("--intrinsics", p)));
@@ -278,12 +285,7 @@ impl ReprojectJob {
                 timing: Some(timing),
                 exact: None,
             };
-            crate::output::write_view(
-                &mut set,
-                &io::ViewNames::tagged(view_name(Some(to))),
-                &view,
-                &self.files,
-            )?;
+            crate::output::write_view(&mut set, &io::ViewNames::tagged(view_name(to)), &view, &self.files)?;
             reports.push(TargetReport {
                 to,
                 coverage,
@@ -348,19 +350,20 @@ impl ReprojectJob {
         Ok(src)
     }
 
-    /// The source eye and the other eye from full GL matrices (3-D gather only).
+    /// The source eye and the target (the other eye, or the middle camera when `to` is None)
+    /// from full GL matrices (3-D gather only).
     #[allow(clippy::type_complexity)]
     fn camera_file_setup(
         &self,
         host: &dyn Host,
         path: &Path,
         from: Eye,
-        to: Eye,
-    ) -> Result<(ReprojectSource, Vec<(Eye, Geometry)>), JobError> {
+        to: Option<Eye>,
+    ) -> Result<(ReprojectSource, Vec<(Option<Eye>, Geometry)>), JobError> {
         let file = CameraFile::load(path)?;
-        let (source, target) = match from {
-            Eye::Left => (&file.left, &file.right),
-            Eye::Right => (&file.right, &file.left),
+        let source = match from {
+            Eye::Left => &file.left,
+            Eye::Right => &file.right,
         };
         let conv = file.conventions;
         let depth_kind = match file.depth_kind {
@@ -377,19 +380,42 @@ impl ReprojectJob {
             path.display()
         );
         let src = self.load_source(host, depth_kind, conv, &what)?;
-        // The target is rendered at the source's size: both cameras must be for that size.
-        for cam in [source, target] {
-            cam.check_size(&self.color.display().to_string(), src.color.width, src.color.height)?;
-        }
+        // The target is rendered at the source's size: its camera must be for that size.
+        let name = self.color.display().to_string();
+        source.check_size(&name, src.color.width, src.color.height)?;
+        let target = match to {
+            Some(eye) => {
+                let cam = if eye == Eye::Left { &file.left } else { &file.right };
+                cam.check_size(&name, src.color.width, src.color.height)?;
+                MiddleCamera {
+                    view: cam.view,
+                    proj: cam.proj,
+                    width: src.color.width,
+                    height: src.color.height,
+                }
+            }
+            None => {
+                let (middle, _) = file.middle_and_fixation().within(|| path.display().to_string())?;
+                if (middle.width, middle.height) != (src.color.width, src.color.height) {
+                    return Err(crate::Error::SizeMismatch {
+                        message: format!(
+                            "{}: the middle camera is {}x{} but {name} is {}x{}",
+                            path.display(),
+                            middle.width,
+                            middle.height,
+                            src.color.width,
+                            src.color.height
+                        ),
+                    }
+                    .into());
+                }
+                middle
+            }
+        };
         let geometry = Geometry::Matrices {
             source_view: source.view,
             source_proj: source.proj,
-            target: MiddleCamera {
-                view: target.view,
-                proj: target.proj,
-                width: src.color.width,
-                height: src.color.height,
-            },
+            target,
         };
         Ok((src, vec![(to, geometry)]))
     }
@@ -411,15 +437,19 @@ fn rig_views(o: &ReprojectOptions) -> Result<Views, ArgError> {
 /// The camera file's checks: an eye to the other, 3-D gather, the file's own conventions.
 fn camera_file_views(o: &ReprojectOptions, path: &Path) -> Result<Views, ArgError> {
     let r = &o.request;
-    let (from, to) = match r.from.eye() {
-        Some(Eye::Left) => (Eye::Left, Eye::Right),
-        Some(Eye::Right) => (Eye::Right, Eye::Left),
-        None => return Err(ArgError::CameraFileFromCentre),
+    let Some(from) = r.from.eye() else {
+        return Err(ArgError::CameraFileFromCentre);
     };
-    if !matches!((r.to, to), (Target::Left, Eye::Left) | (Target::Right, Eye::Right)) {
-        return Err(ArgError::CameraFileTarget(view_name(Some(to))));
+    let to = match r.to {
+        Target::Left => Some(Eye::Left),
+        Target::Right => Some(Eye::Right),
+        Target::Centre => None,
+        Target::Both => return Err(ArgError::BothFromEye),
+    };
+    if to == Some(from) {
+        return Err(ArgError::TargetIsSource);
     }
-    if r.method != MethodChoice::Gather3d {
+    if r.method != Some(MethodChoice::Gather3d) {
         return Err(ArgError::CameraFileNeedsGather);
     }
     // The file carries both; a flag that differs from its default would be silently overridden.
@@ -500,12 +530,22 @@ mod tests {
 
     #[test]
     fn a_camera_file_takes_an_eye_to_the_other_by_3d_gather_under_its_own_conventions() {
-        let mut cams = with(|r| (r.baseline, r.method) = (None, MethodChoice::Gather3d));
+        let mut cams = with(|r| r.baseline = None);
         cams.cameras = Some("cameras.json".into());
         cams.intrinsics = [None; 4];
+        // gather3d is the default with a camera file, and may be named.
         assert!(ReprojectJob::new(cams.clone()).is_ok());
+        let mut named = cams.clone();
+        named.request.method = Some(MethodChoice::Gather3d);
+        assert!(ReprojectJob::new(named).is_ok());
+        for to in [Target::Left, Target::Centre] {
+            let mut other = cams.clone();
+            other.request.to = to;
+            let r = ReprojectJob::new(other);
+            assert_eq!(r.is_ok(), to == Target::Centre, "--to {to:?} from the left eye");
+        }
         let mut shift = cams.clone();
-        shift.request.method = MethodChoice::ShiftScan;
+        shift.request.method = Some(MethodChoice::ShiftScan);
         assert!(matches!(ReprojectJob::new(shift), Err(ArgError::CameraFileNeedsGather)));
         let mut centre = cams.clone();
         centre.request.from = SourceView::Centre;

@@ -71,8 +71,8 @@ pub struct ReprojectRequest {
     pub from: SourceView,
     /// The target view(s).
     pub to: Target,
-    /// The method.
-    pub method: MethodChoice,
+    /// The method; none: gather3d with a camera file, else shift-scan.
+    pub method: Option<MethodChoice>,
     /// Steps of the shift walk / 3-D gather, 1..=16.
     pub steps: u32,
     /// Segment break threshold.
@@ -95,7 +95,7 @@ impl Default for ReprojectRequest {
             convergence: None,
             from: SourceView::Left,
             to: Target::Right,
-            method: MethodChoice::ShiftScan,
+            method: None,
             steps: 3,
             tau_rel: 0.05,
             outputs: None,
@@ -118,8 +118,8 @@ pub struct RigPlan {
 
 /// One target rendered.
 pub struct RenderedTarget {
-    /// The target eye.
-    pub to: Eye,
+    /// The target eye (None: the camera file's middle camera).
+    pub to: Option<Eye>,
     /// Its planes and mask.
     pub out: ReprojectOutput,
     /// Render time.
@@ -136,7 +136,7 @@ impl ReprojectRequest {
 
     /// The method and its parameters, checked.
     pub fn params(&self) -> Result<ReprojectParams, ArgError> {
-        let method = match self.method {
+        let method = match self.method.unwrap_or_default() {
             MethodChoice::Shift => Method::Shift { steps: self.steps },
             MethodChoice::ShiftScan => Method::ShiftScan,
             MethodChoice::Gather3d => Method::Gather3d { steps: self.steps },
@@ -161,6 +161,7 @@ impl ReprojectRequest {
             (Some(Eye::Left), Target::Left) | (Some(Eye::Right), Target::Right) => {
                 return Err(ArgError::TargetIsSource)
             }
+            (_, Target::Centre) => return Err(ArgError::CentreTargetNeedsCameras),
             (_, Target::Left) => vec![Eye::Left],
             (_, Target::Right) => vec![Eye::Right],
         })
@@ -269,7 +270,12 @@ impl RigPlan {
     }
 
     /// Each target eye's geometry for a source camera `k` of `width` x `height`.
-    pub(super) fn geometries(&self, k: Intrinsics, width: u32, height: u32) -> crate::Result<Vec<(Eye, Geometry)>> {
+    pub(super) fn geometries(
+        &self,
+        k: Intrinsics,
+        width: u32,
+        height: u32,
+    ) -> crate::Result<Vec<(Option<Eye>, Geometry)>> {
         let camera = PinholeCamera { k, width, height };
         camera.validate("source intrinsics")?;
         let mut geometries = Vec::new();
@@ -279,7 +285,7 @@ impl RigPlan {
                 None => self.rectified[i],
             };
             shift.validate()?;
-            geometries.push((to, Geometry::Rig { camera, shift }));
+            geometries.push((Some(to), Geometry::Rig { camera, shift }));
         }
         Ok(geometries)
     }
@@ -289,7 +295,7 @@ impl RigPlan {
 pub(super) fn render_targets(
     device: &Device,
     src: &ReprojectSource,
-    targets: &[(Eye, Geometry)],
+    targets: &[(Option<Eye>, Geometry)],
     params: ReprojectParams,
 ) -> crate::Result<Vec<RenderedTarget>> {
     let mut results = Vec::with_capacity(targets.len());
