@@ -121,6 +121,13 @@ pub(crate) struct RefocusArgs {
     /// With --batch: render every frame again, even those finished with the same settings.
     #[arg(help_heading = BATCH, long, alias = "no-resume")]
     force: bool,
+    /// With --batch: also check, before skipping a finished frame, the CRC-32 of each of its
+    /// files and the content of its inputs. By default a finished frame costs a read of its
+    /// manifest.json and a stat of each input and file (the commit journal makes a set
+    /// all-or-none); inputs are recognised by size and mtime, or by content when the mtime
+    /// differs, whatever the path's spelling.
+    #[arg(help_heading = BATCH, long, conflicts_with = "force")]
+    verify: bool,
     /// With --batch: threads in each CPU pool (decoding inputs, encoding files) around the GL
     /// thread; 0 runs every stage in turn on one thread.
     ///
@@ -157,6 +164,7 @@ impl RefocusArgs {
             },
             depth_trunc: self.depth_trunc,
             resume: !self.force,
+            verify: self.verify,
             jobs: self.jobs,
             shard: self.shard.clone(),
             rgb_everywhere: self.rgb_everywhere,

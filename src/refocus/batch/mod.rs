@@ -2,7 +2,8 @@
 //! each into the same textures and queues its targets, the previous frame's outputs are
 //! mapped while the GPU renders the next, and a pool encodes files. Queues between the stages
 //! are bounded, so memory stays flat (see [`BatchSummary::frames_in_flight`]). Resume skips
-//! frames whose manifest records the same settings and whose files are all there; `--shard`
+//! frames whose manifest records the same settings and the same inputs (by identity, whatever
+//! the path's spelling: see [`resume`]) and whose files are all there; `--shard`
 //! takes a deterministic share of the manifest. A failed frame is listed while the others
 //! complete.
 //!
@@ -106,8 +107,11 @@ pub struct BatchOptions {
     pub files: FileFormats,
     /// Input depth beyond this many metres is treated as invalid (Open3D's depth_trunc).
     pub depth_trunc: Option<f64>,
-    /// Skip frames already finished with the same settings.
+    /// Skip frames already finished from the same inputs with the same settings.
     pub resume: bool,
+    /// With `resume`: also check each finished file's CRC-32 and each input's content (by
+    /// default a done frame costs its manifest read and a few `stat`s).
+    pub verify: bool,
     /// Threads in each CPU pool (decode, encode); 0 runs every stage in turn on the GL thread
     /// (the synchronous baseline).
     pub jobs: usize,
