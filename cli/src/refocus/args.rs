@@ -115,7 +115,8 @@ pub(crate) struct RefocusArgs {
     ///
     /// CSV with a header row rgb,depth,fx,fy,cx,cy and optional depth_scale,name columns, or a JSON
     /// array of objects with those keys (and sun_bit_rotate); relative paths are relative to the
-    /// manifest.
+    /// manifest. --fx/--fy/--cx/--cy, --intrinsics and --depth-scale give the values of rows that
+    /// lack them.
     #[arg(help_heading = BATCH, long, conflicts_with_all = ["rgb", "depth"])]
     batch: Option<PathBuf>,
     /// With --batch: render every frame again, even those finished with the same settings.

@@ -77,3 +77,31 @@ fn a_rerun_with_the_manifest_spelt_otherwise_or_from_another_folder_renders_noth
         "--verify redoes the frame whose file no longer matches its CRC"
     );
 }
+
+#[test]
+fn fx_fy_cx_cy_are_the_defaults_of_rows_that_lack_them() {
+    let (dir, _) = setup("batch-intrinsics-defaults", 2);
+    // No fx column; cx, cy empty on the second row; the first row's own cx wins.
+    std::fs::write(
+        dir.join("k.csv"),
+        "rgb,depth,fy,cx,cy,name\nrgb0.png,depth0.npy,40,15,11.5,a\nrgb1.png,depth1.npy,40,,,b\n",
+    )
+    .unwrap();
+    let out = dir.join("out");
+    let defaults = ["--fx", "40", "--cx", "15.5", "--cy", "11.5"];
+    let o = batch_in(&dir, "k.csv", &out, &defaults);
+    assert_eq!(rendered_done(&o), "2 rendered, 0");
+    let k = |f: &str| -> serde_json::Value {
+        let m: serde_json::Value =
+            serde_json::from_slice(&std::fs::read(out.join(f).join("manifest.json")).unwrap()).unwrap();
+        m["settings"]["intrinsics"].clone()
+    };
+    assert_eq!(k("a"), serde_json::json!([40.0, 40.0, 15.0, 11.5]));
+    assert_eq!(k("b"), serde_json::json!([40.0, 40.0, 15.5, 11.5]));
+    // Without the default, the missing value is refused by name, nothing written.
+    let o = batch_in(&dir, "k.csv", &dir.join("out2"), &["--fx", "40"]);
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert_ne!(o.status.code(), Some(0), "{err}");
+    assert!(err.contains("cx"), "{err}");
+    assert!(!dir.join("out2").join("b").exists());
+}

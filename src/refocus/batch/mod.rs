@@ -29,8 +29,8 @@ mod zoom;
 pub use index::{join_index, read_index, write_index, IndexRow};
 pub use index_names::{is_index_name, INDEX_NAME};
 pub use manifest::{
-    frame_folder_name, is_frame_folder_name, load_manifest, BatchFrame, MAX_JSON_MANIFEST_BYTES, MAX_MANIFEST_BYTES,
-    MAX_MANIFEST_ROWS, MAX_MANIFEST_ROW_BYTES,
+    frame_folder_name, is_frame_folder_name, load_manifest, load_manifest_with_defaults, BatchFrame,
+    MAX_JSON_MANIFEST_BYTES, MAX_MANIFEST_BYTES, MAX_MANIFEST_ROWS, MAX_MANIFEST_ROW_BYTES,
 };
 pub use pipeline::{run_batch, BatchSummary, StageTimes};
 pub use zoom::{ZoomRandom, MAX_SAMPLES};
