@@ -62,8 +62,8 @@ pub(crate) struct RefocusArgs {
     /// Target focal scales s (fx' = s fx) [default: 0.5,0.75,1,1.5,2].
     #[arg(help_heading = TARGETS, long, value_delimiter = ',', value_parser = finite_value)]
     zoom_range: Option<Vec<f64>>,
-    /// With --batch: K random focal scales per frame in [LO, HI] (log-uniform: zooming in and
-    /// out equally often), drawn from --seed and the frame's name, so reruns, resumed and
+    /// K random focal scales per frame in [LO, HI] (log-uniform: zooming in and out equally
+    /// often), drawn from --seed and, with --batch, the frame's name, so reruns, resumed and
     /// sharded runs draw the same; files z{k}_s{s}_*, scales recorded in each frame's manifest.
     #[arg(help_heading = TARGETS, long, value_name = "LO,HI", value_delimiter = ',', conflicts_with_all = ["zoom_range", "focal_list"], value_parser = finite_value)]
     zoom_random: Option<Vec<f64>>,

@@ -195,11 +195,27 @@ impl RefocusRequest {
                 "applies with --batch only (it checks finished frames before a resume skips them)",
             )));
         }
-        if self.zoom_random.is_some() || self.samples.is_some() || self.seed.is_some() {
-            return Err(ArgError::Invalid(crate::Error::param(
-                "--zoom-random",
-                "applies with --batch only (scales are drawn from the seed and each frame's name)",
-            )));
+        // One frame draws its random scales from the seed alone (a batch adds each frame's name).
+        if let Some(z) = self.zoom_random()? {
+            if self.focal_list.is_some() {
+                return Err(ArgError::Invalid(crate::Error::param(
+                    "--zoom-random",
+                    "give target focal lengths (--focal-list) or a random range, not both",
+                )));
+            }
+            let scales = z.scales("");
+            let plan = RefocusRequest {
+                scales: Some(scales.clone()),
+                zoom_random: None,
+                samples: None,
+                seed: None,
+                ..self.clone()
+            }
+            .frame()?;
+            return Ok(FramePlan {
+                tags: ZoomRandom::tags(&scales),
+                ..plan
+            });
         }
         let rule = self.rule()?;
         if let Some((w, h)) = self.size {
