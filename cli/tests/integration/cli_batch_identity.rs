@@ -1,6 +1,7 @@
 //! Resume by identity: a finished frame is recognised by its inputs' identity (size and mtime,
 //! or content) and the settings, never by how the manifest's path was spelt, from which working
-//! folder, or where a copy of the data sits.
+//! folder, or where a copy of the data sits. And a row's identity in the other sense: the
+//! intrinsics a row lacks come from `--fx/--fy/--cx/--cy`.
 
 use crate::cli::bin;
 use crate::cli_batch::setup;
