@@ -297,6 +297,7 @@ pub fn options(a: &BatchArgs<'_, '_>) -> PyResult<BatchOptions> {
         exr_compression: a.exr_compression.to_string(),
         depth_trunc: a.depth_trunc,
         resume: a.resume,
+        verify: false,
         jobs: a.jobs,
         shard: a.shard.map(str::to_string),
         rgb_everywhere: a.augment.rgb_everywhere,

@@ -260,7 +260,8 @@ impl ArgError {
 /// Options that hold for one frame, refused with `refocus --batch`.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum PerFrameOption {
-    /// `--intrinsics`, `--fx`, `--fy`, `--cx`, `--cy`.
+    /// `--intrinsics`, `--fx`, `--fy`, `--cx`, `--cy` (kept for callers; refocus --batch now
+    /// takes them as defaults of rows lacking them).
     Intrinsics,
     /// `--focal-list`.
     FocalList,

@@ -62,8 +62,8 @@ pub(crate) struct RefocusArgs {
     /// Target focal scales s (fx' = s fx) [default: 0.5,0.75,1,1.5,2].
     #[arg(help_heading = TARGETS, long, value_delimiter = ',', value_parser = finite_value)]
     zoom_range: Option<Vec<f64>>,
-    /// With --batch: K random focal scales per frame in [LO, HI] (log-uniform: zooming in and
-    /// out equally often), drawn from --seed and the frame's name, so reruns, resumed and
+    /// K random focal scales per frame in [LO, HI] (log-uniform: zooming in and out equally
+    /// often), drawn from --seed and, with --batch, the frame's name, so reruns, resumed and
     /// sharded runs draw the same; files z{k}_s{s}_*, scales recorded in each frame's manifest.
     #[arg(help_heading = TARGETS, long, value_name = "LO,HI", value_delimiter = ',', conflicts_with_all = ["zoom_range", "focal_list"], value_parser = finite_value)]
     zoom_random: Option<Vec<f64>>,
@@ -115,12 +115,20 @@ pub(crate) struct RefocusArgs {
     ///
     /// CSV with a header row rgb,depth,fx,fy,cx,cy and optional depth_scale,name columns, or a JSON
     /// array of objects with those keys (and sun_bit_rotate); relative paths are relative to the
-    /// manifest.
+    /// manifest. --fx/--fy/--cx/--cy, --intrinsics and --depth-scale give the values of rows that
+    /// lack them.
     #[arg(help_heading = BATCH, long, conflicts_with_all = ["rgb", "depth"])]
     batch: Option<PathBuf>,
     /// With --batch: render every frame again, even those finished with the same settings.
     #[arg(help_heading = BATCH, long, alias = "no-resume")]
     force: bool,
+    /// With --batch: also check, before skipping a finished frame, the CRC-32 of each of its
+    /// files and the content of its inputs. By default a finished frame costs a read of its
+    /// manifest.json and a stat of each input and file (the commit journal makes a set
+    /// all-or-none); inputs are recognised by size and mtime, or by content when the mtime
+    /// differs, whatever the path's spelling.
+    #[arg(help_heading = BATCH, long, conflicts_with = "force")]
+    verify: bool,
     /// With --batch: threads in each CPU pool (decoding inputs, encoding files) around the GL
     /// thread; 0 runs every stage in turn on one thread.
     ///
@@ -157,6 +165,7 @@ impl RefocusArgs {
             },
             depth_trunc: self.depth_trunc,
             resume: !self.force,
+            verify: self.verify,
             jobs: self.jobs,
             shard: self.shard.clone(),
             rgb_everywhere: self.rgb_everywhere,

@@ -54,6 +54,7 @@ fn options(jobs: usize) -> BatchOptions {
         },
         depth_trunc: None,
         resume: true,
+        verify: false,
         jobs,
         shard: None,
         index: true,

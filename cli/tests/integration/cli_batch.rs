@@ -1,5 +1,5 @@
 //! `refocus --batch` from the command line, for the README's promises that no other test holds
-//! through the binary: each resume invalidation rule (inputs' size and mtime, conventions,
+//! through the binary: each resume invalidation rule (inputs' size and content, conventions,
 //! outputs, formats), `--shard K/N` taking the frames with i % N == K over several K, resume per
 //! shard, kill -9 mid-batch then resume, and a batch ended after each step of its file commits.
 
@@ -113,13 +113,21 @@ fn resume_redoes_a_frame_for_each_recorded_setting_that_changed() {
     );
     assert_eq!(redone(&before, &manifests(&out)), Vec::<String>::new());
 
-    // An input's mtime only (same bytes): the frames reading it (f0, f2) are redone.
+    // An input's mtime only (same bytes): the same file by content, so nothing is redone.
     let rgb0 = dir.join("rgb0.png");
     let f = std::fs::File::options().write(true).open(&rgb0).unwrap();
     let t = f.metadata().unwrap().modified().unwrap();
     f.set_modified(t - std::time::Duration::from_secs(3600)).unwrap();
     drop(f);
-    assert_eq!(counts(&batch(&manifest, &out, &[])), (2, 2), "mtime of rgb0.png");
+    assert_eq!(counts(&batch(&manifest, &out, &[])), (0, 4), "mtime of rgb0.png only");
+
+    // An input's content, size kept (one depth value of depth0.npy): f0 and f2 are redone.
+    let depth0 = dir.join("depth0.npy");
+    let mut npy = std::fs::read(&depth0).unwrap();
+    let last = npy.len() - 1;
+    npy[last] ^= 0x01;
+    std::fs::write(&depth0, &npy).unwrap();
+    assert_eq!(counts(&batch(&manifest, &out, &[])), (2, 2), "content of depth0.npy");
     let after = manifests(&out);
     assert_eq!(redone(&before, &after), names(&["f0", "f2"]));
     before = after;

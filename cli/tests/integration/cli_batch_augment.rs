@@ -232,3 +232,38 @@ fn a_run_killed_after_an_earlier_complete_run_leaves_no_stale_index() {
     assert!(rows.iter().all(|r| r.scale == 0.75), "{rows:?}");
     assert_index_true_to_disk(&out);
 }
+
+#[test]
+fn zoom_random_on_one_frame_draws_its_samples_from_the_seed() {
+    let dir = crate::cli::scratch("zoom-random-one-frame");
+    let (data, _) = crate::cli_batch::setup("zoom-random-one-frame-in", 1);
+    let run = |out: &str| {
+        crate::cli::bin()
+            .args(["refocus", "--fx", "40", "--fy", "40", "--cx", "15.5", "--cy", "11.5"])
+            .arg("--rgb")
+            .arg(data.join("rgb0.png"))
+            .arg("--depth")
+            .arg(data.join("depth0.npy"))
+            .args(["--zoom-random", "0.5,2", "--samples", "3", "--seed", "7", "--out-dir"])
+            .arg(dir.join(out))
+            .output()
+            .unwrap()
+    };
+    let o = run("a");
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let rgbs = |out: &str| -> Vec<String> {
+        let mut v: Vec<String> = std::fs::read_dir(dir.join(out))
+            .unwrap()
+            .flatten()
+            .map(|e| e.file_name().to_string_lossy().into_owned())
+            .filter(|n| n.ends_with("_rgb.png"))
+            .collect();
+        v.sort();
+        v
+    };
+    let a = rgbs("a");
+    assert_eq!(a.len(), 3, "{a:?}");
+    assert!(a.iter().all(|n| n.starts_with('z')), "{a:?}");
+    assert!(run("b").status.success());
+    assert_eq!(rgbs("b"), a, "the same seed draws the same scales");
+}

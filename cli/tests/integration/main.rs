@@ -6,6 +6,7 @@ mod bounds;
 mod cli;
 mod cli_batch;
 mod cli_batch_augment;
+mod cli_batch_identity;
 mod cli_cameras_cv;
 mod cli_compare;
 mod cli_depth_out;

@@ -239,6 +239,7 @@ pub fn batch_bench(
         files,
         depth_trunc: None,
         resume: false,
+        verify: false,
         jobs,
         shard: None,
         index: true,

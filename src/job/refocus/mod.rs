@@ -7,10 +7,11 @@ mod request;
 pub use request::{FramePlan, RefocusRequest, DEFAULT_DEPTH_FORMAT};
 
 use super::error::InContext;
+use super::error::OptionsContext;
 use super::{ArgError, Backend, Event, GpuRequest, Host, JobError, PerFrameOption, SourceIntrinsics};
 use crate::convention::Conventions;
 use crate::io::{self, DepthDecode, DepthSummary};
-use crate::refocus::batch::{is_index_name, load_manifest, run_batch, BatchOptions, BatchSummary, Shard};
+use crate::refocus::batch::{is_index_name, load_manifest_with_defaults, run_batch, BatchOptions, BatchSummary, Shard};
 use crate::refocus::manifest::{self as job, Manifest};
 use crate::refocus::{RefocusSource, Refocuser};
 use std::path::PathBuf;
@@ -77,6 +78,8 @@ pub struct RefocusJob {
 #[derive(Debug)]
 pub struct RefocusBatchJob {
     manifest: PathBuf,
+    /// `--fx`, `--fy`, `--cx`, `--cy` (over `--intrinsics`): the values of rows that lack them.
+    intrinsics: [Option<f64>; 4],
     /// `--depth-scale`: the scale of frames whose manifest row gives none.
     depth_scale: Option<f64>,
     options: BatchOptions,
@@ -225,9 +228,19 @@ impl RefocusBatchReport {
 
 impl RefocusBatchJob {
     fn new(manifest: PathBuf, o: RefocusOptions) -> Result<Self, ArgError> {
-        if o.intrinsics_file.is_some() || o.intrinsics.iter().any(Option::is_some) {
-            return Err(ArgError::PerFrameInBatch(PerFrameOption::Intrinsics));
-        }
+        // --intrinsics FILE and --fx/--fy/--cx/--cy (laid over the file) are the defaults of
+        // rows that lack them, as --depth-scale is.
+        let stored = match o.intrinsics_file.as_deref() {
+            Some(p) => Some(crate::camera::IntrinsicsFile::load(p).for_options("--intrinsics")?.k),
+            None => None,
+        };
+        let [fx, fy, cx, cy] = o.intrinsics;
+        let intrinsics = [
+            fx.or(stored.map(|k| k.fx)),
+            fy.or(stored.map(|k| k.fy)),
+            cx.or(stored.map(|k| k.cx)),
+            cy.or(stored.map(|k| k.cy)),
+        ];
         // A flag the batch cannot apply is refused, never ignored.
         if o.decode.sun_rgbd_bit_rotate {
             return Err(ArgError::PerFrameInBatch(PerFrameOption::SunBitRotate));
@@ -237,6 +250,7 @@ impl RefocusBatchJob {
         }
         Ok(RefocusBatchJob {
             manifest,
+            intrinsics,
             depth_scale: o.decode.scale,
             options: o.request.batch(o.conventions)?,
             out_dir: o.out_dir,
@@ -275,7 +289,7 @@ impl RefocusBatchJob {
     /// Refocuses every frame (of this shard) into `<out-dir>/<name>/`, skipping those finished
     /// with the same settings unless forced; a failed frame is reported, the others complete.
     pub fn run(&self, host: &dyn Host) -> Result<RefocusBatchReport, JobError> {
-        let mut frames = load_manifest(&self.manifest)?;
+        let mut frames = load_manifest_with_defaults(&self.manifest, self.intrinsics)?;
         // --depth-scale is the scale of every frame whose row gives none (a row's own wins).
         if let Some(scale) = self.depth_scale {
             for f in frames.iter_mut().filter(|f| f.depth_scale.is_none()) {
@@ -357,13 +371,14 @@ mod tests {
             RefocusCommand::new(batch.clone()),
             Ok(RefocusCommand::Batch(_))
         ));
+        // --fx and the others are the defaults of rows lacking them (issue 44), not refused.
         let with_k = RefocusOptions {
             intrinsics: [Some(1.0), None, None, None],
             ..batch.clone()
         };
         assert!(matches!(
             RefocusCommand::new(with_k),
-            Err(ArgError::PerFrameInBatch(PerFrameOption::Intrinsics))
+            Ok(RefocusCommand::Batch(b)) if b.intrinsics == [Some(1.0), None, None, None]
         ));
         let focal_list = with(batch.clone(), |r| (r.scales, r.focal_list) = (None, Some(vec![500.0])));
         assert!(matches!(

@@ -54,6 +54,9 @@ pub struct RefocusRequest {
     pub depth_trunc: Option<f64>,
     /// Batch: skip frames finished with the same settings.
     pub resume: bool,
+    /// Batch: with `resume`, also check the CRC-32 of every finished file and the content of
+    /// every input.
+    pub verify: bool,
     /// Batch: threads per CPU pool (none: the number of cores).
     pub jobs: Option<usize>,
     /// Batch: `K/N`.
@@ -87,6 +90,7 @@ impl Default for RefocusRequest {
             exr_compression: "zip".into(),
             depth_trunc: None,
             resume: true,
+            verify: false,
             jobs: None,
             shard: None,
             rgb_everywhere: false,
@@ -185,11 +189,33 @@ impl RefocusRequest {
                 "applies with --batch only (it picks the manifest rows a run takes)",
             )));
         }
-        if self.zoom_random.is_some() || self.samples.is_some() || self.seed.is_some() {
+        if self.verify {
             return Err(ArgError::Invalid(crate::Error::param(
-                "--zoom-random",
-                "applies with --batch only (scales are drawn from the seed and each frame's name)",
+                "--verify",
+                "applies with --batch only (it checks finished frames before a resume skips them)",
             )));
+        }
+        // One frame draws its random scales from the seed alone (a batch adds each frame's name).
+        if let Some(z) = self.zoom_random()? {
+            if self.focal_list.is_some() {
+                return Err(ArgError::Invalid(crate::Error::param(
+                    "--zoom-random",
+                    "give target focal lengths (--focal-list) or a random range, not both",
+                )));
+            }
+            let scales = z.scales("");
+            let plan = RefocusRequest {
+                scales: Some(scales.clone()),
+                zoom_random: None,
+                samples: None,
+                seed: None,
+                ..self.clone()
+            }
+            .frame()?;
+            return Ok(FramePlan {
+                tags: ZoomRandom::tags(&scales),
+                ..plan
+            });
         }
         let rule = self.rule()?;
         if let Some((w, h)) = self.size {
@@ -261,6 +287,7 @@ impl RefocusRequest {
             files: self.files()?,
             depth_trunc: self.depth_trunc,
             resume: self.resume,
+            verify: self.verify,
             jobs,
             shard,
             index: true,

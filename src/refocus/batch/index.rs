@@ -20,7 +20,7 @@
 //! only regular files.
 
 use super::index_names::{parse_part_name, part_name, INDEX_NAME};
-use super::resume::frame_settings;
+use super::resume::made_from;
 use super::{BatchFrame, BatchOptions};
 use crate::camera::Intrinsics;
 use crate::error::{Error, Result};
@@ -63,15 +63,21 @@ pub struct IndexRow {
     pub manifest: String,
 }
 
-/// The rows of one finished frame: its manifest, when it records `settings`.
-fn frame_rows(root: &Path, name: &str, frame_index: usize, settings: &serde_json::Value) -> Option<Vec<IndexRow>> {
+/// The rows of one finished frame: its manifest, when it was made from `frame` with `opts`.
+fn frame_rows(
+    root: &Path,
+    name: &str,
+    frame_index: usize,
+    frame: &BatchFrame,
+    opts: &BatchOptions,
+) -> Option<Vec<IndexRow>> {
     let manifest_path = root.join(name).join(crate::io::MANIFEST_NAME);
     if std::fs::symlink_metadata(&manifest_path).map_or(true, |m| !m.is_file() || m.len() > 16 << 20) {
         return None;
     }
     let text = crate::io::read_text(&manifest_path, 16 << 20).ok()?;
     let m: serde_json::Value = serde_json::from_str(&text).ok()?;
-    if m.get("settings") != Some(settings) {
+    if !made_from(&m, frame, opts) {
         return None;
     }
     let rel = |v: &serde_json::Value| v.as_str().map(|f| format!("{name}/{f}"));
@@ -114,7 +120,7 @@ fn rows_of(root: &Path, frames: &[BatchFrame], opts: &BatchOptions, take: impl F
     let mut rows = Vec::new();
     for (i, frame) in frames.iter().enumerate().filter(|(i, _)| take(*i)) {
         let name = frame.name.as_deref().unwrap_or_default();
-        if let Some(r) = frame_rows(root, name, i, &frame_settings(frame, opts)) {
+        if let Some(r) = frame_rows(root, name, i, frame, opts) {
             rows.extend(r);
         }
     }

@@ -61,6 +61,12 @@ const CSV_BUFFER: usize = 8 << 10;
 /// Read a CSV or JSON manifest; every frame gets a unique, filesystem-safe name. The file is
 /// streamed (see the module notes): memory is bounded per row, never the file's size twice.
 pub fn load_manifest(path: &Path) -> Result<Vec<BatchFrame>> {
+    load_manifest_with_defaults(path, [None; 4])
+}
+
+/// [`load_manifest`], with `defaults` (fx, fy, cx, cy) for frames that lack them, as
+/// `--depth-scale` is for `depth_scale`: a row's own value wins, and a column may be left out.
+pub fn load_manifest_with_defaults(path: &Path, defaults: [Option<f64>; 4]) -> Result<Vec<BatchFrame>> {
     let json = path.extension().is_some_and(|e| e.eq_ignore_ascii_case("json"));
     let most = if json {
         MAX_JSON_MANIFEST_BYTES
@@ -79,9 +85,25 @@ pub fn load_manifest(path: &Path) -> Result<Vec<BatchFrame>> {
         file.consume(3);
     }
     let mut frames: Vec<BatchFrame> = if json {
-        serde_json::from_reader(file).map_err(|e| Error::decode(path, e.to_string()))?
+        let rows: Vec<JsonFrame> = serde_json::from_reader(file).map_err(|e| Error::decode(path, e.to_string()))?;
+        let mut frames = Vec::with_capacity(rows.len());
+        for (i, r) in rows.into_iter().enumerate() {
+            let [fx, fy, cx, cy] = frame_intrinsics(path, i, [r.fx, r.fy, r.cx, r.cy], defaults)?;
+            frames.push(BatchFrame {
+                name: r.name,
+                rgb: r.rgb,
+                depth: r.depth,
+                fx,
+                fy,
+                cx,
+                cy,
+                depth_scale: r.depth_scale,
+                sun_bit_rotate: r.sun_bit_rotate,
+            });
+        }
+        frames
     } else {
-        parse_csv(path, file)?
+        parse_csv(path, file, defaults)?
     };
     if frames.len() > MAX_MANIFEST_ROWS {
         return Err(Error::decode(
@@ -154,14 +176,56 @@ struct CsvFrame {
     name: Option<String>,
     rgb: PathBuf,
     depth: PathBuf,
-    fx: f64,
-    fy: f64,
-    cx: f64,
-    cy: f64,
+    #[serde(default)]
+    fx: Option<f64>,
+    #[serde(default)]
+    fy: Option<f64>,
+    #[serde(default)]
+    cx: Option<f64>,
+    #[serde(default)]
+    cy: Option<f64>,
     #[serde(default)]
     depth_scale: Option<f64>,
     #[serde(default)]
     sun_bit_rotate: Option<String>,
+}
+
+/// A JSON manifest's frame: [`BatchFrame`] with the intrinsics optional (defaults fill them).
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct JsonFrame {
+    #[serde(default)]
+    name: Option<String>,
+    rgb: PathBuf,
+    depth: PathBuf,
+    #[serde(default)]
+    fx: Option<f64>,
+    #[serde(default)]
+    fy: Option<f64>,
+    #[serde(default)]
+    cx: Option<f64>,
+    #[serde(default)]
+    cy: Option<f64>,
+    #[serde(default)]
+    depth_scale: Option<f64>,
+    #[serde(default)]
+    sun_bit_rotate: bool,
+}
+
+/// The source intrinsics of frame `i`: its own values, else the defaults, else refused by name.
+fn frame_intrinsics(path: &Path, i: usize, own: [Option<f64>; 4], defaults: [Option<f64>; 4]) -> Result<[f64; 4]> {
+    let mut k = [0.0; 4];
+    for (j, name) in ["fx", "fy", "cx", "cy"].into_iter().enumerate() {
+        k[j] = own[j].or(defaults[j]).ok_or_else(|| {
+            Error::decode(
+                path,
+                format!(
+                    "frame {i}: no {name}: give the manifest a {name} value or a default (--{name} or --intrinsics)"
+                ),
+            )
+        })?;
+    }
+    Ok(k)
 }
 
 /// A reader that refuses to read more than `limit` bytes from the start (the parser moves the
@@ -193,7 +257,7 @@ impl<R: Read> Read for RowBound<R> {
     }
 }
 
-fn parse_csv(path: &Path, file: impl Read) -> Result<Vec<BatchFrame>> {
+fn parse_csv(path: &Path, file: impl Read, defaults: [Option<f64>; 4]) -> Result<Vec<BatchFrame>> {
     // The reader may buffer ahead of the row it parses; the row itself gets MAX_MANIFEST_ROW_BYTES.
     let slack = MAX_MANIFEST_ROW_BYTES + CSV_BUFFER as u64;
     let limit = std::rc::Rc::new(std::cell::Cell::new(slack));
@@ -213,11 +277,16 @@ fn parse_csv(path: &Path, file: impl Read) -> Result<Vec<BatchFrame>> {
     if header.iter().all(str::is_empty) {
         return Err(Error::decode(path, "empty manifest"));
     }
+    let defaulted = ["fx", "fy", "cx", "cy"]
+        .into_iter()
+        .zip(defaults)
+        .filter(|(_, d)| d.is_some());
+    let defaulted: Vec<&str> = defaulted.map(|(n, _)| n).collect();
     for r in ["rgb", "depth", "fx", "fy", "cx", "cy"] {
-        if !header.iter().any(|c| c == r) {
+        if !header.iter().any(|c| c == r) && !defaulted.contains(&r) {
             return Err(Error::decode(
                 path,
-                format!("header lacks column '{r}' (needs rgb,depth,fx,fy,cx,cy)"),
+                format!("header lacks column '{r}' (needs rgb,depth,fx,fy,cx,cy; fx,fy,cx,cy may come from --fx/--fy/--cx/--cy or --intrinsics)"),
             ));
         }
     }
@@ -241,14 +310,15 @@ fn parse_csv(path: &Path, file: impl Read) -> Result<Vec<BatchFrame>> {
         let row: CsvFrame = record
             .deserialize(Some(&header))
             .map_err(|e| csv_error(path, &header, Some(&record), e))?;
+        let [fx, fy, cx, cy] = frame_intrinsics(path, frames.len(), [row.fx, row.fy, row.cx, row.cy], defaults)?;
         frames.push(BatchFrame {
             name: row.name.filter(|s| !s.is_empty()),
             rgb: row.rgb,
             depth: row.depth,
-            fx: row.fx,
-            fy: row.fy,
-            cx: row.cx,
-            cy: row.cy,
+            fx,
+            fy,
+            cx,
+            cy,
             depth_scale: row.depth_scale,
             sun_bit_rotate: row
                 .sun_bit_rotate
@@ -406,7 +476,7 @@ mod tests {
     fn csv_rows_are_streamed_and_a_row_without_end_is_refused_after_a_bounded_read() {
         // 10^5 rows parsed from a stream, one at a time, each into its frame.
         let (r, taken) = rows(100_000, false);
-        let f = parse_csv(Path::new("m.csv"), r).unwrap();
+        let f = parse_csv(Path::new("m.csv"), r, [None; 4]).unwrap();
         assert_eq!(f.len(), 100_000);
         assert_eq!(
             (f[99_999].rgb.clone(), f[99_999].fx),
@@ -416,7 +486,7 @@ mod tests {
         // One endless row after 10 good ones: refused by its length, having read at most the
         // rows before it, one row's bound and the reader's buffer (twice: a refill in flight).
         let (r, taken) = rows(10, true);
-        let e = parse_csv(Path::new("m.csv"), r).unwrap_err().to_string();
+        let e = parse_csv(Path::new("m.csv"), r, [None; 4]).unwrap_err().to_string();
         assert!(
             e.contains(&format!("longer than {MAX_MANIFEST_ROW_BYTES} bytes")),
             "{e}"
@@ -427,7 +497,7 @@ mod tests {
         let (mut r, _) = rows(3, false);
         r.head = b"rgb,depth,fx,fy,cx,cy\n\"".to_vec();
         r.endless = true;
-        let e = parse_csv(Path::new("m.csv"), r).unwrap_err().to_string();
+        let e = parse_csv(Path::new("m.csv"), r, [None; 4]).unwrap_err().to_string();
         assert!(e.contains("longer than"), "{e}");
     }
 

@@ -2,7 +2,8 @@
 //! each into the same textures and queues its targets, the previous frame's outputs are
 //! mapped while the GPU renders the next, and a pool encodes files. Queues between the stages
 //! are bounded, so memory stays flat (see [`BatchSummary::frames_in_flight`]). Resume skips
-//! frames whose manifest records the same settings and whose files are all there; `--shard`
+//! frames whose manifest records the same settings and the same inputs (by identity, whatever
+//! the path's spelling: see [`resume`]) and whose files are all there; `--shard`
 //! takes a deterministic share of the manifest. A failed frame is listed while the others
 //! complete.
 //!
@@ -28,8 +29,8 @@ mod zoom;
 pub use index::{join_index, read_index, write_index, IndexRow};
 pub use index_names::{is_index_name, INDEX_NAME};
 pub use manifest::{
-    frame_folder_name, is_frame_folder_name, load_manifest, BatchFrame, MAX_JSON_MANIFEST_BYTES, MAX_MANIFEST_BYTES,
-    MAX_MANIFEST_ROWS, MAX_MANIFEST_ROW_BYTES,
+    frame_folder_name, is_frame_folder_name, load_manifest, load_manifest_with_defaults, BatchFrame,
+    MAX_JSON_MANIFEST_BYTES, MAX_MANIFEST_BYTES, MAX_MANIFEST_ROWS, MAX_MANIFEST_ROW_BYTES,
 };
 pub use pipeline::{run_batch, BatchSummary, StageTimes};
 pub use zoom::{ZoomRandom, MAX_SAMPLES};
@@ -106,8 +107,11 @@ pub struct BatchOptions {
     pub files: FileFormats,
     /// Input depth beyond this many metres is treated as invalid (Open3D's depth_trunc).
     pub depth_trunc: Option<f64>,
-    /// Skip frames already finished with the same settings.
+    /// Skip frames already finished from the same inputs with the same settings.
     pub resume: bool,
+    /// With `resume`: also check each finished file's CRC-32 and each input's content (by
+    /// default a done frame costs its manifest read and a few `stat`s).
+    pub verify: bool,
     /// Threads in each CPU pool (decode, encode); 0 runs every stage in turn on the GL thread
     /// (the synchronous baseline).
     pub jobs: usize,

@@ -3,7 +3,7 @@
 //! (`jobs` = 0, the synchronous baseline).
 
 use super::index::Invalidation;
-use super::resume::{frame_finished, frame_settings};
+use super::resume::{frame_finished, frame_inputs, frame_settings};
 use super::{BatchFrame, BatchOptions, MAX_JOBS};
 use crate::error::{Error, Result};
 use crate::io::FileFormats;
@@ -132,6 +132,9 @@ struct InFlight {
     manifest: Manifest,
 }
 
+/// A frame's inputs' identities (colour, depth), as the manifest records them.
+type Inputs = [serde_json::Value; 2];
+
 /// Upload a decoded frame and queue all its targets.
 fn submit_frame(
     refocuser: &mut Refocuser,
@@ -256,7 +259,7 @@ pub fn run_batch(
             continue;
         }
         let name = frame.name.as_deref().unwrap_or_default();
-        if opts.resume && frame_finished(&out_dir.join(name), &frame_settings(frame, opts)) {
+        if opts.resume && frame_finished(&out_dir.join(name), frame, opts) {
             summary.skipped += 1;
             progress();
             continue;
@@ -284,9 +287,10 @@ pub fn run_batch(
     if opts.jobs == 0 {
         // The synchronous baseline: each stage in turn on this thread.
         for (i, frame) in todo.iter().enumerate() {
-            let (name, settings) = (frame.name.clone().unwrap_or_default(), frame_settings(frame, opts));
+            let name = frame.name.clone().unwrap_or_default();
             let (t0, c0) = (Instant::now(), crate::cpu_time::process_cpu_ms());
             let result = decode_frame(frame, i, opts.depth_trunc, &warnings).and_then(|src| {
+                let settings = frame_settings(frame, opts, frame_inputs(frame));
                 stages.decode.push(ms_since(t0));
                 stages.decode_cpu.extend(cpu_ms_since(c0));
                 submit_frame(
@@ -331,14 +335,16 @@ pub fn run_batch(
     let depth_trunc = opts.depth_trunc;
     let (result_tx, result_rx) = mpsc::channel::<(String, Result<()>, f64)>();
     std::thread::scope(|scope| {
-        let (decoded_tx, decoded_rx) = mpsc::sync_channel::<(usize, Result<RefocusSource>, f64)>(jobs);
+        let (decoded_tx, decoded_rx) = mpsc::sync_channel::<(usize, Result<(RefocusSource, Inputs)>, f64)>(jobs);
         for _ in 0..jobs {
             let (tx, next, todo, warnings) = (decoded_tx.clone(), &next, &todo, &warnings);
             scope.spawn(move || loop {
                 let i = next.fetch_add(1, Ordering::Relaxed);
                 let Some(frame) = todo.get(i) else { break };
                 let t0 = Instant::now();
-                let src = decode_frame(frame, i, depth_trunc, warnings);
+                // The inputs' identities are hashed here, off the GL thread, just after the
+                // decoder read them.
+                let src = decode_frame(frame, i, depth_trunc, warnings).map(|s| (s, frame_inputs(frame)));
                 if tx.send((i, src, ms_since(t0))).is_err() {
                     break;
                 }
@@ -390,8 +396,9 @@ pub fn run_batch(
                 break;
             };
             stages.wait.push(ms_since(t0));
-            let (name, settings) = (todo[i].name.clone().unwrap_or_default(), frame_settings(todo[i], opts));
-            let submitted = src.and_then(|src| {
+            let name = todo[i].name.clone().unwrap_or_default();
+            let submitted = src.and_then(|(src, inputs)| {
+                let settings = frame_settings(todo[i], opts, inputs);
                 stages.decode.push(decode_ms);
                 submit_frame(
                     &mut refocuser,
