@@ -138,9 +138,11 @@ DOCS_ORDER = ["scene", "refocus", "cyclopean", "compare", "reproject", "stereo",
 HELP_ORDER = ["scene", "cyclopean", "compare", "refocus", "index", "reproject", "stitch", "info",
               "bench", "stress", "report", "demo"]
 HELP_FIXTURES = {
-    "frames.csv": "rgb,depth,fx,fy,cx,cy,name\n"
-    "../shared/data/rgbd_open3d_testdata/TUM_color.png,../shared/data/rgbd_open3d_testdata/TUM_depth.png,"
-    "525,525,319.5,239.5,tum\n",
+    # Four rows (one TUM frame under four names): `refocus --help` renders one shard of four, and
+    # a shard count above the manifest's frame count is refused.
+    "frames.csv": "rgb,depth,fx,fy,cx,cy,name\n" + "".join(
+        "../shared/data/rgbd_open3d_testdata/TUM_color.png,../shared/data/rgbd_open3d_testdata/TUM_depth.png,"
+        f"525,525,319.5,239.5,tum{k}\n" for k in range(4)),
 }
 
 

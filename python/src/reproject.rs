@@ -29,7 +29,7 @@ impl Renderer {
     #[allow(non_snake_case, clippy::too_many_arguments)]
     #[pyo3(signature = (rgb, depth, K, *, depth_kind = "view-z", baseline = None, focal = None, doffs = 0.0,
                         separation = None, convergence = None, near = None, far = None, source = "left",
-                        target = "right", method = "shift-scan", steps = 3, tau_rel = 0.05, outputs = None))]
+                        target = "right", method = None, steps = 3, tau_rel = 0.05, outputs = None))]
     fn reproject<'py>(
         &self,
         py: Python<'py>,
@@ -46,7 +46,7 @@ impl Renderer {
         far: Option<f64>,
         source: &str,
         target: &str,
-        method: &str,
+        method: Option<&str>,
         #[pyo3(from_py_with = crate::ints::steps)] steps: u32,
         tau_rel: f64,
         outputs: Option<&Bound<'py, PyAny>>,
@@ -64,7 +64,8 @@ impl Renderer {
             convergence,
             from: choice("--from", source)?,
             to: choice("--to", target)?,
-            method: Some(choice("--method", method)?),
+            // None: the library's default for a rig (shift-scan), as the CLI's.
+            method: method.map(|m| choice("--method", m)).transpose()?,
             steps,
             tau_rel,
             outputs: outputs_given(outputs)?,

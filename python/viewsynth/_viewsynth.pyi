@@ -242,7 +242,7 @@ class Renderer:
         far: Optional[float] = None,
         source: Literal["left", "centre", "center", "right"] = "left",
         target: Literal["left", "right", "both"] = "right",
-        method: Literal["shift-scan", "shift", "gather3d"] = "shift-scan",
+        method: Optional[Literal["shift-scan", "shift", "gather3d"]] = None,
         steps: int = 3,
         tau_rel: float = 0.05,
         outputs: Optional[Union[OutputName, Sequence[OutputName]]] = None,
