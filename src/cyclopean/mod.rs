@@ -119,7 +119,11 @@ impl MiddleCamera {
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(rename_all = "kebab-case")]
 pub enum Method {
-    /// Seed 000 as written: one reconstruction step from the fixation depth.
+    /// One step per eye (seed 000's rule): the point of the middle pixel's ray at the fixation
+    /// distance is projected into the eye; the eye's depth at the texel it lands in, unprojected
+    /// at that landing position, is the surface point, and the eye's bilinear colour there its
+    /// colour (no edge-aware filter). Nothing checks that the point lies on the middle ray, so
+    /// it is exact only near the fixation distance; the eyes merge by [`Blend`].
     Seed,
     /// The seed's step followed by `steps` refinement steps (each re-reads the eye's depth where
     /// the last estimate projects), then a check that the surface found projects onto this

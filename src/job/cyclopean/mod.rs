@@ -46,7 +46,9 @@ pub(crate) fn replaced() -> io::Replaces {
 pub enum CyclopeanMethod {
     /// Splat each eye's surfaces, refine each pixel on the surface it sees, merge the eyes.
     SplatGather,
-    /// Seed 000: one reconstruction step from the fixation depth.
+    /// One step per eye: the middle ray's point at the fixation distance projected into the
+    /// eye, the eye's depth read where it lands taken as the surface (exact only near the
+    /// fixation distance; no projection check), the eyes merged by `--blend`.
     Seed,
     /// The seed's step, `--refine-steps` refinement steps and a projection check.
     Refine,
