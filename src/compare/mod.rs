@@ -7,12 +7,14 @@
 
 mod colour;
 mod colour_check;
+mod depth_share;
 mod diagnose;
 pub mod distribution;
 pub mod flip;
 mod thresholds;
 
 pub use colour::{srgb_decode, srgb_encode, Alpha, ChannelOrder, ColourReading, Transfer};
+pub use depth_share::{DepthShare, DepthValidity};
 pub use distribution::{ErrorDistribution, ShareOver};
 pub use flip::Flip;
 pub use thresholds::{percent, BadPixel, Thresholds};
@@ -96,6 +98,11 @@ pub struct Comparison {
     pub depth_rel_error: Option<ErrorDistribution>,
     /// Pixels valid in exactly one side.
     pub mask_disagreement: Option<usize>,
+    /// Over the compared pixels: depth valid in both, in A only, in B only.
+    pub depth_valid: Option<DepthValidity>,
+    /// The depth share at the bad-pixel threshold as `--max-bad-share` gates it: pixels over
+    /// the threshold plus those valid on one side only, over those with depth on either side.
+    pub depth_bad: Option<DepthShare>,
     /// Pixels compared: all, or those of the mask.
     pub pixels: usize,
     /// FLIP mean over the compared pixels (B the reference), when measured.
@@ -137,7 +144,10 @@ fn infinite_as_string<S: serde::Serializer>(v: &f64, s: S) -> std::result::Resul
     }
 }
 
-fn optional_infinite_as_string<S: serde::Serializer>(v: &Option<f64>, s: S) -> std::result::Result<S::Ok, S::Error> {
+pub(crate) fn optional_infinite_as_string<S: serde::Serializer>(
+    v: &Option<f64>,
+    s: S,
+) -> std::result::Result<S::Ok, S::Error> {
     match v {
         Some(v) => infinite_as_string(v, s),
         None => s.serialize_none(),
@@ -227,24 +237,26 @@ struct DepthErrors {
     max_abs: f64,
     /// |A - B| / A per pixel valid in both.
     rel: Vec<f64>,
-    /// Pixels valid in exactly one side.
-    disagree: usize,
+    /// Which pixels hold depth on each side.
+    valid: DepthValidity,
 }
 
 fn depth_error(a: &[f64], b: &[f64], selected: &[bool]) -> DepthErrors {
     let mut e = DepthErrors {
         max_abs: 0.0,
         rel: Vec::new(),
-        disagree: 0,
+        valid: DepthValidity::default(),
     };
     for ((x, y), _) in a.iter().zip(b).zip(selected).filter(|(_, s)| **s) {
         match (x.is_nan(), y.is_nan()) {
             (false, false) => {
                 e.max_abs = e.max_abs.max((x - y).abs());
                 e.rel.push((x - y).abs() / x.abs());
+                e.valid.both += 1;
             }
             (true, true) => {}
-            _ => e.disagree += 1,
+            (false, true) => e.valid.a_only += 1,
+            (true, false) => e.valid.b_only += 1,
         }
     }
     e
@@ -337,6 +349,8 @@ pub fn compare_with(a: &Side, b: &Side, mask: Option<&Mask>, measures: Measures)
         depth_max_rel: None,
         depth_rel_error: None,
         mask_disagreement: None,
+        depth_valid: None,
+        depth_bad: None,
         pixels,
         flip_mean: None,
         suspicions: Vec::new(),
@@ -351,8 +365,10 @@ pub fn compare_with(a: &Side, b: &Side, mask: Option<&Mask>, measures: Measures)
         // measured, so a depth limit fails ("no depth was compared") instead of passing at 0.
         cmp.depth_max_rel = e.rel.iter().copied().reduce(f64::max);
         cmp.depth_max_abs = cmp.depth_max_rel.map(|_| e.max_abs);
+        cmp.depth_bad = Some(DepthShare::of(&e.rel, e.valid, measures.bad.depth_rel));
         cmp.depth_rel_error = ErrorDistribution::of(e.rel, &rels);
-        cmp.mask_disagreement = Some(e.disagree);
+        cmp.mask_disagreement = Some(e.valid.one_side());
+        cmp.depth_valid = Some(e.valid);
     }
     let colour = colour_check::suspicion(a, b, &ca, &cb, &selected);
     // Flipped rows misplace depth too: the depth check would only name the same mistake.

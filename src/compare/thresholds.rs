@@ -3,7 +3,7 @@
 //! compared pixels may be bad, a pixel being bad when its error is over a per-pixel threshold.
 //! A share gate passes a run that one stray pixel would fail on a maximum.
 
-use super::Comparison;
+use super::{Comparison, DepthShare};
 use crate::error::{Error, Result};
 
 /// When a pixel counts as bad for `--max-bad-share`.
@@ -11,7 +11,8 @@ use crate::error::{Error, Result};
 pub struct BadPixel {
     /// Colour: the largest channel difference is over this many 8-bit levels.
     pub color_levels: f64,
-    /// Depth: the relative view-Z error |A - B| / A is over this (pixels valid in both).
+    /// Depth: the relative view-Z error |A - B| / A is over this (pixels valid in both), or
+    /// the pixel is valid on one side only.
     pub depth_rel: f64,
 }
 
@@ -36,7 +37,8 @@ pub struct Thresholds {
     pub min_psnr_db: Option<f64>,
     /// Largest relative view-Z error allowed over pixels valid in both.
     pub max_depth_rel: Option<f64>,
-    /// Largest share of bad pixels allowed, colour and depth each (a fraction in [0, 1]).
+    /// Largest share of bad pixels allowed, colour and depth each (a fraction in [0, 1]; depth:
+    /// of the pixels with depth on either side, [`DepthShare`]).
     pub max_bad_share: Option<f64>,
     /// What makes a pixel bad for `max_bad_share` (also reported without that gate).
     pub bad: BadPixel,
@@ -99,24 +101,26 @@ impl Thresholds {
                 None => out.push(format!("share over {level} levels: not measured")),
             }
             // Depth only where both sides have it: a colour-only comparison is gated on colour.
-            // Both sides with depth files but no pixel valid in both compared nothing: a share
-            // of nothing is no pass.
+            // A pixel valid on one side only is bad (a surface against none), and the share is
+            // over every pixel with depth on either side; no such pixel compared nothing: a
+            // share of nothing is no pass.
             let rel = self.bad.depth_rel;
-            match (&c.depth_rel_error, c.mask_disagreement) {
-                (None, Some(_)) => out.push(format!(
-                    "share over relative depth error {rel:e}: no pixel holds valid depth on both sides, \
+            match &c.depth_bad {
+                None => {}
+                Some(DepthShare { share: None, .. }) => out.push(format!(
+                    "share over relative depth error {rel:e}: no pixel holds valid depth on either side, \
                      nothing was compared"
                 )),
-                (None, None) => {}
-                (Some(d), _) => match d.share_over(rel) {
-                    Some(s) if s > max => out.push(format!(
-                        "{} of the pixels have a relative depth error over {rel:e} > {}",
-                        percent(s),
-                        percent(max)
-                    )),
-                    Some(_) => {}
-                    None => out.push(format!("share over relative depth error {rel:e}: not measured")),
-                },
+                Some(d @ DepthShare { share: Some(s), .. }) if *s > max => out.push(format!(
+                    "{} of the pixels with depth are bad ({} over relative depth error {rel:e} + {} valid on \
+                     one side only, of {}) > {}",
+                    percent(*s),
+                    d.over_threshold,
+                    d.one_side,
+                    d.denominator,
+                    percent(max)
+                )),
+                Some(_) => {}
             }
         }
         if let Some(max) = self.max_flip_mean {

@@ -102,11 +102,56 @@ pub struct CompareJob {
     json: Option<JsonOutput>,
 }
 
+/// How one side was read, as the JSON records it: the figures hold under these conventions.
+#[derive(serde::Serialize)]
+struct SideReading {
+    /// Channel order, transfer and alpha of its colour.
+    colour: ColourReading,
+    /// What its depth holds ("view-z", "device", "ndc"); None without a depth file.
+    depth_kind: Option<&'static str>,
+    /// Near plane of its device or NDC depth.
+    near: Option<f64>,
+    /// Far plane of its device or NDC depth ("inf" when infinite).
+    #[serde(serialize_with = "crate::compare::optional_infinite_as_string")]
+    far: Option<f64>,
+    /// NDC range of stored NDC z, as `--X-ndc` names it (the only depth it changes).
+    ndc: Option<&'static str>,
+    /// Reversed-Z device or NDC depth.
+    reversed_z: bool,
+    /// Row order of its files.
+    rows: RowOrder,
+}
+
+impl SideReading {
+    fn of(o: &SideOptions, storage: DepthEncoding) -> Self {
+        let planes = match storage {
+            DepthEncoding::Device { planes } => Some(planes),
+            _ => None,
+        };
+        SideReading {
+            colour: o.colour,
+            depth_kind: o.depth.as_ref().map(|_| o.depth_kind.name()),
+            near: planes.map(|p| p.near),
+            far: planes.map(|p| p.far),
+            ndc: (o.depth_kind == SideDepth::Ndc).then(|| match o.ndc.unwrap_or_default() {
+                NdcDepthRange::MinusOneToOne => "gl",
+                NdcDepthRange::ZeroToOne => "vulkan",
+            }),
+            reversed_z: o.reversed_z,
+            rows: o.row_order,
+        }
+    }
+}
+
 /// What `--json` writes.
 #[derive(serde::Serialize)]
 struct Summary<'a> {
     #[serde(flatten)]
     comparison: &'a Comparison,
+    /// How A was read.
+    a: SideReading,
+    /// How B was read.
+    b: SideReading,
     thresholds: Thresholds,
     broken: &'a [String],
     passed: bool,
@@ -248,6 +293,8 @@ impl CompareJob {
         let broken = self.thresholds.broken(&comparison);
         let summary = Summary {
             comparison: &comparison,
+            a: SideReading::of(&self.a, self.storage[0]),
+            b: SideReading::of(&self.b, self.storage[1]),
             thresholds: self.thresholds,
             broken: &broken,
             passed: broken.is_empty(),

@@ -4,7 +4,7 @@
 use crate::host::CliHost;
 use anyhow::Result;
 use std::process::ExitCode;
-use viewsynth::compare::{percent, ErrorDistribution};
+use viewsynth::compare::{percent, DepthShare, ErrorDistribution};
 use viewsynth::job::compare::{CompareJob, JsonOutput};
 
 /// "median m, p99 a, p99.9 b, max c; over T: s %", values through `fmt`.
@@ -66,13 +66,34 @@ pub(crate) fn compare(job: &CompareJob) -> Result<ExitCode> {
                 cmp.diff_scale
             );
         }
-        if let (Some(abs), Some(rel), Some(d)) = (cmp.depth_max_abs, cmp.depth_max_rel, cmp.mask_disagreement) {
-            outln!("depth: max abs {abs:.3e} m, max rel {rel:.3e}; valid in only one: {d} pixels");
+        if let Some(v) = cmp.depth_valid {
+            let errors = match (cmp.depth_max_abs, cmp.depth_max_rel) {
+                (Some(abs), Some(rel)) => format!("max abs {abs:.3e} m, max rel {rel:.3e}; "),
+                _ => String::new(),
+            };
+            outln!(
+                "depth: {errors}valid in only one: {} pixels (A only {}, B only {}; valid in both {})",
+                v.one_side(),
+                v.a_only,
+                v.b_only,
+                v.both
+            );
         }
         if let Some(d) = &cmp.depth_rel_error {
             outln!(
                 "depth relative error: {}",
                 distribution(d, bad.depth_rel, |v| format!("{v:.2e}"))
+            );
+        }
+        // The gate's share: a pixel valid on one side only counts as bad.
+        if let Some(d @ DepthShare { share: Some(s), .. }) = cmp.depth_bad {
+            outln!(
+                "depth bad share: {} ({} over {:.2e} + {} valid in only one, of {} pixels with depth)",
+                percent(s),
+                d.over_threshold,
+                d.threshold,
+                d.one_side,
+                d.denominator
             );
         }
         for s in &cmp.suspicions {

@@ -287,20 +287,106 @@ fn gl_against_vulkan_at_640x480_agree_on_every_pixel_and_the_missing_conventions
     assert_eq!(viewsynth::io::load_rgb(&flip).unwrap().width, 640);
 }
 
-/// Gates never pass on nothing: B's depth all NaN leaves no pixel valid in both, so the share
-/// gate fails naming why (it once passed, gating colour alone).
+/// Gates never pass on nothing: B's depth all NaN leaves no pixel valid in both. Each of A's
+/// valid pixels is then a disagreement (a surface against none), so the share gate fails on
+/// all of them (it once passed, gating colour alone); both sides without any valid depth
+/// compared nothing, and the gate fails saying so.
 #[test]
 fn the_share_gate_fails_when_no_depth_was_compared() {
     let d = scratch("cmp-nan");
     let a = side(&d, "a", 100, 2.0);
     let b_nan = d.join("b_nan.exr");
     io::save_depth_exr(&b_nan, &DepthMap::new(8, 2, vec![f32::NAN; 16]).unwrap()).unwrap();
-    let o = compare(&a, &(a.0.clone(), b_nan), &["--max-bad-share", "0.01"]);
+    let o = compare(&a, &(a.0.clone(), b_nan.clone()), &["--max-bad-share", "0.01"]);
     let err = String::from_utf8_lossy(&o.stderr);
     assert_eq!(o.status.code(), Some(1), "{err}");
     assert!(
-        err.contains("threshold broken") && err.contains("no pixel holds valid depth on both sides"),
+        err.contains("threshold broken")
+            && err.contains("100.00 % of the pixels with depth are bad (0 over relative depth error 1e-3 + 16 valid on one side only, of 16)"),
         "{err}"
+    );
+    let o = compare(
+        &(a.0.clone(), b_nan.clone()),
+        &(a.0.clone(), b_nan),
+        &["--max-bad-share", "0.01"],
+    );
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(1), "{err}");
+    assert!(err.contains("no pixel holds valid depth on either side"), "{err}");
+}
+
+/// A pixel with depth on one side only is a disagreement: it counts as bad in the depth share,
+/// whose denominator is every pixel with depth on either side, and both counts are in the text
+/// and the JSON, beside how each side was read (colour reading, depth kind, planes).
+#[test]
+fn depth_valid_on_one_side_only_is_bad_and_reported_with_each_sides_reading() {
+    let d = scratch("cmp-one-side");
+    // A has no depth at pixel 0, B none at pixel 1: one pixel each, 14 valid in both.
+    let a = side(&d, "a", 100, f32::NAN);
+    let mut z = vec![2.0f32; 16];
+    z[1] = f32::NAN;
+    let b = (a.0.clone(), d.join("b_z.exr"));
+    io::save_depth_exr(&b.1, &DepthMap::new(8, 2, z).unwrap()).unwrap();
+    let summary = d.join("s.json");
+    let o = compare(&a, &b, &["--max-bad-share", "0.1", "--json", s(&summary)]);
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(1), "2 of 16 is over 10 %: {err}");
+    assert!(
+        err.contains("12.50 % of the pixels with depth are bad (0 over relative depth error 1e-3 + 2 valid on one side only, of 16)"),
+        "{err}"
+    );
+    let j = json(&summary);
+    assert_eq!(
+        j["depth_valid"],
+        serde_json::json!({"both": 14, "a_only": 1, "b_only": 1}),
+        "{j}"
+    );
+    assert_eq!(j["depth_bad"]["denominator"], 16, "{j}");
+    assert_eq!(j["depth_bad"]["share"], 0.125, "{j}");
+    assert_eq!(j["a"]["colour"]["channels"], "rgb", "{j}");
+    assert_eq!(j["b"]["depth_kind"], "view-z", "{j}");
+    assert!(j["b"]["near"].is_null(), "{j}");
+    // The text says the same.
+    let o = compare(&a, &b, &[]);
+    let out = String::from_utf8_lossy(&o.stdout);
+    assert!(
+        out.contains("valid in only one: 2 pixels (A only 1, B only 1; valid in both 14)")
+            && out.contains("depth bad share: 12.50 % (0 over 1.00e-3 + 2 valid in only one, of 16 pixels with depth)"),
+        "{out}"
+    );
+    // Per-side planes as read, an infinite far plane included.
+    let dev = d.join("b_dev.exr");
+    io::save_depth_exr(&dev, &DepthMap::new(8, 2, vec![0.5f32; 16]).unwrap()).unwrap();
+    let o = compare(
+        &a,
+        &(a.0.clone(), dev),
+        &[
+            "--b-depth-kind",
+            "device",
+            "--b-near",
+            "0.1",
+            "--b-far",
+            "inf",
+            "--b-channels",
+            "bgr",
+            "--json",
+        ],
+    );
+    let j: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+    assert_eq!(
+        (
+            &j["b"]["depth_kind"],
+            &j["b"]["near"],
+            &j["b"]["far"],
+            &j["b"]["colour"]["channels"]
+        ),
+        (
+            &serde_json::json!("device"),
+            &serde_json::json!(0.1),
+            &serde_json::json!("inf"),
+            &serde_json::json!("bgr")
+        ),
+        "{j}"
     );
 }
 
