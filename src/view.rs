@@ -45,7 +45,8 @@ pub struct ViewOutput {
     pub height: u32,
     /// 8-bit colour; None when the pass writes none.
     pub color: Option<RgbImage>,
-    /// View Z in metres, 0 where invalid.
+    /// View Z in metres, 0 where invalid (stitch: the distance along each pixel's ODS ray,
+    /// 0 = sky; an equirect has no view axis).
     pub depth: Option<DepthMap>,
     /// Nonzero where the pixel is valid (cyclopean: its source-eye bits).
     pub mask: Option<Mask>,
@@ -60,7 +61,8 @@ pub struct ViewOutput {
 pub struct ExactView {
     /// RGB in 0..=255, not rounded.
     pub color: Vec<[f64; 3]>,
-    /// View Z in metres, 0 where invalid; None when the twin computes no depth (stitch).
+    /// View Z in metres (stitch: ray distance), 0 where invalid; None when the twin's depth
+    /// was not asked for.
     pub depth: Option<Vec<f64>>,
 }
 
@@ -120,6 +122,41 @@ impl ViewOutput {
                 depth: None,
             }),
         }
+    }
+
+    /// The stitch's GPU output: colour and ray distance as asked for, no mask.
+    pub fn from_stitch(color: Option<RgbImage>, distance: Option<DepthMap>, timing: Option<Timing>) -> Self {
+        let (width, height) = match (&color, &distance) {
+            (Some(c), _) => (c.width, c.height),
+            (None, Some(d)) => (d.width, d.height),
+            (None, None) => (0, 0),
+        };
+        ViewOutput {
+            width,
+            height,
+            color,
+            depth: distance,
+            mask: None,
+            timing,
+            exact: None,
+        }
+    }
+
+    /// The stitch's f64 twin (rows top-down): colour rounded to 8 bits, ray distance to f32.
+    pub fn from_stitch_f64(width: u32, height: u32, color: &[[f64; 3]], distance: &[f64]) -> Self {
+        ViewOutput {
+            width,
+            height,
+            color: rounded_color(width, height, color),
+            depth: f32_depth(width, height, distance),
+            mask: None,
+            timing: None,
+            exact: Some(ExactView {
+                color: color.to_vec(),
+                depth: Some(distance.to_vec()),
+            }),
+        }
+        .finite()
     }
 
     /// A GPU output: planes as the pass read them back, `mask` nonzero where valid.

@@ -178,8 +178,8 @@ impl PassCase {
                 };
                 let mut r = StitchRenderer::with_conventions(device, &inputs.faces.0, &inputs.faces.1, inputs.conv)?;
                 Box::new(move || {
-                    let (img, t) = r.render(&params)?;
-                    Ok(vec![ViewOutput::color_only(img, Some(t))])
+                    let out = r.render_outputs(&params, OutputSet::RGB_DEPTH)?;
+                    Ok(vec![ViewOutput::from_stitch(out.color, out.distance, Some(out.timing))])
                 })
             }
             PassCase::Scene => {

@@ -7,16 +7,15 @@ use crate::arrays;
 use crate::backend::Backend;
 use crate::errors;
 use crate::renderer::Renderer;
-use crate::shared::{choice, SameThread};
+use crate::shared::{choice, outputs_given, SameThread};
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 use viewsynth::convention::{Conventions, RowOrder};
 use viewsynth::depth::DepthEncoding;
-use viewsynth::gpu::Timing;
-use viewsynth::io::{DepthMap, RgbImage};
+use viewsynth::io::{DepthMap, OutputSet, RgbImage};
 use viewsynth::job::stitch::{StitchPlan, StitchRequest};
 use viewsynth::stitch::faces::{faces_from_images, view_z_of};
-use viewsynth::stitch::render::StitchRenderer;
+use viewsynth::stitch::render::{StitchOutput, StitchRenderer};
 use viewsynth::stitch::{FaceSet, OdsRig, Side, StitchParams};
 
 /// The arguments of one call, as Python gave them.
@@ -37,6 +36,7 @@ struct StitchArgs<'a, 'py> {
     pub far: Option<f64>,
     pub ndc: &'a str,
     pub reversed_z: bool,
+    pub outputs: Option<&'a Bound<'py, PyAny>>,
 }
 
 #[pymethods]
@@ -45,7 +45,8 @@ impl Renderer {
     #[allow(clippy::too_many_arguments)]
     #[pyo3(signature = (left_rgb, left_depth, right_rgb, right_depth, *, fov = None, overlap = None,
                         method = "reproject", width = 2048, height = 1024, ipd = 0.064, pole_fade = 45.0,
-                        depth_kind = "view-z", near = None, far = None, ndc = "gl", reversed_z = false))]
+                        depth_kind = "view-z", near = None, far = None, ndc = "gl", reversed_z = false,
+                        outputs = None))]
     fn stitch<'py>(
         &self,
         py: Python<'py>,
@@ -65,6 +66,7 @@ impl Renderer {
         far: Option<f64>,
         ndc: &str,
         reversed_z: bool,
+        outputs: Option<&Bound<'py, PyAny>>,
     ) -> PyResult<Bound<'py, PyDict>> {
         let (gpu, _busy) = self.enter()?;
         stitch(
@@ -87,6 +89,7 @@ impl Renderer {
                 far,
                 ndc,
                 reversed_z,
+                outputs,
             },
         )
     }
@@ -108,6 +111,7 @@ impl StitchArgs<'_, '_> {
             far: self.far,
             ndc: choice("--ndc", self.ndc)?,
             reversed_z: self.reversed_z,
+            outputs: outputs_given(self.outputs)?,
         })
     }
 }
@@ -149,12 +153,13 @@ fn render(
     right: &FaceSet,
     params: &StitchParams,
     conv: &Conventions,
-) -> viewsynth::Result<(f64, RgbImage, Timing)> {
+    outputs: OutputSet,
+) -> viewsynth::Result<(f64, StitchOutput)> {
     let t0 = std::time::Instant::now();
     let mut renderer = StitchRenderer::with_conventions(gpu, left, right, *conv)?;
     let setup_ms = t0.elapsed().as_secs_f64() * 1e3;
-    let (img, timing) = renderer.render(params)?;
-    Ok((setup_ms, img, timing))
+    let out = renderer.render_outputs(params, outputs)?;
+    Ok((setup_ms, out))
 }
 
 /// Validates `a`, stitches both eyes with the GIL released, and returns the result dict.
@@ -175,6 +180,7 @@ fn stitch<'py>(py: Python<'py>, gpu: Backend, a: StitchArgs<'_, 'py>) -> PyResul
         params,
         depth_kind: kind,
         conventions: conv,
+        outputs,
     } = plan;
     let overlap = params.overlap_deg;
     let left = eye_faces(a.left_rgb, a.left_depth, "left")?;
@@ -194,24 +200,29 @@ fn stitch<'py>(py: Python<'py>, gpu: Backend, a: StitchArgs<'_, 'py>) -> PyResul
     let result = py.detach(move || {
         let work = work;
         let (gpu, left, right, params, conv) = work.0;
-        SameThread(render(&gpu, &left, &right, &params, &conv))
+        SameThread(render(&gpu, &left, &right, &params, &conv, outputs))
     });
-    let (setup_ms, img, timing) = result.0.map_err(errors::from_library)?;
+    let (setup_ms, out) = result.0.map_err(errors::from_library)?;
+    let timing = out.timing;
 
     let d = PyDict::new(py);
-    // Each eye is `height` rows of the W x 2H image.
-    let h = img.height as usize / 2;
-    let top_bottom = arrays::rgb_array(py, img);
-    // The eyes are views of the top-bottom array (left on top), no copy.
-    d.set_item(
-        "left",
-        top_bottom.get_item(pyo3::types::PySlice::new(py, 0, h as isize, 1))?,
-    )?;
-    d.set_item(
-        "right",
-        top_bottom.get_item(pyo3::types::PySlice::new(py, h as isize, 2 * h as isize, 1))?,
-    )?;
-    d.set_item("rgb", top_bottom)?;
+    // Each eye is `height` rows of the W x 2H image; the eyes are views of the top-bottom
+    // array (left on top), no copy.
+    let h = params.height as isize;
+    let eyes = |whole: &Bound<'py, PyAny>, left: &str, right: &str| -> PyResult<()> {
+        d.set_item(left, whole.get_item(pyo3::types::PySlice::new(py, 0, h, 1))?)?;
+        d.set_item(right, whole.get_item(pyo3::types::PySlice::new(py, h, 2 * h, 1))?)
+    };
+    if let Some(img) = out.color {
+        let top_bottom = arrays::rgb_array(py, img);
+        eyes(&top_bottom, "left", "right")?;
+        d.set_item("rgb", top_bottom)?;
+    }
+    if let Some(distance) = out.distance {
+        let top_bottom = arrays::depth_array(py, distance);
+        eyes(&top_bottom, "left_depth", "right_depth")?;
+        d.set_item("depth", top_bottom)?;
+    }
     d.set_item("fov", fov)?;
     d.set_item("overlap", overlap)?;
     let timings = PyDict::new(py);

@@ -102,13 +102,18 @@ class StitchTimings(TypedDict):
     render_ms: float
     gpu_ms: Optional[float]
 
-class StitchResult(TypedDict):
+class StitchResult(TypedDict, total=False):
     """Renderer.stitch's result: "rgb" is top-bottom (left eye on top); "left" and "right" are
-    views of it."""
+    views of it; "depth" (with outputs including "depth") the distance in metres along each
+    pixel's ODS ray from its origin on the viewing circle (0 = sky), "left_depth" and
+    "right_depth" views of it."""
 
     rgb: npt.NDArray[np.uint8]
     left: npt.NDArray[np.uint8]
     right: npt.NDArray[np.uint8]
+    depth: npt.NDArray[np.float32]
+    left_depth: npt.NDArray[np.float32]
+    right_depth: npt.NDArray[np.float32]
     fov: float
     overlap: float
     timings: StitchTimings
@@ -270,6 +275,7 @@ class Renderer:
         far: Optional[float] = None,
         ndc: Literal["gl", "vulkan"] = "gl",
         reversed_z: bool = False,
+        outputs: Optional[Union[Literal["rgb", "depth"], Sequence[Literal["rgb", "depth"]]]] = None,
     ) -> StitchResult:
         """Stitch an ODS 360 (top-bottom, left eye on top) from each eye's six cube faces,
         rgb uint8[6, N, N, 3] and view Z float32[6, N, N] in FACE_ORDER, as `viewsynth stitch

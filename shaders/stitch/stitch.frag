@@ -1,10 +1,13 @@
 // ODS equirect stitch of six over-wide cube faces, one eye per draw (seed 001 and the two
 // alternatives in src/stitch/mod.rs). The f64 twin is src/stitch/reference.rs: keep in step.
 // Defines: METHOD (0 blend, 1 border weight, 2 reproject), REPROJECT_STEPS.
+// Outputs: colour, and the distance along the ODS ray from its origin on the viewing circle to
+// the surface the colour came from (0 = sky); a target without that attachment drops it.
 
 // Parameters and atlases: shaders/stitch/stitch_params.glsl (one block, both backends).
 
 layout(location = 0) out vec4 o_color;
+layout(location = 1) out float o_distance;
 
 const float FAR_DISTANCE = 500.0;
 const float TOLERANCE_PX = 1.5;
@@ -110,6 +113,28 @@ vec3 blend(Pair pw, vec3 d) {
     return mix(plain(pw.a, d), plain(pw.b, d), pw.w);
 }
 
+// Distance along the ODS ray (o, d) to the surface face k sees along d; -1 for none.
+float face_range(int k, vec3 o, vec3 d) {
+    vec2 uv;
+    if (!project_dir(k, d, uv)) {
+        return -1.0;
+    }
+    float z = face_depth(k, uv);
+    return z > 0.0 ? dot(unproject(k, uv, z) - o, d) : -1.0;
+}
+
+// The pair's distance where the colour is a mix of both faces along d (blend, border weight,
+// reproject's last resort): both weighted when their surfaces agree, else the heavier face's
+// (w < 0.5: A), so that no distance lies between two surfaces.
+float mix_range(Pair pw, vec3 o, vec3 d) {
+    float ta = face_range(pw.a, o, d);
+    float tb = face_range(pw.b, o, d);
+    if (ta > 0.0 && tb > 0.0 && abs(ta - tb) <= AGREE_REL * min(ta, tb)) {
+        return ta * (1.0 - pw.w) + tb * pw.w;
+    }
+    return pw.w < 0.5 ? ta : tb;
+}
+
 // Seed 001 "stitch with border weight"; a = the seed's +Z face (cPos), b = its -X face (cPosMX).
 vec3 border_weight(int a, int b, float w, vec3 d) {
     vec3 cpos = u_eye[a].xyz;
@@ -185,25 +210,36 @@ Candidate walk(int k, vec3 o, vec3 d) {
     return invalid;
 }
 
-vec3 reproject(Pair pw, vec3 o, vec3 d) {
+// Colour and (in t) distance; t = 0 where only background is seen.
+vec3 reproject(Pair pw, vec3 o, vec3 d, out float t) {
     Candidate ca = walk(pw.a, o, d);
     Candidate cb = walk(pw.b, o, d);
     float wa = 1.0 - pw.w;
     float wb = pw.w;
     if (ca.kind == 2 && cb.kind == 2) {
         if (abs(ca.t - cb.t) <= AGREE_REL * min(ca.t, cb.t)) {
+            t = ca.t * wa + cb.t * wb;
             return ca.color * wa + cb.color * wb;
         }
+        t = min(ca.t, cb.t);
         return ca.t <= cb.t ? ca.color : cb.color;
     }
-    if (ca.kind == 2) return ca.color;
-    if (cb.kind == 2) return cb.color;
+    if (ca.kind == 2) {
+        t = ca.t;
+        return ca.color;
+    }
+    if (cb.kind == 2) {
+        t = cb.t;
+        return cb.color;
+    }
+    t = 0.0;
     float total = (ca.kind == 1 ? wa : 0.0) + (cb.kind == 1 ? wb : 0.0);
     vec3 sum = (ca.kind == 1 ? ca.color * wa : vec3(0.0)) + (cb.kind == 1 ? cb.color * wb : vec3(0.0));
     if (total > 0.0) return sum / total;
     if (ca.kind == 1 && cb.kind == 1) return 0.5 * (ca.color + cb.color);
     if (ca.kind == 1) return ca.color;
     if (cb.kind == 1) return cb.color;
+    t = mix_range(pw, o, d);
     return blend(pw, d);
 }
 
@@ -220,10 +256,15 @@ void main() {
     Pair pw = pair_weight(d);
 #if METHOD == 0
     vec3 c = blend(pw, d);
+    float t = mix_range(pw, o, d);
 #elif METHOD == 1
     vec3 c = pw.in_band ? border_weight(pw.a, pw.b, pw.w, d) : plain(pw.primary, d);
+    // The seed's warps move colour, not surfaces: the faces' surfaces along d, as blend.
+    float t = mix_range(pw, o, d);
 #else
-    vec3 c = reproject(pw, o, d);
+    float t;
+    vec3 c = reproject(pw, o, d, t);
 #endif
     o_color = vec4(clamp(c, 0.0, 255.0) / 255.0, 1.0);
+    o_distance = max(t, 0.0);
 }

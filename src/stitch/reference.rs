@@ -1,5 +1,5 @@
 //! Float64 CPU twin of the GPU stitch (shaders/stitch/stitch.frag): same steps, same texel
-//! choices, unrounded colour out.
+//! choices, unrounded colour and ray distance out.
 
 use super::{
     equirect_angles, face_camera, pair_weight, CubeFace, FaceSet, Method, PairWeight, StitchParams, FAR_DISTANCE,
@@ -101,6 +101,13 @@ impl Face<'_> {
     fn plain(&self, d: V3) -> V3 {
         self.project_dir(d).map_or([0.0; 3], |uv| self.color(uv))
     }
+    /// Distance along the ODS ray (o, d) to the surface this face sees along d (the sample
+    /// [`Self::plain`] takes); None for sky or a direction behind the face.
+    fn range(&self, o: V3, d: V3) -> Option<f64> {
+        let uv = self.project_dir(d)?;
+        let z = self.depth(uv)?;
+        Some(dot(sub(self.unproject(uv, Some(z)), o), d))
+    }
 }
 
 /// What one face says about an ODS ray.
@@ -159,6 +166,22 @@ fn blend(faces: &[Face], pw: &PairWeight, d: V3) -> V3 {
     mix3(faces[pw.a].plain(d), faces[pw.b].plain(d), pw.w)
 }
 
+/// The pair's distance where the colour mixes both faces along d (blend, border weight,
+/// reproject's last resort): weighted when both surfaces agree within
+/// [`REPROJECT_AGREE_REL`], else the heavier face's (w < 0.5: A), so that no distance lies
+/// between two surfaces; 0 for sky.
+fn mix_range(faces: &[Face], pw: &PairWeight, o: V3, d: V3) -> f64 {
+    let (ta, tb) = (faces[pw.a].range(o, d), faces[pw.b].range(o, d));
+    let t = match (ta, tb) {
+        (Some(a), Some(b)) if a > 0.0 && b > 0.0 && (a - b).abs() <= REPROJECT_AGREE_REL * a.min(b) => {
+            Some(a * (1.0 - pw.w) + b * pw.w)
+        }
+        _ if pw.w < 0.5 => ta,
+        _ => tb,
+    };
+    t.map_or(0.0, |t| t.max(0.0))
+}
+
 /// The seed's far guess of where surface point `iw`, seen by the face whose eye is `from`, would
 /// appear to the other face's eye `to`: `normalize((iw - from) + (to - from)) * FAR_DISTANCE + to`.
 /// With from = cPosMX, to = cPos this is the seed's `iwPos2` (`(iwPos - cPosMX) + dd`,
@@ -201,8 +224,9 @@ fn border_weight(a: &Face, b: &Face, w: f64, d: V3) -> V3 {
     col
 }
 
-/// Depth-aware reprojection along the ODS ray from the pair's two faces.
-fn reproject(faces: &[Face], pw: &PairWeight, o: V3, d: V3) -> V3 {
+/// Depth-aware reprojection along the ODS ray from the pair's two faces: colour and distance
+/// (0 where only background is seen).
+fn reproject(faces: &[Face], pw: &PairWeight, o: V3, d: V3) -> (V3, f64) {
     let cands = [(walk(&faces[pw.a], o, d), 1.0 - pw.w), (walk(&faces[pw.b], o, d), pw.w)];
     let surfaces: Vec<(f64, V3, f64)> = cands
         .iter()
@@ -212,12 +236,12 @@ fn reproject(faces: &[Face], pw: &PairWeight, o: V3, d: V3) -> V3 {
         })
         .collect();
     match surfaces.as_slice() {
-        [(_, c, _)] => return *c,
+        [(t, c, _)] => return (*c, *t),
         [(ta, ca, wa), (tb, cb, wb)] => {
             if (ta - tb).abs() <= REPROJECT_AGREE_REL * ta.min(*tb) {
-                return add(scale(*ca, *wa), scale(*cb, *wb));
+                return (add(scale(*ca, *wa), scale(*cb, *wb)), ta * wa + tb * wb);
             }
-            return if ta <= tb { *ca } else { *cb };
+            return if ta <= tb { (*ca, *ta) } else { (*cb, *tb) };
         }
         _ => {}
     }
@@ -233,16 +257,31 @@ fn reproject(faces: &[Face], pw: &PairWeight, o: V3, d: V3) -> V3 {
         }
     }
     if total > 0.0 {
-        scale(sum, 1.0 / total)
+        (scale(sum, 1.0 / total), 0.0)
     } else if n_bg > 0.0 {
-        scale(any, 1.0 / n_bg)
+        (scale(any, 1.0 / n_bg), 0.0)
     } else {
-        blend(faces, pw, d)
+        (blend(faces, pw, d), mix_range(faces, pw, o, d))
     }
 }
 
 /// Stitched colour (0..255, unrounded) of one eye's equirect, rows top-down.
 pub fn stitch_reference(set: &FaceSet, params: &StitchParams) -> Result<Vec<V3>> {
+    Ok(stitch_reference_eye(set, params)?.color)
+}
+
+/// One eye's stitch from the f64 twin, rows top-down.
+#[derive(Debug, Clone)]
+pub struct EyeReference {
+    /// Colour, 0..=255 per channel, unrounded.
+    pub color: Vec<V3>,
+    /// Distance along the ODS ray from its origin on the viewing circle to the surface the
+    /// colour came from, metres; 0 where that is sky.
+    pub distance: Vec<f64>,
+}
+
+/// Stitched colour and ray distance of one eye's equirect, rows top-down.
+pub fn stitch_reference_eye(set: &FaceSet, params: &StitchParams) -> Result<EyeReference> {
     set.validate()?;
     params.validate(set)?;
     let n = set.size();
@@ -261,19 +300,29 @@ pub fn stitch_reference(set: &FaceSet, params: &StitchParams) -> Result<Vec<V3>>
         })
         .collect();
     let (w, h) = (params.width, params.height);
-    let mut out = Vec::with_capacity(w as usize * h as usize);
+    let n = w as usize * h as usize;
+    let mut out = EyeReference {
+        color: Vec::with_capacity(n),
+        distance: Vec::with_capacity(n),
+    };
     for v in 0..h {
         for u in 0..w {
             let (lon, lat) = equirect_angles(u, v, w, h);
             let (o, d) = set.rig.ray(set.side, lon, lat);
             let pw = pair_weight(d, params.overlap_deg);
-            let c = match params.method {
-                Method::Blend => blend(&faces, &pw, d),
-                Method::BorderWeight if pw.in_band => border_weight(&faces[pw.a], &faces[pw.b], pw.w, d),
-                Method::BorderWeight => faces[pw.primary].plain(d),
+            // Border weight's warps move colour, not surfaces: its distance is blend's.
+            let (c, t) = match params.method {
+                Method::Blend => (blend(&faces, &pw, d), mix_range(&faces, &pw, o, d)),
+                Method::BorderWeight if pw.in_band => (
+                    border_weight(&faces[pw.a], &faces[pw.b], pw.w, d),
+                    mix_range(&faces, &pw, o, d),
+                ),
+                Method::BorderWeight => (faces[pw.primary].plain(d), mix_range(&faces, &pw, o, d)),
                 Method::Reproject => reproject(&faces, &pw, o, d),
             };
-            out.push(c);
+            out.color.push(c);
+            // As the shader writes it: nothing behind the ray's origin.
+            out.distance.push(t.max(0.0));
         }
     }
     Ok(out)

@@ -2,14 +2,15 @@
 //! GLSL cannot index a sampler array per pixel), one full-screen draw per eye into a
 //! W x 2H top-bottom target (left eye on top), rows in the memory order of the row-order
 //! convention, read back top-down. Described once ([`crate::pass`]), run by the GL or the
-//! Vulkan executor.
+//! Vulkan executor. The ray distance is a second colour output of the same draws, attached,
+//! read back and paid for only when asked for ([`StitchRenderer::render_outputs`]).
 
 use super::{face_camera, CubeFace, FaceSet, Method, Side, StitchParams, REPROJECT_STEPS};
 use crate::convention::{Conventions, RowOrder};
 use crate::error::{Error, Result};
 use crate::gpu::shaders::StitchBlend;
 use crate::gpu::{ProgramKind, ShaderProgram, Timing};
-use crate::io::RgbImage;
+use crate::io::{DepthMap, OutputSet, RgbImage};
 use crate::pass::{mat4_std140, Device, Draw, Format, Image, ImageData, Target, ToDevice};
 
 crate::param_block! {
@@ -73,6 +74,33 @@ fn upload(device: &Device, set: &FaceSet, rows: RowOrder) -> Result<EyeAtlas> {
     })
 }
 
+/// A stitch's images, top-bottom (left eye on top), rows top-down; None where not asked for.
+#[derive(Debug, Clone)]
+pub struct StitchOutput {
+    /// The colour equirects.
+    pub color: Option<RgbImage>,
+    /// Per eye, the distance in metres along each pixel's ODS ray, from its origin on the
+    /// viewing circle, to the surface its colour came from (see [`super`]); 0 = sky.
+    pub distance: Option<DepthMap>,
+    /// Render time.
+    pub timing: Timing,
+}
+
+/// Refuses an output the stitch does not make (a mask: distance 0 already marks the sky) and
+/// an empty set.
+pub fn check_outputs(outputs: OutputSet) -> Result<()> {
+    if outputs.mask {
+        return Err(Error::param(
+            "outputs",
+            "stitch writes rgb and depth (the ray distance, 0 = sky); it has no mask",
+        ));
+    }
+    if !(outputs.rgb || outputs.depth) {
+        return Err(Error::param("outputs", "at least one of rgb, depth"));
+    }
+    Ok(())
+}
+
 /// A stereo face capture on the GPU (GL or Vulkan), ready to stitch with any method.
 pub struct StitchRenderer {
     device: Device,
@@ -121,6 +149,17 @@ impl StitchRenderer {
 
     /// Top-bottom stereo equirect (left eye on top), `params.width` x `2 params.height`.
     pub fn render(&mut self, params: &StitchParams) -> Result<(RgbImage, Timing)> {
+        let out = self.render_outputs(params, OutputSet::RGB)?;
+        let color = out
+            .color
+            .ok_or_else(|| Error::param("outputs", "colour asked for, none read"))?;
+        Ok((color, out.timing))
+    }
+
+    /// As [`Self::render`], with the outputs asked for (rgb, depth: the ray distance); the
+    /// others get no attachment and no readback.
+    pub fn render_outputs(&mut self, params: &StitchParams, outputs: OutputSet) -> Result<StitchOutput> {
+        check_outputs(outputs)?;
         params.validate(&self.template)?;
         let (w, h) = (params.width, params.height);
         // Top-bottom: both eyes in one image of 2 h rows.
@@ -189,13 +228,31 @@ impl StitchRenderer {
         let target = Target {
             width: w,
             height: 2 * h,
-            outputs: vec![Some(Format::Rgba8)],
+            outputs: vec![
+                outputs.rgb.then_some(Format::Rgba8),
+                outputs.depth.then_some(Format::R32F),
+            ],
             rows: self.conv.row_order,
             depth_test: None,
         };
         let mut out = self.device.render(&target, &draws)?;
-        let rgb = out.take(0, "stitch")?;
-        Ok((RgbImage::new(w, 2 * h, rgb)?, out.timing))
+        let color = match outputs.rgb {
+            true => Some(RgbImage::new(w, 2 * h, out.take(0, "stitch")?)?),
+            false => None,
+        };
+        let distance = match outputs.depth {
+            true => {
+                let mut t = out.take_floats(1, "stitch distance")?;
+                crate::view::clear_non_finite(Some(&mut t), None);
+                Some(DepthMap::new(w, 2 * h, t)?)
+            }
+            false => None,
+        };
+        Ok(StitchOutput {
+            color,
+            distance,
+            timing: out.timing,
+        })
     }
 }
 

@@ -93,15 +93,21 @@ pub(crate) struct StitchArgs {
     /// Latitude (deg) above which the eye radius fades to 0 at the poles.
     #[arg(help_heading = METHOD, long, default_value_t = StitchRequest::default().pole_fade, value_parser = finite_value)]
     pole_fade: f64,
-    /// Also write each eye's equirect (ods_left.png, ods_right.png).
+    /// Outputs to produce: any of rgb (or color), depth. depth: each eye's distance in metres
+    /// along the pixel's ODS ray, from its origin on the viewing circle to the surface (0 =
+    /// sky), written as float32 EXR [default: rgb].
+    #[arg(help_heading = OUTPUTS, long)]
+    outputs: Option<String>,
+    /// Also write each eye's equirect (ods_left.png, ods_right.png; with depth also
+    /// ods_left_depth.exr, ods_right_depth.exr).
     #[arg(help_heading = OUTPUTS, long)]
     per_eye: bool,
     /// With --scene: ray-trace the ODS ground truth and print PSNR on the seam band and the
     /// whole image.
     #[arg(help_heading = OUTPUTS, long)]
     truth: bool,
-    /// Output folder (created if missing): ods_top_bottom.png (left eye on top), with
-    /// --per-eye also ods_left.png and ods_right.png.
+    /// Output folder (created if missing): ods_top_bottom.png (left eye on top) and, with
+    /// depth in --outputs, ods_top_bottom_depth.exr; with --per-eye also each eye's files.
     #[arg(help_heading = OUTPUTS, long)]
     out_dir: PathBuf,
     /// Conventions of device-depth faces; the row order also sets the GPU pass's memory order.
@@ -139,6 +145,7 @@ impl StitchArgs {
             far: self.far,
             ndc,
             reversed_z,
+            outputs: crate::options::parse_outputs(self.outputs.as_deref())?,
         })
     }
 }

@@ -351,17 +351,39 @@ fn cyclopean_stitch_and_scene_write_exactly_the_files_their_help_names() {
     ]);
     let mut per_eye = base.clone();
     per_eye.push("--per-eye".into());
+    let with = |args: &[String], extra: &[&str]| args.iter().cloned().chain(strs(extra)).collect::<Vec<_>>();
     let rows = vec![
         Row {
-            args: base,
+            args: base.clone(),
             files: strs(&["ods_top_bottom.png"]),
         },
         Row {
-            args: per_eye,
+            args: per_eye.clone(),
             files: strs(&["ods_left.png", "ods_right.png", "ods_top_bottom.png"]),
+        },
+        Row {
+            args: with(&base, &["--outputs", "depth"]),
+            files: strs(&["ods_top_bottom_depth.exr"]),
+        },
+        Row {
+            args: with(&per_eye, &["--outputs", "rgb,depth"]),
+            files: strs(&[
+                "ods_left.png",
+                "ods_left_depth.exr",
+                "ods_right.png",
+                "ods_right_depth.exr",
+                "ods_top_bottom.png",
+                "ods_top_bottom_depth.exr",
+            ]),
         },
     ];
     check("stitch", str::to_string, rows, &d);
+    // A mask is not a stitch output (distance 0 marks the sky).
+    let out = d.join("stitch-refused").display().to_string();
+    let mut args: Vec<&str> = base.iter().map(String::as_str).collect();
+    args.extend(["--outputs", "rgb,mask", "--out-dir", &out]);
+    args.insert(0, "stitch");
+    refused(&args, "--outputs");
 }
 
 #[test]

@@ -400,6 +400,7 @@ fn stitch_rows(device: &Device, opts: StressOptions) -> Result<Vec<StressRow>> {
                         width: 32,
                         height: 16,
                     },
+                    outputs: OutputSet::RGB,
                     conv: Conventions::default(),
                 };
                 let tag = format!("depth {v:e} {}", method.label());

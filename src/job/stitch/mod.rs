@@ -38,8 +38,13 @@ fn stacked_depth(set: &FaceSet) -> DepthMap {
     }
 }
 
-/// The stitched images, colour only: `{name}.png`.
+/// The stitched images: `{name}.png`, and with depth asked for `{name}_depth.exr`.
 const OUTPUT_NAMES: [&str; 3] = ["ods_top_bottom", "ods_left", "ods_right"];
+
+/// The files of the stitched image `stem` (one of [`OUTPUT_NAMES`]).
+fn view_names(stem: &str) -> io::ViewNames {
+    io::ViewNames::named(stem, &format!("{stem}_depth"))
+}
 
 /// Refuses a face folder whose files an output would replace: a face file under an output's
 /// name in the out-dir, or one an output's name already is (a hard link, a symlink). Every
@@ -65,7 +70,7 @@ fn check_faces_against_outputs(faces: &std::path::Path, out_dir: &std::path::Pat
         .map(|e| e.path())
         .collect();
     let inputs: Vec<io::NamedPath<'_>> = files.iter().map(|p| ("--faces", p.as_path())).collect();
-    let writes = |name: &str| OUTPUT_NAMES.iter().any(|n| io::ViewNames::named(n, "").may_write(name));
+    let writes = |name: &str| OUTPUT_NAMES.iter().any(|n| view_names(n).may_write(name));
     io::check_out_dir(out_dir, writes, &replaced(), &inputs).map_err(ArgError::Invalid)
 }
 
@@ -121,6 +126,7 @@ pub struct StitchJob {
     npz_key: Option<String>,
     depth_kind: DepthEncoding,
     conventions: Conventions,
+    outputs: io::OutputSet,
     per_eye: bool,
     truth: bool,
     out_dir: PathBuf,
@@ -190,9 +196,16 @@ impl StitchJob {
             params,
             depth_kind,
             conventions,
+            outputs,
         } = o.request.plan(base, o.rows)?;
         if o.truth && o.scene.is_none() {
             return Err(ArgError::TruthWithoutScene);
+        }
+        if o.truth && !outputs.rgb {
+            return Err(ArgError::Invalid(crate::Error::param(
+                "--truth",
+                "scores the colour image: add rgb to --outputs",
+            )));
         }
         if o.faces.is_none() && o.request.depth_kind != FaceDepth::ViewZ {
             return Err(ArgError::FaceDepthKindWithoutFaces);
@@ -214,6 +227,7 @@ impl StitchJob {
             npz_key: o.npz_key,
             depth_kind,
             conventions,
+            outputs,
             per_eye: o.per_eye,
             truth: o.truth,
             out_dir: o.out_dir,
@@ -276,33 +290,25 @@ impl StitchJob {
         let t0 = Instant::now();
         let mut renderer = StitchRenderer::with_conventions(&gpu, &left, &right, conv)?;
         let setup_ms = t0.elapsed().as_secs_f64() * 1e3;
-        let (img, timing) = renderer.render(&self.params)?;
+        let out = renderer.render_outputs(&self.params, self.outputs)?;
+        let timing = out.timing;
         let (w, h) = (self.params.width, self.params.height);
-        let eyes = if self.per_eye {
-            let half = img.data.len() / 2;
-            Some([
-                RgbImage::new(w, h, img.data[..half].to_vec())?,
-                RgbImage::new(w, h, img.data[half..].to_vec())?,
-            ])
-        } else {
-            None
-        };
-        // Colour-only views through the output layer, all or none.
-        let colour = io::FileFormats::of(io::OutputSet::RGB);
+        let whole = ViewOutput::from_stitch(out.color, out.distance, None);
+        let image_size = (whole.width, whole.height);
+        // Through the output layer, all or none: colour PNGs, distance EXRs.
+        let formats = io::FileFormats::of(self.outputs);
         let mut set = out_dir.file_set()?.replacing(replaced());
-        let mut whole = ViewOutput::color_only(img, None);
-        crate::output::write_view(&mut set, &io::ViewNames::named("ods_top_bottom", ""), &whole, &colour)?;
-        if let Some([l, r]) = eyes {
-            for (name, eye) in [("ods_left", l), ("ods_right", r)] {
-                let view = ViewOutput::color_only(eye, None);
-                crate::output::write_view(&mut set, &io::ViewNames::named(name, ""), &view, &colour)?;
+        crate::output::write_view(&mut set, &view_names("ods_top_bottom"), &whole, &formats)?;
+        if self.per_eye {
+            for (name, eye) in [("ods_left", 0), ("ods_right", 1)] {
+                let view = eye_of(&whole, eye, w, h)?;
+                crate::output::write_view(&mut set, &view_names(name), &view, &formats)?;
             }
         }
         let written = set.commit()?;
-        let img = whole.color.take().expect("the view holds the image written");
-        let truth = match self.truth {
-            true => Some(self.score(&img)?),
-            false => None,
+        let truth = match (self.truth, &whole.color) {
+            (true, Some(img)) => Some(self.score(img)?),
+            _ => None,
         };
         Ok(StitchReport {
             source,
@@ -311,7 +317,7 @@ impl StitchJob {
             setup_ms,
             rig,
             params: self.params,
-            image_size: (img.width, img.height),
+            image_size,
             timing,
             truth,
             written,
@@ -335,6 +341,24 @@ impl StitchJob {
             score: score_eyes([&el, &er], [&tl, &tr], &band),
         })
     }
+}
+
+/// Eye `eye` (0 left, 1 right) of a top-bottom stitch: its `height` rows of every plane.
+fn eye_of(whole: &ViewOutput, eye: usize, width: u32, height: u32) -> crate::Result<ViewOutput> {
+    let n = width as usize * height as usize;
+    let color = match &whole.color {
+        Some(c) => Some(RgbImage::new(
+            width,
+            height,
+            c.data[eye * 3 * n..(eye + 1) * 3 * n].to_vec(),
+        )?),
+        None => None,
+    };
+    let distance = match &whole.depth {
+        Some(d) => Some(DepthMap::new(width, height, d.data[eye * n..(eye + 1) * n].to_vec())?),
+        None => None,
+    };
+    Ok(ViewOutput::from_stitch(color, distance, None))
 }
 
 /// What a run's set replaces: the files the previous run's record lists (the one deletion rule,

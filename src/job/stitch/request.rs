@@ -8,7 +8,7 @@
 use super::FaceDepth;
 use crate::convention::{Conventions, NdcDepthRange, RowOrder};
 use crate::depth::DepthEncoding;
-use crate::io;
+use crate::io::{self, OutputSet};
 use crate::job::error::OptionsContext;
 use crate::job::reproject::device_depth;
 use crate::job::ArgError;
@@ -63,6 +63,9 @@ pub struct StitchRequest {
     pub ndc: Ndc,
     /// Reversed-Z device depth (and pass).
     pub reversed_z: bool,
+    /// The outputs: rgb, depth (each eye's distance along its ODS rays); none: rgb.
+    #[serde(serialize_with = "crate::job::outputs_text")]
+    pub outputs: Option<OutputSet>,
 }
 
 impl Default for StitchRequest {
@@ -80,6 +83,7 @@ impl Default for StitchRequest {
             far: None,
             ndc: Ndc::Gl,
             reversed_z: false,
+            outputs: None,
         }
     }
 }
@@ -97,9 +101,16 @@ pub struct StitchPlan {
     pub depth_kind: DepthEncoding,
     /// Conventions of device-depth faces and of the pass.
     pub conventions: Conventions,
+    /// The outputs asked for (rgb, depth).
+    pub outputs: OutputSet,
 }
 
 impl StitchRequest {
+    /// The outputs asked for: colour alone unless given.
+    pub fn outputs(&self) -> OutputSet {
+        self.outputs.unwrap_or(OutputSet::RGB)
+    }
+
     /// The face field of view and the overlap: either alone sets the other.
     fn fov_and_overlap(&self) -> Result<(f64, f64), ArgError> {
         if let (None, Some(overlap)) = (self.fov, self.overlap) {
@@ -158,6 +169,7 @@ impl StitchRequest {
             self.width,
             self.height.saturating_mul(2),
         )?;
+        crate::stitch::render::check_outputs(self.outputs()).for_options("--outputs")?;
         let depth_kind = match (self.depth_kind, self.near, self.far) {
             (FaceDepth::ViewZ, None, None) => DepthEncoding::ViewZ,
             (FaceDepth::ViewZ, _, _) => return Err(ArgError::PlanesWithoutDevice),
@@ -173,6 +185,7 @@ impl StitchRequest {
                 reversed_z: self.reversed_z,
                 row_order: rows,
             },
+            outputs: self.outputs(),
         })
     }
 }
