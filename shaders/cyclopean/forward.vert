@@ -21,7 +21,7 @@ vec3 corner_world(ivec2 c) {
     px.y = u_eye_size.y - 1 - px.y;
 #endif
     float dist = texelFetch(u_distance, px, 0).r;
-    vec3 ray = view_ray(u_inv_proj_e, ndc_of_pixel(img, vec2(u_eye_size)));
+    vec3 ray = view_ray(u_ray_basis_e, ndc_of_pixel(img, vec2(u_eye_size)));
     return transform_point(u_inv_view_e, ray * dist);
 }
 
@@ -52,8 +52,7 @@ void main() {
         if (pushed_out_corner(w0, wn, wp, u_expand_px, w_new)) {
             // The middle ray through the moved point, met with the triangle's plane.
             vec2 ndc = w_new / u_size_m * 2.0 - 1.0;
-            vec4 far_point = u_inv_view_proj_m * vec4(ndc, 0.5, 1.0);
-            vec3 dir = far_point.xyz / far_point.w - u_middle_centre;
+            vec3 dir = view_ray(u_ray_basis_vp_m, ndc);  // world direction: the basis of view-proj
             vec3 nrm = cross(p[1] - p[0], p[2] - p[0]);
             float den = dot(nrm, dir);
             if (abs(den) > 1e-30) {

@@ -3,11 +3,11 @@
 // one per eye's draw, and the eye's images (bindings 1..3).
 layout(std140, binding = 0) PARAM_BLOCK ForwardParams {
     mat4 u_inv_view_e;
-    mat4 u_inv_proj_e;
+    mat4 u_ray_basis_e;
     mat4 u_view_proj_e;
     mat4 u_view_m;
     mat4 u_view_proj_m;
-    mat4 u_inv_view_proj_m;
+    mat4 u_ray_basis_vp_m;  // world ray basis of the middle view-projection (src/camera/rays.rs)
     vec3 u_middle_centre;
     float u_expand_px;
     vec2 u_size_m;

@@ -19,28 +19,30 @@ bool depth_valid(float d) {
 #endif
 }
 
-// Eye view-space point at ndc with stored depth d (assumed valid).
-vec3 eye_view_point(mat4 inv_proj, vec2 ndc, float d) {
+// Eye view-space point at ndc with stored depth d (assumed valid): device depth through the
+// inverse projection, a view distance along the pixel's ray (the ray basis).
+vec3 eye_view_point(mat4 inv_proj, mat4 ray_basis, vec2 ndc, float d) {
 #if DEPTH_IS_DEVICE
     return transform_point(inv_proj, vec3(ndc, ndc_z_of_window_depth(d)));
 #else
-    return view_ray(inv_proj, ndc) * d;
+    return view_ray(ray_basis, ndc) * d;
 #endif
 }
 
 // View distance stored at texel t, or -1 for background.
-float texel_distance(sampler2D depth, mat4 inv_proj, ivec2 t) {
+float texel_distance(sampler2D depth, mat4 inv_proj, mat4 ray_basis, ivec2 t) {
     float d = texelFetch(depth, t, 0).r;
     if (!depth_valid(d)) {
         return -1.0;
     }
     vec2 ndc = ndc_of_pixel(vec2(t), vec2(textureSize(depth, 0)));
-    return -eye_view_point(inv_proj, ndc, d).z;
+    return -eye_view_point(inv_proj, ray_basis, ndc, d).z;
 }
 
 // Bilinear colour at uv (clamp to edge); with REFINE, texels at another depth than z_eye get
 // no weight (the texel holding uv always qualifies).
-vec3 sample_color(sampler2D color, sampler2D depth, mat4 inv_proj, vec2 uv, float z_eye, bool edge_aware) {
+vec3 sample_color(sampler2D color, sampler2D depth, mat4 inv_proj, mat4 ray_basis, vec2 uv, float z_eye,
+                  bool edge_aware) {
     ivec2 size = textureSize(color, 0);
     vec2 t = uv * vec2(size) - 0.5;
     vec2 f0 = floor(t);
@@ -54,7 +56,7 @@ vec3 sample_color(sampler2D color, sampler2D depth, mat4 inv_proj, vec2 uv, floa
         float w = tap_weight(o, fr);
         bool keep = true;
         if (edge_aware) {
-            float zt = texel_distance(depth, inv_proj, tx);
+            float zt = texel_distance(depth, inv_proj, ray_basis, tx);
             keep = zt >= 0.0 && abs(zt - z_eye) <= u_z_threshold;
         }
         if (keep) {
@@ -71,8 +73,8 @@ struct EyeSample {
     float z_middle;
 };
 
-EyeSample walk(sampler2D color, sampler2D depth, mat4 view_proj, mat4 inv_view, mat4 inv_proj, mat4 view,
-               vec3 ray_m, vec2 pixel) {
+EyeSample walk(sampler2D color, sampler2D depth, mat4 view_proj, mat4 inv_view, mat4 inv_proj, mat4 ray_basis,
+               mat4 view, vec3 ray_m, vec2 pixel) {
     EyeSample invalid = EyeSample(false, vec3(0.0), 0.0);
     ivec2 size = textureSize(depth, 0);
     float z = u_fixation;
@@ -95,7 +97,7 @@ EyeSample walk(sampler2D color, sampler2D depth, mat4 view_proj, mat4 inv_view, 
         if (!depth_valid(d)) {
             return invalid;
         }
-        world = transform_point(inv_view, eye_view_point(inv_proj, ndc, d));
+        world = transform_point(inv_view, eye_view_point(inv_proj, ray_basis, ndc, d));
         z = -transform_point(u_view_m, world).z;
         if (!(z > 0.0) || isinf(z)) {
             return invalid;
@@ -103,12 +105,12 @@ EyeSample walk(sampler2D color, sampler2D depth, mat4 view_proj, mat4 inv_view, 
     }
     bool edge_aware = false;
 #if REFINE
-    float z_texel = texel_distance(depth, inv_proj, texel);
+    float z_texel = texel_distance(depth, inv_proj, ray_basis, texel);
     if (z_texel < 0.0) {
         return invalid;
     }
     vec2 centre = ndc_of_pixel(vec2(texel), vec2(size));
-    vec3 sample_ws = transform_point(inv_view, view_ray(inv_proj, centre) * z_texel);
+    vec3 sample_ws = transform_point(inv_view, view_ray(ray_basis, centre) * z_texel);
     vec4 clip_m = u_view_proj_m * vec4(sample_ws, 1.0);
     vec2 px = window_of_clip(clip_m, u_size_m);
     if (any(greaterThan(abs(px - pixel), vec2(REFINE_TOLERANCE_PX)))) {
@@ -117,23 +119,24 @@ EyeSample walk(sampler2D color, sampler2D depth, mat4 view_proj, mat4 inv_view, 
     edge_aware = true;
 #endif
     float z_eye = -transform_point(view, world).z;
-    return EyeSample(true, sample_color(color, depth, inv_proj, uv, z_eye, edge_aware), z);
+    return EyeSample(true, sample_color(color, depth, inv_proj, ray_basis, uv, z_eye, edge_aware), z);
 }
 
 void main() {
     vec2 pixel = gl_FragCoord.xy;
     vec2 uv = pixel / u_size_m;
-    vec3 ray = view_ray(u_inv_proj_m, uv * 2.0 - 1.0);
-    EyeSample l = walk(u_color_l, u_depth_l, u_view_proj_l, u_inv_view_l, u_inv_proj_l, u_view_l, ray, pixel);
-    EyeSample r = walk(u_color_r, u_depth_r, u_view_proj_r, u_inv_view_r, u_inv_proj_r, u_view_r, ray, pixel);
+    // Exactly mirrored under the other row order (2 pixel is an integer).
+    vec3 ray = view_ray(u_ray_basis_m, (2.0 * pixel - u_size_m) / u_size_m);
+    EyeSample l = walk(u_color_l, u_depth_l, u_view_proj_l, u_inv_view_l, u_inv_proj_l, u_ray_basis_l, u_view_l, ray, pixel);
+    EyeSample r = walk(u_color_r, u_depth_r, u_view_proj_r, u_inv_view_r, u_inv_proj_r, u_ray_basis_r, u_view_r, ray, pixel);
 
     vec3 c;
     float z = 0.0;
     int bits = 0;
     if (!l.valid && !r.valid) {
         // The seed's fallback: both eyes at the same uv, averaged.
-        c = 0.5 * (sample_color(u_color_l, u_depth_l, u_inv_proj_l, uv, 0.0, false)
-                 + sample_color(u_color_r, u_depth_r, u_inv_proj_r, uv, 0.0, false));
+        c = 0.5 * (sample_color(u_color_l, u_depth_l, u_inv_proj_l, u_ray_basis_l, uv, 0.0, false)
+                 + sample_color(u_color_r, u_depth_r, u_inv_proj_r, u_ray_basis_r, uv, 0.0, false));
     } else if (l.valid && !r.valid) {
         c = l.color; z = l.z_middle; bits = 1;
     } else if (!l.valid && r.valid) {

@@ -12,8 +12,10 @@ layout(std140, binding = 0) PARAM_BLOCK GatherParams {
     mat4 u_view_r;
     mat4 u_view_m;
     mat4 u_inv_view_m;
-    mat4 u_inv_proj_m;
+    mat4 u_ray_basis_m;  // pixel rays (src/camera/rays.rs), the same under every convention
     mat4 u_view_proj_m;
+    mat4 u_ray_basis_l;  // the eyes' pixel rays (view-distance depth)
+    mat4 u_ray_basis_r;
     vec2 u_size_m;
     float u_fixation;    // initial distance along the middle view axis
     float u_z_threshold;

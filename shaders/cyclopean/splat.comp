@@ -8,7 +8,7 @@ layout(local_size_x = 8, local_size_y = 8) in;
 // Parameters (`SplatParams` in src/cyclopean/splat.rs), one block for GL and Vulkan.
 layout(std140, binding = 0) PARAM_BLOCK SplatParams {
     mat4 u_inv_view_e;
-    mat4 u_inv_proj_e;
+    mat4 u_ray_basis_e;
     mat4 u_view_proj_m;
     mat4 u_view_m;
     ivec2 u_grid;       // invocation grid: the eye's size
@@ -26,7 +26,7 @@ void main() {
     if (!(z > 0.0) || isinf(z)) {
         return;
     }
-    vec3 ray = view_ray(u_inv_proj_e, ndc_of_pixel(vec2(t), vec2(u_grid)));
+    vec3 ray = view_ray(u_ray_basis_e, ndc_of_pixel(vec2(t), vec2(u_grid)));
     vec4 world = vec4(transform_point(u_inv_view_e, ray * z), 1.0);
     vec4 clip = u_view_proj_m * world;
     if (!(clip.w > 0.0)) {

@@ -8,14 +8,14 @@ layout(std140, binding = 0) PARAM_BLOCK SplatGatherParams {
     mat4 u_view_proj_l;
     mat4 u_view_l;
     mat4 u_inv_view_l;
-    mat4 u_inv_proj_l;
+    mat4 u_ray_basis_l;
     mat4 u_view_proj_r;
     mat4 u_view_r;
     mat4 u_inv_view_r;
-    mat4 u_inv_proj_r;
+    mat4 u_ray_basis_r;
     mat4 u_view_m;
     mat4 u_inv_view_m;
-    mat4 u_inv_proj_m;
+    mat4 u_ray_basis_m;
     vec2 u_size_m;
     float u_parallax_px;  // focal (px) x baseline: full-baseline disparity = this / distance
     float u_tolerance_px;
@@ -104,7 +104,7 @@ void surface_color(sampler2D dist, sampler2D color, vec2 e, float zn, out float 
     c /= total;
 }
 
-Sample eye_sample(sampler2D color, sampler2D dist, mat4 view_proj, mat4 view, mat4 inv_view, mat4 inv_proj,
+Sample eye_sample(sampler2D color, sampler2D dist, mat4 view_proj, mat4 view, mat4 inv_view, mat4 ray_basis,
                   vec3 ray_m, float z0) {
     Sample none = Sample(false, vec3(0.0), 0.0, 0.0);
     ivec2 size = textureSize(dist, 0);
@@ -120,7 +120,7 @@ Sample eye_sample(sampler2D color, sampler2D dist, mat4 view_proj, mat4 view, ma
     float z_surface, total;
     surface_depth(dist, e0, zn, z_surface, total);
     vec2 ndc = ndc_of_pixel(e0, vec2(size));
-    vec3 on_surface = transform_point(inv_view, view_ray(inv_proj, ndc) * z_surface);
+    vec3 on_surface = transform_point(inv_view, view_ray(ray_basis, ndc) * z_surface);
     float z1 = -transform_point(u_view_m, on_surface).z;
     if (!(z1 > 0.0) || isinf(z1)) {
         return none;
@@ -182,14 +182,14 @@ Neighbourhood neighbourhood(usampler2D splat, ivec2 p) {
     return Neighbourhood(vec2(near, second), hi > 0.0 && !same_surface(lo, hi));
 }
 
-Sample eye(sampler2D color, sampler2D dist, mat4 view_proj, mat4 view, mat4 inv_view, mat4 inv_proj, vec3 ray_m,
+Sample eye(sampler2D color, sampler2D dist, mat4 view_proj, mat4 view, mat4 inv_view, mat4 ray_basis, vec3 ray_m,
            vec2 cand) {
     Sample s = Sample(false, vec3(0.0), 0.0, 0.0);
     // A loop, not two branches: llvmpipe leaves it as soon as every lane has its answer.
     for (int k = 0; k < 2; ++k) {
         float z0 = k == 0 ? cand.x : cand.y;
         if (!absent(z0)) {
-            s = eye_sample(color, dist, view_proj, view, inv_view, inv_proj, ray_m, z0);
+            s = eye_sample(color, dist, view_proj, view, inv_view, ray_basis, ray_m, z0);
             if (s.valid) {
                 break;
             }
@@ -209,10 +209,10 @@ struct Merged {
 // candidates, merged: on one surface weighted by nearness to each eye and confidence; else the
 // nearer; one eye alone: that eye.
 Merged shade(vec2 frag, vec2 cand_l, vec2 cand_r) {
-    vec2 ndc = frag / u_size_m * 2.0 - 1.0;
-    vec3 ray = view_ray(u_inv_proj_m, ndc);
-    Sample l = eye(u_color_l, u_dist_l, u_view_proj_l, u_view_l, u_inv_view_l, u_inv_proj_l, ray, cand_l);
-    Sample r = eye(u_color_r, u_dist_r, u_view_proj_r, u_view_r, u_inv_view_r, u_inv_proj_r, ray, cand_r);
+    vec2 ndc = (2.0 * frag - u_size_m) / u_size_m;  // exactly mirrored under the other row order
+    vec3 ray = view_ray(u_ray_basis_m, ndc);
+    Sample l = eye(u_color_l, u_dist_l, u_view_proj_l, u_view_l, u_inv_view_l, u_ray_basis_l, ray, cand_l);
+    Sample r = eye(u_color_r, u_dist_r, u_view_proj_r, u_view_r, u_inv_view_r, u_ray_basis_r, ray, cand_r);
     Merged m = Merged(false, vec3(0.0), 0.0, 0);
     if (l.valid && r.valid && same_surface(l.z_middle, r.z_middle)) {
         // > 0: each confidence is >= 1/4 and the two position weights sum to 1.

@@ -3,7 +3,7 @@
 // current one (m), and the accumulation's rule.
 layout(std140, binding = 0) PARAM_BLOCK TemporalParams {
     mat4 u_inv_view_h;
-    mat4 u_inv_proj_h;
+    mat4 u_ray_basis_h;
     mat4 u_view_proj_m;
     mat4 u_view_m;
     ivec2 u_size_h;          // W, H of the previous view

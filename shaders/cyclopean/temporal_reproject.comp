@@ -41,7 +41,7 @@ void main() {
             return;
         }
     }
-    vec3 ray = view_ray(u_inv_proj_h, ndc_of_pixel(vec2(t), vec2(u_size_h)));
+    vec3 ray = view_ray(u_ray_basis_h, ndc_of_pixel(vec2(t), vec2(u_size_h)));
     vec4 world = vec4(transform_point(u_inv_view_h, ray * z), 1.0);
     vec4 clip = u_view_proj_m * world;
     if (!(clip.w > 0.0)) {

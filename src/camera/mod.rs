@@ -5,6 +5,7 @@ pub mod intrinsics_file;
 pub mod mat4;
 pub mod pose;
 mod projection;
+pub mod rays;
 pub mod stereo;
 pub mod vergence;
 

@@ -22,6 +22,8 @@ pub const RIGHT_EYE_DEPTH_BIAS: f32 = 1e-4;
 /// View distance per eye pixel (rows top-down), 0 where the depth is background or invalid.
 pub fn eye_distances(eye: &EyeInput, kind: FrameDepth, conv: &crate::convention::Conventions) -> Result<Vec<f32>> {
     let inv_proj = mat4::inverse(&eye.proj).ok_or_else(|| Error::param("eye projection", "singular"))?;
+    let basis =
+        crate::camera::rays::ray_basis(&eye.proj).ok_or_else(|| Error::param("eye projection", "not perspective"))?;
     let (w, h) = (eye.depth.width as usize, eye.depth.height as usize);
     let mut out = vec![0f32; w * h];
     for y in 0..h {
@@ -33,11 +35,11 @@ pub fn eye_distances(eye: &EyeInput, kind: FrameDepth, conv: &crate::convention:
         };
         for x in 0..w {
             let ndc = [
-                (x as f64 + 0.5) / w as f64 * 2.0 - 1.0,
-                (y_mem as f64 + 0.5) / h as f64 * 2.0 - 1.0,
+                crate::camera::rays::pixel_ndc(x as f64, w as f64),
+                crate::camera::rays::pixel_ndc(y_mem as f64, h as f64),
             ];
             let d = eye.depth.data[y * w + x] as f64;
-            out[y * w + x] = super::reference::stored_view_point(d, ndc, kind, conv, &inv_proj)
+            out[y * w + x] = super::reference::stored_view_point(d, ndc, kind, conv, &inv_proj, &basis)
                 .map(|p| -p[2])
                 .filter(|v| v.is_finite() && *v > 0.0)
                 .unwrap_or(0.0) as f32;
@@ -50,11 +52,11 @@ crate::param_block! {
     /// One eye's draw: shaders/cyclopean/forward_params.glsl, member for member.
     pub struct ForwardParams("ForwardParams") {
         u_inv_view_e: [[f32; 4]; 4],
-        u_inv_proj_e: [[f32; 4]; 4],
+        u_ray_basis_e: [[f32; 4]; 4],
         u_view_proj_e: [[f32; 4]; 4],
         u_view_m: [[f32; 4]; 4],
         u_view_proj_m: [[f32; 4]; 4],
-        u_inv_view_proj_m: [[f32; 4]; 4],
+        u_ray_basis_vp_m: [[f32; 4]; 4],
         u_middle_centre: [f32; 3],
         u_expand_px: f32,
         u_size_m: [f32; 2],
@@ -154,7 +156,7 @@ impl ForwardWarp {
         let vp_m = mat4::mul(&mid.proj, &mid.view);
         let centre = crate::scene::gpu::projection_centre(&vp_m)
             .ok_or_else(|| Error::param("middle projection", "not perspective"))?;
-        let inv_vp_m = mat4::inverse(&vp_m).ok_or_else(|| Error::param("middle view-projection", "singular"))?;
+        let rays_vp_m = super::ray_basis_std140(&vp_m, "middle view-projection")?;
         let inv = |m: &Mat4, what: &str| {
             mat4::inverse(m)
                 .map(|m| mat4_std140(&m))
@@ -166,11 +168,11 @@ impl ForwardWarp {
             let Some(tris) = &eye.tris else { continue };
             blocks.push(ForwardParams {
                 u_inv_view_e: inv(&eye.view, "eye view")?,
-                u_inv_proj_e: inv(&eye.proj, "eye projection")?,
+                u_ray_basis_e: super::ray_basis_std140(&eye.proj, "eye projection")?,
                 u_view_proj_e: mat4_std140(&mat4::mul(&eye.proj, &eye.view)),
                 u_view_m: mat4_std140(&mid.view),
                 u_view_proj_m: mat4_std140(&vp_m),
-                u_inv_view_proj_m: mat4_std140(&inv_vp_m),
+                u_ray_basis_vp_m: rays_vp_m,
                 u_middle_centre: centre.map(|v| v as f32),
                 u_expand_px: 1.0 / 32.0,
                 u_size_m: [w as f32, h as f32],

@@ -45,6 +45,14 @@ use crate::io::{DepthMap, RgbImage};
 use serde::{Deserialize, Serialize};
 
 pub use frame_depth::FrameDepth;
+
+/// The ray basis of `m` ([`crate::camera::rays::ray_basis`]: pixel rays the same under every
+/// convention) as a std140 mat4 for the shaders' `view_ray`; `what` names `m` in the refusal.
+pub(crate) fn ray_basis_std140(m: &Mat4, what: &str) -> Result<[[f32; 4]; 4]> {
+    crate::camera::rays::ray_basis(m)
+        .map(|b| crate::pass::mat4_std140(&b))
+        .ok_or_else(|| Error::param(what.to_string(), "not perspective"))
+}
 pub use pass::{CyclopeanInput, CyclopeanPass};
 
 /// One eye: colour, depth (rows top-down) and the GL matrices it was rendered with.

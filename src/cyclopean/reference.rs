@@ -5,6 +5,7 @@
 use super::ambiguity::{distance_bound, position_bound, row_condition, Reach, EPS32};
 use super::{Blend, CyclopeanOutput, CyclopeanParams, EyeInput, FrameDepth, MiddleCamera, StereoFrame};
 use crate::camera::mat4::{self, Mat4};
+use crate::camera::rays::{pixel_ndc, ray_basis, view_ray};
 use crate::convention::{Conventions, RowOrder};
 use crate::depth::{is_background, ndc_z_of_window_depth};
 use crate::error::Result;
@@ -16,6 +17,8 @@ struct Eye64<'a> {
     flip: bool,
     inv_view: Mat4,
     inv_proj: Mat4,
+    /// Pixel rays ([`crate::camera::rays`]), the same under every convention.
+    ray_basis: Mat4,
 }
 
 impl Eye64<'_> {
@@ -95,14 +98,12 @@ impl Eye64<'_> {
 
     /// View-space distance stored at texel (x, y) (memory order), None for background.
     fn view_distance(&self, x: i64, y: i64, kind: FrameDepth, conv: &Conventions) -> Option<f64> {
-        stored_view_point(self.depth_at(x, y), self.texel_ndc(x, y), kind, conv, &self.inv_proj).map(|p| -p[2])
+        let (ndc, inv_proj) = (self.texel_ndc(x, y), &self.inv_proj);
+        stored_view_point(self.depth_at(x, y), ndc, kind, conv, inv_proj, &self.ray_basis).map(|p| -p[2])
     }
     fn texel_ndc(&self, x: i64, y: i64) -> [f64; 2] {
         let (w, h) = self.size();
-        [
-            (x as f64 + 0.5) / w as f64 * 2.0 - 1.0,
-            (y as f64 + 0.5) / h as f64 * 2.0 - 1.0,
-        ]
+        [pixel_ndc(x as f64, w as f64), pixel_ndc(y as f64, h as f64)]
     }
     /// The condition of reconstructing texel (x, y)'s distance (see [`unprojection_condition`]).
     fn condition(&self, x: i64, y: i64, kind: FrameDepth, conv: &Conventions) -> f64 {
@@ -111,7 +112,8 @@ impl Eye64<'_> {
 }
 
 /// The eye view-space point a stored depth `d` describes at NDC (x, y): device depth unprojected
-/// through the eye's inverse projection, or a view distance along the pixel's ray. None for
+/// through the eye's inverse projection, or a view distance along the pixel's ray (from the ray
+/// basis, [`crate::camera::rays`]). None for
 /// background (device depth by [`crate::depth::is_background`], distance <= 0) and non-finite values.
 pub(crate) fn stored_view_point(
     d: f64,
@@ -119,6 +121,7 @@ pub(crate) fn stored_view_point(
     kind: FrameDepth,
     conv: &Conventions,
     inv_proj: &Mat4,
+    ray_basis: &Mat4,
 ) -> Option<[f64; 3]> {
     if !d.is_finite() {
         return None;
@@ -135,7 +138,7 @@ pub(crate) fn stored_view_point(
             if d <= 0.0 {
                 return None;
             }
-            let r = view_ray(inv_proj, ndc);
+            let r = view_ray(ray_basis, ndc);
             Some([r[0] * d, r[1] * d, r[2] * d])
         }
     }
@@ -169,16 +172,6 @@ fn parallax(view_proj: &Mat4, dir: [f64; 3], px: [f64; 2], size: [f64; 2]) -> f6
     }
     let inf = window(c, size);
     (px[0] - inf[0]).hypot(px[1] - inf[1])
-}
-
-/// NDC z where rays are unprojected: inside the depth range under every convention.
-pub const RAY_NDC_Z: f64 = 0.5;
-
-/// View-space direction through NDC (x, y) of projection inverse `inv_proj`, scaled so that its
-/// GL z is -1 (unit distance along the view axis).
-fn view_ray(inv_proj: &Mat4, ndc: [f64; 2]) -> [f64; 3] {
-    let p = mat4::transform_point(inv_proj, [ndc[0], ndc[1], RAY_NDC_Z]);
-    [p[0] / -p[2], p[1] / -p[2], -1.0]
 }
 
 /// Result of walking one eye along a middle ray.
@@ -246,7 +239,8 @@ impl Ctx<'_> {
             let ty = ((uv[1] * h as f64).floor() as i64).clamp(0, h - 1);
             let d = eye.depth_at(tx, ty);
             texel = (tx, ty);
-            let Some(view) = stored_view_point(d, ndc, self.frame.depth_kind, &self.frame.conv, &eye.inv_proj) else {
+            let kind = self.frame.depth_kind;
+            let Some(view) = stored_view_point(d, ndc, kind, &self.frame.conv, &eye.inv_proj, &eye.ray_basis) else {
                 return invalid;
             };
             world = mat4::transform_point(&eye.inv_view, view);
@@ -269,11 +263,8 @@ impl Ctx<'_> {
             let Some(z_eye) = eye.view_distance(texel.0, texel.1, self.frame.depth_kind, &self.frame.conv) else {
                 return invalid;
             };
-            let centre = [
-                (texel.0 as f64 + 0.5) / w as f64 * 2.0 - 1.0,
-                (texel.1 as f64 + 0.5) / h as f64 * 2.0 - 1.0,
-            ];
-            let r = view_ray(&eye.inv_proj, centre);
+            let centre = [pixel_ndc(texel.0 as f64, w as f64), pixel_ndc(texel.1 as f64, h as f64)];
+            let r = view_ray(&eye.ray_basis, centre);
             let sample = mat4::transform_point(&eye.inv_view, [r[0] * z_eye, r[1] * z_eye, r[2] * z_eye]);
             let clip = mat4::transform(
                 &mat4::mul(&self.mid.proj, &self.mid.view),
@@ -383,6 +374,8 @@ fn twin(
             flip,
             inv_view: mat4::inverse(&input.view).ok_or_else(|| crate::Error::param("eye view", "singular"))?,
             inv_proj: mat4::inverse(&input.proj).ok_or_else(|| crate::Error::param("eye projection", "singular"))?,
+            ray_basis: ray_basis(&input.proj)
+                .ok_or_else(|| crate::Error::param("eye projection", "not perspective"))?,
         })
     }
     let (left, right) = (prep(&frame.left, flip)?, prep(&frame.right, flip)?);
@@ -393,7 +386,7 @@ fn twin(
         params,
         reach: Reach::new(track),
     };
-    let inv_proj_m = mat4::inverse(&mid.proj).ok_or_else(|| crate::Error::param("middle projection", "singular"))?;
+    let basis_m = ray_basis(&mid.proj).ok_or_else(|| crate::Error::param("middle projection", "not perspective"))?;
     let (w, h) = (mid.width as usize, mid.height as usize);
     let mut out = CyclopeanReference {
         color: vec![[0.0; 3]; w * h],
@@ -406,7 +399,12 @@ fn twin(
         for x in 0..w {
             let pixel = [x as f64 + 0.5, y_mem as f64 + 0.5];
             let uv = [pixel[0] / w as f64, pixel[1] / h as f64];
-            let ray = view_ray(&inv_proj_m, [uv[0] * 2.0 - 1.0, uv[1] * 2.0 - 1.0]);
+            // As the shader: (2 pixel - size) / size, exactly mirrored under the other row order.
+            let ndc = [
+                (2.0 * pixel[0] - w as f64) / w as f64,
+                (2.0 * pixel[1] - h as f64) / h as f64,
+            ];
+            let ray = view_ray(&basis_m, ndc);
             let (l, rel_l) = ctx.walk(&left, ray, pixel);
             let (r, rel_r) = ctx.walk(&right, ray, pixel);
             let o = y_img * w + x;

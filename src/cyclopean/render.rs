@@ -24,8 +24,10 @@ crate::param_block! {
         u_view_r: [[f32; 4]; 4],
         u_view_m: [[f32; 4]; 4],
         u_inv_view_m: [[f32; 4]; 4],
-        u_inv_proj_m: [[f32; 4]; 4],
+        u_ray_basis_m: [[f32; 4]; 4],
         u_view_proj_m: [[f32; 4]; 4],
+        u_ray_basis_l: [[f32; 4]; 4],
+        u_ray_basis_r: [[f32; 4]; 4],
         u_size_m: [f32; 2],
         u_fixation: f32,
         u_z_threshold: f32,
@@ -122,6 +124,7 @@ impl CyclopeanRenderer {
                 .map(|m| mat4_std140(&m))
                 .ok_or_else(|| Error::param(what.to_string(), "singular"))
         };
+        let rays = super::ray_basis_std140;
         let (l, r) = (&self.left, &self.right);
         Ok(GatherParams {
             u_view_proj_l: mat4_std140(&mat4::mul(&l.proj, &l.view)),
@@ -134,8 +137,10 @@ impl CyclopeanRenderer {
             u_view_r: mat4_std140(&r.view),
             u_view_m: mat4_std140(&mid.view),
             u_inv_view_m: inv(&mid.view, "middle view")?,
-            u_inv_proj_m: inv(&mid.proj, "middle projection")?,
+            u_ray_basis_m: rays(&mid.proj, "middle projection")?,
             u_view_proj_m: mat4_std140(&mat4::mul(&mid.proj, &mid.view)),
+            u_ray_basis_l: rays(&l.proj, "eye projection")?,
+            u_ray_basis_r: rays(&r.proj, "eye projection")?,
             u_size_m: [mid.width as f32, mid.height as f32],
             u_fixation: self.params.fixation_distance as f32,
             u_z_threshold: self.params.z_threshold as f32,

@@ -8,6 +8,7 @@ use super::reference::CyclopeanReference;
 use super::splat::{SplatGeometry, SplatParams};
 use super::{MiddleCamera, StereoFrame};
 use crate::camera::mat4::{self, Mat4};
+use crate::camera::rays::{pixel_ndc, ray_basis, view_ray};
 use crate::convention::RowOrder;
 use crate::error::Result;
 
@@ -20,7 +21,8 @@ struct Eye<'a> {
     h: i64,
     view: Mat4,
     inv_view: Mat4,
-    inv_proj: Mat4,
+    /// Pixel rays ([`crate::camera::rays`]), the same under every convention.
+    ray_basis: Mat4,
     view_proj: Mat4,
 }
 
@@ -35,10 +37,9 @@ impl Eye<'_> {
     }
 }
 
-/// View-space direction through NDC (x, y) with GL z = -1.
-fn view_ray(inv_proj: &Mat4, ndc: [f64; 2]) -> [f64; 3] {
-    let p = mat4::transform_point(inv_proj, [ndc[0], ndc[1], super::reference::RAY_NDC_Z]);
-    [p[0] / -p[2], p[1] / -p[2], -1.0]
+/// The ray basis of projection `proj`, refused as the GPU side refuses it.
+fn basis(proj: &Mat4, what: &str) -> Result<Mat4> {
+    ray_basis(proj).ok_or_else(|| crate::Error::param(what.to_string(), "not perspective"))
 }
 
 fn scaled(r: [f64; 3], z: f64) -> [f64; 3] {
@@ -70,11 +71,8 @@ fn splat(eye: &Eye, view_proj_m: &Mat4, view_m: &Mat4, wm: i64, hm: i64, track: 
             if z <= 0.0 {
                 continue;
             }
-            let ndc = [
-                (x as f64 + 0.5) / eye.w as f64 * 2.0 - 1.0,
-                (y as f64 + 0.5) / eye.h as f64 * 2.0 - 1.0,
-            ];
-            let world = mat4::transform_point(&eye.inv_view, scaled(view_ray(&eye.inv_proj, ndc), z));
+            let ndc = [pixel_ndc(x as f64, eye.w as f64), pixel_ndc(y as f64, eye.h as f64)];
+            let world = mat4::transform_point(&eye.inv_view, scaled(view_ray(&eye.ray_basis, ndc), z));
             let clip = mat4::transform(view_proj_m, [world[0], world[1], world[2], 1.0]);
             if clip[3].partial_cmp(&0.0) != Some(std::cmp::Ordering::Greater) {
                 continue;
@@ -268,11 +266,8 @@ impl Ctx<'_> {
         let rel0 = distance_bound(1.0);
         let (e0, z_eye0, bound0) = self.to_eye(eye, ray_m, z0, rel0)?;
         let (z_surface, _, _) = self.surface_at(eye, e0, z_eye0, bound0, 2.0 * rel0)?;
-        let ndc = [
-            (e0[0] + 0.5) / eye.w as f64 * 2.0 - 1.0,
-            (e0[1] + 0.5) / eye.h as f64 * 2.0 - 1.0,
-        ];
-        let on_surface = mat4::transform_point(&eye.inv_view, scaled(view_ray(&eye.inv_proj, ndc), z_surface));
+        let ndc = [pixel_ndc(e0[0], eye.w as f64), pixel_ndc(e0[1], eye.h as f64)];
+        let on_surface = mat4::transform_point(&eye.inv_view, scaled(view_ray(&eye.ray_basis, ndc), z_surface));
         let z1 = -mat4::transform_point(&self.geo.view_m, on_surface)[2];
         if !(z1.is_finite() && z1 > 0.0) {
             return None;
@@ -423,7 +418,7 @@ fn twin(
                 h: h as i64,
                 view: input.view,
                 inv_view: inv(&input.view)?,
-                inv_proj: inv(&input.proj)?,
+                ray_basis: basis(&input.proj, "eye projection")?,
                 view_proj: mat4::mul(&input.proj, &input.view),
             })
         })
@@ -440,7 +435,7 @@ fn twin(
         inv_view_m: mat4::inverse(&mid.view).ok_or_else(|| crate::Error::param("middle view", "singular"))?,
         reach: Reach::new(track),
     };
-    let inv_proj_m = mat4::inverse(&mid.proj).ok_or_else(|| crate::Error::param("middle projection", "singular"))?;
+    let basis_m = basis(&mid.proj, "middle projection")?;
     let n = (wm * hm) as usize;
     let mut out = CyclopeanReference {
         color: vec![[0.0; 3]; n],
@@ -455,10 +450,10 @@ fn twin(
             // from this pixel's splat candidates.
             let shade = |dx: f64| {
                 let ndc = [
-                    (x as f64 + 0.5 + dx) / wm as f64 * 2.0 - 1.0,
-                    (y as f64 + 0.5) / hm as f64 * 2.0 - 1.0,
+                    (2.0 * (x as f64 + 0.5 + dx) - wm as f64) / wm as f64,
+                    pixel_ndc(y as f64, hm as f64),
                 ];
-                let ray = view_ray(&inv_proj_m, ndc);
+                let ray = view_ray(&basis_m, ndc);
                 let samples: Vec<Option<Sample>> = eyes
                     .iter()
                     .zip(&splats)

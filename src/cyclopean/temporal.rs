@@ -21,6 +21,7 @@
 
 use super::{CyclopeanOutput, MiddleCamera};
 use crate::camera::mat4;
+use crate::camera::rays;
 use crate::convention::{Conventions, RowOrder};
 use crate::error::{Error, Result};
 use crate::gpu::{ProgramKind, ShaderProgram};
@@ -41,7 +42,7 @@ crate::param_block! {
     /// shaders/cyclopean/temporal_params.glsl, member for member.
     pub struct TemporalParams("TemporalParams") {
         u_inv_view_h: [[f32; 4]; 4],
-        u_inv_proj_h: [[f32; 4]; 4],
+        u_ray_basis_h: [[f32; 4]; 4],
         u_view_proj_m: [[f32; 4]; 4],
         u_view_m: [[f32; 4]; 4],
         u_size_h: [i32; 2],
@@ -176,7 +177,7 @@ impl Accumulator {
         let stage = |u_stage| -> Result<TemporalParams> {
             Ok(TemporalParams {
                 u_inv_view_h: inv(&hist.mid.view, "previous middle view")?,
-                u_inv_proj_h: inv(&hist.mid.proj, "previous middle projection")?,
+                u_ray_basis_h: super::ray_basis_std140(&hist.mid.proj, "previous middle projection")?,
                 u_view_proj_m: mat4_std140(&mat4::mul(&mid.proj, &mid.view)),
                 u_view_m: mat4_std140(&mid.view),
                 u_size_h: [hist.mid.width as i32, hist.mid.height as i32],
@@ -304,8 +305,8 @@ fn pixel_ndc(x: usize, y: usize, w: usize, h: usize, conv: &Conventions) -> [f64
         y
     };
     [
-        (x as f64 + 0.5) / w as f64 * 2.0 - 1.0,
-        (y_mem as f64 + 0.5) / h as f64 * 2.0 - 1.0,
+        rays::pixel_ndc(x as f64, w as f64),
+        rays::pixel_ndc(y_mem as f64, h as f64),
     ]
 }
 
@@ -392,7 +393,7 @@ impl TemporalAccumulator {
     ) -> Result<(Vec<[f64; 3]>, Vec<f64>)> {
         let (prev_color, prev_depth) = color_and_depth(prev)?;
         let singular = |what: &str| Error::param(what.to_string(), "singular");
-        let inv_proj = mat4::inverse(&prev_cam.proj).ok_or_else(|| singular("previous middle projection"))?;
+        let basis = rays::ray_basis(&prev_cam.proj).ok_or_else(|| singular("previous middle projection"))?;
         let inv_view = mat4::inverse(&prev_cam.view).ok_or_else(|| singular("previous middle view"))?;
         let vp = mat4::mul(&mid.proj, &mid.view);
         let (pw, ph) = (prev_cam.width as usize, prev_cam.height as usize);
@@ -407,8 +408,8 @@ impl TemporalAccumulator {
                     continue;
                 }
                 let ndc = pixel_ndc(x, y, pw, ph, &self.conv);
-                let p = mat4::transform_point(&inv_proj, [ndc[0], ndc[1], 0.5]);
-                let view = [p[0] / -p[2] * d, p[1] / -p[2] * d, -d];
+                let r = rays::view_ray(&basis, ndc);
+                let view = [r[0] * d, r[1] * d, r[2] * d];
                 let world = mat4::transform_point(&inv_view, view);
                 let clip = mat4::transform(&vp, [world[0], world[1], world[2], 1.0]);
                 if clip[3].partial_cmp(&0.0) != Some(std::cmp::Ordering::Greater) {

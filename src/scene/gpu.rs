@@ -4,6 +4,7 @@
 
 use super::{pattern_color, Scene, Shape, MAX_OBJECTS};
 use crate::camera::mat4::{self, Mat4};
+pub use crate::camera::rays::{pixel_ndc, ray_basis};
 use crate::convention::{Conventions, DepthPlanes, RowOrder};
 use crate::error::{Error, Result};
 use crate::gpu::{ProgramKind, ShaderProgram, Timing};
@@ -29,28 +30,6 @@ crate::param_block! {
         u_c: [[f32; 4]; MAX_OBJECTS],
         u_d: [[f32; 4]; MAX_OBJECTS],
     }
-}
-
-/// The ray basis of a perspective view-projection `vp`: the inverse of the 3x3 that takes a
-/// direction to its clip (x, y, w), so a pixel's ray is `basis (ndc_x, ndc_y, 1)`, in the upper
-/// left 3x3 of a 4x4 (the rest identity). The depth conventions change only clip z and the row
-/// order only the sign of clip y (the pixel's NDC y flips with it, exactly), so every convention
-/// gives the same rays bit for bit. The ray through an unprojected NDC point (inv(vp) at some
-/// NDC z, minus the eye) rounds differently under each convention: at 320 x 240 the demo's
-/// floor-wall edge row cracked under Vulkan NDC and reversed-Z only (issue 47).
-pub fn ray_basis(vp: &Mat4) -> Option<Mat4> {
-    let mut m = mat4::IDENTITY;
-    for (r, src) in [0, 1, 3].into_iter().enumerate() {
-        m[r][..3].copy_from_slice(&vp[src][..3]);
-    }
-    mat4::inverse(&m)
-}
-
-/// NDC of pixel centre `p` (counted from 0) along an axis of `n` pixels, as `(2 p + 1 - n) / n`:
-/// the numerator is exact, so the mirrored pixel `n - 1 - p` gets exactly the negated value
-/// (`(p + 0.5) / n * 2 - 1` does not), and both row orders give the same ray.
-pub fn pixel_ndc(p: f64, n: f64) -> f64 {
-    (2.0 * p + 1.0 - n) / n
 }
 
 /// A GL camera: world -> eye `view`, eye -> clip `proj` (matching `conv`), image size.

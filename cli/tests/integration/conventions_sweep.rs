@@ -175,6 +175,9 @@ fn sweep(device: &Device, sizes: &[(u32, u32)], cases: &[PassCase], kind: FrameD
             .collect();
         for case in cases {
             let mut base: Option<Vec<ViewOutput>> = None;
+            // The largest differences from the GL defaults over every convention and view, printed
+            // (`--nocapture`) so a change's effect is measured, not only passed.
+            let (mut colour_worst, mut depth_worst) = (0, 0f64);
             for inp in &inputs {
                 let views = case.frame(device, inp).unwrap()().unwrap();
                 if *case == PassCase::Scene {
@@ -194,6 +197,8 @@ fn sweep(device: &Device, sizes: &[(u32, u32)], cases: &[PassCase], kind: FrameD
                 };
                 for (k, (v, bv)) in views.iter().zip(b).enumerate() {
                     let d = diff(v, bv, depth_bound(case));
+                    colour_worst = colour_worst.max(d.colour_worst);
+                    depth_worst = depth_worst.max(d.depth_worst);
                     if d.coverage + d.colour + d.depth > 0 {
                         let (i, what) = d.first.unwrap();
                         failures.push(format!(
@@ -213,6 +218,10 @@ fn sweep(device: &Device, sizes: &[(u32, u32)], cases: &[PassCase], kind: FrameD
                     }
                 }
             }
+            println!(
+                "{w}x{h} {kind:?} {}: worst over conventions: colour {colour_worst} levels, depth {depth_worst:.1e} relative",
+                case.name()
+            );
         }
     }
     failures
