@@ -137,10 +137,10 @@ pub(crate) struct CyclopeanArgs {
     /// Fill the holes (pixels no eye saw) so the frame is complete; filled pixels are 128 in
     /// middle_mask.png.
     ///
-    /// Two images alone first render on disparities made dense (unknown ones filled from
-    /// similar-coloured neighbours, leaning to the background), then every remaining hole takes
-    /// the background layer around it in 2-D. Filled pixels are 128 in middle_mask.png (rendered
-    /// from matched or given disparities: 255). Off: holes stay 0.
+    /// Disparities, given or estimated from two images alone, first render on maps made dense
+    /// (unknown ones filled from similar-coloured neighbours, leaning to the background), then
+    /// every remaining hole takes the background layer around it in 2-D. Filled pixels are 128 in
+    /// middle_mask.png (rendered from matched or given disparities: 255). Off: holes stay 0.
     #[arg(help_heading = OUTPUTS, long)]
     fill: bool,
     /// Two images alone (no disparities, no depth): the largest disparity the census matcher

@@ -27,6 +27,7 @@ mod conventions_sweep;
 mod cyclopean;
 mod cyclopean_dense;
 mod cyclopean_fill;
+mod cyclopean_given_dense;
 mod cyclopean_one_eye;
 mod cyclopean_real;
 mod cyclopean_temporal;
