@@ -12,7 +12,8 @@
 # Where no image registry is reachable, it makes the base images itself: a Debian bookworm root
 # from debootstrap, imported as debian:bookworm-slim, and rust:1-bookworm built on it from this
 # machine's Rust toolchain. Where no daemon runs, it starts one as
-# `dockerd --iptables=false --bridge=none --storage-driver=vfs` (builds then use --network host).
+# `dockerd --iptables=false --bridge=none --storage-driver=overlay2` (vfs where overlay cannot be
+# mounted; builds then use --network host).
 #
 #   VIEWSYNTH_IMAGE   tag to build (viewsynth:smoke)
 #   DEBIAN_MIRROR     debootstrap mirror (http://deb.debian.org/debian)
@@ -44,18 +45,30 @@ DATA=$(cd "$DATA" && pwd)
 command -v docker >/dev/null || die "no docker client (Debian: apt-get install docker.io)"
 
 # --- a daemon ----------------------------------------------------------------------------------
+# Storage: overlay2 keeps each layer's changes only; vfs copies the whole tree per layer (over
+# 30 GB for this build's 30-odd steps), so it is the fallback where overlay cannot be mounted.
+start_dockerd() {
+  say "starting dockerd ($1 storage, no bridge, no iptables)"
+  dockerd --iptables=false --bridge=none --storage-driver="$1" >"$WORK/dockerd.log" 2>&1 &
+  DOCKERD_PID=$!
+  for _ in $(seq 60); do
+    docker info >/dev/null 2>&1 && return 0
+    if ! kill -0 "$DOCKERD_PID" 2>/dev/null; then
+      wait "$DOCKERD_PID" 2>/dev/null || true
+      DOCKERD_PID=
+      return 1
+    fi
+    sleep 1
+  done
+  die "dockerd did not answer within 60 s: $(tail -5 "$WORK/dockerd.log")"
+}
 if ! docker info >/dev/null 2>&1; then
   command -v dockerd >/dev/null || die "no docker daemon and no dockerd to start (Debian: apt-get install docker.io)"
   [ "$(id -u)" -eq 0 ] || die "no docker daemon running, and starting one needs root"
-  say "starting dockerd (vfs storage, no bridge, no iptables)"
-  dockerd --iptables=false --bridge=none --storage-driver=vfs >"$WORK/dockerd.log" 2>&1 &
-  DOCKERD_PID=$!
-  for _ in $(seq 60); do
-    docker info >/dev/null 2>&1 && break
-    kill -0 "$DOCKERD_PID" 2>/dev/null || die "dockerd exited: $(tail -5 "$WORK/dockerd.log")"
-    sleep 1
-  done
-  docker info >/dev/null 2>&1 || die "dockerd did not answer within 60 s: $(tail -5 "$WORK/dockerd.log")"
+  start_dockerd overlay2 || {
+    say "overlay2 refused ($(tail -1 "$WORK/dockerd.log")): vfs instead"
+    start_dockerd vfs || die "dockerd exited: $(tail -5 "$WORK/dockerd.log")"
+  }
 fi
 
 # --- base images ---------------------------------------------------------------------------------
