@@ -126,3 +126,21 @@ def test_refocus_batch_bad_inputs(renderer, tmp_path):
     batch_error(renderer, tmp_path, [frame], "scales", ["no target given"], scales=[])
     batch_error(renderer, tmp_path, [frame], "tau", [], tau_rel=-1.0)
     assert not (tmp_path / "out").exists()  # nothing written for a refused call
+
+
+def test_verify_redoes_a_frame_whose_file_changed_with_its_size_kept(renderer, tmp_path):
+    frames = vs.load_manifest(write_manifest(tmp_path / "in"))[1:2]
+    out = tmp_path / "py"
+    assert renderer.refocus_batch(frames, out, scales=[1.0], jobs=1)["rendered"] == 1
+    rgb = out / frames[0]["name"] / "s1_rgb.png"
+    good = rgb.read_bytes()
+    changed = bytearray(good)
+    changed[len(changed) // 2] ^= 0xFF
+    rgb.write_bytes(bytes(changed))
+    # Resume checks sizes (the commit journal makes a frame all-or-none); verify=True, as the
+    # CLI's --verify, checks every file's CRC-32 and redoes the frame.
+    assert renderer.refocus_batch(frames, out, scales=[1.0], jobs=1)["skipped"] == 1
+    summary = renderer.refocus_batch(frames, out, scales=[1.0], jobs=1, verify=True)
+    assert (summary["rendered"], summary["skipped"]) == (1, 0)
+    assert rgb.read_bytes() == good
+    assert renderer.refocus_batch(frames, out, scales=[1.0], jobs=1, verify=True)["skipped"] == 1

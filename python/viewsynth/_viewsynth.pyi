@@ -296,6 +296,7 @@ class Renderer:
         exr_compression: Literal["none", "rle", "zip", "piz"] = "zip",
         depth_trunc: Optional[float] = None,
         resume: bool = True,
+        verify: bool = False,
         jobs: Optional[int] = None,
         shard: Optional[str] = None,
         rgb_everywhere: bool = False,
