@@ -12,7 +12,7 @@ pub(crate) const EXAMPLES: &str = "\
 Examples:
   # a TUM RGB-D sequence (rgb.txt, depth.txt) into a manifest, then every frame at two scales
   viewsynth manifest tum_seq --fx 525 --fy 525 --cx 319.5 --cy 239.5 --out tum_seq/frames.csv
-  viewsynth refocus --batch tum_seq/frames.csv --zoom-range 0.5,2 --out-dir out/tum_seq";
+  viewsynth refocus --batch tum_seq/frames.csv --zoom-range 0.5,2 --out-dir out/tum_frames";
 
 #[derive(Args)]
 pub(crate) struct ManifestArgs {
