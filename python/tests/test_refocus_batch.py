@@ -87,11 +87,11 @@ def test_write_index_takes_refocus_batchs_settings_with_the_same_defaults():
     # write_index keeps a frame's rows only where its manifest records these settings, so its
     # keywords must be refocus_batch's settings, same names, order and defaults. pyo3 takes each
     # signature as a literal (python/src/index.rs and batch.rs write the list twice): this
-    # holds the two together. What only steers a run (resume, jobs, shard, progress, index)
+    # holds the two together. What only steers a run (resume, verify, jobs, shard, progress, index)
     # is not a setting.
     import inspect
 
-    run_only = {"self", "resume", "jobs", "shard", "progress", "index"}
+    run_only = {"self", "resume", "verify", "jobs", "shard", "progress", "index"}
     batch = inspect.signature(vs.Renderer.refocus_batch).parameters.values()
     index = inspect.signature(vs.write_index).parameters.values()
     want = [(p.name, p.kind, p.default) for p in batch if p.name not in run_only]
