@@ -169,7 +169,7 @@ class Renderer:
         depth: npt.NDArray[np.float32],
         K: ArrayLike3x3,
         *,
-        scales: Optional[Sequence[float]] = None,
+        scales: Optional[Union[Sequence[float], Sequence[Sequence[float]], npt.NDArray[np.floating[Any]]]] = None,
         K_out: Optional[Union[Sequence[ArrayLike3x3], npt.NDArray[np.floating[Any]]]] = None,
         size: Optional[Tuple[int, int]] = None,
         principal: Optional[Tuple[float, float]] = None,
@@ -181,6 +181,7 @@ class Renderer:
     ) -> List[RefocusView]:
         """Re-render rgb uint8[H, W, 3] + depth float32[H, W] (metres) with intrinsics K at
         other focal lengths (scales=[...] or K_out=[...]), same pose. size is (width, height).
+        A stack (rgb [N, H, W, 3]) takes one list of scales or one per sample ([N, k]).
         See help(viewsynth.Renderer.refocus)."""
         ...
     def cyclopean(
@@ -295,6 +296,7 @@ class Renderer:
         exr_compression: Literal["none", "rle", "zip", "piz"] = "zip",
         depth_trunc: Optional[float] = None,
         resume: bool = True,
+        verify: bool = False,
         jobs: Optional[int] = None,
         shard: Optional[str] = None,
         rgb_everywhere: bool = False,

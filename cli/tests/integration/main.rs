@@ -13,6 +13,7 @@ mod cli_depth_out;
 mod cli_end_to_end;
 mod cli_formats;
 mod cli_help;
+mod cli_manifest_tum;
 mod cli_output;
 mod cli_outputs_table;
 mod cli_plausibility;
