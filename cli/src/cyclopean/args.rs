@@ -154,8 +154,8 @@ pub(crate) struct CyclopeanArgs {
     /// from matched or given disparities: 255). Off: holes stay 0.
     #[arg(help_heading = OUTPUTS, long)]
     fill: bool,
-    /// Two images alone (no disparities, no depth): the largest disparity the census matcher
-    /// searches, pixels.
+    /// Two images alone (no disparities, no depth): the largest disparity the matcher searches,
+    /// pixels.
     ///
     /// Default: estimated from the images by a coarse pass, with a margin; the range used is
     /// printed. The search is bounded: at most 1024 disparities past 0 (max - min when the
@@ -180,6 +180,9 @@ pub(crate) struct CyclopeanArgs {
     #[arg(help_heading = OUTPUTS, long)]
     confidence: bool,
     /// Two images alone: the stereo matcher [default: census].
+    ///
+    /// sgm is smoother (low-texture regions take the surrounding surface's disparity, so more
+    /// pixels are rendered) but less precise on textured ones; see docs/cyclopean.md.
     #[arg(help_heading = INPUTS, long, value_enum)]
     matcher: Option<MatcherArg>,
     /// Writes middle_rgb.png, middle_depth.exr, middle_mask.png (those in --outputs), and
