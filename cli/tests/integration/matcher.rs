@@ -168,6 +168,16 @@ fn matcher_refuses_a_pair_of_another_size_and_a_bad_range() {
         Matcher::new(&g, 4096, 4096, 64),
         Err(viewsynth::Error::InvalidParameter { .. })
     ));
+    // 4096 x 2048 fits the census matcher; the semi-global one's level-0 volume (5 cells a
+    // pixel) would pass a storage buffer's 2^25 words: refused by name, before any allocation.
+    match Matcher::with_method(&g, 4096, 2048, 64, MatcherMethod::Sgm) {
+        Err(viewsynth::Error::InvalidParameter { name, message }) => {
+            assert_eq!(name, "stereo pair");
+            assert!(message.contains("census matcher"), "{message}");
+        }
+        Err(e) => panic!("{e}"),
+        Ok(_) => panic!("a 4096x2048 semi-global matcher was made"),
+    }
     let mut m = Matcher::new(&g, 64, 32, 8).unwrap();
     let img = |w: u32| RgbImage::new(w, 32, vec![7; 3 * w as usize * 32]).unwrap();
     assert!(matches!(

@@ -51,7 +51,7 @@ impl SgmStages {
                 "stereo pair",
                 format!(
                     "{width}x{height}: the semi-global matcher's cost volume ({cells} cells) passes its \
-                     {MAX_BUFFER_WORDS}; use --matcher census for pairs this large"
+                     {MAX_BUFFER_WORDS}; the census matcher takes pairs this large"
                 ),
             ));
         }
