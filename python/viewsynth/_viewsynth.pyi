@@ -208,6 +208,7 @@ class Renderer:
         max_disparity: Optional[int] = None,
         min_confidence: Optional[float] = None,
         confidence: bool = False,
+        matcher: Optional[Literal["census", "sgm"]] = None,
     ) -> CyclopeanView:
         """Synthesise an in-between view of a stereo pair (rgb uint8[H, W, 3] per eye), as
         `viewsynth cyclopean`, from either
@@ -220,7 +221,8 @@ class Renderer:
           or gaze). The view is the middle camera's; or
         - the two images alone: the disparities are estimated by the census matcher over
           0..=max_disparity px; min_confidence drops the estimates it trusts less, and
-          confidence=True returns each eye's confidence ("left_confidence", "right_confidence").
+          confidence=True returns each eye's confidence ("left_confidence", "right_confidence");
+          matcher="sgm" matches semi-globally (smooth where there is no texture).
         See help(viewsynth.Renderer.cyclopean)."""
         ...
     def gl_objects(self) -> GlObjectCounts:

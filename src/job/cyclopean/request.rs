@@ -17,7 +17,7 @@ use crate::cyclopean::disparity_frame::{disparity_frame, median_fixation, Dispar
 use crate::cyclopean::fill::{Filler, FILLED};
 use crate::cyclopean::forward::ForwardWarp;
 use crate::cyclopean::matcher::range::{estimate_range, DisparityRange, SignedSearch};
-use crate::cyclopean::matcher::{EyeEstimate, Matcher};
+use crate::cyclopean::matcher::{EyeEstimate, Matcher, MatcherMethod};
 use crate::cyclopean::render::CyclopeanRenderer;
 use crate::cyclopean::splat::{SplatParams, SplatRenderer};
 use crate::cyclopean::temporal::FROM_HISTORY;
@@ -70,6 +70,8 @@ pub struct CyclopeanRequest {
     /// Two images alone: also give each eye's matcher confidence (a float map in [0, 1], 0 where
     /// the disparity is unknown), the same values `min_confidence` is held against.
     pub confidence: bool,
+    /// Two images alone: the stereo matcher (none: [`MatcherMethod::default`], the census one).
+    pub matcher: Option<MatcherMethod>,
 }
 
 /// The matcher's search range for two images alone when none is given and the images give none
@@ -171,6 +173,7 @@ pub struct CyclopeanPlan {
     range: (Option<i32>, Option<i32>),
     min_confidence: Option<f64>,
     confidence: bool,
+    matcher: MatcherMethod,
 }
 
 /// `--dominant`'s `eye:weight`.
@@ -222,6 +225,7 @@ impl CyclopeanRequest {
             ("--min-disparity", self.min_disparity.is_some()),
             ("--min-confidence", self.min_confidence.is_some()),
             ("--confidence", self.confidence),
+            ("--matcher", self.matcher.is_some()),
         ] {
             if given && kind != StereoKind::Images {
                 return Err(ArgError::MatcherOptionWithMaps(flag));
@@ -294,6 +298,7 @@ impl CyclopeanRequest {
             range: (self.min_disparity, self.max_disparity),
             min_confidence: self.min_confidence,
             confidence: self.confidence,
+            matcher: self.matcher.unwrap_or_default(),
         })
     }
 
@@ -623,9 +628,9 @@ impl CyclopeanPlan {
         };
         let mut own;
         let matcher = match reuse {
-            Some(re) => re.matcher(device, l.width, l.height, search.max_disparity)?,
+            Some(re) => re.matcher(device, l.width, l.height, search.max_disparity, self.matcher)?,
             None => {
-                own = Matcher::new(device, l.width, l.height, search.max_disparity)?;
+                own = Matcher::with_method(device, l.width, l.height, search.max_disparity, self.matcher)?;
                 &mut own
             }
         };
