@@ -1,6 +1,7 @@
 # viewsynth for GPU servers: a build stage with the Rust toolchain, and a slim Debian runtime with
 # glvnd's libEGL, Mesa (software fallback), the glvnd vendor file for NVIDIA's EGL, and the Python
-# package (its wheel built in the build stage; the runtime holds only the wheel and numpy).
+# package (its wheel built in the build stage; the runtime holds only the wheel, numpy
+# and Pillow).
 #
 #   docker build -t viewsynth .
 #   docker run --rm --gpus all -e NVIDIA_DRIVER_CAPABILITIES=graphics,utility \
@@ -17,7 +18,8 @@
 #       -v "$PWD:/work" viewsynth python3 my_augment.py
 #       the Python package (`import viewsynth`, numpy in and out) in /opt/viewsynth, a venv whose
 #       python3 comes first on PATH; `python`, `python3` and `pip` as the first argument run
-#       themselves instead of `viewsynth`. Extend it with `FROM viewsynth` and `RUN pip install ...`.
+#       themselves instead of `viewsynth`. The venv (numpy and Pillow too) belongs to the image's
+#       user, so `FROM viewsynth` and `RUN pip install ...` extend it as that user.
 # Outputs go under /work (the working directory, owned by the non-root user `viewsynth`, uid
 # 1000): mount a host folder there or at /work/out, e.g. -v "$PWD/out:/work/out" --user
 # "$(id -u):$(id -g)"; without one the entry point says the outputs will be lost, and how to
@@ -69,11 +71,12 @@ RUN cargo build --release --locked --bin viewsynth
 COPY python/pyproject.toml python/
 COPY python/src python/src
 COPY python/viewsynth python/viewsynth
+# With the `examples` extra (Pillow): the README's Python quick start reads PNGs with it.
 RUN /opt/maturin/bin/maturin build --release --locked --strip --manifest-path python/Cargo.toml \
       --interpreter python3 --out /wheels \
  && python3 -m venv /opt/viewsynth \
- && /opt/viewsynth/bin/pip install -q --no-cache-dir --disable-pip-version-check /wheels/viewsynth-*.whl \
- && /opt/viewsynth/bin/python -c "import viewsynth, numpy; print('viewsynth', viewsynth.__version__, 'numpy', numpy.__version__)"
+ && /opt/viewsynth/bin/pip install -q --no-cache-dir --disable-pip-version-check "$(echo /wheels/viewsynth-*.whl)[examples]" \
+ && /opt/viewsynth/bin/python -c "import viewsynth, numpy, PIL; print('viewsynth', viewsynth.__version__, 'numpy', numpy.__version__, 'Pillow', PIL.__version__)"
 
 FROM debian:bookworm-slim
 RUN apt-get update -qq \
@@ -91,11 +94,13 @@ RUN mkdir -p /usr/share/glvnd/egl_vendor.d \
 ENV NVIDIA_VISIBLE_DEVICES=all \
     NVIDIA_DRIVER_CAPABILITIES=graphics,utility \
     PATH=/opt/viewsynth/bin:$PATH
-COPY --from=build /src/target/release/viewsynth /usr/local/bin/viewsynth
-COPY --from=build /opt/viewsynth /opt/viewsynth
-COPY docker/entrypoint.sh /usr/local/bin/viewsynth-entrypoint
 RUN useradd --create-home --uid 1000 --user-group viewsynth \
  && mkdir -p /work/out && chown -R viewsynth:viewsynth /work
+COPY --from=build /src/target/release/viewsynth /usr/local/bin/viewsynth
+# The venv belongs to the image's user, so that `FROM viewsynth` + `RUN pip install ...` (run as
+# that user) adds packages to it without a switch to root.
+COPY --from=build --chown=viewsynth:viewsynth /opt/viewsynth /opt/viewsynth
+COPY docker/entrypoint.sh /usr/local/bin/viewsynth-entrypoint
 USER viewsynth
 WORKDIR /work
 ENTRYPOINT ["viewsynth-entrypoint"]

@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
 # Builds the Docker image and tries it: `info`, a refocus into a mounted folder as a non-root
-# uid, the Python package (a numpy frame refocused from `python3` in the container), the
+# uid, the Python package (a numpy frame refocused from `python3` in the container), the README's
+# Python quick start, a derived image (`FROM` it, `RUN pip install` into its venv), the
 # no-argument run (demo, and where its outputs went), and the VIEWSYNTH_REQUIRE_GPU=1 refusal of
 # a software renderer. Prints the build time and the image size.
 #
@@ -11,7 +12,8 @@
 # Where no image registry is reachable, it makes the base images itself: a Debian bookworm root
 # from debootstrap, imported as debian:bookworm-slim, and rust:1-bookworm built on it from this
 # machine's Rust toolchain. Where no daemon runs, it starts one as
-# `dockerd --iptables=false --bridge=none --storage-driver=vfs` (builds then use --network host).
+# `dockerd --iptables=false --bridge=none --storage-driver=overlay2` (vfs where overlay cannot be
+# mounted; builds then use --network host).
 #
 #   VIEWSYNTH_IMAGE   tag to build (viewsynth:smoke)
 #   DEBIAN_MIRROR     debootstrap mirror (http://deb.debian.org/debian)
@@ -43,18 +45,30 @@ DATA=$(cd "$DATA" && pwd)
 command -v docker >/dev/null || die "no docker client (Debian: apt-get install docker.io)"
 
 # --- a daemon ----------------------------------------------------------------------------------
+# Storage: overlay2 keeps each layer's changes only; vfs copies the whole tree per layer (over
+# 30 GB for this build's 30-odd steps), so it is the fallback where overlay cannot be mounted.
+start_dockerd() {
+  say "starting dockerd ($1 storage, no bridge, no iptables)"
+  dockerd --iptables=false --bridge=none --storage-driver="$1" >"$WORK/dockerd.log" 2>&1 &
+  DOCKERD_PID=$!
+  for _ in $(seq 60); do
+    docker info >/dev/null 2>&1 && return 0
+    if ! kill -0 "$DOCKERD_PID" 2>/dev/null; then
+      wait "$DOCKERD_PID" 2>/dev/null || true
+      DOCKERD_PID=
+      return 1
+    fi
+    sleep 1
+  done
+  die "dockerd did not answer within 60 s: $(tail -5 "$WORK/dockerd.log")"
+}
 if ! docker info >/dev/null 2>&1; then
   command -v dockerd >/dev/null || die "no docker daemon and no dockerd to start (Debian: apt-get install docker.io)"
   [ "$(id -u)" -eq 0 ] || die "no docker daemon running, and starting one needs root"
-  say "starting dockerd (vfs storage, no bridge, no iptables)"
-  dockerd --iptables=false --bridge=none --storage-driver=vfs >"$WORK/dockerd.log" 2>&1 &
-  DOCKERD_PID=$!
-  for _ in $(seq 60); do
-    docker info >/dev/null 2>&1 && break
-    kill -0 "$DOCKERD_PID" 2>/dev/null || die "dockerd exited: $(tail -5 "$WORK/dockerd.log")"
-    sleep 1
-  done
-  docker info >/dev/null 2>&1 || die "dockerd did not answer within 60 s: $(tail -5 "$WORK/dockerd.log")"
+  start_dockerd overlay2 || {
+    say "overlay2 refused ($(tail -1 "$WORK/dockerd.log")): vfs instead"
+    start_dockerd vfs || die "dockerd exited: $(tail -5 "$WORK/dockerd.log")"
+  }
 fi
 
 # --- base images ---------------------------------------------------------------------------------
@@ -162,6 +176,68 @@ out=$(run -v "$DATA:/data:ro" -v "$WORK/smoke.py:/smoke.py:ro" "$IMAGE" python3 
   die "the Python step failed: $out"
 line=$(grep '^python: viewsynth' <<<"$out") || die "the Python step printed no result: $out"
 say "$line"
+
+# The README's Python quick start (its first ```python block after "## Quick start: Python"), run
+# in the image from /work with the data at /shared/data (so its ../shared/data/ paths hold), its
+# stated `# =>` outputs checked as ci/readme-examples.sh checks them.
+python3 - "$ROOT" "$WORK/quickstart.py" <<'PY'
+import sys
+sys.path.insert(0, sys.argv[1] + "/ci")
+from readme_examples import blocks
+readme = open(sys.argv[1] + "/README.md", encoding="utf-8").read()
+heading = readme.splitlines().index("## Quick start: Python") + 1
+text = next(t for kind, line, t in blocks(readme) if kind == "python" and line > heading)
+open(sys.argv[2], "w", encoding="utf-8").write(text)
+PY
+chmod 644 "$WORK/quickstart.py"
+out=$(run -v "$DATA:/shared/data:ro" -v "$WORK/quickstart.py:/quickstart.py:ro" "$IMAGE" python3 /quickstart.py 2>&1) ||
+  die "the README's Python quick start failed in the image: $out"
+missing=$(
+  python3 - "$ROOT" "$WORK/quickstart.py" "$out" <<'PY'
+import sys
+sys.path.insert(0, sys.argv[1] + "/ci")
+from readme_examples import expectations, found
+stated = expectations(open(sys.argv[2], encoding="utf-8").read())
+print("; ".join(e for e in stated if not found(e, sys.argv[3])) if stated else "(it states no output)")
+PY
+)
+[ -z "$missing" ] || die "the README's Python quick start did not print: $missing (it printed: $out)"
+say "README Python quick start in the image: $(grep -v -e '^note:' -e '^ ' <<<"$out" | tr '\n' ';')"
+
+# A derived image, as docs/docker.md says to extend it: `FROM $IMAGE` + `RUN pip install`, run as
+# the image's user. It installs a one-module wheel made here (zipfile: no index needed), so the
+# step proves that pip can write the image's venv, whatever the network.
+DERIVED=$IMAGE-derived
+mkdir -p "$WORK/derived"
+python3 - "$WORK/derived" <<'PY'
+import base64, hashlib, sys, zipfile
+name = "viewsynth_smoke_ext-0.1"
+files = {
+    "viewsynth_smoke_ext.py": "MESSAGE = 'installed by RUN pip install in a derived image'\n",
+    f"{name}.dist-info/METADATA": "Metadata-Version: 2.1\nName: viewsynth-smoke-ext\nVersion: 0.1\n",
+    f"{name}.dist-info/WHEEL": "Wheel-Version: 1.0\nGenerator: docker-smoke\nRoot-Is-Purelib: true\nTag: py3-none-any\n",
+}
+def digest(text):
+    return "sha256=" + base64.urlsafe_b64encode(hashlib.sha256(text.encode()).digest()).rstrip(b"=").decode()
+record = "".join(f"{path},{digest(text)},{len(text.encode())}\n" for path, text in files.items())
+files[f"{name}.dist-info/RECORD"] = record + f"{name}.dist-info/RECORD,,\n"
+with zipfile.ZipFile(f"{sys.argv[1]}/{name}-py3-none-any.whl", "w") as whl:
+    for path, text in files.items():
+        whl.writestr(path, text)
+PY
+cat >"$WORK/derived/Dockerfile" <<DOCKERFILE
+FROM $IMAGE
+COPY viewsynth_smoke_ext-0.1-py3-none-any.whl /tmp/
+RUN pip install --no-index --no-cache-dir /tmp/viewsynth_smoke_ext-0.1-py3-none-any.whl
+DOCKERFILE
+docker build --network host -t "$DERIVED" "$WORK/derived" >"$WORK/derived.log" 2>&1 ||
+  die "building the derived image (FROM $IMAGE, RUN pip install) failed: $(tail -15 "$WORK/derived.log")"
+out=$(run "$DERIVED" python3 -c "import viewsynth, PIL, viewsynth_smoke_ext as m; print(m.__file__, '-', m.MESSAGE)" 2>&1) ||
+  die "the derived image cannot import what it installed: $out"
+grep -q "^/opt/viewsynth/lib/python3[.0-9]*/site-packages/viewsynth_smoke_ext.py - " <<<"$out" ||
+  die "the derived image's package is not in the image's venv: $out"
+say "derived image (FROM $IMAGE, RUN pip install as $(docker image inspect "$DERIVED" --format '{{.Config.User}}')): $(grep '^/opt' <<<"$out")"
+docker image rm "$DERIVED" >/dev/null 2>&1 || true
 
 # No arguments, no mount: info, the demo, and the note that its outputs are not kept.
 run "$IMAGE" >"$WORK/demo.log" 2>&1 || die "the no-argument run failed: $(tail -20 "$WORK/demo.log")"

@@ -135,7 +135,7 @@ DOCS_ORDER = ["scene", "refocus", "cyclopean", "compare", "reproject", "stereo",
 
 # The order of the commands whose `--help` examples run last, and the files the examples name
 # as a user's own (a manifest), written into the scratch repository first.
-HELP_ORDER = ["scene", "cyclopean", "compare", "refocus", "index", "reproject", "stitch", "info",
+HELP_ORDER = ["scene", "cyclopean", "compare", "refocus", "index", "manifest", "reproject", "stitch", "info",
               "bench", "stress", "report", "demo"]
 HELP_FIXTURES = {
     # Four rows (one TUM frame under four names): `refocus --help` renders one shard of four, and
@@ -143,6 +143,9 @@ HELP_FIXTURES = {
     "frames.csv": "rgb,depth,fx,fy,cx,cy,name\n" + "".join(
         "../shared/data/rgbd_open3d_testdata/TUM_color.png,../shared/data/rgbd_open3d_testdata/TUM_depth.png,"
         f"525,525,319.5,239.5,tum{k}\n" for k in range(4)),
+    # A TUM-style sequence for `manifest --help`: its one frame, listed by timestamp.
+    "tum_seq/rgb.txt": "# color images\n1305031102.175304 ../../shared/data/rgbd_open3d_testdata/TUM_color.png\n",
+    "tum_seq/depth.txt": "# depth maps\n1305031102.160407 ../../shared/data/rgbd_open3d_testdata/TUM_depth.png\n",
 }
 
 
@@ -181,6 +184,7 @@ def main():
     readme_path, scratch = sys.argv[1], sys.argv[2]
     repo = os.path.join(scratch, "repo")
     for name, text in HELP_FIXTURES.items():
+        os.makedirs(os.path.dirname(os.path.join(repo, name)), exist_ok=True)
         with open(os.path.join(repo, name), "w", encoding="utf-8") as f:
             f.write(text)
     # By hand: a third argument runs only the pages whose name holds it (e.g. "compare").

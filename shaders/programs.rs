@@ -294,6 +294,42 @@ pub const PROGRAMS: &[ProgramEntry] = &[
         vulkan: Some(&[]),
     },
     ProgramEntry {
+        name: "cyclopean/matcher_sgm_downsample",
+        stages: &[(
+            "comp",
+            &[MATCHER_COMMON[0], MATCHER_COMMON[1], "cyclopean/matcher_sgm.glsl", "cyclopean/matcher_sgm_downsample.comp"],
+        )],
+        switches: &[],
+        vulkan: Some(&[]),
+    },
+    ProgramEntry {
+        name: "cyclopean/matcher_sgm_cost",
+        stages: &[(
+            "comp",
+            &[MATCHER_COMMON[0], MATCHER_COMMON[1], "cyclopean/matcher_sgm.glsl", "cyclopean/matcher_sgm_cost.comp"],
+        )],
+        switches: &[],
+        vulkan: Some(&[]),
+    },
+    ProgramEntry {
+        name: "cyclopean/matcher_sgm_path",
+        stages: &[(
+            "comp",
+            &[MATCHER_COMMON[0], MATCHER_COMMON[1], "cyclopean/matcher_sgm.glsl", "cyclopean/matcher_sgm_path.comp"],
+        )],
+        switches: &[],
+        vulkan: Some(&[]),
+    },
+    ProgramEntry {
+        name: "cyclopean/matcher_sgm_winner",
+        stages: &[(
+            "comp",
+            &[MATCHER_COMMON[0], MATCHER_COMMON[1], "cyclopean/matcher_sgm.glsl", "cyclopean/matcher_sgm_winner.comp"],
+        )],
+        switches: &[],
+        vulkan: Some(&[]),
+    },
+    ProgramEntry {
         name: "reproject/shift",
         stages: &[
             ("vert", FULLSCREEN_VERT),

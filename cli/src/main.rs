@@ -73,6 +73,10 @@ mod info {
     pub(crate) mod args;
     pub(crate) mod run;
 }
+mod manifest {
+    pub(crate) mod args;
+    pub(crate) mod run;
+}
 mod refocus {
     pub(crate) mod args;
     pub(crate) mod run;
@@ -127,6 +131,10 @@ enum Command {
     /// row per target (frame, scale, K', size, coverage, files).
     #[command(after_help = SHORT_HELP_NOTE, after_long_help = index::args::EXAMPLES)]
     Index(index::args::IndexArgs),
+    /// Make a `refocus --batch` manifest (CSV) from a TUM-style RGB-D sequence: rgb.txt and
+    /// depth.txt paired by nearest timestamp, with the dataset's intrinsics and depth scale.
+    #[command(allow_negative_numbers = true, after_help = SHORT_HELP_NOTE, after_long_help = manifest::args::EXAMPLES)]
+    Manifest(manifest::args::ManifestArgs),
     /// Synthesise the middle (spectator) view of a stereo pair from each eye's colour and depth.
     #[command(allow_negative_numbers = true, after_help = SHORT_HELP_NOTE, after_long_help = cyclopean::args::EXAMPLES)]
     Cyclopean(Box<cyclopean::args::CyclopeanArgs>),
@@ -286,6 +294,7 @@ fn run(command: Command) -> Result<ExitCode> {
         Command::Info(a) => info::run::info(&job(a)?)?,
         Command::Refocus(a) => refocus::run::refocus(job(*a)?)?,
         Command::Index(a) => index::run::index(&a)?,
+        Command::Manifest(a) => manifest::run::manifest(&job(a)?)?,
         Command::Cyclopean(a) => cyclopean::run::cyclopean(&job(*a)?)?,
         Command::Reproject(a) => reproject::run::reproject(&job(*a)?)?,
         Command::Stitch(a) => stitch::run::stitch(&job(*a)?)?,

@@ -133,7 +133,7 @@ pub fn run_with_progress(
     reproject_outputs(device, &reproject_dir)?;
     stages.start("demo: stitched stereo panoramas");
     stitch_outputs(device, &stitch_dir)?;
-    let mut written = crate::eval::report_stages(device, out_dir, None, &[], None, 3, &stages)?;
+    let mut written = crate::eval::report_stages(device, out_dir, None, &[], &[], 3, &stages)?;
     written.files.push(path);
     Ok(written)
 }

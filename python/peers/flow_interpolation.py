@@ -9,7 +9,9 @@ pixels (8-bit peak) as JSON on stdout: {"psnr_db": ...}. `viewsynth report --dat
 --flow-peer DIR` scores images written this way beside viewsynth's own rows, one per real pair
 with a true middle view, each named after its pair: DIR/cones_2_6_4.png (Middlebury 2003 Cones
 im2 + im6 -> im4), DIR/tsukuba_2_4_3.png and DIR/tsukuba_1_5_3.png (Tsukuba views 2 + 4 and
-1 + 5 -> 3); a pair whose set DATA holds and whose file is missing fails the report.
+1 + 5 -> 3), DIR/art_1_5_3.png ... DIR/midd2_1_5_3.png (the Middlebury 2005/2006 development
+scenes, view1 + view5 -> view3); a pair whose set DATA holds and whose file is missing fails the
+report. python/peers/rife_interpolation.py writes the RIFE peer's the same way (--rife-peer).
 docs/report.md ("The optical-flow peer") has the shell loop that writes them all. Needs
 opencv-python(-headless) and numpy; neither is a dependency of viewsynth.
 """

@@ -194,6 +194,8 @@ pub struct BatchArgs<'a, 'py> {
     pub exr_compression: &'a str,
     pub depth_trunc: Option<f64>,
     pub resume: bool,
+    /// With resume: also check every finished file's CRC-32 and every input's content.
+    pub verify: bool,
     pub jobs: Option<usize>,
     pub shard: Option<&'a str>,
     /// Write the index part (and join it); False where the caller splits the manifest itself.
@@ -209,7 +211,7 @@ impl Renderer {
     #[pyo3(signature = (frames, out_dir, *, scales = None, size = None, principal = None,
                         outputs = None, tau_rel = 0.05, tau_abs = 0.2, method = "fullscreen", rgb_format = "png",
                         depth_format = None, depth_png_scale = None, depth_preview = false, png_compression = "fast",
-                        exr_compression = "zip", depth_trunc = None, resume = true, jobs = None, shard = None,
+                        exr_compression = "zip", depth_trunc = None, resume = true, verify = false, jobs = None, shard = None,
                         rgb_everywhere = false, zoom_random = None, samples = None, seed = None, progress = None,
                         index = true))]
     fn refocus_batch<'py>(
@@ -232,6 +234,7 @@ impl Renderer {
         exr_compression: &str,
         depth_trunc: Option<f64>,
         resume: bool,
+        verify: bool,
         #[pyo3(from_py_with = crate::ints::jobs)] jobs: Option<usize>,
         shard: Option<&str>,
         rgb_everywhere: bool,
@@ -263,6 +266,7 @@ impl Renderer {
                 exr_compression,
                 depth_trunc,
                 resume,
+                verify,
                 jobs,
                 shard,
                 index,
@@ -297,7 +301,7 @@ pub fn options(a: &BatchArgs<'_, '_>) -> PyResult<BatchOptions> {
         exr_compression: a.exr_compression.to_string(),
         depth_trunc: a.depth_trunc,
         resume: a.resume,
-        verify: false,
+        verify: a.verify,
         jobs: a.jobs,
         shard: a.shard.map(str::to_string),
         rgb_everywhere: a.augment.rgb_everywhere,

@@ -44,7 +44,7 @@ impl Renderer {
                         left_depth = None, right_depth = None, cameras = None, method = None,
                         refine_steps = None, blend = None, z_threshold = None, dominant = None,
                         focal = None, baseline = None, doffs = 0.0, outputs = None, fill = false,
-                        max_disparity = None, min_confidence = None, confidence = false))]
+                        max_disparity = None, min_confidence = None, confidence = false, matcher = None))]
     fn cyclopean<'py>(
         &self,
         py: Python<'py>,
@@ -69,6 +69,7 @@ impl Renderer {
         #[pyo3(from_py_with = crate::ints::max_disparity)] max_disparity: Option<u32>,
         min_confidence: Option<f64>,
         confidence: bool,
+        matcher: Option<&str>,
     ) -> PyResult<Bound<'py, PyDict>> {
         let (gpu, _busy) = self.enter()?;
         // The settings as the library's request: it alone decides and checks them.
@@ -88,6 +89,7 @@ impl Renderer {
             min_disparity: None,
             min_confidence,
             confidence,
+            matcher: matcher.map(|m| choice("--matcher", m)).transpose()?,
         };
         cyclopean(
             py,

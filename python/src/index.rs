@@ -64,6 +64,7 @@ pub fn write_index<'py>(
         exr_compression,
         depth_trunc,
         resume: true,
+        verify: false,
         jobs: None,
         shard: None,
         index: true,

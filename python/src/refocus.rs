@@ -44,7 +44,7 @@ impl Renderer {
         rgb: &Bound<'py, PyAny>,
         depth: &Bound<'py, PyAny>,
         K: &Bound<'py, PyAny>,
-        scales: Option<Vec<f64>>,
+        scales: Option<&Bound<'py, PyAny>>,
         K_out: Option<&Bound<'py, PyAny>>,
         #[pyo3(from_py_with = crate::ints::size)] size: Option<(u32, u32)>,
         principal: Option<(f64, f64)>,
@@ -69,14 +69,23 @@ impl Renderer {
             rgb_everywhere,
         };
         let stacked = stack::frames(rgb, depth, K)?;
+        // Per frame: the one list, or (a stack) each sample's own.
+        let mut scales = match stack::scales(scales)? {
+            Some(s) => s
+                .per_frame(stacked.as_ref().map(Vec::len))?
+                .into_iter()
+                .map(Some)
+                .collect(),
+            None => vec![None; stacked.as_ref().map_or(1, Vec::len)],
+        };
         let (gpu, _busy) = self.enter()?;
         let Some(frames) = stacked else {
-            return refocus(py, gpu, args(rgb, depth, K, scales));
+            return refocus(py, gpu, args(rgb, depth, K, scales.pop().flatten()));
         };
         // One call over a stack: each frame as a call of its own, the Renderer busy throughout.
         let views = PyList::empty(py);
-        for (rgb, depth, k) in &frames {
-            views.append(refocus(py, gpu.clone(), args(rgb, depth, k, scales.clone()))?)?;
+        for ((rgb, depth, k), scales) in frames.iter().zip(scales) {
+            views.append(refocus(py, gpu.clone(), args(rgb, depth, k, scales))?)?;
         }
         Ok(views)
     }

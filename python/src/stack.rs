@@ -46,3 +46,69 @@ pub fn frames<'py>(
         .collect::<PyResult<Vec<_>>>()
         .map(Some)
 }
+
+/// `scales` as given: one list for every frame, or (a stack only) one list per sample, as
+/// Kornia-style augmentation draws them: a list of lists, or a float array (N, k).
+pub enum Scales {
+    /// One list of scales for the frame or for every frame of a stack.
+    Shared(Vec<f64>),
+    /// A list of scales per frame of a stack.
+    PerSample(Vec<Vec<f64>>),
+}
+
+/// Reads `scales`: a 1-D array or a flat sequence is [`Scales::Shared`]; a 2-D array, or a
+/// sequence whose items are sequences, is [`Scales::PerSample`]. The array's dimensions decide
+/// (not whether an item converts to a float: a (N, 1) array's rows would).
+pub fn scales(given: Option<&Bound<'_, PyAny>>) -> PyResult<Option<Scales>> {
+    let Some(given) = given else { return Ok(None) };
+    let expected = "expected a list of numbers, or per sample of a stack a list of lists or an (N, k) array";
+    let floats = |item: &Bound<'_, PyAny>, what: &str| {
+        item.extract::<Vec<f64>>()
+            .map_err(|_| errors::invalid("scales", format!("{what}: {expected}")))
+    };
+    let nested = match given.cast::<PyUntypedArray>() {
+        Ok(array) => match array.ndim() {
+            1 => false,
+            2 => true,
+            d => return Err(errors::invalid("scales", format!("a {d}-D array: {expected}"))),
+        },
+        Err(_) => {
+            let is_sequence = |o: &Bound<'_, PyAny>| {
+                o.cast::<PyUntypedArray>().is_ok()
+                    || o.cast::<pyo3::types::PyList>().is_ok()
+                    || o.cast::<pyo3::types::PyTuple>().is_ok()
+            };
+            given.len().is_ok() && given.len()? > 0 && is_sequence(&given.get_item(0)?)
+        }
+    };
+    if !nested {
+        return Ok(Some(Scales::Shared(floats(given, "scales")?)));
+    }
+    let mut rows = Vec::new();
+    for (i, row) in given.try_iter()?.enumerate() {
+        rows.push(floats(&row?, &format!("scales[{i}]"))?);
+    }
+    Ok(Some(Scales::PerSample(rows)))
+}
+
+impl Scales {
+    /// The scales of each of `n` frames (`n` None: a single frame), or why they do not fit.
+    pub fn per_frame(self, n: Option<usize>) -> PyResult<Vec<Vec<f64>>> {
+        match (self, n) {
+            (Scales::Shared(s), None) => Ok(vec![s]),
+            (Scales::Shared(s), Some(n)) => Ok(vec![s; n]),
+            (Scales::PerSample(_), None) => Err(errors::invalid(
+                "scales",
+                "a list per sample is for a stack (rgb uint8[N, H, W, 3]); one frame takes one list",
+            )),
+            (Scales::PerSample(rows), Some(n)) if rows.len() != n => Err(errors::invalid(
+                "scales",
+                format!(
+                    "{} lists of scales for a stack of {n} frames: give one per frame",
+                    rows.len()
+                ),
+            )),
+            (Scales::PerSample(rows), Some(_)) => Ok(rows),
+        }
+    }
+}

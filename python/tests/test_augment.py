@@ -110,3 +110,31 @@ def test_a_stack_of_four_equals_four_single_calls(renderer):
         renderer.refocus(rgb, depth[0], Ks)
     with pytest.raises(vs.InvalidInputError, match="K"):
         renderer.refocus(rgb, depth, Ks[:3])
+
+
+def test_a_stack_takes_scales_per_sample(renderer):
+    frames = [make_frame(48, 36, seed=s) for s in range(3)]
+    rgb = np.stack([f[0] for f in frames])
+    depth = np.stack([f[1] for f in frames])
+    K = frames[0][2]
+    draws = np.array([[0.6, 1.2], [0.8, 1.7], [1.1, 0.9]])  # (N, k), as Kornia draws per sample
+    for scales in (draws, draws.tolist()):
+        stacked = renderer.refocus(rgb, depth, K, scales=scales)
+        assert len(stacked) == 3
+        for i, views in enumerate(stacked):
+            assert [v["scale"] for v in views] == pytest.approx(list(draws[i]))
+            single = renderer.refocus(rgb[i], depth[i], K, scales=list(draws[i]))
+            for a, b in zip(views, single):
+                assert np.array_equal(a["rgb"], b["rgb"]) and np.array_equal(a["mask"], b["mask"]), i
+    # An (N, 1) array is one scale per sample, never N scales for every frame.
+    per_sample = renderer.refocus(rgb, depth, K, scales=draws[:, :1])
+    assert [len(views) for views in per_sample] == [1, 1, 1]
+    assert [views[0]["scale"] for views in per_sample] == pytest.approx([0.6, 0.8, 1.1])
+    with pytest.raises(vs.InvalidInputError, match=r"scales: 2 lists of scales for a stack of 3 frames"):
+        renderer.refocus(rgb, depth, K, scales=draws[:2])
+    with pytest.raises(vs.InvalidInputError, match=r"scales: a list per sample is for a stack"):
+        renderer.refocus(rgb[0], depth[0], K, scales=draws)
+    with pytest.raises(vs.InvalidInputError, match=r"scales\[1\]"):
+        renderer.refocus(rgb, depth, K, scales=[[1.0], "x", [1.0]])
+    with pytest.raises(vs.InvalidInputError, match=r"scales: a 3-D array"):
+        renderer.refocus(rgb, depth, K, scales=draws[None])

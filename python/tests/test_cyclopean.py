@@ -175,6 +175,7 @@ def test_bad_inputs(renderer, pair):
     check(renderer, pair, "doffs", ["finite"], doffs=float("inf"))
     check(renderer, pair, "outputs", ["needs focal and baseline"], outputs=("rgb", "depth"))
     check(renderer, pair, "outputs", [], outputs=("rgb", "normals"))
+    check(renderer, pair, "matcher", ["two images alone"], matcher="sgm")
     # Nothing was left broken: a good call still works.
     assert renderer.cyclopean(*pair)["coverage"] > 0.5
 
@@ -256,3 +257,47 @@ def test_two_images_alone_equal_cli(renderer, cli, pair, tmp_path):
     with pytest.raises(vs.InvalidInputError) as err:
         renderer.cyclopean(pair[0], pair[1], max_disparity=pair[0].shape[1])
     assert err.value.parameter == "left_rgb" and "less than the width" in str(err.value)
+
+
+def test_fill_densifies_a_hole_in_given_disparities(renderer):
+    """fill=True densifies given disparities before rendering (the CLI's --fill): a hole in both
+    maps on a textured plane at disparity 4 renders the plane's own texture, marked "filled", not
+    the 2-D fill's guess from the sides (cli/tests/integration/cyclopean_given_dense.rs)."""
+    h, w = 24, 48
+    rng = np.random.default_rng(7)
+    texture = rng.integers(0, 256, (h, w + 4, 3), dtype=np.uint8)  # middle column x at x + 2
+    left, right, middle = (np.ascontiguousarray(texture[:, s : s + w]) for s in (0, 4, 2))
+    rows, cols = slice(8, 16), slice(18, 26)  # the hole, in the middle view's columns
+
+    def disparity(to_middle):
+        d = np.full((h, w), 4.0, np.float32)
+        d[rows, cols.start - to_middle : cols.stop - to_middle] = 0.0
+        return d
+
+    view = renderer.cyclopean(left, right, disparity(-2), disparity(2), fill=True)
+    hole = np.zeros((h, w), bool)
+    hole[rows, cols] = True
+    assert view["filled"][hole].all() and not view["mask"][hole].any()
+    assert view["mask"][~hole].all(), "pixels of given disparities stay rendered"
+    diff = np.abs(view["rgb"].astype(int) - middle.astype(int))[hole]
+    assert diff.max() <= 1, f"the hole is off by up to {diff.max()} levels: filled, not rendered"
+
+
+def test_two_images_alone_with_the_semi_global_matcher_equal_cli(renderer, cli, pair, tmp_path):
+    """matcher="sgm": the semi-global matcher, the CLI's --matcher sgm view exactly (not the
+    census matcher's); an unknown matcher is refused by name."""
+    view = renderer.cyclopean(pair[0], pair[1], max_disparity=32, matcher="sgm")
+    paths = [tmp_path / "l.png", tmp_path / "r.png"]
+    Image.fromarray(pair[0]).save(paths[0])
+    Image.fromarray(pair[1]).save(paths[1])
+    out = tmp_path / "out"
+    done = subprocess.run([str(cli), "cyclopean", "--left-rgb", str(paths[0]), "--right-rgb", str(paths[1]),
+                           "--max-disparity", "32", "--matcher", "sgm", "--out-dir", str(out)],
+                          capture_output=True, text=True)
+    assert done.returncode == 0, done.stderr
+    assert np.array_equal(view["rgb"], np.asarray(Image.open(out / "middle_rgb.png").convert("RGB")))
+    census = renderer.cyclopean(pair[0], pair[1], max_disparity=32, matcher="census")
+    assert not np.array_equal(view["rgb"], census["rgb"])
+    with pytest.raises(vs.InvalidInputError) as err:
+        renderer.cyclopean(pair[0], pair[1], matcher="graph-cut")
+    assert "graph-cut" in str(err.value)

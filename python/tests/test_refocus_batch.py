@@ -87,11 +87,11 @@ def test_write_index_takes_refocus_batchs_settings_with_the_same_defaults():
     # write_index keeps a frame's rows only where its manifest records these settings, so its
     # keywords must be refocus_batch's settings, same names, order and defaults. pyo3 takes each
     # signature as a literal (python/src/index.rs and batch.rs write the list twice): this
-    # holds the two together. What only steers a run (resume, jobs, shard, progress, index)
+    # holds the two together. What only steers a run (resume, verify, jobs, shard, progress, index)
     # is not a setting.
     import inspect
 
-    run_only = {"self", "resume", "jobs", "shard", "progress", "index"}
+    run_only = {"self", "resume", "verify", "jobs", "shard", "progress", "index"}
     batch = inspect.signature(vs.Renderer.refocus_batch).parameters.values()
     index = inspect.signature(vs.write_index).parameters.values()
     want = [(p.name, p.kind, p.default) for p in batch if p.name not in run_only]
@@ -126,3 +126,21 @@ def test_refocus_batch_bad_inputs(renderer, tmp_path):
     batch_error(renderer, tmp_path, [frame], "scales", ["no target given"], scales=[])
     batch_error(renderer, tmp_path, [frame], "tau", [], tau_rel=-1.0)
     assert not (tmp_path / "out").exists()  # nothing written for a refused call
+
+
+def test_verify_redoes_a_frame_whose_file_changed_with_its_size_kept(renderer, tmp_path):
+    frames = vs.load_manifest(write_manifest(tmp_path / "in"))[1:2]
+    out = tmp_path / "py"
+    assert renderer.refocus_batch(frames, out, scales=[1.0], jobs=1)["rendered"] == 1
+    rgb = out / frames[0]["name"] / "s1_rgb.png"
+    good = rgb.read_bytes()
+    changed = bytearray(good)
+    changed[len(changed) // 2] ^= 0xFF
+    rgb.write_bytes(bytes(changed))
+    # Resume checks sizes (the commit journal makes a frame all-or-none); verify=True, as the
+    # CLI's --verify, checks every file's CRC-32 and redoes the frame.
+    assert renderer.refocus_batch(frames, out, scales=[1.0], jobs=1)["skipped"] == 1
+    summary = renderer.refocus_batch(frames, out, scales=[1.0], jobs=1, verify=True)
+    assert (summary["rendered"], summary["skipped"]) == (1, 0)
+    assert rgb.read_bytes() == good
+    assert renderer.refocus_batch(frames, out, scales=[1.0], jobs=1, verify=True)["skipped"] == 1

@@ -11,6 +11,7 @@
     rows = vs.read_index("out/")             # one dict per target; vs.read_depth(rows[0]["depth"],
                                              #   depth_scale=rows[0].get("depth_scale"))
     vs.write_index(frames, "out/")           # after shares rendered with refocus_batch(index=False)
+    ds = vs.IndexDataset("out/")             # ds[i]: one target's arrays; ds.torch() for a DataLoader
 
 A Renderer belongs to the thread that created it, and to the process that created it:
 see the Renderer docstring for threads, fork and spawn.
@@ -18,6 +19,7 @@ see the Renderer docstring for threads, fork and spawn.
 
 from ._viewsynth import FACE_ORDER, Renderer, __version__, info, load_manifest, read_depth, write_index
 from .dataset import read_index
+from .index_dataset import IndexDataset
 from .errors import (
     FileError,
     GpuError,
@@ -36,6 +38,7 @@ __all__ = [
     "load_manifest",
     "read_depth",
     "read_index",
+    "IndexDataset",
     "write_index",
     "FACE_ORDER",
     "__version__",

@@ -174,7 +174,7 @@ class Renderer:
         depth: npt.NDArray[np.float32],
         K: ArrayLike3x3,
         *,
-        scales: Optional[Sequence[float]] = None,
+        scales: Optional[Union[Sequence[float], Sequence[Sequence[float]], npt.NDArray[np.floating[Any]]]] = None,
         K_out: Optional[Union[Sequence[ArrayLike3x3], npt.NDArray[np.floating[Any]]]] = None,
         size: Optional[Tuple[int, int]] = None,
         principal: Optional[Tuple[float, float]] = None,
@@ -186,6 +186,7 @@ class Renderer:
     ) -> List[RefocusView]:
         """Re-render rgb uint8[H, W, 3] + depth float32[H, W] (metres) with intrinsics K at
         other focal lengths (scales=[...] or K_out=[...]), same pose. size is (width, height).
+        A stack (rgb [N, H, W, 3]) takes one list of scales or one per sample ([N, k]).
         See help(viewsynth.Renderer.refocus)."""
         ...
     def cyclopean(
@@ -212,6 +213,7 @@ class Renderer:
         max_disparity: Optional[int] = None,
         min_confidence: Optional[float] = None,
         confidence: bool = False,
+        matcher: Optional[Literal["census", "sgm"]] = None,
     ) -> CyclopeanView:
         """Synthesise an in-between view of a stereo pair (rgb uint8[H, W, 3] per eye), as
         `viewsynth cyclopean`, from either
@@ -224,7 +226,8 @@ class Renderer:
           or gaze). The view is the middle camera's; or
         - the two images alone: the disparities are estimated by the census matcher over
           0..=max_disparity px; min_confidence drops the estimates it trusts less, and
-          confidence=True returns each eye's confidence ("left_confidence", "right_confidence").
+          confidence=True returns each eye's confidence ("left_confidence", "right_confidence");
+          matcher="sgm" matches semi-globally (smooth where there is no texture).
         See help(viewsynth.Renderer.cyclopean)."""
         ...
     def gl_objects(self) -> GlObjectCounts:
@@ -301,6 +304,7 @@ class Renderer:
         exr_compression: Literal["none", "rle", "zip", "piz"] = "zip",
         depth_trunc: Optional[float] = None,
         resume: bool = True,
+        verify: bool = False,
         jobs: Optional[int] = None,
         shard: Optional[str] = None,
         rgb_everywhere: bool = False,

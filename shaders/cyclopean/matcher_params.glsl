@@ -8,6 +8,12 @@ layout(std140, binding = 0) PARAM_BLOCK MatcherParams {
     int u_max_disparity;  // disparities 0..=u_max_disparity are searched
     int u_first_d;        // the chunk's first disparity (even)
     int u_pairs;          // words per pixel in the chunk buffers: disparity pairs, 16-bit lanes
+    // The semi-global matcher's stages (matcher_sgm_*.comp) only:
+    int u_window;         // disparities each pixel of the level searches
+    ivec2 u_direction;    // the path stage's step (dx, dy)
+    ivec2 u_other_size;   // the finer level (downsample) or the coarser one (cost; 0 = none)
+    int u_final;          // winner stage: 1 at the pair's own level (winners), 0 (guides)
+    int u_pad;
 };
 
 const int CENSUS_HALF_W = 3;

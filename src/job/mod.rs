@@ -16,6 +16,7 @@ mod intrinsics;
 
 pub mod compare;
 pub mod cyclopean;
+pub mod manifest;
 pub mod refocus;
 pub mod reproject;
 pub mod scene;

@@ -89,8 +89,8 @@ pub enum StitchBlend {
     Reproject,
 }
 
-/// The stages of the census stereo matcher (src/cyclopean/matcher/), one compute program each,
-/// in the order a run dispatches them.
+/// The stages of the stereo matchers (src/cyclopean/matcher/: census, then semi-global), one
+/// compute program each.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum MatcherStage {
     /// Grey levels of both eyes.
@@ -111,11 +111,19 @@ pub enum MatcherStage {
     Median,
     /// Each eye's confidence in its final disparity (where asked for).
     Confidence,
+    /// Semi-global: the next coarser level's grey levels.
+    SgmDownsample,
+    /// Semi-global: one level's window starts and cost volume.
+    SgmCost,
+    /// Semi-global: one path direction's costs added into the sums.
+    SgmPath,
+    /// Semi-global: winner takes all on the sums, both eyes.
+    SgmWinner,
 }
 
 impl MatcherStage {
     /// Every stage, in dispatch order.
-    pub const ALL: [MatcherStage; 9] = [
+    pub const ALL: [MatcherStage; 13] = [
         MatcherStage::Grey,
         MatcherStage::Census,
         MatcherStage::Rows,
@@ -125,6 +133,10 @@ impl MatcherStage {
         MatcherStage::LrCheck,
         MatcherStage::Median,
         MatcherStage::Confidence,
+        MatcherStage::SgmDownsample,
+        MatcherStage::SgmCost,
+        MatcherStage::SgmPath,
+        MatcherStage::SgmWinner,
     ];
 
     fn program_name(self) -> &'static str {
@@ -138,6 +150,10 @@ impl MatcherStage {
             MatcherStage::LrCheck => "cyclopean/matcher_lr_check",
             MatcherStage::Median => "cyclopean/matcher_median",
             MatcherStage::Confidence => "cyclopean/matcher_confidence",
+            MatcherStage::SgmDownsample => "cyclopean/matcher_sgm_downsample",
+            MatcherStage::SgmCost => "cyclopean/matcher_sgm_cost",
+            MatcherStage::SgmPath => "cyclopean/matcher_sgm_path",
+            MatcherStage::SgmWinner => "cyclopean/matcher_sgm_winner",
         }
     }
 }

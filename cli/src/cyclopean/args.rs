@@ -7,6 +7,7 @@ use crate::options::{BackendArg, GpuArgs};
 use crate::options::{GPU, INPUTS, INTRINSICS, METHOD, OUTPUTS, TARGETS};
 use clap::{Args, ValueEnum};
 use std::path::PathBuf;
+use viewsynth::cyclopean::matcher::MatcherMethod;
 use viewsynth::cyclopean::Blend;
 use viewsynth::job::cyclopean::{
     CyclopeanJob, CyclopeanMethod, CyclopeanOptions, CyclopeanRequest, CyclopeanSequenceJob,
@@ -17,6 +18,16 @@ use viewsynth::job::{finite_value, ArgError};
 pub(crate) enum BlendArg {
     Hard,
     Soft,
+}
+
+#[derive(Clone, Copy, PartialEq, Eq, ValueEnum)]
+pub(crate) enum MatcherArg {
+    /// Census costs averaged over a 9 x 9 box, winner takes all: precise where there is
+    /// texture, unknown where there is none.
+    Census,
+    /// Semi-global matching of the census costs along 8 paths (coarse to fine for wide
+    /// searches): smooth, so low-texture regions take the surrounding surface's disparity.
+    Sgm,
 }
 
 #[derive(Clone, Copy, PartialEq, Eq, ValueEnum)]
@@ -137,14 +148,14 @@ pub(crate) struct CyclopeanArgs {
     /// Fill the holes (pixels no eye saw) so the frame is complete; filled pixels are 128 in
     /// middle_mask.png.
     ///
-    /// Two images alone first render on disparities made dense (unknown ones filled from
-    /// similar-coloured neighbours, leaning to the background), then every remaining hole takes
-    /// the background layer around it in 2-D. Filled pixels are 128 in middle_mask.png (rendered
-    /// from matched or given disparities: 255). Off: holes stay 0.
+    /// Disparities, given or estimated from two images alone, first render on maps made dense
+    /// (unknown ones filled from similar-coloured neighbours, leaning to the background), then
+    /// every remaining hole takes the background layer around it in 2-D. Filled pixels are 128 in
+    /// middle_mask.png (rendered from matched or given disparities: 255). Off: holes stay 0.
     #[arg(help_heading = OUTPUTS, long)]
     fill: bool,
-    /// Two images alone (no disparities, no depth): the largest disparity the census matcher
-    /// searches, pixels.
+    /// Two images alone (no disparities, no depth): the largest disparity the matcher searches,
+    /// pixels.
     ///
     /// Default: estimated from the images by a coarse pass, with a margin; the range used is
     /// printed. The search is bounded: at most 1024 disparities past 0 (max - min when the
@@ -168,6 +179,12 @@ pub(crate) struct CyclopeanArgs {
     /// --min-confidence is held against.
     #[arg(help_heading = OUTPUTS, long)]
     confidence: bool,
+    /// Two images alone: the stereo matcher [default: census].
+    ///
+    /// sgm is smoother (low-texture regions take the surrounding surface's disparity, so more
+    /// pixels are rendered) but less precise on textured ones; see docs/cyclopean.md.
+    #[arg(help_heading = INPUTS, long, value_enum)]
+    matcher: Option<MatcherArg>,
     /// Writes middle_rgb.png, middle_depth.exr, middle_mask.png (those in --outputs), and
     /// left_confidence.exr, right_confidence.exr with --confidence; with --sequence,
     /// middle_00000_rgb.png, ... per frame.
@@ -208,6 +225,10 @@ impl CyclopeanArgs {
             min_disparity: self.min_disparity,
             min_confidence: self.min_confidence,
             confidence: self.confidence,
+            matcher: self.matcher.map(|m| match m {
+                MatcherArg::Census => MatcherMethod::Census,
+                MatcherArg::Sgm => MatcherMethod::Sgm,
+            }),
         })
     }
 }

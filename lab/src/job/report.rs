@@ -15,9 +15,9 @@ pub struct ReportJob {
     pub data_dir: Option<PathBuf>,
     /// User cyclopean cases laid out as `viewsynth scene` writes them.
     pub cases: Vec<PathBuf>,
-    /// Folder with the optical-flow peer's middle views, one per real pair
-    /// ([`crate::eval::flow_peer`]); needs `data_dir`.
-    pub flow_peer: Option<PathBuf>,
+    /// The interpolating peers' folders of middle views, one image per real pair
+    /// ([`crate::eval::flow_peer`]: DIS flow, RIFE); need `data_dir`.
+    pub peers: Vec<crate::eval::flow_peer::PeerImages>,
     /// Timed repetitions per row.
     pub repeats: usize,
     /// The GPU to render on.
@@ -51,9 +51,11 @@ impl ReportJob {
                 host.event(Event::EmptyDataDir(d));
             }
         }
-        if let (Some(data), Some(peer)) = (&self.data_dir, &self.flow_peer) {
-            // A missing peer image fails the run before the GPU opens or a row is measured.
-            crate::eval::flow_peer::check_flow_peer(data, peer)?;
+        if let Some(data) = &self.data_dir {
+            for images in &self.peers {
+                // A missing peer image fails the run before the GPU opens or a row is measured.
+                crate::eval::flow_peer::check_peer(data, images)?;
+            }
         }
         let device = host.open_device(&self.gpu, viewsynth::job::Backend::Gl)?;
         let files = crate::eval::run_report_with_progress(
@@ -61,7 +63,7 @@ impl ReportJob {
             &self.out_dir,
             self.data_dir.as_deref(),
             &self.cases,
-            self.flow_peer.as_deref(),
+            &self.peers,
             self.repeats,
             &HostStages(host),
         );

@@ -3,7 +3,8 @@
 //! [`Matcher`] is made for one image size and search range; its buffers are created once and
 //! its input images rewritten for each pair, so a stream of pairs creates nothing.
 
-use super::{check_pair, check_range};
+use super::sgm::gpu::{Planned, SgmStages};
+use super::{check_pair, check_range, MatcherMethod};
 use crate::convention::RowOrder;
 use crate::error::{Error, Result};
 use crate::gpu::shaders::MatcherStage;
@@ -20,6 +21,11 @@ crate::param_block! {
         u_max_disparity: i32,
         u_first_d: i32,
         u_pairs: i32,
+        u_window: i32,
+        u_direction: [i32; 2],
+        u_other_size: [i32; 2],
+        u_final: i32,
+        u_pad: i32,
     }
 }
 
@@ -68,6 +74,8 @@ pub struct Matcher {
     /// Sub-pixel disparities, then the checked ones, both eyes (f32 bits).
     raw: Buffer,
     checked: Buffer,
+    /// The semi-global stages' buffers, where the matcher is the semi-global one.
+    sgm: Option<SgmStages>,
 }
 
 impl Matcher {
@@ -75,6 +83,18 @@ impl Matcher {
     /// [`Device`], or a GL context). Fails as [`super::estimate_disparities`] does on the range,
     /// and on a size the device cannot hold or above [`MAX_PIXELS`].
     pub fn new(device: impl ToDevice, width: u32, height: u32, max_disparity: u32) -> Result<Self> {
+        Self::with_method(device, width, height, max_disparity, MatcherMethod::Census)
+    }
+
+    /// [`Matcher::new`] for the matcher `method` names: its disparities are that method's twin's
+    /// ([`MatcherMethod::estimate_reference`]) bit for bit.
+    pub fn with_method(
+        device: impl ToDevice,
+        width: u32,
+        height: u32,
+        max_disparity: u32,
+        method: MatcherMethod,
+    ) -> Result<Self> {
         check_range(width, max_disparity)?;
         let device = device.to_device()?;
         device.check_image_size("stereo pair", width, height)?;
@@ -88,11 +108,16 @@ impl Matcher {
         let pairs = (max_disparity as usize + 1).div_ceil(2);
         let chunk_pairs = pairs.min((CHUNK_WORDS / n).max(1));
         let buffer = |words: usize, label: &str| device.create_buffer(words, label);
+        let (sgm, chunk_words) = match method {
+            MatcherMethod::Census => (None, chunk_pairs * n),
+            MatcherMethod::Sgm => (Some(SgmStages::new(&device, width, height, max_disparity)?), 1),
+        };
         Ok(Matcher {
+            sgm,
             greys: buffer(n, "matcher grey levels")?,
             codes: buffer(4 * n, "matcher census codes")?,
-            means: buffer(chunk_pairs * n, "matcher means")?,
-            rows: buffer(chunk_pairs * n, "matcher row sums")?,
+            means: buffer(chunk_words, "matcher means")?,
+            rows: buffer(chunk_words, "matcher row sums")?,
             winners: [
                 buffer(4 * n, "matcher left winners")?,
                 buffer(4 * n, "matcher right winners")?,
@@ -147,6 +172,11 @@ impl Matcher {
             u_max_disparity: self.max_disparity as i32,
             u_first_d: first_d as i32,
             u_pairs: pairs as i32,
+            u_window: 0,
+            u_direction: [0, 0],
+            u_other_size: [0, 0],
+            u_final: 0,
+            u_pad: 0,
         };
         let pairs = (self.max_disparity + 1).div_ceil(2);
         let chunks: Vec<MatcherParams> = (0..pairs.div_ceil(self.chunk_pairs))
@@ -185,27 +215,29 @@ impl Matcher {
             }),
             Step::Dispatch(dispatch(MatcherStage::Census, &whole, &census_buffers, pixels)),
         ];
-        for chunk in &chunks {
-            // Rows and columns: one invocation per row (column) and disparity pair.
-            let lines = |n: u32| Groups::Fixed([n.div_ceil(8), (chunk.u_pairs as u32).div_ceil(8)]);
-            steps.push(Step::Dispatch(dispatch(
-                MatcherStage::Rows,
-                chunk,
-                &rows_buffers,
-                lines(h),
-            )));
-            steps.push(Step::Dispatch(dispatch(
-                MatcherStage::Columns,
-                chunk,
-                &columns_buffers,
-                lines(w),
-            )));
-            steps.push(Step::Dispatch(dispatch(
-                MatcherStage::Winner,
-                chunk,
-                &winner_buffers,
-                pixels,
-            )));
+        let planned: Vec<Planned> = match &self.sgm {
+            Some(sgm) => sgm.dispatches(&self.greys, &self.codes, [&self.winners[0], &self.winners[1]]),
+            None => chunks
+                .iter()
+                .flat_map(|chunk| {
+                    // Rows and columns: one invocation per row (column) and disparity pair.
+                    let lines = |n: u32| Groups::Fixed([n.div_ceil(8), (chunk.u_pairs as u32).div_ceil(8)]);
+                    [
+                        (MatcherStage::Rows, &rows_buffers, lines(h)),
+                        (MatcherStage::Columns, &columns_buffers, lines(w)),
+                        (MatcherStage::Winner, &winner_buffers, pixels),
+                    ]
+                    .map(|(stage, buffers, groups)| Planned {
+                        stage,
+                        params: *chunk,
+                        buffers: buffers.clone(),
+                        groups,
+                    })
+                })
+                .collect(),
+        };
+        for p in &planned {
+            steps.push(Step::Dispatch(dispatch(p.stage, &p.params, &p.buffers, p.groups)));
         }
         steps.push(Step::Dispatch(dispatch(
             MatcherStage::Subpixel,

@@ -52,13 +52,41 @@ pub mod confidence;
 pub mod gpu;
 pub mod range;
 pub mod reference;
+pub mod sgm;
 
 pub use confidence::confidence_reference;
 pub use gpu::{EyeEstimate, Matcher};
 pub use reference::estimate_disparities;
+pub use sgm::estimate_disparities_sgm;
 
 use crate::error::{Error, Result};
-use crate::io::RgbImage;
+use crate::io::{DepthMap, RgbImage};
+
+/// Which matcher estimates the disparities of a pair alone.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, serde::Serialize, serde::Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum MatcherMethod {
+    /// Census costs averaged over a 9 x 9 box, winner takes all (this module's design).
+    #[default]
+    Census,
+    /// Semi-global matching of the census costs ([`sgm`]): smooth where there is no texture.
+    Sgm,
+}
+
+impl MatcherMethod {
+    /// Both eyes' disparities by this method's CPU twin.
+    pub fn estimate_reference(
+        self,
+        left: &RgbImage,
+        right: &RgbImage,
+        max_disparity: u32,
+    ) -> Result<(DepthMap, DepthMap)> {
+        match self {
+            MatcherMethod::Census => estimate_disparities(left, right, max_disparity),
+            MatcherMethod::Sgm => estimate_disparities_sgm(left, right, max_disparity),
+        }
+    }
+}
 
 /// Census window half-width (7 columns).
 pub const CENSUS_HALF_W: usize = 3;

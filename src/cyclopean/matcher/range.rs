@@ -6,7 +6,8 @@
 //!   averaged to at most [`COARSE_WIDTH`] columns, searched over a third of that width either
 //!   way), whose left-right-checked disparities give the 1st and 99th percentiles, scaled back
 //!   and widened by a margin for the coarse pass's error; from 0 where the coarse pass saw no
-//!   negative disparity.
+//!   negative disparity. A small cluster wholly below 0 and apart from the rest is left out
+//!   first: a repeated texture matched one period off ([`MIN_CLUSTER`]).
 //! - [`SignedSearch`]: how a signed range runs on the unsigned matcher. The matcher searches
 //!   0..=max with 0 meaning unknown; a range whose minimum is negative is moved up by an offset
 //!   `o = -min` by widening both images by `o` columns (the left one replicated on its left,
@@ -34,6 +35,23 @@ pub const COARSE_WIDTH: u32 = 128;
 /// Share of the coarse pass's pixels below the 1st and above the 99th percentile left out of
 /// the range (mismatches the left-right check let through).
 const TAIL: f64 = 0.01;
+
+/// Width of the histogram bins (coarse pixels) that split the coarse disparities into clusters:
+/// a bin holding under [`SPARSE_BIN`] of them is empty, and an empty bin ends a cluster.
+const BIN: f64 = 1.0;
+/// Share of the coarse pass's disparities under which a bin counts as empty (scattered
+/// mismatches between two clusters do not join them).
+const SPARSE_BIN: f64 = 0.001;
+/// Share a cluster of negative disparities apart from the median's must hold to count. A
+/// repeated texture (a grid, a fence) that the coarse pass matches one period off makes a small
+/// cluster far from the scene's own disparities, which the left-right check passes (both eyes
+/// agree on the wrong period): Middlebury Laundry's basket, 2.8 % of the coarse pixels near
+/// -127 px, widened its search from 0..116 to -133..116 and cost 1.7 dB with `--fill`. Negative
+/// disparities are real only behind a converged rig's zero-parallax plane or in a cropped pair,
+/// where they are the background's, a large share joined to the rest; so only clusters wholly
+/// below 0 are held to this share. Positive ones always count: a small near object (Tsukuba's
+/// lamp, 3-4 % of the pixels, apart from the rest) is real more often than not.
+const MIN_CLUSTER: f64 = 0.05;
 
 /// Most disparities the matcher searches past 0 (its `max_disparity`, the signed range moved
 /// up by its offset): its work grows with each one (a 16384-wide pair searched to its width
@@ -200,6 +218,51 @@ fn downsample(img: &RgbImage, f: u32) -> Result<RgbImage> {
     RgbImage::new(w, h, out)
 }
 
+/// The coarse disparities (sorted) of the clusters that count (see [`BIN`]): the one holding the
+/// median, every one reaching above 0, and one wholly below 0 only when it holds at least
+/// [`MIN_CLUSTER`] of them. Sorted on return.
+fn main_clusters(sorted: &[f64]) -> Vec<f64> {
+    let n = sorted.len();
+    let bin = |v: f64| (v / BIN).floor() as i64;
+    let (first, last) = (bin(sorted[0]), bin(sorted[n - 1]));
+    let mut counts = vec![0usize; (last - first + 1) as usize];
+    for &v in sorted {
+        counts[(bin(v) - first) as usize] += 1;
+    }
+    let full = |c: usize| c as f64 >= SPARSE_BIN * n as f64 && c > 0;
+    // Clusters: maximal runs of full bins, as (first bin, last bin, count).
+    let mut clusters: Vec<(i64, i64, usize)> = Vec::new();
+    let mut open: Option<(i64, usize)> = None;
+    for (i, &c) in counts.iter().enumerate() {
+        let i = i as i64 + first;
+        match (full(c), open) {
+            (true, None) => open = Some((i, c)),
+            (true, Some((s, sum))) => open = Some((s, sum + c)),
+            (false, Some((s, sum))) => {
+                clusters.push((s, i - 1, sum));
+                open = None;
+            }
+            (false, None) => {}
+        }
+    }
+    if let Some((s, sum)) = open {
+        clusters.push((s, last, sum));
+    }
+    let median = bin(sorted[n / 2]);
+    let keep = |&(s, e, sum): &(i64, i64, usize)| {
+        (s..=e).contains(&median) || (e + 1) as f64 * BIN > 0.0 || sum as f64 >= MIN_CLUSTER * n as f64
+    };
+    let kept: Vec<&(i64, i64, usize)> = clusters.iter().filter(|c| keep(c)).collect();
+    if kept.is_empty() {
+        return sorted.to_vec();
+    }
+    sorted
+        .iter()
+        .copied()
+        .filter(|&v| kept.iter().any(|&&(s, e, _)| (s..=e).contains(&bin(v))))
+        .collect()
+}
+
 /// The pair's disparity range from the images alone (see the module notes), or None when the
 /// coarse pass keeps too few disparities to say (under 1 % of its pixels, or the pair smaller
 /// than 16 x 8 after the box average).
@@ -229,6 +292,7 @@ pub fn estimate_range(left: &RgbImage, right: &RgbImage) -> Result<Option<Dispar
         return Ok(None);
     }
     known.sort_by(f64::total_cmp);
+    let known = main_clusters(&known);
     let at = |q: f64| known[((known.len() - 1) as f64 * q).round() as usize] * f as f64;
     let (lo, hi) = (at(TAIL), at(1.0 - TAIL));
     // The coarse pass is about one coarse pixel off: that and a pixel either way. A wider range
@@ -309,6 +373,52 @@ mod tests {
         let range = estimate_range(&l, &r).unwrap().expect("a textured pair gives a range");
         assert!(range.min <= -9 && range.min >= -20, "{range:?}");
         assert!(range.max >= 13 && range.max <= 24, "{range:?}");
+    }
+
+    /// `share` of 2,000 coarse disparities at `at`, the rest spread over 20..100.
+    fn coarse(at: f64, share: f64) -> Vec<f64> {
+        let n = 2000;
+        let off = (n as f64 * share) as usize;
+        let mut v: Vec<f64> = (0..n - off)
+            .map(|i| 20.0 + 80.0 * i as f64 / (n - off) as f64)
+            .collect();
+        v.extend((0..off).map(|i| at + (i % 3) as f64 * 0.4));
+        v.sort_by(f64::total_cmp);
+        v
+    }
+
+    #[test]
+    fn a_small_cluster_below_zero_apart_from_the_scene_is_left_out() {
+        // A grid matched one period off: 3 % of the coarse pixels far below 0.
+        let kept = main_clusters(&coarse(-21.0, 0.03));
+        assert!(kept.iter().all(|&v| v >= 20.0), "{:?}", &kept[..5]);
+        // Under the same 5 % but joined to the rest by a continuous run: kept (a slanted background).
+        let mut joined = coarse(-21.0, 0.0);
+        joined.extend((0..90).map(|i| -10.0 + 30.0 * i as f64 / 90.0));
+        joined.sort_by(f64::total_cmp);
+        assert_eq!(main_clusters(&joined).len(), joined.len());
+    }
+
+    #[test]
+    fn a_large_negative_cluster_and_any_positive_one_are_kept() {
+        // 10 % behind a converged rig's zero-parallax plane: real.
+        let v = coarse(-21.0, 0.10);
+        assert_eq!(main_clusters(&v).len(), v.len());
+        // A small near object apart from the rest (Tsukuba's lamp): real.
+        let v = coarse(140.0, 0.03);
+        assert_eq!(main_clusters(&v).len(), v.len());
+    }
+
+    #[test]
+    fn laundrys_basket_does_not_widen_its_search_below_zero() {
+        // Middlebury Laundry (half size): true disparities 13.5..116 px. Its basket's grid made
+        // the coarse pass's 1st percentile -127 px, a search of -133..116 (issue 48).
+        let dir = crate::test_data::dir().join("middlebury2005_2006_dev/2005_laundry");
+        let l = crate::io::load_rgb(&dir.join("view1.png")).unwrap();
+        let r = crate::io::load_rgb(&dir.join("view5.png")).unwrap();
+        let range = estimate_range(&l, &r).unwrap().unwrap();
+        assert_eq!(range.min, 0, "{range:?}");
+        assert!((110..=125).contains(&range.max), "{range:?}");
     }
 
     #[test]

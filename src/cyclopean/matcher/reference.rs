@@ -8,7 +8,7 @@ use crate::error::Result;
 use crate::io::{DepthMap, RgbImage};
 
 /// No cost: the disparity cannot exist at this pixel (it would look outside the other image).
-const NO_COST: u32 = u32::MAX;
+pub(super) const NO_COST: u32 = u32::MAX;
 
 /// Disparities of both eyes of a rectified pair, searched over 0..=`max_disparity` px (0 is
 /// returned as unknown, as are occluded and inconsistent pixels). Fails on images of different
@@ -48,7 +48,7 @@ pub fn estimate_disparities(left: &RgbImage, right: &RgbImage, max_disparity: u3
     ))
 }
 
-fn grey(img: &RgbImage) -> Vec<u16> {
+pub(super) fn grey(img: &RgbImage) -> Vec<u16> {
     img.data
         .chunks_exact(3)
         .map(|p| p[0] as u16 + p[1] as u16 + p[2] as u16)
@@ -56,7 +56,7 @@ fn grey(img: &RgbImage) -> Vec<u16> {
 }
 
 /// One bit per window neighbour: set where the neighbour is darker than the centre.
-fn census(grey: &[u16], w: usize, h: usize) -> Vec<u64> {
+pub(super) fn census(grey: &[u16], w: usize, h: usize) -> Vec<u64> {
     let mut out = vec![0u64; w * h];
     for y in 0..h {
         for x in 0..w {
@@ -184,19 +184,27 @@ impl Winner {
     /// The winner refined by the parabola through its neighbours' costs; 0 = unknown, which
     /// includes a winner that is not unique (see [`unique`]).
     fn disparity(&self, i: usize) -> f32 {
-        let (c, below, above) = (self.cost[i], self.below[i], self.above[i]);
-        if c == NO_COST || !unique(c, self.second[i]) {
-            return 0.0;
-        }
-        let mut d = self.d[i] as f32;
-        if below != NO_COST && above != NO_COST {
-            let curvature = below as f32 - 2.0 * c as f32 + above as f32;
-            if curvature > 0.0 {
-                d += ((below as f32 - above as f32) / (2.0 * curvature)).clamp(-0.5, 0.5);
-            }
-        }
-        d
+        subpixel(self.cost[i], self.d[i], self.below[i], self.above[i], self.second[i])
     }
+}
+
+/// A winner `d` of cost `cost` refined by the parabola through it and its neighbours' costs
+/// (`below` at d - 1, `above` at d + 1, [`NO_COST`] where none; offset clamped to half a pixel);
+/// 0 = unknown: no winner, or one that is not unique against `second`, the lowest cost at least
+/// two disparities away (see [`unique`]).
+pub(super) fn subpixel(cost: u32, d: u32, below: u32, above: u32, second: u32) -> f32 {
+    if cost == NO_COST || !unique(cost, second) {
+        return 0.0;
+    }
+    let c = cost;
+    let mut d = d as f32;
+    if below != NO_COST && above != NO_COST {
+        let curvature = below as f32 - 2.0 * c as f32 + above as f32;
+        if curvature > 0.0 {
+            d += ((below as f32 - above as f32) / (2.0 * curvature)).clamp(-0.5, 0.5);
+        }
+    }
+    d
 }
 
 /// The uniqueness test: the winner's cost is below every cost at least two disparities away by
@@ -210,7 +218,7 @@ pub(super) fn unique(cost: u32, second: u32) -> bool {
 
 /// `own` where the other eye's disparity, read at the pixel `own` points to (x + `sign` d),
 /// agrees within [`LR_TOLERANCE_PX`]; 0 elsewhere.
-fn left_right_check(own: &[f32], other: &[f32], w: usize, h: usize, sign: f32) -> Vec<f32> {
+pub(super) fn left_right_check(own: &[f32], other: &[f32], w: usize, h: usize, sign: f32) -> Vec<f32> {
     let mut out = vec![0.0f32; w * h];
     for y in 0..h {
         for x in 0..w {
@@ -233,7 +241,7 @@ fn left_right_check(own: &[f32], other: &[f32], w: usize, h: usize, sign: f32) -
 
 /// Each known pixel replaced by the median of the known values in its 3 x 3 neighbourhood (the
 /// mean of the two middle ones for an even count); unknown pixels stay 0.
-fn median_of_known(d: &[f32], w: usize, h: usize) -> Vec<f32> {
+pub(super) fn median_of_known(d: &[f32], w: usize, h: usize) -> Vec<f32> {
     let mut out = vec![0.0f32; w * h];
     let mut near = Vec::with_capacity(9);
     for y in 0..h {

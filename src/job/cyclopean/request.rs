@@ -17,7 +17,7 @@ use crate::cyclopean::disparity_frame::{disparity_frame, median_fixation, Dispar
 use crate::cyclopean::fill::{Filler, FILLED};
 use crate::cyclopean::forward::ForwardWarp;
 use crate::cyclopean::matcher::range::{estimate_range, DisparityRange, SignedSearch};
-use crate::cyclopean::matcher::{EyeEstimate, Matcher};
+use crate::cyclopean::matcher::{EyeEstimate, Matcher, MatcherMethod};
 use crate::cyclopean::render::CyclopeanRenderer;
 use crate::cyclopean::splat::{SplatParams, SplatRenderer};
 use crate::cyclopean::temporal::FROM_HISTORY;
@@ -70,6 +70,8 @@ pub struct CyclopeanRequest {
     /// Two images alone: also give each eye's matcher confidence (a float map in [0, 1], 0 where
     /// the disparity is unknown), the same values `min_confidence` is held against.
     pub confidence: bool,
+    /// Two images alone: the stereo matcher (none: [`MatcherMethod::default`], the census one).
+    pub matcher: Option<MatcherMethod>,
 }
 
 /// The matcher's search range for two images alone when none is given and the images give none
@@ -171,6 +173,7 @@ pub struct CyclopeanPlan {
     range: (Option<i32>, Option<i32>),
     min_confidence: Option<f64>,
     confidence: bool,
+    matcher: MatcherMethod,
 }
 
 /// `--dominant`'s `eye:weight`.
@@ -222,6 +225,7 @@ impl CyclopeanRequest {
             ("--min-disparity", self.min_disparity.is_some()),
             ("--min-confidence", self.min_confidence.is_some()),
             ("--confidence", self.confidence),
+            ("--matcher", self.matcher.is_some()),
         ] {
             if given && kind != StereoKind::Images {
                 return Err(ArgError::MatcherOptionWithMaps(flag));
@@ -294,6 +298,7 @@ impl CyclopeanRequest {
             range: (self.min_disparity, self.max_disparity),
             min_confidence: self.min_confidence,
             confidence: self.confidence,
+            matcher: self.matcher.unwrap_or_default(),
         })
     }
 
@@ -383,7 +388,7 @@ pub struct Framed {
     pub confidence: Option<[DepthMap; 2]>,
     /// Two images alone: the disparity range searched, and whether it was estimated (else given).
     pub range: Option<(DisparityRange, bool)>,
-    /// Two images alone with `fill`: the same frame on disparities made dense
+    /// Disparities (given or estimated) with `fill`: the same frame on disparities made dense
     /// ([`crate::cyclopean::densify`]); what it renders fills the holes of `frame`'s view.
     pub dense: Option<StereoFrame>,
 }
@@ -495,24 +500,31 @@ impl CyclopeanPlan {
     ) -> crate::Result<Framed> {
         let [left_rgb, right_rgb, left_map, cameras_name] = names;
         match input {
-            StereoInput::Disparity { left, right } => self.disparity_frame(left, right, left_map, 0),
+            StereoInput::Disparity { left, right } => {
+                // Given disparities (ground truth, a sensor) have unknown pixels too: densified
+                // as the matcher's are, so only true disocclusions reach the colour fill.
+                let dense = match self.fill {
+                    true => Some(self.dense_frame(
+                        device,
+                        [(&left.0, &left.1), (&right.0, &right.1)],
+                        left_map,
+                        0,
+                        reuse,
+                    )?),
+                    false => None,
+                };
+                Ok(Framed {
+                    dense,
+                    ..self.disparity_frame(left, right, left_map, 0)?
+                })
+            }
             StereoInput::Images { left, right } => {
                 let mut reuse = reuse;
                 let est = self.estimate(device, &left, &right, left_rgb, reuse.as_deref_mut())?;
                 let dense = match self.fill {
                     true => {
-                        let mut own;
-                        let densifier = match reuse {
-                            Some(r) => r.densifier(device)?,
-                            None => {
-                                own = Densifier::new(device)?;
-                                &mut own
-                            }
-                        };
-                        let dl = densifier.densify(&est.left, &left)?.disparity;
-                        let dr = densifier.densify(&est.right, &right)?.disparity;
-                        let eyes = ((left.clone(), dl), (right.clone(), dr));
-                        Some(self.disparity_frame(eyes.0, eyes.1, left_map, est.offset)?.frame)
+                        let eyes = [(&left, &est.left), (&right, &est.right)];
+                        Some(self.dense_frame(device, eyes, left_map, est.offset, reuse)?)
                     }
                     false => None,
                 };
@@ -616,9 +628,9 @@ impl CyclopeanPlan {
         };
         let mut own;
         let matcher = match reuse {
-            Some(re) => re.matcher(device, l.width, l.height, search.max_disparity)?,
+            Some(re) => re.matcher(device, l.width, l.height, search.max_disparity, self.matcher)?,
             None => {
-                own = Matcher::new(device, l.width, l.height, search.max_disparity)?;
+                own = Matcher::with_method(device, l.width, l.height, search.max_disparity, self.matcher)?;
                 &mut own
             }
         };
@@ -648,6 +660,35 @@ impl CyclopeanPlan {
             range,
             estimated,
         })
+    }
+
+    /// With `fill`: the frame on both eyes' disparities (stored as d + `offset`) made dense
+    /// ([`Densifier`], on `device` or a sequence's `reuse`), whose view fills the holes of the
+    /// view on the disparities as they are. Non-finite values are unknown, as for the render.
+    fn dense_frame(
+        &self,
+        device: &Device,
+        eyes: [(&RgbImage, &DepthMap); 2],
+        left_map: InputName,
+        offset: u32,
+        reuse: Option<&mut Reused>,
+    ) -> crate::Result<StereoFrame> {
+        let mut own;
+        let densifier = match reuse {
+            Some(r) => r.densifier(device)?,
+            None => {
+                own = Densifier::new(device)?;
+                &mut own
+            }
+        };
+        let [left, right] = eyes.map(|(color, disparity)| {
+            let mut known = disparity.clone();
+            known.data.iter_mut().filter(|d| !d.is_finite()).for_each(|d| *d = 0.0);
+            densifier
+                .densify(&known, color)
+                .map(|dense| (color.clone(), dense.disparity))
+        });
+        Ok(self.disparity_frame(left?, right?, left_map, offset)?.frame)
     }
 
     /// A rectified pair with disparities: the frame, the view and the seed's fixation (the
@@ -704,9 +745,10 @@ impl CyclopeanPlan {
     /// A sequence passes what it keeps between frames (`reuse`): the default method's renderer
     /// and the fill are reused, and with `fill` the holes the last frame's eyes saw take the
     /// temporal history first and the fill fills the rest (both count as filled in the mask).
-    /// `dense`: two images alone with `fill`, the frame on dense disparities; its view fills
-    /// the holes of `frame`'s first (pixels from filled disparities count as filled, so the
-    /// mask's rendered pixels stay those of matched disparities), then the fill fills the rest.
+    /// `dense`: disparities (given or estimated) with `fill`, the frame on dense disparities; its
+    /// view fills the holes of `frame`'s first (pixels from densified disparities count as filled,
+    /// so the mask's rendered pixels stay those of given or matched disparities), then the fill
+    /// fills the rest.
     pub fn synthesise(
         &self,
         device: &Device,

@@ -7,7 +7,7 @@
 use crate::convention::Conventions;
 use crate::cyclopean::densify::Densifier;
 use crate::cyclopean::fill::Filler;
-use crate::cyclopean::matcher::Matcher;
+use crate::cyclopean::matcher::{Matcher, MatcherMethod};
 use crate::cyclopean::splat::{SplatParams, SplatRenderer};
 use crate::cyclopean::temporal::{Accumulator, DEPTH_TOLERANCE, FILL_ONLY};
 use crate::cyclopean::{CyclopeanOutputs, StereoFrame};
@@ -17,8 +17,8 @@ use crate::pass::Device;
 /// A sequence's renderers, made at its first frame and reused (see the module notes).
 #[derive(Default)]
 pub struct Reused {
-    /// The matcher and the width, height and search range it was made for.
-    matcher: Option<((u32, u32, u32), Matcher)>,
+    /// The matcher and the width, height, search range and method it was made for.
+    matcher: Option<((u32, u32, u32, MatcherMethod), Matcher)>,
     splat: Option<SplatRenderer>,
     filler: Option<Filler>,
     densifier: Option<Densifier>,
@@ -48,7 +48,7 @@ impl Reused {
         Ok(self.splat.insert(renderer))
     }
 
-    /// The census matcher for `width` x `height` pairs searching 0..=`max_disparity` px: the
+    /// The `method` matcher for `width` x `height` pairs searching 0..=`max_disparity` px: the
     /// last one where those match (its inputs are rewritten in place), else a new one (the old
     /// one freed first).
     pub(crate) fn matcher(
@@ -57,13 +57,14 @@ impl Reused {
         width: u32,
         height: u32,
         max_disparity: u32,
+        method: MatcherMethod,
     ) -> Result<&mut Matcher> {
-        let key = (width, height, max_disparity);
+        let key = (width, height, max_disparity, method);
         let matcher = match self.matcher.take() {
             Some((k, m)) if k == key => m,
             old => {
                 drop(old);
-                Matcher::new(device, width, height, max_disparity)?
+                Matcher::with_method(device, width, height, max_disparity, method)?
             }
         };
         Ok(&mut self.matcher.insert((key, matcher)).1)

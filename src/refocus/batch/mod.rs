@@ -17,13 +17,14 @@
 //! marks the frame finished.
 //!
 //! The parts: [`manifest`] reads the frame list, [`resume`] decides which frames are finished,
-//! [`pipeline`] runs the stages.
+//! [`pipeline`] runs the stages; [`tum`] makes a manifest from a TUM-style sequence's listings.
 
 mod index;
 mod index_names;
 mod manifest;
 mod pipeline;
 mod resume;
+mod tum;
 mod zoom;
 
 pub use index::{join_index, read_index, write_index, IndexRow};
@@ -33,6 +34,9 @@ pub use manifest::{
     MAX_JSON_MANIFEST_BYTES, MAX_MANIFEST_BYTES, MAX_MANIFEST_ROWS, MAX_MANIFEST_ROW_BYTES,
 };
 pub use pipeline::{run_batch, BatchSummary, StageTimes};
+pub use tum::{
+    associate_tum, write_manifest_csv, TumAssociation, MAX_LISTING_BYTES, TUM_DEPTH_SCALE, TUM_MAX_DIFFERENCE,
+};
 pub use zoom::{ZoomRandom, MAX_SAMPLES};
 
 use super::{BreakRule, Method};
