@@ -3,6 +3,7 @@
 //! [`Matcher`] is made for one image size and search range; its buffers are created once and
 //! its input images rewritten for each pair, so a stream of pairs creates nothing.
 
+pub use super::params::MatcherParams;
 use super::sgm::gpu::{Planned, SgmStages};
 use super::{check_pair, check_range, MatcherMethod};
 use crate::convention::RowOrder;
@@ -13,21 +14,6 @@ use crate::io::{DepthMap, RgbImage};
 use crate::pass::{
     Buffer, Device, Dispatch, Format, Groups, Image, ImageData, ImageId, Rendered, Step, StorageImage, Target, ToDevice,
 };
-
-crate::param_block! {
-    /// Every matcher stage's parameters: shaders/cyclopean/matcher_params.glsl, member for member.
-    pub struct MatcherParams("MatcherParams") {
-        u_size: [i32; 2],
-        u_max_disparity: i32,
-        u_first_d: i32,
-        u_pairs: i32,
-        u_window: i32,
-        u_direction: [i32; 2],
-        u_other_size: [i32; 2],
-        u_final: i32,
-        u_pad: i32,
-    }
-}
 
 /// Words a chunk buffer holds at most (64 MiB): under GL's guaranteed-in-practice storage-block
 /// size (llvmpipe: 128 MiB) and Vulkan's storage-buffer range on the devices we run.

@@ -50,6 +50,7 @@
 
 pub mod confidence;
 pub mod gpu;
+pub mod params;
 pub mod range;
 pub mod reference;
 pub mod sgm;

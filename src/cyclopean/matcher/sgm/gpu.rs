@@ -7,7 +7,7 @@
 //! throughout, so the disparities are [`super::reference`]'s bit for bit.
 
 use super::{Plan, DIRECTIONS};
-use crate::cyclopean::matcher::gpu::MatcherParams;
+use crate::cyclopean::matcher::params::MatcherParams;
 use crate::error::{Error, Result};
 use crate::gpu::shaders::MatcherStage;
 use crate::pass::{Buffer, BufferId, Device, Groups};
