@@ -59,9 +59,20 @@ impl TumManifestJob {
         positive("--depth-scale", depth_scale)?;
         positive("--max-difference", max_difference)?;
         let (rgb_list, depth_list) = lists;
+        let rgb_list = rgb_list.unwrap_or_else(|| sequence.join("rgb.txt"));
+        let depth_list = depth_list.unwrap_or_else(|| sequence.join("depth.txt"));
+        // The one output rule of every command: --out never replaces a listing it reads.
+        crate::io::check_outputs(
+            &[
+                ("--rgb-list", rgb_list.as_path()),
+                ("--depth-list", depth_list.as_path()),
+            ],
+            &[("--out", out.as_path())],
+        )
+        .map_err(ArgError::Invalid)?;
         Ok(TumManifestJob {
-            rgb_list: rgb_list.unwrap_or_else(|| sequence.join("rgb.txt")),
-            depth_list: depth_list.unwrap_or_else(|| sequence.join("depth.txt")),
+            rgb_list,
+            depth_list,
             sequence,
             intrinsics,
             depth_scale,
@@ -80,6 +91,13 @@ impl TumManifestJob {
             self.depth_scale,
             self.max_difference,
         )?;
+        // Nor a frame the listings name (known only once they are read: a run error).
+        let frames: Vec<(&str, &std::path::Path)> = a
+            .frames
+            .iter()
+            .flat_map(|f| [("rgb.txt", f.rgb.as_path()), ("depth.txt", f.depth.as_path())])
+            .collect();
+        crate::io::check_outputs(&frames, &[("--out", self.out.as_path())])?;
         write_manifest_csv(&self.out, &a.frames)?;
         Ok(TumManifestReport {
             frames: a.frames.len(),

@@ -207,6 +207,24 @@ fn case(command: &str, d: &Path) -> Result<Case, &'static str> {
                 keep: vec![a, b],
             })
         }
+        "manifest" => {
+            // A TUM-style sequence whose manifest would replace its own colour listing.
+            let seq = d.join("sequence");
+            std::fs::create_dir_all(&seq).unwrap();
+            let (rgb, depth) = frame(&seq, "f", 16, 12);
+            let rgb_list = seq.join("rgb.txt");
+            std::fs::write(&rgb_list, format!("# colour\n1.000 {}\n", s(&rgb))).unwrap();
+            std::fs::write(seq.join("depth.txt"), format!("# depth\n1.001 {}\n", s(&depth))).unwrap();
+            let mut args = own(&["manifest", s(&seq)]);
+            args.extend(own(&K));
+            args.extend(own(&["--out", s(&rgb_list)]));
+            Ok(Case {
+                args,
+                input: "--rgb-list",
+                output: "--out",
+                keep: vec![rgb_list],
+            })
+        }
         "info" => Err("writes no file (stdout only)"),
         "bench" => Err("writes only stdout and its own temporary folder, never a name the user gives"),
         "stress" => Err("reads no file: --json is its only output"),
