@@ -271,7 +271,7 @@ pub(super) fn median_of_known(d: &[f32], w: usize, h: usize) -> Vec<f32> {
 }
 
 #[cfg(test)]
-mod tests {
+pub(super) mod tests {
     use super::*;
     use crate::error::Error;
     use crate::test_rng::Rng;
@@ -279,7 +279,8 @@ mod tests {
     /// Margin (px) from the image edges where census windows and boxes see replicated borders.
     const EDGE: usize = CENSUS_HALF_W + BOX_RADIUS;
 
-    fn texture(w: usize, h: usize, seed: u64) -> Vec<[u8; 3]> {
+    /// Random colours, one a pixel (also the semi-global twin's tests' texture).
+    pub(in crate::cyclopean::matcher) fn texture(w: usize, h: usize, seed: u64) -> Vec<[u8; 3]> {
         let mut rng = Rng(seed);
         (0..w * h)
             .map(|_| {
@@ -289,7 +290,12 @@ mod tests {
             .collect()
     }
 
-    fn image(w: usize, h: usize, pixel: impl Fn(usize, usize) -> [u8; 3]) -> RgbImage {
+    /// A `w` x `h` image of `pixel(x, y)`.
+    pub(in crate::cyclopean::matcher) fn image(
+        w: usize,
+        h: usize,
+        pixel: impl Fn(usize, usize) -> [u8; 3],
+    ) -> RgbImage {
         let pixel = &pixel;
         let data = (0..h)
             .flat_map(|y| (0..w).flat_map(move |x| pixel(x, y)))

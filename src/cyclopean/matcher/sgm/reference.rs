@@ -267,25 +267,7 @@ fn guides(wins: &[Win], start: &[u32], window: u32) -> Vec<u32> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::test_rng::Rng;
-
-    fn image(w: usize, h: usize, pixel: impl Fn(usize, usize) -> [u8; 3]) -> RgbImage {
-        let pixel = &pixel;
-        let data = (0..h)
-            .flat_map(|y| (0..w).flat_map(move |x| pixel(x, y)))
-            .collect::<Vec<u8>>();
-        RgbImage::new(w as u32, h as u32, data).unwrap()
-    }
-
-    fn texture(w: usize, h: usize, seed: u64) -> Vec<[u8; 3]> {
-        let mut rng = Rng(seed);
-        (0..w * h)
-            .map(|_| {
-                let v = rng.next_u64();
-                [v as u8, (v >> 8) as u8, (v >> 16) as u8]
-            })
-            .collect()
-    }
+    use crate::cyclopean::matcher::reference::tests::{image, texture};
 
     /// A textured wall at disparity 6 with a flat grey band across it, textured only at its
     /// ends: the census matcher leaves the band's middle unknown (no trusted minimum), the
