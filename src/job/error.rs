@@ -213,6 +213,7 @@ pub enum ArgError {
     #[error("invalid ipd {0}: must be finite and >= 0")]
     Ipd(f64),
     /// Compare's planes out of order.
+    #[cfg(feature = "compare")]
     #[error("invalid {options} {near} / {far}: need 0 < near < far (far may be inf)")]
     ComparePlanes {
         /// The options, e.g. `--b-near/--b-far`.
@@ -223,6 +224,7 @@ pub enum ArgError {
         far: f64,
     },
     /// A compare side's device or NDC depth without the planes it was written with.
+    #[cfg(feature = "compare")]
     #[error(
         "{side}'s depth is {kind} depth: give the planes it was written with, --{s}-near N --{s}-far F \
          (far may be inf; --near/--far set both sides)",
@@ -235,6 +237,7 @@ pub enum ArgError {
         kind: &'static str,
     },
     /// A compare convention option that cannot change the reading of the side it names.
+    #[cfg(feature = "compare")]
     #[error("{option} does not apply: {why}")]
     CompareNotApplicable {
         /// The option, e.g. `--b-ndc`.

@@ -14,6 +14,7 @@ mod files;
 mod host;
 mod intrinsics;
 
+#[cfg(feature = "compare")]
 pub mod compare;
 pub mod cyclopean;
 pub mod manifest;
