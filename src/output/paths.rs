@@ -6,8 +6,8 @@
 //! device or FIFO (`/dev/null`, `/dev/stdout`) is written in place, never replaced, and two
 //! outputs may share one. Refusals name both options and the path.
 
-use super::file_set::Replaces;
 use crate::error::{Error, Result};
+use crate::io::Replaces;
 use std::fs;
 use std::os::unix::fs::{FileTypeExt, MetadataExt};
 use std::path::{Path, PathBuf};
@@ -29,7 +29,7 @@ fn output_key(path: &Path) -> Option<PathBuf> {
         }
     }
     let name = path.file_name()?;
-    let parent = super::atomic::parent_dir(path);
+    let parent = crate::io::parent_dir(path);
     let dir = fs::canonicalize(parent).unwrap_or_else(|_| parent.to_path_buf());
     Some(dir.join(name))
 }

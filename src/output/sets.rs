@@ -8,8 +8,8 @@
 //! [`ViewNames`] lets a command keep other names it has always written (stitch's
 //! `ods_left.png`, scene's `left_view_z.exr`).
 
-use super::{Encoding, FileSet, FileWriter, Png16Units, PreviewRange};
 use crate::error::{Error, Result};
+use crate::io::{Encoding, FileSet, FileWriter, Png16Units, PreviewRange};
 use serde::{Deserialize, Serialize};
 use std::path::Path;
 
@@ -373,7 +373,7 @@ pub fn write_float_exrs(set: &mut FileSet, maps: &[(&str, &crate::io::DepthMap)]
         .map(|&(name, map)| {
             let shown = set.final_path(name);
             let write: FileWriter =
-                Box::new(move |out| super::depth::encode_map_exr(&shown, out, map, "Y", super::ExrCompression::Zip));
+                Box::new(move |out| crate::io::encode_map_exr(&shown, out, map, "Y", crate::io::ExrCompression::Zip));
             (name.to_string(), write)
         })
         .collect();

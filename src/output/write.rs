@@ -1,17 +1,13 @@
-//! The output layer: one synthesised view ([`ViewOutput`]), the outputs asked for and their
-//! formats become files in a [`FileSet`] (atomic, all or none) and the manifest entry naming
-//! them. Every command writes its views through [`write_view`], so a format one command
-//! accepts is written the same way by all of them (refocus single frame and batch,
-//! reproject, cyclopean, stitch, scene, and Python's batch). It sits above the view type; the
-//! formats, names and entries it fills are the files layer's ([`crate::io::FileFormats`],
-//! [`ViewNames`], [`ViewFiles`]).
+//! [`write_view`]: the outputs of one synthesised view asked for become files in a
+//! [`FileSet`] (atomic, all or none) and the manifest entry naming them.
 
 use std::fs::File;
 use std::io::BufWriter;
 use std::path::Path;
 
+use super::{FileFormats, ViewFiles, ViewNames};
 use crate::error::{Error, Result};
-use crate::io::{self, FileFormats, FileSet, FileWriter, ViewFiles, ViewNames};
+use crate::io::{self, FileSet, FileWriter};
 use crate::view::ViewOutput;
 
 /// Writes the outputs of `view` that `formats` asks for into `set`, named by `names`, and
@@ -110,7 +106,8 @@ fn job<'a>(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::io::{DepthFormats, DepthMap, Mask, OutDir, OutputSet, RgbImage};
+    use crate::io::{DepthMap, Mask, OutDir, RgbImage};
+    use crate::output::{DepthFormats, OutputSet};
 
     fn view(z: Vec<f32>) -> ViewOutput {
         let (w, h) = (z.len() as u32, 1);

@@ -189,7 +189,7 @@ fn stitch_methods_agree_between_gl_and_vulkan_under_every_convention() {
                     width: 128,
                     height: 64,
                 },
-                outputs: viewsynth::io::OutputSet::RGB_DEPTH,
+                outputs: viewsynth::output::OutputSet::RGB_DEPTH,
                 conv,
             };
             let a = stitch::pass::gpu(&gl, &input).unwrap();

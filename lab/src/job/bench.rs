@@ -6,9 +6,9 @@ use crate::bench::batch::{batch_bench, BatchBench, BatchInput};
 use crate::bench::{cyclopean_bench, refocus_bench, BenchCase};
 use std::path::PathBuf;
 use viewsynth::io;
-use viewsynth::io::FileFormats;
 use viewsynth::job::HostStages;
 use viewsynth::job::{ArgError, Event, GpuRequest, Host, JobError};
+use viewsynth::output::FileFormats;
 use viewsynth::progress::Progress as _;
 
 /// The bench options as given.

@@ -5,7 +5,7 @@
 //! several times better than at any power-of-two neighbour (Cones: mean grey difference 6.6 at
 //! scale 4, 38.5 at 1; Teddy 5.4 at 4, 30.4 at 2). A subsample of the pixels says as much as all of them.
 
-use super::{DepthMap, RgbImage};
+use crate::io::{DepthMap, RgbImage};
 
 /// Raw units per pixel tried beside the scale given: the powers of two datasets use (Middlebury
 /// 2003: 4, KITTI: 256, float maps: 1) and the halves a doubled map would need.

@@ -5,8 +5,8 @@
 
 use std::fmt;
 
-use super::disparity_fit::ScaleFit;
-use super::{DepthMap, DepthSummary};
+use crate::io::depth::disparity_fit::ScaleFit;
+use crate::io::{DepthMap, DepthSummary};
 
 /// A 95th-percentile disparity beyond this share of the image width is implausible: the
 /// widest common rigs (KITTI) stay under a fifth of it; Cones read at 1 instead of 4 is 45 %.

@@ -4,19 +4,20 @@ use std::path::Path;
 
 use image::ImageFormat;
 
-use super::atomic::atomic_write;
-use super::decode::{decode_image, image_dimensions, Samples};
-use super::exr_io::{exr_dimensions, read_depth_channel, write_f32_planes};
-use super::grey_png::grey_of;
-use super::image_types::{decode_dims, encode_dims, DepthMap};
-use super::input::max_pixels;
-use super::netpbm::netpbm_dimensions;
-use super::npy::{open_npy, read_npy, save_npy_f32, NpyArray, NpyDtype};
-use super::npz::load_npz_array_within;
-use super::raw_depth::{RawDepth, RawSamples};
-use super::rgb::lowercase_extension;
-use super::{pfm, pgm};
 use crate::error::{Error, Result};
+use crate::io::files::atomic::atomic_write;
+use crate::io::files::input::max_pixels;
+use crate::io::formats::decode::{decode_image, image_dimensions, Samples};
+use crate::io::formats::exr::{exr_dimensions, read_depth_channel, write_f32_planes};
+use crate::io::formats::grey_png::grey_of;
+use crate::io::formats::netpbm::netpbm_dimensions;
+use crate::io::formats::npy::{open_npy, read_npy, save_npy_f32, NpyArray};
+use crate::io::formats::npz::load_npz_array_within;
+use crate::io::formats::raw_depth::{RawDepth, RawSamples};
+use crate::io::formats::{pfm, pgm};
+use crate::io::image::rgb::lowercase_extension;
+use crate::io::image::types::{decode_dims, encode_dims, DepthMap};
+use crate::io::NpyDtype;
 
 /// How stored depth samples map to metres.
 ///
@@ -133,11 +134,11 @@ pub fn check_rgbd_sizes(rgb: &Path, depth: &Path) -> Result<(u32, u32)> {
 
 /// Writes one f32 channel named "Z", ZIP compressed, rows top-down.
 pub fn save_depth_exr(path: &Path, depth: &DepthMap) -> Result<()> {
-    save_depth_exr_with(path, depth, super::ExrCompression::default())
+    save_depth_exr_with(path, depth, crate::io::ExrCompression::default())
 }
 
 /// [`save_depth_exr`] with a chosen compression.
-pub fn save_depth_exr_with(path: &Path, depth: &DepthMap, compression: super::ExrCompression) -> Result<()> {
+pub fn save_depth_exr_with(path: &Path, depth: &DepthMap, compression: crate::io::ExrCompression) -> Result<()> {
     encode_dims(path, depth.width, depth.height, 1, depth.data.len())?;
     atomic_write(path, |out| encode_depth_exr(path, out, depth, compression))
 }
@@ -147,7 +148,7 @@ pub fn encode_depth_exr(
     path: &Path,
     out: &mut std::io::BufWriter<std::fs::File>,
     depth: &DepthMap,
-    compression: super::ExrCompression,
+    compression: crate::io::ExrCompression,
 ) -> Result<()> {
     encode_map_exr(path, out, depth, "Z", compression)
 }
@@ -158,7 +159,7 @@ pub(crate) fn encode_map_exr(
     out: &mut std::io::BufWriter<std::fs::File>,
     map: &DepthMap,
     channel: &str,
-    compression: super::ExrCompression,
+    compression: crate::io::ExrCompression,
 ) -> Result<()> {
     encode_dims(path, map.width, map.height, 1, map.data.len())?;
     write_f32_planes(path, out, map.width, map.height, &[(channel, &map.data)], compression)
@@ -173,7 +174,7 @@ pub fn save_depth_npy(path: &Path, depth: &DepthMap) -> Result<()> {
 /// Encodes [`save_depth_npy`]'s file into `out`; errors name `path`.
 pub fn encode_depth_npy(path: &Path, out: &mut std::io::BufWriter<std::fs::File>, depth: &DepthMap) -> Result<()> {
     encode_dims(path, depth.width, depth.height, 1, depth.data.len())?;
-    super::npy::encode_npy_f32(path, out, &[depth.height as usize, depth.width as usize], &depth.data)
+    crate::io::formats::npy::encode_npy_f32(path, out, &[depth.height as usize, depth.width as usize], &depth.data)
 }
 
 /// A single-channel PNG, or a palette, RGB or RGBA one holding a grey map
@@ -292,7 +293,7 @@ fn to_metres(path: &Path, raw: RawDepth, decode: &DepthDecode) -> Result<DepthMa
         RawSamples::F64(v) => v.into_iter().map(|x| (x / scale.unwrap_or(1.0)) as f32).collect(),
     };
     let mut data = data;
-    super::clear_unusable_depth(&mut data);
+    crate::io::clear_unusable_depth(&mut data);
     DepthMap::new(raw.width, raw.height, data).map_err(|e| Error::decode(path, e.to_string()))
 }
 
@@ -306,9 +307,9 @@ fn int_to_metres(raw: u32, scale: f64) -> f32 {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::io::exr_io::write_f32_channels;
-    use crate::io::npy::build_npy;
-    use crate::io::pfm::build_pfm;
+    use crate::io::formats::exr::write_f32_channels;
+    use crate::io::formats::npy::build_npy;
+    use crate::io::formats::pfm::build_pfm;
     use crate::io::test_util::{list_dir, scratch_dir};
 
     fn scaled(scale: f64) -> DepthDecode {

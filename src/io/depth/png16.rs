@@ -8,10 +8,10 @@ use std::path::Path;
 use image::codecs::png::{FilterType, PngEncoder};
 use image::{ExtendedColorType, ImageEncoder};
 
-use super::atomic::atomic_write;
-use super::image_types::{encode_dims, DepthMap};
-use super::PngCompression;
 use crate::error::{Error, Result};
+use crate::io::files::atomic::atomic_write;
+use crate::io::image::types::{encode_dims, DepthMap};
+use crate::io::PngCompression;
 use serde::Serialize;
 
 /// Stored units per metre by default (millimetres).

@@ -7,9 +7,9 @@ use std::path::Path;
 
 use serde::Serialize;
 
-use super::image_types::{DepthMap, RgbImage};
-use super::Encoding;
 use crate::error::Result;
+use crate::io::image::types::{DepthMap, RgbImage};
+use crate::io::Encoding;
 
 /// The depth (metres) at the near (red) and far (blue) ends of the preview's colour map.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize)]
@@ -74,7 +74,7 @@ pub fn depth_preview(depth: &DepthMap, range: Option<PreviewRange>) -> RgbImage 
 /// range it used (None when no pixel is valid: the picture is black).
 pub fn save_depth_preview(path: &Path, depth: &DepthMap, encoding: &Encoding) -> Result<Option<PreviewRange>> {
     let range = depth_preview_range(depth);
-    super::save_rgb_with(path, &depth_preview(depth, range), encoding)?;
+    crate::io::save_rgb_with(path, &depth_preview(depth, range), encoding)?;
     Ok(range)
 }
 

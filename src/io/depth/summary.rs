@@ -8,9 +8,9 @@
 
 use std::fmt;
 
-use super::depth_ranks::ValidRanks;
-use super::DepthMap;
 use crate::convention::DepthPlanes;
+use crate::io::depth::ranks::ValidRanks;
+use crate::io::DepthMap;
 
 /// Medians outside this range (metres) are implausible for RGB-D cameras and most scenes.
 pub const PLAUSIBLE_MEDIAN_M: (f64, f64) = (0.05, 20.0);

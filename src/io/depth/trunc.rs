@@ -1,8 +1,8 @@
 //! Depth truncation, as Open3D's `depth_trunc`: input depth beyond a distance is treated as
 //! invalid (far readings of RGB-D sensors are the noisiest).
 
-use super::image_types::DepthMap;
 use crate::error::{Error, Result};
+use crate::io::image::types::DepthMap;
 
 /// Checks a truncation distance: finite and > 0 metres.
 pub fn check_depth_trunc(max_m: f64) -> Result<()> {

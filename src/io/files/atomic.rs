@@ -17,7 +17,7 @@
 use std::fs::{self, File};
 use std::io::{self, BufWriter, Write};
 use std::os::unix::fs::{FileTypeExt, OpenOptionsExt};
-use std::path::Path;
+use std::path::{Component, Path};
 
 use crate::error::{Error, Result};
 
@@ -207,10 +207,26 @@ pub fn probe_writable(dir: &Path) -> Result<()> {
     temp.close().map_err(|e| Error::io(dir, e))
 }
 
+/// `name` must be one normal path component and not look like one of our temporaries.
+pub(crate) fn check_plain_name(name: &str, dir: &Path) -> Result<()> {
+    let mut parts = Path::new(name).components();
+    let plain = matches!((parts.next(), parts.next()), (Some(Component::Normal(_)), None));
+    if !plain || name.starts_with(TEMP_PREFIX) {
+        return Err(Error::param(
+            "output name",
+            format!(
+                "'{name}' in {}: must be a plain file name (no '/', '..' or '{TEMP_PREFIX}' prefix)",
+                dir.display()
+            ),
+        ));
+    }
+    Ok(())
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::io::file_set::remove_orphan_temporaries;
+    use crate::io::files::staging::remove_orphan_temporaries;
     use crate::io::test_util::{list_dir, scratch_dir};
 
     #[test]

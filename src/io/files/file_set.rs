@@ -1,7 +1,7 @@
 //! The output folder of a run and all-or-none sets of output files in it.
 //!
-//! [`OutDir`] is `--out-dir` made ready (created, resolved, probed) and the only way to reach
-//! folders under it: [`OutDir::subdir`] refuses a subfolder that is a symlink or resolves
+//! [`OutDir`](super::out_dir::OutDir) is `--out-dir` made ready (created, resolved, probed) and the only way to reach
+//! folders under it: [`OutDir::subdir`](super::out_dir::OutDir::subdir) refuses a subfolder that is a symlink or resolves
 //! elsewhere, so outputs never land outside the real out-dir.
 //!
 //! [`FileSet`] stages every file of a set in a private folder `.viewsynth-<pid>-<random>/`
@@ -21,12 +21,12 @@
 //! 5. the folder is emptied in an order that keeps it recognisable: the journal, then the lock
 //!    file, then the folder itself.
 //!
-//! A later run that finds an unlocked staging folder ([`remove_orphan_temporaries`]) removes
+//! A later run that finds an unlocked staging folder ([`remove_orphan_temporaries`](super::staging::remove_orphan_temporaries)) removes
 //! it when it has no journal (killed before step 3: the old set is untouched) and otherwise
 //! finishes step 4 (rolls forward to the new set). A folder with no lock file at all (killed
 //! while it was being made or removed) is claimed by making its lock file, then treated the
 //! same, at once: its maker, if alive, finds its lock file taken or gone and starts again in a
-//! new folder (see [`claim_lock`]), so no age threshold is needed. So after any kill and the
+//! new folder (see `staging::claim_lock`), so no age threshold is needed. So after any kill and the
 //! next run's start, a folder holds the old set or the new set, complete, and no temporary.
 //! `VIEWSYNTH_FAULT_AFTER` injects a kill or a failure after any step (see [`super::atomic`]).
 //!
@@ -43,177 +43,17 @@
 
 use std::fs::{self, File};
 use std::io::{self, BufWriter, Write};
-use std::path::{Component, Path, PathBuf};
+use std::path::{Path, PathBuf};
 
 mod parallel;
 mod replaces;
 pub use parallel::FileWriter;
 pub(crate) use replaces::remove_own_file;
-pub use replaces::Replaces;
+pub use replaces::{Replaces, MANIFEST_NAME};
 
-use super::atomic::{
-    check_replaceable, fault_point, lock_if_current, open_for_lock, own_prefix, probe_writable, TEMP_PREFIX,
-};
-
-/// The lock file inside a staging folder (see the module notes).
-const LOCK_NAME: &str = ".viewsynth-lock";
-/// The journal naming a committing set's files in rename order.
-const JOURNAL_NAME: &str = ".viewsynth-commit";
-/// The name renamed last in every set: its presence marks the set complete.
-pub const MANIFEST_NAME: &str = "manifest.json";
-/// How many staging folders [`FileSet::new`] makes before giving up, when a cleaner of
-/// another run takes each one between its creation and its lock (a race of microseconds).
-const STAGING_TRIES: usize = 16;
+use super::atomic::{check_plain_name, check_replaceable, fault_point};
+use super::staging::{make_staging, remove_staging, roll_forward, sync_dir, Staging, JOURNAL_NAME, LOCK_NAME};
 use crate::error::{Error, Result};
-
-/// An output folder that exists, accepts files, and bounds where outputs may go.
-#[derive(Debug, Clone)]
-pub struct OutDir {
-    /// As the user gave it (for messages and the paths printed).
-    shown: PathBuf,
-    /// Resolved (symlinks followed once, at the root only).
-    real: PathBuf,
-}
-
-impl OutDir {
-    /// Creates `dir` (and its parents) if missing, resolves it, checks that it accepts new
-    /// files (without opening any existing name) and removes temporaries that killed runs left
-    /// in it (never those of a live process). The folder itself may be a symlink: where it
-    /// points is the out-dir.
-    pub fn prepare(dir: &Path) -> Result<Self> {
-        check_not_a_broken_link(dir)?;
-        fs::create_dir_all(dir).map_err(|e| Error::io(dir, e))?;
-        let real = fs::canonicalize(dir).map_err(|e| Error::io(dir, e))?;
-        if !real.is_dir() {
-            return Err(Error::io(
-                dir,
-                io::Error::new(io::ErrorKind::NotADirectory, "not a directory"),
-            ));
-        }
-        probe_writable(&real).map_err(|e| match e {
-            Error::Io { source, .. } => Error::Io {
-                path: dir.to_path_buf(),
-                source: io::Error::new(source.kind(), format!("output directory is not writable ({source})")),
-            },
-            other => other,
-        })?;
-        remove_orphan_temporaries(&real);
-        Ok(Self {
-            shown: dir.to_path_buf(),
-            real,
-        })
-    }
-
-    /// The folder as given (join output names onto this for messages).
-    pub fn path(&self) -> &Path {
-        &self.shown
-    }
-
-    /// The folder with symlinks resolved.
-    pub fn real_path(&self) -> &Path {
-        &self.real
-    }
-
-    /// The folder `name` (one plain path component) directly inside, created if missing.
-    /// Refused, with the path named, when it exists as a symlink or as anything but a folder,
-    /// or when it resolves outside this out-dir.
-    pub fn subdir(&self, name: &str) -> Result<OutDir> {
-        check_plain_name(name, &self.shown)?;
-        let shown = self.shown.join(name);
-        let real = self.real.join(name);
-        match fs::symlink_metadata(&real) {
-            Ok(m) if m.file_type().is_symlink() => {
-                let target = fs::read_link(&real)
-                    .map(|t| t.display().to_string())
-                    .unwrap_or_default();
-                return Err(outside(&shown, &self.shown, &format!("is a symlink to {target}")));
-            }
-            Ok(m) if !m.is_dir() => {
-                return Err(Error::io(
-                    &shown,
-                    io::Error::new(io::ErrorKind::NotADirectory, "exists and is not a directory"),
-                ))
-            }
-            Ok(_) => {}
-            Err(e) if e.kind() == io::ErrorKind::NotFound => match fs::create_dir(&real) {
-                Ok(()) => {}
-                // Another process made it meanwhile: checked below like any existing folder.
-                Err(e) if e.kind() == io::ErrorKind::AlreadyExists => {}
-                Err(e) => return Err(Error::io(&shown, e)),
-            },
-            Err(e) => return Err(Error::io(&shown, e)),
-        }
-        let resolved = fs::canonicalize(&real).map_err(|e| Error::io(&shown, e))?;
-        if resolved.parent() != Some(self.real.as_path()) || !resolved.is_dir() {
-            return Err(outside(
-                &shown,
-                &self.shown,
-                &format!("resolves to {}", resolved.display()),
-            ));
-        }
-        remove_orphan_temporaries(&resolved);
-        Ok(OutDir { shown, real: resolved })
-    }
-
-    /// A new, empty set of files to be written into this folder.
-    pub fn file_set(&self) -> Result<FileSet> {
-        FileSet::new(&self.real).map(|s| s.shown_as(&self.shown))
-    }
-}
-
-/// A symlink that leads nowhere (dangling, or a loop) is refused saying so: creating the folder
-/// would fail with a bare "File exists".
-fn check_not_a_broken_link(dir: &Path) -> Result<()> {
-    let is_link = fs::symlink_metadata(dir).is_ok_and(|m| m.file_type().is_symlink());
-    if !is_link {
-        return Ok(());
-    }
-    let what = match fs::metadata(dir) {
-        Ok(_) => return Ok(()),
-        Err(e) if e.raw_os_error() == Some(libc::ELOOP) => "is a symlink loop".to_string(),
-        Err(e) if e.kind() == io::ErrorKind::NotFound => format!(
-            "is a dangling symlink (to {}, which does not exist)",
-            fs::read_link(dir).map(|t| t.display().to_string()).unwrap_or_default()
-        ),
-        Err(e) => return Err(Error::io(dir, e)),
-    };
-    Err(Error::io(
-        dir,
-        io::Error::new(
-            io::ErrorKind::NotFound,
-            format!("the output directory {what}: create its target or give another --out-dir"),
-        ),
-    ))
-}
-
-fn outside(path: &Path, root: &Path, what: &str) -> Error {
-    Error::io(
-        path,
-        io::Error::new(
-            io::ErrorKind::InvalidInput,
-            format!(
-                "{what}: outputs are only written inside --out-dir {}; remove or rename it",
-                root.display()
-            ),
-        ),
-    )
-}
-
-/// `name` must be one normal path component and not look like one of our temporaries.
-fn check_plain_name(name: &str, dir: &Path) -> Result<()> {
-    let mut parts = Path::new(name).components();
-    let plain = matches!((parts.next(), parts.next()), (Some(Component::Normal(_)), None));
-    if !plain || name.starts_with(TEMP_PREFIX) {
-        return Err(Error::param(
-            "output name",
-            format!(
-                "'{name}' in {}: must be a plain file name (no '/', '..' or '{TEMP_PREFIX}' prefix)",
-                dir.display()
-            ),
-        ));
-    }
-    Ok(())
-}
 
 /// Files written all-or-none: staged privately, renamed into place by [`FileSet::commit`].
 #[derive(Debug)]
@@ -265,7 +105,7 @@ impl FileSet {
         self
     }
 
-    fn shown_as(mut self, shown: &Path) -> Self {
+    pub(super) fn shown_as(mut self, shown: &Path) -> Self {
         self.shown = shown.to_path_buf();
         self
     }
@@ -492,41 +332,10 @@ impl FileSet {
     }
 }
 
-/// Removes the temporaries (files or staging folders named `.viewsynth-…`) that a run killed
-/// before it could clean up left in `dir`; returns how many were removed. A temporary whose
-/// lock another process holds is a live run's and is never touched, whatever its pid says (a
-/// pid is meaningless across PID namespaces); an unlocked one goes at once, however young
-/// (its maker, if alive, makes another: see the module notes). A staging folder killed after
-/// its journal was written is first rolled forward (its remaining files renamed into `dir`,
-/// the manifest last), so a set is always either the old one or the new one, complete.
-pub fn remove_orphan_temporaries(dir: &Path) -> usize {
-    let Ok(entries) = fs::read_dir(dir) else { return 0 };
-    let mut removed = 0;
-    for e in entries.flatten() {
-        let name = e.file_name();
-        if !name.to_str().is_some_and(|n| n.starts_with(TEMP_PREFIX)) {
-            continue;
-        }
-        // file_type does not follow symlinks: a planted link is removed, not its target.
-        let ok = match e.file_type() {
-            Ok(t) if t.is_dir() => recover_staging(dir, &e.path()),
-            Ok(t) if t.is_file() => match open_for_lock(&e.path()) {
-                // Removed while locked, so its maker's late lock finds the name gone.
-                Ok(f) => lock_if_current(&f, &e.path()).unwrap_or(false) && fs::remove_file(e.path()).is_ok(),
-                Err(_) => false,
-            },
-            // Never ours (we make none) and harmless: left alone.
-            _ => false,
-        };
-        removed += usize::from(ok);
-    }
-    removed
-}
-
-/// Writes `file` through a [`super::atomic::WRITE_BUFFER`]-sized buffer with `write`, flushed;
+/// Writes `file` through a [`crate::io::files::atomic::WRITE_BUFFER`]-sized buffer with `write`, flushed;
 /// errors name `shown`. Returns the file, not yet synced.
 fn write_file(file: File, shown: &Path, write: impl FnOnce(&mut BufWriter<File>) -> Result<()>) -> Result<File> {
-    let mut writer = BufWriter::with_capacity(super::atomic::WRITE_BUFFER, file);
+    let mut writer = BufWriter::with_capacity(crate::io::files::atomic::WRITE_BUFFER, file);
     write(&mut writer)?;
     writer.flush().map_err(|e| Error::io(shown, e))?;
     writer.into_inner().map_err(|e| Error::io(shown, e.into_error()))
@@ -543,287 +352,10 @@ fn sync_panicked(dir: &Path) -> Error {
     Error::io(dir, io::Error::other("a thread syncing the set's files panicked"))
 }
 
-fn sync_dir(dir: &Path) {
-    if let Ok(d) = File::open(dir) {
-        let _ = d.sync_all();
-    }
-}
-
-/// Renames the files a journalled staging folder still holds into `dir`, in the journal's
-/// order, then removes the folder. True when the folder is gone.
-fn roll_forward(dir: &Path, staging: &Path) -> bool {
-    let Ok(journal) = fs::read_to_string(staging.join(JOURNAL_NAME)) else {
-        return false;
-    };
-    for name in journal.lines() {
-        if let Some(stale) = name.strip_prefix('/') {
-            if check_plain_name(stale, dir).is_err() || remove_own_file(&dir.join(stale)).is_err() {
-                return false;
-            }
-            continue;
-        }
-        // Names were checked when the set was made; anything else is not ours to move.
-        if check_plain_name(name, dir).is_err() {
-            return false;
-        }
-        let from = staging.join(name);
-        match fs::symlink_metadata(&from) {
-            Ok(m) if m.is_file() => {
-                if check_replaceable(&dir.join(name)).is_err() || fs::rename(&from, dir.join(name)).is_err() {
-                    return false;
-                }
-            }
-            Ok(_) => return false,
-            Err(_) => {} // renamed before the kill
-        }
-    }
-    sync_dir(dir);
-    fs::remove_dir_all(staging).is_ok()
-}
-
-/// Makes a staging folder in `dir` and takes its lock. A cleaner of another run may take the
-/// folder between its creation and its lock (it looks orphaned then): this maker notices (see
-/// [`claim_lock`]) and makes another.
-fn make_staging(dir: &Path) -> Result<(Staging, File)> {
-    for _ in 0..STAGING_TRIES {
-        let staging = Staging {
-            path: tempfile::Builder::new()
-                .prefix(&own_prefix())
-                .tempdir_in(dir)
-                .map_err(|e| Error::io(dir, e))?
-                .keep(),
-            names: Vec::new(),
-            kept: false,
-        };
-        match claim_lock(staging.path()) {
-            Ok(Some(lock)) => return Ok((staging, lock)),
-            // Taken by a cleaner: dropping `staging` removes what it left, if anything.
-            Ok(None) => continue,
-            Err(e) => return Err(Error::io(dir, e)),
-        }
-    }
-    Err(Error::io(
-        dir,
-        io::Error::other(format!(
-            "another process removed each of {STAGING_TRIES} staging folders as soon as it was made"
-        )),
-    ))
-}
-
-/// A set's staging folder, removed when dropped uncommitted, even when the process ran out of
-/// file descriptors (EMFILE: often the very error that failed the set). A removal that lists
-/// the folder needs a descriptor, unlinking a name does not: the names staged are removed by
-/// name, the listing (for files staged by path) is retried while other threads free theirs,
-/// then the lock file and the folder go. `tempfile::TempDir` tried one listing and silently
-/// left the folder, with its partial files, when it failed.
-#[derive(Debug)]
-struct Staging {
-    path: PathBuf,
-    /// Names created in it so far.
-    names: Vec<String>,
-    /// Handed over to the commit: no longer removed on drop.
-    kept: bool,
-}
-
-/// How long [`Staging`]'s removal waits, in all, for a descriptor to list its folder.
-const STAGING_LIST_TRIES: usize = 50;
-
-impl Staging {
-    fn path(&self) -> &Path {
-        &self.path
-    }
-
-    /// The folder, no longer removed on drop.
-    fn keep(mut self) -> PathBuf {
-        self.kept = true;
-        std::mem::take(&mut self.path)
-    }
-}
-
-impl Drop for Staging {
-    fn drop(&mut self) {
-        if self.kept {
-            return;
-        }
-        for name in self.names.iter().map(String::as_str).chain([JOURNAL_NAME]) {
-            let _ = fs::remove_file(self.path.join(name));
-        }
-        if let Ok(entries) = read_dir_patiently(&self.path) {
-            for e in entries.flatten() {
-                if e.file_name() != LOCK_NAME {
-                    let _ = fs::remove_file(e.path());
-                }
-            }
-        }
-        let _ = fs::remove_file(self.path.join(LOCK_NAME));
-        let _ = fs::remove_dir(&self.path);
-    }
-}
-
-/// `fs::read_dir(path)`, retried while the process has no descriptor to spare (EMFILE, ENFILE:
-/// other threads free theirs), for at most [`STAGING_LIST_TRIES`] x 10 ms. Listing a folder
-/// needs a descriptor; the commit's own cleanup failed on it under `ulimit -n` and left the
-/// emptied staging folder of a committed set behind.
-fn read_dir_patiently(path: &Path) -> io::Result<fs::ReadDir> {
-    let mut tries = 0;
-    loop {
-        match fs::read_dir(path) {
-            Err(e) if matches!(e.raw_os_error(), Some(libc::EMFILE | libc::ENFILE)) && tries < STAGING_LIST_TRIES => {
-                tries += 1;
-                std::thread::sleep(std::time::Duration::from_millis(10));
-            }
-            r => return r,
-        }
-    }
-}
-
-/// Creates the lock file of the staging folder `staging` and takes its lock: `Some` when this
-/// call now owns the folder, `None` when another process got there first (made the lock file,
-/// holds its lock, or removed it or the folder meanwhile). The maker of a folder and a cleaner
-/// of a lockless one both claim it this way, so exactly one of them wins.
-fn claim_lock(staging: &Path) -> io::Result<Option<File>> {
-    let path = staging.join(LOCK_NAME);
-    let file = match File::options().write(true).create_new(true).open(&path) {
-        Ok(f) => f,
-        Err(e) if matches!(e.kind(), io::ErrorKind::AlreadyExists | io::ErrorKind::NotFound) => return Ok(None),
-        Err(e) => return Err(e),
-    };
-    // Between the create and the lock a cleaner may have taken the file and removed it.
-    Ok(lock_if_current(&file, &path)?.then_some(file))
-}
-
-/// Empties and removes this run's own staging folder after its commit: the journal first (a
-/// kill now leaves a locked-file folder with nothing to roll forward), then anything else, then
-/// the lock file (a kill now leaves an empty folder), then the folder. Every state a kill can
-/// leave is one [`recover_staging`] removes at once.
-fn remove_staging(staging: &Path) -> io::Result<()> {
-    let gone = |r: io::Result<()>| match r {
-        Err(e) if e.kind() == io::ErrorKind::NotFound => Ok(()),
-        other => other,
-    };
-    gone(fs::remove_file(staging.join(JOURNAL_NAME)))?;
-    fault_point("journal removed").map_err(io::Error::other)?;
-    for e in read_dir_patiently(staging)?.flatten() {
-        if e.file_name() != LOCK_NAME {
-            gone(fs::remove_file(e.path()))?;
-        }
-    }
-    gone(fs::remove_file(staging.join(LOCK_NAME)))?;
-    fault_point("lock file removed").map_err(io::Error::other)?;
-    match fs::remove_dir(staging) {
-        // A cleaner claimed the lockless folder meanwhile (its new lock file is inside): the
-        // folder holds nothing of this set any more, and that cleaner removes it.
-        Err(e) if e.kind() == io::ErrorKind::DirectoryNotEmpty => {}
-        r => gone(r)?,
-    }
-    fault_point("staging removed").map_err(io::Error::other)
-}
-
-/// What a later run does with a staging folder `staging` in `dir` (see the module notes):
-/// nothing while its lock is held; else rolled forward when journalled, removed otherwise. A
-/// folder without a lock file is claimed first (see [`claim_lock`]). True when the folder is
-/// gone.
-fn recover_staging(dir: &Path, staging: &Path) -> bool {
-    let path = staging.join(LOCK_NAME);
-    let _lock = match open_for_lock(&path) {
-        // Held only if it is still the folder's lock file once locked.
-        Ok(f) if lock_if_current(&f, &path).unwrap_or(false) => f,
-        Ok(_) => return false,
-        Err(e) if e.kind() == io::ErrorKind::NotFound => match claim_lock(staging) {
-            Ok(Some(f)) => f,
-            _ => return false,
-        },
-        Err(_) => return false,
-    };
-    if staging.join(JOURNAL_NAME).exists() {
-        roll_forward(dir, staging)
-    } else {
-        fs::remove_dir_all(staging).is_ok()
-    }
-}
-
-/// Writes files at arbitrary paths (e.g. `compare --diff D --json J`) all-or-none: each is
-/// staged in a [`FileSet`] of its own folder, and nothing is renamed until every one was
-/// written and every destination checked (absent, a regular file or a symlink; never a
-/// folder). A character device or FIFO (`--json /dev/stdout`, `/dev/null`, a pipe), or any
-/// path under `/dev/`, is a stream, not a file to replace: it is written in place, without
-/// staging, after the staged files were written and before they are renamed. Returns the
-/// paths written.
-pub fn write_paths_all_or_none(jobs: Vec<(PathBuf, PathWriter<'_>)>) -> Result<Vec<PathBuf>> {
-    let mut sets = Vec::with_capacity(jobs.len());
-    let mut streams = Vec::new();
-    for (path, _) in &jobs {
-        if path.file_name().is_none() {
-            return Err(Error::io(
-                path,
-                io::Error::new(io::ErrorKind::InvalidInput, "path has no file name"),
-            ));
-        }
-        if !is_stream(path) {
-            check_replaceable(path)?;
-        }
-    }
-    for (path, write) in jobs {
-        if is_stream(&path) {
-            streams.push((path, write));
-            continue;
-        }
-        let dir = super::atomic::parent_dir(&path).to_path_buf();
-        let name = path.file_name().map(|n| n.to_os_string()).unwrap_or_default();
-        let set = FileSet::new(&dir)?.shown_as(&dir);
-        write(&set.staging().join(&name)).map_err(|e| set.final_error(e))?;
-        sets.push(set);
-    }
-    let mut done = Vec::new();
-    for (path, write) in streams {
-        // Held open while writing: a FIFO's reader then sees one writer, start to end.
-        let _reader_present = check_reader(&path)?;
-        write(&path)?;
-        done.push(path);
-    }
-    for set in sets {
-        done.extend(set.commit()?);
-    }
-    Ok(done)
-}
-
-/// A FIFO without a reader would block the run forever: refused at once, naming it. Returns
-/// the FIFO opened for writing (without blocking), to hold while the writer writes.
-fn check_reader(path: &Path) -> Result<Option<File>> {
-    use std::os::unix::fs::{FileTypeExt, OpenOptionsExt};
-    if !fs::metadata(path).is_ok_and(|m| m.file_type().is_fifo()) {
-        return Ok(None);
-    }
-    match fs::OpenOptions::new()
-        .write(true)
-        .custom_flags(libc::O_NONBLOCK)
-        .open(path)
-    {
-        Ok(f) => Ok(Some(f)),
-        Err(e) if e.raw_os_error() == Some(libc::ENXIO) => Err(Error::io(
-            path,
-            io::Error::new(
-                io::ErrorKind::BrokenPipe,
-                "a FIFO that no process reads: start its reader first",
-            ),
-        )),
-        Err(e) => Err(Error::io(path, e)),
-    }
-}
-
-/// Whether `path` is written in place: a character device or FIFO (after symlinks), or a path
-/// under `/dev/` (`/dev/stdout` resolves to whatever stdout is, a regular file included).
-fn is_stream(path: &Path) -> bool {
-    use std::os::unix::fs::FileTypeExt;
-    path.starts_with("/dev/")
-        || fs::metadata(path).is_ok_and(|m| m.file_type().is_char_device() || m.file_type().is_fifo())
-}
-
-/// Writes one file given its path (the path-based savers: `io::save_rgb`, ...).
-pub type PathWriter<'a> = Box<dyn FnOnce(&Path) -> Result<()> + 'a>;
-
 #[cfg(test)]
 mod tests {
+    use super::super::out_dir::OutDir;
+    use super::super::staging::remove_orphan_temporaries;
     use super::*;
     use crate::io::test_util::{list_dir, scratch_dir};
 

@@ -6,9 +6,9 @@ use std::path::Path;
 
 use image::{DynamicImage, ImageDecoder, ImageFormat, ImageReader, Limits};
 
-use super::image_types::{decode_dims, MAX_DIMENSION};
-use super::input::{max_pixels, open_regular};
 use crate::error::{Error, Result};
+use crate::io::files::input::{max_pixels, open_regular};
+use crate::io::image::types::{decode_dims, MAX_DIMENSION};
 
 /// Samples of one decoded image, interleaved, rows top-down.
 pub(crate) enum Samples {
@@ -38,7 +38,7 @@ fn reader(path: &Path, format: Option<ImageFormat>) -> Result<ImageReader<BufRea
         return Err(Error::decode(path, "unrecognised image format"));
     }
     if reader.format() == Some(ImageFormat::OpenExr) {
-        super::exr_io::check_exr_sampling(path)?;
+        crate::io::formats::exr::check_exr_sampling(path)?;
     }
     let mut limits = Limits::default();
     limits.max_image_width = Some(MAX_DIMENSION);

@@ -9,10 +9,10 @@ use exr::prelude::{
     WritableImage,
 };
 
-use super::image_types::{decode_dims, sample_count};
-use super::input::{check_file_len, max_pixels, open_regular};
-use super::raw_depth::{RawDepth, RawSamples};
 use crate::error::{Error, Result};
+use crate::io::files::input::{check_file_len, max_pixels, open_regular};
+use crate::io::formats::raw_depth::{RawDepth, RawSamples};
+use crate::io::image::types::{decode_dims, sample_count};
 
 /// Width and height of a single-layer EXR from its header alone.
 pub(crate) fn exr_dimensions(path: &Path) -> Result<(u32, u32)> {
@@ -251,7 +251,7 @@ pub(crate) fn write_f32_channels(
     width: u32,
     height: u32,
     channels: Vec<(&str, Vec<f32>)>,
-    compression: super::ExrCompression,
+    compression: crate::io::ExrCompression,
 ) -> Result<()> {
     let planes: Vec<(&str, &[f32])> = channels.iter().map(|(name, v)| (*name, v.as_slice())).collect();
     write_f32_planes(path, out, width, height, &planes, compression)
@@ -271,9 +271,9 @@ pub(crate) fn write_f32_planes(
     width: u32,
     height: u32,
     channels: &[(&str, &[f32])],
-    compression: super::ExrCompression,
+    compression: crate::io::ExrCompression,
 ) -> Result<()> {
-    let zip = compression == super::ExrCompression::Zip;
+    let zip = compression == crate::io::ExrCompression::Zip;
     // With ZIP the layer only names the channels (its header); the samples stay the caller's.
     let list: SmallVec<[AnyChannel<FlatSamples>; 4]> = channels
         .iter()
@@ -286,7 +286,7 @@ pub(crate) fn write_f32_planes(
         AnyChannels::sort(list),
     );
     let image = Image::from_layer(layer);
-    let result = if compression == super::ExrCompression::Zip {
+    let result = if compression == crate::io::ExrCompression::Zip {
         let headers = image.write().infer_meta_data();
         // In the header's order: AnyChannels::sort orders the channels by name.
         let mut sorted = channels.to_vec();

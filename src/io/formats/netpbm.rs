@@ -5,14 +5,14 @@ use std::str::FromStr;
 /// Width and height from a PGM/PFM header (magic, width, height), checked against the limits
 /// and the pixel budget; the rest is validated when the file is loaded.
 pub(crate) fn netpbm_dimensions(path: &std::path::Path) -> crate::Result<(u32, u32)> {
-    let (mut file, len) = super::input::open_regular(path)?;
-    let prefix = super::input::read_prefix(path, &mut file, len, NETPBM_HEADER_CAP)?;
+    let (mut file, len) = crate::io::files::input::open_regular(path)?;
+    let prefix = crate::io::files::input::read_prefix(path, &mut file, len, NETPBM_HEADER_CAP)?;
     let mut header = HeaderReader::new(&prefix);
     let bad = |msg: String| crate::Error::decode(path, format!("invalid header: {msg}"));
     header.token().ok_or_else(|| bad("empty file".into()))?;
     let width: u64 = header.number("width").map_err(bad)?;
     let height: u64 = header.number("height").map_err(bad)?;
-    super::image_types::decode_dims(path, width, height)
+    crate::io::image::types::decode_dims(path, width, height)
 }
 
 /// Bytes read for a Netpbm/PFM text header (comments included) before the raster.

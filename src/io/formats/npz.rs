@@ -18,8 +18,9 @@ use std::path::Path;
 use zip::read::ZipFile;
 use zip::{CompressionMethod, ZipArchive};
 
-use super::npy::{NpyArray, NpyDtype, NpyStream};
 use crate::error::{Error, Result};
+use crate::io::formats::npy::{NpyArray, NpyStream};
+use crate::io::NpyDtype;
 
 /// Most members an archive may list (numpy archives hold a handful).
 const MAX_MEMBERS: usize = 1024;
@@ -42,7 +43,12 @@ fn key(name: &str) -> &str {
 /// first floating-point one. Returns the key read with the array. At most 4 values per
 /// budget pixel (as `.npy` files).
 pub fn load_npz_array(path: &Path, key: Option<&str>) -> Result<(String, NpyArray)> {
-    load_npz_array_within(path, key, super::input::max_pixels().saturating_mul(4), &|_| Ok(()))
+    load_npz_array_within(
+        path,
+        key,
+        crate::io::files::input::max_pixels().saturating_mul(4),
+        &|_| Ok(()),
+    )
 }
 
 /// [`load_npz_array`] with at most `max_values` values, and `check` run on the chosen array's
@@ -53,7 +59,7 @@ pub(crate) fn load_npz_array_within(
     max_values: u64,
     check: &dyn Fn(&[usize]) -> Result<()>,
 ) -> Result<(String, NpyArray)> {
-    let (file, _) = super::input::open_regular(path)?;
+    let (file, _) = crate::io::files::input::open_regular(path)?;
     let bad = |m: String| Error::decode(path, format!("npz: {m}"));
     // Every read of the archive seeks first, so `unlisted` may share the file's cursor.
     let mut zip =
@@ -62,12 +68,15 @@ pub(crate) fn load_npz_array_within(
         return Err(bad(format!("{} members, more than {MAX_MEMBERS}", zip.len())));
     }
     let members = check_tiling(&mut zip, &file).map_err(bad)?;
-    let keys = || super::excerpt(&members.iter().map(|m| key(&m.name)).collect::<Vec<_>>().join(", "));
+    let keys = || crate::io::excerpt(&members.iter().map(|m| key(&m.name)).collect::<Vec<_>>().join(", "));
     let index = match wanted {
-        Some(wanted) => members
-            .iter()
-            .position(|m| key(&m.name) == wanted)
-            .ok_or_else(|| bad(format!("no array '{}' (arrays: {})", super::excerpt(wanted), keys())))?,
+        Some(wanted) => members.iter().position(|m| key(&m.name) == wanted).ok_or_else(|| {
+            bad(format!(
+                "no array '{}' (arrays: {})",
+                crate::io::excerpt(wanted),
+                keys()
+            ))
+        })?,
         None if members.len() == 1 => 0,
         None => {
             // The first floating-point array, told from the headers alone: an array of a type
@@ -91,13 +100,13 @@ pub(crate) fn load_npz_array_within(
     let stream = open(&mut zip, m, index, max_values).map_err(bad)?;
     check(stream.shape()).map_err(|e| match e {
         Error::Decode { path, message } => {
-            Error::decode(path, format!("array '{}': {message}", super::excerpt(key(&m.name))))
+            Error::decode(path, format!("array '{}': {message}", crate::io::excerpt(key(&m.name))))
         }
         other => other,
     })?;
     let array = stream
         .read()
-        .map_err(|e| bad(format!("{}: {e}", super::excerpt(key(&m.name)))))?;
+        .map_err(|e| bad(format!("{}: {e}", crate::io::excerpt(key(&m.name)))))?;
     Ok((key(&m.name).to_string(), array))
 }
 
@@ -110,7 +119,7 @@ fn open<'z, 'f>(
     index: usize,
     max_values: u64,
 ) -> std::result::Result<NpyStream<Take<ZipFile<'z, &'f File>>>, String> {
-    let name = super::excerpt(key(&m.name));
+    let name = crate::io::excerpt(key(&m.name));
     let file = member(zip, m, index)?;
     let size = file.size();
     NpyStream::open(file.take(size.saturating_add(1)), size, max_values).map_err(|e| format!("{name}: {e}"))
@@ -122,7 +131,7 @@ fn member<'z, 'f>(
     m: &Member,
     index: usize,
 ) -> std::result::Result<ZipFile<'z, &'f File>, String> {
-    let name = super::excerpt(key(&m.name));
+    let name = crate::io::excerpt(key(&m.name));
     if !matches!(m.method, CompressionMethod::Stored | CompressionMethod::Deflated) {
         return Err(format!(
             "{name}: compression method {} (only stored and deflate)",
@@ -135,10 +144,10 @@ fn member<'z, 'f>(
 /// Member `index`'s element type from its `.npy` header (`None`: a type the reader does not
 /// decode), read within the size the central directory declares.
 fn dtype(zip: &mut ZipArchive<&File>, m: &Member, index: usize) -> std::result::Result<Option<NpyDtype>, String> {
-    let name = super::excerpt(key(&m.name));
+    let name = crate::io::excerpt(key(&m.name));
     let file = member(zip, m, index)?;
     let size = file.size();
-    super::npy::read_dtype(&mut file.take(size), size).map_err(|e| format!("{name}: {e}"))
+    crate::io::formats::npy::read_dtype(&mut file.take(size), size).map_err(|e| format!("{name}: {e}"))
 }
 
 /// The listed members, in directory order, once they are known to tile the archive: each
@@ -156,7 +165,7 @@ fn check_tiling(zip: &mut ZipArchive<&File>, file: &File) -> std::result::Result
         let end = f
             .data_start()
             .and_then(|start| start.checked_add(f.compressed_size()))
-            .ok_or_else(|| format!("member {}: its data runs past the end", super::excerpt(&name)))?;
+            .ok_or_else(|| format!("member {}: its data runs past the end", crate::io::excerpt(&name)))?;
         if members.iter().any(|m: &Member| key(&m.name) == key(&name)) {
             return Err(ambiguous(&name));
         }
@@ -173,14 +182,14 @@ fn check_tiling(zip: &mut ZipArchive<&File>, file: &File) -> std::result::Result
         if start < at {
             return Err(format!(
                 "member {} at byte {start} overlaps the one before it",
-                super::excerpt(&members[i].name)
+                crate::io::excerpt(&members[i].name)
             ));
         }
         unlisted(file, at, start, &members)?;
         at = end;
     }
     if at > directory {
-        let last = super::excerpt(spans.last().map_or("", |s| members[s.2].name.as_str()));
+        let last = crate::io::excerpt(spans.last().map_or("", |s| members[s.2].name.as_str()));
         return Err(format!(
             "member {last}: its data runs past the end of the members (the central directory at byte {directory})"
         ));
@@ -207,14 +216,14 @@ fn unlisted(mut file: &File, from: u64, to: u64, members: &[Member]) -> std::res
     }
     Err(format!(
         "bytes {from}..{to} hold member {}, which the central directory does not list",
-        super::excerpt(&hidden)
+        crate::io::excerpt(&hidden)
     ))
 }
 
 fn ambiguous(name: &str) -> String {
     format!(
         "two arrays named '{}': ambiguous (numpy reads the last, other readers the first)",
-        super::excerpt(key(name))
+        crate::io::excerpt(key(name))
     )
 }
 

@@ -4,7 +4,7 @@
 //! cli/tests/integration/reproject.rs).
 
 use super::*;
-use crate::io::npy::build_npy;
+use crate::io::formats::npy::build_npy;
 use std::io::Write;
 use zip::write::SimpleFileOptions;
 

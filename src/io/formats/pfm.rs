@@ -5,11 +5,11 @@
 
 use std::path::Path;
 
-use super::image_types::{decode_dims, sample_count};
-use super::input::{open_regular, read_body, read_prefix};
-use super::netpbm::{HeaderReader, NETPBM_HEADER_CAP};
-use super::raw_depth::{RawDepth, RawSamples};
 use crate::error::{Error, Result};
+use crate::io::files::input::{open_regular, read_body, read_prefix};
+use crate::io::formats::netpbm::{HeaderReader, NETPBM_HEADER_CAP};
+use crate::io::formats::raw_depth::{RawDepth, RawSamples};
+use crate::io::image::types::{decode_dims, sample_count};
 
 pub(crate) fn read_pfm(path: &Path) -> Result<RawDepth> {
     let (mut file, len) = open_regular(path)?;

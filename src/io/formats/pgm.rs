@@ -6,11 +6,11 @@
 
 use std::path::Path;
 
-use super::image_types::{decode_dims, sample_count};
-use super::input::{check_file_len, open_regular, read_body, read_prefix};
-use super::netpbm::{HeaderReader, NETPBM_HEADER_CAP};
-use super::raw_depth::{RawDepth, RawSamples};
 use crate::error::{Error, Result};
+use crate::io::files::input::{check_file_len, open_regular, read_body, read_prefix};
+use crate::io::formats::netpbm::{HeaderReader, NETPBM_HEADER_CAP};
+use crate::io::formats::raw_depth::{RawDepth, RawSamples};
+use crate::io::image::types::{decode_dims, sample_count};
 
 pub(crate) fn read_pgm(path: &Path) -> Result<RawDepth> {
     let (mut file, len) = open_regular(path)?;

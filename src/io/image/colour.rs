@@ -4,9 +4,9 @@
 
 use std::path::Path;
 
-use super::decode::{decode_image, Decoded, Samples};
-use super::image_types::RgbImage;
 use crate::error::{Error, Result};
+use crate::io::formats::decode::{decode_image, Decoded, Samples};
+use crate::io::image::types::RgbImage;
 
 /// RGB (and alpha, when the file has it) as f32, rows top-down, interleaved.
 #[derive(Debug, Clone, PartialEq)]

@@ -5,14 +5,14 @@ use std::path::Path;
 use image::codecs::png::PngEncoder;
 use image::{ExtendedColorType, ImageEncoder, ImageFormat};
 
-use super::atomic::atomic_write;
-use super::decode::{decode_image, Decoded, Samples};
-use super::image_types::{encode_dims, Mask};
 use crate::error::{Error, Result};
+use crate::io::files::atomic::atomic_write;
+use crate::io::formats::decode::{decode_image, Decoded, Samples};
+use crate::io::image::types::{encode_dims, Mask};
 
 /// Writes 8-bit gray: 0 -> 0, [`MASK_FILLED`] -> itself, any other nonzero value -> 255.
 pub fn save_mask_png(path: &Path, mask: &Mask) -> Result<()> {
-    save_mask_png_with(path, mask, super::PngCompression::default())
+    save_mask_png_with(path, mask, crate::io::PngCompression::default())
 }
 
 /// The mask value of a pixel that was filled (cyclopean `--fill`), not rendered: kept as it is
@@ -20,7 +20,7 @@ pub fn save_mask_png(path: &Path, mask: &Mask) -> Result<()> {
 pub const MASK_FILLED: u8 = 128;
 
 /// [`save_mask_png`] with a chosen compression.
-pub fn save_mask_png_with(path: &Path, mask: &Mask, compression: super::PngCompression) -> Result<()> {
+pub fn save_mask_png_with(path: &Path, mask: &Mask, compression: crate::io::PngCompression) -> Result<()> {
     atomic_write(path, |out| encode_mask_png(path, out, mask, compression))
 }
 
@@ -29,7 +29,7 @@ pub fn encode_mask_png(
     path: &Path,
     out: &mut std::io::BufWriter<std::fs::File>,
     mask: &Mask,
-    compression: super::PngCompression,
+    compression: crate::io::PngCompression,
 ) -> Result<()> {
     encode_dims(path, mask.width, mask.height, 1, mask.data.len())?;
     // The file's bytes go into this thread's buffer, kept between masks (no image-sized

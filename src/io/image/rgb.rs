@@ -8,11 +8,11 @@ use image::codecs::jpeg::JpegEncoder;
 use image::codecs::png::PngEncoder;
 use image::{ExtendedColorType, ImageEncoder};
 
-use super::atomic::atomic_write;
-use super::decode::{decode_image, Decoded, Samples};
-use super::exr_io::write_f32_channels;
-use super::image_types::{encode_dims, RgbImage};
 use crate::error::{Error, Result};
+use crate::io::files::atomic::atomic_write;
+use crate::io::formats::decode::{decode_image, Decoded, Samples};
+use crate::io::formats::exr::write_f32_channels;
+use crate::io::image::types::{encode_dims, RgbImage};
 
 const JPEG_QUALITY: u8 = 95;
 
@@ -41,11 +41,11 @@ pub fn load_rgb(path: &Path) -> Result<RgbImage> {
 /// Saves by extension (case-insensitive): `.png`, `.jpg`/`.jpeg` (quality 95), or `.exr`
 /// (three f32 channels R, G, B holding `v / 255`, linear, no sRGB decoding, ZIP compressed).
 pub fn save_rgb(path: &Path, img: &RgbImage) -> Result<()> {
-    save_rgb_with(path, img, &super::Encoding::default())
+    save_rgb_with(path, img, &crate::io::Encoding::default())
 }
 
 /// [`save_rgb`] with chosen PNG/EXR compression.
-pub fn save_rgb_with(path: &Path, img: &RgbImage, encoding: &super::Encoding) -> Result<()> {
+pub fn save_rgb_with(path: &Path, img: &RgbImage, encoding: &crate::io::Encoding) -> Result<()> {
     let ext = lowercase_extension(path);
     if !matches!(ext.as_str(), "png" | "jpg" | "jpeg" | "exr") {
         return Err(Error::encode(
@@ -63,7 +63,7 @@ pub fn encode_rgb(
     out: &mut BufWriter<File>,
     img: &RgbImage,
     ext: &str,
-    encoding: &super::Encoding,
+    encoding: &crate::io::Encoding,
 ) -> Result<()> {
     encode_dims(path, img.width, img.height, 3, img.data.len())?;
     let (w, h) = (img.width, img.height);

@@ -136,7 +136,7 @@ pub(crate) fn decode_dims(path: &Path, width: u64, height: u64) -> Result<(u32, 
     match dims_problem(width, height) {
         Some(msg) => Err(Error::decode(path, msg)),
         None => {
-            super::input::check_budget(path, width, height)?;
+            crate::io::files::input::check_budget(path, width, height)?;
             // Both are <= MAX_DIMENSION here, so the casts are lossless.
             Ok((width as u32, height as u32))
         }
@@ -164,7 +164,7 @@ mod tests {
     fn coverage_of_masks_and_depth() {
         let mask = super::Mask::new(2, 2, vec![0, 255, 1, 0]).unwrap();
         assert_eq!(mask.coverage(), 0.5);
-        let depth = super::DepthMap::new(2, 2, vec![1.5, 0.0, f32::NAN, -1.0]).unwrap();
+        let depth = crate::io::DepthMap::new(2, 2, vec![1.5, 0.0, f32::NAN, -1.0]).unwrap();
         assert_eq!(depth.coverage(), 0.25);
     }
 

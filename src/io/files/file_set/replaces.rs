@@ -7,14 +7,17 @@
 //! the opened file must be the one listed) of a bounded size. A name must be a plain one, and the
 //! file a regular file when it is removed. A run's inputs are never among them: each command
 //! refuses, before any work, inputs that are files the previous set lists
-//! ([`super::super::check_out_dir`] takes this rule).
+//! ([`crate::output::check_out_dir`] takes this rule).
 
 use std::fs::{self, File};
 use std::io::{self, Read};
 use std::os::unix::fs::{MetadataExt, OpenOptionsExt};
 use std::path::Path;
 
-use super::MANIFEST_NAME;
+use crate::io::files::atomic::check_plain_name;
+
+/// The name renamed last in every set: its presence marks the set complete.
+pub const MANIFEST_NAME: &str = "manifest.json";
 
 /// The largest manifest or set record read (a 10 000-frame scene's record is about 3 MB): a
 /// larger file is not one this program wrote, and nothing is removed on its word.
@@ -61,7 +64,7 @@ impl Replaces {
         };
         let mut names: Vec<String> = listed
             .into_iter()
-            .filter(|n| super::check_plain_name(n, dir).is_ok() && is_regular(&dir.join(n)))
+            .filter(|n| check_plain_name(n, dir).is_ok() && is_regular(&dir.join(n)))
             .collect();
         names.sort();
         names.dedup();
