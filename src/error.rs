@@ -7,6 +7,7 @@ pub type Result<T, E = Error> = std::result::Result<T, E>;
 
 /// Everything the library can fail with; the message names the file or parameter at fault.
 #[derive(Debug, thiserror::Error)]
+#[non_exhaustive]
 pub enum Error {
     /// A file could not be opened, read, created or renamed.
     #[error("{path}: {source}")]
@@ -79,6 +80,16 @@ pub enum Error {
     /// A GL call or object failed (shader compile/link, incomplete framebuffer, GL error).
     #[error("OpenGL error: {0}")]
     Gl(String),
+    /// A run did not hand back what its pass asked for (an output not read back, a run waited
+    /// twice). Raised by backend-neutral code, so it names the graphics API the run was on
+    /// (`pass::Api::name`): an "OpenGL error" on GL as before, never one on Vulkan.
+    #[error("{backend} error: {message}")]
+    Readback {
+        /// The graphics API of the run: "OpenGL" or "Vulkan".
+        backend: &'static str,
+        /// What is missing, naming the pass.
+        message: String,
+    },
     /// The Vulkan loader or a device is missing, or a Vulkan call failed (`--backend vulkan`).
     #[error("Vulkan error: {0}")]
     Vulkan(String),

@@ -5,7 +5,7 @@
 //!
 //! Every `crate::`, `super::` and `self::` path in a crate's `*.rs` is resolved to the file that defines what it names,
 //! following the `use` re-exports of the modules on the way, so `crate::io::DepthMap` is an
-//! import of `src/io/image_types.rs`, not of `src/io/mod.rs`. A module's own `pub use` of its
+//! import of `src/io/image/types.rs`, not of `src/io/mod.rs`. A module's own `pub use` of its
 //! children is its facade, not an import. Test modules (`#[cfg(test)] mod ... { }`) are left
 //! out: the layers are the library's build. Two rules, each failure naming the files:
 //!
@@ -703,4 +703,32 @@ fn the_scan_resolves_use_trees_and_re_exports() {
         Some("io/encoding.rs")
     );
     assert_eq!(krate.resolve(&s(&["io", "load"]), 0).as_deref(), Some("io/mod.rs"));
+}
+
+/// Most lines a file under `src/io/` may have (issue 45): past it a file holds more than one
+/// concern and is split by concern, as `files/` (out-dir, file set, staging, paths) was.
+const MAX_IO_FILE_LINES: usize = 600;
+
+/// The `src/io/` files longer than [`MAX_IO_FILE_LINES`], with their lengths.
+fn io_files_over_limit(dir: &Path) -> Vec<String> {
+    let mut files = Vec::new();
+    rust_files(dir, &mut files);
+    files.sort();
+    files
+        .iter()
+        .filter_map(|p| {
+            let lines = fs::read_to_string(p).unwrap().lines().count();
+            (lines > MAX_IO_FILE_LINES).then(|| format!("{} ({lines} lines)", p.display()))
+        })
+        .collect()
+}
+
+#[test]
+fn no_file_under_src_io_exceeds_600_lines() {
+    let over = io_files_over_limit(&Path::new(env!("CARGO_MANIFEST_DIR")).join("src/io"));
+    assert!(
+        over.is_empty(),
+        "files under src/io over {MAX_IO_FILE_LINES} lines (split them by concern): {}",
+        over.join(", ")
+    );
 }

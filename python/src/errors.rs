@@ -79,10 +79,13 @@ pub fn from_library(e: Error) -> PyErr {
         Error::ImageTooLarge { name, .. } => raise(Kind::InvalidInput, message, Some(name)),
         Error::SizeMismatch { .. } => raise(Kind::InvalidInput, message, None),
         Error::Egl(_) | Error::SoftwareRenderer { .. } => raise(Kind::GpuUnavailable, message, None),
-        Error::Gl(_) | Error::Vulkan(_) => raise(Kind::Gpu, message, None),
+        Error::Gl(_) | Error::Vulkan(_) | Error::Readback { .. } => raise(Kind::Gpu, message, None),
         Error::Io { .. } | Error::Decode { .. } | Error::Encode { .. } => raise(Kind::File, message, None),
         // Python's own class for it: the host could not allocate an image-sized buffer.
         Error::OutOfMemory { .. } => pyo3::exceptions::PyMemoryError::new_err(message),
+        // `Error` is non-exhaustive: a variant added later and not classed here yet keeps its
+        // message, as a plain RuntimeError.
+        _ => pyo3::exceptions::PyRuntimeError::new_err(message),
     }
 }
 

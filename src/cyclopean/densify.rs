@@ -186,7 +186,7 @@ impl Densifier {
         let mut r = self.device.render(&target, &[draw])?;
         let disparity = r
             .depth(0)?
-            .ok_or_else(|| Error::Gl("densify: the disparity was not read back".into()))?;
+            .ok_or_else(|| r.api.readback_error("densify: the disparity was not read back"))?;
         Ok(Dense {
             disparity,
             filled: r.take(1, "densify flags")?,

@@ -216,6 +216,7 @@ impl ForwardWarp {
                     wall_ms: 0.0,
                 },
                 size: (w, h),
+                api: self.device.api(),
             }
         } else {
             self.device.run(Some(&target), &steps)?

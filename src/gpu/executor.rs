@@ -223,6 +223,7 @@ impl Executor for GlExecutor {
                 wall_ms: run.submit_ms,
             },
             size: (0, 0),
+            api: Api::Gl,
         })
     }
 

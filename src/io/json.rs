@@ -8,7 +8,7 @@ use std::path::Path;
 use serde::de::DeserializeOwned;
 use serde_json::Value;
 
-use super::input::{check_file_len, open_regular};
+use super::files::input::{check_file_len, open_regular};
 use crate::error::{Error, Result};
 
 /// Largest JSON input read (camera and scene files are a few KiB).

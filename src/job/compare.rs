@@ -185,7 +185,7 @@ impl CompareJob {
                 why: "neither side's depth is device or ndc depth (view-z is metres: no planes)".into(),
             });
         }
-        let inputs: Vec<io::NamedPath<'_>> = [
+        let inputs: Vec<crate::output::NamedPath<'_>> = [
             ("--a-rgb", Some(&o.a.rgb)),
             ("--a-depth", o.a.depth.as_ref()),
             ("--b-rgb", Some(&o.b.rgb)),
@@ -195,12 +195,12 @@ impl CompareJob {
         .into_iter()
         .filter_map(|(option, p)| p.map(|p| (option, p.as_path())))
         .collect();
-        let mut outputs: Vec<io::NamedPath<'_>> = o.diff.iter().map(|p| ("--diff", p.as_path())).collect();
+        let mut outputs: Vec<crate::output::NamedPath<'_>> = o.diff.iter().map(|p| ("--diff", p.as_path())).collect();
         outputs.extend(o.flip_map.iter().map(|p| ("--flip-map", p.as_path())));
         if let Some(JsonOutput::File(p)) = &o.json {
             outputs.push(("--json", p));
         }
-        io::check_outputs(&inputs, &outputs).map_err(ArgError::Invalid)?;
+        crate::output::check_outputs(&inputs, &outputs).map_err(ArgError::Invalid)?;
         Ok(CompareJob {
             a: o.a,
             b: o.b,

@@ -7,6 +7,7 @@ use std::path::PathBuf;
 /// Options that do not make a valid job: refused in the conversion from the command line,
 /// before any input is read, GPU opened or file written.
 #[derive(Debug, thiserror::Error)]
+#[non_exhaustive]
 pub enum ArgError {
     /// A library rule refused a value (intrinsics, break rule, outputs, sizes, ...).
     #[error(transparent)]
@@ -265,6 +266,7 @@ impl std::fmt::Display for PerFrameOption {
 
 /// A job that failed while running; nothing of its output was written (files are all-or-none).
 #[derive(Debug, thiserror::Error)]
+#[non_exhaustive]
 pub enum JobError {
     /// The library failed (a file, the GPU, a value found in the data).
     #[error(transparent)]

@@ -4,7 +4,7 @@
 
 use super::ArgError;
 use crate::io;
-use crate::io::{DepthFormats, FileFormats, OutputSet, RgbFormat};
+use crate::output::{DepthFormats, FileFormats, OutputSet, RgbFormat};
 
 /// The file options as given.
 #[derive(Debug, Clone, Copy)]

@@ -62,7 +62,7 @@ impl TumManifestJob {
         let rgb_list = rgb_list.unwrap_or_else(|| sequence.join("rgb.txt"));
         let depth_list = depth_list.unwrap_or_else(|| sequence.join("depth.txt"));
         // The one output rule of every command: --out never replaces a listing it reads.
-        crate::io::check_outputs(
+        crate::output::check_outputs(
             &[
                 ("--rgb-list", rgb_list.as_path()),
                 ("--depth-list", depth_list.as_path()),
@@ -97,7 +97,7 @@ impl TumManifestJob {
             .iter()
             .flat_map(|f| [("rgb.txt", f.rgb.as_path()), ("depth.txt", f.depth.as_path())])
             .collect();
-        crate::io::check_outputs(&frames, &[("--out", self.out.as_path())])?;
+        crate::output::check_outputs(&frames, &[("--out", self.out.as_path())])?;
         write_manifest_csv(&self.out, &a.frames)?;
         Ok(TumManifestReport {
             frames: a.frames.len(),

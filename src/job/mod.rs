@@ -80,7 +80,7 @@ pub(crate) fn check_npz_key(key: Option<&str>, depths: &[&std::path::Path]) -> R
 /// A request's outputs as the text `--outputs` takes ("rgb,depth,mask"), or none: one value
 /// for each front end's default to be compared with.
 pub(crate) fn outputs_text<S: serde::Serializer>(
-    outputs: &Option<crate::io::OutputSet>,
+    outputs: &Option<crate::output::OutputSet>,
     s: S,
 ) -> Result<S::Ok, S::Error> {
     match outputs {

@@ -129,7 +129,8 @@ impl SceneJob {
             )));
         }
         if let SceneSource::File(path) = &scene {
-            io::check_out_dir(&o.out_dir, writes, &replaced(), &[("--scene", path)]).map_err(ArgError::Invalid)?;
+            crate::output::check_out_dir(&o.out_dir, writes, &replaced(), &[("--scene", path)])
+                .map_err(ArgError::Invalid)?;
         }
         let mut rig = StereoRig::demo(o.width, o.height);
         rig.camera.validate("scene camera")?;
@@ -218,15 +219,16 @@ impl SceneJob {
                     conv,
                 })?;
                 let (rgb_depth, depth_only) = (
-                    io::FileFormats::of(io::OutputSet::RGB_DEPTH),
-                    io::FileFormats::of(io::OutputSet::DEPTH),
+                    crate::output::FileFormats::of(crate::output::OutputSet::RGB_DEPTH),
+                    crate::output::FileFormats::of(crate::output::OutputSet::DEPTH),
                 );
                 let mut planes = ViewOutput::color_only(img.color, None);
                 planes.depth = Some(img.view_z);
-                let names = io::ViewNames::named(&format!("{prefix}{eye}_rgb"), &format!("{prefix}{eye}_view_z"));
+                let names =
+                    crate::output::ViewNames::named(&format!("{prefix}{eye}_rgb"), &format!("{prefix}{eye}_view_z"));
                 crate::output::write_view(&mut set, &names, &planes, &rgb_depth)?;
                 planes.depth = Some(img.device_depth);
-                let names = io::ViewNames::named("", &format!("{prefix}{eye}_device_depth"));
+                let names = crate::output::ViewNames::named("", &format!("{prefix}{eye}_device_depth"));
                 crate::output::write_view(&mut set, &names, &planes, &depth_only)?;
                 let entry = if eye == "middle" {
                     serde_json::json!({ "view": view, "proj": proj, "width": width, "height": height })
@@ -272,12 +274,13 @@ impl SceneJob {
                     for (face, tag) in faces.faces.into_iter().zip(FACE_TAGS) {
                         let mut view = ViewOutput::color_only(face.color, None);
                         view.depth = Some(face.depth);
-                        let names = io::ViewNames::named(&format!("{eye}_{tag}"), &format!("{eye}_{tag}_depth"));
+                        let names =
+                            crate::output::ViewNames::named(&format!("{eye}_{tag}"), &format!("{eye}_{tag}_depth"));
                         crate::output::write_view(
                             &mut set,
                             &names,
                             &view,
-                            &io::FileFormats::of(io::OutputSet::RGB_DEPTH),
+                            &crate::output::FileFormats::of(crate::output::OutputSet::RGB_DEPTH),
                         )?;
                     }
                 }
@@ -306,12 +309,12 @@ fn writes(name: &str) -> bool {
     let view = ["left", "right", "middle"].iter().any(|eye| {
         stems
             .iter()
-            .any(|s| io::ViewNames::named(&format!("{eye}_{s}"), "").may_write(frame))
+            .any(|s| crate::output::ViewNames::named(&format!("{eye}_{s}"), "").may_write(frame))
     });
     let face = ["left", "right"].iter().any(|eye| {
-        FACE_TAGS
-            .iter()
-            .any(|t| io::ViewNames::named(&format!("{eye}_{t}"), &format!("{eye}_{t}_depth")).may_write(name))
+        FACE_TAGS.iter().any(|t| {
+            crate::output::ViewNames::named(&format!("{eye}_{t}"), &format!("{eye}_{t}_depth")).may_write(name)
+        })
     });
     view || face || frame == "cameras.json" || name == "sequence.json"
 }

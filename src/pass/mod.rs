@@ -28,6 +28,8 @@
 
 mod limits;
 mod policy;
+#[cfg(test)]
+mod readback_tests;
 pub mod shaders;
 mod timing;
 
@@ -243,6 +245,8 @@ pub struct Rendered {
     pub timing: Timing,
     /// The target's width and height (0 x 0 without one).
     pub size: (u32, u32),
+    /// The graphics API the run was on (named by a [`crate::Error::Readback`]).
+    pub api: Api,
 }
 
 impl Target {
@@ -296,7 +300,7 @@ impl Rendered {
         self.outputs
             .get_mut(i)
             .and_then(Option::take)
-            .ok_or_else(|| crate::Error::Gl(format!("{what}: output {i} was not rendered")))
+            .ok_or_else(|| self.api.readback_error(format!("{what}: output {i} was not rendered")))
     }
 }
 
@@ -307,6 +311,24 @@ pub enum Api {
     Gl,
     /// Vulkan 1.3.
     Vulkan,
+}
+
+impl Api {
+    /// The API's name in messages.
+    pub fn name(self) -> &'static str {
+        match self {
+            Api::Gl => "OpenGL",
+            Api::Vulkan => "Vulkan",
+        }
+    }
+
+    /// A [`crate::Error::Readback`] of a run on this API.
+    pub fn readback_error(self, message: impl Into<String>) -> crate::Error {
+        crate::Error::Readback {
+            backend: self.name(),
+            message: message.into(),
+        }
+    }
 }
 
 /// A queued run ([`Executor::submit`]); its outputs come with [`Executor::wait`].
@@ -523,7 +545,7 @@ impl Pending {
         let ticket = self
             .ticket
             .take()
-            .ok_or_else(|| crate::Error::Gl("run waited twice".into()))?;
+            .ok_or_else(|| self.device.api().readback_error("run waited twice"))?;
         let mut out = self.device.0.borrow_mut().wait(ticket)?;
         out.size = self.size;
         Ok(out)

@@ -5,7 +5,8 @@
 use super::RefocusOutput;
 use crate::camera::{Intrinsics, PinholeCamera};
 use crate::error::{Error, Result};
-use crate::io::{self, FileFormats, FileRecord, FileSet, ViewFiles, ViewNames};
+use crate::io::{self, FileSet};
+use crate::output::{FileFormats, FileRecord, ViewFiles, ViewNames};
 use crate::view::ViewOutput;
 use serde::Serialize;
 use std::path::Path;
@@ -218,7 +219,7 @@ impl Manifest {
 
 /// The files `entries` name, with their sizes and CRC-32 on disk (under `dir`).
 pub fn file_records(dir: &Path, entries: &[ManifestEntry]) -> Result<Vec<FileRecord>> {
-    io::file_records(dir, entries.iter().flat_map(|e| e.files.names()))
+    crate::output::file_records(dir, entries.iter().flat_map(|e| e.files.names()))
 }
 
 /// The file-name prefix of a zoom scale: 0.5 -> "s0.5", 1 -> "s1", 1.25 -> "s1.25" (short,
@@ -474,7 +475,7 @@ mod tests {
         let dir = scratch("viewsynth-job-png16-");
         let out = synthetic_output(vec![1.5, 0.0, 70.0, 65.6]);
         let files = FileFormats {
-            depth: io::DepthFormats {
+            depth: crate::output::DepthFormats {
                 exr: false,
                 npy: false,
                 png16: true,

@@ -131,4 +131,4 @@ impl std::str::FromStr for Method {
     }
 }
 
-pub use crate::io::OutputSet;
+pub use crate::output::OutputSet;

@@ -9,7 +9,7 @@ use super::render::StitchRenderer;
 use super::{FaceSet, StitchParams};
 use crate::convention::Conventions;
 use crate::error::Result;
-use crate::io::OutputSet;
+use crate::output::OutputSet;
 use crate::pass::ToDevice;
 use crate::view::ViewOutput;
 

@@ -10,7 +10,8 @@ use crate::convention::{Conventions, RowOrder};
 use crate::error::{Error, Result};
 use crate::gpu::shaders::StitchBlend;
 use crate::gpu::{ProgramKind, ShaderProgram, Timing};
-use crate::io::{DepthMap, OutputSet, RgbImage};
+use crate::io::{DepthMap, RgbImage};
+use crate::output::OutputSet;
 use crate::pass::{mat4_std140, Device, Draw, Format, Image, ImageData, Target, ToDevice};
 
 crate::param_block! {

@@ -654,6 +654,7 @@ impl Executor for VkExecutor {
             outputs,
             timing,
             size: (0, 0),
+            api: Api::Vulkan,
         })
     }
 }

@@ -1,8 +1,8 @@
 //! Which outputs to write and in which file formats (refocus, batch and reproject).
 
 use clap::{Args, ValueEnum};
-use viewsynth::io::RgbFormat;
 use viewsynth::job::FileOptions;
+use viewsynth::output::RgbFormat;
 
 #[derive(Clone, Copy, ValueEnum)]
 enum RgbFormatArg {
@@ -46,14 +46,14 @@ pub(crate) struct FileOutputArgs {
 }
 
 /// `--outputs` parsed, its errors naming the option as given.
-pub(crate) fn parse_outputs(list: Option<&str>) -> Result<Option<viewsynth::io::OutputSet>, viewsynth::Error> {
-    list.map(|l| viewsynth::io::OutputSet::parse(l).map_err(|e| e.renamed("--outputs")))
+pub(crate) fn parse_outputs(list: Option<&str>) -> Result<Option<viewsynth::output::OutputSet>, viewsynth::Error> {
+    list.map(|l| viewsynth::output::OutputSet::parse(l).map_err(|e| e.renamed("--outputs")))
         .transpose()
 }
 
 impl FileOutputArgs {
     /// `--outputs` as given (None: the request's default, all three).
-    pub(crate) fn outputs_given(&self) -> Result<Option<viewsynth::io::OutputSet>, viewsynth::Error> {
+    pub(crate) fn outputs_given(&self) -> Result<Option<viewsynth::output::OutputSet>, viewsynth::Error> {
         parse_outputs(self.outputs.as_deref())
     }
 
@@ -79,7 +79,7 @@ impl FileOutputArgs {
     }
 
     /// The options as the library checks them, with `outputs` parsed once (the request's).
-    pub(crate) fn options(&self, outputs: viewsynth::io::OutputSet) -> FileOptions<'_> {
+    pub(crate) fn options(&self, outputs: viewsynth::output::OutputSet) -> FileOptions<'_> {
         FileOptions {
             outputs,
             rgb: self.rgb_format(),

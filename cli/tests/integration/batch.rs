@@ -6,8 +6,8 @@ use super::common::gpu;
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 use viewsynth::convention::Conventions;
-use viewsynth::io::FileFormats;
 use viewsynth::io::{self, Encoding, PngCompression};
+use viewsynth::output::FileFormats;
 use viewsynth::refocus::batch::{load_manifest, run_batch, BatchOptions, Shard};
 use viewsynth::refocus::{BreakRule, Method, OutputSet};
 use viewsynth::scene;
@@ -44,7 +44,7 @@ fn options(jobs: usize) -> BatchOptions {
         conv: Conventions::default(),
         files: FileFormats {
             outputs: OutputSet::default(),
-            depth: viewsynth::io::DepthFormats {
+            depth: viewsynth::output::DepthFormats {
                 exr: true,
                 npy: true,
                 png16: true,
@@ -239,7 +239,8 @@ fn the_jobs_limit_is_an_error_not_a_panic() {
 /// rendered by a `Refocuser` and kept in memory.
 #[test]
 fn every_output_kind_reads_back_as_rendered() {
-    use viewsynth::io::{DepthDecode, DepthFormats, RgbFormat};
+    use viewsynth::io::DepthDecode;
+    use viewsynth::output::{DepthFormats, RgbFormat};
     use viewsynth::refocus::manifest::{scale_tag, TargetSpec, DEFAULT_SCALES};
     use viewsynth::refocus::{RefocusSource, Refocuser};
     let data = super::common::data_dir().join("rgbd_open3d_testdata");

@@ -1131,7 +1131,7 @@ fn round3_library_passes_refuse_unusable_depth_and_are_finite_where_valid() {
                 left: &l,
                 right: &r0,
                 params,
-                outputs: viewsynth::io::OutputSet::RGB_DEPTH,
+                outputs: viewsynth::output::OutputSet::RGB_DEPTH,
                 conv,
             };
             cases += 2;
@@ -1148,7 +1148,7 @@ fn round3_library_passes_refuse_unusable_depth_and_are_finite_where_valid() {
                 left: &l,
                 right: &r0,
                 params,
-                outputs: viewsynth::io::OutputSet::RGB_DEPTH,
+                outputs: viewsynth::output::OutputSet::RGB_DEPTH,
                 conv,
             };
             cases += 1;

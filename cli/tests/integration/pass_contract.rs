@@ -228,7 +228,7 @@ fn stitch_pass_and_twin_are_the_renderer_and_the_twin() {
                 width: 128,
                 height: 64,
             },
-            outputs: viewsynth::io::OutputSet::RGB,
+            outputs: viewsynth::output::OutputSet::RGB,
             conv: other_conventions(),
         };
         let (image, _) = StitchRenderer::with_conventions(&g, &l, &r, input.conv)

@@ -21,7 +21,7 @@
 
 use crate::common::gpu;
 use viewsynth::convention::Conventions;
-use viewsynth::io::OutputSet;
+use viewsynth::output::OutputSet;
 use viewsynth::pass::Device;
 use viewsynth::stitch::faces::{faces_from_images, scene_faces};
 use viewsynth::stitch::reference::{stitch_reference, stitch_reference_eye};

@@ -189,7 +189,7 @@ fn stitch_methods_agree_between_gl_and_vulkan_under_every_convention() {
                     width: 128,
                     height: 64,
                 },
-                outputs: viewsynth::io::OutputSet::RGB_DEPTH,
+                outputs: viewsynth::output::OutputSet::RGB_DEPTH,
                 conv,
             };
             let a = stitch::pass::gpu(&gl, &input).unwrap();
@@ -843,4 +843,21 @@ fn a_write_queued_for_a_freed_image_does_not_reach_the_next_image() {
         [10, 20, 30, 40, 50, 60],
         "the rendered pixels pass through the fill as uploaded"
     );
+}
+
+/// An output a run did not give back, found by the backend-neutral `Rendered::take`, is an
+/// error of the API the run was on: "Vulkan error" on Vulkan (it said "OpenGL error" there
+/// before issue 45), the GL message unchanged on GL.
+#[test]
+fn a_missing_output_is_an_error_of_the_backend_the_run_was_on() {
+    let (gl, vk) = devices();
+    for (device, want) in [
+        (&vk, "Vulkan error: a pass: output 0 was not rendered"),
+        (&gl, "OpenGL error: a pass: output 0 was not rendered"),
+    ] {
+        // A run with no target reads nothing back.
+        let mut out = device.run(None, &[]).unwrap();
+        let e = out.take(0, "a pass").unwrap_err().to_string();
+        assert_eq!(e, want);
+    }
 }

@@ -8,7 +8,7 @@ use serde::Serialize;
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 use viewsynth::error::{Error, Result};
-use viewsynth::io::FileFormats;
+use viewsynth::output::FileFormats;
 use viewsynth::pass::Device;
 use viewsynth::refocus::batch::{load_manifest, run_batch, BatchFrame, BatchOptions, BatchSummary, StageTimes};
 use viewsynth::refocus::{BreakRule, Method};

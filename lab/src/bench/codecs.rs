@@ -11,7 +11,8 @@ use std::io::{BufWriter, Write};
 use std::path::Path;
 use viewsynth::convention::Conventions;
 use viewsynth::error::{Error, Result};
-use viewsynth::io::{self, DepthDecode, DepthMap, Encoding, ExrCompression, OutputSet, PngCompression, RgbImage};
+use viewsynth::io::{self, DepthDecode, DepthMap, Encoding, ExrCompression, PngCompression, RgbImage};
+use viewsynth::output::OutputSet;
 use viewsynth::refocus::manifest::TargetSpec;
 use viewsynth::refocus::{BreakRule, Method, RefocusOutput, RefocusSource, Refocuser};
 

@@ -12,7 +12,7 @@ use std::fmt::Write as _;
 use std::time::Instant;
 use viewsynth::convention::Conventions;
 use viewsynth::error::Result;
-use viewsynth::io::FileFormats;
+use viewsynth::output::FileFormats;
 use viewsynth::pass::Device;
 use viewsynth::refocus::manifest::{self as job, TargetSpec};
 use viewsynth::refocus::{reference, BreakRule, Method, OutputSet, RefocusSource, Refocuser};

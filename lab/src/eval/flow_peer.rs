@@ -244,9 +244,11 @@ pub fn fill_two_images_rows(device: &viewsynth::pass::Device, data_dir: &Path) -
         let t0 = std::time::Instant::now();
         let view = job.render_only(device, &Quiet)?.view;
         let wall_ms = t0.elapsed().as_secs_f64() * 1e3;
-        let image = view
-            .color
-            .ok_or_else(|| Error::Gl(format!("{}: the --fill view has no colour", pair.scene)))?;
+        let image = view.color.ok_or_else(|| {
+            device
+                .api()
+                .readback_error(format!("{}: the --fill view has no colour", pair.scene))
+        })?;
         let truth = io::load_rgb(&pair.truth)?;
         rows.push(all_pixels_row(
             &pair.scene,

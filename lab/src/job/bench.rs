@@ -8,8 +8,8 @@ use crate::bench::{cyclopean_bench, refocus_bench, BenchCase};
 use crate::progress::Progress as _;
 use std::path::PathBuf;
 use viewsynth::io;
-use viewsynth::io::FileFormats;
 use viewsynth::job::{Event, GpuRequest};
+use viewsynth::output::FileFormats;
 
 /// The bench options as given.
 #[derive(Debug, Clone)]

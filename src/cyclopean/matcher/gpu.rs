@@ -30,8 +30,10 @@ pub struct EyeEstimate {
 
 /// Output `k` of a run, read back as a map.
 fn disparity(out: &mut Rendered, k: usize) -> Result<DepthMap> {
-    out.depth(k)?
-        .ok_or_else(|| Error::Gl(format!("stereo matcher: output {k} was not read back")))
+    out.depth(k)?.ok_or_else(|| {
+        out.api
+            .readback_error(format!("stereo matcher: output {k} was not read back"))
+    })
 }
 
 /// Largest pair the pass takes (8 Mpx, 4K UHD fits): its census codes (4 words a pixel) then

@@ -193,7 +193,7 @@ impl CyclopeanJob {
         ];
         inputs.extend(map_files);
         inputs.extend(o.cameras.as_deref().map(|c| ("--cameras", c)));
-        io::check_out_dir(&o.out_dir, owned_name, &replaced(), &inputs).map_err(ArgError::Invalid)?;
+        crate::output::check_out_dir(&o.out_dir, owned_name, &replaced(), &inputs).map_err(ArgError::Invalid)?;
         Ok(CyclopeanJob {
             left_rgb: o.left_rgb,
             right_rgb: o.right_rgb,
@@ -226,7 +226,7 @@ impl CyclopeanJob {
         let mut set = out_dir.file_set()?.replacing(replaced());
         crate::output::write_view(
             &mut set,
-            &io::ViewNames::tagged("middle"),
+            &crate::output::ViewNames::tagged("middle"),
             &view.done.view,
             &self.formats(),
         )?;
@@ -234,7 +234,7 @@ impl CyclopeanJob {
             .into_iter()
             .zip(view.confidence.iter().flatten())
             .collect();
-        io::write_float_exrs(&mut set, &maps)?;
+        crate::output::write_float_exrs(&mut set, &maps)?;
         let written = set.commit()?;
         Ok(CyclopeanReport {
             width: view.size.0,
@@ -247,8 +247,8 @@ impl CyclopeanJob {
     }
 
     /// The file formats of the plan's outputs.
-    pub(crate) fn formats(&self) -> io::FileFormats {
-        io::FileFormats {
+    pub(crate) fn formats(&self) -> crate::output::FileFormats {
+        crate::output::FileFormats {
             outputs: self.plan.outputs(),
             ..Default::default()
         }
@@ -529,7 +529,7 @@ mod tests {
         let job = CyclopeanJob::new(disparity_options(CyclopeanRequest::default())).unwrap();
         assert!(!job.plan.outputs().depth && job.plan.outputs().rgb);
         let o = disparity_options(CyclopeanRequest {
-            outputs: Some(crate::io::OutputSet::parse("depth").unwrap()),
+            outputs: Some(crate::output::OutputSet::parse("depth").unwrap()),
             ..Default::default()
         });
         assert!(matches!(CyclopeanJob::new(o), Err(ArgError::DepthOutputNotMetric)));

@@ -184,7 +184,7 @@ impl CyclopeanSequenceJob {
                         .replacing(super::replaced()),
                 ),
             };
-            let names = io::ViewNames::tagged(&format!("middle_{k:05}"));
+            let names = crate::output::ViewNames::tagged(&format!("middle_{k:05}"));
             crate::output::write_view(set, &names, &view.done.view, &job.formats())?;
             size = view.size;
             coverage += view.done.coverage;

@@ -108,7 +108,7 @@ impl RefocusCommand {
             |name: &str| name == io::MANIFEST_NAME || plan.tags.iter().any(|t| name.starts_with(&format!("{t}_")));
         let mut inputs = vec![("--rgb", rgb.as_path()), ("--depth", depth.as_path())];
         inputs.extend(o.intrinsics_file.as_deref().map(|p| ("--intrinsics", p)));
-        io::check_out_dir(&o.out_dir, writes, &job::replaced(), &inputs).map_err(ArgError::Invalid)?;
+        crate::output::check_out_dir(&o.out_dir, writes, &job::replaced(), &inputs).map_err(ArgError::Invalid)?;
         Ok(RefocusCommand::Frame(RefocusJob {
             rgb,
             depth,
@@ -265,7 +265,7 @@ impl RefocusBatchJob {
     fn check_outputs(&self, frames: &[crate::refocus::batch::BatchFrame]) -> Result<(), JobError> {
         // The index's own names are written and (those of other runs) removed at the root.
         let index = is_index_name;
-        io::check_out_dir(
+        crate::output::check_out_dir(
             &self.out_dir,
             index,
             &io::Replaces::Owned(index),
@@ -280,7 +280,7 @@ impl RefocusBatchJob {
                 ("--batch rgb", frame.rgb.as_path()),
                 ("--batch depth", frame.depth.as_path()),
             ];
-            io::check_out_dir(&self.out_dir.join(name), writes, &job::replaced(), &inputs)
+            crate::output::check_out_dir(&self.out_dir.join(name), writes, &job::replaced(), &inputs)
                 .map_err(ArgError::Invalid)?;
         }
         Ok(())

@@ -8,8 +8,9 @@
 
 use crate::camera::PinholeCamera;
 use crate::convention::Conventions;
-use crate::io::{self, FileFormats, OutputSet, RgbFormat};
+use crate::io::{self};
 use crate::job::{ArgError, FileOptions, PerFrameOption};
+use crate::output::{FileFormats, OutputSet, RgbFormat};
 use crate::refocus::batch::{BatchOptions, Shard, ZoomRandom};
 use crate::refocus::manifest::{self, TargetSpec, DEFAULT_SCALES};
 use crate::refocus::{BreakRule, Method};

@@ -14,8 +14,8 @@ use crate::cyclopean::camera_file::CameraFile;
 use crate::cyclopean::{FrameDepth, MiddleCamera};
 use crate::depth::DepthEncoding;
 use crate::gpu::Timing;
-use crate::io::FileFormats;
 use crate::io::{self, DepthDecode};
+use crate::output::FileFormats;
 use crate::reproject::{Geometry, ReprojectParams, ReprojectSource};
 use crate::view::ViewOutput;
 use serde::{Deserialize, Serialize};
@@ -215,12 +215,12 @@ impl ReprojectJob {
         };
         let writes = |name: &str| {
             eyes.iter()
-                .any(|&e| io::ViewNames::tagged(view_name(e)).may_write(name))
+                .any(|&e| crate::output::ViewNames::tagged(view_name(e)).may_write(name))
         };
         let mut inputs = vec![("--color", o.color.as_path()), ("--depth", o.depth.as_path())];
         inputs.extend(o.intrinsics_file.as_deref().map(|p| ("--intrinsics", p)));
         inputs.extend(o.cameras.as_deref().map(|p| ("--cameras", p)));
-        io::check_out_dir(&o.out_dir, writes, &replaced(), &inputs).map_err(ArgError::Invalid)?;
+        crate::output::check_out_dir(&o.out_dir, writes, &replaced(), &inputs).map_err(ArgError::Invalid)?;
         Ok(ReprojectJob {
             decode: DepthDecode {
                 scale: o.depth_scale,
@@ -285,7 +285,12 @@ impl ReprojectJob {
                 timing: Some(timing),
                 exact: None,
             };
-            crate::output::write_view(&mut set, &io::ViewNames::tagged(view_name(to)), &view, &self.files)?;
+            crate::output::write_view(
+                &mut set,
+                &crate::output::ViewNames::tagged(view_name(to)),
+                &view,
+                &self.files,
+            )?;
             reports.push(TargetReport {
                 to,
                 coverage,

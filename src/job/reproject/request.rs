@@ -12,9 +12,9 @@ use crate::camera::{Intrinsics, PinholeCamera};
 use crate::convention::Conventions;
 use crate::depth::DepthEncoding;
 use crate::gpu::Timing;
-use crate::io::OutputSet;
 use crate::job::error::OptionsContext;
 use crate::job::ArgError;
+use crate::output::OutputSet;
 use crate::pass::Device;
 use crate::reproject::render::Reprojector;
 use crate::reproject::{

@@ -42,8 +42,8 @@ fn stacked_depth(set: &FaceSet) -> DepthMap {
 const OUTPUT_NAMES: [&str; 3] = ["ods_top_bottom", "ods_left", "ods_right"];
 
 /// The files of the stitched image `stem` (one of [`OUTPUT_NAMES`]).
-fn view_names(stem: &str) -> io::ViewNames {
-    io::ViewNames::named(stem, &format!("{stem}_depth"))
+fn view_names(stem: &str) -> crate::output::ViewNames {
+    crate::output::ViewNames::named(stem, &format!("{stem}_depth"))
 }
 
 /// Refuses a face folder whose files an output would replace: a face file under an output's
@@ -69,9 +69,9 @@ fn check_faces_against_outputs(faces: &std::path::Path, out_dir: &std::path::Pat
         .filter(|e| e.file_name().to_str().is_some_and(is_face))
         .map(|e| e.path())
         .collect();
-    let inputs: Vec<io::NamedPath<'_>> = files.iter().map(|p| ("--faces", p.as_path())).collect();
+    let inputs: Vec<crate::output::NamedPath<'_>> = files.iter().map(|p| ("--faces", p.as_path())).collect();
     let writes = |name: &str| OUTPUT_NAMES.iter().any(|n| view_names(n).may_write(name));
-    io::check_out_dir(out_dir, writes, &replaced(), &inputs).map_err(ArgError::Invalid)
+    crate::output::check_out_dir(out_dir, writes, &replaced(), &inputs).map_err(ArgError::Invalid)
 }
 
 /// What face depth files hold.
@@ -126,7 +126,7 @@ pub struct StitchJob {
     npz_key: Option<String>,
     depth_kind: DepthEncoding,
     conventions: Conventions,
-    outputs: io::OutputSet,
+    outputs: crate::output::OutputSet,
     per_eye: bool,
     truth: bool,
     out_dir: PathBuf,
@@ -296,7 +296,7 @@ impl StitchJob {
         let whole = ViewOutput::from_stitch(out.color, out.distance, None);
         let image_size = (whole.width, whole.height);
         // Through the output layer, all or none: colour PNGs, distance EXRs.
-        let formats = io::FileFormats::of(self.outputs);
+        let formats = crate::output::FileFormats::of(self.outputs);
         let mut set = out_dir.file_set()?.replacing(replaced());
         crate::output::write_view(&mut set, &view_names("ods_top_bottom"), &whole, &formats)?;
         if self.per_eye {

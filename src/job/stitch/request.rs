@@ -8,10 +8,11 @@
 use super::FaceDepth;
 use crate::convention::{Conventions, NdcDepthRange, RowOrder};
 use crate::depth::DepthEncoding;
-use crate::io::{self, OutputSet};
+use crate::io::{self};
 use crate::job::error::OptionsContext;
 use crate::job::reproject::device_depth;
 use crate::job::ArgError;
+use crate::output::OutputSet;
 use crate::stitch::{FaceSet, Method, OdsRig, Side, StitchParams};
 use serde::{Deserialize, Serialize};
 

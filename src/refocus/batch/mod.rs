@@ -42,7 +42,7 @@ pub use zoom::{ZoomRandom, MAX_SAMPLES};
 use super::{BreakRule, Method};
 use crate::convention::Conventions;
 use crate::error::{Error, Result};
-use crate::io::FileFormats;
+use crate::output::FileFormats;
 use serde::Serialize;
 
 /// Most threads either pool may have: each holds a frame in memory (VGA x 5 scales: 14 MB),

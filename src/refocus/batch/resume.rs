@@ -24,7 +24,7 @@ pub(super) fn input_identity(p: &Path) -> serde_json::Value {
     };
     let path = std::fs::canonicalize(p).unwrap_or_else(|_| p.to_path_buf());
     let mut id = serde_json::json!({ "path": path.to_string_lossy(), "bytes": m.len(), "mtime_ns": mtime_ns(&m) });
-    if let Ok(crc) = crate::io::file_crc32(p) {
+    if let Ok(crc) = crate::output::file_crc32(p) {
         id["crc32"] = crc.into();
     }
     id
@@ -107,7 +107,7 @@ fn same_input(p: &Path, recorded: &serde_json::Value, verify: bool) -> bool {
     if same_mtime && !(verify && crc.is_some()) {
         return true;
     }
-    crc.is_some_and(|crc| crate::io::file_crc32(p).is_ok_and(|c| u64::from(c) == crc))
+    crc.is_some_and(|crc| crate::output::file_crc32(p).is_ok_and(|c| u64::from(c) == crc))
 }
 
 /// Whether a frame's manifest `m` records this run's settings for `frame` and inputs that are
@@ -172,6 +172,6 @@ pub(super) fn frame_finished(dir: &Path, frame: &BatchFrame, opts: &BatchOptions
             !name.contains('/')
                 && !name.starts_with('.')
                 && std::fs::symlink_metadata(dir.join(name)).is_ok_and(|m| m.is_file() && m.len() == bytes)
-                && (!opts.verify || crate::io::file_crc32(&dir.join(name)).is_ok_and(|c| u64::from(c) == crc))
+                && (!opts.verify || crate::output::file_crc32(&dir.join(name)).is_ok_and(|c| u64::from(c) == crc))
         })
 }
