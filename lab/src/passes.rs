@@ -92,7 +92,7 @@ impl PassCase {
     /// This pass's frame on `device` over `inputs`.
     pub fn frame<'a>(&self, device: &'a Device, inputs: &'a PassInputs) -> Result<Frame<'a>> {
         let (w, h) = (inputs.width, inputs.height);
-        let cyclopean = move |(out, t): (CyclopeanOutput, viewsynth::gpu::Timing)| {
+        let cyclopean = move |(out, t): (CyclopeanOutput, viewsynth::pass::Timing)| {
             vec![ViewOutput::from_cyclopean(&out, w, h, Some(t))]
         };
         let mid = &inputs.mid;

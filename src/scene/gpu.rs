@@ -7,9 +7,8 @@ use crate::camera::mat4::{self, Mat4};
 pub use crate::camera::rays::{pixel_ndc, ray_basis};
 use crate::convention::{Conventions, DepthPlanes, RowOrder};
 use crate::error::{Error, Result};
-use crate::gpu::{ProgramKind, ShaderProgram, Timing};
 use crate::io::{DepthMap, RgbImage};
-use crate::pass::{mat4_std140, Device, Draw, Format, Target, ToDevice};
+use crate::pass::{mat4_std140, Device, Draw, Format, ProgramKind, ShaderProgram, Target, Timing, ToDevice};
 
 crate::param_block! {
     /// The ray tracer's parameters: shaders/scene/raytrace_params.glsl, member for member.
@@ -256,15 +255,8 @@ impl SceneRenderer {
             rows: cam.conv.row_order,
             depth_test: None,
         };
-        let draw = Draw {
-            program: ShaderProgram::new(cam.conv, ProgramKind::SceneRaytrace),
-            params: bytemuck::bytes_of(&block),
-            images: &[],
-            buffers: &[],
-            viewport: [0, 0, w, h],
-            triangles: 1,
-            indices: None,
-        };
+        let program = ShaderProgram::new(cam.conv, ProgramKind::SceneRaytrace);
+        let draw = Draw::fullscreen(program, bytemuck::bytes_of(&block), &[], w, h);
         let mut out = self.device.render(&target, &[draw])?;
         let color = out.take(0, "scene ray trace")?;
         let view_z = out.take_floats(1, "scene ray trace")?;

@@ -26,9 +26,8 @@ use viewsynth::cyclopean::render::{CyclopeanRenderer, GatherParams};
 use viewsynth::cyclopean::scene_frame::{scene_frame, StereoRig};
 use viewsynth::cyclopean::splat::{EdgeSnapBlock, SplatBlock, SplatGatherBlock, SplatParams, SplatRenderer};
 use viewsynth::cyclopean::{CyclopeanOutputs, CyclopeanParams, FrameDepth, Method};
-use viewsynth::gpu::shaders::{ShiftDepth, StitchBlend};
-use viewsynth::gpu::{ProgramKind, ShaderProgram};
-use viewsynth::pass::{Device, ParamBlock};
+use viewsynth::pass::shaders::{ShiftDepth, StitchBlend};
+use viewsynth::pass::{Device, ParamBlock, ProgramKind, ShaderProgram};
 use viewsynth::refocus::{BreakRule, RefocusParams};
 use viewsynth::reproject::render::ShiftParams;
 use viewsynth::reproject::{self, ReprojectInput};
@@ -97,7 +96,7 @@ fn every_parameter_block_has_the_layout_the_gl_compiler_reports() {
         winner: true,
     });
     check_block::<viewsynth::cyclopean::temporal::TemporalParams>(ProgramKind::CyclopeanTemporalCompose);
-    for stage in viewsynth::gpu::shaders::MatcherStage::ALL {
+    for stage in viewsynth::pass::shaders::MatcherStage::ALL {
         check_block::<viewsynth::cyclopean::matcher::gpu::MatcherParams>(ProgramKind::CyclopeanMatcher(stage));
     }
     check_block::<RefocusParams>(ProgramKind::RefocusMeshBoundary { want_rgb: true });
