@@ -333,7 +333,7 @@ pub const PROGRAMS: &[ProgramEntry] = &[
         name: "reproject/shift",
         stages: &[
             ("vert", FULLSCREEN_VERT),
-            ("frag", &["common/depth.glsl", "reproject/shift_params.glsl", "reproject/shift.frag"]),
+            ("frag", &["common/depth.glsl", "reproject/reproject_params.glsl", "reproject/shift.frag"]),
         ],
         switches: &[("DEPTH_MODE", &[0, 1, 2]), ("SCAN", &[0, 1]), ("SCAN_MARGIN", &[1])],
         vulkan: Some(&[]),
@@ -348,7 +348,7 @@ pub const PROGRAMS: &[ProgramEntry] = &[
                     "common/camera.glsl",
                     "common/depth.glsl",
                     "common/ods.glsl",
-                    "scene/raytrace_params.glsl",
+                    "scene/scene_params.glsl",
                     "scene/raytrace.frag",
                 ],
             ),

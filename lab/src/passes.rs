@@ -20,7 +20,7 @@ use viewsynth::pass::Device;
 use viewsynth::refocus::manifest::{TargetSpec, DEFAULT_SCALES};
 use viewsynth::refocus::{BreakRule, Method, OutputSet, RefocusSource, Refocuser};
 use viewsynth::reproject::render::Reprojector;
-use viewsynth::scene::gpu::{GlCamera, SceneRenderer};
+use viewsynth::scene::render::{GlCamera, SceneRenderer};
 use viewsynth::stitch::render::StitchRenderer;
 use viewsynth::stitch::FaceSet;
 use viewsynth::stitch::{faces::scene_faces, Method as Sm, OdsRig, Side, StitchParams};
@@ -267,7 +267,7 @@ impl PassInputs {
     /// view Z gives every convention the same input bits.
     pub fn with_depth(width: u32, height: u32, conv: Conventions, kind: FrameDepth) -> Result<Self> {
         let cam = viewsynth::scene::demo_camera(width, height);
-        let (rgb, depth) = viewsynth::scene::gpu(&cam);
+        let (rgb, depth) = viewsynth::scene::render(&cam);
         let refocus = RefocusSource::new(rgb, depth, cam.k)?;
         let targets = TargetSpec {
             scales: DEFAULT_SCALES.to_vec(),

@@ -156,7 +156,7 @@ impl ForwardWarp {
         let (w, h) = (mid.width, mid.height);
         self.device.check_image_size("middle size", w, h)?;
         let vp_m = mat4::mul(&mid.proj, &mid.view);
-        let centre = crate::scene::gpu::projection_centre(&vp_m)
+        let centre = crate::scene::render::projection_centre(&vp_m)
             .ok_or_else(|| Error::param("middle projection", "not perspective"))?;
         let rays_vp_m = super::ray_basis_std140(&vp_m, "middle view-projection")?;
         let inv = |m: &Mat4, what: &str| {

@@ -17,7 +17,7 @@ use crate::pass::shaders::ShiftDepth;
 use crate::pass::{Device, Draw, Format, Image, ImageData, ProgramKind, ShaderProgram, Target, Timing, ToDevice};
 
 crate::param_block! {
-    /// The shift's parameters: shaders/reproject/shift_params.glsl, member for member.
+    /// The shift's parameters: shaders/reproject/reproject_params.glsl, member for member.
     pub struct ShiftParams("ShiftParams") {
         u_a: f32,
         u_b: f32,

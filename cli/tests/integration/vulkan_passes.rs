@@ -32,7 +32,7 @@ use viewsynth::pass::{Device, ParamBlock, ProgramKind, ShaderProgram};
 use viewsynth::refocus::{BreakRule, RefocusParams};
 use viewsynth::reproject::render::ShiftParams;
 use viewsynth::reproject::{self, ReprojectInput};
-use viewsynth::scene::gpu::{GlCamera, RaytraceParams, SceneRenderer};
+use viewsynth::scene::render::{GlCamera, RaytraceParams, SceneRenderer};
 use viewsynth::stitch::faces::scene_faces;
 use viewsynth::stitch::render::StitchBlock;
 use viewsynth::stitch::{self, Method as StitchMethod, OdsRig, Side, StitchInput, StitchParams};
@@ -215,7 +215,7 @@ fn scene_ray_tracer_agrees_between_gl_and_vulkan_under_every_convention() {
         };
         let a = SceneRenderer::new(&gl, &scene).unwrap().render(&cam).unwrap().0;
         let b = SceneRenderer::new(&vk, &scene).unwrap().render(&cam).unwrap().0;
-        let view = |img: &viewsynth::scene::gpu::SceneImage, depth: &viewsynth::io::DepthMap| ViewOutput {
+        let view = |img: &viewsynth::scene::render::SceneImage, depth: &viewsynth::io::DepthMap| ViewOutput {
             width: 120,
             height: 90,
             color: Some(img.color.clone()),

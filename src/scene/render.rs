@@ -11,7 +11,7 @@ use crate::io::{DepthMap, RgbImage};
 use crate::pass::{mat4_std140, Device, Draw, Format, ProgramKind, ShaderProgram, Target, Timing, ToDevice};
 
 crate::param_block! {
-    /// The ray tracer's parameters: shaders/scene/raytrace_params.glsl, member for member.
+    /// The ray tracer's parameters: shaders/scene/scene_params.glsl, member for member.
     pub struct RaytraceParams("RaytraceParams") {
         u_ray_basis: [[f32; 4]; 4],
         u_view_proj: [[f32; 4]; 4],
