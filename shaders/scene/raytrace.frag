@@ -1,4 +1,4 @@
-// Ray tracer of a scene description (src/scene/shapes.rs; f64 twin: src/scene/gpu.rs
+// Ray tracer of a scene description (src/scene/shapes.rs; f64 twin: src/scene/reference.rs
 // `trace_gl_reference`). One ray per pixel centre from the camera's ray basis (the inverse of
 // the view-projection's clip x, y, w rows), the same under every convention.
 // Outputs colour, view distance (GL: -z_eye; 0 on a miss) and window depth under the

@@ -6,6 +6,7 @@
 //! discontinuities, slanted surfaces and texture at several frequencies. Any posed pinhole
 //! camera can look at it ([`render_posed`]), e.g. the eyes of a stereo rig.
 
+pub mod reference;
 pub mod render;
 mod shapes;
 

@@ -1,11 +1,11 @@
 //! The scene ray-traced on the GPU (shaders/scene/raytrace.frag) for any GL camera (view V,
-//! projection P, conventions), and its f64 twin with the same ray construction. Both give
-//! colour, view distance and window depth, rows top-down.
+//! projection P, conventions); its f64 twin with the same ray construction is
+//! [`super::reference`]. Both give colour, view distance and window depth, rows top-down.
 
-use super::{pattern_color, Scene, Shape, MAX_OBJECTS};
+use super::{Scene, Shape, MAX_OBJECTS};
 use crate::camera::mat4::{self, Mat4};
 pub use crate::camera::rays::{pixel_ndc, ray_basis};
-use crate::convention::{Conventions, DepthPlanes, RowOrder};
+use crate::convention::{Conventions, RowOrder};
 use crate::error::{Error, Result};
 use crate::io::{DepthMap, RgbImage};
 use crate::pass::{mat4_std140, Device, Draw, Format, ProgramKind, ShaderProgram, Target, Timing, ToDevice};
@@ -72,7 +72,7 @@ pub fn projection_centre(vp: &Mat4) -> Option<[f64; 3]> {
 }
 
 impl GlCamera {
-    fn matrices(&self) -> Result<(Mat4, Mat4, [f64; 3])> {
+    pub(super) fn matrices(&self) -> Result<(Mat4, Mat4, [f64; 3])> {
         let vp = mat4::mul(&self.proj, &self.view);
         mat4::inverse(&vp).ok_or_else(|| Error::param("camera view-projection", "singular"))?;
         let basis = ray_basis(&vp).ok_or_else(|| Error::param("camera projection", "not perspective"))?;
@@ -81,43 +81,12 @@ impl GlCamera {
     }
 
     /// Image row of framebuffer row `y`.
-    fn image_row(&self, y: u32) -> u32 {
+    pub(super) fn image_row(&self, y: u32) -> u32 {
         match self.conv.row_order {
             RowOrder::BottomUp => self.height - 1 - y,
             RowOrder::TopDown => y,
         }
     }
-}
-
-/// f64 twin of the shader: same rays, same rounding of colour to 8 bits.
-pub fn trace_gl_reference(scene: &Scene, cam: &GlCamera) -> Result<SceneImage> {
-    let (vp, basis, eye) = cam.matrices()?;
-    let (w, h) = (cam.width as usize, cam.height as usize);
-    let mut color = vec![0u8; w * h * 3];
-    let mut view_z = vec![0f32; w * h];
-    let far = cam.conv.clear_depth() as f32;
-    let mut device = vec![far; w * h];
-    for y in 0..cam.height {
-        for x in 0..cam.width {
-            let ndc = [pixel_ndc(x as f64, w as f64), pixel_ndc(y as f64, h as f64), 1.0, 0.0];
-            let d = mat4::transform(&basis, ndc);
-            let dir = [d[0], d[1], d[2]];
-            let Some(hit) = scene.trace(eye, dir) else { continue };
-            let o = cam.image_row(y) as usize * w + x as usize;
-            let c = pattern_color(&hit);
-            for k in 0..3 {
-                color[o * 3 + k] = c[k].round().clamp(0.0, 255.0) as u8;
-            }
-            view_z[o] = -mat4::transform_point(&cam.view, hit.p)[2] as f32;
-            let z = mat4::transform_point(&vp, hit.p)[2];
-            device[o] = DepthPlanes::window_depth_of_ndc_z(&cam.conv, z) as f32;
-        }
-    }
-    Ok(SceneImage {
-        color: RgbImage::new(cam.width, cam.height, color)?,
-        view_z: DepthMap::new(cam.width, cam.height, view_z)?,
-        device_depth: DepthMap::new(cam.width, cam.height, device)?,
-    })
 }
 
 enum Camera<'a> {
@@ -276,6 +245,7 @@ impl SceneRenderer {
 mod tests {
     use super::*;
     use crate::camera::{gl_projection, Pose};
+    use crate::convention::DepthPlanes;
 
     #[test]
     fn projection_centre_of_a_posed_pinhole_is_its_position() {
