@@ -47,13 +47,7 @@ fn code_image(device: &Device, codes: &[u32], max_side: u32, label: &str) -> Res
     let Some((rows, bytes)) = code_rows(codes, max_side)? else {
         return Ok(None);
     };
-    let image = device.upload(&ImageData {
-        width: TRI_TEX_WIDTH,
-        height: rows,
-        format: Format::R32Ui,
-        bytes: &bytes,
-        label,
-    })?;
+    let image = device.upload(&ImageData::new(TRI_TEX_WIDTH, rows, Format::R32Ui, &bytes, label))?;
     Ok(Some(image))
 }
 
