@@ -1,7 +1,7 @@
 // The shader library's one table: every program, its stages with the files each concatenates
 // (shared ones first), the values its own `#define` switches take, and whether it is compiled
 // to SPIR-V for the Vulkan backend. Read by build.rs (which compiles every Vulkan variant with
-// glslangValidator) and by src/gpu/shaders.rs (the GL loader's file lists), through `include!`,
+// glslangValidator) and by src/pass/shaders.rs (the GL loader's file lists), through `include!`,
 // so the two cannot drift. Plain data only: no crate items are visible here.
 //
 // Switch order is the order `ProgramKind::defines` renders them in; the SPIR-V lookup is by the
@@ -333,7 +333,7 @@ pub const PROGRAMS: &[ProgramEntry] = &[
         name: "reproject/shift",
         stages: &[
             ("vert", FULLSCREEN_VERT),
-            ("frag", &["common/depth.glsl", "reproject/shift_params.glsl", "reproject/shift.frag"]),
+            ("frag", &["common/depth.glsl", "reproject/reproject_params.glsl", "reproject/shift.frag"]),
         ],
         switches: &[("DEPTH_MODE", &[0, 1, 2]), ("SCAN", &[0, 1]), ("SCAN_MARGIN", &[1])],
         vulkan: Some(&[]),
@@ -348,7 +348,7 @@ pub const PROGRAMS: &[ProgramEntry] = &[
                     "common/camera.glsl",
                     "common/depth.glsl",
                     "common/ods.glsl",
-                    "scene/raytrace_params.glsl",
+                    "scene/scene_params.glsl",
                     "scene/raytrace.frag",
                 ],
             ),

@@ -42,7 +42,7 @@ pub enum Error {
         /// Why its value is refused.
         message: String,
     },
-    /// An image side exceeds what the GPU context renders (`gpu::check_image_size`).
+    /// An image side exceeds what the GPU context renders (`pass::check_image_size`).
     #[error("invalid {name}: {width}x{height} exceeds this GPU's limit of {limit} px per side")]
     ImageTooLarge {
         /// The parameter giving the size.

@@ -14,9 +14,9 @@
 //! `reference(&input)`, both returning a `ViewOutput`, and the conversions from its own output
 //! types (`ViewOutput::from_refocus`, ...), so this module imports no capability.
 
-use crate::gpu::Timing;
 use crate::io::{DepthMap, Mask, RgbImage};
 use crate::metrics::quantize_u8;
+use crate::pass::Timing;
 
 /// The output rule of every pass, applied once after readback (and to the f64 twins when they
 /// are rounded to f32): a pixel whose depth is not finite is invalid, mask 0 and depth 0, so

@@ -1,7 +1,7 @@
 //! Small text helpers shared by the commands' closing messages.
 
 use std::path::PathBuf;
-use viewsynth::gpu::Timing;
+use viewsynth::pass::Timing;
 
 /// The file names of written outputs, comma-separated.
 pub(crate) fn file_names(paths: &[PathBuf]) -> String {

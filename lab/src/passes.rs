@@ -20,7 +20,7 @@ use viewsynth::pass::Device;
 use viewsynth::refocus::manifest::{TargetSpec, DEFAULT_SCALES};
 use viewsynth::refocus::{BreakRule, Method, OutputSet, RefocusSource, Refocuser};
 use viewsynth::reproject::render::Reprojector;
-use viewsynth::scene::gpu::{GlCamera, SceneRenderer};
+use viewsynth::scene::render::{GlCamera, SceneRenderer};
 use viewsynth::stitch::render::StitchRenderer;
 use viewsynth::stitch::FaceSet;
 use viewsynth::stitch::{faces::scene_faces, Method as Sm, OdsRig, Side, StitchParams};
@@ -89,10 +89,43 @@ impl PassCase {
         }
     }
 
+    /// The shader-library programs (`ProgramKind::name`) this case's frame runs: what ties the
+    /// lab's cases to the registered programs (the test below).
+    pub fn programs(&self) -> &'static [&'static str] {
+        match self {
+            PassCase::Refocus(Method::Fullscreen) => &["refocus/fullscreen"],
+            PassCase::Refocus(Method::Mesh) => &["refocus/mesh_interior", "refocus/mesh_boundary"],
+            PassCase::Cyclopean { .. } => &["cyclopean/gather"],
+            PassCase::Splat => &[
+                "cyclopean/edge_snap",
+                "cyclopean/splat",
+                "cyclopean/splat_gather",
+                "cyclopean/splat_edges",
+            ],
+            PassCase::Forward => &["cyclopean/forward"],
+            PassCase::Matcher => &[
+                "cyclopean/matcher_grey",
+                "cyclopean/matcher_census",
+                "cyclopean/matcher_rows",
+                "cyclopean/matcher_columns",
+                "cyclopean/matcher_winner",
+                "cyclopean/matcher_subpixel",
+                "cyclopean/matcher_lr_check",
+                "cyclopean/matcher_median",
+            ],
+            PassCase::Reproject(k) => match reproject_methods()[*k].method {
+                viewsynth::reproject::Method::Gather3d { .. } => &["cyclopean/gather"],
+                _ => &["reproject/shift"],
+            },
+            PassCase::Stitch(_) => &["stitch/stitch"],
+            PassCase::Scene => &["scene/raytrace"],
+        }
+    }
+
     /// This pass's frame on `device` over `inputs`.
     pub fn frame<'a>(&self, device: &'a Device, inputs: &'a PassInputs) -> Result<Frame<'a>> {
         let (w, h) = (inputs.width, inputs.height);
-        let cyclopean = move |(out, t): (CyclopeanOutput, viewsynth::gpu::Timing)| {
+        let cyclopean = move |(out, t): (CyclopeanOutput, viewsynth::pass::Timing)| {
             vec![ViewOutput::from_cyclopean(&out, w, h, Some(t))]
         };
         let mid = &inputs.mid;
@@ -275,5 +308,76 @@ impl PassInputs {
             scene: viewsynth::scene::builtin("demo")?,
             camera,
         })
+    }
+}
+
+/// Registered programs the lab has no case for yet, each with why: a program added to the
+/// shader library must get a case in [`PassCase::all`] or a line here
+/// (`every_registered_program_has_a_lab_case`, the add-a-pass recipe in ARCHITECTURE.md).
+pub const PROGRAMS_WITHOUT_A_CASE: &[(&str, &str)] = &[
+    (
+        "refocus/colour_everywhere",
+        "only under --rgb-everywhere, which the refocus cases leave off",
+    ),
+    ("cyclopean/densify", "the two-image --fill path; no lab case yet"),
+    ("cyclopean/fill", "--fill; no lab case yet"),
+    ("cyclopean/temporal_reproject", "--sequence history; no lab case yet"),
+    ("cyclopean/temporal_compose", "--sequence history; no lab case yet"),
+    (
+        "cyclopean/matcher_confidence",
+        "only where confidence is asked for; the matcher case is not",
+    ),
+    (
+        "cyclopean/matcher_sgm_downsample",
+        "the semi-global matcher; the matcher case is census",
+    ),
+    (
+        "cyclopean/matcher_sgm_cost",
+        "the semi-global matcher; the matcher case is census",
+    ),
+    (
+        "cyclopean/matcher_sgm_path",
+        "the semi-global matcher; the matcher case is census",
+    ),
+    (
+        "cyclopean/matcher_sgm_winner",
+        "the semi-global matcher; the matcher case is census",
+    ),
+];
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The registered programs (by name) that neither a case of [`PassCase::all`] runs nor
+    /// [`PROGRAMS_WITHOUT_A_CASE`] lists, and the names those two give that are not registered.
+    fn programs_without_a_case() -> (Vec<&'static str>, Vec<&'static str>) {
+        use std::collections::BTreeSet;
+        let registered: BTreeSet<&'static str> = viewsynth::pass::ShaderProgram::all(Conventions::default())
+            .iter()
+            .map(|p| p.kind.name())
+            .collect();
+        let named: BTreeSet<&'static str> = PassCase::all()
+            .iter()
+            .flat_map(|c| c.programs().iter().copied())
+            .chain(PROGRAMS_WITHOUT_A_CASE.iter().map(|(name, _)| *name))
+            .collect();
+        (
+            registered.difference(&named).copied().collect(),
+            named.difference(&registered).copied().collect(),
+        )
+    }
+
+    #[test]
+    fn every_registered_program_has_a_lab_case() {
+        let (missing, unknown) = programs_without_a_case();
+        assert!(
+            missing.is_empty(),
+            "programs with no lab case (PassCase) and no line in PROGRAMS_WITHOUT_A_CASE: {missing:?}"
+        );
+        assert!(
+            unknown.is_empty(),
+            "program names the lab gives that are not registered: {unknown:?}"
+        );
     }
 }

@@ -5,8 +5,8 @@
 use crate::context;
 use crate::errors::{self, Kind};
 use pyo3::PyResult;
-use viewsynth::gpu::{Gpu, GpuPolicy};
-use viewsynth::pass::{Device, ToDevice};
+use viewsynth::gpu::Gpu;
+use viewsynth::pass::{Device, GpuPolicy, ToDevice};
 
 /// A Renderer's API.
 #[derive(Clone)]

@@ -4,7 +4,7 @@
 // Defines: DEPTH_MODE (0 view Z, 1 device depth, 2 disparity), SCAN (exact scan, else walk),
 // SCAN_MARGIN, plus the conventions preamble (REVERSED_Z, through common/depth.glsl).
 
-// Parameters and images: shaders/reproject/shift_params.glsl (one block, both backends).
+// Parameters and images: shaders/reproject/reproject_params.glsl (one block, both backends).
 
 layout(location = 0) out vec4 o_color;
 layout(location = 1) out float o_depth;

@@ -1,10 +1,10 @@
-// Ray tracer of a scene description (src/scene/shapes.rs; f64 twin: src/scene/gpu.rs
+// Ray tracer of a scene description (src/scene/shapes.rs; f64 twin: src/scene/reference.rs
 // `trace_gl_reference`). One ray per pixel centre from the camera's ray basis (the inverse of
 // the view-projection's clip x, y, w rows), the same under every convention.
 // Outputs colour, view distance (GL: -z_eye; 0 on a miss) and window depth under the
 // conventions (the far value on a miss).
 
-// Parameters: shaders/scene/raytrace_params.glsl (one block, both backends).
+// Parameters: shaders/scene/scene_params.glsl (one block, both backends).
 
 layout(location = 0) out vec4 o_color;
 layout(location = 1) out float o_view_z;
@@ -99,7 +99,7 @@ void main() {
         ods_ray(lon, lat, u_ods_centre, u_ods_radius, u_ods_fade_start, eye, dir);
     } else {
         // (2 p + 1 - n) / n with gl_FragCoord = p + 0.5: exact numerator, so mirrored rows get
-        // exactly negated NDC and both row orders the same ray (src/scene/gpu.rs pixel_ndc).
+        // exactly negated NDC and both row orders the same ray (src/camera/rays.rs pixel_ndc).
         vec2 ndc = (2.0 * gl_FragCoord.xy - u_size) / u_size;
         dir = (u_ray_basis * vec4(ndc, 1.0, 0.0)).xyz;
     }

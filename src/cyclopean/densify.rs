@@ -22,9 +22,8 @@
 //! the GPU's maps are the twin's bit for bit.
 
 use crate::error::{Error, Result};
-use crate::gpu::{ProgramKind, ShaderProgram};
 use crate::io::{DepthMap, RgbImage};
-use crate::pass::{Device, Draw, Format, Image, ImageData, Target, ToDevice};
+use crate::pass::{Device, Draw, Format, Image, ImageData, ProgramKind, ShaderProgram, Target, ToDevice};
 
 /// The flag of a filled disparity.
 pub const FILLED: u8 = 1;
@@ -144,7 +143,7 @@ impl Densifier {
     pub fn densify(&mut self, disparity: &DepthMap, color: &RgbImage) -> Result<Dense> {
         check(disparity, color)?;
         let (w, h) = (disparity.width, disparity.height);
-        let rgba = crate::gpu::pixels::rgb_to_rgba(&color.data);
+        let rgba = crate::pass::pixels::rgb_to_rgba(&color.data);
         let image = |format, bytes, label| ImageData {
             width: w,
             height: h,

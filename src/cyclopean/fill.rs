@@ -27,8 +27,7 @@
 
 use super::CyclopeanOutput;
 use crate::error::{Error, Result};
-use crate::gpu::{ProgramKind, ShaderProgram};
-use crate::pass::{Device, Draw, Format, Image, ImageData, Target, ToDevice};
+use crate::pass::{Device, Draw, Image, ImageData, ProgramKind, ShaderProgram, Target, ToDevice};
 
 /// The source bit of filled pixels (above the eye and history bits).
 pub const FILLED: u8 = crate::io::MASK_FILLED;
@@ -88,21 +87,13 @@ impl Filler {
     pub fn fill(&mut self, out: &CyclopeanOutput, width: u32, height: u32) -> Result<CyclopeanOutput> {
         let (color, depth) = planes(out)?;
         let (w, h) = (width, height);
-        let rgba = crate::gpu::pixels::rgb_to_rgba(&color.data);
-        let depth_bytes: &[u8] = bytemuck::cast_slice(&depth.data);
-        let image = |format, bytes, label| ImageData {
-            width: w,
-            height: h,
-            format,
-            bytes,
-            label,
-        };
+        let rgba = crate::pass::pixels::rgb_to_rgba(&color.data);
         let [color_slot, depth_slot, sources_slot] = &mut self.inputs;
         let d = &self.device;
         let images = [
-            d.put_image(color_slot, &image(Format::Rgba8, &rgba, "fill colour"))?,
-            d.put_image(depth_slot, &image(Format::R32F, depth_bytes, "fill depth"))?,
-            d.put_image(sources_slot, &image(Format::R8Ui, &out.sources, "fill sources"))?,
+            d.put_image(color_slot, &ImageData::rgba8(w, h, &rgba, "fill colour"))?,
+            d.put_image(depth_slot, &ImageData::r32f(w, h, &depth.data, "fill depth"))?,
+            d.put_image(sources_slot, &ImageData::r8ui(w, h, &out.sources, "fill sources"))?,
         ];
         let params = FillParams {
             u_size: [w as i32, h as i32],
@@ -112,15 +103,8 @@ impl Filler {
         };
         // Memory rows are the top-down rows: the rule is symmetric, nothing to flip.
         let target = Target::view(w, h, true, true, crate::convention::RowOrder::TopDown);
-        let draw = Draw {
-            program: ShaderProgram::new(Default::default(), ProgramKind::CyclopeanFill),
-            params: bytemuck::bytes_of(&params),
-            images: &images,
-            buffers: &[],
-            viewport: [0, 0, w, h],
-            triangles: 1,
-            indices: None,
-        };
+        let program = ShaderProgram::new(Default::default(), ProgramKind::CyclopeanFill);
+        let draw = Draw::fullscreen(program, bytemuck::bytes_of(&params), &images, w, h);
         let mut r = self.device.render(&target, &[draw])?;
         Ok(CyclopeanOutput {
             color: r.color(0)?,

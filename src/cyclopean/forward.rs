@@ -8,9 +8,11 @@ use super::{CyclopeanOutput, EyeInput, FrameDepth, MiddleCamera, StereoFrame};
 use crate::camera::mat4::{self, Mat4};
 use crate::convention::RowOrder;
 use crate::error::{Error, Result};
-use crate::gpu::shaders::TRI_TEX_WIDTH;
-use crate::gpu::{ProgramKind, ShaderProgram, Timing};
-use crate::pass::{mat4_std140, Device, Draw, Format, Image, ImageData, Step, Target, Texels, ToDevice};
+use crate::pass::shaders::TRI_TEX_WIDTH;
+use crate::pass::{
+    mat4_std140, Device, Draw, Format, Image, ImageData, ProgramKind, ShaderProgram, Step, Target, Texels, Timing,
+    ToDevice,
+};
 use crate::refocus::mesh::code_rows;
 use crate::refocus::{BreakRule, Grid};
 
@@ -98,8 +100,8 @@ impl ForwardWarp {
             let grid = Grid { width: w, height: h };
             let keep = grid.keep_mask(&dist, rule);
             let codes = grid.kept_triangles(&keep);
-            let rgba: Vec<u8> = crate::gpu::pixels::rgb_to_rgba(&eye.color.data);
-            let dbytes: Vec<u8> = crate::gpu::pixels::f32_to_bytes(&dist);
+            let rgba: Vec<u8> = crate::pass::pixels::rgb_to_rgba(&eye.color.data);
+            let dbytes: Vec<u8> = crate::pass::pixels::f32_to_bytes(&dist);
             let image = |width, height, format, bytes: &[u8], label| {
                 device.upload(&ImageData {
                     width,
@@ -154,7 +156,7 @@ impl ForwardWarp {
         let (w, h) = (mid.width, mid.height);
         self.device.check_image_size("middle size", w, h)?;
         let vp_m = mat4::mul(&mid.proj, &mid.view);
-        let centre = crate::scene::gpu::projection_centre(&vp_m)
+        let centre = crate::scene::render::projection_centre(&vp_m)
             .ok_or_else(|| Error::param("middle projection", "not perspective"))?;
         let rays_vp_m = super::ray_basis_std140(&vp_m, "middle view-projection")?;
         let inv = |m: &Mat4, what: &str| {

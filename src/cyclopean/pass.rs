@@ -85,7 +85,7 @@ impl ViewOutput {
         out: &super::CyclopeanOutput,
         width: u32,
         height: u32,
-        timing: Option<crate::gpu::Timing>,
+        timing: Option<crate::pass::Timing>,
     ) -> Self {
         Self::from_gpu(
             width,

@@ -8,8 +8,9 @@ use super::{
 use crate::camera::mat4::{self, Mat4};
 use crate::convention::RowOrder;
 use crate::error::{Error, Result};
-use crate::gpu::{ProgramKind, ShaderProgram, Timing};
-use crate::pass::{mat4_std140, Device, Draw, Format, Image, ImageData, Target, ToDevice};
+use crate::pass::{
+    mat4_std140, Device, Draw, Format, Image, ImageData, ProgramKind, ShaderProgram, Target, Timing, ToDevice,
+};
 
 crate::param_block! {
     /// The gather's parameters: shaders/cyclopean/gather_params.glsl, member for member.
@@ -46,17 +47,9 @@ struct EyeGpu {
 fn upload_eye(device: &Device, eye: &EyeInput, rows: RowOrder) -> Result<EyeGpu> {
     let (w, h) = (eye.color.width, eye.color.height);
     device.check_image_size("eye size", w, h)?;
-    let rgba: Vec<u8> = crate::gpu::pixels::rgb_to_rgba(&eye.color.data);
-    let depth: Vec<u8> = crate::gpu::pixels::f32_to_bytes(&eye.depth.data);
-    let image = |bytes: &[u8], format, label| {
-        device.upload(&ImageData {
-            width: w,
-            height: h,
-            format,
-            bytes,
-            label,
-        })
-    };
+    let rgba: Vec<u8> = crate::pass::pixels::rgb_to_rgba(&eye.color.data);
+    let depth: Vec<u8> = crate::pass::pixels::f32_to_bytes(&eye.depth.data);
+    let image = |bytes: &[u8], format, label| device.upload(&ImageData::new(w, h, format, bytes, label));
     Ok(EyeGpu {
         color: image(
             &rows.convert_rows(rgba, w as usize * 4),
@@ -161,15 +154,7 @@ impl CyclopeanRenderer {
             self.left.depth.id(),
             self.right.depth.id(),
         ];
-        let draw = Draw {
-            program: self.program,
-            params: bytemuck::bytes_of(&block),
-            images: &images,
-            buffers: &[],
-            viewport: [0, 0, w, h],
-            triangles: 1,
-            indices: None,
-        };
+        let draw = Draw::fullscreen(self.program, bytemuck::bytes_of(&block), &images, w, h);
         let mut out = self.device.render(&target, &[draw])?;
         let (color, depth) = (out.color(0)?, out.depth(1)?);
         let sources = out.take(2, "cyclopean gather")?;

@@ -35,11 +35,11 @@ use super::{CyclopeanOutput, CyclopeanOutputs, MiddleCamera, StereoFrame};
 use crate::camera::mat4::{self, Mat4};
 use crate::convention::RowOrder;
 use crate::error::{Error, Result};
-use crate::gpu::{ProgramKind, ShaderProgram, Timing};
 use crate::pass::{
     mat4_std140, Buffer, Device, Dispatch, Draw, Format, Groups, Image, ImageData, ImageId, Step, StorageImage, Target,
     ToDevice,
 };
+use crate::pass::{ProgramKind, ShaderProgram, Timing};
 
 crate::param_block! {
     /// The splat's parameters: shaders/cyclopean/splat.comp, member for member.
@@ -179,8 +179,8 @@ impl SplatGeometry {
             let bytes = frame
                 .conv
                 .row_order
-                .convert_rows(crate::gpu::pixels::f32_to_bytes(&d), w * 4);
-            Ok(crate::gpu::pixels::bytes_to_f32(&bytes))
+                .convert_rows(crate::pass::pixels::f32_to_bytes(&d), w * 4);
+            Ok(crate::pass::pixels::bytes_to_f32(&bytes))
         };
         Ok(SplatGeometry {
             dist_mem: [mem(&frame.left)?, mem(&frame.right)?],
@@ -241,19 +241,12 @@ fn upload_eye(
 ) -> Result<EyeGpu> {
     let (w, h) = (eye.color.width, eye.color.height);
     device.check_image_size("eye size", w, h)?;
-    let rgba = crate::gpu::pixels::rgb_to_rgba(&eye.color.data);
+    let rgba = crate::pass::pixels::rgb_to_rgba(&eye.color.data);
     let mut gpu = old.unwrap_or_else(EyeGpu::empty);
-    let image = |format, bytes, label| ImageData {
-        width: w,
-        height: h,
-        format,
-        bytes,
-        label,
-    };
     let resized = gpu.size != (w, h);
     let color = rows.convert_rows(rgba, w as usize * 4);
-    let color = device.put_image(&mut gpu.color, &image(Format::Rgba8, &color, "splat eye colour"))?;
-    let dist = image(Format::R32F, bytemuck::cast_slice(dist), "splat eye distance");
+    let color = device.put_image(&mut gpu.color, &ImageData::rgba8(w, h, &color, "splat eye colour"))?;
+    let dist = ImageData::r32f(w, h, dist, "splat eye distance");
     let raw = device.put_image(&mut gpu.raw, &dist)?;
     (gpu.size, gpu.view, gpu.proj) = ((w, h), eye.view, eye.proj);
     gpu.snapped = match (snap, gpu.snapped.take()) {
@@ -498,13 +491,8 @@ impl SplatRenderer {
         });
         // Pass 2: gather and merge, listing the edge pixels.
         steps.push(Step::Draw(Draw {
-            program: self.gather,
-            params: bytemuck::bytes_of(&gather),
-            images: &gather_images,
             buffers: &edges,
-            viewport: [0, 0, w, h],
-            triangles: 1,
-            indices: None,
+            ..Draw::fullscreen(self.gather, bytemuck::bytes_of(&gather), &gather_images, w, h)
         }));
         // Pass 3: the listed pixels' colour mixed (colour only: without it, nothing to mix).
         if self.outputs.color {

@@ -24,11 +24,11 @@ use crate::camera::mat4;
 use crate::camera::rays;
 use crate::convention::{Conventions, RowOrder};
 use crate::error::{Error, Result};
-use crate::gpu::{ProgramKind, ShaderProgram};
 use crate::pass::{
     mat4_std140, Device, Dispatch, Draw, Format, Groups, Image, ImageData, ImageId, Step, StorageImage, Target,
     ToDevice,
 };
+use crate::pass::{ProgramKind, ShaderProgram};
 
 /// Source bit of pixels filled from the history (temporal_compose.frag's FROM_HISTORY).
 pub const FROM_HISTORY: u8 = 4;
@@ -124,20 +124,11 @@ impl Accumulator {
         let (color, depth) = color_and_depth(out)?;
         let (w, h) = (mid.width, mid.height);
         let rows = conv.row_order;
-        let rgba = rows.convert_rows(crate::gpu::pixels::rgb_to_rgba(&color.data), w as usize * 4);
+        let rgba = rows.convert_rows(crate::pass::pixels::rgb_to_rgba(&color.data), w as usize * 4);
         let dist = rows.convert_rows(bytemuck::cast_slice(&depth.data).to_vec(), w as usize * 4);
         let sources = rows.convert_rows(out.sources.clone(), w as usize);
         let [c, d, s] = slots;
-        let put = |slot, format, bytes: &[u8]| {
-            let data = ImageData {
-                width: w,
-                height: h,
-                format,
-                bytes,
-                label: what,
-            };
-            device.put_image(slot, &data)
-        };
+        let put = |slot, format, bytes: &[u8]| device.put_image(slot, &ImageData::new(w, h, format, bytes, what));
         Ok([
             put(c, Format::Rgba8, &rgba)?,
             put(d, Format::R32F, &dist)?,
@@ -215,15 +206,13 @@ impl Accumulator {
             },
             reproject(0),
             reproject(1),
-            Step::Draw(Draw {
-                program: ShaderProgram::new(self.conv, ProgramKind::CyclopeanTemporalCompose),
-                params: bytemuck::bytes_of(&blocks[1]),
-                images: &compose_images,
-                buffers: &[],
-                viewport: [0, 0, w, h],
-                triangles: 1,
-                indices: None,
-            }),
+            Step::Draw(Draw::fullscreen(
+                ShaderProgram::new(self.conv, ProgramKind::CyclopeanTemporalCompose),
+                bytemuck::bytes_of(&blocks[1]),
+                &compose_images,
+                w,
+                h,
+            )),
         ];
         let target = Target::view(w, h, true, true, self.conv.row_order);
         let mut r = self.device.run(Some(&target), &steps)?;

@@ -11,13 +11,13 @@
 
 use super::{
     Attachment, DeferredTimer, DrawState, Framebuffer, Gpu, IndexBuffer, PendingRead, Program, ReadFormat,
-    ShaderProgram, StorageBuffer, Texture, TextureFormat, Timing, UniformBuffer, VertexArray,
+    StorageBuffer, Texture, TextureFormat, UniformBuffer, VertexArray,
 };
 use crate::convention::RowOrder;
 use crate::error::{Error, Result};
 use crate::pass::{
-    Api, BufferId, Device, Executor, Format, Groups, ImageData, ImageId, Rendered, Slots, Step, StorageImage, Target,
-    Texels, Ticket, ToDevice,
+    Api, BufferId, Device, Executor, Format, Groups, ImageData, ImageId, Rendered, ShaderProgram, Slots, Step,
+    StorageImage, Target, Texels, Ticket, Timing, ToDevice,
 };
 use std::time::Instant;
 

@@ -18,7 +18,6 @@ mod egl;
 mod executor;
 mod framebuffer;
 mod khronos;
-pub mod pixels;
 mod policy;
 mod program;
 mod readback;
@@ -42,11 +41,10 @@ pub(crate) use readback::PendingRead;
 pub(crate) use state::DrawState;
 pub(crate) use texture::Texture;
 pub(crate) use timer::DeferredTimer;
-// The shared vocabulary of both executors (the pass layer below), under its old names here.
-pub use crate::pass::{check_image_size, shaders, GpuPolicy, ProgramKind, ShaderProgram, Timing};
 pub use vertex_array::VertexArray;
 
 use crate::error::{Error, Result};
+use crate::pass::{check_image_size, GpuPolicy};
 use glow::HasContext;
 use std::cell::{Cell, RefCell};
 use std::rc::Rc;

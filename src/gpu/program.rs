@@ -3,9 +3,9 @@
 //! with numbered source so the line in the message can be found.
 
 use super::census::GlObject;
-use super::shaders::{ShaderFile, ShaderProgram, Stage};
 use super::{Gpu, StorageBuffer};
 use crate::error::{Error, Result};
+use crate::pass::shaders::{ShaderFile, ShaderProgram, Stage};
 use glow::HasContext;
 
 /// A linked GL program of the shader library, owning its GL object (deleted on drop).

@@ -2,8 +2,9 @@
 //! about to render (after its inputs are read and checked), and someone to tell things to.
 
 use super::ArgError;
-use crate::gpu::{DeviceChoice, Gpu, GpuPolicy};
+use crate::gpu::{DeviceChoice, Gpu};
 use crate::io::{DepthSummary, DisparitySummary};
+use crate::pass::GpuPolicy;
 use crate::vulkan::{Vk, VulkanContext, VulkanDeviceChoice};
 use std::path::Path;
 

@@ -8,7 +8,7 @@ use crate::camera::gl_projection;
 use crate::convention::Conventions;
 use crate::cyclopean::scene_frame::StereoRig;
 use crate::io;
-use crate::scene::gpu::{GlCamera, SceneRenderer};
+use crate::scene::render::{GlCamera, SceneRenderer};
 use crate::scene::{builtin, Scene};
 use crate::stitch::faces::{scene_faces_of, FACE_TAGS};
 use crate::stitch::{OdsRig, Side};

@@ -27,6 +27,7 @@
 //! cache programs/pipelines and targets, so a steady state creates nothing.
 
 mod limits;
+pub mod pixels;
 mod policy;
 #[cfg(test)]
 mod readback_tests;
@@ -90,6 +91,34 @@ pub struct ImageData<'a> {
     pub bytes: &'a [u8],
     /// Debugger name (GL object label, Vulkan debug-utils name).
     pub label: &'a str,
+}
+
+impl<'a> ImageData<'a> {
+    /// `bytes` as `width` x `height` texels of `format`.
+    pub fn new(width: u32, height: u32, format: Format, bytes: &'a [u8], label: &'a str) -> Self {
+        ImageData {
+            width,
+            height,
+            format,
+            bytes,
+            label,
+        }
+    }
+
+    /// RGBA8 texels (an RGB image goes through [`pixels::rgb_to_rgba`] first).
+    pub fn rgba8(width: u32, height: u32, texels: &'a [u8], label: &'a str) -> Self {
+        Self::new(width, height, Format::Rgba8, texels, label)
+    }
+
+    /// R32F texels: the f32s' native-endian bytes, borrowed as they are.
+    pub fn r32f(width: u32, height: u32, values: &'a [f32], label: &'a str) -> Self {
+        Self::new(width, height, Format::R32F, bytemuck::cast_slice(values), label)
+    }
+
+    /// R8UI texels (flags, source bits).
+    pub fn r8ui(width: u32, height: u32, texels: &'a [u8], label: &'a str) -> Self {
+        Self::new(width, height, Format::R8Ui, texels, label)
+    }
 }
 
 /// An executor's handle of an uploaded or created image.
@@ -204,6 +233,28 @@ pub struct Draw<'a> {
     /// `3 * triangles` indices (`gl_VertexID` is the index, so the vertex shader runs once per
     /// shared vertex where the driver caches); None: vertex `3 t + k` is corner k of triangle t.
     pub indices: Option<BufferId>,
+}
+
+impl<'a> Draw<'a> {
+    /// One full-screen triangle of `program` over the whole `width` x `height` target, sampling
+    /// `images`, without storage buffers or indices: what most passes draw.
+    pub fn fullscreen(
+        program: ShaderProgram,
+        params: &'a [u8],
+        images: &'a [ImageId],
+        width: u32,
+        height: u32,
+    ) -> Self {
+        Draw {
+            program,
+            params,
+            images,
+            buffers: &[],
+            viewport: [0, 0, width, height],
+            triangles: 1,
+            indices: None,
+        }
+    }
 }
 
 /// One output's texels as read back, rows top-down: bytes (RGB8 from an RGBA8 target, R8, the

@@ -12,7 +12,7 @@ use crate::error::{Error, Result};
 use crate::pass::{Buffer, Device, Format, Image, ImageData, ImageId};
 
 /// Width of the texture holding kept-triangle codes for vertex pulling (the shader library's).
-pub use crate::gpu::shaders::TRI_TEX_WIDTH;
+pub use crate::pass::shaders::TRI_TEX_WIDTH;
 /// How far (window pixels) boundary triangles are pushed out before the exact closed test:
 /// above the rasteriser's vertex snapping (1/512 px at 8 subpixel bits).
 pub(crate) const EXPAND_PX: f32 = 1.0 / 32.0;
@@ -47,13 +47,7 @@ fn code_image(device: &Device, codes: &[u32], max_side: u32, label: &str) -> Res
     let Some((rows, bytes)) = code_rows(codes, max_side)? else {
         return Ok(None);
     };
-    let image = device.upload(&ImageData {
-        width: TRI_TEX_WIDTH,
-        height: rows,
-        format: Format::R32Ui,
-        bytes: &bytes,
-        label,
-    })?;
+    let image = device.upload(&ImageData::new(TRI_TEX_WIDTH, rows, Format::R32Ui, &bytes, label))?;
     Ok(Some(image))
 }
 

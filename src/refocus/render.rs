@@ -19,9 +19,11 @@ use super::{BreakRule, Method, OutputSet, RefocusSource};
 use crate::camera::{clip_from_view_opencv, PinholeCamera};
 use crate::convention::{Conventions, DepthPlanes};
 use crate::error::{Error, Result};
-use crate::gpu::{ProgramKind, ShaderProgram, Timing};
 use crate::io::{DepthMap, Mask, RgbImage};
-use crate::pass::{mat4_std140, Device, Draw, Format, Image, ImageData, ImageId, Pending, Step, Target, ToDevice};
+use crate::pass::{
+    mat4_std140, Device, Draw, Format, Image, ImageData, ImageId, Pending, ProgramKind, ShaderProgram, Step, Target,
+    Timing, ToDevice,
+};
 use std::time::Instant;
 
 /// Output sizes whose lookup images are kept (a batch uses one; a sweep over sizes a few).
@@ -227,7 +229,7 @@ impl Refocuser {
         // The grid's cells include a half-pixel border ring: (w + 1) x (h + 1) of them, each a
         // texel of the coverage image, so the source side is one less than the device's limit.
         let max_side = self.device.max_image_side();
-        crate::gpu::check_image_size("source size", w.into(), h.into(), max_side.saturating_sub(1))?;
+        crate::pass::check_image_size("source size", w.into(), h.into(), max_side.saturating_sub(1))?;
         let grid = Grid { width: w, height: h };
         let keep = grid.keep_mask(&src.depth.data, &self.rule);
         if self
@@ -238,32 +240,24 @@ impl Refocuser {
             self.images = SourceImages::default(); // free a differently sized source before allocating
         }
         self.source = None; // and the previous triangles before uploading new ones
-        let rgba: Option<Vec<u8>> = self.outputs.rgb.then(|| crate::gpu::pixels::rgb_to_rgba(&src.rgb.data));
-        let depth_bytes: &[u8] = bytemuck::cast_slice(&src.depth.data);
+        let rgba: Option<Vec<u8>> = self
+            .outputs
+            .rgb
+            .then(|| crate::pass::pixels::rgb_to_rgba(&src.rgb.data));
         let (cx, cy) = (grid.cells_x() as u32, grid.cells_y() as u32);
-        let data = |width, height, format, bytes, label| ImageData {
-            width,
-            height,
-            format,
-            bytes,
-            label,
-        };
         let (d, images) = (&self.device, &mut self.images);
         let rgb = match &rgba {
-            Some(texels) => Some(d.put_image(
-                &mut images.rgb,
-                &data(w, h, Format::Rgba8, texels, "refocus source rgb"),
-            )?),
+            Some(texels) => Some(d.put_image(&mut images.rgb, &ImageData::rgba8(w, h, texels, "refocus source rgb"))?),
             None => None,
         };
         let depth = d.put_image(
             &mut images.depth,
-            &data(w, h, Format::R32F, depth_bytes, "refocus source depth"),
+            &ImageData::r32f(w, h, &src.depth.data, "refocus source depth"),
         )?;
         let geometry = match self.method {
             Method::Fullscreen => {
                 let flags = grid.coverage_flags(&keep);
-                let data = data(cx, cy, Format::R8Ui, &flags, "refocus coverage flags");
+                let data = ImageData::r8ui(cx, cy, &flags, "refocus coverage flags");
                 Geometry::Fullscreen {
                     keep: d.put_image(&mut images.keep, &data)?,
                 }
@@ -310,15 +304,7 @@ impl Refocuser {
             if self.lookups.len() >= KEEP_TARGET_SIZES {
                 self.lookups.remove(0); // free the least recently used before allocating
             }
-            let image = |n, bytes, label| {
-                self.device.upload(&ImageData {
-                    width: n,
-                    height: 1,
-                    format: Format::Rgba32F,
-                    bytes,
-                    label,
-                })
-            };
+            let image = |n, bytes, label| self.device.upload(&ImageData::new(n, 1, Format::Rgba32F, bytes, label));
             let l = Lookups {
                 size: (w, h),
                 cols: image(w, cols, "refocus column lookup")?,

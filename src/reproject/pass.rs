@@ -63,7 +63,7 @@ impl ViewOutput {
         out: &super::ReprojectOutput,
         width: u32,
         height: u32,
-        timing: Option<crate::gpu::Timing>,
+        timing: Option<crate::pass::Timing>,
     ) -> Self {
         Self::from_gpu(
             width,

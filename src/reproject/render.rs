@@ -12,13 +12,12 @@ use crate::cyclopean::render::CyclopeanRenderer;
 use crate::cyclopean::{CyclopeanOutputs, MiddleCamera};
 use crate::depth::DepthEncoding;
 use crate::error::{Error, Result};
-use crate::gpu::shaders::ShiftDepth;
-use crate::gpu::{ProgramKind, ShaderProgram, Timing};
 use crate::io::{DepthMap, RgbImage};
-use crate::pass::{Device, Draw, Format, Image, ImageData, Target, ToDevice};
+use crate::pass::shaders::ShiftDepth;
+use crate::pass::{Device, Draw, Format, Image, ImageData, ProgramKind, ShaderProgram, Target, Timing, ToDevice};
 
 crate::param_block! {
-    /// The shift's parameters: shaders/reproject/shift_params.glsl, member for member.
+    /// The shift's parameters: shaders/reproject/reproject_params.glsl, member for member.
     pub struct ShiftParams("ShiftParams") {
         u_a: f32,
         u_b: f32,
@@ -93,16 +92,16 @@ impl Reprojector {
                     scan: params.method == Method::ShiftScan,
                     scan_margin: SCAN_MARGIN as u32,
                 };
-                let rgba: Vec<u8> = crate::gpu::pixels::rgb_to_rgba(&src.color.data);
-                let depth: Vec<u8> = crate::gpu::pixels::f32_to_bytes(&src.depth.data);
+                let rgba: Vec<u8> = crate::pass::pixels::rgb_to_rgba(&src.color.data);
+                let depth: Vec<u8> = crate::pass::pixels::f32_to_bytes(&src.depth.data);
                 let image = |bytes: Vec<u8>, format, label| {
-                    device.upload(&ImageData {
-                        width: w,
-                        height: h,
+                    device.upload(&ImageData::new(
+                        w,
+                        h,
                         format,
-                        bytes: &rows.convert_rows(bytes, w as usize * 4),
+                        &rows.convert_rows(bytes, w as usize * 4),
                         label,
-                    })
+                    ))
                 };
                 let (alpha, beta) = src.depth_kind.affine_inverse_depth(&src.conv).unwrap_or((0.0, 0.0));
                 // No valid depth: q_max = 0 makes every pixel invalid.
@@ -193,15 +192,7 @@ impl Reprojector {
                 let outputs = self.params.outputs;
                 let target = Target::view(w, h, outputs.color, outputs.depth, self.rows);
                 let images = [s.color.id(), s.depth.id()];
-                let draw = Draw {
-                    program: s.program,
-                    params: bytemuck::bytes_of(&s.block),
-                    images: &images,
-                    buffers: &[],
-                    viewport: [0, 0, w, h],
-                    triangles: 1,
-                    indices: None,
-                };
+                let draw = Draw::fullscreen(s.program, bytemuck::bytes_of(&s.block), &images, w, h);
                 let mut out = self.device.render(&target, &[draw])?;
                 // A non-finite depth makes its pixel invalid (`finite`, below).
                 let (color, depth) = (out.color(0)?, out.depth(1)?);

@@ -6,7 +6,8 @@
 //! discontinuities, slanted surfaces and texture at several frequencies. Any posed pinhole
 //! camera can look at it ([`render_posed`]), e.g. the eyes of a stereo rig.
 
-pub mod gpu;
+pub mod reference;
+pub mod render;
 mod shapes;
 
 pub use shapes::{boxes_scene, builtin, demo_scene, Hit, Object, Scene, Shape, EDGE_SLACK, MAX_OBJECTS};

@@ -8,11 +8,12 @@
 use super::{face_camera, CubeFace, FaceSet, Method, Side, StitchParams, REPROJECT_STEPS};
 use crate::convention::{Conventions, RowOrder};
 use crate::error::{Error, Result};
-use crate::gpu::shaders::StitchBlend;
-use crate::gpu::{ProgramKind, ShaderProgram, Timing};
 use crate::io::{DepthMap, RgbImage};
 use crate::output::OutputSet;
-use crate::pass::{mat4_std140, Device, Draw, Format, Image, ImageData, Target, ToDevice};
+use crate::pass::shaders::StitchBlend;
+use crate::pass::{
+    mat4_std140, Device, Draw, Format, Image, ImageData, ProgramKind, ShaderProgram, Target, Timing, ToDevice,
+};
 
 crate::param_block! {
     /// One eye's draw: shaders/stitch/stitch_params.glsl, member for member.
@@ -58,18 +59,9 @@ fn upload(device: &Device, set: &FaceSet, rows: RowOrder) -> Result<EyeAtlas> {
         }
     }
     let (w, h) = (6 * n as u32, n as u32);
-    let image = |bytes: &[u8], format, label| {
-        device.upload(&ImageData {
-            width: w,
-            height: h,
-            format,
-            bytes,
-            label,
-        })
-    };
     Ok(EyeAtlas {
-        color: image(&rgba, Format::Rgba8, "stitch face colour atlas")?,
-        depth: image(&depth, Format::R32F, "stitch face depth atlas")?,
+        color: device.upload(&ImageData::rgba8(w, h, &rgba, "stitch face colour atlas"))?,
+        depth: device.upload(&ImageData::new(w, h, Format::R32F, &depth, "stitch face depth atlas"))?,
         side: set.side,
         eyes: CubeFace::ALL.map(|f| f.pose(&set.rig, set.side).position),
     })
@@ -216,14 +208,9 @@ impl StitchRenderer {
         let draws: Vec<Draw> = [(left_row0, 0), (right_row0, 1)]
             .into_iter()
             .map(|(row0, e)| Draw {
-                program,
-                params: bytemuck::bytes_of(&blocks[e]),
-                images: &images[e],
-                buffers: &[],
                 // One full-screen triangle into this eye's half of the target.
                 viewport: [0, row0, w, h],
-                triangles: 1,
-                indices: None,
+                ..Draw::fullscreen(program, bytemuck::bytes_of(&blocks[e]), &images[e], w, h)
             })
             .collect();
         let target = Target {

@@ -17,7 +17,7 @@ use viewsynth::refocus::{BreakRule, Method as RefocusMethod, OutputSet, RefocusS
 use viewsynth::reproject::render::Reprojector;
 use viewsynth::reproject::{Geometry, Method, ReprojectParams, ReprojectSource, ShiftModel};
 use viewsynth::scene::builtin;
-use viewsynth::scene::gpu::{GlCamera, SceneRenderer};
+use viewsynth::scene::render::{GlCamera, SceneRenderer};
 use viewsynth::stitch::faces::scene_faces;
 use viewsynth::stitch::render::StitchRenderer;
 use viewsynth::stitch::{Method as StitchMethod, OdsRig, Side, StitchParams};

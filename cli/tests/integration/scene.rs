@@ -13,7 +13,8 @@ use viewsynth::camera::stereo::{stereo_projection_gl, Eye, Frustum, StereoParams
 use viewsynth::camera::{gl_projection, Pose};
 use viewsynth::convention::{Conventions, DepthPlanes};
 use viewsynth::pass::Device;
-use viewsynth::scene::gpu::{trace_gl_reference, GlCamera, SceneImage, SceneRenderer};
+use viewsynth::scene::reference::trace_gl_reference;
+use viewsynth::scene::render::{GlCamera, SceneImage, SceneRenderer};
 use viewsynth::scene::{builtin, Scene};
 
 fn check(tag: &str, gpu_img: &SceneImage, reference: &SceneImage) {

@@ -5,7 +5,7 @@
 use super::common::gpu;
 use std::collections::BTreeSet;
 use viewsynth::convention::Conventions;
-use viewsynth::gpu::ShaderProgram;
+use viewsynth::pass::ShaderProgram;
 
 #[test]
 fn every_program_compiles_and_links_under_every_convention() {

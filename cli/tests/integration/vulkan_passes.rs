@@ -19,6 +19,7 @@
 use crate::cli::{bin, scratch};
 use crate::common::{cyclopean_cli, data_dir, gpu, write_cyclopean_files};
 use crate::vulkan_refocus::vulkan;
+use std::collections::BTreeSet;
 use std::path::Path;
 use viewsynth::convention::Conventions;
 use viewsynth::cyclopean::forward::{ForwardParams, ForwardWarp};
@@ -26,13 +27,12 @@ use viewsynth::cyclopean::render::{CyclopeanRenderer, GatherParams};
 use viewsynth::cyclopean::scene_frame::{scene_frame, StereoRig};
 use viewsynth::cyclopean::splat::{EdgeSnapBlock, SplatBlock, SplatGatherBlock, SplatParams, SplatRenderer};
 use viewsynth::cyclopean::{CyclopeanOutputs, CyclopeanParams, FrameDepth, Method};
-use viewsynth::gpu::shaders::{ShiftDepth, StitchBlend};
-use viewsynth::gpu::{ProgramKind, ShaderProgram};
-use viewsynth::pass::{Device, ParamBlock};
+use viewsynth::pass::shaders::{ShiftDepth, StitchBlend};
+use viewsynth::pass::{Device, ParamBlock, ProgramKind, ShaderProgram};
 use viewsynth::refocus::{BreakRule, RefocusParams};
 use viewsynth::reproject::render::ShiftParams;
 use viewsynth::reproject::{self, ReprojectInput};
-use viewsynth::scene::gpu::{GlCamera, RaytraceParams, SceneRenderer};
+use viewsynth::scene::render::{GlCamera, RaytraceParams, SceneRenderer};
 use viewsynth::stitch::faces::scene_faces;
 use viewsynth::stitch::render::StitchBlock;
 use viewsynth::stitch::{self, Method as StitchMethod, OdsRig, Side, StitchInput, StitchParams};
@@ -66,41 +66,106 @@ fn check_block<P: ParamBlock>(program: ProgramKind) {
     }
 }
 
+/// A program and the check of its parameter block.
+type LayoutCheck = (ProgramKind, fn(ProgramKind));
+
+/// Every program's parameter-block check, one row per program (a switch does not change the
+/// block): a program added to the shader library without its row here fails
+/// `every_registered_program_has_a_layout_check` (the add-a-pass recipe, ARCHITECTURE.md).
+fn layout_checks() -> Vec<LayoutCheck> {
+    let mut checks: Vec<LayoutCheck> = vec![
+        (
+            ProgramKind::CyclopeanGather {
+                depth_is_device: true,
+                refine: true,
+                blend_soft: true,
+            },
+            check_block::<GatherParams>,
+        ),
+        (
+            ProgramKind::ReprojectShift {
+                depth: ShiftDepth::Device,
+                scan: false,
+                scan_margin: 1,
+            },
+            check_block::<ShiftParams>,
+        ),
+        (
+            ProgramKind::Stitch {
+                method: StitchBlend::Reproject,
+                reproject_steps: 3,
+            },
+            check_block::<StitchBlock>,
+        ),
+        (ProgramKind::SceneRaytrace, check_block::<RaytraceParams>),
+        (ProgramKind::CyclopeanSplat, check_block::<SplatBlock>),
+        (ProgramKind::CyclopeanEdgeSnap, check_block::<EdgeSnapBlock>),
+        (ProgramKind::CyclopeanSplatGather, check_block::<SplatGatherBlock>),
+        (ProgramKind::CyclopeanSplatEdges, check_block::<SplatGatherBlock>),
+        (ProgramKind::CyclopeanForward, check_block::<ForwardParams>),
+        (
+            ProgramKind::RefocusFullscreen {
+                want_rgb: true,
+                rgb_everywhere: false,
+            },
+            check_block::<RefocusParams>,
+        ),
+        (
+            ProgramKind::CyclopeanFill,
+            check_block::<viewsynth::cyclopean::fill::FillParams>,
+        ),
+        (
+            ProgramKind::CyclopeanTemporalReproject { winner: true },
+            check_block::<viewsynth::cyclopean::temporal::TemporalParams>,
+        ),
+        (
+            ProgramKind::CyclopeanTemporalCompose,
+            check_block::<viewsynth::cyclopean::temporal::TemporalParams>,
+        ),
+    ];
+    for stage in viewsynth::pass::shaders::MatcherStage::ALL {
+        checks.push((
+            ProgramKind::CyclopeanMatcher(stage),
+            check_block::<viewsynth::cyclopean::matcher::gpu::MatcherParams>,
+        ));
+    }
+    checks.extend([
+        (
+            ProgramKind::RefocusMeshBoundary { want_rgb: true },
+            check_block::<RefocusParams> as fn(ProgramKind),
+        ),
+        (
+            ProgramKind::RefocusMeshInterior { want_rgb: true },
+            check_block::<RefocusParams>,
+        ),
+        (ProgramKind::RefocusColourEverywhere, check_block::<RefocusParams>),
+        (
+            ProgramKind::CyclopeanDensify,
+            check_block::<viewsynth::cyclopean::densify::DensifyParams>,
+        ),
+    ]);
+    checks
+}
+
 #[test]
 fn every_parameter_block_has_the_layout_the_gl_compiler_reports() {
-    check_block::<GatherParams>(ProgramKind::CyclopeanGather {
-        depth_is_device: true,
-        refine: true,
-        blend_soft: true,
-    });
-    check_block::<ShiftParams>(ProgramKind::ReprojectShift {
-        depth: ShiftDepth::Device,
-        scan: false,
-        scan_margin: 1,
-    });
-    check_block::<StitchBlock>(ProgramKind::Stitch {
-        method: StitchBlend::Reproject,
-        reproject_steps: 3,
-    });
-    check_block::<RaytraceParams>(ProgramKind::SceneRaytrace);
-    check_block::<SplatBlock>(ProgramKind::CyclopeanSplat);
-    check_block::<EdgeSnapBlock>(ProgramKind::CyclopeanEdgeSnap);
-    check_block::<SplatGatherBlock>(ProgramKind::CyclopeanSplatGather);
-    check_block::<SplatGatherBlock>(ProgramKind::CyclopeanSplatEdges);
-    check_block::<ForwardParams>(ProgramKind::CyclopeanForward);
-    check_block::<RefocusParams>(ProgramKind::RefocusFullscreen {
-        want_rgb: true,
-        rgb_everywhere: false,
-    });
-    check_block::<viewsynth::cyclopean::fill::FillParams>(ProgramKind::CyclopeanFill);
-    check_block::<viewsynth::cyclopean::temporal::TemporalParams>(ProgramKind::CyclopeanTemporalReproject {
-        winner: true,
-    });
-    check_block::<viewsynth::cyclopean::temporal::TemporalParams>(ProgramKind::CyclopeanTemporalCompose);
-    for stage in viewsynth::gpu::shaders::MatcherStage::ALL {
-        check_block::<viewsynth::cyclopean::matcher::gpu::MatcherParams>(ProgramKind::CyclopeanMatcher(stage));
+    for (program, check) in layout_checks() {
+        check(program);
     }
-    check_block::<RefocusParams>(ProgramKind::RefocusMeshBoundary { want_rgb: true });
+}
+
+#[test]
+fn every_registered_program_has_a_layout_check() {
+    let checked: BTreeSet<&str> = layout_checks().iter().map(|(p, _)| p.name()).collect();
+    let missing: BTreeSet<&str> = ShaderProgram::all(Conventions::default())
+        .iter()
+        .map(|p| p.kind.name())
+        .filter(|name| !checked.contains(name))
+        .collect();
+    assert!(
+        missing.is_empty(),
+        "programs of the shader library without a parameter-block check in layout_checks(): {missing:?}"
+    );
 }
 
 fn devices() -> (Device, Device) {
@@ -150,7 +215,7 @@ fn scene_ray_tracer_agrees_between_gl_and_vulkan_under_every_convention() {
         };
         let a = SceneRenderer::new(&gl, &scene).unwrap().render(&cam).unwrap().0;
         let b = SceneRenderer::new(&vk, &scene).unwrap().render(&cam).unwrap().0;
-        let view = |img: &viewsynth::scene::gpu::SceneImage, depth: &viewsynth::io::DepthMap| ViewOutput {
+        let view = |img: &viewsynth::scene::render::SceneImage, depth: &viewsynth::io::DepthMap| ViewOutput {
             width: 120,
             height: 90,
             color: Some(img.color.clone()),

@@ -21,8 +21,8 @@
 
 use crate::common::*;
 use viewsynth::convention::Conventions;
-use viewsynth::gpu::GpuPolicy;
 use viewsynth::io::{DepthMap, RgbImage};
+use viewsynth::pass::GpuPolicy;
 use viewsynth::refocus::manifest::TargetSpec;
 use viewsynth::refocus::{BreakRule, Method, OutputSet, RefocusOutput, RefocusSource, Refocuser};
 use viewsynth::vulkan::{Vk, VkExecutor, VulkanContext, VulkanDeviceChoice};

@@ -208,7 +208,7 @@ pub fn device_table(rows: &[DeviceRow], names: [&str; 2]) -> String {
 pub fn write_section(first: &Device, out_dir: &std::path::Path) -> Result<std::path::PathBuf> {
     let second = viewsynth::vulkan::VulkanContext::open(
         viewsynth::vulkan::VulkanDeviceChoice::Auto,
-        viewsynth::gpu::GpuPolicy::default(),
+        viewsynth::pass::GpuPolicy::default(),
     )
     .and_then(|vk| viewsynth::vulkan::VkExecutor::device(&vk));
     let mut text = format!(

@@ -17,9 +17,8 @@ use viewsynth::cyclopean::{
     StereoFrame,
 };
 use viewsynth::error::Result;
-use viewsynth::gpu::Timing;
 use viewsynth::io::{self, DepthDecode, DepthMap, RgbImage};
-use viewsynth::pass::Device;
+use viewsynth::pass::{Device, Timing};
 use viewsynth::refocus::BreakRule;
 
 /// Report name of the forward-warp method.

@@ -19,10 +19,9 @@ pub mod stitch;
 use crate::report::{Report, ReportRow, WrittenReport};
 use std::path::{Path, PathBuf};
 use viewsynth::error::Result;
-use viewsynth::gpu::Timing;
 use viewsynth::io::{DepthMap, RgbImage};
 use viewsynth::metrics;
-use viewsynth::pass::Device;
+use viewsynth::pass::{Device, Timing};
 use viewsynth::ssim;
 
 /// Median of `repeats` timings after one warm-up run (shader JIT, allocations).

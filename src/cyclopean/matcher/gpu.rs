@@ -8,12 +8,12 @@ use super::sgm::gpu::{Planned, SgmStages};
 use super::{check_pair, check_range, MatcherMethod};
 use crate::convention::RowOrder;
 use crate::error::{Error, Result};
-use crate::gpu::shaders::MatcherStage;
-use crate::gpu::{ProgramKind, ShaderProgram};
 use crate::io::{DepthMap, RgbImage};
+use crate::pass::shaders::MatcherStage;
 use crate::pass::{
     Buffer, Device, Dispatch, Format, Groups, Image, ImageData, ImageId, Rendered, Step, StorageImage, Target, ToDevice,
 };
+use crate::pass::{ProgramKind, ShaderProgram};
 
 /// Words a chunk buffer holds at most (64 MiB): under GL's guaranteed-in-practice storage-block
 /// size (llvmpipe: 128 MiB) and Vulkan's storage-buffer range on the devices we run.
@@ -270,8 +270,8 @@ impl Matcher {
             label,
         };
         let (l, r) = (
-            crate::gpu::pixels::rgb_to_rgba(&left.data),
-            crate::gpu::pixels::rgb_to_rgba(&right.data),
+            crate::pass::pixels::rgb_to_rgba(&left.data),
+            crate::pass::pixels::rgb_to_rgba(&right.data),
         );
         let [left_slot, right_slot] = &mut self.inputs;
         Ok([

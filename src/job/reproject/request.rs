@@ -11,11 +11,10 @@ use crate::camera::stereo::{Eye, StereoParams};
 use crate::camera::{Intrinsics, PinholeCamera};
 use crate::convention::Conventions;
 use crate::depth::DepthEncoding;
-use crate::gpu::Timing;
 use crate::job::error::OptionsContext;
 use crate::job::ArgError;
 use crate::output::OutputSet;
-use crate::pass::Device;
+use crate::pass::{Device, Timing};
 use crate::reproject::render::Reprojector;
 use crate::reproject::{
     Geometry, Method, ReprojectOutput, ReprojectOutputs, ReprojectParams, ReprojectSource, ShiftModel,

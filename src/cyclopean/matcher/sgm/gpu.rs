@@ -9,7 +9,7 @@
 use super::{Plan, DIRECTIONS};
 use crate::cyclopean::matcher::params::MatcherParams;
 use crate::error::{Error, Result};
-use crate::gpu::shaders::MatcherStage;
+use crate::pass::shaders::MatcherStage;
 use crate::pass::{Buffer, BufferId, Device, Groups};
 
 /// Words one cost or sum buffer may hold (128 MiB, llvmpipe's storage-block limit).

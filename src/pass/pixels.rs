@@ -1,4 +1,4 @@
-//! Pixel layout conversions between the library's images and GL transfer buffers: RGB8 images
+//! Pixel layout conversions between the library's images and the texels a pass uploads: RGB8 images
 //! travel as RGBA8 (GL has no 3-byte render target), f32 data as native-endian bytes.
 
 /// RGB8 -> RGBA8 with opaque alpha.

@@ -1,8 +1,8 @@
 // scene/raytrace's interface, the same text for GL and Vulkan: the std140 parameter block
-// (binding 0) mirrored by `RaytraceParams` in src/scene/gpu.rs. No images.
+// (binding 0) mirrored by `RaytraceParams` in src/scene/render.rs. No images.
 const int MAX_OBJECTS = 32;
 layout(std140, binding = 0) PARAM_BLOCK RaytraceParams {
-    // Pixel NDC (x, y, 1, 0) -> ray direction (src/scene/gpu.rs ray_basis): the same rays under
+    // Pixel NDC (x, y, 1, 0) -> ray direction (src/camera/rays.rs ray_basis): the same rays under
     // every convention.
     mat4 u_ray_basis;
     mat4 u_view_proj;

@@ -1,18 +1,17 @@
 //! The scene ray-traced on the GPU (shaders/scene/raytrace.frag) for any GL camera (view V,
-//! projection P, conventions), and its f64 twin with the same ray construction. Both give
-//! colour, view distance and window depth, rows top-down.
+//! projection P, conventions); its f64 twin with the same ray construction is
+//! [`super::reference`]. Both give colour, view distance and window depth, rows top-down.
 
-use super::{pattern_color, Scene, Shape, MAX_OBJECTS};
+use super::{Scene, Shape, MAX_OBJECTS};
 use crate::camera::mat4::{self, Mat4};
 pub use crate::camera::rays::{pixel_ndc, ray_basis};
-use crate::convention::{Conventions, DepthPlanes, RowOrder};
+use crate::convention::{Conventions, RowOrder};
 use crate::error::{Error, Result};
-use crate::gpu::{ProgramKind, ShaderProgram, Timing};
 use crate::io::{DepthMap, RgbImage};
-use crate::pass::{mat4_std140, Device, Draw, Format, Target, ToDevice};
+use crate::pass::{mat4_std140, Device, Draw, Format, ProgramKind, ShaderProgram, Target, Timing, ToDevice};
 
 crate::param_block! {
-    /// The ray tracer's parameters: shaders/scene/raytrace_params.glsl, member for member.
+    /// The ray tracer's parameters: shaders/scene/scene_params.glsl, member for member.
     pub struct RaytraceParams("RaytraceParams") {
         u_ray_basis: [[f32; 4]; 4],
         u_view_proj: [[f32; 4]; 4],
@@ -73,7 +72,7 @@ pub fn projection_centre(vp: &Mat4) -> Option<[f64; 3]> {
 }
 
 impl GlCamera {
-    fn matrices(&self) -> Result<(Mat4, Mat4, [f64; 3])> {
+    pub(super) fn matrices(&self) -> Result<(Mat4, Mat4, [f64; 3])> {
         let vp = mat4::mul(&self.proj, &self.view);
         mat4::inverse(&vp).ok_or_else(|| Error::param("camera view-projection", "singular"))?;
         let basis = ray_basis(&vp).ok_or_else(|| Error::param("camera projection", "not perspective"))?;
@@ -82,43 +81,12 @@ impl GlCamera {
     }
 
     /// Image row of framebuffer row `y`.
-    fn image_row(&self, y: u32) -> u32 {
+    pub(super) fn image_row(&self, y: u32) -> u32 {
         match self.conv.row_order {
             RowOrder::BottomUp => self.height - 1 - y,
             RowOrder::TopDown => y,
         }
     }
-}
-
-/// f64 twin of the shader: same rays, same rounding of colour to 8 bits.
-pub fn trace_gl_reference(scene: &Scene, cam: &GlCamera) -> Result<SceneImage> {
-    let (vp, basis, eye) = cam.matrices()?;
-    let (w, h) = (cam.width as usize, cam.height as usize);
-    let mut color = vec![0u8; w * h * 3];
-    let mut view_z = vec![0f32; w * h];
-    let far = cam.conv.clear_depth() as f32;
-    let mut device = vec![far; w * h];
-    for y in 0..cam.height {
-        for x in 0..cam.width {
-            let ndc = [pixel_ndc(x as f64, w as f64), pixel_ndc(y as f64, h as f64), 1.0, 0.0];
-            let d = mat4::transform(&basis, ndc);
-            let dir = [d[0], d[1], d[2]];
-            let Some(hit) = scene.trace(eye, dir) else { continue };
-            let o = cam.image_row(y) as usize * w + x as usize;
-            let c = pattern_color(&hit);
-            for k in 0..3 {
-                color[o * 3 + k] = c[k].round().clamp(0.0, 255.0) as u8;
-            }
-            view_z[o] = -mat4::transform_point(&cam.view, hit.p)[2] as f32;
-            let z = mat4::transform_point(&vp, hit.p)[2];
-            device[o] = DepthPlanes::window_depth_of_ndc_z(&cam.conv, z) as f32;
-        }
-    }
-    Ok(SceneImage {
-        color: RgbImage::new(cam.width, cam.height, color)?,
-        view_z: DepthMap::new(cam.width, cam.height, view_z)?,
-        device_depth: DepthMap::new(cam.width, cam.height, device)?,
-    })
 }
 
 enum Camera<'a> {
@@ -256,15 +224,8 @@ impl SceneRenderer {
             rows: cam.conv.row_order,
             depth_test: None,
         };
-        let draw = Draw {
-            program: ShaderProgram::new(cam.conv, ProgramKind::SceneRaytrace),
-            params: bytemuck::bytes_of(&block),
-            images: &[],
-            buffers: &[],
-            viewport: [0, 0, w, h],
-            triangles: 1,
-            indices: None,
-        };
+        let program = ShaderProgram::new(cam.conv, ProgramKind::SceneRaytrace);
+        let draw = Draw::fullscreen(program, bytemuck::bytes_of(&block), &[], w, h);
         let mut out = self.device.render(&target, &[draw])?;
         let color = out.take(0, "scene ray trace")?;
         let view_z = out.take_floats(1, "scene ray trace")?;
@@ -284,6 +245,7 @@ impl SceneRenderer {
 mod tests {
     use super::*;
     use crate::camera::{gl_projection, Pose};
+    use crate::convention::DepthPlanes;
 
     #[test]
     fn projection_centre_of_a_posed_pinhole_is_its_position() {
