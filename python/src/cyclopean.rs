@@ -14,9 +14,9 @@ use crate::renderer::Renderer;
 use crate::shared::{choice, outputs_given, SameThread};
 use pyo3::prelude::*;
 use pyo3::types::{PyBool, PyDict, PyFloat, PyInt, PyList, PyString, PyTuple};
-use viewsynth::cyclopean::camera_file::CameraFile;
-use viewsynth::cyclopean::one_eye::other_eye_disparity;
-use viewsynth::cyclopean::Eye;
+use viewsynth::stereo::camera_file::CameraFile;
+use viewsynth::stereo::one_eye::other_eye_disparity;
+use viewsynth::stereo::Eye;
 use viewsynth::io::{DepthMap, RgbImage, MASK_FILLED};
 use viewsynth::job::cyclopean::{
     CyclopeanPlan, CyclopeanRequest, Framed, InputName, StereoGiven, StereoInput, StereoKind, Synthesised,

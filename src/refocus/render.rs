@@ -13,7 +13,6 @@
 //! outputs later, so a caller can keep several targets (and frames) in flight.
 //! [`Refocuser::render`] is the two in a row.
 
-use super::grid::{axis_lookup, Grid};
 use super::mesh::{MeshGeometry, EXPAND_PX};
 use super::{BreakRule, Method, OutputSet, RefocusSource};
 use crate::camera::{clip_from_view_opencv, PinholeCamera};
@@ -21,6 +20,7 @@ use crate::convention::{Conventions, DepthPlanes};
 use crate::error::{Error, Result};
 use crate::gpu::{ProgramKind, ShaderProgram, Timing};
 use crate::io::{DepthMap, Mask, RgbImage};
+use crate::mesh::{axis_lookup, Grid};
 use crate::pass::{mat4_std140, Device, Draw, Format, Image, ImageData, ImageId, Pending, Step, Target, ToDevice};
 use std::time::Instant;
 

@@ -45,10 +45,10 @@ use crate::camera::mat4::{self, Mat4};
 use crate::camera::stereo::{Eye, StereoParams};
 use crate::camera::{gl_projection, PinholeCamera, Pose};
 use crate::convention::{Conventions, DepthPlanes};
-use crate::cyclopean::{EyeInput, FrameDepth, MiddleCamera, StereoFrame};
 use crate::depth::{DepthEncoding, DepthKind};
 use crate::error::{Error, Result};
 use crate::io::{DepthMap, RgbImage};
+use crate::stereo::{EyeInput, FrameDepth, MiddleCamera, StereoFrame};
 
 /// The source view: colour and depth (rows top-down), what the depth holds, and the
 /// conventions it was produced under (device depth, and the GPU pass's row order).
@@ -427,12 +427,12 @@ pub fn gather3d_params(
     src: &ReprojectSource,
     geometry: &Geometry,
     steps: u32,
-) -> [crate::cyclopean::CyclopeanParams; 2] {
+) -> [crate::stereo::gather::CyclopeanParams; 2] {
     let fix = fixation_distance(src, geometry);
     let near = src.inverse_depth_range().map_or(fix, |(_, q_hi)| 1.0 / q_hi);
-    [fix, near].map(|f| crate::cyclopean::CyclopeanParams {
-        method: crate::cyclopean::Method::Refine { steps },
-        ..crate::cyclopean::CyclopeanParams::seed(f)
+    [fix, near].map(|f| crate::stereo::gather::CyclopeanParams {
+        method: crate::stereo::gather::Method::Refine { steps },
+        ..crate::stereo::gather::CyclopeanParams::seed(f)
     })
 }
 

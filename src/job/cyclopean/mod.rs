@@ -5,12 +5,12 @@
 
 use super::{ArgError, Backend, Event, GpuRequest, Host, JobError};
 use crate::convention::{Conventions, DepthPlanes};
-use crate::cyclopean::camera_file::CameraFile;
-use crate::cyclopean::one_eye::other_eye_disparity;
-use crate::cyclopean::{Eye, EyeInput, FrameDepth};
 use crate::depth::DepthEncoding;
 use crate::io::{self, DepthDecode, DepthMap, DepthSummary, RgbImage};
 use crate::pass::Device;
+use crate::stereo::camera_file::CameraFile;
+use crate::stereo::one_eye::other_eye_disparity;
+use crate::stereo::{Eye, EyeInput, FrameDepth};
 use serde::Serialize;
 use std::path::{Path, PathBuf};
 
@@ -107,7 +107,7 @@ pub struct CyclopeanJob {
     left_rgb: PathBuf,
     right_rgb: PathBuf,
     /// Left and right disparity or depth files (none: two images alone). Disparities may give
-    /// one eye only: the other's is derived ([`crate::cyclopean::one_eye`]).
+    /// one eye only: the other's is derived ([`crate::stereo::one_eye`]).
     maps: Option<(Option<PathBuf>, Option<PathBuf>)>,
     cameras: Option<PathBuf>,
     decode: DepthDecode,
@@ -462,7 +462,8 @@ pub(crate) fn check_scale(option: &'static str, value: Option<f64>) -> Result<()
 mod tests {
     use super::request::dominant;
     use super::{ArgError, CyclopeanJob, CyclopeanMethod, CyclopeanOptions, CyclopeanRequest};
-    use crate::cyclopean::{Blend, Eye};
+    use crate::stereo::gather::Blend;
+    use crate::stereo::Eye;
 
     fn disparity_options(request: CyclopeanRequest) -> CyclopeanOptions {
         CyclopeanOptions {

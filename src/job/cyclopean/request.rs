@@ -11,21 +11,22 @@
 use super::reuse::Reused;
 use super::CyclopeanMethod;
 use crate::convention::Conventions;
-use crate::cyclopean::camera_file::{CameraFile, EyeCameras};
-use crate::cyclopean::densify::Densifier;
-use crate::cyclopean::disparity_frame::{disparity_frame, median_fixation, DisparityRig};
 use crate::cyclopean::fill::{Filler, FILLED};
 use crate::cyclopean::forward::ForwardWarp;
-use crate::cyclopean::matcher::range::{estimate_range, DisparityRange, SignedSearch};
-use crate::cyclopean::matcher::{EyeEstimate, Matcher, MatcherMethod};
-use crate::cyclopean::render::CyclopeanRenderer;
 use crate::cyclopean::splat::{SplatParams, SplatRenderer};
 use crate::cyclopean::temporal::FROM_HISTORY;
-use crate::cyclopean::{Blend, CyclopeanOutputs, CyclopeanParams, Eye, EyeInput, MiddleCamera, StereoFrame};
 use crate::io::{self, DepthMap, OutputSet, RgbImage};
 use crate::job::ArgError;
+use crate::mesh::BreakRule;
 use crate::pass::Device;
-use crate::refocus::BreakRule;
+use crate::stereo::camera_file::{CameraFile, EyeCameras};
+use crate::stereo::densify::Densifier;
+use crate::stereo::disparity_frame::{disparity_frame, median_fixation, DisparityRig};
+use crate::stereo::gather::render::CyclopeanRenderer;
+use crate::stereo::gather::{Blend, CyclopeanOutputs, CyclopeanParams};
+use crate::stereo::matcher::range::{estimate_range, DisparityRange, SignedSearch};
+use crate::stereo::matcher::{EyeEstimate, Matcher, MatcherMethod};
+use crate::stereo::{Eye, EyeInput, MiddleCamera, StereoFrame};
 use crate::view::ViewOutput;
 use serde::Serialize;
 use std::path::Path;
@@ -58,7 +59,7 @@ pub struct CyclopeanRequest {
     /// Holes filled from the background side (mask 128 there); off, holes stay.
     pub fill: bool,
     /// Two images alone: the largest disparity searched, pixels (none: estimated from the
-    /// images, see [`crate::cyclopean::matcher::range`]).
+    /// images, see [`crate::stereo::matcher::range`]).
     pub max_disparity: Option<i32>,
     /// Two images alone: the smallest disparity searched, pixels, negative allowed (none:
     /// estimated from the images).
@@ -147,7 +148,7 @@ impl GatherSettings {
     fn params(&self, fixation: f64) -> crate::Result<CyclopeanParams> {
         let mut params = CyclopeanParams::seed(fixation);
         if self.refine && self.steps > 0 {
-            params.method = crate::cyclopean::Method::Refine { steps: self.steps };
+            params.method = crate::stereo::gather::Method::Refine { steps: self.steps };
         }
         params.blend = self.blend;
         if let Some(t) = self.z_threshold {
@@ -342,9 +343,9 @@ impl CyclopeanRequest {
 
 /// `out` with its holes taken from `dense` where that view has a pixel, marked [`FILLED`].
 fn holes_from(
-    mut out: crate::cyclopean::CyclopeanOutput,
-    dense: &crate::cyclopean::CyclopeanOutput,
-) -> crate::Result<crate::cyclopean::CyclopeanOutput> {
+    mut out: crate::stereo::gather::CyclopeanOutput,
+    dense: &crate::stereo::gather::CyclopeanOutput,
+) -> crate::Result<crate::stereo::gather::CyclopeanOutput> {
     let missing = || crate::Error::param("fill", "the dense view needs colour and depth");
     let (dc, dd) = (
         dense.color.as_ref().ok_or_else(missing)?,
@@ -389,7 +390,7 @@ pub struct Framed {
     /// Two images alone: the disparity range searched, and whether it was estimated (else given).
     pub range: Option<(DisparityRange, bool)>,
     /// Disparities (given or estimated) with `fill`: the same frame on disparities made dense
-    /// ([`crate::cyclopean::densify`]); what it renders fills the holes of `frame`'s view.
+    /// ([`crate::stereo::densify`]); what it renders fills the holes of `frame`'s view.
     pub dense: Option<StereoFrame>,
 }
 
