@@ -18,9 +18,8 @@ use viewsynth::stereo::camera_file::CameraFile;
 use viewsynth::stereo::one_eye::other_eye_disparity;
 use viewsynth::stereo::Eye;
 use viewsynth::io::{DepthMap, RgbImage, MASK_FILLED};
-use viewsynth::job::cyclopean::{
-    CyclopeanPlan, CyclopeanRequest, Framed, InputName, StereoGiven, StereoInput, StereoKind, Synthesised,
-};
+use viewsynth::cyclopean::pipeline::{CyclopeanPlan, Framed, InputName, StereoInput, StereoKind, Synthesised};
+use viewsynth::job::cyclopean::{CyclopeanRequest, StereoGiven};
 use viewsynth::pass::ToDevice;
 
 /// The arguments of one call, as Python gave them.

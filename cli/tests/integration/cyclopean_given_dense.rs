@@ -5,8 +5,9 @@
 
 use crate::cli::{bin, scratch};
 use crate::common::{data_dir, gpu};
+use viewsynth::cyclopean::pipeline::{InputName, StereoInput, StereoKind};
 use viewsynth::io::{load_depth_with_key, load_rgb, DepthMap, RgbImage, MASK_FILLED};
-use viewsynth::job::cyclopean::{CyclopeanRequest, InputName, StereoInput, StereoKind};
+use viewsynth::job::cyclopean::CyclopeanRequest;
 use viewsynth::pass::Device;
 use viewsynth::stereo::densify::{densify_reference, Densifier, FILLED};
 
