@@ -9,7 +9,7 @@
 //!   accepts a walk's end only if a source segment [j, j+1] next to it covers u.
 //! - [`Method::ShiftScan`]: the exact shift gather: every segment of the row whose source
 //!   position can reach u (the frame's q range bounds it) is tested; all of them cover u.
-//! - [`Method::Gather3d`]: the cyclopean 3-D walk (`crate::cyclopean`, unchanged) with the
+//! - [`Method::Gather3d`]: the cyclopean 3-D walk ([`crate::stereo::gather`], unchanged) with the
 //!   target as the "middle camera" and the source as the only eye (the other eye has no valid
 //!   depth), run twice: from the zero-parallax (or mid-range) distance and from the nearest
 //!   depth of the frame; the nearer result that passes cyclopean's 1 px projection check wins.
