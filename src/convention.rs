@@ -256,7 +256,7 @@ mod tests {
 
     #[test]
     fn planes_come_back_from_the_gl_projection_under_every_convention() {
-        let cam = crate::scene::demo_camera(64, 48);
+        let cam = crate::world::demo_camera(64, 48);
         for conv in Conventions::all() {
             for planes in [
                 DepthPlanes { near: 0.05, far: 100.0 },

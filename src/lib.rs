@@ -28,7 +28,12 @@
 //! - [`output`]: the output layer, a view's files written into an all-or-none file set.
 //! - [`ssim`]: structural similarity, f64.
 //! - [`metrics`]: error measures of the tests, reports and benchmarks (PSNR, masks, depth).
-//! - [`scene`]: ground-truth scenes as data, ray-traced in f64 and on the GPU.
+//! - [`world`]: the built-in scenes as data (shapes) and their f64 ray tracer.
+//! - [`stereo`]: a stereo pair's geometry below the capabilities: frame types, the camera
+//!   file, frames from disparities, the stereo matcher, densify and the middle-ray walk.
+//! - [`mesh`]: the 2.5D grid mesh of a depth map and its break rule (refocus, cyclopean's
+//!   forward warp).
+//! - [`scene`]: ground-truth frames of the built-in scenes, ray-traced on the GPU.
 //! - [`refocus`]: same-pose re-rendering at other focal lengths, one frame or a pipelined batch.
 //! - [`cyclopean`]: the middle (spectator) view of a stereo pair, five methods.
 //! - [`reproject`]: one view of a stereo rig to another eye.
@@ -59,6 +64,7 @@ pub mod error;
 pub mod gpu;
 pub mod io;
 pub mod job;
+pub mod mesh;
 pub mod metrics;
 pub mod output;
 pub mod pass;
@@ -67,6 +73,7 @@ pub mod refocus;
 pub mod reproject;
 pub mod scene;
 pub mod ssim;
+pub mod stereo;
 pub mod stitch;
 pub mod view;
 #[cfg(feature = "vulkan")]
@@ -74,6 +81,7 @@ pub mod vulkan;
 #[cfg(not(feature = "vulkan"))]
 #[path = "vulkan_off.rs"]
 pub mod vulkan;
+pub mod world;
 
 #[cfg(test)]
 mod test_data;

@@ -11,7 +11,8 @@
 //!
 //! - no circle between files;
 //! - no import from a file of a lower layer (the table below, ARCHITECTURE.md's picture) to a
-//!   file of a higher one. Imports within one layer are free (the circle rule still holds).
+//!   file of a higher one. Imports within one layer are free (the circle rule still holds),
+//!   but for the capabilities: no capability's folder imports another's.
 //!
 //! A plain text scan (comments and string literals blanked first) rather than a Rust parser:
 //! the library's imports are ordinary paths and use trees, and a path the scan cannot follow
@@ -30,17 +31,20 @@ const LAYERS: &[(&str, &[&str])] = &[
     ("files", &["io/", "alloc.rs", "cpu_time.rs"]),
     ("maths", &["camera/", "test_rng.rs"]),
     ("data", &["depth/", "metrics.rs", "ssim.rs"]),
+    ("built-in scenes", &["world/"]),
     ("pass descriptions", &["pass/"]),
     ("backends", &["gpu/", "vulkan/", "vulkan_off.rs"]),
     ("view", &["view.rs", "progress.rs"]),
     ("output", &["output.rs", "output/"]),
-    (
-        "capabilities",
-        &["refocus/", "cyclopean/", "reproject/", "stitch/", "scene/"],
-    ),
+    ("stereo and mesh", &["stereo/", "mesh/"]),
+    ("capabilities", CAPABILITIES),
     ("checking", &["compare/"]),
     ("jobs", &["job/"]),
 ];
+
+/// The capabilities: peers, none importing another (what two share sits below them, in the
+/// stereo and mesh layer or lower).
+const CAPABILITIES: &[&str] = &["refocus/", "cyclopean/", "reproject/", "stitch/", "scene/"];
 
 fn layer_of(file: &str) -> Option<usize> {
     let mut best: Option<(usize, usize)> = None;
@@ -624,6 +628,30 @@ fn no_import_runs_from_a_lower_layer_to_a_higher_one() {
         "{} import(s) run up the layers:\n{}",
         upward.len(),
         upward.join("\n")
+    );
+}
+
+/// The capabilities are peers: no file of one capability's folder imports a file of another's
+/// (what they share sits below them: `stereo/`, `mesh/`, `world/`, `camera/`).
+#[test]
+fn no_capability_imports_another() {
+    let graph = import_graph();
+    let capability = |f: &str| CAPABILITIES.iter().copied().find(|c| f.starts_with(c));
+    let mut across = Vec::new();
+    for (from, tos) in &graph {
+        for to in tos {
+            if let (Some(cf), Some(ct)) = (capability(from), capability(to)) {
+                if cf != ct {
+                    across.push(format!("{from} -> {to}"));
+                }
+            }
+        }
+    }
+    assert!(
+        across.is_empty(),
+        "{} import(s) from one capability to another:\n{}",
+        across.len(),
+        across.join("\n")
     );
 }
 

@@ -55,8 +55,8 @@ impl Host for CliHost {
             }
             Event::DisparityDerived { eye, known_fraction } => {
                 let (this, other) = match eye {
-                    viewsynth::cyclopean::Eye::Left => ("left", "right"),
-                    viewsynth::cyclopean::Eye::Right => ("right", "left"),
+                    viewsynth::stereo::Eye::Left => ("left", "right"),
+                    viewsynth::stereo::Eye::Right => ("right", "left"),
                 };
                 errln!(
                     "note: no --{this}-disparity: the {this} eye's disparity is the {other} one forward-warped \

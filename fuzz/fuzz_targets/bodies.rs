@@ -7,10 +7,10 @@
 use std::path::PathBuf;
 
 use viewsynth::convention::DepthPlanes;
-use viewsynth::cyclopean::camera_file::CameraFile;
 use viewsynth::io::{load_depth, load_mask_png, load_npz_array, load_rgb, DepthDecode};
 use viewsynth::refocus::batch::load_manifest;
-use viewsynth::scene::Scene;
+use viewsynth::stereo::camera_file::CameraFile;
+use viewsynth::world::Scene;
 
 /// The loaders take paths: each input goes to a scratch file of this process and thread with
 /// the extension that selects the format.

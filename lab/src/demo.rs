@@ -12,7 +12,7 @@ use viewsynth::output::FileFormats;
 use viewsynth::pass::Device;
 use viewsynth::refocus::manifest as job;
 use viewsynth::refocus::{reference, BreakRule, Method, OutputSet, RefocusSource, Refocuser};
-use viewsynth::{io, scene};
+use viewsynth::{io, world};
 
 /// The focal scales the demo refocuses at.
 pub const DEMO_SCALES: [f64; 5] = viewsynth::refocus::manifest::DEFAULT_SCALES;
@@ -36,8 +36,8 @@ pub fn run_with_progress(
     let sub = |name: &str| out.subdir(name).map(|d| d.path().to_path_buf());
     let (cyclopean_dir, reproject_dir, stitch_dir) = (sub("cyclopean")?, sub("reproject")?, sub("stitch")?);
     let method_dirs = [sub("fullscreen")?, sub("mesh")?];
-    let cam = scene::demo_camera(640, 480);
-    let (rgb, depth) = scene::render(&cam);
+    let cam = world::demo_camera(640, 480);
+    let (rgb, depth) = world::render(&cam);
     io::save_rgb(&out_dir.join("source_rgb.png"), &rgb)?;
     io::save_depth_exr(&out_dir.join("source_depth.exr"), &depth)?;
     let src = RefocusSource::new(rgb, depth, cam.k)?;
@@ -72,7 +72,7 @@ pub fn run_with_progress(
                     ..Default::default()
                 },
             )?;
-            let (gt_rgb, gt_depth) = scene::render(target);
+            let (gt_rgb, gt_depth) = world::render(target);
             let mask: Vec<bool> = out
                 .mask
                 .as_ref()
@@ -141,9 +141,9 @@ pub fn run_with_progress(
 /// The built-in stereo pair (64 mm IPD, device depth, GL conventions), its ray-traced middle
 /// view, and the middle view of each cyclopean method.
 fn cyclopean_outputs(device: &Device, dir: &Path) -> Result<()> {
-    use viewsynth::cyclopean::render::CyclopeanRenderer;
-    use viewsynth::cyclopean::scene_frame::{scene_frame, StereoRig};
-    use viewsynth::cyclopean::FrameDepth;
+    use viewsynth::stereo::gather::render::CyclopeanRenderer;
+    use viewsynth::stereo::scene_frame::{scene_frame, StereoRig};
+    use viewsynth::stereo::FrameDepth;
     let rig = StereoRig::demo(640, 480);
     let (frame, mid, truth) = scene_frame(&rig, Conventions::default(), FrameDepth::Device);
     io::save_rgb(&dir.join("left_rgb.png"), &frame.left.color)?;
@@ -187,7 +187,7 @@ fn reproject_outputs(device: &Device, dir: &Path) -> Result<()> {
         480,
         0.064,
         Conventions::default(),
-        viewsynth::cyclopean::FrameDepth::Device,
+        viewsynth::stereo::FrameDepth::Device,
     )?
     .into_iter()
     .next()

@@ -9,11 +9,7 @@
 
 use viewsynth::convention::Conventions;
 use viewsynth::cyclopean::forward::ForwardWarp;
-use viewsynth::cyclopean::matcher::Matcher;
-use viewsynth::cyclopean::render::CyclopeanRenderer;
-use viewsynth::cyclopean::scene_frame::{scene_frame, StereoRig};
 use viewsynth::cyclopean::splat::{SplatParams, SplatRenderer};
-use viewsynth::cyclopean::{CyclopeanOutput, CyclopeanOutputs, CyclopeanParams, FrameDepth, Method as Cm, StereoFrame};
 use viewsynth::error::Result;
 use viewsynth::io::RgbImage;
 use viewsynth::pass::Device;
@@ -21,6 +17,11 @@ use viewsynth::refocus::manifest::{TargetSpec, DEFAULT_SCALES};
 use viewsynth::refocus::{BreakRule, Method, OutputSet, RefocusSource, Refocuser};
 use viewsynth::reproject::render::Reprojector;
 use viewsynth::scene::render::{GlCamera, SceneRenderer};
+use viewsynth::stereo::gather::render::CyclopeanRenderer;
+use viewsynth::stereo::gather::{CyclopeanOutput, CyclopeanOutputs, CyclopeanParams, Method as Cm};
+use viewsynth::stereo::matcher::Matcher;
+use viewsynth::stereo::scene_frame::{scene_frame, StereoRig};
+use viewsynth::stereo::{FrameDepth, StereoFrame};
 use viewsynth::stitch::render::StitchRenderer;
 use viewsynth::stitch::FaceSet;
 use viewsynth::stitch::{faces::scene_faces, Method as Sm, OdsRig, Side, StitchParams};
@@ -249,11 +250,11 @@ pub struct PassInputs {
     refocus: RefocusSource,
     targets: Vec<viewsynth::camera::PinholeCamera>,
     frame: StereoFrame,
-    mid: viewsynth::cyclopean::MiddleCamera,
+    mid: viewsynth::stereo::MiddleCamera,
     pair: (RgbImage, RgbImage),
     reproject: ReprojectCase,
     faces: (FaceSet, FaceSet),
-    scene: viewsynth::scene::Scene,
+    scene: viewsynth::world::Scene,
     camera: GlCamera,
 }
 
@@ -266,8 +267,8 @@ impl PassInputs {
     /// [`PassInputs::new`] with the eyes' depth (stereo frame and reprojection source) as `kind`:
     /// view Z gives every convention the same input bits.
     pub fn with_depth(width: u32, height: u32, conv: Conventions, kind: FrameDepth) -> Result<Self> {
-        let cam = viewsynth::scene::demo_camera(width, height);
-        let (rgb, depth) = viewsynth::scene::render(&cam);
+        let cam = viewsynth::world::demo_camera(width, height);
+        let (rgb, depth) = viewsynth::world::render(&cam);
         let refocus = RefocusSource::new(rgb, depth, cam.k)?;
         let targets = TargetSpec {
             scales: DEFAULT_SCALES.to_vec(),
@@ -305,7 +306,7 @@ impl PassInputs {
             pair: (l, r),
             reproject,
             faces,
-            scene: viewsynth::scene::builtin("demo")?,
+            scene: viewsynth::world::builtin("demo")?,
             camera,
         })
     }

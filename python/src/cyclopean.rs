@@ -14,14 +14,13 @@ use crate::renderer::Renderer;
 use crate::shared::{choice, outputs_given, SameThread};
 use pyo3::prelude::*;
 use pyo3::types::{PyBool, PyDict, PyFloat, PyInt, PyList, PyString, PyTuple};
-use viewsynth::cyclopean::camera_file::CameraFile;
-use viewsynth::cyclopean::one_eye::other_eye_disparity;
-use viewsynth::cyclopean::Eye;
+use viewsynth::cyclopean::pipeline::{CyclopeanPlan, Framed, InputName, StereoInput, StereoKind, Synthesised};
 use viewsynth::io::{DepthMap, RgbImage, MASK_FILLED};
-use viewsynth::job::cyclopean::{
-    CyclopeanPlan, CyclopeanRequest, Framed, InputName, StereoGiven, StereoInput, StereoKind, Synthesised,
-};
+use viewsynth::job::cyclopean::{CyclopeanRequest, StereoGiven};
 use viewsynth::pass::ToDevice;
+use viewsynth::stereo::camera_file::CameraFile;
+use viewsynth::stereo::one_eye::other_eye_disparity;
+use viewsynth::stereo::Eye;
 
 /// The arguments of one call, as Python gave them.
 struct CyclopeanArgs<'a, 'py> {

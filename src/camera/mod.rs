@@ -12,4 +12,4 @@ pub mod vergence;
 pub use intrinsics::{Intrinsics, PinholeCamera, MAX_INTRINSIC, MIN_FOCAL_PX};
 pub use intrinsics_file::{IntrinsicsFile, IntrinsicsFormat};
 pub use pose::{gl_projection, Pose};
-pub use projection::clip_from_view_opencv;
+pub use projection::{clip_from_view_opencv, projection_centre};

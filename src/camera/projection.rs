@@ -1,5 +1,6 @@
 //! GL clip transforms built from intrinsics, under any [`Conventions`].
 
+use super::mat4::Mat4;
 use super::PinholeCamera;
 use crate::convention::{Conventions, DepthPlanes, RowOrder};
 
@@ -27,6 +28,20 @@ pub fn clip_from_view_opencv(cam: &PinholeCamera, planes: &DepthPlanes, conv: &C
         [0.0, 0.0, a, b],
         [0.0, 0.0, 1.0, 0.0],
     ]
+}
+
+/// Centre of projection of a perspective view-projection: the point whose clip x, y and w are
+/// all 0 (null vector of those three rows, by cofactors). Not inv(V)'s origin: a stereo
+/// projection with a clip-space shift (seed 004) projects from the offset eye.
+pub fn projection_centre(vp: &Mat4) -> Option<[f64; 3]> {
+    let rows = [vp[0], vp[1], vp[3]];
+    let det3 = |c: [usize; 3]| {
+        let m = |r: usize, k: usize| rows[r][c[k]];
+        m(0, 0) * (m(1, 1) * m(2, 2) - m(1, 2) * m(2, 1)) - m(0, 1) * (m(1, 0) * m(2, 2) - m(1, 2) * m(2, 0))
+            + m(0, 2) * (m(1, 0) * m(2, 1) - m(1, 1) * m(2, 0))
+    };
+    let c = [det3([1, 2, 3]), -det3([0, 2, 3]), det3([0, 1, 3]), -det3([0, 1, 2])];
+    (c[3].abs() > 1e-300 && c.iter().all(|v| v.is_finite())).then(|| [c[0] / c[3], c[1] / c[3], c[2] / c[3]])
 }
 
 #[cfg(test)]

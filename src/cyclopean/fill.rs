@@ -25,9 +25,10 @@
 //! agree exactly; the weighted means are the same f32 sums, up to the GPU's division (GLSL allows
 //! 2.5 ulp) and its rounding of the normalised colour: one level at most, 1e-5 relative in depth.
 
-use super::CyclopeanOutput;
 use crate::error::{Error, Result};
-use crate::pass::{Device, Draw, Image, ImageData, ProgramKind, ShaderProgram, Target, ToDevice};
+use crate::pass::{Device, Draw, Image, ImageData, Target, ToDevice};
+use crate::pass::{ProgramKind, ShaderProgram};
+use crate::stereo::gather::CyclopeanOutput;
 
 /// The source bit of filled pixels (above the eye and history bits).
 pub const FILLED: u8 = crate::io::MASK_FILLED;
@@ -46,7 +47,7 @@ crate::param_block! {
 /// surface, and the hole is interpolated between them instead of copied from the farther.
 pub const SAME_SURFACE: f32 = 0.05;
 
-/// [`super::walk::DIRECTIONS`]' entries along the row: +x and -x.
+/// [`crate::stereo::walk::DIRECTIONS`]' entries along the row: +x and -x.
 const ROW_RIGHT: usize = 0;
 const ROW_LEFT: usize = 8;
 
@@ -132,9 +133,9 @@ pub fn fill_reference(out: &CyclopeanOutput, width: u32, height: u32) -> Result<
             }
             // (depth, distance, index) of the first rendered pixel along each direction; and
             // whether the row runs off the image either way with none (a border strip).
-            let hits: Vec<_> = super::walk::DIRECTIONS
+            let hits: Vec<_> = crate::stereo::walk::DIRECTIONS
                 .iter()
-                .map(|&d| super::walk::first_along((x, y), d, (w, h), w.max(h), valid))
+                .map(|&d| crate::stereo::walk::first_along((x, y), d, (w, h), w.max(h), valid))
                 .collect();
             let (right, left) = (hits[ROW_RIGHT], hits[ROW_LEFT]);
             let border_strip = right.is_none() || left.is_none();

@@ -4,17 +4,16 @@
 //! guess to get wrong and fills every pixel a kept triangle covers; its oracle is the
 //! ray-traced middle view (cli/tests/integration/cyclopean.rs).
 
-use super::{CyclopeanOutput, EyeInput, FrameDepth, MiddleCamera, StereoFrame};
 use crate::camera::mat4::{self, Mat4};
 use crate::convention::RowOrder;
 use crate::error::{Error, Result};
+use crate::mesh::code_rows;
+use crate::mesh::{BreakRule, Grid};
 use crate::pass::shaders::TRI_TEX_WIDTH;
-use crate::pass::{
-    mat4_std140, Device, Draw, Format, Image, ImageData, ProgramKind, ShaderProgram, Step, Target, Texels, Timing,
-    ToDevice,
-};
-use crate::refocus::mesh::code_rows;
-use crate::refocus::{BreakRule, Grid};
+use crate::pass::{mat4_std140, Device, Draw, Format, Image, ImageData, Step, Target, Texels, ToDevice};
+use crate::pass::{ProgramKind, ShaderProgram, Timing};
+use crate::stereo::gather::CyclopeanOutput;
+use crate::stereo::{EyeInput, FrameDepth, MiddleCamera, StereoFrame};
 
 /// The right eye replaces the left only where it is nearer by more than this (relative): ties
 /// between the two views of one surface go to the left eye under every convention. Far above
@@ -41,7 +40,7 @@ pub fn eye_distances(eye: &EyeInput, kind: FrameDepth, conv: &crate::convention:
                 crate::camera::rays::pixel_ndc(y_mem as f64, h as f64),
             ];
             let d = eye.depth.data[y * w + x] as f64;
-            out[y * w + x] = super::reference::stored_view_point(d, ndc, kind, conv, &inv_proj, &basis)
+            out[y * w + x] = crate::stereo::gather::reference::stored_view_point(d, ndc, kind, conv, &inv_proj, &basis)
                 .map(|p| -p[2])
                 .filter(|v| v.is_finite() && *v > 0.0)
                 .unwrap_or(0.0) as f32;
@@ -156,9 +155,9 @@ impl ForwardWarp {
         let (w, h) = (mid.width, mid.height);
         self.device.check_image_size("middle size", w, h)?;
         let vp_m = mat4::mul(&mid.proj, &mid.view);
-        let centre = crate::scene::render::projection_centre(&vp_m)
+        let centre = crate::camera::projection_centre(&vp_m)
             .ok_or_else(|| Error::param("middle projection", "not perspective"))?;
-        let rays_vp_m = super::ray_basis_std140(&vp_m, "middle view-projection")?;
+        let rays_vp_m = crate::stereo::ray_basis_std140(&vp_m, "middle view-projection")?;
         let inv = |m: &Mat4, what: &str| {
             mat4::inverse(m)
                 .map(|m| mat4_std140(&m))
@@ -170,7 +169,7 @@ impl ForwardWarp {
             let Some(tris) = &eye.tris else { continue };
             blocks.push(ForwardParams {
                 u_inv_view_e: inv(&eye.view, "eye view")?,
-                u_ray_basis_e: super::ray_basis_std140(&eye.proj, "eye projection")?,
+                u_ray_basis_e: crate::stereo::ray_basis_std140(&eye.proj, "eye projection")?,
                 u_view_proj_e: mat4_std140(&mat4::mul(&eye.proj, &eye.view)),
                 u_view_m: mat4_std140(&mid.view),
                 u_view_proj_m: mat4_std140(&vp_m),

@@ -4,12 +4,13 @@
 //! ([`CyclopeanRenderer`], [`SplatRenderer`]) and their f64 twins ([`cyclopean_reference`],
 //! [`splat_reference`]): no numerics of its own, so the views are exactly what those return.
 
-use super::reference::cyclopean_reference;
-use super::render::CyclopeanRenderer;
 use super::splat::{SplatParams, SplatRenderer};
 use super::splat_reference::splat_reference;
-use super::{CyclopeanOutputs, CyclopeanParams, MiddleCamera, StereoFrame};
 use crate::error::Result;
+use crate::stereo::gather::reference::cyclopean_reference;
+use crate::stereo::gather::render::CyclopeanRenderer;
+use crate::stereo::gather::{CyclopeanOutputs, CyclopeanParams};
+use crate::stereo::{MiddleCamera, StereoFrame};
 use crate::view::ViewOutput;
 
 /// Which middle-view pass, with its parameters.
@@ -68,7 +69,7 @@ pub fn reference(input: &CyclopeanInput) -> Result<ViewOutput> {
     Ok(view)
 }
 
-impl super::CyclopeanOutput {
+impl crate::stereo::gather::CyclopeanOutput {
     /// [`crate::view::clear_non_finite`] on the planes read back (the source bits are the mask).
     pub fn finite(mut self) -> Self {
         crate::view::clear_non_finite(
@@ -82,7 +83,7 @@ impl super::CyclopeanOutput {
 impl ViewOutput {
     /// A cyclopean GPU output of a `width` x `height` middle camera (mask: the source bits).
     pub fn from_cyclopean(
-        out: &super::CyclopeanOutput,
+        out: &crate::stereo::gather::CyclopeanOutput,
         width: u32,
         height: u32,
         timing: Option<crate::pass::Timing>,
@@ -98,7 +99,11 @@ impl ViewOutput {
     }
 
     /// The cyclopean f64 twin of a `width` x `height` middle camera.
-    pub fn from_cyclopean_reference(r: &super::reference::CyclopeanReference, width: u32, height: u32) -> Self {
+    pub fn from_cyclopean_reference(
+        r: &crate::stereo::gather::reference::CyclopeanReference,
+        width: u32,
+        height: u32,
+    ) -> Self {
         Self::from_f64_twin_mask(width, height, &r.color, &r.depth, r.sources.clone())
     }
 }

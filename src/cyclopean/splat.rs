@@ -31,7 +31,6 @@
 //! "Same surface" is about one pixel of full-baseline disparity (`SplatParams::surface_tolerance_px`),
 //! a unit that means the same on every rig. The f64 twin is [`splat_reference`](super::splat_reference).
 
-use super::{CyclopeanOutput, CyclopeanOutputs, MiddleCamera, StereoFrame};
 use crate::camera::mat4::{self, Mat4};
 use crate::convention::RowOrder;
 use crate::error::{Error, Result};
@@ -40,6 +39,8 @@ use crate::pass::{
     ToDevice,
 };
 use crate::pass::{ProgramKind, ShaderProgram, Timing};
+use crate::stereo::gather::{CyclopeanOutput, CyclopeanOutputs};
+use crate::stereo::{MiddleCamera, StereoFrame};
 
 crate::param_block! {
     /// The splat's parameters: shaders/cyclopean/splat.comp, member for member.
@@ -173,7 +174,7 @@ impl SplatGeometry {
                 "the splat method needs two distinct eye positions (baseline > 0)",
             ));
         }
-        let mem = |eye: &super::EyeInput| -> Result<Vec<f32>> {
+        let mem = |eye: &crate::stereo::EyeInput| -> Result<Vec<f32>> {
             let d = super::forward::eye_distances(eye, frame.depth_kind, &frame.conv)?;
             let w = eye.depth.width as usize;
             let bytes = frame
@@ -233,7 +234,7 @@ impl EyeGpu {
 /// otherwise, and snaps its distances when `snap` says so.
 fn upload_eye(
     device: &Device,
-    eye: &super::EyeInput,
+    eye: &crate::stereo::EyeInput,
     dist: &[f32],
     rows: RowOrder,
     old: Option<EyeGpu>,
@@ -428,7 +429,7 @@ impl SplatRenderer {
             .map(|eye| {
                 Ok(SplatBlock {
                     u_inv_view_e: inverse(&eye.view, "eye view")?,
-                    u_ray_basis_e: super::ray_basis_std140(&eye.proj, "eye projection")?,
+                    u_ray_basis_e: crate::stereo::ray_basis_std140(&eye.proj, "eye projection")?,
                     u_view_proj_m: view_proj_m,
                     u_view_m: mat4_std140(&mid.view),
                     u_grid: [eye.size.0 as i32, eye.size.1 as i32],
@@ -441,14 +442,14 @@ impl SplatRenderer {
             u_view_proj_l: mat4_std140(&mat4::mul(&l.proj, &l.view)),
             u_view_l: mat4_std140(&l.view),
             u_inv_view_l: inverse(&l.view, "eye view")?,
-            u_ray_basis_l: super::ray_basis_std140(&l.proj, "eye projection")?,
+            u_ray_basis_l: crate::stereo::ray_basis_std140(&l.proj, "eye projection")?,
             u_view_proj_r: mat4_std140(&mat4::mul(&r.proj, &r.view)),
             u_view_r: mat4_std140(&r.view),
             u_inv_view_r: inverse(&r.view, "eye view")?,
-            u_ray_basis_r: super::ray_basis_std140(&r.proj, "eye projection")?,
+            u_ray_basis_r: crate::stereo::ray_basis_std140(&r.proj, "eye projection")?,
             u_view_m: mat4_std140(&mid.view),
             u_inv_view_m: inverse(&mid.view, "middle view")?,
-            u_ray_basis_m: super::ray_basis_std140(&mid.proj, "middle projection")?,
+            u_ray_basis_m: crate::stereo::ray_basis_std140(&mid.proj, "middle projection")?,
             u_size_m: [w as f32, h as f32],
             u_parallax_px: self.parallax_px as f32,
             u_tolerance_px: self.params.surface_tolerance_px as f32,

@@ -2,15 +2,15 @@
 //! and splat_gather.frag): the same passes, the same texel choices, in memory order (row 0 =
 //! framebuffer row 0) as the GPU sees its textures; converted to top-down rows at the end.
 
-use super::ambiguity::{distance_bound, position_bound, Reach, EPS32};
 use super::edge_snap::SnapRule;
-use super::reference::CyclopeanReference;
 use super::splat::{SplatGeometry, SplatParams};
-use super::{MiddleCamera, StereoFrame};
 use crate::camera::mat4::{self, Mat4};
 use crate::camera::rays::{pixel_ndc, ray_basis, view_ray};
 use crate::convention::RowOrder;
 use crate::error::Result;
+use crate::stereo::gather::ambiguity::{distance_bound, position_bound, Reach, EPS32};
+use crate::stereo::gather::reference::CyclopeanReference;
+use crate::stereo::{MiddleCamera, StereoFrame};
 
 /// One eye as the passes read it: distance (0 = invalid) and colour in memory order.
 struct Eye<'a> {

@@ -19,7 +19,6 @@
 //! lands in or which texel is nearer (texels within about 1e-4 px of a pixel edge), and by one
 //! level where a blended colour rounds at a tie.
 
-use super::{CyclopeanOutput, MiddleCamera};
 use crate::camera::mat4;
 use crate::camera::rays;
 use crate::convention::{Conventions, RowOrder};
@@ -29,6 +28,8 @@ use crate::pass::{
     ToDevice,
 };
 use crate::pass::{ProgramKind, ShaderProgram};
+use crate::stereo::gather::CyclopeanOutput;
+use crate::stereo::MiddleCamera;
 
 /// Source bit of pixels filled from the history (temporal_compose.frag's FROM_HISTORY).
 pub const FROM_HISTORY: u8 = 4;
@@ -168,7 +169,7 @@ impl Accumulator {
         let stage = |u_stage| -> Result<TemporalParams> {
             Ok(TemporalParams {
                 u_inv_view_h: inv(&hist.mid.view, "previous middle view")?,
-                u_ray_basis_h: super::ray_basis_std140(&hist.mid.proj, "previous middle projection")?,
+                u_ray_basis_h: crate::stereo::ray_basis_std140(&hist.mid.proj, "previous middle projection")?,
                 u_view_proj_m: mat4_std140(&mat4::mul(&mid.proj, &mid.view)),
                 u_view_m: mat4_std140(&mid.view),
                 u_size_h: [hist.mid.width as i32, hist.mid.height as i32],

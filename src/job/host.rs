@@ -99,10 +99,10 @@ pub enum Event<'a> {
         summary: &'a DisparitySummary,
     },
     /// A rectified pair given one eye's disparity: `eye`'s map was derived from the other's
-    /// ([`crate::cyclopean::one_eye`]), known at this fraction of its pixels.
+    /// ([`crate::stereo::one_eye`]), known at this fraction of its pixels.
     DisparityDerived {
         /// The eye without a file.
-        eye: crate::cyclopean::Eye,
+        eye: crate::stereo::Eye,
         /// Fraction of its pixels the given eye's geometry reaches.
         known_fraction: f64,
     },

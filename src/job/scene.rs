@@ -6,13 +6,13 @@
 use super::{ArgError, Backend, GpuRequest, Host, JobError};
 use crate::camera::gl_projection;
 use crate::convention::Conventions;
-use crate::cyclopean::scene_frame::StereoRig;
 use crate::io;
 use crate::scene::render::{GlCamera, SceneRenderer};
-use crate::scene::{builtin, Scene};
+use crate::stereo::scene_frame::StereoRig;
 use crate::stitch::faces::{scene_faces_of, FACE_TAGS};
 use crate::stitch::{OdsRig, Side};
 use crate::view::ViewOutput;
+use crate::world::{builtin, Scene};
 use std::path::{Path, PathBuf};
 
 /// The scene options as given.

@@ -188,7 +188,7 @@ pub enum ProgramKind {
         depth_is_device: bool,
         /// Refine method: check that the surface found projects back onto the middle pixel.
         refine: bool,
-        /// Soft blend of the two eyes ([`crate::cyclopean::Blend::Soft`]).
+        /// Soft blend of the two eyes ([`crate::stereo::gather::Blend::Soft`]).
         blend_soft: bool,
     },
     /// cyclopean/forward.*: each eye's depth mesh warped into the middle camera.

@@ -7,8 +7,9 @@
 //! pushed out by a fraction of a pixel, with an exact closed test per fragment, so pixel centres
 //! on a kept edge next to a hole are kept whatever the fill rule or the row order.
 
-use super::grid::Grid;
-use crate::error::{Error, Result};
+use crate::error::Result;
+use crate::mesh::code_rows;
+use crate::mesh::Grid;
 use crate::pass::{Buffer, Device, Format, Image, ImageData, ImageId};
 
 /// Width of the texture holding kept-triangle codes for vertex pulling (the shader library's).
@@ -20,27 +21,6 @@ pub(crate) const EXPAND_PX: f32 = 1.0 / 32.0;
 /// and the interior argument (a pixel near a triangle lies in a neighbour sharing a corner) no
 /// longer holds: every triangle then takes the boundary path.
 pub(crate) const MIN_INTERIOR_SCALE: f64 = 1.0 / 64.0;
-
-/// The rows and R32UI texels of a kept-triangle code image `TRI_TEX_WIDTH` wide (None without
-/// triangles), refused beyond a device's `max_side` or a 32-bit vertex count.
-pub fn code_rows(codes: &[u32], max_side: u32) -> Result<Option<(u32, Vec<u8>)>> {
-    if codes.is_empty() {
-        return Ok(None);
-    }
-    let rows = codes.len().div_ceil(TRI_TEX_WIDTH as usize);
-    if rows > max_side as usize || codes.len().checked_mul(3).is_none_or(|v| v > i32::MAX as usize) {
-        return Err(Error::param(
-            "source size",
-            format!(
-                "{} triangles exceed the mesh path's limit; use the full-screen method",
-                codes.len()
-            ),
-        ));
-    }
-    let mut padded = codes.to_vec();
-    padded.resize(rows * TRI_TEX_WIDTH as usize, 0);
-    Ok(Some((rows as u32, bytemuck::cast_slice(&padded).to_vec())))
-}
 
 /// Kept-triangle codes as an R32UI image `TRI_TEX_WIDTH` wide, for vertex pulling.
 fn code_image(device: &Device, codes: &[u32], max_side: u32, label: &str) -> Result<Option<Image>> {

@@ -1,7 +1,8 @@
 //! refocus: one RGB image + metric depth + intrinsics -> RGB, metric depth and validity mask at
 //! other focal lengths, same pose. No hole filling: what the source did not see stays invalid.
 //!
-//! - `grid`: the 2.5D grid mesh and its break rule, shared by every path.
+//! - [`crate::mesh`]: the 2.5D grid mesh and its break rule, shared by every path (re-exported
+//!   here: the break rule is a refocus setting).
 //! - `render`: the GPU refocus, described once as pass steps and run by the GL or the Vulkan
 //!   executor: the full-screen pass, which evaluates the kept triangles analytically per pixel
 //!   (same pose only), or the mesh pass (`mesh`: the same triangles rasterised into the MRT
@@ -13,14 +14,13 @@
 //!   (the files go through the output layer, [`crate::output::write_view`]).
 
 pub mod batch;
-mod grid;
 pub mod manifest;
 pub(crate) mod mesh;
 pub mod pass;
 pub mod reference;
 mod render;
 
-pub use grid::{axis_lookup, frame_span, valid_depth, BreakRule, Grid};
+pub use crate::mesh::{axis_lookup, frame_span, valid_depth, BreakRule, Grid};
 pub use mesh::TRI_TEX_WIDTH;
 pub use pass::RefocusInput;
 pub use render::{PendingRefocus, RefocusOutput, RefocusParams, Refocuser};

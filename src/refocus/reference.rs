@@ -1,9 +1,9 @@
 //! Float64 CPU twin of the GPU refocus passes: same grid, same break rule, same triangulation,
 //! exact ray/triangle depth and exact bilinear colour. The tests hold both GPU paths to it.
 
-use super::grid::{frame_span, Grid, TRI1, TRI2};
 use super::{source_point, RefocusSource};
 use crate::camera::PinholeCamera;
+use crate::mesh::{frame_span, Grid, TRI1, TRI2};
 use crate::refocus::BreakRule;
 
 /// Unquantised reference result, rows top-down.

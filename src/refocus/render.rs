@@ -13,17 +13,15 @@
 //! outputs later, so a caller can keep several targets (and frames) in flight.
 //! [`Refocuser::render`] is the two in a row.
 
-use super::grid::{axis_lookup, Grid};
 use super::mesh::{MeshGeometry, EXPAND_PX};
 use super::{BreakRule, Method, OutputSet, RefocusSource};
 use crate::camera::{clip_from_view_opencv, PinholeCamera};
 use crate::convention::{Conventions, DepthPlanes};
 use crate::error::{Error, Result};
 use crate::io::{DepthMap, Mask, RgbImage};
-use crate::pass::{
-    mat4_std140, Device, Draw, Format, Image, ImageData, ImageId, Pending, ProgramKind, ShaderProgram, Step, Target,
-    Timing, ToDevice,
-};
+use crate::mesh::{axis_lookup, Grid};
+use crate::pass::{mat4_std140, Device, Draw, Format, Image, ImageData, ImageId, Pending, Step, Target, ToDevice};
+use crate::pass::{ProgramKind, ShaderProgram, Timing};
 use std::time::Instant;
 
 /// Output sizes whose lookup images are kept (a batch uses one; a sweep over sizes a few).

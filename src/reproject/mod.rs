@@ -9,7 +9,7 @@
 //!   accepts a walk's end only if a source segment [j, j+1] next to it covers u.
 //! - [`Method::ShiftScan`]: the exact shift gather: every segment of the row whose source
 //!   position can reach u (the frame's q range bounds it) is tested; all of them cover u.
-//! - [`Method::Gather3d`]: the cyclopean 3-D walk (`crate::cyclopean`, unchanged) with the
+//! - [`Method::Gather3d`]: the cyclopean 3-D walk ([`crate::stereo::gather`], unchanged) with the
 //!   target as the "middle camera" and the source as the only eye (the other eye has no valid
 //!   depth), run twice: from the zero-parallax (or mid-range) distance and from the nearest
 //!   depth of the frame; the nearer result that passes cyclopean's 1 px projection check wins.
@@ -45,10 +45,10 @@ use crate::camera::mat4::{self, Mat4};
 use crate::camera::stereo::{Eye, StereoParams};
 use crate::camera::{gl_projection, PinholeCamera, Pose};
 use crate::convention::{Conventions, DepthPlanes};
-use crate::cyclopean::{EyeInput, FrameDepth, MiddleCamera, StereoFrame};
 use crate::depth::{DepthEncoding, DepthKind};
 use crate::error::{Error, Result};
 use crate::io::{DepthMap, RgbImage};
+use crate::stereo::{EyeInput, FrameDepth, MiddleCamera, StereoFrame};
 
 /// The source view: colour and depth (rows top-down), what the depth holds, and the
 /// conventions it was produced under (device depth, and the GPU pass's row order).
@@ -427,12 +427,12 @@ pub fn gather3d_params(
     src: &ReprojectSource,
     geometry: &Geometry,
     steps: u32,
-) -> [crate::cyclopean::CyclopeanParams; 2] {
+) -> [crate::stereo::gather::CyclopeanParams; 2] {
     let fix = fixation_distance(src, geometry);
     let near = src.inverse_depth_range().map_or(fix, |(_, q_hi)| 1.0 / q_hi);
-    [fix, near].map(|f| crate::cyclopean::CyclopeanParams {
-        method: crate::cyclopean::Method::Refine { steps },
-        ..crate::cyclopean::CyclopeanParams::seed(f)
+    [fix, near].map(|f| crate::stereo::gather::CyclopeanParams {
+        method: crate::stereo::gather::Method::Refine { steps },
+        ..crate::stereo::gather::CyclopeanParams::seed(f)
     })
 }
 

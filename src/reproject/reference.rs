@@ -7,9 +7,9 @@ use super::{
     check, gather3d_params, one_eye_frame, Geometry, Method, ReprojectOutput, ReprojectParams, ReprojectSource,
     ShiftModel,
 };
-use crate::cyclopean::reference::cyclopean_reference;
 use crate::error::Result;
 use crate::io::{DepthMap, RgbImage};
+use crate::stereo::gather::reference::cyclopean_reference;
 
 /// Margin (texels) added to each end of the scan window, so f32 rounding of the window bounds
 /// on the GPU never drops a segment the f64 window holds.

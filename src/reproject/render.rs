@@ -8,13 +8,15 @@ use super::{
     check, gather3d_params, one_eye_frame, Geometry, Method, ReprojectOutput, ReprojectParams, ReprojectSource,
 };
 use crate::convention::RowOrder;
-use crate::cyclopean::render::CyclopeanRenderer;
-use crate::cyclopean::{CyclopeanOutputs, MiddleCamera};
 use crate::depth::DepthEncoding;
 use crate::error::{Error, Result};
 use crate::io::{DepthMap, RgbImage};
 use crate::pass::shaders::ShiftDepth;
-use crate::pass::{Device, Draw, Format, Image, ImageData, ProgramKind, ShaderProgram, Target, Timing, ToDevice};
+use crate::pass::{Device, Draw, Format, Image, ImageData, Target, ToDevice};
+use crate::pass::{ProgramKind, ShaderProgram, Timing};
+use crate::stereo::gather::render::CyclopeanRenderer;
+use crate::stereo::gather::CyclopeanOutputs;
+use crate::stereo::MiddleCamera;
 
 crate::param_block! {
     /// The shift's parameters: shaders/reproject/reproject_params.glsl, member for member.

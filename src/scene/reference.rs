@@ -2,12 +2,12 @@
 //! rays from the same camera matrices, traced through the scene in f64.
 
 use super::render::{GlCamera, SceneImage};
-use super::{pattern_color, Scene};
 use crate::camera::mat4;
 use crate::camera::rays::pixel_ndc;
 use crate::convention::DepthPlanes;
 use crate::error::Result;
 use crate::io::{DepthMap, RgbImage};
+use crate::world::{pattern_color, Scene};
 
 /// f64 twin of the shader: same rays, same rounding of colour to 8 bits.
 pub fn trace_gl_reference(scene: &Scene, cam: &GlCamera) -> Result<SceneImage> {

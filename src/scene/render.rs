@@ -2,13 +2,15 @@
 //! projection P, conventions); its f64 twin with the same ray construction is
 //! [`super::reference`]. Both give colour, view distance and window depth, rows top-down.
 
-use super::{Scene, Shape, MAX_OBJECTS};
 use crate::camera::mat4::{self, Mat4};
+use crate::camera::projection_centre;
 pub use crate::camera::rays::{pixel_ndc, ray_basis};
 use crate::convention::{Conventions, RowOrder};
 use crate::error::{Error, Result};
 use crate::io::{DepthMap, RgbImage};
-use crate::pass::{mat4_std140, Device, Draw, Format, ProgramKind, ShaderProgram, Target, Timing, ToDevice};
+use crate::pass::{mat4_std140, Device, Draw, Format, Target, ToDevice};
+use crate::pass::{ProgramKind, ShaderProgram, Timing};
+use crate::world::{Scene, Shape, MAX_OBJECTS};
 
 crate::param_block! {
     /// The ray tracer's parameters: shaders/scene/scene_params.glsl, member for member.
@@ -55,20 +57,6 @@ pub struct SceneImage {
     pub view_z: DepthMap,
     /// Window depth under the camera's conventions; the far value where the ray misses.
     pub device_depth: DepthMap,
-}
-
-/// Centre of projection of a perspective view-projection: the point whose clip x, y and w are
-/// all 0 (null vector of those three rows, by cofactors). Not inv(V)'s origin: a stereo
-/// projection with a clip-space shift (seed 004) projects from the offset eye.
-pub fn projection_centre(vp: &Mat4) -> Option<[f64; 3]> {
-    let rows = [vp[0], vp[1], vp[3]];
-    let det3 = |c: [usize; 3]| {
-        let m = |r: usize, k: usize| rows[r][c[k]];
-        m(0, 0) * (m(1, 1) * m(2, 2) - m(1, 2) * m(2, 1)) - m(0, 1) * (m(1, 0) * m(2, 2) - m(1, 2) * m(2, 0))
-            + m(0, 2) * (m(1, 0) * m(2, 1) - m(1, 1) * m(2, 0))
-    };
-    let c = [det3([1, 2, 3]), -det3([0, 2, 3]), det3([0, 1, 3]), -det3([0, 1, 2])];
-    (c[3].abs() > 1e-300 && c.iter().all(|v| v.is_finite())).then(|| [c[0] / c[3], c[1] / c[3], c[2] / c[3]])
 }
 
 impl GlCamera {
@@ -249,7 +237,7 @@ mod tests {
 
     #[test]
     fn projection_centre_of_a_posed_pinhole_is_its_position() {
-        let cam = crate::scene::demo_camera(64, 48);
+        let cam = crate::world::demo_camera(64, 48);
         let pose = Pose::yawed(0.4, [0.3, -0.2, 1.5]);
         let planes = DepthPlanes {
             near: 0.1,

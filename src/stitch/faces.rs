@@ -15,16 +15,16 @@ pub const FACE_TAGS: [&str; 6] = ["pz", "nz", "up", "down", "px", "nx"];
 pub const FACE_COLOR_EXTS: [&str; 5] = ["png", "jpg", "jpeg", "ppm", "exr"];
 /// Depth (view-space Z) file extensions tried in a face folder, in this order.
 pub const FACE_DEPTH_EXTS: [&str; 5] = ["exr", "npy", "npz", "pfm", "png"];
-use crate::scene;
+use crate::world;
 
 /// The six faces of `side`, N x N, FOV `fov_deg`, from the f64 ray tracer: colour rounded to
 /// 8 bits, view-space Z, 0 where no surface is hit.
 pub fn scene_faces(rig: &OdsRig, side: Side, n: u32, fov_deg: f64) -> Result<FaceSet> {
-    scene_faces_of(&scene::demo_scene(), rig, side, n, fov_deg)
+    scene_faces_of(&world::demo_scene(), rig, side, n, fov_deg)
 }
 
 /// [`scene_faces`] for any scene (built in or loaded).
-pub fn scene_faces_of(scene: &scene::Scene, rig: &OdsRig, side: Side, n: u32, fov_deg: f64) -> Result<FaceSet> {
+pub fn scene_faces_of(scene: &world::Scene, rig: &OdsRig, side: Side, n: u32, fov_deg: f64) -> Result<FaceSet> {
     rig.validate()?;
     if !(2..=crate::io::MAX_DIMENSION).contains(&n) {
         return Err(Error::param("face size", format!("{n} outside 2..=16384")));
@@ -38,7 +38,7 @@ pub fn scene_faces_of(scene: &scene::Scene, rig: &OdsRig, side: Side, n: u32, fo
             .iter()
             .map(|f| {
                 let pose = f.pose(rig, side);
-                s.spawn(move || scene::render_scene(scene, &cam, &pose))
+                s.spawn(move || world::render_scene(scene, &cam, &pose))
             })
             .collect();
         handles

@@ -1,6 +1,6 @@
 //! stitch: omni-directional stereo (ODS) 360 from over-wide cube faces (seed 001).
 //!
-//! # Geometry (world frame of [`crate::scene`]: OpenCV axes, x right, y down, z forward)
+//! # Geometry (world frame of [`crate::world`]: OpenCV axes, x right, y down, z forward)
 //! - Equirect pixel (u, v) of a W x H eye image looks along longitude
 //!   `lon = 2 pi (u + 0.5) / W - pi` (0 = +Z, +pi/2 = +X) and latitude
 //!   `lat = pi/2 - pi (v + 0.5) / H` (row 0 at the top, +pi/2 = up = -Y), direction

@@ -3,7 +3,7 @@
 
 use super::{equirect_angles, OdsRig, Side};
 use crate::error::{Error, Result};
-use crate::scene;
+use crate::world;
 
 /// Exact colour (0..255, unrounded; black where nothing is hit) and ray distance (0 = none) of
 /// one eye's equirect, rows top-down.
@@ -31,9 +31,9 @@ pub fn ods_truth(rig: &OdsRig, side: Side, width: u32, height: u32) -> Result<Od
         for u in 0..width {
             let (lon, lat) = equirect_angles(u, v, width, height);
             let (o, d) = rig.ray(side, lon, lat);
-            if let Some(hit) = scene::trace(o, d) {
+            if let Some(hit) = world::trace(o, d) {
                 let i = v as usize * width as usize + u as usize;
-                color[i] = scene::hit_color(&hit);
+                color[i] = world::hit_color(&hit);
                 distance[i] = hit.t;
             }
         }

@@ -7,12 +7,11 @@ use crate::options::{BackendArg, GpuArgs};
 use crate::options::{GPU, INPUTS, INTRINSICS, METHOD, OUTPUTS, TARGETS};
 use clap::{Args, ValueEnum};
 use std::path::PathBuf;
-use viewsynth::cyclopean::matcher::MatcherMethod;
-use viewsynth::cyclopean::Blend;
-use viewsynth::job::cyclopean::{
-    CyclopeanJob, CyclopeanMethod, CyclopeanOptions, CyclopeanRequest, CyclopeanSequenceJob,
-};
+use viewsynth::cyclopean::CyclopeanMethod;
+use viewsynth::job::cyclopean::{CyclopeanJob, CyclopeanOptions, CyclopeanRequest, CyclopeanSequenceJob};
 use viewsynth::job::{finite_value, ArgError};
+use viewsynth::stereo::gather::Blend;
+use viewsynth::stereo::matcher::MatcherMethod;
 
 #[derive(Clone, Copy, ValueEnum)]
 pub(crate) enum BlendArg {

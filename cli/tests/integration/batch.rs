@@ -10,21 +10,21 @@ use viewsynth::io::{self, Encoding, PngCompression};
 use viewsynth::output::FileFormats;
 use viewsynth::refocus::batch::{load_manifest, run_batch, BatchOptions, Shard};
 use viewsynth::refocus::{BreakRule, Method, OutputSet};
-use viewsynth::scene;
+use viewsynth::world;
 
 /// A scratch folder with two distinct scene frames listed `n` times in a manifest.
 fn setup(name: &str, n: usize) -> (tempfile::TempDir, PathBuf) {
     let dir = tempfile::Builder::new().prefix(name).tempdir().unwrap();
     let mut csv = String::from("rgb,depth,fx,fy,cx,cy,name\n");
     for (i, (w, h)) in [(64u32, 48u32), (80, 60)].iter().enumerate() {
-        let cam = scene::demo_camera(*w, *h);
-        let (rgb, depth) = scene::render(&cam);
+        let cam = world::demo_camera(*w, *h);
+        let (rgb, depth) = world::render(&cam);
         io::save_rgb(&dir.path().join(format!("rgb{i}.png")), &rgb).unwrap();
         io::save_depth_npy(&dir.path().join(format!("depth{i}.npy")), &depth).unwrap();
     }
     for f in 0..n {
         let i = f % 2;
-        let k = scene::demo_camera([64, 80][i], [48, 60][i]).k;
+        let k = world::demo_camera([64, 80][i], [48, 60][i]).k;
         csv += &format!("rgb{i}.png,depth{i}.npy,{},{},{},{},f{f}\n", k.fx, k.fy, k.cx, k.cy);
     }
     let manifest = dir.path().join("frames.csv");

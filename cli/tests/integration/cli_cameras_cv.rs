@@ -6,8 +6,8 @@ use crate::cli::{assert_clean_failure, bin, files_in, scratch, RUN_ERROR};
 use serde_json::{json, Value};
 use std::path::Path;
 use std::process::Output;
-use viewsynth::cyclopean::camera_file::CameraFile;
-use viewsynth::cyclopean::scene_frame::StereoRig;
+use viewsynth::stereo::camera_file::CameraFile;
+use viewsynth::stereo::scene_frame::StereoRig;
 
 fn s(p: &Path) -> &str {
     p.to_str().unwrap()

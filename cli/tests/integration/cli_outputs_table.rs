@@ -148,8 +148,8 @@ fn format_rows(base: &[String], tag: &str, extra: &[&str]) -> Vec<Row> {
 /// A W x H frame of the built-in scene (PNG colour, EXR view Z) and its intrinsics options;
 /// the colour file follows `colour_flag`.
 fn scene_frame(dir: &Path, colour_flag: &str) -> Vec<String> {
-    let cam = viewsynth::scene::demo_camera(W, H);
-    let (rgb, depth) = viewsynth::scene::render(&cam);
+    let cam = viewsynth::world::demo_camera(W, H);
+    let (rgb, depth) = viewsynth::world::render(&cam);
     let (c, d) = (dir.join("src_rgb.png"), dir.join("src_depth.exr"));
     io::save_rgb(&c, &rgb).unwrap();
     io::save_depth_exr(&d, &depth).unwrap();
@@ -183,7 +183,7 @@ fn refocus_writes_exactly_the_files_its_help_names_for_every_output_and_format()
     check("refocus", named, format_rows(&base, "s1", &["manifest.json"]), &d);
     // The batch: the same files for every frame, in <out-dir>/<name>/.
     let manifest = d.join("frames.csv");
-    let k = viewsynth::scene::demo_camera(W, H).k;
+    let k = viewsynth::world::demo_camera(W, H).k;
     std::fs::write(
         &manifest,
         format!(

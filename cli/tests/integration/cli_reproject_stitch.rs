@@ -8,10 +8,10 @@ use std::path::{Path, PathBuf};
 use std::process::Output;
 use viewsynth::camera::stereo::{Eye, StereoParams};
 use viewsynth::convention::Conventions;
-use viewsynth::cyclopean::FrameDepth;
 use viewsynth::io::{self, DepthMap};
 use viewsynth::reproject::render::Reprojector;
 use viewsynth::reproject::{Geometry, Method, ReprojectOutput, ReprojectParams};
+use viewsynth::stereo::FrameDepth;
 use viewsynth::stitch::faces::scene_faces;
 use viewsynth::stitch::render::StitchRenderer;
 use viewsynth::stitch::{Method as StitchMethod, OdsRig, Side, StitchParams};
@@ -729,10 +729,10 @@ fn reproject_with_full_eye_matrices_from_a_cameras_file() {
     // left eye through the file's matrices must give the library's 3-D gather exactly, and the
     // ray-traced right eye where it is valid.
     use viewsynth::convention::DepthPlanes;
-    use viewsynth::cyclopean::camera_file::CameraFile;
-    use viewsynth::cyclopean::MiddleCamera;
     use viewsynth::depth::DepthEncoding;
     use viewsynth::reproject::ReprojectSource;
+    use viewsynth::stereo::camera_file::CameraFile;
+    use viewsynth::stereo::MiddleCamera;
     let dir = scratch("reproject_cameras");
     let scene = dir.join("scene");
     ok(&run(&[

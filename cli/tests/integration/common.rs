@@ -95,8 +95,8 @@ pub fn real_frame(name: &str) -> RefocusSource {
 }
 
 pub fn synthetic(width: u32, height: u32) -> RefocusSource {
-    let cam = viewsynth::scene::demo_camera(width, height);
-    let (rgb, depth) = viewsynth::scene::render(&cam);
+    let cam = viewsynth::world::demo_camera(width, height);
+    let (rgb, depth) = viewsynth::world::render(&cam);
     RefocusSource::new(rgb, depth, cam.k).unwrap()
 }
 
@@ -145,8 +145,8 @@ pub fn reference(src: &RefocusSource, target: &PinholeCamera) -> ReferenceImage 
 /// (tests write variants of it).
 pub fn write_cyclopean_files(
     dir: &std::path::Path,
-    frame: &viewsynth::cyclopean::StereoFrame,
-    mid: &viewsynth::cyclopean::MiddleCamera,
+    frame: &viewsynth::stereo::StereoFrame,
+    mid: &viewsynth::stereo::MiddleCamera,
 ) -> serde_json::Value {
     for (name, eye) in [("left", &frame.left), ("right", &frame.right)] {
         io::save_rgb(&dir.join(format!("{name}.png")), &eye.color).unwrap();

@@ -12,8 +12,8 @@ const PLANES: DepthPlanes = DepthPlanes { near: 0.05, far: 50.0 };
 /// One rendering of the scene, stored as a renderer under `conv` would store it: rows in
 /// `conv.row_order`, window depth under `conv` (the far value where nothing was hit).
 fn stored(conv: Conventions) -> Side {
-    let cam = viewsynth::scene::demo_camera(96, 72);
-    let (color, z) = viewsynth::scene::render_scene(&viewsynth::scene::builtin("demo").unwrap(), &cam, &Pose::IDENTITY);
+    let cam = viewsynth::world::demo_camera(96, 72);
+    let (color, z) = viewsynth::world::render_scene(&viewsynth::world::builtin("demo").unwrap(), &cam, &Pose::IDENTITY);
     let window: Vec<f32> = z
         .data
         .iter()

@@ -12,8 +12,8 @@ const PLANES: DepthPlanes = DepthPlanes { near: 0.05, far: 100.0 };
 
 /// The built-in scene at `w` x `h`: colour (top-down) and view Z (0 where nothing was hit).
 fn render(w: u32, h: u32) -> (RgbImage, DepthMap) {
-    let cam = viewsynth::scene::demo_camera(w, h);
-    viewsynth::scene::render_scene(&viewsynth::scene::builtin("demo").unwrap(), &cam, &Pose::IDENTITY)
+    let cam = viewsynth::world::demo_camera(w, h);
+    viewsynth::world::render_scene(&viewsynth::world::builtin("demo").unwrap(), &cam, &Pose::IDENTITY)
 }
 
 fn rows(data: &[f32], w: u32, order: RowOrder) -> Vec<f32> {

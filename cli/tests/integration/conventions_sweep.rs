@@ -23,8 +23,8 @@
 
 use crate::common::gpu;
 use viewsynth::convention::Conventions;
-use viewsynth::cyclopean::FrameDepth;
 use viewsynth::pass::Device;
+use viewsynth::stereo::FrameDepth;
 use viewsynth::view::ViewOutput;
 use viewsynth_lab::passes::{PassCase, PassInputs};
 

@@ -14,14 +14,13 @@
 
 use crate::common::{cyclopean_cli, gpu, write_cyclopean_files};
 use viewsynth::convention::Conventions;
-use viewsynth::cyclopean::reference::{ambiguity, cyclopean_reference};
-use viewsynth::cyclopean::render::CyclopeanRenderer;
-use viewsynth::cyclopean::scene_frame::{scene_frame, MiddleTruth, StereoRig};
-use viewsynth::cyclopean::{
-    pass, Blend, CyclopeanInput, CyclopeanOutput, CyclopeanOutputs, CyclopeanParams, CyclopeanPass, Eye, FrameDepth,
-    Method,
-};
+use viewsynth::cyclopean::{pass, CyclopeanInput, CyclopeanPass};
 use viewsynth::metrics;
+use viewsynth::stereo::gather::reference::{ambiguity, cyclopean_reference};
+use viewsynth::stereo::gather::render::CyclopeanRenderer;
+use viewsynth::stereo::gather::{Blend, CyclopeanOutput, CyclopeanOutputs, CyclopeanParams, Method};
+use viewsynth::stereo::scene_frame::{scene_frame, MiddleTruth, StereoRig};
+use viewsynth::stereo::{Eye, FrameDepth};
 use viewsynth::view::ViewOutput;
 use viewsynth_lab::eval::image_check;
 
@@ -447,7 +446,7 @@ fn temporal_accumulation_fills_disocclusions_from_the_previous_frame() {
 
 #[test]
 fn unrequested_colour_and_depth_get_no_attachment_and_no_readback() {
-    use viewsynth::cyclopean::CyclopeanOutputs;
+    use viewsynth::stereo::gather::CyclopeanOutputs;
     let g = gpu();
     let (frame, mid, _) = scene_frame(&StereoRig::demo(64, 48), Conventions::all()[7], FrameDepth::Device);
     let params = CyclopeanParams {

@@ -6,10 +6,10 @@
 //! copies a disparity, so the GPU's maps must be the twin's bit for bit (no pixel excused).
 
 use crate::common::{data_dir, gpu};
-use viewsynth::cyclopean::densify::{densify_reference, Densifier, FILLED};
-use viewsynth::cyclopean::matcher::estimate_disparities;
 use viewsynth::io::{load_rgb, DepthMap, RgbImage};
 use viewsynth::pass::Device;
+use viewsynth::stereo::densify::{densify_reference, Densifier, FILLED};
+use viewsynth::stereo::matcher::estimate_disparities;
 
 /// Cones' left image and the matcher's left disparities (13 % unknown), cropped to keep the
 /// twin quick.

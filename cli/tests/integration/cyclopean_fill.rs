@@ -12,10 +12,11 @@
 use crate::common::{data_dir, gpu};
 use viewsynth::convention::Conventions;
 use viewsynth::cyclopean::fill::{fill_reference, Filler, FILLED};
-use viewsynth::cyclopean::scene_frame::{scene_frame, StereoRig};
 use viewsynth::cyclopean::splat::{SplatParams, SplatRenderer};
-use viewsynth::cyclopean::{CyclopeanOutput, CyclopeanOutputs, FrameDepth};
 use viewsynth::pass::Device;
+use viewsynth::stereo::gather::{CyclopeanOutput, CyclopeanOutputs};
+use viewsynth::stereo::scene_frame::{scene_frame, StereoRig};
+use viewsynth::stereo::FrameDepth;
 
 /// The built-in scene's middle view (disocclusions at every object edge) with extra holes: a
 /// deterministic scatter of single pixels and runs, so both rules (background side, one surface)

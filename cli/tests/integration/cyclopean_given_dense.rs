@@ -5,10 +5,11 @@
 
 use crate::cli::{bin, scratch};
 use crate::common::{data_dir, gpu};
-use viewsynth::cyclopean::densify::{densify_reference, Densifier, FILLED};
+use viewsynth::cyclopean::pipeline::{InputName, StereoInput, StereoKind};
 use viewsynth::io::{load_depth_with_key, load_rgb, DepthMap, RgbImage, MASK_FILLED};
-use viewsynth::job::cyclopean::{CyclopeanRequest, InputName, StereoInput, StereoKind};
+use viewsynth::job::cyclopean::CyclopeanRequest;
 use viewsynth::pass::Device;
+use viewsynth::stereo::densify::{densify_reference, Densifier, FILLED};
 
 /// A textured plane at disparity 4 (texture `t(x, y)` in the middle view's columns): the middle
 /// view is `t`, the left image `t(x - 2)`, the right `t(x + 2)`. Both maps are 4 but for a square

@@ -18,25 +18,26 @@ use viewsynth::camera::{gl_projection, Intrinsics, PinholeCamera};
 use viewsynth::convention::Conventions;
 use viewsynth::convention::DepthPlanes;
 use viewsynth::cyclopean::baseline::{forward_splat, forward_splat_offset, forward_splat_rounded, Rounding};
-use viewsynth::cyclopean::disparity_frame::{disparity_frame, median_fixation, DisparityRig};
-use viewsynth::cyclopean::reference::CyclopeanReference;
-use viewsynth::cyclopean::render::CyclopeanRenderer;
-use viewsynth::cyclopean::scene_frame::{scene_frame, StereoRig};
 use viewsynth::cyclopean::splat::{SplatParams, SplatRenderer};
 use viewsynth::cyclopean::splat_reference::{self, splat_reference};
-use viewsynth::cyclopean::{CyclopeanOutput, CyclopeanOutputs, CyclopeanParams, FrameDepth, Method, StereoFrame};
 use viewsynth::io::{self, DepthDecode, DepthMap, RgbImage};
 use viewsynth::metrics;
+use viewsynth::stereo::disparity_frame::{disparity_frame, median_fixation, DisparityRig};
+use viewsynth::stereo::gather::reference::CyclopeanReference;
+use viewsynth::stereo::gather::render::CyclopeanRenderer;
+use viewsynth::stereo::gather::{CyclopeanOutput, CyclopeanOutputs, CyclopeanParams, Method};
+use viewsynth::stereo::scene_frame::{scene_frame, StereoRig};
+use viewsynth::stereo::{FrameDepth, StereoFrame};
 use viewsynth_lab::eval::cyclopean::{estimated_cases, estimated_eyes};
 
-fn splat_gpu(frame: &StereoFrame, mid: &viewsynth::cyclopean::MiddleCamera) -> CyclopeanOutput {
+fn splat_gpu(frame: &StereoFrame, mid: &viewsynth::stereo::MiddleCamera) -> CyclopeanOutput {
     splat_on(&viewsynth::pass::Device::gl(&gpu()).unwrap(), frame, mid)
 }
 
 fn splat_on(
     device: &viewsynth::pass::Device,
     frame: &StereoFrame,
-    mid: &viewsynth::cyclopean::MiddleCamera,
+    mid: &viewsynth::stereo::MiddleCamera,
 ) -> CyclopeanOutput {
     SplatRenderer::new(device, frame, SplatParams::default(), CyclopeanOutputs::default())
         .unwrap()
@@ -45,11 +46,7 @@ fn splat_on(
         .0
 }
 
-fn gather_gpu(
-    frame: &StereoFrame,
-    mid: &viewsynth::cyclopean::MiddleCamera,
-    params: CyclopeanParams,
-) -> CyclopeanOutput {
+fn gather_gpu(frame: &StereoFrame, mid: &viewsynth::stereo::MiddleCamera, params: CyclopeanParams) -> CyclopeanOutput {
     CyclopeanRenderer::new(&gpu(), frame, params)
         .unwrap()
         .render(mid)
@@ -111,7 +108,7 @@ fn check_twin(
     device: &viewsynth::pass::Device,
     tag: &str,
     frame: &StereoFrame,
-    mid: &viewsynth::cyclopean::MiddleCamera,
+    mid: &viewsynth::stereo::MiddleCamera,
     max_ambiguous: f64,
 ) {
     let out = splat_on(device, frame, mid);
@@ -319,7 +316,7 @@ fn cones_im4_sits_off_the_halfway_view_which_costs_the_sub_pixel_default_not_the
             width: w,
             height: h,
         };
-        let shifted = viewsynth::cyclopean::MiddleCamera {
+        let shifted = viewsynth::stereo::MiddleCamera {
             proj: gl_projection(&cam, &DepthPlanes { near: 0.01, far: 1e4 }, &conv),
             ..mid
         };
@@ -665,7 +662,7 @@ fn estimated_versus_splats(scene_prefix: &str) -> [Versus; 2] {
 }
 
 /// Issue 13's "generalises": the default's settings, unchanged, on real pairs whose disparities
-/// the census matcher (`viewsynth::cyclopean::matcher`) estimated from the two images alone, the
+/// the census matcher (`viewsynth::stereo::matcher`) estimated from the two images alone, the
 /// cases and search ranges of the report's estimated rows; against both forward splats on the
 /// same disparities, on the pixels both cover, and covering at least as many pixels.
 ///
@@ -784,7 +781,7 @@ fn cli_two_images_alone_render_the_matchers_disparities() {
     let out = out_dir("cyclopean-two-images");
     let (l, r) = (dir.join("im2.png"), dir.join("im6.png"));
     let (dl, dr) =
-        viewsynth::cyclopean::matcher::estimate_disparities(&io::load_rgb(&l).unwrap(), &io::load_rgb(&r).unwrap(), 64)
+        viewsynth::stereo::matcher::estimate_disparities(&io::load_rgb(&l).unwrap(), &io::load_rgb(&r).unwrap(), 64)
             .unwrap();
     let (dl_file, dr_file) = (out.join("dl.npy"), out.join("dr.npy"));
     io::save_depth_npy(&dl_file, &dl).unwrap();
@@ -799,7 +796,7 @@ fn cli_two_images_alone_render_the_matchers_disparities() {
     // Each eye's confidence file holds the matcher's confidence stage: its twin on the twin's
     // disparities, within the stage's GPU-vs-twin bound (CONFIDENCE_BOUND, derived beside it in
     // cli/tests/integration/matcher.rs), and exactly 0 where the disparity is unknown.
-    let twin = viewsynth::cyclopean::matcher::confidence_reference(&dl, &dr).unwrap();
+    let twin = viewsynth::stereo::matcher::confidence_reference(&dl, &dr).unwrap();
     for (name, want, d) in [
         ("left_confidence.exr", &twin.0, &dl),
         ("right_confidence.exr", &twin.1, &dr),
@@ -940,7 +937,7 @@ fn cli_two_images_alone_render_the_matchers_disparities() {
 /// unknown name, it is a usage error.
 #[test]
 fn cli_two_images_alone_render_the_semi_global_matchers_disparities() {
-    use viewsynth::cyclopean::matcher::MatcherMethod;
+    use viewsynth::stereo::matcher::MatcherMethod;
     let dir = data_dir().join("tsukuba_5view_no_gt");
     let out = out_dir("cyclopean-two-images-sgm");
     let (l, r) = (dir.join("tsukuba2.png"), dir.join("tsukuba4.png"));

@@ -18,11 +18,12 @@
 use crate::common::gpu;
 use viewsynth::camera::mat4;
 use viewsynth::convention::{Conventions, RowOrder};
-use viewsynth::cyclopean::render::CyclopeanRenderer;
-use viewsynth::cyclopean::scene_frame::{scene_frame, StereoRig};
 use viewsynth::cyclopean::temporal::{carried, Accumulator, TemporalAccumulator, FROM_HISTORY};
-use viewsynth::cyclopean::{CyclopeanOutput, CyclopeanParams, FrameDepth, Method, MiddleCamera};
 use viewsynth::pass::Device;
+use viewsynth::stereo::gather::render::CyclopeanRenderer;
+use viewsynth::stereo::gather::{CyclopeanOutput, CyclopeanParams, Method};
+use viewsynth::stereo::scene_frame::{scene_frame, StereoRig};
+use viewsynth::stereo::{FrameDepth, MiddleCamera};
 use viewsynth_lab::eval::image_check::{self, Plane};
 
 /// Middle views of the scene from a head at `at` (right eye's depth emptied: holes), rendered

@@ -5,11 +5,12 @@
 use super::common::{gpu, synthetic};
 use viewsynth::camera::PinholeCamera;
 use viewsynth::convention::Conventions;
-use viewsynth::cyclopean::scene_frame::{scene_frame, StereoRig};
 use viewsynth::cyclopean::splat::{SplatParams, SplatRenderer};
-use viewsynth::cyclopean::{CyclopeanOutputs, FrameDepth};
 use viewsynth::gpu::{Attachment, Framebuffer, Gpu, IndexBuffer, LiveObjects, TextureFormat, VertexArray};
 use viewsynth::refocus::{BreakRule, Method, OutputSet, RefocusSource, Refocuser};
+use viewsynth::stereo::gather::CyclopeanOutputs;
+use viewsynth::stereo::scene_frame::{scene_frame, StereoRig};
+use viewsynth::stereo::FrameDepth;
 
 #[test]
 fn each_object_is_counted_while_it_lives() {

@@ -861,12 +861,14 @@ fn valid_non_finite(v: &viewsynth::view::ViewOutput) -> usize {
 #[test]
 fn round3_library_passes_refuse_unusable_depth_and_are_finite_where_valid() {
     use viewsynth::cyclopean::forward::ForwardWarp;
-    use viewsynth::cyclopean::scene_frame::{scene_frame, StereoRig};
     use viewsynth::cyclopean::splat::SplatParams;
-    use viewsynth::cyclopean::{self, CyclopeanInput, CyclopeanOutputs, CyclopeanParams, CyclopeanPass, FrameDepth};
+    use viewsynth::cyclopean::{self, CyclopeanInput, CyclopeanPass};
     use viewsynth::depth::clear_unusable_depth;
     use viewsynth::refocus::{self, BreakRule, Method, OutputSet, RefocusInput, RefocusSource};
     use viewsynth::reproject::{self, ReprojectInput};
+    use viewsynth::stereo::gather::{CyclopeanOutputs, CyclopeanParams};
+    use viewsynth::stereo::scene_frame::{scene_frame, StereoRig};
+    use viewsynth::stereo::FrameDepth;
     use viewsynth::stitch::{self, faces::scene_faces, OdsRig, Side, StitchInput, StitchParams};
     use viewsynth::view::ViewOutput;
 
@@ -980,7 +982,7 @@ fn round3_library_passes_refuse_unusable_depth_and_are_finite_where_valid() {
     let passes = [
         CyclopeanPass::Gather(CyclopeanParams::seed(3.0)),
         CyclopeanPass::Gather(CyclopeanParams {
-            method: cyclopean::Method::Refine { steps: 4 },
+            method: viewsynth::stereo::gather::Method::Refine { steps: 4 },
             ..CyclopeanParams::seed(3.0)
         }),
         CyclopeanPass::Splat(SplatParams::default()),
@@ -1040,7 +1042,7 @@ fn round3_library_passes_refuse_unusable_depth_and_are_finite_where_valid() {
     // Disparity frames: tiny and huge disparities and focal lengths at the bounds become holes
     // where f B / d leaves the usable range, never refused, never valid-and-NaN.
     {
-        use viewsynth::cyclopean::disparity_frame::{disparity_frame, DisparityRig};
+        use viewsynth::stereo::disparity_frame::{disparity_frame, DisparityRig};
         for focal in [1e-3, 1.0, 1e6] {
             let mut disp = DepthMap::new(W, H, vec![4.0; (W * H) as usize]).unwrap();
             for (i, z) in disp.data.iter_mut().enumerate() {

@@ -177,7 +177,7 @@ fn case(command: &str, d: &Path) -> Result<Case, &'static str> {
             let out = d.join("scene");
             std::fs::create_dir_all(&out).unwrap();
             let file = out.join("cameras.json");
-            let scene = viewsynth::scene::builtin("boxes").unwrap();
+            let scene = viewsynth::world::builtin("boxes").unwrap();
             std::fs::write(&file, serde_json::to_string(&scene).unwrap()).unwrap();
             let args = own(&[
                 "scene",

@@ -8,19 +8,20 @@ use viewsynth::camera::stereo::Eye;
 use viewsynth::camera::{gl_projection, Intrinsics, PinholeCamera, Pose};
 use viewsynth::convention::{Conventions, DepthPlanes};
 use viewsynth::cyclopean::forward::ForwardWarp;
-use viewsynth::cyclopean::render::CyclopeanRenderer;
-use viewsynth::cyclopean::scene_frame::{scene_frame, StereoRig};
-use viewsynth::cyclopean::{CyclopeanParams, FrameDepth};
 use viewsynth::depth::DepthEncoding;
 use viewsynth::io::{DepthMap, RgbImage};
 use viewsynth::refocus::{BreakRule, Method as RefocusMethod, OutputSet, RefocusSource, Refocuser};
 use viewsynth::reproject::render::Reprojector;
 use viewsynth::reproject::{Geometry, Method, ReprojectParams, ReprojectSource, ShiftModel};
-use viewsynth::scene::builtin;
 use viewsynth::scene::render::{GlCamera, SceneRenderer};
+use viewsynth::stereo::gather::render::CyclopeanRenderer;
+use viewsynth::stereo::gather::CyclopeanParams;
+use viewsynth::stereo::scene_frame::{scene_frame, StereoRig};
+use viewsynth::stereo::FrameDepth;
 use viewsynth::stitch::faces::scene_faces;
 use viewsynth::stitch::render::StitchRenderer;
 use viewsynth::stitch::{Method as StitchMethod, OdsRig, Side, StitchParams};
+use viewsynth::world::builtin;
 use viewsynth::Error;
 
 /// The one refusal: `invalid <name>: <w>x<h> exceeds this GPU's limit of <limit>`; returns the

@@ -17,10 +17,10 @@
 //! both disparity maps and their difference are written (eval::image_check).
 
 use crate::common::{data_dir, gpu, max_abs_difference};
-use viewsynth::cyclopean::matcher::sgm::Plan;
-use viewsynth::cyclopean::matcher::{confidence_reference, estimate_disparities, Matcher, MatcherMethod};
 use viewsynth::io::{load_rgb, DepthMap, RgbImage};
 use viewsynth::pass::Device;
+use viewsynth::stereo::matcher::sgm::Plan;
+use viewsynth::stereo::matcher::{confidence_reference, estimate_disparities, Matcher, MatcherMethod};
 use viewsynth_lab::eval::image_check::{ensure, Plane};
 
 /// The GPU's maps against the twin's, both eyes: the same pixels known, the same values.
@@ -246,7 +246,7 @@ fn matcher_sgm_gpu_pass_is_its_twin_on_gl() {
 /// (the census matcher's would hold W: 1001 here). It runs, on the GPU as the twin.
 #[test]
 fn matcher_sgm_search_as_wide_as_the_pair_is_bounded_work() {
-    use viewsynth::cyclopean::matcher::sgm::{FULL_SEARCH, WINDOW};
+    use viewsynth::stereo::matcher::sgm::{FULL_SEARCH, WINDOW};
     let (w, h) = (1001u32, 65u32);
     let plan = Plan::new(w, h, w - 1);
     let coarsest = plan.levels.last().unwrap();

@@ -5,17 +5,19 @@
 
 use crate::common::{gpu, synthetic};
 use viewsynth::convention::Conventions;
-use viewsynth::cyclopean::reference::cyclopean_reference;
-use viewsynth::cyclopean::render::CyclopeanRenderer;
-use viewsynth::cyclopean::scene_frame::{scene_frame, StereoRig};
 use viewsynth::cyclopean::splat::{SplatParams, SplatRenderer};
 use viewsynth::cyclopean::splat_reference::splat_reference;
-use viewsynth::cyclopean::{self, CyclopeanInput, CyclopeanOutputs, CyclopeanParams, CyclopeanPass, FrameDepth};
+use viewsynth::cyclopean::{self, CyclopeanInput, CyclopeanPass};
 use viewsynth::refocus::reference::refocus_reference;
 use viewsynth::refocus::{self, BreakRule, Method, OutputSet, RefocusInput, Refocuser};
 use viewsynth::reproject::reference::reproject_reference;
 use viewsynth::reproject::render::Reprojector;
 use viewsynth::reproject::{self, ReprojectInput, ReprojectOutputs, ReprojectParams};
+use viewsynth::stereo::gather::reference::cyclopean_reference;
+use viewsynth::stereo::gather::render::CyclopeanRenderer;
+use viewsynth::stereo::gather::{CyclopeanOutputs, CyclopeanParams};
+use viewsynth::stereo::scene_frame::{scene_frame, StereoRig};
+use viewsynth::stereo::FrameDepth;
 use viewsynth::stitch::faces::scene_faces;
 use viewsynth::stitch::reference::stitch_reference;
 use viewsynth::stitch::render::StitchRenderer;

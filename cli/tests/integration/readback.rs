@@ -7,7 +7,7 @@ use viewsynth::camera::PinholeCamera;
 use viewsynth::convention::{Conventions, RowOrder};
 use viewsynth::gpu::{Attachment, Framebuffer, ReadFormat, TextureFormat};
 use viewsynth::refocus::{BreakRule, Method, OutputSet, RefocusSource, Refocuser};
-use viewsynth::scene;
+use viewsynth::world;
 
 fn attachment(format: TextureFormat) -> Option<Attachment> {
     Some(Attachment {
@@ -71,8 +71,8 @@ fn layouts_and_row_flip_match_the_uploaded_bytes() {
 #[test]
 fn steady_state_refocus_allocates_no_readback_buffers() {
     let g = gpu();
-    let cam = scene::demo_camera(64, 48);
-    let (rgb, depth) = scene::render(&cam);
+    let cam = world::demo_camera(64, 48);
+    let (rgb, depth) = world::render(&cam);
     let src = RefocusSource::new(rgb, depth, cam.k).unwrap();
     let conv = Conventions {
         row_order: RowOrder::BottomUp,

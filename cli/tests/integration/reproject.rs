@@ -19,7 +19,6 @@ use crate::common::{data_dir, gpu};
 use viewsynth::camera::stereo::{Eye, StereoParams};
 use viewsynth::camera::{Intrinsics, PinholeCamera};
 use viewsynth::convention::Conventions;
-use viewsynth::cyclopean::{FrameDepth, MiddleCamera};
 use viewsynth::depth::DepthEncoding;
 use viewsynth::io::{DepthMap, RgbImage};
 use viewsynth::metrics;
@@ -30,6 +29,7 @@ use viewsynth::reproject::{
     pass, Geometry, Method, ReprojectInput, ReprojectOutput, ReprojectOutputs, ReprojectParams, ReprojectSource,
     ShiftModel,
 };
+use viewsynth::stereo::{FrameDepth, MiddleCamera};
 use viewsynth::view::ViewOutput;
 use viewsynth_lab::eval::image_check;
 use viewsynth_lab::eval::reproject::{methods, motorcycle_case, run_timed, scene_cases, score, teddy_case, Case};
@@ -516,9 +516,9 @@ fn full_eye_matrices_drive_the_3d_gather_like_the_rig() {
     // target view, so the same mask and depth up to f32 rounding of the other world frame.
     let g = gpu();
     let conv = Conventions::default();
-    let mut rig = viewsynth::cyclopean::scene_frame::StereoRig::demo(160, 120);
+    let mut rig = viewsynth::stereo::scene_frame::StereoRig::demo(160, 120);
     rig.ipd = 0.2;
-    let (frame, _, _) = viewsynth::cyclopean::scene_frame::scene_frame(&rig, conv, FrameDepth::Device);
+    let (frame, _, _) = viewsynth::stereo::scene_frame::scene_frame(&rig, conv, FrameDepth::Device);
     let case = &scene_cases(160, 120, 0.2, conv, FrameDepth::Device).unwrap()[0];
     let matrices = Geometry::Matrices {
         source_view: frame.left.view,

@@ -15,7 +15,7 @@ use viewsynth::convention::{Conventions, DepthPlanes};
 use viewsynth::pass::Device;
 use viewsynth::scene::reference::trace_gl_reference;
 use viewsynth::scene::render::{GlCamera, SceneImage, SceneRenderer};
-use viewsynth::scene::{builtin, Scene};
+use viewsynth::world::{builtin, Scene};
 
 fn check(tag: &str, gpu_img: &SceneImage, reference: &SceneImage) {
     let n = reference.view_z.data.len();
@@ -61,7 +61,7 @@ fn vulkan_ray_tracer_matches_f64_for_posed_pinholes() {
 
 fn posed_pinholes_against_the_twin(g: &Device) {
     eprintln!("scene twin check on {:?}", g.api());
-    let cam = viewsynth::scene::demo_camera(160, 120);
+    let cam = viewsynth::world::demo_camera(160, 120);
     let pose = Pose::yawed(0.15, [0.2, -0.1, 0.3]);
     let planes = DepthPlanes { near: 0.05, far: 50.0 };
     for scene in scenes() {
@@ -89,7 +89,7 @@ fn posed_pinholes_against_the_twin(g: &Device) {
             height: 120,
             conv: Conventions::all()[1],
         };
-        let (rgb, z) = viewsynth::scene::render_scene(&scene, &cam, &pose);
+        let (rgb, z) = viewsynth::world::render_scene(&scene, &cam, &pose);
         let gl = trace_gl_reference(&scene, &glc).unwrap();
         let same = rgb.data.iter().zip(&gl.color.data).filter(|(a, b)| a == b).count();
         assert!(

@@ -30,9 +30,10 @@ use crate::common::{cyclopean_cli, gpu, write_cyclopean_files};
 use crate::cyclopean::methods;
 use crate::vulkan_refocus::vulkan;
 use viewsynth::convention::Conventions;
-use viewsynth::cyclopean::render::CyclopeanRenderer;
-use viewsynth::cyclopean::scene_frame::{scene_frame, StereoRig};
-use viewsynth::cyclopean::{CyclopeanOutput, CyclopeanParams, FrameDepth, Method};
+use viewsynth::stereo::gather::render::CyclopeanRenderer;
+use viewsynth::stereo::gather::{CyclopeanOutput, CyclopeanParams, Method};
+use viewsynth::stereo::scene_frame::{scene_frame, StereoRig};
+use viewsynth::stereo::FrameDepth;
 use viewsynth::vulkan::VkExecutor;
 
 /// Derivation above.
@@ -146,7 +147,7 @@ fn vulkan_reads_back_only_the_requested_outputs() {
         .unwrap()
         .render(&mid)
         .unwrap();
-    let outputs = viewsynth::cyclopean::CyclopeanOutputs {
+    let outputs = viewsynth::stereo::gather::CyclopeanOutputs {
         color: false,
         depth: true,
     };

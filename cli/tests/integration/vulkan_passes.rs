@@ -23,16 +23,17 @@ use std::collections::BTreeSet;
 use std::path::Path;
 use viewsynth::convention::Conventions;
 use viewsynth::cyclopean::forward::{ForwardParams, ForwardWarp};
-use viewsynth::cyclopean::render::{CyclopeanRenderer, GatherParams};
-use viewsynth::cyclopean::scene_frame::{scene_frame, StereoRig};
 use viewsynth::cyclopean::splat::{EdgeSnapBlock, SplatBlock, SplatGatherBlock, SplatParams, SplatRenderer};
-use viewsynth::cyclopean::{CyclopeanOutputs, CyclopeanParams, FrameDepth, Method};
 use viewsynth::pass::shaders::{ShiftDepth, StitchBlend};
 use viewsynth::pass::{Device, ParamBlock, ProgramKind, ShaderProgram};
 use viewsynth::refocus::{BreakRule, RefocusParams};
 use viewsynth::reproject::render::ShiftParams;
 use viewsynth::reproject::{self, ReprojectInput};
 use viewsynth::scene::render::{GlCamera, RaytraceParams, SceneRenderer};
+use viewsynth::stereo::gather::render::{CyclopeanRenderer, GatherParams};
+use viewsynth::stereo::gather::{CyclopeanOutputs, CyclopeanParams, Method};
+use viewsynth::stereo::scene_frame::{scene_frame, StereoRig};
+use viewsynth::stereo::FrameDepth;
 use viewsynth::stitch::faces::scene_faces;
 use viewsynth::stitch::render::StitchBlock;
 use viewsynth::stitch::{self, Method as StitchMethod, OdsRig, Side, StitchInput, StitchParams};
@@ -126,7 +127,7 @@ fn layout_checks() -> Vec<LayoutCheck> {
     for stage in viewsynth::pass::shaders::MatcherStage::ALL {
         checks.push((
             ProgramKind::CyclopeanMatcher(stage),
-            check_block::<viewsynth::cyclopean::matcher::gpu::MatcherParams>,
+            check_block::<viewsynth::stereo::matcher::gpu::MatcherParams>,
         ));
     }
     checks.extend([
@@ -141,7 +142,7 @@ fn layout_checks() -> Vec<LayoutCheck> {
         (ProgramKind::RefocusColourEverywhere, check_block::<RefocusParams>),
         (
             ProgramKind::CyclopeanDensify,
-            check_block::<viewsynth::cyclopean::densify::DensifyParams>,
+            check_block::<viewsynth::stereo::densify::DensifyParams>,
         ),
     ]);
     checks
@@ -202,7 +203,7 @@ fn reproject_shift_scan_and_gather3d_agree_between_gl_and_vulkan_under_every_con
 #[test]
 fn scene_ray_tracer_agrees_between_gl_and_vulkan_under_every_convention() {
     let (gl, vk) = devices();
-    let scene = viewsynth::scene::builtin("demo").unwrap();
+    let scene = viewsynth::world::builtin("demo").unwrap();
     let rig = StereoRig::demo(120, 90);
     for conv in Conventions::all() {
         let (frame, _, _) = scene_frame(&rig, conv, FrameDepth::Device);
@@ -341,7 +342,7 @@ fn a_steady_state_frame_creates_nothing_on_either_api() {
         scene_faces(&rig, Side::Left, 32, 110.0).unwrap(),
         scene_faces(&rig, Side::Right, 32, 110.0).unwrap(),
     );
-    let scene = viewsynth::scene::builtin("demo").unwrap();
+    let scene = viewsynth::world::builtin("demo").unwrap();
     let cam = GlCamera {
         view: frame.left.view,
         proj: frame.left.proj,
@@ -360,11 +361,11 @@ fn a_steady_state_frame_creates_nothing_on_either_api() {
             viewsynth::reproject::render::Reprojector::new(d, &case.source, &case.geometry, methods()[0]).unwrap();
         let mut stitch = viewsynth::stitch::render::StitchRenderer::new(d, &left, &right).unwrap();
         let mut tracer = SceneRenderer::new(d, &scene).unwrap();
-        let mut matcher = viewsynth::cyclopean::matcher::Matcher::new(d, 64, 48, 8).unwrap();
+        let mut matcher = viewsynth::stereo::matcher::Matcher::new(d, 64, 48, 8).unwrap();
         // The first pair uploads the matcher's images; the frames below rewrite them.
         let (matched, _) = matcher.estimate(&frame.left.color, &frame.right.color).unwrap();
         // The densify pass (issue 38) on those disparities: its first eye uploads the inputs.
-        let mut densifier = viewsynth::cyclopean::densify::Densifier::new(d).unwrap();
+        let mut densifier = viewsynth::stereo::densify::Densifier::new(d).unwrap();
         drop(densifier.densify(&matched, &frame.left.color).unwrap());
         let source = crate::common::synthetic(64, 48);
         let targets = viewsynth::refocus::manifest::TargetSpec {
@@ -880,9 +881,9 @@ fn every_vulkan_pass_runs_clean_under_the_validation_layer() {
 #[test]
 fn a_write_queued_for_a_freed_image_does_not_reach_the_next_image() {
     use viewsynth::cyclopean::fill::Filler;
-    use viewsynth::cyclopean::CyclopeanOutput;
     use viewsynth::io::{DepthMap, RgbImage};
     use viewsynth::pass::{Format, ImageData};
+    use viewsynth::stereo::gather::CyclopeanOutput;
     let device = VkExecutor::device(&vulkan()).unwrap();
     let rgba = |c: [u8; 4]| [c, c].concat();
     let black = rgba([0, 0, 0, 255]);

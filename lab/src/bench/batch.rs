@@ -12,7 +12,7 @@ use viewsynth::output::FileFormats;
 use viewsynth::pass::Device;
 use viewsynth::refocus::batch::{load_manifest, run_batch, BatchFrame, BatchOptions, BatchSummary, StageTimes};
 use viewsynth::refocus::{BreakRule, Method};
-use viewsynth::{convention::Conventions, io, scene};
+use viewsynth::{convention::Conventions, io, world};
 
 /// Where the frames come from.
 #[derive(Debug, Clone)]
@@ -188,8 +188,8 @@ const CODEC_REPEATS: usize = 5;
 
 /// Write the built-in scene's frame and a manifest of `n` copies of it under `dir`.
 fn scene_manifest(dir: &Path, n: usize) -> Result<PathBuf> {
-    let cam = scene::demo_camera(640, 480);
-    let (rgb, depth) = scene::render(&cam);
+    let cam = world::demo_camera(640, 480);
+    let (rgb, depth) = world::render(&cam);
     io::save_rgb(&dir.join("rgb.png"), &rgb)?;
     io::save_depth_exr(&dir.join("depth.exr"), &depth)?;
     let k = cam.k;

@@ -16,7 +16,7 @@ use viewsynth::output::FileFormats;
 use viewsynth::pass::Device;
 use viewsynth::refocus::manifest::{self as job, TargetSpec};
 use viewsynth::refocus::{reference, BreakRule, Method, OutputSet, RefocusSource, Refocuser};
-use viewsynth::scene;
+use viewsynth::world;
 
 use crate::stats::median;
 
@@ -69,8 +69,8 @@ pub fn refocus_bench(
     let tmp = std::env::temp_dir().join(format!("viewsynth-bench-{}", std::process::id()));
     std::fs::create_dir_all(&tmp).map_err(|e| viewsynth::Error::io(&tmp, e))?;
     for &(w, h) in sizes {
-        let cam = scene::demo_camera(w, h);
-        let (rgb, depth) = scene::render(&cam);
+        let cam = world::demo_camera(w, h);
+        let (rgb, depth) = world::render(&cam);
         let src = RefocusSource::new(rgb, depth, cam.k)?;
         let rule = BreakRule::default();
         let targets = TargetSpec {
@@ -168,9 +168,9 @@ pub fn cyclopean_bench(
     repeats: usize,
     cases: &mut Vec<BenchCase>,
 ) -> Result<String> {
-    use viewsynth::cyclopean::render::CyclopeanRenderer;
-    use viewsynth::cyclopean::scene_frame::{scene_frame, StereoRig};
-    use viewsynth::cyclopean::FrameDepth;
+    use viewsynth::stereo::gather::render::CyclopeanRenderer;
+    use viewsynth::stereo::scene_frame::{scene_frame, StereoRig};
+    use viewsynth::stereo::FrameDepth;
     let rig = StereoRig::demo(width, height);
     let (frame, mid, _) = scene_frame(&rig, Conventions::default(), FrameDepth::Device);
     let mut t = format!(
@@ -210,7 +210,7 @@ pub fn cyclopean_bench(
                 device,
                 &frame,
                 viewsynth::cyclopean::splat::SplatParams::default(),
-                viewsynth::cyclopean::CyclopeanOutputs::default(),
+                viewsynth::stereo::gather::CyclopeanOutputs::default(),
             )
         },
         |r| r.render(&mid),
@@ -222,7 +222,7 @@ pub fn cyclopean_bench(
     // blocks (the 13-27 % a real pair leaves unknown, in regions as wide as a real pair's).
     let (left, right, _) = matcher::synthetic_pair(width, height)?;
     let (matched_left, matched_right) =
-        viewsynth::cyclopean::matcher::Matcher::new(device, width, height, MATCHER_BENCH_MAX_DISPARITY)?
+        viewsynth::stereo::matcher::Matcher::new(device, width, height, MATCHER_BENCH_MAX_DISPARITY)?
             .estimate(&left, &right)?;
     let unknown = |maps: [&viewsynth::io::DepthMap; 2]| {
         let n: usize = maps.iter().map(|m| m.data.iter().filter(|d| **d <= 0.0).count()).sum();
@@ -247,7 +247,7 @@ pub fn cyclopean_bench(
         let share = unknown(maps);
         let timing = setup_and_median(
             repeats,
-            || viewsynth::cyclopean::densify::Densifier::new(device),
+            || viewsynth::stereo::densify::Densifier::new(device),
             |d| {
                 d.densify(maps[0], &left)?;
                 d.densify(maps[1], &right)
@@ -263,7 +263,7 @@ pub fn cyclopean_bench(
         device,
         &frame,
         viewsynth::cyclopean::splat::SplatParams::default(),
-        viewsynth::cyclopean::CyclopeanOutputs::default(),
+        viewsynth::stereo::gather::CyclopeanOutputs::default(),
     )?
     .render(&mid)?;
     let fill = setup_and_median(
@@ -281,7 +281,7 @@ pub fn cyclopean_bench(
         device,
         &last,
         viewsynth::cyclopean::splat::SplatParams::default(),
-        viewsynth::cyclopean::CyclopeanOutputs::default(),
+        viewsynth::stereo::gather::CyclopeanOutputs::default(),
     )?
     .render(&last_mid)?;
     use viewsynth::cyclopean::temporal::{Accumulator, TemporalAccumulator, DEPTH_TOLERANCE, FILL_ONLY};
@@ -320,7 +320,7 @@ pub fn cyclopean_bench(
     for (stages, confidence) in [(", GPU pass", false), (" + confidence stage, GPU pass", true)] {
         let timing = setup_and_median(
             repeats,
-            || viewsynth::cyclopean::matcher::Matcher::new(device, width, height, max_d),
+            || viewsynth::stereo::matcher::Matcher::new(device, width, height, max_d),
             |m| match confidence {
                 false => m.estimate(&left, &right).map(drop),
                 true => m.estimate_with_confidence(&left, &right).map(drop),
@@ -334,17 +334,17 @@ pub fn cyclopean_bench(
     let on_cpu = setup_and_median(
         repeats.min(3),
         || Ok(()),
-        |_| viewsynth::cyclopean::matcher::estimate_disparities(&left, &right, max_d),
+        |_| viewsynth::stereo::matcher::estimate_disparities(&left, &right, max_d),
     )?;
     record(
         &format!("census matcher, CPU twin (1 thread, both eyes, search 0-{max_d} px)"),
         on_cpu,
     );
     // The semi-global matcher (issue 48) on the same pair and search, beside the census one.
-    let sgm = viewsynth::cyclopean::matcher::MatcherMethod::Sgm;
+    let sgm = viewsynth::stereo::matcher::MatcherMethod::Sgm;
     let timing = setup_and_median(
         repeats,
-        || viewsynth::cyclopean::matcher::Matcher::with_method(device, width, height, max_d, sgm),
+        || viewsynth::stereo::matcher::Matcher::with_method(device, width, height, max_d, sgm),
         |m| m.estimate(&left, &right).map(drop),
     )?;
     record(

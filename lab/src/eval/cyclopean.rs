@@ -1,25 +1,23 @@
 //! Cyclopean report rows: every method on the built-in scene under the depth conventions (exact
 //! ray-traced middle view), on Middlebury 2003 (real data, ground-truth disparities), on real
-//! pairs with disparities estimated by [`viewsynth::cyclopean::matcher`] and on user cases, with run times.
+//! pairs with disparities estimated by [`viewsynth::stereo::matcher`] and on user cases, with run times.
 
 use super::{score, timed};
 use crate::report::ReportRow;
 use std::path::Path;
 use viewsynth::convention::{Conventions, NdcDepthRange, RowOrder};
 use viewsynth::cyclopean::baseline::{self, BaselineView};
-use viewsynth::cyclopean::disparity_frame::{disparity_frame, DisparityRig};
 use viewsynth::cyclopean::forward::ForwardWarp;
-use viewsynth::cyclopean::render::CyclopeanRenderer;
-use viewsynth::cyclopean::scene_frame::{scene_frame, StereoRig};
 use viewsynth::cyclopean::splat::{SplatParams, SplatRenderer};
-use viewsynth::cyclopean::{
-    Blend, CyclopeanOutput, CyclopeanOutputs, CyclopeanParams, FrameDepth, Method as CyclopeanMethod, MiddleCamera,
-    StereoFrame,
-};
 use viewsynth::error::Result;
 use viewsynth::io::{self, DepthDecode, DepthMap, RgbImage};
 use viewsynth::pass::{Device, Timing};
 use viewsynth::refocus::BreakRule;
+use viewsynth::stereo::disparity_frame::{disparity_frame, DisparityRig};
+use viewsynth::stereo::gather::render::CyclopeanRenderer;
+use viewsynth::stereo::gather::{Blend, CyclopeanOutput, CyclopeanOutputs, CyclopeanParams, Method as CyclopeanMethod};
+use viewsynth::stereo::scene_frame::{scene_frame, StereoRig};
+use viewsynth::stereo::{FrameDepth, MiddleCamera, StereoFrame};
 
 /// Report name of the forward-warp method.
 pub const FORWARD_NAME: &str = "forward warp (mesh, depth-tested merge)";
@@ -372,7 +370,7 @@ pub const TSUKUBA_MAX_DISPARITY_PER_STEP: u32 = 16;
 /// 7.2 to 59.9 px.
 pub const MOTORCYCLE_MAX_DISPARITY: u32 = 64;
 
-/// A real pair scored with disparities estimated by [`viewsynth::cyclopean::matcher`] between its two
+/// A real pair scored with disparities estimated by [`viewsynth::stereo::matcher`] between its two
 /// images (no ground truth used), against a real view at `position`.
 pub struct EstimatedCase {
     /// Report scene name.
@@ -484,8 +482,7 @@ pub type Eye = (RgbImage, DepthMap);
 /// rig, on the nominal Middlebury focal length and baseline: disparities are estimated between
 /// these very images, so there is no principal-point offset (doffs 0) and only t d matters.
 pub fn estimated_eyes(case: &EstimatedCase) -> Result<(Eye, Eye, DisparityRig)> {
-    let (dl, mut dr) =
-        viewsynth::cyclopean::matcher::estimate_disparities(&case.left, &case.right, case.max_disparity)?;
+    let (dl, mut dr) = viewsynth::stereo::matcher::estimate_disparities(&case.left, &case.right, case.max_disparity)?;
     if case.left_eye_only {
         dr.data.iter_mut().for_each(|d| *d = 0.0);
     }
@@ -523,7 +520,7 @@ pub fn cyclopean_estimated_rows(
         let (l, r, rig) = estimated_eyes(case)?;
         let twin_ms = t0.elapsed().as_secs_f64() * 1e3;
         let (w, h) = (case.left.width, case.left.height);
-        let mut matcher = viewsynth::cyclopean::matcher::Matcher::new(device, w, h, case.max_disparity)?;
+        let mut matcher = viewsynth::stereo::matcher::Matcher::new(device, w, h, case.max_disparity)?;
         let ((gpu_left, _), gpu_t) = timed(repeats, || {
             let t0 = std::time::Instant::now();
             let maps = matcher.estimate(&case.left, &case.right)?;
@@ -586,15 +583,15 @@ fn describe_estimate(estimate: &DepthMap, truth: Option<&DepthMap>) -> String {
 /// `cameras.json`, `{left,right}_rgb.png`, `{left,right}_device_depth.exr` (or `_view_z.exr` when
 /// the camera file says `view-z`) and the reference middle view `middle_rgb.png`.
 pub fn cyclopean_case_rows(device: &Device, dir: &Path, repeats: usize) -> Result<Vec<ReportRow>> {
-    use viewsynth::cyclopean::camera_file::CameraFile;
-    use viewsynth::cyclopean::EyeInput;
+    use viewsynth::stereo::camera_file::CameraFile;
+    use viewsynth::stereo::EyeInput;
     let cams = CameraFile::load(&dir.join("cameras.json"))?;
     let (mid, fixation) = cams.middle_and_fixation()?;
     let suffix = match cams.depth_kind {
         FrameDepth::Device => "device_depth",
         FrameDepth::ViewZ => "view_z",
     };
-    let eye = |name: &str, cam: &viewsynth::cyclopean::camera_file::EyeCameras| -> Result<EyeInput> {
+    let eye = |name: &str, cam: &viewsynth::stereo::camera_file::EyeCameras| -> Result<EyeInput> {
         Ok(EyeInput {
             color: io::load_rgb(&dir.join(format!("{name}_rgb.png")))?,
             depth: io::load_depth(&dir.join(format!("{name}_{suffix}.exr")), &DepthDecode::default())?,

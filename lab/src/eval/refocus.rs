@@ -8,12 +8,12 @@ use viewsynth::error::Result;
 use viewsynth::pass::Device;
 use viewsynth::refocus::manifest::TargetSpec;
 use viewsynth::refocus::{BreakRule, Method as RefocusMethod, OutputSet, RefocusSource, Refocuser};
-use viewsynth::scene;
+use viewsynth::world;
 
 /// Refocus of the built-in scene against the scene ray-traced from each target camera.
 pub fn refocus_rows(device: &Device, repeats: usize) -> Result<Vec<ReportRow>> {
-    let cam = scene::demo_camera(640, 480);
-    let (rgb, depth) = scene::render(&cam);
+    let cam = world::demo_camera(640, 480);
+    let (rgb, depth) = world::render(&cam);
     let src = RefocusSource::new(rgb, depth, cam.k)?;
     let scales = [0.5, 1.0, 2.0];
     let targets = TargetSpec {
@@ -38,7 +38,7 @@ pub fn refocus_rows(device: &Device, repeats: usize) -> Result<Vec<ReportRow>> {
                 let t = o.render;
                 Ok((o, t))
             })?;
-            let (truth, truth_depth) = scene::render(target);
+            let (truth, truth_depth) = world::render(target);
             let mask: Vec<bool> = out
                 .mask
                 .as_ref()

@@ -6,8 +6,6 @@ use std::path::Path;
 use viewsynth::camera::stereo::Eye;
 use viewsynth::camera::{Intrinsics, PinholeCamera};
 use viewsynth::convention::Conventions;
-use viewsynth::cyclopean::scene_frame::{scene_frame, StereoRig};
-use viewsynth::cyclopean::FrameDepth;
 use viewsynth::depth::DepthEncoding;
 use viewsynth::error::Result;
 use viewsynth::io::{self, DepthDecode, DepthMap, RgbImage};
@@ -16,6 +14,8 @@ use viewsynth::pass::{Device, Timing};
 use viewsynth::reproject::render::Reprojector;
 use viewsynth::reproject::{Geometry, Method, ReprojectOutput, ReprojectParams, ReprojectSource, ShiftModel};
 use viewsynth::ssim;
+use viewsynth::stereo::scene_frame::{scene_frame, StereoRig};
+use viewsynth::stereo::FrameDepth;
 
 /// The methods compared.
 pub fn methods() -> Vec<ReprojectParams> {
@@ -49,7 +49,7 @@ pub fn scene_cases(width: u32, height: u32, ipd: f64, conv: Conventions, kind: F
     let mut rig = StereoRig::demo(width, height);
     rig.ipd = ipd;
     let (frame, _, mid_truth) = scene_frame(&rig, conv, kind);
-    let right = viewsynth::scene::render_posed(&rig.camera, &rig.eye_pose(1.0));
+    let right = viewsynth::world::render_posed(&rig.camera, &rig.eye_pose(1.0));
     let depth_kind = DepthEncoding::with_planes(kind.into(), rig.planes)?;
     let fx = rig.camera.k.fx;
     Ok(vec![
@@ -97,11 +97,11 @@ fn seed_case(rig: &StereoRig, conv: Conventions) -> Result<Case> {
     let separation = rig.ipd * cam.k.fx / (cam.width as f64 * convergence);
     let params = viewsynth::camera::stereo::StereoParams::new(separation, convergence)?;
     let shift = ShiftModel::seed(&params, cam.width, None, Some(Eye::Right));
-    let (color, depth) = viewsynth::scene::render_posed(&cam, &rig.head);
+    let (color, depth) = viewsynth::world::render_posed(&cam, &rig.head);
     let mut target = cam;
     target.k.cx += shift.a_px;
     let right =
-        viewsynth::scene::render_posed(&target, &viewsynth::camera::Pose::at([shift.b_px / cam.k.fx, 0.0, 0.0]));
+        viewsynth::world::render_posed(&target, &viewsynth::camera::Pose::at([shift.b_px / cam.k.fx, 0.0, 0.0]));
     Ok(Case {
         name: format!("centre -> right (seed S = {separation:.4}, c = {convergence} m)"),
         source: ReprojectSource {

@@ -22,13 +22,14 @@ use super::refocus::refused;
 use super::{test_texture, GpuPixels, RefPixels, StressOptions, StressRow, Tally, Tolerance, EPS32};
 use viewsynth::camera::Pose;
 use viewsynth::convention::{Conventions, DepthPlanes};
-use viewsynth::cyclopean::reference::cyclopean_reference;
-use viewsynth::cyclopean::render::CyclopeanRenderer;
-use viewsynth::cyclopean::scene_frame::{scene_frame, StereoRig};
-use viewsynth::cyclopean::{CyclopeanParams, FrameDepth, Method, MiddleCamera, StereoFrame};
 use viewsynth::error::Result;
 use viewsynth::io::RgbImage;
 use viewsynth::pass::Device;
+use viewsynth::stereo::gather::reference::cyclopean_reference;
+use viewsynth::stereo::gather::render::CyclopeanRenderer;
+use viewsynth::stereo::gather::{CyclopeanParams, Method};
+use viewsynth::stereo::scene_frame::{scene_frame, StereoRig};
+use viewsynth::stereo::{FrameDepth, MiddleCamera, StereoFrame};
 
 /// Eye separation of the stress rig (metres) and the fixation distance of most cases.
 const IPD: f64 = 0.2011;

@@ -103,8 +103,8 @@ pub fn rows(device: &Device, opts: StressOptions) -> Result<Vec<StressRow>> {
     let (w, h) = if opts.quick { (96, 72) } else { (320, 240) };
     let mut rows = Vec::new();
 
-    let cam = viewsynth::scene::demo_camera(w, h);
-    let (rgb, depth) = viewsynth::scene::render(&cam);
+    let cam = viewsynth::world::demo_camera(w, h);
+    let (rgb, depth) = viewsynth::world::render(&cam);
     let demo = RefocusSource::new(rgb, depth, cam.k)?;
     rows.push(sweep(
         device,

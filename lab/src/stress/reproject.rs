@@ -19,8 +19,6 @@ use crate::eval::reproject::methods;
 use viewsynth::camera::stereo::{Eye, StereoParams};
 use viewsynth::camera::{Intrinsics, PinholeCamera};
 use viewsynth::convention::{Conventions, DepthPlanes};
-use viewsynth::cyclopean::scene_frame::{scene_frame, StereoRig};
-use viewsynth::cyclopean::FrameDepth;
 use viewsynth::depth::DepthEncoding;
 use viewsynth::error::Result;
 use viewsynth::io::{DepthMap, RgbImage};
@@ -28,6 +26,8 @@ use viewsynth::pass::Device;
 use viewsynth::reproject::reference::reproject_reference;
 use viewsynth::reproject::render::Reprojector;
 use viewsynth::reproject::{Geometry, ReprojectSource, ShiftModel};
+use viewsynth::stereo::scene_frame::{scene_frame, StereoRig};
+use viewsynth::stereo::FrameDepth;
 
 const VIEW_Z_BOUND: f64 = 1e-5;
 

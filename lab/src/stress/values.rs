@@ -15,15 +15,17 @@
 use super::{GpuPixels, RefPixels, StressOptions, StressRow, Tally, Tolerance};
 use viewsynth::convention::Conventions;
 use viewsynth::cyclopean::forward::ForwardWarp;
-use viewsynth::cyclopean::scene_frame::{scene_frame, StereoRig};
 use viewsynth::cyclopean::splat::SplatParams;
-use viewsynth::cyclopean::{self, CyclopeanInput, CyclopeanOutputs, CyclopeanParams, CyclopeanPass, FrameDepth};
+use viewsynth::cyclopean::{self, CyclopeanInput, CyclopeanPass};
 use viewsynth::depth::clear_unusable_depth;
 use viewsynth::error::Result;
 use viewsynth::io::DepthMap;
 use viewsynth::pass::Device;
 use viewsynth::refocus::{self, BreakRule, Method, OutputSet, RefocusInput, RefocusSource};
 use viewsynth::reproject::{self, ReprojectInput};
+use viewsynth::stereo::gather::{CyclopeanOutputs, CyclopeanParams};
+use viewsynth::stereo::scene_frame::{scene_frame, StereoRig};
+use viewsynth::stereo::FrameDepth;
 use viewsynth::stitch::{self, faces::scene_faces, OdsRig, Side, StitchInput, StitchParams};
 use viewsynth::view::ViewOutput;
 
@@ -189,8 +191,8 @@ fn values<T: Copy>(all: &[T], quick: bool) -> Vec<T> {
 }
 
 fn refocus_rows(device: &Device, opts: StressOptions) -> Result<Vec<StressRow>> {
-    let cam = viewsynth::scene::demo_camera(32, 24);
-    let (rgb, depth) = viewsynth::scene::render(&cam);
+    let cam = viewsynth::world::demo_camera(32, 24);
+    let (rgb, depth) = viewsynth::world::render(&cam);
     let conv = Conventions::default();
     let mut depth_sweep = Sweep::default();
     let mut focal_sweep = Sweep::default();
@@ -268,7 +270,7 @@ fn refocus_rows(device: &Device, opts: StressOptions) -> Result<Vec<StressRow>> 
 /// A cyclopean pass as the table names it.
 fn pass_label(pass: &CyclopeanPass) -> &'static str {
     match pass {
-        CyclopeanPass::Gather(p) if p.method == cyclopean::Method::Seed => "seed",
+        CyclopeanPass::Gather(p) if p.method == viewsynth::stereo::gather::Method::Seed => "seed",
         CyclopeanPass::Gather(_) => "refine",
         CyclopeanPass::Splat(_) => "splat-gather",
     }
@@ -282,7 +284,7 @@ fn cyclopean_rows(device: &Device, opts: StressOptions) -> Result<Vec<StressRow>
         let passes = [
             CyclopeanPass::Gather(CyclopeanParams::seed(3.0)),
             CyclopeanPass::Gather(CyclopeanParams {
-                method: cyclopean::Method::Refine { steps: 4 },
+                method: viewsynth::stereo::gather::Method::Refine { steps: 4 },
                 ..CyclopeanParams::seed(3.0)
             }),
             CyclopeanPass::Splat(SplatParams::default()),

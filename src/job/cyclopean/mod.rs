@@ -5,23 +5,19 @@
 
 use super::{ArgError, Backend, Event, GpuRequest, Host, JobError};
 use crate::convention::{Conventions, DepthPlanes};
-use crate::cyclopean::camera_file::CameraFile;
-use crate::cyclopean::one_eye::other_eye_disparity;
-use crate::cyclopean::{Eye, EyeInput, FrameDepth};
+use crate::cyclopean::pipeline::{CyclopeanPlan, Framed, InputName, Reused, StereoInput, StereoKind, Synthesised};
 use crate::depth::DepthEncoding;
 use crate::io::{self, DepthDecode, DepthMap, DepthSummary, RgbImage};
 use crate::pass::Device;
-use serde::Serialize;
+use crate::stereo::camera_file::CameraFile;
+use crate::stereo::one_eye::other_eye_disparity;
+use crate::stereo::{Eye, EyeInput, FrameDepth};
 use std::path::{Path, PathBuf};
 
 mod request;
-mod reuse;
 mod sequence;
 
-pub use request::{
-    CyclopeanPlan, CyclopeanRequest, Framed, InputName, StereoGiven, StereoInput, StereoKind, Synthesised,
-};
-pub use reuse::Reused;
+pub use request::{CyclopeanRequest, StereoGiven};
 pub use sequence::{load_sequence, CyclopeanSequenceJob, SequenceFrame, MAX_SEQUENCE_FRAMES};
 
 /// The files of each eye's matcher confidence (`--confidence`), left then right.
@@ -38,34 +34,6 @@ pub(crate) fn owned_name(name: &str) -> bool {
 /// [`io::Replaces`]), never a file merely named as this command names its outputs.
 pub(crate) fn replaced() -> io::Replaces {
     io::Replaces::recorded("cyclopean")
-}
-
-/// How the middle view is synthesised.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, serde::Deserialize)]
-#[serde(rename_all = "kebab-case")]
-pub enum CyclopeanMethod {
-    /// Splat each eye's surfaces, refine each pixel on the surface it sees, merge the eyes.
-    SplatGather,
-    /// One step per eye: the middle ray's point at the fixation distance projected into the
-    /// eye, the eye's depth read where it lands taken as the surface (exact only near the
-    /// fixation distance; no projection check), the eyes merged by `--blend`.
-    Seed,
-    /// The seed's step, `--refine-steps` refinement steps and a projection check.
-    Refine,
-    /// Each eye's depth mesh rendered into the view, the nearest surface wins.
-    Forward,
-}
-
-impl CyclopeanMethod {
-    /// The name `--method` takes.
-    pub fn name(self) -> &'static str {
-        match self {
-            CyclopeanMethod::SplatGather => "splat-gather",
-            CyclopeanMethod::Seed => "seed",
-            CyclopeanMethod::Refine => "refine",
-            CyclopeanMethod::Forward => "forward",
-        }
-    }
 }
 
 /// The cyclopean options as given: the files, how to decode them, and the request.
@@ -107,7 +75,7 @@ pub struct CyclopeanJob {
     left_rgb: PathBuf,
     right_rgb: PathBuf,
     /// Left and right disparity or depth files (none: two images alone). Disparities may give
-    /// one eye only: the other's is derived ([`crate::cyclopean::one_eye`]).
+    /// one eye only: the other's is derived ([`crate::stereo::one_eye`]).
     maps: Option<(Option<PathBuf>, Option<PathBuf>)>,
     cameras: Option<PathBuf>,
     decode: DepthDecode,
@@ -461,8 +429,10 @@ pub(crate) fn check_scale(option: &'static str, value: Option<f64>) -> Result<()
 #[cfg(test)]
 mod tests {
     use super::request::dominant;
-    use super::{ArgError, CyclopeanJob, CyclopeanMethod, CyclopeanOptions, CyclopeanRequest};
-    use crate::cyclopean::{Blend, Eye};
+    use super::{ArgError, CyclopeanJob, CyclopeanOptions, CyclopeanRequest};
+    use crate::cyclopean::CyclopeanMethod;
+    use crate::stereo::gather::Blend;
+    use crate::stereo::Eye;
 
     fn disparity_options(request: CyclopeanRequest) -> CyclopeanOptions {
         CyclopeanOptions {

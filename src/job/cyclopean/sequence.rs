@@ -16,7 +16,8 @@
 //! most [`MAX_SEQUENCE_FRAMES`] frames; each frame's images are decoded when it is rendered,
 //! written to the set's staging folder and dropped.
 
-use super::{CyclopeanJob, CyclopeanOptions, CyclopeanReport, Reused};
+use super::{CyclopeanJob, CyclopeanOptions, CyclopeanReport};
+use crate::cyclopean::pipeline::Reused;
 use crate::error::{Error, Result};
 use crate::io;
 use crate::job::{ArgError, Event, Host, JobError};

@@ -5,14 +5,15 @@
 //! its renderers and drops them.
 
 use crate::convention::Conventions;
-use crate::cyclopean::densify::Densifier;
 use crate::cyclopean::fill::Filler;
-use crate::cyclopean::matcher::{Matcher, MatcherMethod};
 use crate::cyclopean::splat::{SplatParams, SplatRenderer};
 use crate::cyclopean::temporal::{Accumulator, DEPTH_TOLERANCE, FILL_ONLY};
-use crate::cyclopean::{CyclopeanOutputs, StereoFrame};
 use crate::error::Result;
 use crate::pass::Device;
+use crate::stereo::densify::Densifier;
+use crate::stereo::gather::CyclopeanOutputs;
+use crate::stereo::matcher::{Matcher, MatcherMethod};
+use crate::stereo::StereoFrame;
 
 /// A sequence's renderers, made at its first frame and reused (see the module notes).
 #[derive(Default)]

@@ -1,16 +1,16 @@
 //! The semi-global matcher's CPU twin: the rule of [`super`], plainly, one level at a time,
 //! one path direction at a time over whole cost volumes. The GPU stages
-//! ([`super::gpu`], run by [`crate::cyclopean::matcher::Matcher`]) reproduce it bit for bit.
+//! ([`super::gpu`], run by [`crate::stereo::matcher::Matcher`]) reproduce it bit for bit.
 
 use super::{p2_across, window_start, Level, Plan, COST_OUTSIDE, COST_RADIUS, DIRECTIONS, P1};
-use crate::cyclopean::matcher::reference::{census, grey, left_right_check, median_of_known, subpixel, NO_COST};
-use crate::cyclopean::matcher::{check_pair, check_range};
 use crate::error::Result;
 use crate::io::{DepthMap, RgbImage};
+use crate::stereo::matcher::reference::{census, grey, left_right_check, median_of_known, subpixel, NO_COST};
+use crate::stereo::matcher::{check_pair, check_range};
 
 /// Disparities of both eyes of a rectified pair by semi-global matching over
 /// 0..=`max_disparity` px (0 = unknown, as the census matcher's
-/// [`estimate_disparities`](crate::cyclopean::matcher::estimate_disparities)). Fails as that
+/// [`estimate_disparities`](crate::stereo::matcher::estimate_disparities)). Fails as that
 /// does on images of different sizes and on the range.
 pub fn estimate_disparities_sgm(left: &RgbImage, right: &RgbImage, max_disparity: u32) -> Result<(DepthMap, DepthMap)> {
     check_pair(left, right)?;
@@ -267,7 +267,7 @@ fn guides(wins: &[Win], start: &[u32], window: u32) -> Vec<u32> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::cyclopean::matcher::reference::tests::{image, texture};
+    use crate::stereo::matcher::reference::tests::{image, texture};
 
     /// A textured wall at disparity 6 with a flat grey band across it, textured only at its
     /// ends: the census matcher leaves the band's middle unknown (no trusted minimum), the
@@ -294,7 +294,7 @@ mod tests {
             }
             (right_d, n)
         };
-        let (census_l, _) = crate::cyclopean::matcher::estimate_disparities(&left, &right, 16).unwrap();
+        let (census_l, _) = crate::stereo::matcher::estimate_disparities(&left, &right, 16).unwrap();
         let (sgm_l, sgm_r) = estimate_disparities_sgm(&left, &right, 16).unwrap();
         let (c, n) = inside(&census_l);
         let (s, _) = inside(&sgm_l);

@@ -234,7 +234,7 @@ mod tests {
     use super::*;
     use crate::camera::{mat4, Pose};
     use crate::convention::RowOrder;
-    use crate::cyclopean::camera_file::CameraFile;
+    use crate::stereo::camera_file::CameraFile;
     use serde_json::{json, Value};
 
     const K: [[f64; 3]; 3] = [[525.0, 0.0, 319.5], [0.0, 520.0, 239.25], [0.0, 0.0, 1.0]];

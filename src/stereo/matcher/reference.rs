@@ -280,7 +280,7 @@ pub(super) mod tests {
     const EDGE: usize = CENSUS_HALF_W + BOX_RADIUS;
 
     /// Random colours, one a pixel (also the semi-global twin's tests' texture).
-    pub(in crate::cyclopean::matcher) fn texture(w: usize, h: usize, seed: u64) -> Vec<[u8; 3]> {
+    pub(in crate::stereo::matcher) fn texture(w: usize, h: usize, seed: u64) -> Vec<[u8; 3]> {
         let mut rng = Rng(seed);
         (0..w * h)
             .map(|_| {
@@ -291,11 +291,7 @@ pub(super) mod tests {
     }
 
     /// A `w` x `h` image of `pixel(x, y)`.
-    pub(in crate::cyclopean::matcher) fn image(
-        w: usize,
-        h: usize,
-        pixel: impl Fn(usize, usize) -> [u8; 3],
-    ) -> RgbImage {
+    pub(in crate::stereo::matcher) fn image(w: usize, h: usize, pixel: impl Fn(usize, usize) -> [u8; 3]) -> RgbImage {
         let pixel = &pixel;
         let data = (0..h)
             .flat_map(|y| (0..w).flat_map(move |x| pixel(x, y)))

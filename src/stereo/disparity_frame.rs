@@ -7,7 +7,7 @@
 //! shift is exactly `t d`, whatever f, B and doffs, and only the metric depth depends on them.
 //!
 //! With `offset` the stored values are d + offset (the signed matcher's maps, see
-//! [`crate::cyclopean::matcher::range`]): 0 stays unknown, the image shift is the stored value
+//! [`crate::stereo::matcher::range`]): 0 stays unknown, the image shift is the stored value
 //! minus the offset and the depth f B / (stored - offset + doffs).
 
 use super::scene_frame::StereoRig;

@@ -6,7 +6,7 @@ use crate::camera::{gl_projection, PinholeCamera, Pose};
 use crate::convention::{Conventions, DepthPlanes};
 use crate::depth::DepthEncoding;
 use crate::io::{DepthMap, RgbImage};
-use crate::scene;
+use crate::world;
 
 /// A parallel stereo rig: both eyes share the head's orientation, offset by ∓ipd/2 along its x.
 #[derive(Debug, Clone, Copy)]
@@ -25,7 +25,7 @@ impl StereoRig {
     /// 64 mm IPD at the demo camera's pose, near 0.05 m, far 100 m.
     pub fn demo(width: u32, height: u32) -> Self {
         StereoRig {
-            camera: scene::demo_camera(width, height),
+            camera: world::demo_camera(width, height),
             ipd: 0.064,
             head: Pose::IDENTITY,
             planes: DepthPlanes { near: 0.05, far: 100.0 },
@@ -57,7 +57,7 @@ pub struct MiddleTruth {
 }
 
 fn eye_input(rig: &StereoRig, pose: &Pose, conv: &Conventions, kind: FrameDepth) -> EyeInput {
-    let (color, z) = scene::render_posed(&rig.camera, pose);
+    let (color, z) = world::render_posed(&rig.camera, pose);
     let depth = match kind {
         FrameDepth::ViewZ => z,
         FrameDepth::Device => {
@@ -102,6 +102,6 @@ pub fn scene_frame(rig: &StereoRig, conv: Conventions, kind: FrameDepth) -> (Ste
         width: rig.camera.width,
         height: rig.camera.height,
     };
-    let (color, depth) = scene::render_posed(&rig.camera, &rig.head);
+    let (color, depth) = world::render_posed(&rig.camera, &rig.head);
     (frame, mid, MiddleTruth { color, depth })
 }

@@ -44,7 +44,7 @@
 //! [`confidence`]: per pixel, how far to trust each eye's disparity (the eyes' agreement and the
 //! local spread), a further stage ([`Matcher::estimate_with_confidence`]) with its twin.
 //!
-//! Conventions as [`crate::cyclopean::disparity_frame`]: the left disparity maps x_left to
+//! Conventions as [`crate::stereo::disparity_frame`]: the left disparity maps x_left to
 //! x_right = x_left - d, the right one x_right to x_left = x_right + d; 0 = unknown. Images and
 //! disparities have top-down rows.
 

@@ -2,14 +2,15 @@
 //! texel choices. Images are handled in memory order (row 0 = framebuffer row 0 under the
 //! frame's row order) exactly as the GPU sees its textures, and converted at the end.
 
-use super::ambiguity::{distance_bound, position_bound, row_condition, Reach, EPS32};
-use super::{Blend, CyclopeanOutput, CyclopeanParams, EyeInput, FrameDepth, MiddleCamera, StereoFrame};
 use crate::camera::mat4::{self, Mat4};
 use crate::camera::rays::{pixel_ndc, ray_basis, view_ray};
 use crate::convention::{Conventions, RowOrder};
 use crate::depth::{is_background, ndc_z_of_window_depth};
 use crate::error::Result;
 use crate::io::{DepthMap, RgbImage};
+use crate::stereo::gather::ambiguity::{distance_bound, position_bound, row_condition, Reach, EPS32};
+use crate::stereo::gather::{Blend, CyclopeanOutput, CyclopeanParams};
+use crate::stereo::{EyeInput, FrameDepth, MiddleCamera, StereoFrame};
 
 /// An eye prepared for sampling: rows in memory order, inverse matrices.
 struct Eye64<'a> {
@@ -256,7 +257,7 @@ impl Ctx<'_> {
                 return invalid;
             }
         }
-        if let super::Method::Refine { .. } = self.params.method {
+        if let crate::stereo::gather::Method::Refine { .. } = self.params.method {
             // The surface sample found (at its texel centre, where the eye really measured it;
             // reconstructing at uv would put it on the middle ray by construction) must project
             // back onto this middle pixel.
@@ -286,8 +287,8 @@ impl Ctx<'_> {
             }
         }
         let edge_aware = match self.params.method {
-            super::Method::Seed => None,
-            super::Method::Refine { .. } => {
+            crate::stereo::gather::Method::Seed => None,
+            crate::stereo::gather::Method::Refine { .. } => {
                 let z_eye = -mat4::transform_point(&eye.input.view, world)[2];
                 Some((z_eye, self.params.z_threshold, self.frame.depth_kind, &self.frame.conv))
             }
@@ -341,7 +342,7 @@ pub struct CyclopeanReference {
     pub sources: Vec<u8>,
 }
 
-/// The f64 twin of [`CyclopeanRenderer`](super::render::CyclopeanRenderer): the middle view of `frame` through `mid` under `params`, rows top-down.
+/// The f64 twin of [`CyclopeanRenderer`](crate::stereo::gather::render::CyclopeanRenderer): the middle view of `frame` through `mid` under `params`, rows top-down.
 pub fn cyclopean_reference(
     frame: &StereoFrame,
     mid: &MiddleCamera,

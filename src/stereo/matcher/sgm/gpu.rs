@@ -1,16 +1,16 @@
 //! The semi-global matcher's GPU stages (shaders/cyclopean/matcher_sgm_*.comp), run by
-//! [`Matcher`](crate::cyclopean::matcher::Matcher) made with
-//! [`MatcherMethod::Sgm`](crate::cyclopean::matcher::MatcherMethod::Sgm) between its census
+//! [`Matcher`](crate::stereo::matcher::Matcher) made with
+//! [`MatcherMethod::Sgm`](crate::stereo::matcher::MatcherMethod::Sgm) between its census
 //! stage and its sub-pixel stage: the coarser levels' grey levels and census codes, then per
 //! level from the coarsest the cost volume, the 8 path directions and the winners (guides for
 //! the next level, the census matcher's winner words at the pair's own level). Integers
 //! throughout, so the disparities are [`super::reference`]'s bit for bit.
 
 use super::{Plan, DIRECTIONS};
-use crate::cyclopean::matcher::params::MatcherParams;
 use crate::error::{Error, Result};
 use crate::pass::shaders::MatcherStage;
 use crate::pass::{Buffer, BufferId, Device, Groups};
+use crate::stereo::matcher::params::MatcherParams;
 
 /// Words one cost or sum buffer may hold (128 MiB, llvmpipe's storage-block limit).
 const MAX_BUFFER_WORDS: usize = 1 << 25;

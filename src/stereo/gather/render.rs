@@ -2,15 +2,13 @@
 //! middle depth and source bits, read back top-down; described once ([`crate::pass`]) and run
 //! by the GL or the Vulkan executor.
 
-use super::{
-    Blend, CyclopeanOutput, CyclopeanOutputs, CyclopeanParams, EyeInput, FrameDepth, Method, MiddleCamera, StereoFrame,
-};
 use crate::camera::mat4::{self, Mat4};
 use crate::convention::RowOrder;
 use crate::error::{Error, Result};
-use crate::pass::{
-    mat4_std140, Device, Draw, Format, Image, ImageData, ProgramKind, ShaderProgram, Target, Timing, ToDevice,
-};
+use crate::pass::{mat4_std140, Device, Draw, Format, Image, ImageData, Target, ToDevice};
+use crate::pass::{ProgramKind, ShaderProgram, Timing};
+use crate::stereo::gather::{Blend, CyclopeanOutput, CyclopeanOutputs, CyclopeanParams, Method};
+use crate::stereo::{EyeInput, FrameDepth, MiddleCamera, StereoFrame};
 
 crate::param_block! {
     /// The gather's parameters: shaders/cyclopean/gather_params.glsl, member for member.
@@ -117,7 +115,7 @@ impl CyclopeanRenderer {
                 .map(|m| mat4_std140(&m))
                 .ok_or_else(|| Error::param(what.to_string(), "singular"))
         };
-        let rays = super::ray_basis_std140;
+        let rays = crate::stereo::ray_basis_std140;
         let (l, r) = (&self.left, &self.right);
         Ok(GatherParams {
             u_view_proj_l: mat4_std140(&mat4::mul(&l.proj, &l.view)),

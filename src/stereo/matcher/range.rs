@@ -15,7 +15,7 @@
 //!   at the stored disparity d + o >= 0 (the range's lowest end, like 0 before, reads as
 //!   unknown). The maps are cropped back to the input's columns, their
 //!   values kept as d + o (0 still unknown), and [`SignedSearch::offset`] goes into the rig's
-//!   `offset` (see [`crate::cyclopean::disparity_frame::DisparityRig`]). Nothing is lost at the
+//!   `offset` (see [`crate::stereo::disparity_frame::DisparityRig`]). Nothing is lost at the
 //!   borders: every column of both images is matched as in an unshifted pair.
 //!   A range whose minimum is at least 0 runs as before, 0..=max, bit for bit the unsigned
 //!   matcher's maps.
