@@ -2,14 +2,14 @@
 //! it lives, and a second identical frame (refocus, cyclopean) leaves the counts where the first
 //! left them: no GL object leaks per frame. Exact oracles: the objects this test makes.
 
-use super::common::{gpu, synthetic};
-use viewsynth::camera::PinholeCamera;
-use viewsynth::convention::Conventions;
-use viewsynth::cyclopean::scene_frame::{scene_frame, StereoRig};
-use viewsynth::cyclopean::splat::{SplatParams, SplatRenderer};
-use viewsynth::cyclopean::{CyclopeanOutputs, FrameDepth};
-use viewsynth::gpu::{Attachment, Framebuffer, Gpu, IndexBuffer, LiveObjects, TextureFormat, VertexArray};
-use viewsynth::refocus::{BreakRule, Method, OutputSet, RefocusSource, Refocuser};
+use super::{gpu, synthetic};
+use crate::camera::PinholeCamera;
+use crate::convention::Conventions;
+use crate::cyclopean::scene_frame::{scene_frame, StereoRig};
+use crate::cyclopean::splat::{SplatParams, SplatRenderer};
+use crate::cyclopean::{CyclopeanOutputs, FrameDepth};
+use crate::gpu::{Attachment, Framebuffer, Gpu, IndexBuffer, LiveObjects, TextureFormat, VertexArray};
+use crate::refocus::{BreakRule, Method, OutputSet, RefocusSource, Refocuser};
 
 #[test]
 fn each_object_is_counted_while_it_lives() {
@@ -35,7 +35,7 @@ fn each_object_is_counted_while_it_lives() {
     assert_eq!(live.total(), before.total() + 6);
     // A queued read holds a fence (and a pooled pixel-pack buffer) until finished.
     let pending = fb
-        .read_async(0, viewsynth::gpu::ReadFormat::RGB8, false)
+        .read_async(0, crate::gpu::ReadFormat::RGB8, false)
         .unwrap()
         .unwrap();
     assert_eq!(g.live_objects().syncs, before.syncs + 1);
@@ -80,7 +80,7 @@ fn a_second_identical_refocus_frame_allocates_no_gl_objects() {
     let targets: Vec<PinholeCamera> = [0.5, 1.0, 2.0]
         .iter()
         .map(|&s| PinholeCamera {
-            k: viewsynth::camera::Intrinsics {
+            k: crate::camera::Intrinsics {
                 fx: cam.k.fx * s,
                 fy: cam.k.fy * s,
                 ..cam.k
@@ -178,7 +178,7 @@ fn a_sequence_frame_rewrites_the_splat_renderer_in_place() {
     assert!(err.contains("conventions"), "{err}");
     // A frame the device cannot hold fails set_frame; the renderer then refuses to render
     // (an error, not a panic, nor the last frame's eyes) until it is given a frame again.
-    let side = viewsynth::pass::Device::gl(&g).unwrap().max_image_side() + 1;
+    let side = crate::pass::Device::gl(&g).unwrap().max_image_side() + 1;
     let (huge, _, _) = scene_frame(&StereoRig::demo(side, 1), conv, FrameDepth::Device);
     assert!(r.set_frame(&huge).is_err());
     let Err(err) = r.render(&mid_b) else {
@@ -194,7 +194,7 @@ fn a_sequence_frame_rewrites_the_splat_renderer_in_place() {
 /// refused upload leaves the slot empty, so the next call uploads anew.
 #[test]
 fn put_image_rewrites_in_place_and_replaces_on_a_new_shape() {
-    use viewsynth::pass::{Device, Format, ImageData};
+    use crate::pass::{Device, Format, ImageData};
     let g = gpu();
     let d = Device::gl(&g).unwrap();
     let data = |width, height, format, bytes| ImageData {

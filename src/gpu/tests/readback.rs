@@ -2,12 +2,12 @@
 //! flip, targets in flight, and no GL allocation in the steady state. Exact oracles: the bytes
 //! uploaded are the bytes expected.
 
-use super::common::gpu;
-use viewsynth::camera::PinholeCamera;
-use viewsynth::convention::{Conventions, RowOrder};
-use viewsynth::gpu::{Attachment, Framebuffer, ReadFormat, TextureFormat};
-use viewsynth::refocus::{BreakRule, Method, OutputSet, RefocusSource, Refocuser};
-use viewsynth::scene;
+use super::gpu;
+use crate::camera::PinholeCamera;
+use crate::convention::{Conventions, RowOrder};
+use crate::gpu::{Attachment, Framebuffer, ReadFormat, TextureFormat};
+use crate::refocus::{BreakRule, Method, OutputSet, RefocusSource, Refocuser};
+use crate::scene;
 
 fn attachment(format: TextureFormat) -> Option<Attachment> {
     Some(Attachment {
@@ -90,7 +90,7 @@ fn steady_state_refocus_allocates_no_readback_buffers() {
     let targets: Vec<PinholeCamera> = [0.5, 1.0, 2.0]
         .iter()
         .map(|&s| PinholeCamera {
-            k: viewsynth::camera::Intrinsics {
+            k: crate::camera::Intrinsics {
                 fx: cam.k.fx * s,
                 fy: cam.k.fy * s,
                 ..cam.k

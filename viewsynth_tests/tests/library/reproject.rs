@@ -15,7 +15,7 @@
 //! - colour: the same t error times at most 255 levels/px is < 0.05 level: more than one level
 //!   off is allowed only where a rounding tie flips (0.1 % of pixels).
 
-use crate::common::{data_dir, gpu};
+use viewsynth_tests::{data_dir, gpu};
 use viewsynth::camera::stereo::{Eye, StereoParams};
 use viewsynth::camera::{Intrinsics, PinholeCamera};
 use viewsynth::convention::Conventions;
@@ -118,7 +118,7 @@ fn gpu_matches_the_f64_reference_under_every_convention_and_depth_kind() {
 #[cfg(feature = "vulkan")]
 fn vulkan_matches_the_f64_reference_under_every_convention_and_depth_kind() {
     twin_under_every_convention_and_depth_kind(
-        &viewsynth::vulkan::VkExecutor::device(&crate::vulkan_refocus::vulkan()).unwrap(),
+        &viewsynth::vulkan::VkExecutor::device(&viewsynth_tests::vulkan()).unwrap(),
     );
 }
 

@@ -7,7 +7,7 @@
 //! within 1 level, view distance within 2e-5 relative (f32 ray parameter through a 4x4 inverse)
 //! and window depth within 2e-6 (f32 clip z / w near 1).
 
-use crate::common::gpu;
+use viewsynth_tests::gpu;
 use viewsynth::camera::mat4::Mat4;
 use viewsynth::camera::stereo::{stereo_projection_gl, Eye, Frustum, StereoParams};
 use viewsynth::camera::{gl_projection, Pose};
@@ -55,7 +55,7 @@ fn gpu_ray_tracer_matches_f64_for_posed_pinholes() {
 #[test]
 #[cfg(feature = "vulkan")]
 fn vulkan_ray_tracer_matches_f64_for_posed_pinholes() {
-    posed_pinholes_against_the_twin(&viewsynth::vulkan::VkExecutor::device(&crate::vulkan_refocus::vulkan()).unwrap());
+    posed_pinholes_against_the_twin(&viewsynth::vulkan::VkExecutor::device(&viewsynth_tests::vulkan()).unwrap());
 }
 
 fn posed_pinholes_against_the_twin(g: &Device) {

@@ -19,7 +19,7 @@
 //! = 1e-5. A distance past it, or on one side only, is a discrete choice taken the other way
 //! (another texel, the other face): counted with the colour's 0.5 %.
 
-use crate::common::gpu;
+use viewsynth_tests::gpu;
 use viewsynth::convention::Conventions;
 use viewsynth::io::OutputSet;
 use viewsynth::pass::Device;
@@ -246,7 +246,7 @@ fn gpu_matches_the_f64_reference_for_every_method() {
 #[test]
 #[cfg(feature = "vulkan")]
 fn vulkan_matches_the_f64_reference_for_every_method() {
-    twin_for_every_method(&viewsynth::vulkan::VkExecutor::device(&crate::vulkan_refocus::vulkan()).unwrap());
+    twin_for_every_method(&viewsynth::vulkan::VkExecutor::device(&viewsynth_tests::vulkan()).unwrap());
 }
 
 fn twin_for_every_method(g: &Device) {

@@ -16,7 +16,7 @@
 //! rounded sum. So validity must agree everywhere and |d_gpu - d_twin| must be 0; on failure
 //! both disparity maps and their difference are written (eval::image_check).
 
-use crate::common::{data_dir, gpu, max_abs_difference};
+use viewsynth_tests::{data_dir, gpu, max_abs_difference};
 use viewsynth::cyclopean::matcher::sgm::Plan;
 use viewsynth::cyclopean::matcher::{confidence_reference, estimate_disparities, Matcher, MatcherMethod};
 use viewsynth::io::{load_rgb, DepthMap, RgbImage};
@@ -78,15 +78,7 @@ fn real_pairs(device: &Device, api: &str) {
     check_confidence(&format!("{api} Cones"), (&l.confidence, &r.confidence), &twin);
 }
 
-/// Bound on |confidence_gpu - confidence_twin|, from the numerics: the GPU's decisions (which
-/// pixel is read, whether the eyes agree within 1 px) are f32 operations the twin repeats in f32,
-/// so the same pixels are 0. The value `(1 - |d - e|) / (1 + variance)` over at most 9 known
-/// disparities below 2^7 px: the f32 mean is off by at most ~9 x 2^7 x 2^-24 < 7e-5 px (plus
-/// GLSL's 2.5 ulp division), so each squared deviation by 2 |v - m| 7e-5 and the variance by
-/// about 1.4e-4 sqrt(variance) plus its own rounding (a few 2^-24 relative); divided by
-/// (1 + variance)^2 that moves the confidence by at most 1.4e-4 x max sqrt(v) / (1 + v)^2
-/// (0.33 at v = 1/3) < 5e-5, and the agreement's f32 difference by 2^-24. So 1e-4.
-pub(crate) const CONFIDENCE_BOUND: f32 = 1e-4;
+use viewsynth_tests::CONFIDENCE_BOUND;
 
 fn check_confidence(what: &str, gpu: (&DepthMap, &DepthMap), twin_maps: &(DepthMap, DepthMap)) {
     let twin = confidence_reference(&twin_maps.0, &twin_maps.1).unwrap();
@@ -121,7 +113,7 @@ fn matcher_gpu_pass_is_its_twin_on_real_pairs_on_gl() {
 #[cfg(feature = "vulkan")]
 #[test]
 fn matcher_gpu_pass_is_its_twin_on_real_pairs_on_vulkan() {
-    let device = viewsynth::vulkan::VkExecutor::device(&crate::vulkan_refocus::vulkan()).unwrap();
+    let device = viewsynth::vulkan::VkExecutor::device(&viewsynth_tests::vulkan()).unwrap();
     real_pairs(&device, "Vulkan");
 }
 
@@ -276,6 +268,6 @@ fn matcher_sgm_search_as_wide_as_the_pair_is_bounded_work() {
 #[cfg(feature = "vulkan")]
 #[test]
 fn matcher_sgm_gpu_pass_is_its_twin_on_vulkan() {
-    let device = viewsynth::vulkan::VkExecutor::device(&crate::vulkan_refocus::vulkan()).unwrap();
+    let device = viewsynth::vulkan::VkExecutor::device(&viewsynth_tests::vulkan()).unwrap();
     sgm_pairs(&device, "Vulkan");
 }

@@ -15,7 +15,7 @@
 //! they cluster (a wall facing the camera puts a whole texel row at one window y, so a row
 //! inside the band excuses its pixels at once); 2.5 % at most when written.
 
-use crate::common::gpu;
+use viewsynth_tests::gpu;
 use viewsynth::camera::mat4;
 use viewsynth::convention::{Conventions, RowOrder};
 use viewsynth::cyclopean::render::CyclopeanRenderer;
@@ -207,7 +207,7 @@ fn temporal_passes_match_their_twin_on_gl_under_every_convention() {
 #[test]
 fn temporal_passes_match_their_twin_on_vulkan_under_every_convention() {
     check(
-        || viewsynth::vulkan::VkExecutor::device(&crate::vulkan_refocus::vulkan()).unwrap(),
+        || viewsynth::vulkan::VkExecutor::device(&viewsynth_tests::vulkan()).unwrap(),
         "Vulkan",
     );
 }

@@ -1,4 +1,4 @@
-use crate::common::gpu;
+use viewsynth_tests::gpu;
 
 #[test]
 fn context_is_gl_4_5_core_or_newer_with_sane_limits() {

@@ -3,7 +3,7 @@
 //! the GPU view carries its timing and the twin view its unrounded values, and both sides leave
 //! out the same planes when an output is not asked for.
 
-use crate::common::{gpu, synthetic};
+use viewsynth_tests::{gpu, synthetic};
 use viewsynth::convention::Conventions;
 use viewsynth::cyclopean::reference::cyclopean_reference;
 use viewsynth::cyclopean::render::CyclopeanRenderer;

@@ -21,7 +21,7 @@
 //! sits at the threshold (65 x 49, reversed-Z), one or two pixels of the reprojection scans. That
 //! run is a diagnostic, not part of the rule.
 
-use crate::common::gpu;
+use viewsynth_tests::gpu;
 use viewsynth::convention::Conventions;
 use viewsynth::cyclopean::FrameDepth;
 use viewsynth::pass::Device;
@@ -287,6 +287,6 @@ fn every_pass_gives_the_same_view_under_every_convention_at_every_size_on_gl() {
 #[test]
 #[cfg(feature = "vulkan")]
 fn every_pass_gives_the_same_view_under_every_convention_at_every_size_on_vulkan() {
-    let v = crate::vulkan_refocus::vulkan();
+    let v = viewsynth_tests::vulkan();
     run_sweep(&viewsynth::vulkan::VkExecutor::device(&v).unwrap(), "Vulkan");
 }

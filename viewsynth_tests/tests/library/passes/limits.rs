@@ -3,7 +3,7 @@
 //! and refuses one past it with the same message: the parameter, the size and the limit.
 //! One-row images keep the oversized cases cheap.
 
-use crate::common::gpu;
+use viewsynth_tests::gpu;
 use viewsynth::camera::stereo::Eye;
 use viewsynth::camera::{gl_projection, Intrinsics, PinholeCamera, Pose};
 use viewsynth::convention::{Conventions, DepthPlanes};

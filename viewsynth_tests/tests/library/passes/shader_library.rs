@@ -2,7 +2,7 @@
 //! (NDC range x reversed-Z x row order) on this context, and every GLSL file under shaders/ is
 //! used by some program (a file no program lists would never be compiled by any test).
 
-use super::common::gpu;
+use viewsynth_tests::gpu;
 use std::collections::BTreeSet;
 use viewsynth::convention::Conventions;
 use viewsynth::gpu::ShaderProgram;

@@ -13,7 +13,7 @@
 //!   of a kept edge from outside: IoU >= 0.999 (lowest measured on llvmpipe over 7 scales x 3
 //!   sizes: SUN 0.999425, TUM 0.999648, synthetic 0.999852, NYU 1.0).
 
-use crate::common::*;
+use viewsynth_tests::*;
 use viewsynth::camera::PinholeCamera;
 use viewsynth::convention::Conventions;
 use viewsynth::pass::Device;
@@ -91,7 +91,7 @@ fn tum_frame_matches_reference() {
 #[cfg(feature = "vulkan")]
 #[test]
 fn tum_frame_on_vulkan_matches_reference() {
-    let device = viewsynth::vulkan::VkExecutor::device(&crate::vulkan_refocus::vulkan()).unwrap();
+    let device = viewsynth::vulkan::VkExecutor::device(&viewsynth_tests::vulkan()).unwrap();
     check_source_on("TUM on Vulkan", &real_frame("TUM"), &device);
     check_source_on("synthetic on Vulkan", &synthetic(320, 240), &device);
 }

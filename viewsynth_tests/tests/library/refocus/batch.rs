@@ -2,7 +2,7 @@
 //! the manifest, resume that redoes frames whose settings or files changed, and frame folders
 //! that cannot lead outside --out-dir.
 
-use super::common::gpu;
+use viewsynth_tests::gpu;
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 use viewsynth::convention::Conventions;
@@ -242,7 +242,7 @@ fn every_output_kind_reads_back_as_rendered() {
     use viewsynth::io::{DepthDecode, DepthFormats, RgbFormat};
     use viewsynth::refocus::manifest::{scale_tag, TargetSpec, DEFAULT_SCALES};
     use viewsynth::refocus::{RefocusSource, Refocuser};
-    let data = super::common::data_dir().join("rgbd_open3d_testdata");
+    let data = viewsynth_tests::data_dir().join("rgbd_open3d_testdata");
     let (rgb_path, depth_path) = (data.join("TUM_color.png"), data.join("TUM_depth.png"));
     let dir = tempfile::Builder::new().prefix("readback-kinds").tempdir().unwrap();
     let manifest = dir.path().join("frames.csv");

@@ -1,6 +1,6 @@
 //! Degenerate and extreme inputs: every output finite, and a stated rule for each.
 
-use crate::common::*;
+use viewsynth_tests::*;
 use viewsynth::camera::{Intrinsics, PinholeCamera};
 use viewsynth::convention::Conventions;
 use viewsynth::io::{DepthMap, RgbImage};

@@ -25,7 +25,7 @@
 //! seed). Beyond the ring (outside [-0.5, W - 0.5]) nothing may be valid (§1, "new areas remain
 //! invalid").
 
-use crate::common::{gpu, real_frame};
+use viewsynth_tests::{gpu, real_frame};
 use viewsynth::camera::{Intrinsics, PinholeCamera};
 use viewsynth::convention::Conventions;
 use viewsynth::io::{DepthMap, RgbImage};

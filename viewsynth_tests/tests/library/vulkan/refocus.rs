@@ -19,22 +19,16 @@
 //! - colour: the bilinear mix is f32 in both; only values within an f32 rounding of a k + 0.5
 //!   tie may round to different bytes: one level.
 
-use crate::common::*;
+use viewsynth_tests::*;
 use viewsynth::convention::Conventions;
-use viewsynth::gpu::GpuPolicy;
 use viewsynth::io::{DepthMap, RgbImage};
 use viewsynth::refocus::manifest::TargetSpec;
 use viewsynth::refocus::{BreakRule, Method, OutputSet, RefocusOutput, RefocusSource, Refocuser};
-use viewsynth::vulkan::{Vk, VkExecutor, VulkanContext, VulkanDeviceChoice};
+use viewsynth::vulkan::VkExecutor;
 
 /// 32 ulp of f32 relative (derivation above).
 const DEPTH_REL_BOUND: f32 = 32.0 / (1u32 << 24) as f32;
 
-pub fn vulkan() -> Vk {
-    VulkanContext::open(VulkanDeviceChoice::Auto, GpuPolicy::default()).unwrap_or_else(|e| {
-        panic!("Vulkan tests need the loader and a driver (ci/install-deps.sh installs Mesa lavapipe): {e}")
-    })
-}
 
 /// Largest differences of one GL/Vulkan pair.
 #[derive(Default, Debug, Clone, Copy)]
