@@ -37,7 +37,6 @@ pub struct Framebuffer {
 }
 
 impl Framebuffer {
-
     /// The colour attachment of output location `index`; None for an empty slot (or past the
     /// last).
     pub fn color(&self, index: usize) -> Option<&Texture> {

@@ -117,7 +117,6 @@ impl Framebuffer {
         self.bind_and_clear(clear_depth);
         RenderPass { fb: self }
     }
-
 }
 
 impl RenderPass<'_> {

@@ -60,7 +60,6 @@ pub struct Texture {
 }
 
 impl Texture {
-
     /// Allocate a texture; `data` (tightly packed rows, row 0 first) is uploaded when given.
     /// Sampling is nearest with clamp-to-edge: passes that filter do it themselves in f32 with
     /// `texelFetch`, because fixed-function bilinear weights have only ~8 bits.
@@ -206,7 +205,6 @@ impl Texture {
             self.gpu.gl().bind_texture(glow::TEXTURE_2D, Some(self.raw));
         }
     }
-
 }
 
 /// A texture bound as a compute image unit; unbound on drop.

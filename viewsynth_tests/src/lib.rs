@@ -5,13 +5,13 @@
 
 use std::path::PathBuf;
 use viewsynth::camera::{Intrinsics, PinholeCamera};
+use viewsynth::cyclopean::{Blend, CyclopeanParams, Eye, Method};
 use viewsynth::gpu::{DeviceChoice, Gpu};
 use viewsynth::io::{self, DepthDecode};
 use viewsynth::metrics::{self, Agreement};
 use viewsynth::refocus::reference::{refocus_reference, ReferenceImage};
 use viewsynth::refocus::{BreakRule, RefocusOutput, RefocusSource};
 use viewsynth::view::ViewOutput;
-use viewsynth::cyclopean::{Blend, CyclopeanParams, Eye, Method};
 
 pub fn gpu() -> Gpu {
     Gpu::new(DeviceChoice::Auto).unwrap_or_else(|e| {
@@ -200,7 +200,11 @@ pub fn methods() -> Vec<(&'static str, CyclopeanParams)> {
 /// The Vulkan executor's context (Mesa lavapipe in CI).
 #[cfg(feature = "vulkan")]
 pub fn vulkan() -> viewsynth::vulkan::Vk {
-    viewsynth::vulkan::VulkanContext::open(viewsynth::vulkan::VulkanDeviceChoice::Auto, viewsynth::pass::GpuPolicy::default()).unwrap_or_else(|e| {
+    viewsynth::vulkan::VulkanContext::open(
+        viewsynth::vulkan::VulkanDeviceChoice::Auto,
+        viewsynth::pass::GpuPolicy::default(),
+    )
+    .unwrap_or_else(|e| {
         panic!("Vulkan tests need the loader and a driver (ci/install-deps.sh installs Mesa lavapipe): {e}")
     })
 }

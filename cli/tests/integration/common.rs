@@ -29,4 +29,3 @@ pub fn cyclopean_cli(
         .output()
         .unwrap()
 }
-

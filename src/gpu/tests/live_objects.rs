@@ -34,10 +34,7 @@ fn each_object_is_counted_while_it_lives() {
     assert_eq!(live, expected);
     assert_eq!(live.total(), before.total() + 6);
     // A queued read holds a fence (and a pooled pixel-pack buffer) until finished.
-    let pending = fb
-        .read_async(0, crate::gpu::ReadFormat::RGB8, false)
-        .unwrap()
-        .unwrap();
+    let pending = fb.read_async(0, crate::gpu::ReadFormat::RGB8, false).unwrap().unwrap();
     assert_eq!(g.live_objects().syncs, before.syncs + 1);
     pending.finish().unwrap();
     assert_eq!(g.live_objects().syncs, before.syncs);

@@ -2,9 +2,7 @@
 //! values that cannot be used are refused by name, and every view is finite where it is valid;
 //! the output rule invalidates non-finite depth.
 
-
 use viewsynth::io::DepthMap;
-
 
 const W: u32 = 32;
 const H: u32 = 24;

@@ -15,7 +15,6 @@
 //! - colour: the same t error times at most 255 levels/px is < 0.05 level: more than one level
 //!   off is allowed only where a rounding tie flips (0.1 % of pixels).
 
-use viewsynth_tests::{data_dir, gpu};
 use viewsynth::camera::stereo::{Eye, StereoParams};
 use viewsynth::camera::{Intrinsics, PinholeCamera};
 use viewsynth::convention::Conventions;
@@ -33,6 +32,7 @@ use viewsynth::reproject::{
 use viewsynth::view::ViewOutput;
 use viewsynth_lab::eval::image_check;
 use viewsynth_lab::eval::reproject::{methods, motorcycle_case, run_timed, scene_cases, score, teddy_case, Case};
+use viewsynth_tests::{data_dir, gpu};
 
 const DEPTH_REL_TOL: f64 = 3e-5;
 

@@ -7,7 +7,6 @@
 //! within 1 level, view distance within 2e-5 relative (f32 ray parameter through a 4x4 inverse)
 //! and window depth within 2e-6 (f32 clip z / w near 1).
 
-use viewsynth_tests::gpu;
 use viewsynth::camera::mat4::Mat4;
 use viewsynth::camera::stereo::{stereo_projection_gl, Eye, Frustum, StereoParams};
 use viewsynth::camera::{gl_projection, Pose};
@@ -15,6 +14,7 @@ use viewsynth::convention::{Conventions, DepthPlanes};
 use viewsynth::pass::Device;
 use viewsynth::scene::gpu::{trace_gl_reference, GlCamera, SceneImage, SceneRenderer};
 use viewsynth::scene::{builtin, Scene};
+use viewsynth_tests::gpu;
 
 fn check(tag: &str, gpu_img: &SceneImage, reference: &SceneImage) {
     let n = reference.view_z.data.len();

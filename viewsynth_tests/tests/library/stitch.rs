@@ -19,7 +19,6 @@
 //! = 1e-5. A distance past it, or on one side only, is a discrete choice taken the other way
 //! (another texel, the other face): counted with the colour's 0.5 %.
 
-use viewsynth_tests::gpu;
 use viewsynth::convention::Conventions;
 use viewsynth::io::OutputSet;
 use viewsynth::pass::Device;
@@ -31,6 +30,7 @@ use viewsynth::stitch::truth::ods_truth;
 use viewsynth::stitch::{pass, seam_band_mask, top_bottom, FaceSet, Method, OdsRig, Side, StitchInput, StitchParams};
 use viewsynth::{metrics, Error};
 use viewsynth_lab::eval::image_check;
+use viewsynth_tests::gpu;
 
 /// Ray distance agreement, GPU against twin (module docs).
 const DISTANCE_REL: f64 = 1e-5;

@@ -2,8 +2,8 @@
 //! marked lost by design) and no output holds NaN/Inf. The bounds are derived in src/stress/*.rs
 //! beside each case.
 
-use viewsynth_tests::gpu;
 use viewsynth_lab::stress::{first_failure, run_stress, table, StressOptions, CAPABILITIES};
+use viewsynth_tests::gpu;
 
 #[test]
 fn quick_sweep_of_every_capability_passes_with_no_nan_or_inf() {

@@ -3,8 +3,8 @@
 //! a run, after two shards (the last joins; `viewsynth index` joins by hand) and after a killed
 //! and resumed run, and a run killed after an earlier complete one leaves no stale index.
 
-use crate::cli::bin;
 use crate::batch::resume::setup;
+use crate::cli::bin;
 use std::path::Path;
 use std::process::{Output, Stdio};
 use viewsynth::refocus::batch::{read_index, IndexRow, INDEX_NAME};

@@ -3,8 +3,8 @@
 //! folder, or where a copy of the data sits. And a row's identity in the other sense: the
 //! intrinsics a row lacks come from `--fx/--fy/--cx/--cy`.
 
-use crate::cli::bin;
 use crate::batch::resume::setup;
+use crate::cli::bin;
 use std::path::Path;
 use std::process::Output;
 

@@ -5,8 +5,8 @@
 //! MB a frame of `cyclopean --sequence --method seed --fill`, 2.7 MB a frame of `scene
 //! --frames`); the block is a storage buffer there now (shaders/common/vulkan.glsl).
 
-use crate::safety::bounds::peak_memory;
 use crate::cli::{bin, scratch};
+use crate::safety::bounds::peak_memory;
 use std::path::{Path, PathBuf};
 
 #[cfg(feature = "vulkan")]

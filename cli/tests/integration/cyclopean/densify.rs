@@ -1,52 +1,9 @@
-//! A whole spectator frame from two images (issue 38): the densify pass against its twin on both
-//! executors, the signed disparity range, and the complete frames of the real pairs against the
-//! optical-flow peer (python/peers/flow_interpolation.py).
-//!
-//! Bounds, from the numerics: the densify rule compares integer weights and f32 disparities and
-//! copies a disparity, so the GPU's maps must be the twin's bit for bit (no pixel excused).
+//! A whole spectator frame from two images through the command (issue 38): the real pairs'
+//! complete frames against the optical-flow peer (python/peers/flow_interpolation.py). The
+//! densify pass against its twin is `viewsynth_tests`' `cyclopean::densify`.
 
-use crate::common::{data_dir, gpu};
-use viewsynth::cyclopean::densify::{densify_reference, Densifier, FILLED};
-use viewsynth::cyclopean::matcher::estimate_disparities;
-use viewsynth::io::{load_rgb, DepthMap, RgbImage};
-use viewsynth::pass::Device;
-
-/// Cones' left image and the matcher's left disparities (13 % unknown), cropped to keep the
-/// twin quick.
-fn cones_eye() -> (RgbImage, DepthMap) {
-    let dir = data_dir().join("middlebury2003_cones");
-    let (l, r) = (
-        load_rgb(&dir.join("im2.png")).unwrap(),
-        load_rgb(&dir.join("im6.png")).unwrap(),
-    );
-    let (dl, _) = estimate_disparities(&l, &r, 64).unwrap();
-    (l, dl)
-}
-
-/// `eye` made before the device: a GL context made after another is current in its place.
-fn check(eye: (RgbImage, DepthMap), device: &Device, what: &str) {
-    let (color, disparity) = eye;
-    let unknown = disparity.data.iter().filter(|v| **v <= 0.0).count();
-    assert!(
-        unknown * 20 > disparity.data.len(),
-        "{what}: the matcher leaves holes ({unknown})"
-    );
-    let gpu_out = Densifier::new(device).unwrap().densify(&disparity, &color).unwrap();
-    let twin = densify_reference(&disparity, &color).unwrap();
-    assert_eq!(gpu_out.filled, twin.filled, "{what}: filled flags differ");
-    let differ: Vec<usize> = (0..twin.filled.len())
-        .filter(|&i| gpu_out.disparity.data[i].to_bits() != twin.disparity.data[i].to_bits())
-        .collect();
-    assert!(
-        differ.is_empty(),
-        "{what}: {} disparities differ, first at {:?}",
-        differ.len(),
-        differ.first()
-    );
-    let filled = twin.filled.iter().filter(|f| **f == FILLED).count();
-    assert_eq!(filled, unknown, "{what}: every unknown disparity of Cones is filled");
-    println!("{what}: {filled} disparities filled, the twin's bit for bit");
-}
+use crate::common::data_dir;
+use viewsynth::io::{load_rgb, RgbImage};
 
 /// One pair of the issue's table: its images, the true middle view, and the flow peer's PSNR
 /// over all pixels (python/peers/flow_interpolation.py, OpenCV 5.0.0 DIS preset MEDIUM, run on

@@ -1,33 +1,16 @@
-//! The splat-gather middle view on real stereo (Middlebury 2003 Cones), on thin structures, and
-//! against its f64 twin; the rectified-stereo CLI.
-//!
-//! GPU vs twin tolerance, from the numerics: the GPU computes positions in f32, the twin in f64.
-//! A pixel's answer can only differ where a decision sits within f32 reach of its threshold: a
-//! splat near a pixel border that may change a neighbourhood's nearest distance, a middle ray
-//! near the half-texel that decides the nearest eye texel, or two disparities near the
-//! same-surface tolerance. `splat_reference::ambiguity` marks those pixels from the twin's own
-//! geometry (bounds derived in src/cyclopean/ambiguity.rs); only they are excused. Every other
-//! pixel must carry the twin's source bits, its colour within one level (the same weighted sum of
-//! the same texels; rounding of a value near a half level) and its middle depth within 2e-5
-//! relative (the f32 error of the chain, ~1e-6; as for the gather method). So one pixel 40 levels
-//! off fails. The marked share is bounded per case (see `splat_gather_twin`).
+//! The rectified-stereo command on real pairs: a pair with disparities renders what the library
+//! renders and bad input is refused cleanly; two images alone render the census and semi-global
+//! matchers' disparities (the splat-gather pass against its twin is `viewsynth_tests`'
+//! `cyclopean::real_pairs`).
 
 use crate::common::{data_dir, gpu};
 use std::path::{Path, PathBuf};
-use viewsynth::camera::{gl_projection, Intrinsics, PinholeCamera};
 use viewsynth::convention::Conventions;
-use viewsynth::convention::DepthPlanes;
-use viewsynth::cyclopean::baseline::{forward_splat, forward_splat_offset, forward_splat_rounded, Rounding};
-use viewsynth::cyclopean::disparity_frame::{disparity_frame, median_fixation, DisparityRig};
-use viewsynth::cyclopean::reference::CyclopeanReference;
-use viewsynth::cyclopean::render::CyclopeanRenderer;
-use viewsynth::cyclopean::scene_frame::{scene_frame, StereoRig};
+use viewsynth::cyclopean::disparity_frame::{disparity_frame, DisparityRig};
 use viewsynth::cyclopean::splat::{SplatParams, SplatRenderer};
-use viewsynth::cyclopean::splat_reference::{self, splat_reference};
-use viewsynth::cyclopean::{CyclopeanOutput, CyclopeanOutputs, CyclopeanParams, FrameDepth, Method, StereoFrame};
+use viewsynth::cyclopean::{CyclopeanOutput, CyclopeanOutputs, StereoFrame};
 use viewsynth::io::{self, DepthDecode, DepthMap, RgbImage};
 use viewsynth::metrics;
-use viewsynth_lab::eval::cyclopean::{estimated_cases, estimated_eyes};
 
 fn splat_gpu(frame: &StereoFrame, mid: &viewsynth::cyclopean::MiddleCamera) -> CyclopeanOutput {
     splat_on(&viewsynth::pass::Device::gl(&gpu()).unwrap(), frame, mid)
@@ -45,127 +28,11 @@ fn splat_on(
         .0
 }
 
-fn gather_gpu(
-    frame: &StereoFrame,
-    mid: &viewsynth::cyclopean::MiddleCamera,
-    params: CyclopeanParams,
-) -> CyclopeanOutput {
-    CyclopeanRenderer::new(&gpu(), frame, params)
-        .unwrap()
-        .render(mid)
-        .unwrap()
-        .0
-}
-
 fn out_dir(name: &str) -> PathBuf {
     let dir = std::env::temp_dir().join(format!("viewsynth-{name}-{}", std::process::id()));
     let _ = std::fs::remove_dir_all(&dir);
     std::fs::create_dir_all(&dir).unwrap();
     dir
-}
-
-/// Among the pixels the twin does not mark `ambiguous`: those whose source bits differ; those
-/// (same bits) whose colour differs by more than one level; those (same bits) whose depth
-/// differs by more than 2e-5 relative.
-fn compare(out: &CyclopeanOutput, r: &CyclopeanReference, ambiguous: &[bool]) -> (Vec<usize>, usize, usize) {
-    let (mut src, mut col, mut z) = (Vec::new(), 0, 0);
-    let color = out.color().unwrap();
-    let depth = out.depth().unwrap();
-    for i in (0..r.depth.len()).filter(|&i| !ambiguous[i]) {
-        if out.sources[i] != r.sources[i] {
-            src.push(i);
-            continue;
-        }
-        let e = (0..3)
-            .map(|c| metrics::quantization_error(color.data[i * 3 + c], r.color[i][c]))
-            .max()
-            .unwrap();
-        col += (e > 1) as usize;
-        if r.sources[i] != 0 {
-            z += ((depth.data[i] as f64 - r.depth[i]).abs() > 2e-5 * r.depth[i]) as usize;
-        }
-    }
-    (src, col, z)
-}
-
-/// Write the GPU image, the twin's and their difference (x8) for a failed comparison.
-fn dump(tag: &str, out: &CyclopeanOutput, r: &CyclopeanReference, w: u32, h: u32) -> String {
-    let dir = out_dir(&format!("splat-twin-{tag}"));
-    let twin = r.to_output(w, h);
-    let (g, t) = (out.color().unwrap(), twin.color().unwrap());
-    let diff: Vec<u8> = g
-        .data
-        .iter()
-        .zip(&t.data)
-        .map(|(a, b)| (a.abs_diff(*b) as u32 * 8).min(255) as u8)
-        .collect();
-    io::save_rgb(&dir.join("gpu.png"), g).unwrap();
-    io::save_rgb(&dir.join("twin.png"), t).unwrap();
-    io::save_rgb(&dir.join("diff_x8.png"), &RgbImage::new(w, h, diff).unwrap()).unwrap();
-    dir.display().to_string()
-}
-
-/// No pixel outside those the twin marks ambiguous may differ (in source bits, colour beyond one
-/// level or depth beyond 2e-5 relative), and at most `max_ambiguous` of the pixels are marked.
-fn check_twin(
-    device: &viewsynth::pass::Device,
-    tag: &str,
-    frame: &StereoFrame,
-    mid: &viewsynth::cyclopean::MiddleCamera,
-    max_ambiguous: f64,
-) {
-    let out = splat_on(device, frame, mid);
-    let r = splat_reference(frame, mid, &SplatParams::default()).unwrap();
-    let ambiguous = splat_reference::ambiguity(frame, mid, &SplatParams::default()).unwrap();
-    let (src, col, z) = compare(&out, &r, &ambiguous);
-    let n = r.depth.len();
-    let marked = ambiguous.iter().filter(|a| **a).count();
-    let w = mid.width as usize;
-    // How many of the marked pixels this device answers otherwise (told, not asserted: another
-    // driver may round the other way).
-    let unmarked: Vec<bool> = ambiguous.iter().map(|a| !a).collect();
-    let (m_src, m_col, m_z) = compare(&out, &r, &unmarked);
-    let msg = format!(
-        "{tag}: of {n} pixels, {marked} ({:.2} %) ambiguous (of them, on this device, {} differ in source bits, {m_col} in colour, {m_z} in depth); of the others {} differ in source bits (first {:?}), {col} in colour, {z} in depth",
-        marked as f64 * 100.0 / n as f64,
-        m_src.len(),
-        src.len(),
-        src.first().map(|i| (i % w, i / w))
-    );
-    if !src.is_empty() || col + z > 0 || marked as f64 > max_ambiguous * n as f64 {
-        let dir = dump(tag, &out, &r, mid.width, mid.height);
-        panic!("{msg}; images in {dir}");
-    }
-    eprintln!("{msg}");
-}
-
-/// The share of Cones the twin may mark ambiguous. Its disparities are quarter pixels (d = k/4)
-/// and the middle view sits halfway, so each eye's texels move by k/8 px: for k = 4 mod 8 (one
-/// disparity value in eight) a texel centre lands exactly on a pixel border, and a middle ray's
-/// nearest eye texel exactly on a texel border, for whole surfaces at once; f32 may land either
-/// side there. One eye in eight, either of two eyes: 1 - (7/8)^2 = 23 % of the pixels, against
-/// 22.22 % marked (measured when written; 23.97 % before nearest-texel choices were tested for
-/// their effect, see `splat_reference::ambiguity`). The marks are not too broad: on llvmpipe and
-/// lavapipe alike 1499 of the marked pixels take other source bits, 132 another colour and 500
-/// another depth (each printed by the test), none outside them; which of them go which way is
-/// the driver's rounding, so only their share is bounded: 30 %. Every other pixel must match.
-/// On the built-in scene (generic geometry) 0.01 % (one pixel) was marked when written (none
-/// now); the bound there is 0.5 %.
-const CONES_MAX_AMBIGUOUS: f64 = 0.30;
-
-fn splat_gather_twin(device: &viewsynth::pass::Device) {
-    eprintln!("splat-gather twin check on {:?}", device.api());
-    let mut rig = StereoRig::demo(160, 120);
-    rig.ipd = 0.2;
-    for conv in Conventions::all() {
-        for kind in [FrameDepth::Device, FrameDepth::ViewZ] {
-            let (frame, mid, _) = scene_frame(&rig, conv, kind);
-            check_twin(device, &format!("scene-{}-{kind:?}", conv.label()), &frame, &mid, 0.005);
-        }
-    }
-    let (l, r, _) = cones();
-    let (frame, mid) = disparity_frame(l, r, &DisparityRig::middle(400.0, 0.1), Conventions::default()).unwrap();
-    check_twin(device, "cones", &frame, &mid, CONES_MAX_AMBIGUOUS);
 }
 
 type Eye = (RgbImage, DepthMap);
@@ -203,45 +70,6 @@ fn psnr(a: &RgbImage, b: &RgbImage, mask: &[bool]) -> f64 {
 
 fn count(mask: &[bool]) -> usize {
     mask.iter().filter(|m| **m).count()
-}
-
-/// A far textured wall (disparity 4 px) behind poles 1, 2 and 3 px wide (disparity 20.6 px: the
-/// middle view shifts them by 10.3 px, off the pixel grid), rendered exactly into both eyes.
-fn poles_frame() -> (Eye, Eye, Vec<(usize, usize)>) {
-    let (w, h) = (96usize, 24usize);
-    let (d_wall, d_pole) = (4.0f32, 20.6f32);
-    let poles = [(30usize, 1usize), (50, 2), (70, 3)]; // left-image x and width
-    let wall = |x: f64| -> [u8; 3] {
-        // Texture in wall coordinates (left-image x).
-        let k = (x.floor() as i64).rem_euclid(7) as u8;
-        [200, 40 + 20 * k, 30]
-    };
-    const POLE: [u8; 3] = [20, 30, 230];
-    let render = |right: bool| -> Eye {
-        let mut rgb = vec![0u8; w * h * 3];
-        let mut disp = vec![0f32; w * h];
-        for y in 0..h {
-            for x in 0..w {
-                // The pole texels: in the left image x0..x0+width; in the right shifted by -d_pole.
-                let xl_pole = if right { x as f64 + d_pole as f64 } else { x as f64 };
-                let on_pole = poles
-                    .iter()
-                    .any(|&(x0, pw)| xl_pole >= x0 as f64 - 1e-9 && xl_pole < (x0 + pw) as f64 - 1e-9);
-                let (c, d) = if on_pole {
-                    (POLE, d_pole)
-                } else {
-                    (wall(if right { x as f64 + d_wall as f64 } else { x as f64 }), d_wall)
-                };
-                rgb[(y * w + x) * 3..(y * w + x) * 3 + 3].copy_from_slice(&c);
-                disp[y * w + x] = d;
-            }
-        }
-        (
-            RgbImage::new(w as u32, h as u32, rgb).unwrap(),
-            DepthMap::new(w as u32, h as u32, disp).unwrap(),
-        )
-    };
-    (render(false), render(true), poles.to_vec())
 }
 
 fn viewsynth(args: &[&str], paths: &[(&str, &Path)]) -> std::process::Output {
@@ -348,54 +176,9 @@ fn cli_rectified_pair_matches_the_library_and_refuses_bad_input_cleanly() {
     }
 }
 
-/// On one estimated-disparity case, the default against a forward-splat baseline on the pixels
-/// both cover: (default dB, baseline dB) there, and (default, baseline) covered pixel counts.
-struct Versus {
-    db: (f64, f64),
-    covered: (usize, usize),
-}
-
-/// The default against both forward splats (round half away from zero, then numpy's half to
-/// even) on the case whose scene name starts with `scene_prefix`.
-fn estimated_versus_splats(scene_prefix: &str) -> [Versus; 2] {
-    let (cases, skipped) = estimated_cases(&data_dir()).unwrap();
-    let case = cases
-        .iter()
-        .find(|c| c.scene.starts_with(scene_prefix))
-        .unwrap_or_else(|| panic!("{scene_prefix}: not in the data folder ({skipped:?})"));
-    let (l, r, rig) = estimated_eyes(case).unwrap();
-    let bases = [Rounding::HalfAway, Rounding::HalfEven]
-        .map(|rounding| forward_splat_rounded((&l.0, &l.1), (&r.0, &r.1), rig.position, [0.0, 0.0], rounding).unwrap());
-    let (frame, mid) = disparity_frame(l, r, &rig, Conventions::default()).unwrap();
-    let out = splat_gpu(&frame, &mid);
-    let covered: Vec<bool> = out.sources.iter().map(|s| *s != 0).collect();
-    bases.map(|base| {
-        let common: Vec<bool> = covered.iter().zip(&base.covered).map(|(a, b)| *a && *b).collect();
-        let v = Versus {
-            db: (
-                psnr(out.color().unwrap(), &case.truth, &common),
-                psnr(&base.color, &case.truth, &common),
-            ),
-            covered: (count(&covered), count(&base.covered)),
-        };
-        eprintln!(
-            "{}, {}: splat-gather {:.3} dB vs splat baseline {:.3} dB ({:+.3}) on {} common pixels; covered {:.2} % vs {:.2} %",
-            case.scene,
-            case.setting,
-            v.db.0,
-            v.db.1,
-            v.db.0 - v.db.1,
-            count(&common),
-            100.0 * v.covered.0 as f64 / covered.len() as f64,
-            100.0 * v.covered.1 as f64 / covered.len() as f64,
-        );
-        v
-    })
-}
-
 /// Two images alone: the CLI estimates the disparities with the census matcher (its GPU pass)
 /// and renders as if they had been given. Oracle: the matcher's twin's disparities (the GPU
-/// pass is bit-exact with it, cli/tests/integration/matcher.rs) written to files and given
+/// pass is bit-exact with it, viewsynth_tests/tests/library/cyclopean/matcher.rs) written to files and given
 /// with --left-disparity/--right-disparity must give the same files, byte for byte. Options
 /// that decode disparity files, and a search range with disparities given, are usage errors.
 #[test]
@@ -418,7 +201,7 @@ fn cli_two_images_alone_render_the_matchers_disparities() {
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
     // Each eye's confidence file holds the matcher's confidence stage: its twin on the twin's
     // disparities, within the stage's GPU-vs-twin bound (CONFIDENCE_BOUND, derived beside it in
-    // cli/tests/integration/matcher.rs), and exactly 0 where the disparity is unknown.
+    // viewsynth_tests/tests/library/cyclopean/matcher.rs), and exactly 0 where the disparity is unknown.
     let twin = viewsynth::cyclopean::matcher::confidence_reference(&dl, &dr).unwrap();
     for (name, want, d) in [
         ("left_confidence.exr", &twin.0, &dl),

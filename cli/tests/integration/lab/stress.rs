@@ -1,9 +1,5 @@
-//! `viewsynth stress --quick`: every case of every capability passes its derived bound (or is
-//! marked lost by design) and no output holds NaN/Inf. The bounds are derived in src/stress/*.rs
-//! beside each case.
-
-use crate::common::gpu;
-use viewsynth_lab::stress::{first_failure, run_stress, table, StressOptions, CAPABILITIES};
+//! `viewsynth stress`: the table, the JSON, an unknown capability refused (the sweep itself is
+//! `viewsynth_tests`' `stress`).
 
 #[test]
 fn cli_prints_the_table_writes_json_and_refuses_an_unknown_capability() {

@@ -1,92 +1,13 @@
-//! `--rgb-everywhere`: colour at every target pixel inside the source frame, mask and depth
-//! unchanged.
-//!
-//! Bounds, from the numerics:
-//! - mask and depth: the option only adds a colour write (the full-screen pass, before the
-//!   coverage test) or a colour draw at the far depth before the mesh draws (which pass the depth
-//!   test over it and write what they wrote before), so both are bit-identical to a render
-//!   without it, on every backend and convention.
-//! - colour: the same f32 bilinear over the same gathered texels as the covered pixels, whose
-//!   bound `refocus_accuracy` derives: within one level of the f64 twin's exact value, with
-//!   either neighbour of a rounding tie counted right ([`metrics::quantization_error`]). Which
-//!   pixels are inside the frame is decided in f64 by the same span on both sides
-//!   ([`viewsynth::refocus::frame_span`]), so outside it both are exactly 0.
+//! `refocus --rgb-everywhere` on a real frame: the source colour kept, no black holes inside the
+//! frame (the pass against its twin, bounds derived, is `viewsynth_tests`' `refocus::rgb_everywhere`).
 
 use crate::cli::{bin, scratch};
 use crate::common::*;
 use std::path::Path;
-use viewsynth::camera::PinholeCamera;
-use viewsynth::convention::Conventions;
 use viewsynth::io;
-use viewsynth::metrics;
-use viewsynth::pass::Device;
 use viewsynth::refocus::manifest::TargetSpec;
-use viewsynth::refocus::reference::{bilinear_rgb, refocus_reference_with, ReferenceImage};
-use viewsynth::refocus::{source_point, BreakRule, Method, OutputSet, RefocusOutput, RefocusSource, Refocuser};
-
-const SCALES: [f64; 3] = [0.5, 1.0, 2.0];
-
-fn targets(src: &RefocusSource) -> Vec<PinholeCamera> {
-    TargetSpec {
-        scales: SCALES.to_vec(),
-        size: None,
-        principal: None,
-    }
-    .targets(&src.camera())
-    .unwrap()
-}
-
-/// Largest level difference of `out`'s colour from the twin's exact colour, over every pixel.
-fn worst_colour(out: &RefocusOutput, twin: &ReferenceImage) -> u32 {
-    let c = &out.rgb.as_ref().unwrap().data;
-    twin.rgb
-        .iter()
-        .enumerate()
-        .flat_map(|(i, px)| (0..3).map(move |k| (i * 3 + k, px[k])))
-        .map(|(o, exact)| metrics::quantization_error(c[o], exact))
-        .max()
-        .unwrap_or(0)
-}
-
-/// On `device`, under every convention and both methods: with the option, mask and depth are
-/// bit-identical to the render without it, covered colour too, and every pixel's colour is
-/// within one level of the twin's (which is 0 outside the frame).
-fn matches_the_twin_on(api: &str, device: &Device) {
-    for (name, src) in [("TUM", real_frame("TUM")), ("synthetic", synthetic(160, 120))] {
-        let targets = targets(&src);
-        let twins: Vec<ReferenceImage> = targets
-            .iter()
-            .map(|t| refocus_reference_with(&src, &BreakRule::default(), t, true))
-            .collect();
-        for method in [Method::Fullscreen, Method::Mesh] {
-            for conv in Conventions::all() {
-                let rule = BreakRule::default();
-                let mut plain = Refocuser::new(device, &src, &rule, method, OutputSet::default(), conv).unwrap();
-                let mut every = Refocuser::new(device, &src, &rule, method, OutputSet::default(), conv).unwrap();
-                every.set_rgb_everywhere(true);
-                for ((s, t), twin) in SCALES.iter().zip(&targets).zip(&twins) {
-                    let tag = format!("{api} {name} {method:?} {} s{s}", conv.label());
-                    let (a, b) = (plain.render(t).unwrap(), every.render(t).unwrap());
-                    let (ma, mb) = (&a.mask.as_ref().unwrap().data, &b.mask.as_ref().unwrap().data);
-                    assert_eq!(ma, mb, "{tag}: mask changed");
-                    let bits = |o: &RefocusOutput| -> Vec<u32> {
-                        o.depth.as_ref().unwrap().data.iter().map(|z| z.to_bits()).collect()
-                    };
-                    assert_eq!(bits(&a), bits(&b), "{tag}: depth changed");
-                    let (ca, cb) = (&a.rgb.as_ref().unwrap().data, &b.rgb.as_ref().unwrap().data);
-                    let covered_differs =
-                        (0..ma.len()).filter(|&i| ma[i] != 0 && ca[3 * i..3 * i + 3] != cb[3 * i..3 * i + 3]);
-                    assert_eq!(covered_differs.count(), 0, "{tag}: covered colour changed");
-                    let worst = worst_colour(&b, twin);
-                    assert!(worst <= 1, "{tag}: colour {worst} levels from the f64 twin");
-                    let outside =
-                        (0..ma.len()).filter(|&i| twin.rgb[i] == [0.0; 3] && cb[3 * i..3 * i + 3] != [0, 0, 0]);
-                    assert_eq!(outside.count(), 0, "{tag}: colour outside the frame");
-                }
-            }
-        }
-    }
-}
+use viewsynth::refocus::reference::bilinear_rgb;
+use viewsynth::refocus::source_point;
 
 fn refocus_tum(out: &Path, extra: &[&str]) {
     let d = data_dir().join("rgbd_open3d_testdata");

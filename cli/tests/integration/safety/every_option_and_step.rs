@@ -826,38 +826,6 @@ fn round3_resume_verifies_folders_and_float_settings() {
     report(failures, cases);
 }
 
-/// Depth values a library caller can put in a `DepthMap` by hand that every pass must refuse
-/// (the loaders make them holes): subnormals, below 1e-6, above 1e6, up to f32::MAX.
-const UNUSABLE: [f32; 9] = [1e-45, 1e-40, 1e-38, 1e-7, 1.5e6, 1e38, f32::MAX, -1e-40, -1e38];
-
-/// Overwrites every third depth value with `v` (the rest keeps the scene, so the pass has
-/// neighbours of ordinary depth next to the extreme one).
-fn plant(depth: &mut DepthMap, v: f32) {
-    depth.data.iter_mut().step_by(3).for_each(|z| *z = v);
-}
-
-/// Whether `res` is a refusal naming depth (not a panic, not a run).
-fn refused_naming_depth<T>(res: viewsynth::Result<T>) -> Result<(), String> {
-    match res {
-        Ok(_) => Err("accepted".into()),
-        Err(e) if e.to_string().contains("depth") && e.to_string().contains("usable") => Ok(()),
-        Err(e) => Err(format!("refused without naming depth: {e}")),
-    }
-}
-
-/// Pixels the mask marks valid whose depth is not finite (every plane the view has).
-fn valid_non_finite(v: &viewsynth::view::ViewOutput) -> usize {
-    match (&v.depth, &v.mask) {
-        (Some(d), Some(m)) => d
-            .data
-            .iter()
-            .zip(&m.data)
-            .filter(|(z, m)| **m != 0 && !z.is_finite())
-            .count(),
-        _ => 0,
-    }
-}
-
 /// The chunk offset table of an EXR `save_depth_exr` wrote: (position, entries). Found as the
 /// run of increasing u64s whose first entry points just past the table.
 fn exr_offset_table(bytes: &[u8]) -> (usize, usize) {

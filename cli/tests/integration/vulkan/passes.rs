@@ -1,74 +1,16 @@
-//! The backend-neutral passes (src/pass/): every parameter block laid out as the GL compiler
-//! lays out its GLSL mirror; GL against Vulkan for every full-screen pass under all eight
-//! conventions; the commands' `--backend vulkan` runs writing what their GL runs write; and
-//! those runs clean under the Khronos validation layer. A missing Vulkan loader, driver or
-//! validation layer fails these tests, never skips them.
-//!
-//! GL-vs-Vulkan bounds (the issue of record's agreement rule, `eval::backends`): masks differ
-//! on at most 0.5 % of pixels, colour within one level on at least 99.5 %, depth within 1e-4
-//! relative on at least 99.5 % of the pixels valid in both. Why they hold: both executors run
-//! the same GLSL on the same f32 inputs (images in the same memory rows, parameter blocks of
-//! identical bytes), so the outputs differ only where the two compilers (Mesa's GLSL front end
-//! against glslang + SPIR-V to NIR) order or fuse f32 arithmetic differently. Each pass's own
-//! GPU-vs-f64 derivation (cli/tests/integration/{reproject,scene,stitch,cyclopean}.rs) bounds either
-//! backend's distance to the twin by e (depth: 3e-5 reproject, 2e-5 scene and gather), so two
-//! backends are within 2e of each other, inside 1e-4; a decision (mask, surface, rounding tie)
-//! flips only for values within a few ulp of a threshold, which the twin tests put at under
-//! 0.1 % of pixels per backend. Measured values are printed.
+//! The commands on `--backend vulkan`: reproject, stitch, scene, cyclopean and the refocus
+//! batch write what their GL runs write, under the agreement rule of `eval::backends` (bounds
+//! derived in `viewsynth_tests`' `vulkan::passes`), and every pass runs clean under the Khronos
+//! validation layer. A missing Vulkan loader, driver or validation layer fails, never skips.
 
 use crate::cli::{bin, scratch};
-use crate::common::{cyclopean_cli, data_dir, gpu, write_cyclopean_files};
-use crate::common::vulkan;
+use crate::common::{cyclopean_cli, data_dir, write_cyclopean_files};
 use std::path::Path;
 use viewsynth::convention::Conventions;
-use viewsynth::cyclopean::forward::{ForwardParams, ForwardWarp};
-use viewsynth::cyclopean::render::{CyclopeanRenderer, GatherParams};
 use viewsynth::cyclopean::scene_frame::{scene_frame, StereoRig};
-use viewsynth::cyclopean::splat::{EdgeSnapBlock, SplatBlock, SplatGatherBlock, SplatParams, SplatRenderer};
-use viewsynth::cyclopean::{CyclopeanOutputs, CyclopeanParams, FrameDepth, Method};
-use viewsynth::gpu::shaders::{ShiftDepth, StitchBlend};
-use viewsynth::gpu::{ProgramKind, ShaderProgram};
-use viewsynth::pass::{Device, ParamBlock};
-use viewsynth::refocus::{BreakRule, RefocusParams};
-use viewsynth::reproject::render::ShiftParams;
-use viewsynth::reproject::{self, ReprojectInput};
-use viewsynth::scene::gpu::{GlCamera, RaytraceParams, SceneRenderer};
-use viewsynth::stitch::faces::scene_faces;
-use viewsynth::stitch::render::StitchBlock;
-use viewsynth::stitch::{self, Method as StitchMethod, OdsRig, Side, StitchInput, StitchParams};
+use viewsynth::cyclopean::FrameDepth;
 use viewsynth::view::ViewOutput;
-use viewsynth::vulkan::VkExecutor;
 use viewsynth_lab::eval::backends::{backend_diff, BackendDiff};
-use viewsynth_lab::eval::reproject::{methods, scene_cases};
-
-/// Rust offsets and size against what the GL compiler reports for `P`'s block in `program`.
-fn check_block<P: ParamBlock>(program: ProgramKind) {
-    let g = gpu();
-    let built = ShaderProgram::new(Conventions::default(), program).build(&g).unwrap();
-    let (size, members) = built
-        .uniform_block_layout(P::BLOCK)
-        .unwrap_or_else(|| panic!("{}: no uniform block {}", program.name(), P::BLOCK));
-    // std140 rounds a block's size up to a multiple of 16 bytes.
-    assert_eq!(
-        size,
-        std::mem::size_of::<P>().div_ceil(16) * 16,
-        "{}: block size",
-        P::BLOCK
-    );
-    assert_eq!(members.len(), P::FIELDS.len(), "{}: members {members:?}", P::BLOCK);
-    for (name, offset) in &members {
-        let name = name.strip_suffix("[0]").unwrap_or(name);
-        let rust = P::FIELDS
-            .iter()
-            .find(|(f, _)| *f == name)
-            .unwrap_or_else(|| panic!("{}: GLSL member {name} has no Rust field", P::BLOCK));
-        assert_eq!(rust.1, *offset, "{}: offset of {name}", P::BLOCK);
-    }
-}
-
-fn devices() -> (Device, Device) {
-    (Device::gl(&gpu()).unwrap(), VkExecutor::device(&vulkan()).unwrap())
-}
 
 fn assert_agree(tag: &str, d: &BackendDiff) {
     println!("{tag}: {d:?}");

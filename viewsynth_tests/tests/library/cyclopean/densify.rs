@@ -5,11 +5,11 @@
 //! Bounds, from the numerics: the densify rule compares integer weights and f32 disparities and
 //! copies a disparity, so the GPU's maps must be the twin's bit for bit (no pixel excused).
 
-use viewsynth_tests::{data_dir, gpu};
 use viewsynth::cyclopean::densify::{densify_reference, Densifier, FILLED};
 use viewsynth::cyclopean::matcher::estimate_disparities;
 use viewsynth::io::{load_rgb, DepthMap, RgbImage};
 use viewsynth::pass::Device;
+use viewsynth_tests::{data_dir, gpu};
 
 /// Cones' left image and the matcher's left disparities (13 % unknown), cropped to keep the
 /// twin quick.

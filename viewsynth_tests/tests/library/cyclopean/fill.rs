@@ -9,13 +9,13 @@
 //! rounds half away from zero: one level at most. Depth: the same mean, a few ulp (bound 1e-5
 //! relative). A 40-level error in any filled pixel fails.
 
-use viewsynth_tests::gpu;
 use viewsynth::convention::Conventions;
 use viewsynth::cyclopean::fill::{fill_reference, Filler, FILLED};
 use viewsynth::cyclopean::scene_frame::{scene_frame, StereoRig};
 use viewsynth::cyclopean::splat::{SplatParams, SplatRenderer};
 use viewsynth::cyclopean::{CyclopeanOutput, CyclopeanOutputs, FrameDepth};
 use viewsynth::pass::Device;
+use viewsynth_tests::gpu;
 
 /// The built-in scene's middle view (disocclusions at every object edge) with extra holes: a
 /// deterministic scatter of single pixels and runs, so both rules (background side, one surface)

@@ -12,19 +12,17 @@
 //! near 0.05 m that is ~5e-6 relative, so 2e-5 is the bound. So one pixel 40 levels off fails.
 //! The excused share is bounded (see [`MAX_AMBIGUOUS`]) so that the comparison keeps its power.
 
-use viewsynth_tests::{gpu, methods};
 use viewsynth::convention::Conventions;
 use viewsynth::cyclopean::reference::{ambiguity, cyclopean_reference};
 use viewsynth::cyclopean::render::CyclopeanRenderer;
 use viewsynth::cyclopean::scene_frame::{scene_frame, MiddleTruth, StereoRig};
 use viewsynth::cyclopean::{
-    pass, CyclopeanInput, CyclopeanOutput, CyclopeanOutputs, CyclopeanParams, CyclopeanPass, Eye, FrameDepth,
-    Method,
+    pass, CyclopeanInput, CyclopeanOutput, CyclopeanOutputs, CyclopeanParams, CyclopeanPass, Eye, FrameDepth, Method,
 };
 use viewsynth::metrics;
 use viewsynth::view::ViewOutput;
 use viewsynth_lab::eval::image_check;
-
+use viewsynth_tests::{gpu, methods};
 
 /// Largest share of the frame the twin may mark ambiguous. Measured when written: at most
 /// 1.49 % over the 48 cases (the marks are the twin's, the same for GL and Vulkan; they follow

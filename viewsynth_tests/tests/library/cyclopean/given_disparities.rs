@@ -3,11 +3,11 @@
 //! renders it from geometry; only true disocclusions reach the colour fill. The densify pass on
 //! given disparities against its twin on both executors, bit for bit as for the matcher's maps.
 
-use viewsynth_tests::{data_dir, gpu};
 use viewsynth::cyclopean::densify::{densify_reference, Densifier, FILLED};
 use viewsynth::io::{load_depth_with_key, load_rgb, DepthMap, RgbImage, MASK_FILLED};
 use viewsynth::job::cyclopean::{CyclopeanRequest, InputName, StereoInput, StereoKind};
 use viewsynth::pass::Device;
+use viewsynth_tests::{data_dir, gpu};
 
 /// A textured plane at disparity 4 (texture `t(x, y)` in the middle view's columns): the middle
 /// view is `t`, the left image `t(x - 2)`, the right `t(x + 2)`. Both maps are 4 but for a square

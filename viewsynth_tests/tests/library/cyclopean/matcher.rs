@@ -16,12 +16,12 @@
 //! rounded sum. So validity must agree everywhere and |d_gpu - d_twin| must be 0; on failure
 //! both disparity maps and their difference are written (eval::image_check).
 
-use viewsynth_tests::{data_dir, gpu, max_abs_difference};
 use viewsynth::cyclopean::matcher::sgm::Plan;
 use viewsynth::cyclopean::matcher::{confidence_reference, estimate_disparities, Matcher, MatcherMethod};
 use viewsynth::io::{load_rgb, DepthMap, RgbImage};
 use viewsynth::pass::Device;
 use viewsynth_lab::eval::image_check::{ensure, Plane};
+use viewsynth_tests::{data_dir, gpu, max_abs_difference};
 
 /// The GPU's maps against the twin's, both eyes: the same pixels known, the same values.
 fn check(what: &str, gpu: (DepthMap, DepthMap), twin: &(DepthMap, DepthMap)) {

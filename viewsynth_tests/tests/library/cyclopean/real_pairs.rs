@@ -12,7 +12,6 @@
 //! relative (the f32 error of the chain, ~1e-6; as for the gather method). So one pixel 40 levels
 //! off fails. The marked share is bounded per case (see `splat_gather_twin`).
 
-use viewsynth_tests::{data_dir, gpu};
 use std::path::PathBuf;
 use viewsynth::camera::{gl_projection, Intrinsics, PinholeCamera};
 use viewsynth::convention::Conventions;
@@ -28,6 +27,7 @@ use viewsynth::cyclopean::{CyclopeanOutput, CyclopeanOutputs, CyclopeanParams, F
 use viewsynth::io::{self, DepthDecode, DepthMap, RgbImage};
 use viewsynth::metrics;
 use viewsynth_lab::eval::cyclopean::{estimated_cases, estimated_eyes};
+use viewsynth_tests::{data_dir, gpu};
 
 fn splat_gpu(frame: &StereoFrame, mid: &viewsynth::cyclopean::MiddleCamera) -> CyclopeanOutput {
     splat_on(&viewsynth::pass::Device::gl(&gpu()).unwrap(), frame, mid)

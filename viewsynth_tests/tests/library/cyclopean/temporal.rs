@@ -15,7 +15,6 @@
 //! they cluster (a wall facing the camera puts a whole texel row at one window y, so a row
 //! inside the band excuses its pixels at once); 2.5 % at most when written.
 
-use viewsynth_tests::gpu;
 use viewsynth::camera::mat4;
 use viewsynth::convention::{Conventions, RowOrder};
 use viewsynth::cyclopean::render::CyclopeanRenderer;
@@ -24,6 +23,7 @@ use viewsynth::cyclopean::temporal::{carried, Accumulator, TemporalAccumulator, 
 use viewsynth::cyclopean::{CyclopeanOutput, CyclopeanParams, FrameDepth, Method, MiddleCamera};
 use viewsynth::pass::Device;
 use viewsynth_lab::eval::image_check::{self, Plane};
+use viewsynth_tests::gpu;
 
 /// Middle views of the scene from a head at `at` (right eye's depth emptied: holes), rendered
 /// on GL whatever device accumulates them.

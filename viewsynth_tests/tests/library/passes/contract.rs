@@ -3,7 +3,6 @@
 //! the GPU view carries its timing and the twin view its unrounded values, and both sides leave
 //! out the same planes when an output is not asked for.
 
-use viewsynth_tests::{gpu, synthetic};
 use viewsynth::convention::Conventions;
 use viewsynth::cyclopean::reference::cyclopean_reference;
 use viewsynth::cyclopean::render::CyclopeanRenderer;
@@ -22,6 +21,7 @@ use viewsynth::stitch::render::StitchRenderer;
 use viewsynth::stitch::{self, OdsRig, Side, StitchInput, StitchParams};
 use viewsynth::view::ViewOutput;
 use viewsynth_lab::eval::reproject::scene_cases;
+use viewsynth_tests::{gpu, synthetic};
 
 /// A convention other than the default, so the input's conventions reach the GPU side.
 fn other_conventions() -> Conventions {

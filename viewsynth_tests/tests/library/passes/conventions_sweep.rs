@@ -21,12 +21,12 @@
 //! sits at the threshold (65 x 49, reversed-Z), one or two pixels of the reprojection scans. That
 //! run is a diagnostic, not part of the rule.
 
-use viewsynth_tests::gpu;
 use viewsynth::convention::Conventions;
 use viewsynth::cyclopean::FrameDepth;
 use viewsynth::pass::Device;
 use viewsynth::view::ViewOutput;
 use viewsynth_lab::passes::{PassCase, PassInputs};
+use viewsynth_tests::gpu;
 
 /// Relative depth agreement: 4 f32 roundings of window depth at z / near = 160 under standard Z
 /// where the pass reads device depth, 1e-6 (reordered f32 arithmetic) otherwise.

@@ -3,7 +3,6 @@
 //! and refuses one past it with the same message: the parameter, the size and the limit.
 //! One-row images keep the oversized cases cheap.
 
-use viewsynth_tests::gpu;
 use viewsynth::camera::stereo::Eye;
 use viewsynth::camera::{gl_projection, Intrinsics, PinholeCamera, Pose};
 use viewsynth::convention::{Conventions, DepthPlanes};
@@ -22,6 +21,7 @@ use viewsynth::stitch::faces::scene_faces;
 use viewsynth::stitch::render::StitchRenderer;
 use viewsynth::stitch::{Method as StitchMethod, OdsRig, Side, StitchParams};
 use viewsynth::Error;
+use viewsynth_tests::gpu;
 
 /// The one refusal: `invalid <name>: <w>x<h> exceeds this GPU's limit of <limit>`; returns the
 /// parameter name.

@@ -2,10 +2,10 @@
 //! (NDC range x reversed-Z x row order) on this context, and every GLSL file under shaders/ is
 //! used by some program (a file no program lists would never be compiled by any test).
 
-use viewsynth_tests::gpu;
 use std::collections::BTreeSet;
 use viewsynth::convention::Conventions;
 use viewsynth::gpu::ShaderProgram;
+use viewsynth_tests::gpu;
 
 #[test]
 fn every_program_compiles_and_links_under_every_convention() {

@@ -13,13 +13,13 @@
 //!   of a kept edge from outside: IoU >= 0.999 (lowest measured on llvmpipe over 7 scales x 3
 //!   sizes: SUN 0.999425, TUM 0.999648, synthetic 0.999852, NYU 1.0).
 
-use viewsynth_tests::*;
 use viewsynth::camera::PinholeCamera;
 use viewsynth::convention::Conventions;
 use viewsynth::pass::Device;
 use viewsynth::refocus::manifest::TargetSpec;
 use viewsynth::refocus::{pass, BreakRule, Method, OutputSet, RefocusInput, RefocusSource, Refocuser};
 use viewsynth_lab::eval::image_check;
+use viewsynth_tests::*;
 
 const SCALES: [f64; 7] = [0.25, 0.5, 0.75, 1.0, 1.5, 2.0, 4.0];
 

@@ -2,7 +2,6 @@
 //! the manifest, resume that redoes frames whose settings or files changed, and frame folders
 //! that cannot lead outside --out-dir.
 
-use viewsynth_tests::gpu;
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 use viewsynth::convention::Conventions;
@@ -11,6 +10,7 @@ use viewsynth::io::{self, Encoding, PngCompression};
 use viewsynth::refocus::batch::{load_manifest, run_batch, BatchOptions, Shard};
 use viewsynth::refocus::{BreakRule, Method, OutputSet};
 use viewsynth::scene;
+use viewsynth_tests::gpu;
 
 /// A scratch folder with two distinct scene frames listed `n` times in a manifest.
 fn setup(name: &str, n: usize) -> (tempfile::TempDir, PathBuf) {

@@ -2,10 +2,10 @@
 //! reversed-Z x row order gives the same mask and depth within 1e-6 relative (f32 rounding of
 //! differently ordered arithmetic), for both paths.
 
-use viewsynth_tests::*;
 use viewsynth::convention::Conventions;
 use viewsynth::refocus::manifest::TargetSpec;
 use viewsynth::refocus::{BreakRule, Method, OutputSet, Refocuser};
+use viewsynth_tests::*;
 
 #[test]
 fn all_conventions_give_the_same_output() {

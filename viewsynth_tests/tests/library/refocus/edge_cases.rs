@@ -1,11 +1,11 @@
 //! Degenerate and extreme inputs: every output finite, and a stated rule for each.
 
-use viewsynth_tests::*;
 use viewsynth::camera::{Intrinsics, PinholeCamera};
 use viewsynth::convention::Conventions;
 use viewsynth::io::{DepthMap, RgbImage};
 use viewsynth::refocus::manifest::TargetSpec;
 use viewsynth::refocus::{BreakRule, Method, OutputSet, RefocusSource, Refocuser};
+use viewsynth_tests::*;
 
 fn source(w: u32, h: u32, depth: Vec<f32>) -> RefocusSource {
     let rgb: Vec<u8> = (0..w * h * 3).map(|i| (i * 53 % 256) as u8).collect();

@@ -25,11 +25,11 @@
 //! seed). Beyond the ring (outside [-0.5, W - 0.5]) nothing may be valid (§1, "new areas remain
 //! invalid").
 
-use viewsynth_tests::{gpu, real_frame};
 use viewsynth::camera::{Intrinsics, PinholeCamera};
 use viewsynth::convention::Conventions;
 use viewsynth::io::{DepthMap, RgbImage};
 use viewsynth::refocus::{BreakRule, Method, OutputSet, RefocusSource, Refocuser};
+use viewsynth_tests::{gpu, real_frame};
 
 /// Local coordinates closer than this to a cell side or the diagonal are ties (the GPU locates
 /// points in f64 and tests them in f32 with a 1e-5 cell tolerance: 1e-4 leaves 10x room).

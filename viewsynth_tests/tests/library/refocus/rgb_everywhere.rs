@@ -12,7 +12,6 @@
 //!   pixels are inside the frame is decided in f64 by the same span on both sides
 //!   ([`viewsynth::refocus::frame_span`]), so outside it both are exactly 0.
 
-use viewsynth_tests::*;
 use viewsynth::camera::PinholeCamera;
 use viewsynth::convention::Conventions;
 use viewsynth::metrics;
@@ -20,6 +19,7 @@ use viewsynth::pass::Device;
 use viewsynth::refocus::manifest::TargetSpec;
 use viewsynth::refocus::reference::{bilinear_rgb, refocus_reference_with, ReferenceImage};
 use viewsynth::refocus::{source_point, BreakRule, Method, OutputSet, RefocusOutput, RefocusSource, Refocuser};
+use viewsynth_tests::*;
 
 const SCALES: [f64; 3] = [0.5, 1.0, 2.0];
 

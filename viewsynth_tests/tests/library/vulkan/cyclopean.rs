@@ -1,6 +1,6 @@
 //! GL against a real Vulkan run of the same cyclopean gather shader (Mesa lavapipe in CI): for
 //! every convention combination, both depth kinds and the seed/refine methods of
-//! cli/tests/integration/cyclopean.rs, on the built-in scene's stereo frame, the middle views agree:
+//! viewsynth_tests/tests/library/cyclopean/gather.rs, on the built-in scene's stereo frame, the middle views agree:
 //! source bits (and so the mask) identical, colour within one 8-bit level, depth within
 //! DEPTH_REL_BOUND. The `viewsynth cyclopean --backend vulkan` run writes the same view, and
 //! the methods Vulkan does not run are refused by name. A missing Vulkan loader or driver fails
@@ -12,7 +12,7 @@
 //! each compiler (Mesa's GLSL front end vs glslang + SPIR-V to NIR) orders or fuses the f32
 //! arithmetic of the walk.
 //! - depth: the middle depth is reconstructed in f32 from the eye's stored depth; the GL pass is
-//!   within 2e-5 relative of the f64 twin (cli/tests/integration/cyclopean.rs derives it: the f32
+//!   within 2e-5 relative of the f64 twin (viewsynth_tests/tests/library/cyclopean/gather.rs derives it: the f32
 //!   error of reconstructing from device depth with standard Z at 6 m and near 0.05 m is ~5e-6
 //!   relative, with a factor 4 of headroom). The Vulkan pass computes the same expression in f32
 //!   with possibly another rounding order, which is inside the same derivation, so it meets the
@@ -25,14 +25,14 @@
 //!   never on these frames (none happened when written), so asserted identical, as the brief of
 //!   the GL-vs-Vulkan comparison asks.
 
-use viewsynth_tests::gpu;
-use viewsynth_tests::methods;
-use viewsynth_tests::vulkan;
 use viewsynth::convention::Conventions;
 use viewsynth::cyclopean::render::CyclopeanRenderer;
 use viewsynth::cyclopean::scene_frame::{scene_frame, StereoRig};
 use viewsynth::cyclopean::{CyclopeanOutput, CyclopeanParams, FrameDepth};
 use viewsynth::vulkan::VkExecutor;
+use viewsynth_tests::gpu;
+use viewsynth_tests::methods;
+use viewsynth_tests::vulkan;
 
 /// Derivation above.
 const DEPTH_REL_BOUND: f64 = 4e-5;
@@ -85,7 +85,7 @@ fn gather_pass_gl_and_vulkan_agree_under_every_convention_depth_kind_and_method(
     eprintln!("| conventions | valid px | source mismatches | worst colour (levels) | colour values off by 1 | worst depth rel | GL ms | Vulkan ms |");
     eprintln!("|---|---|---|---|---|---|---|---|");
     let mut rig = StereoRig::demo(160, 120);
-    // As cli/tests/integration/cyclopean.rs: a wide baseline, so each eye has disocclusions.
+    // As viewsynth_tests/tests/library/cyclopean/gather.rs: a wide baseline, so each eye has disocclusions.
     rig.ipd = 0.2;
     for conv in Conventions::all() {
         let mut row = Diff::default();

@@ -10,14 +10,12 @@
 //! the same GLSL on the same f32 inputs (images in the same memory rows, parameter blocks of
 //! identical bytes), so the outputs differ only where the two compilers (Mesa's GLSL front end
 //! against glslang + SPIR-V to NIR) order or fuse f32 arithmetic differently. Each pass's own
-//! GPU-vs-f64 derivation (cli/tests/integration/{reproject,scene,stitch,cyclopean}.rs) bounds either
+//! GPU-vs-f64 derivation (viewsynth_tests/tests/library/{reproject,scene,stitch,cyclopean/gather}.rs) bounds either
 //! backend's distance to the twin by e (depth: 3e-5 reproject, 2e-5 scene and gather), so two
 //! backends are within 2e of each other, inside 1e-4; a decision (mask, surface, rounding tie)
 //! flips only for values within a few ulp of a threshold, which the twin tests put at under
 //! 0.1 % of pixels per backend. Measured values are printed.
 
-use viewsynth_tests::gpu;
-use viewsynth_tests::vulkan;
 use viewsynth::convention::Conventions;
 use viewsynth::cyclopean::forward::{ForwardParams, ForwardWarp};
 use viewsynth::cyclopean::render::{CyclopeanRenderer, GatherParams};
@@ -38,6 +36,8 @@ use viewsynth::view::ViewOutput;
 use viewsynth::vulkan::VkExecutor;
 use viewsynth_lab::eval::backends::{backend_diff, BackendDiff};
 use viewsynth_lab::eval::reproject::{methods, scene_cases};
+use viewsynth_tests::gpu;
+use viewsynth_tests::vulkan;
 
 /// Rust offsets and size against what the GL compiler reports for `P`'s block in `program`.
 fn check_block<P: ParamBlock>(program: ProgramKind) {
@@ -200,7 +200,7 @@ fn stitch_methods_agree_between_gl_and_vulkan_under_every_convention() {
 /// The splat-gather method (edge snap, splat with atomics, gather listing edge pixels, indirect
 /// edge pass rewriting the colour) on both executors, under every convention and both depth
 /// kinds, with and without colour (no colour: no edge pass). Its twin check on Vulkan is in
-/// cli/tests/integration/cyclopean_real.rs.
+/// viewsynth_tests/tests/library/cyclopean/real_pairs.rs.
 #[test]
 fn splat_gather_agrees_between_gl_and_vulkan_under_every_convention() {
     let (gl, vk) = devices();

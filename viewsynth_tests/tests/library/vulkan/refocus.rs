@@ -19,16 +19,15 @@
 //! - colour: the bilinear mix is f32 in both; only values within an f32 rounding of a k + 0.5
 //!   tie may round to different bytes: one level.
 
-use viewsynth_tests::*;
 use viewsynth::convention::Conventions;
 use viewsynth::io::{DepthMap, RgbImage};
 use viewsynth::refocus::manifest::TargetSpec;
 use viewsynth::refocus::{BreakRule, Method, OutputSet, RefocusOutput, RefocusSource, Refocuser};
 use viewsynth::vulkan::VkExecutor;
+use viewsynth_tests::*;
 
 /// 32 ulp of f32 relative (derivation above).
 const DEPTH_REL_BOUND: f32 = 32.0 / (1u32 << 24) as f32;
-
 
 /// Largest differences of one GL/Vulkan pair.
 #[derive(Default, Debug, Clone, Copy)]
