@@ -49,7 +49,7 @@ fn valid_non_finite(v: &viewsynth::view::ViewOutput) -> usize {
 }
 
 #[test]
-fn round3_library_passes_refuse_unusable_depth_and_are_finite_where_valid() {
+fn library_passes_refuse_unusable_depth_and_are_finite_where_valid() {
     use viewsynth::cyclopean::forward::ForwardWarp;
     use viewsynth::cyclopean::scene_frame::{scene_frame, StereoRig};
     use viewsynth::cyclopean::splat::SplatParams;
@@ -353,7 +353,7 @@ fn round3_library_passes_refuse_unusable_depth_and_are_finite_where_valid() {
 }
 
 #[test]
-fn round3_output_rule_invalidates_non_finite_depth() {
+fn output_rule_invalidates_non_finite_depth() {
     use viewsynth::view::clear_non_finite;
     let mut depth = vec![1.0, f32::NAN, f32::INFINITY, -f32::INFINITY, 2.0, f32::NAN];
     let mut mask = vec![255, 255, 1, 0, 255, 0];

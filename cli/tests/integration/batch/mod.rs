@@ -8,3 +8,5 @@ mod memory_flat;
 pub(crate) mod resume;
 /// `viewsynth manifest` from a TUM-style sequence.
 mod tum_manifest;
+/// Resume that verifies folders and float settings.
+mod verify;
