@@ -18,6 +18,13 @@ cargo build --release --locked --bin viewsynth
 export PYO3_PYTHON="$VENV/bin/python"
 cargo fmt --manifest-path python/Cargo.toml --check
 cargo clippy --manifest-path python/Cargo.toml --release --locked --all-targets -- -D warnings
+# `compare` and nv-flip's C++ are the command line's only: the extension builds without them
+# (issue 45; tests/features.rs reads the manifests, this asks cargo).
+python_tree=$(cargo tree --manifest-path python/Cargo.toml --locked -e normal,build --prefix none)
+if grep -q '^nv-flip ' <<<"$python_tree"; then
+  echo "python extension depends on nv-flip: build viewsynth without its compare feature" >&2
+  exit 1
+fi
 # Small single-purpose files: none under python/src over 500 lines (issue 37; each capability's
 # Renderer method lives in its own file, so renderer.rs does not grow with each capability).
 too_long=$(find python/src -type f -exec awk 'END { if (NR > 500) print FILENAME ": " NR " lines" }' {} \;)

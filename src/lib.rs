@@ -33,7 +33,8 @@
 //! - [`cyclopean`]: the middle (spectator) view of a stereo pair, five methods.
 //! - [`reproject`]: one view of a stereo rig to another eye.
 //! - [`stitch`]: ODS 360 equirects from over-wide cube faces.
-//! - [`compare`]: two renderings compared across conventions, with CI thresholds.
+//! - [`compare`]: two renderings compared across conventions, with CI thresholds (feature
+//!   `compare`, on by default; the command line needs it, the Python package builds without it).
 //! - [`pass`]: backend-neutral pass descriptions and the vocabulary both executors share (the
 //!   shader library, timing, the GPU policy, the image-size rule); it knows no backend. [`gpu`]
 //!   holds the GL executor beside the GL layer, [`vulkan`] the Vulkan backend (ash) with its
@@ -48,6 +49,7 @@
 
 pub mod alloc;
 pub mod camera;
+#[cfg(feature = "compare")]
 pub mod compare;
 pub mod convention;
 pub mod cpu_time;

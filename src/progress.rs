@@ -1,10 +1,7 @@
-//! Progress of long library runs (`demo`, `report`), handed to the caller rather than printed:
-//! the library names each stage as it starts, and the caller shows it as it likes (the CLI: a
-//! bar on a terminal, a log line per stage otherwise). For counted work (batch frames) the
-//! rule of the log line is here too, so that the CLI and the Python package write the same
-//! lines where no terminal shows a bar: [`CountLog`].
+//! The log line of counted work (batch frames) where no terminal shows a bar, here so that the
+//! CLI and the Python package write the same lines: [`CountLog`]. (The stages of the lab's long
+//! runs, `demo` and `report`, are the lab's: `viewsynth_lab::progress`.)
 
-use std::cell::Cell;
 use std::time::{Duration, Instant};
 
 /// How often a [`CountLog`] writes its line: often enough to show a run is alive in a log, rare
@@ -76,61 +73,9 @@ pub fn count_line(what: &str, done: u64, total: u64, elapsed: Duration) -> Strin
     format!("{what}: {done}/{total} ({pct:.1} %), {rate:.2} /s, ETA {eta}")
 }
 
-/// Receives the stages of a long run.
-pub trait Progress {
-    /// Stage `index` (1-based) of `total` starts; `label` says what it does.
-    fn stage(&self, index: usize, total: usize, label: &str);
-}
-
-/// Reports nothing: for callers that do not watch.
-pub struct Silent;
-
-impl Progress for Silent {
-    fn stage(&self, _: usize, _: usize, _: &str) {}
-}
-
-/// A run of a known number of stages, numbered as they start.
-pub struct Stages<'a> {
-    sink: &'a dyn Progress,
-    total: usize,
-    started: Cell<usize>,
-}
-
-impl<'a> Stages<'a> {
-    /// A run of `total` stages reported to `sink`; none has started.
-    pub fn new(sink: &'a dyn Progress, total: usize) -> Self {
-        Stages {
-            sink,
-            total,
-            started: Cell::new(0),
-        }
-    }
-
-    /// The next stage starts. A run that starts more stages than announced reports the larger
-    /// count rather than an index beyond the total.
-    pub fn start(&self, label: &str) {
-        let index = self.started.get() + 1;
-        self.started.set(index);
-        self.sink.stage(index, self.total.max(index), label);
-    }
-
-    /// Stages started so far.
-    pub fn started(&self) -> usize {
-        self.started.get()
-    }
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
-    use std::cell::RefCell;
-
-    struct Log(RefCell<Vec<(usize, usize, String)>>);
-    impl Progress for Log {
-        fn stage(&self, index: usize, total: usize, label: &str) {
-            self.0.borrow_mut().push((index, total, label.to_string()));
-        }
-    }
 
     #[test]
     fn count_line_gives_rate_and_eta() {
@@ -153,24 +98,5 @@ mod tests {
         assert_eq!(written, [0, 2, 4]);
         assert_eq!(lines[0].as_deref(), Some("frames: 1/5 (20.0 %), 1.00 /s, ETA 0m04s"));
         assert_eq!(lines[4].as_deref(), Some("frames: 5/5 (100.0 %), 0.38 /s, ETA 0m00s"));
-    }
-
-    #[test]
-    fn stages_are_numbered_in_order_and_never_past_the_total() {
-        let log = Log(RefCell::new(Vec::new()));
-        let stages = Stages::new(&log, 2);
-        for label in ["a", "b", "c"] {
-            stages.start(label);
-        }
-        assert_eq!(stages.started(), 3);
-        let got = log.0.into_inner();
-        assert_eq!(
-            got,
-            [
-                (1, 2, "a".to_string()),
-                (2, 2, "b".to_string()),
-                (3, 3, "c".to_string())
-            ]
-        );
     }
 }

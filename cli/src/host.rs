@@ -1,4 +1,4 @@
-//! The command line as a job's [`Host`]: opens the GPU (warning loudly when it renders in
+//! The command line as a job's [`Host`] (and a lab job's [`LabHost`]): opens the GPU (warning loudly when it renders in
 //! software although hardware is visible, with a note when no hardware is), prints the input summaries and notes to stderr, and
 //! shows progress.
 
@@ -6,7 +6,8 @@ use crate::progress::{Progress, StageProgress};
 use std::cell::RefCell;
 use viewsynth::gpu::Gpu;
 use viewsynth::job::{Event, GpuRequest, Host};
-use viewsynth::progress::Progress as _;
+use viewsynth_lab::job::{LabEvent, LabHost};
+use viewsynth_lab::progress::Progress as _;
 
 #[derive(Default)]
 pub(crate) struct CliHost {
@@ -76,12 +77,6 @@ impl Host for CliHost {
                 };
                 errln!("disparity range {min}..{max} px ({how}; --min-disparity/--max-disparity override it)");
             }
-            Event::EmptyDataDir(d) => {
-                errln!(
-                    "note: --data-dir {} is empty: the real-data rows are skipped",
-                    d.display()
-                );
-            }
             Event::Started { what, total } => *self.progress.borrow_mut() = Some(Progress::new(what, total)),
             Event::Advanced => {
                 if let Some(p) = self.progress.borrow().as_ref() {
@@ -96,7 +91,20 @@ impl Host for CliHost {
                     s.finish();
                 }
             }
-            Event::Stage { index, total, label } => self
+        }
+    }
+}
+
+impl LabHost for CliHost {
+    fn lab_event(&self, event: LabEvent<'_>) {
+        match event {
+            LabEvent::EmptyDataDir(d) => {
+                errln!(
+                    "note: --data-dir {} is empty: the real-data rows are skipped",
+                    d.display()
+                );
+            }
+            LabEvent::Stage { index, total, label } => self
                 .stages
                 .borrow_mut()
                 .get_or_insert_with(StageProgress::new)

@@ -6,7 +6,7 @@
 //! - 2: anything wrong with the command line: it does not parse (clap's own usage error,
 //!   printed with `try '--help'`; a malformed `--shard` included), or a value parses but the
 //!   job's conversion refuses it (out of range, conflicting options;
-//!   [`viewsynth::job::ArgError::is_usage`]);
+//!   [`viewsynth::job::ArgError::is_usage`], [`viewsynth_lab::job::ArgError::is_usage`]);
 //! - 1: anything found while running: inputs (a file named by an option included), the GPU,
 //!   output files, a failed batch frame or stress case, a broken compare threshold;
 //! - killed by SIGPIPE (141 in a shell): stdout or stderr was closed early (`| head`).
@@ -186,17 +186,47 @@ const RUN_ERROR: u8 = 1;
 /// Exit status of a command line that is wrong (clap uses the same for what it refuses).
 const USAGE_ERROR: u8 = 2;
 
-/// A conversion's refusal of the command line (exit 2), told apart from run errors in `main`.
-#[derive(Debug, thiserror::Error)]
-#[error(transparent)]
-struct Usage(viewsynth::job::ArgError);
+/// A conversion's refusal of the command line (exit 2), told apart from run errors in `main`;
+/// it reads as the refusal it holds (its message, then its causes).
+#[derive(Debug)]
+struct Usage(Box<dyn std::error::Error + Send + Sync>);
+
+impl std::fmt::Display for Usage {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        self.0.fmt(f)
+    }
+}
+
+impl std::error::Error for Usage {
+    fn source(&self) -> Option<&(dyn std::error::Error + 'static)> {
+        self.0.source()
+    }
+}
+
+/// A job conversion's refusal: the library's or the lab's, each saying whether the command
+/// line itself is at fault.
+trait Refusal: std::error::Error + Send + Sync + 'static {
+    fn is_usage(&self) -> bool;
+}
+
+impl Refusal for viewsynth::job::ArgError {
+    fn is_usage(&self) -> bool {
+        viewsynth::job::ArgError::is_usage(self)
+    }
+}
+
+impl Refusal for viewsynth_lab::job::ArgError {
+    fn is_usage(&self) -> bool {
+        viewsynth_lab::job::ArgError::is_usage(self)
+    }
+}
 
 /// The job a command's options convert to; a refusal of the command line itself becomes
 /// [`Usage`], one found in a file an option names stays a run error.
-fn job<A, J: TryFrom<A, Error = viewsynth::job::ArgError>>(args: A) -> Result<J> {
+fn job<A, J: TryFrom<A, Error = E>, E: Refusal>(args: A) -> Result<J> {
     J::try_from(args).map_err(|e| {
         if e.is_usage() {
-            anyhow::Error::new(Usage(e))
+            anyhow::Error::new(Usage(Box::new(e)))
         } else {
             anyhow::Error::new(e)
         }

@@ -53,7 +53,7 @@ impl Progress {
     }
 }
 
-/// The library's stage reports ([`viewsynth::progress::Progress`]) for `demo` and `report`: on a
+/// The lab's stage reports ([`viewsynth_lab::progress::Progress`]) for `demo` and `report`: on a
 /// terminal a bar whose message is the running stage and whose clock keeps ticking through long
 /// stages; otherwise a log line when a stage starts and every [`LOG_EVERY`] while it runs.
 pub(crate) struct StageProgress {
@@ -149,7 +149,7 @@ impl Drop for StageProgress {
     }
 }
 
-impl viewsynth::progress::Progress for StageProgress {
+impl viewsynth_lab::progress::Progress for StageProgress {
     fn stage(&self, index: usize, total: usize, label: &str) {
         if let Some(bar) = &self.bar {
             bar.set_length(total as u64);

@@ -19,7 +19,7 @@ pub const DEMO_SCALES: [f64; 5] = viewsynth::refocus::manifest::DEFAULT_SCALES;
 
 /// Run the demo into `out_dir`; returns the report, its files and, last, refocus_check.md.
 pub fn run(device: &Device, out_dir: &Path) -> Result<WrittenReport> {
-    run_with_progress(device, out_dir, &viewsynth::progress::Silent)
+    run_with_progress(device, out_dir, &crate::progress::Silent)
 }
 
 /// [`run`] with each stage reported to `progress` as it starts: the two refocus methods, the
@@ -27,9 +27,9 @@ pub fn run(device: &Device, out_dir: &Path) -> Result<WrittenReport> {
 pub fn run_with_progress(
     device: &Device,
     out_dir: &Path,
-    progress: &dyn viewsynth::progress::Progress,
+    progress: &dyn crate::progress::Progress,
 ) -> Result<WrittenReport> {
-    let stages = viewsynth::progress::Stages::new(progress, 5 + crate::eval::report_stage_count(None, &[]));
+    let stages = crate::progress::Stages::new(progress, 5 + crate::eval::report_stage_count(None, &[]));
     // Subfolders through OutDir::subdir: a symlinked one is refused, never written through.
     // All of them first, so a refused one fails the run before any rendering.
     let out = io::OutDir::prepare(out_dir)?;

@@ -16,11 +16,13 @@
 //!   (`bench::codecs`), every pass on each device (`bench::passes`).
 //! - [`passes`]: every pass of the library described once and run on any device: the rows of
 //!   the GL-against-Vulkan agreement table and of the per-pass benchmark.
+//! - [`progress`]: the stages of long runs (demo, report, bench, stress) handed to the caller.
 //! - [`stats`]: the median of the timings.
 //! - [`stress`]: stiff and extreme cases of every capability, GPU f32 against f64.
 //! - [`demo`]: the built-in scene rendered, refocused and synthesised, with its report.
-//! - [`job`]: the checked jobs of `viewsynth bench`, `report` and `stress`, run through the
-//!   library's [`viewsynth::job::Host`].
+//! - [`job`]: the checked jobs of `viewsynth bench`, `report` and `stress`, run through a
+//!   [`job::LabHost`] (the library's [`viewsynth::job::Host`] and the lab's events), with the
+//!   lab's own errors.
 
 #![warn(missing_docs)]
 
@@ -29,6 +31,7 @@ pub mod demo;
 pub mod eval;
 pub mod job;
 pub mod passes;
+pub mod progress;
 pub mod report;
 pub mod stats;
 pub mod stress;

@@ -63,29 +63,6 @@ pub enum ArgError {
         /// The most a pool takes.
         max: usize,
     },
-    /// `bench --batch 0`.
-    #[error("--batch 0: give a number of frames >= 1 or a manifest file")]
-    NoBenchFrames,
-    /// `bench --batch N` beyond what the built-in scene is rendered for.
-    #[error("--batch {0}: at most 100000 frames of the built-in scene")]
-    TooManyBenchFrames(usize),
-    /// A `bench --sizes` entry without the `x`.
-    #[error("--sizes '{0}': expected WxH with W, H >= 1")]
-    BenchSize(String),
-    /// A `bench --sizes` side that is no number.
-    #[error("--sizes: a side is no whole number")]
-    BenchSide(#[from] std::num::ParseIntError),
-    /// `stress --only` names no capability.
-    #[error("--only '{given}': expected a list of {known}")]
-    StressCapability {
-        /// The unknown name.
-        given: String,
-        /// The names known, comma-separated.
-        known: String,
-    },
-    /// `report --data-dir` is no folder.
-    #[error("--data-dir {}: not a directory", .0.display())]
-    DataDirMissing(PathBuf),
     /// Cyclopean disparities and depth input both given.
     #[error(
         "give disparities (--left-disparity, --right-disparity) or depth (--left-depth, --right-depth, --cameras), not both"
@@ -148,9 +125,6 @@ pub enum ArgError {
          (--baseline goes with --separation only to make --depth-kind disparity metric)"
     )]
     RigConflict,
-    /// `stress --only` given but naming nothing.
-    #[error("--only '{0}': names no capability (omit --only to sweep them all)")]
-    StressNothing(String),
     /// A scale option outside (0, inf).
     #[error("invalid {option} {value}: must be finite and > 0")]
     Scale {
@@ -213,6 +187,7 @@ pub enum ArgError {
     #[error("invalid ipd {0}: must be finite and >= 0")]
     Ipd(f64),
     /// Compare's planes out of order.
+    #[cfg(feature = "compare")]
     #[error("invalid {options} {near} / {far}: need 0 < near < far (far may be inf)")]
     ComparePlanes {
         /// The options, e.g. `--b-near/--b-far`.
@@ -223,6 +198,7 @@ pub enum ArgError {
         far: f64,
     },
     /// A compare side's device or NDC depth without the planes it was written with.
+    #[cfg(feature = "compare")]
     #[error(
         "{side}'s depth is {kind} depth: give the planes it was written with, --{s}-near N --{s}-far F \
          (far may be inf; --near/--far set both sides)",
@@ -235,6 +211,7 @@ pub enum ArgError {
         kind: &'static str,
     },
     /// A compare convention option that cannot change the reading of the side it names.
+    #[cfg(feature = "compare")]
     #[error("{option} does not apply: {why}")]
     CompareNotApplicable {
         /// The option, e.g. `--b-ndc`.
@@ -321,16 +298,6 @@ pub enum JobError {
         left: u32,
         /// Right face side.
         right: u32,
-    },
-    /// A stress case exceeded its bound.
-    #[error("stress case failed: {capability} / {case} ({worst})")]
-    StressFailed {
-        /// Capability of the first failing row.
-        capability: String,
-        /// Its case.
-        case: String,
-        /// Its worst error against the bound.
-        worst: String,
     },
 }
 

@@ -121,8 +121,6 @@ pub enum Event<'a> {
         /// Estimated from the images (else both ends were given).
         estimated: bool,
     },
-    /// `--data-dir` exists but is empty: the real-data rows are skipped.
-    EmptyDataDir(&'a Path),
     /// Work of `total` items (targets, frames) starts.
     Started {
         /// What the items are, e.g. "refocus targets".
@@ -134,25 +132,6 @@ pub enum Event<'a> {
     Advanced,
     /// All items finished (or the stages of a long run).
     Finished,
-    /// Stage `index` (1-based) of `total` of a long run (`demo`, `report`) starts.
-    Stage {
-        /// This stage's number.
-        index: usize,
-        /// How many stages the run announced.
-        total: usize,
-        /// What the stage does.
-        label: &'a str,
-    },
-}
-
-/// A job's stages told to its host as [`Event::Stage`] (the library's
-/// [`Progress`](crate::progress::Progress) sink for long runs).
-pub struct HostStages<'h>(pub &'h dyn Host);
-
-impl crate::progress::Progress for HostStages<'_> {
-    fn stage(&self, index: usize, total: usize, label: &str) {
-        self.0.event(Event::Stage { index, total, label });
-    }
 }
 
 /// The program around a job: opens the GPU when asked and hears the job's events.

@@ -14,6 +14,7 @@ mod files;
 mod host;
 mod intrinsics;
 
+#[cfg(feature = "compare")]
 pub mod compare;
 pub mod cyclopean;
 pub mod manifest;
@@ -25,7 +26,7 @@ pub mod stitch;
 pub use depth_file::{DepthFileReading, DepthFileRequest};
 pub use error::{ArgError, InContext, JobError, PerFrameOption};
 pub use files::{depth_formats, file_formats, png_compression, FileOptions};
-pub use host::{Backend, Event, GpuRequest, Host, HostStages};
+pub use host::{Backend, Event, GpuRequest, Host};
 pub use intrinsics::SourceIntrinsics;
 
 /// Largest magnitude of a real-valued option (pixels, metres, degrees, scales): far beyond any

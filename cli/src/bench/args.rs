@@ -3,8 +3,8 @@
 use crate::options::GpuArgs;
 use crate::options::{MEASURE, OUTPUTS};
 use clap::Args;
-use viewsynth::job::ArgError;
 use viewsynth_lab::job::bench::{BenchJob, BenchOptions};
+use viewsynth_lab::job::ArgError;
 
 /// The example under `viewsynth bench --help` (paths from the repository root, as in the README).
 pub(crate) const EXAMPLES: &str = "\

@@ -4,8 +4,8 @@ use crate::options::GpuArgs;
 use crate::options::{MEASURE, OUTPUTS};
 use clap::Args;
 use std::path::PathBuf;
-use viewsynth::job::ArgError;
 use viewsynth_lab::job::stress::StressJob;
+use viewsynth_lab::job::ArgError;
 
 /// The example under `viewsynth stress --help` (paths from the repository root, as in the README).
 pub(crate) const EXAMPLES: &str = "\

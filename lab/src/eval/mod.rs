@@ -89,15 +89,7 @@ pub fn run_report_with_cases(
     cases: &[PathBuf],
     repeats: usize,
 ) -> Result<WrittenReport> {
-    run_report_with_progress(
-        device,
-        out_dir,
-        data_dir,
-        cases,
-        &[],
-        repeats,
-        &viewsynth::progress::Silent,
-    )
+    run_report_with_progress(device, out_dir, data_dir, cases, &[], repeats, &crate::progress::Silent)
 }
 
 /// [`run_report_with_cases`] with each stage reported to `progress` as it starts, and the
@@ -109,10 +101,10 @@ pub fn run_report_with_progress(
     cases: &[PathBuf],
     peers: &[flow_peer::PeerImages],
     repeats: usize,
-    progress: &dyn viewsynth::progress::Progress,
+    progress: &dyn crate::progress::Progress,
 ) -> Result<WrittenReport> {
     let count = report_stage_count(data_dir, cases) + (data_dir.is_some() && !peers.is_empty()) as usize;
-    let stages = viewsynth::progress::Stages::new(progress, count);
+    let stages = crate::progress::Stages::new(progress, count);
     report_stages(device, out_dir, data_dir, cases, peers, repeats, &stages)
 }
 
@@ -139,7 +131,7 @@ pub fn report_stages(
     cases: &[PathBuf],
     peers: &[flow_peer::PeerImages],
     repeats: usize,
-    stages: &viewsynth::progress::Stages,
+    stages: &crate::progress::Stages,
 ) -> Result<WrittenReport> {
     for images in peers {
         let data_dir =

@@ -2,14 +2,14 @@
 //! `--batch` the pipelined refocus batch against its synchronous baseline. The options become a
 //! [`BenchJob`]; running it returns the tables and the cases measured.
 
+use super::{ArgError, HostStages, JobError, LabHost};
 use crate::bench::batch::{batch_bench, BatchBench, BatchInput};
 use crate::bench::{cyclopean_bench, refocus_bench, BenchCase};
+use crate::progress::Progress as _;
 use std::path::PathBuf;
 use viewsynth::io;
 use viewsynth::io::FileFormats;
-use viewsynth::job::HostStages;
-use viewsynth::job::{ArgError, Event, GpuRequest, Host, JobError};
-use viewsynth::progress::Progress as _;
+use viewsynth::job::{Event, GpuRequest};
 
 /// The bench options as given.
 #[derive(Debug, Clone)]
@@ -130,7 +130,7 @@ impl BenchJob {
     }
 
     /// Measures.
-    pub fn run(&self, host: &dyn Host) -> Result<BenchReport, JobError> {
+    pub fn run(&self, host: &dyn LabHost) -> Result<BenchReport, JobError> {
         let device = host.open_device(&self.gpu, viewsynth::job::Backend::Gl)?;
         match &self.bench {
             Bench::Batch {

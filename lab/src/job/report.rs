@@ -1,10 +1,10 @@
 //! `report` and `demo`: every method's error against ground truth next to its run time
 //! (report.{md,csv,svg}), and the demo that renders, refocuses and reports in one go.
 
+use super::{ArgError, HostStages, JobError, LabEvent, LabHost};
 use crate::report::WrittenReport;
 use std::path::{Path, PathBuf};
-use viewsynth::job::HostStages;
-use viewsynth::job::{ArgError, Event, GpuRequest, Host, JobError};
+use viewsynth::job::{Event, GpuRequest};
 
 /// A checked report run.
 #[derive(Debug, Clone)]
@@ -27,9 +27,9 @@ pub struct ReportJob {
 impl ReportJob {
     /// Refuses a `--case` that is no case folder (one `viewsynth scene` wrote, with its
     /// cameras.json): a wrong command line (exit 2), seen before the GPU opens or a row is measured.
-    pub fn check_cases(cases: &[PathBuf]) -> Result<(), ArgError> {
+    pub fn check_cases(cases: &[PathBuf]) -> Result<(), viewsynth::job::ArgError> {
         match cases.iter().find(|c| !c.join("cameras.json").is_file()) {
-            Some(case) => Err(ArgError::Invalid(viewsynth::Error::param(
+            Some(case) => Err(viewsynth::job::ArgError::Invalid(viewsynth::Error::param(
                 "--case",
                 format!(
                     "{} is not a case folder (no cameras.json; `viewsynth scene --out-dir` writes one)",
@@ -41,14 +41,14 @@ impl ReportJob {
     }
 
     /// Measures every row and writes the report files; returns the report and their paths.
-    pub fn run(&self, host: &dyn Host) -> Result<WrittenReport, JobError> {
+    pub fn run(&self, host: &dyn LabHost) -> Result<WrittenReport, JobError> {
         Self::check_cases(&self.cases)?;
         if let Some(d) = &self.data_dir {
             if !d.is_dir() {
                 return Err(ArgError::DataDirMissing(d.clone()).into());
             }
             if std::fs::read_dir(d).map_or(true, |mut e| e.next().is_none()) {
-                host.event(Event::EmptyDataDir(d));
+                host.lab_event(LabEvent::EmptyDataDir(d));
             }
         }
         if let Some(data) = &self.data_dir {
@@ -84,7 +84,7 @@ pub struct DemoJob {
 
 impl DemoJob {
     /// Renders everything; returns the report, its files and, last, refocus_check.md.
-    pub fn run(&self, host: &dyn Host) -> Result<WrittenReport, JobError> {
+    pub fn run(&self, host: &dyn LabHost) -> Result<WrittenReport, JobError> {
         let device = host.open_device(&self.gpu, viewsynth::job::Backend::Gl)?;
         let report = crate::demo::run_with_progress(&device, Path::new(&self.out_dir), &HostStages(host));
         host.event(Event::Finished);

@@ -2,12 +2,12 @@
 //! The options become a [`StressJob`]; a failing case fails the job after the table is
 //! written.
 
+use super::{ArgError, HostStages, JobError, LabHost};
+use crate::progress::Progress as _;
 use crate::stress::{first_failure, run_stress, StressOptions, StressRow, CAPABILITIES};
 use std::path::PathBuf;
-use viewsynth::job::HostStages;
 use viewsynth::job::InContext;
-use viewsynth::job::{ArgError, Event, GpuRequest, Host, JobError};
-use viewsynth::progress::Progress as _;
+use viewsynth::job::{Event, GpuRequest};
 
 /// A checked stress sweep.
 #[derive(Debug, Clone)]
@@ -45,7 +45,7 @@ impl StressJob {
     }
 
     /// Sweeps the cases: one row each.
-    pub fn run(&self, host: &dyn Host) -> Result<Vec<StressRow>, JobError> {
+    pub fn run(&self, host: &dyn LabHost) -> Result<Vec<StressRow>, JobError> {
         let device = host.open_device(&self.gpu, viewsynth::job::Backend::Gl)?;
         // One capability at a time, each a stage of the progress shown.
         let (stages, mut rows) = (HostStages(host), Vec::new());
