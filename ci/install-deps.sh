@@ -28,7 +28,7 @@ PKGS+=(python3 python3-venv)
 # Vulkan) and glslangValidator, which build.rs runs to compile the shaders to SPIR-V.
 PKGS+=(libvulkan1 mesa-vulkan-drivers glslang-tools)
 # The Khronos validation layer: a test runs one case of every Vulkan pass under it and fails on
-# any message (cli/tests/integration/vulkan_passes.rs).
+# any message (viewsynth_tests/tests/library/vulkan/passes.rs).
 PKGS+=(vulkan-validationlayers)
 missing=()
 if command -v dpkg >/dev/null 2>&1; then

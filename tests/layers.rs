@@ -172,6 +172,9 @@ struct File {
     paths: Vec<(Vec<String>, Vec<String>, bool)>,
     /// Names a `use` brings into a module: (module, name) -> absolute path.
     uses: Vec<(Vec<String>, String, Vec<String>)>,
+    /// Child modules declared `#[cfg(test)] mod name;` (a file of tests, left out like an inline
+    /// test module).
+    test_children: Vec<Vec<String>>,
 }
 
 fn module_of(rel: &str) -> Vec<String> {
@@ -241,6 +244,7 @@ fn parse(rel: &str, text: &str) -> File {
     let mut stack: Vec<(String, usize, bool)> = Vec::new();
     let mut depth = 0usize;
     let mut cfg_test_pending = false;
+    let mut test_children = Vec::new();
     let chars: Vec<(usize, char)> = src.char_indices().collect();
     let mut k = 0;
     while k < chars.len() {
@@ -270,6 +274,10 @@ fn parse(rel: &str, text: &str) -> File {
                 let name = &after[..name_end];
                 if after[name_end..].trim_start().starts_with('{') {
                     stack.push((name.to_string(), depth + 1, cfg_test_pending));
+                } else if cfg_test_pending || in_test {
+                    let mut child = here();
+                    child.push(name.to_string());
+                    test_children.push(child);
                 }
                 cfg_test_pending = false;
             } else if word == "use" && !in_test {
@@ -334,6 +342,7 @@ fn parse(rel: &str, text: &str) -> File {
         module,
         paths,
         uses,
+        test_children,
     }
 }
 
@@ -431,6 +440,9 @@ fn crate_graph(dir: &str) -> BTreeMap<String, BTreeSet<String>> {
         let text = fs::read_to_string(&p).unwrap();
         files.push(parse(&rel, &text));
     }
+    // Files of tests (`#[cfg(test)] mod name;` and what lies below) are not the library's build.
+    let test_modules: Vec<Vec<String>> = files.iter().flat_map(|f| f.test_children.clone()).collect();
+    files.retain(|f| !test_modules.iter().any(|t| f.module.starts_with(t)));
     let mut krate = Crate {
         modules: BTreeMap::new(),
         uses: BTreeMap::new(),
@@ -731,6 +743,10 @@ fn the_scan_resolves_use_trees_and_re_exports() {
         Some("io/encoding.rs")
     );
     assert_eq!(krate.resolve(&s(&["io", "load"]), 0).as_deref(), Some("io/mod.rs"));
+    // A file of tests (`#[cfg(test)] mod tests;`) is named as a test module, so it is left out;
+    // a plain child module is not.
+    let g = parse("gpu/mod.rs", "mod buffer;\n#[cfg(test)]\nmod tests;\n");
+    assert_eq!(g.test_children, vec![s(&["gpu", "tests"])]);
 }
 
 /// Most lines a file under `src/io/` may have (issue 45): past it a file holds more than one

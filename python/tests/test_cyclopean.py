@@ -213,7 +213,7 @@ def test_vulkan_renderer_matches_gl(renderer, pair):
 
         rgb, depth, K = make_frame()
         for ra, rb in zip(renderer.refocus(rgb, depth, K, scales=[0.5, 1.5]), vk.refocus(rgb, depth, K, scales=[0.5, 1.5])):
-            # The refocus bound of cli/tests/integration/vulkan_refocus.rs: masks identical, colour
+            # The refocus bound of viewsynth_tests/tests/library/vulkan/refocus.rs: masks identical, colour
             # within one level.
             assert np.array_equal(ra["mask"], rb["mask"])
             assert np.abs(ra["rgb"].astype(int) - rb["rgb"].astype(int)).max() <= 1
@@ -262,7 +262,7 @@ def test_two_images_alone_equal_cli(renderer, cli, pair, tmp_path):
 def test_fill_densifies_a_hole_in_given_disparities(renderer):
     """fill=True densifies given disparities before rendering (the CLI's --fill): a hole in both
     maps on a textured plane at disparity 4 renders the plane's own texture, marked "filled", not
-    the 2-D fill's guess from the sides (cli/tests/integration/cyclopean_given_dense.rs)."""
+    the 2-D fill's guess from the sides (viewsynth_tests/tests/library/cyclopean/given_disparities.rs)."""
     h, w = 24, 48
     rng = np.random.default_rng(7)
     texture = rng.integers(0, 256, (h, w + 4, 3), dtype=np.uint8)  # middle column x at x + 2

@@ -2,7 +2,7 @@
 //! mesh (broken at depth discontinuities), is rendered into the middle camera with a depth test,
 //! and the two eyes merge by depth (nearest surface wins). Rasterised, so it has no fixation
 //! guess to get wrong and fills every pixel a kept triangle covers; its oracle is the
-//! ray-traced middle view (cli/tests/integration/cyclopean.rs).
+//! ray-traced middle view (viewsynth_tests/tests/library/cyclopean/gather.rs).
 
 use crate::camera::mat4::{self, Mat4};
 use crate::convention::RowOrder;

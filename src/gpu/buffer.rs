@@ -41,11 +41,6 @@ impl IndexBuffer {
         self
     }
 
-    /// Number of indices.
-    pub fn count(&self) -> usize {
-        self.count
-    }
-
     /// Bind as the element buffer of the currently bound vertex array.
     pub(super) fn bind(&self) {
         // SAFETY: valid handle.

@@ -37,25 +37,10 @@ pub struct Framebuffer {
 }
 
 impl Framebuffer {
-    /// Width in pixels.
-    pub fn width(&self) -> u32 {
-        self.width
-    }
-
-    /// Height in pixels.
-    pub fn height(&self) -> u32 {
-        self.height
-    }
-
     /// The colour attachment of output location `index`; None for an empty slot (or past the
     /// last).
     pub fn color(&self, index: usize) -> Option<&Texture> {
         self.colors.get(index).and_then(|t| t.as_ref())
-    }
-
-    /// The float depth attachment, when the framebuffer has one.
-    pub fn depth(&self) -> Option<&Texture> {
-        self.depth.as_ref()
     }
 
     /// A `width` x `height` FBO with one texture per `Some` attachment and, if `with_depth`, a [`TextureFormat::Depth32F`] depth buffer; fails if GL reports it incomplete.
@@ -172,6 +157,7 @@ impl Framebuffer {
     /// Read colour attachment `index` back (rows in memory order, row 0 = framebuffer row 0,
     /// the texture's own transfer layout); None for an empty slot. Goes through the streaming
     /// readback and waits for it: callers that can overlap work use [`Framebuffer::read_async`].
+    #[cfg(test)]
     pub fn read_color(&self, index: usize) -> Result<Option<Vec<u8>>> {
         let Some(t) = self.colors.get(index).and_then(|t| t.as_ref()) else {
             return Ok(None);

@@ -26,13 +26,16 @@ mod texture;
 mod timer;
 mod vertex_array;
 
-pub use buffer::IndexBuffer;
+#[cfg(test)]
+mod tests;
+
+pub(crate) use buffer::IndexBuffer;
 pub use census::LiveObjects;
 pub use devices::EglDevice;
 pub use egl::{DeviceChoice, DeviceChoiceError, GpuInfo};
-pub use framebuffer::{Attachment, Framebuffer};
-pub use readback::ReadFormat;
-pub use texture::TextureFormat;
+pub(crate) use framebuffer::{Attachment, Framebuffer};
+pub(crate) use readback::ReadFormat;
+pub(crate) use texture::TextureFormat;
 // Sealed: the wrappers only the GL code (its executor included) uses.
 pub(crate) use buffer::{StorageBuffer, UniformBuffer};
 pub(crate) use egl::EglContext;
@@ -41,7 +44,7 @@ pub(crate) use readback::PendingRead;
 pub(crate) use state::DrawState;
 pub(crate) use texture::Texture;
 pub(crate) use timer::DeferredTimer;
-pub use vertex_array::VertexArray;
+pub(crate) use vertex_array::VertexArray;
 
 use crate::error::{Error, Result};
 use crate::pass::{check_image_size, GpuPolicy};

@@ -141,16 +141,6 @@ impl PendingRead {
         Ok(pending)
     }
 
-    /// Bytes this read delivers.
-    pub fn len(&self) -> usize {
-        self.len
-    }
-
-    /// Whether this read delivers no bytes.
-    pub fn is_empty(&self) -> bool {
-        self.len == 0
-    }
-
     /// Whether the copy has finished (never blocks).
     pub fn is_ready(&self) -> bool {
         let Some(fence) = self.fence else { return true };

@@ -117,13 +117,6 @@ impl Framebuffer {
         self.bind_and_clear(clear_depth);
         RenderPass { fb: self }
     }
-
-    /// Clear every attachment to its clear value, drawing nothing: images that a compute pass
-    /// then fills (splat atomics). A fill the driver does itself, where a compute pass storing
-    /// every texel costs llvmpipe about 17 ms per 720p image.
-    pub fn clear(&self) {
-        drop(self.begin_pass(DrawState::default(), 1.0));
-    }
 }
 
 impl RenderPass<'_> {

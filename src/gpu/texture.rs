@@ -60,21 +60,6 @@ pub struct Texture {
 }
 
 impl Texture {
-    /// Width in texels.
-    pub fn width(&self) -> u32 {
-        self.width
-    }
-
-    /// Height in texels.
-    pub fn height(&self) -> u32 {
-        self.height
-    }
-
-    /// Texel format.
-    pub fn format(&self) -> TextureFormat {
-        self.format
-    }
-
     /// Allocate a texture; `data` (tightly packed rows, row 0 first) is uploaded when given.
     /// Sampling is nearest with clamp-to-edge: passes that filter do it themselves in f32 with
     /// `texelFetch`, because fixed-function bilinear weights have only ~8 bits.
@@ -219,22 +204,6 @@ impl Texture {
             self.gpu.gl().active_texture(glow::TEXTURE0 + unit);
             self.gpu.gl().bind_texture(glow::TEXTURE_2D, Some(self.raw));
         }
-    }
-
-    /// Read the whole texture back, rows in memory order (row 0 = framebuffer row 0).
-    pub fn read(&self) -> Result<Vec<u8>> {
-        let (fmt, ty, bpp) = self.format.transfer();
-        let mut out = vec![0u8; self.width as usize * self.height as usize * bpp];
-        // SAFETY: the buffer is exactly the texture's size in this format; pack alignment 1.
-        unsafe {
-            let gl = self.gpu.gl();
-            gl.pixel_store_i32(glow::PACK_ALIGNMENT, 1);
-            gl.bind_texture(glow::TEXTURE_2D, Some(self.raw));
-            gl.get_tex_image(glow::TEXTURE_2D, 0, fmt, ty, glow::PixelPackData::Slice(Some(&mut out)));
-            gl.bind_texture(glow::TEXTURE_2D, None);
-        }
-        self.gpu.check("texture readback")?;
-        Ok(out)
     }
 }
 

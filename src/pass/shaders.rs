@@ -11,7 +11,7 @@
 //! per stage by listing it before the stage's own file; each file starts with a `#line 1 k`
 //! directive so a compile error names the file (source string k) and its own line.
 //! `ShaderProgram::all` lists every program under one set of conventions, which the
-//! compile-all test (cli/tests/integration/shader_library.rs) links under all eight.
+//! compile-all test (viewsynth_tests/tests/library/passes/shader_library.rs) links under all eight.
 
 use crate::convention::{Conventions, NdcDepthRange, RowOrder};
 

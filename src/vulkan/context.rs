@@ -171,7 +171,7 @@ pub struct VulkanContext {
 }
 
 /// Objects created (and waits) on a device since it opened: a steady state adds nothing
-/// (cli/tests/integration/vulkan_passes.rs holds every pass to it, as gpu/census.rs does for GL).
+/// (viewsynth_tests/tests/library/vulkan/passes.rs holds every pass to it, as gpu/census.rs does for GL).
 #[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
 pub struct VkCensus {
     /// Graphics and compute pipelines.

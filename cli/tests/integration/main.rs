@@ -1,66 +1,33 @@
-//! Integration tests: one binary. GPU tests need EGL with GL 4.5 (Mesa llvmpipe in CI); a
-//! missing EGL fails them with the library's error, never a skip.
+//! The command line's end-to-end tests: one binary, grouped by concern; each runs the
+//! `viewsynth` binary (GPU commands need EGL with GL 4.5, Mesa llvmpipe in CI; a missing EGL
+//! fails, never skips). The library's own tests are the `viewsynth_tests` crate; its helpers
+//! are re-exported by `common`.
 
+/// `refocus --batch` and `viewsynth manifest`: resume, identity, augmentation, memory per frame.
 mod batch;
-mod bounds;
+/// The binary's shared helpers (`bin`, `scratch`, clean-failure checks) and refocus end to end.
 mod cli;
-mod cli_batch;
-mod cli_batch_augment;
-mod cli_batch_identity;
-mod cli_cameras_cv;
-mod cli_compare;
-mod cli_depth_out;
-mod cli_end_to_end;
-mod cli_formats;
-mod cli_help;
-mod cli_manifest_tum;
-mod cli_output;
-mod cli_outputs_table;
-mod cli_plausibility;
-mod cli_reproject_stitch;
-mod cli_sequence;
-mod cli_units;
-mod cli_warning_flags;
+/// The library tests' helpers, and `viewsynth cyclopean` on the files they write.
 mod common;
+/// `viewsynth compare`: thresholds and exit codes, masks, JSON, FLIP, convention checks.
 mod compare;
-mod compare_robust;
-mod conventions_sweep;
+/// `viewsynth cyclopean`: files against the library, real pairs, one eye, sequences, cameras.
 mod cyclopean;
-mod cyclopean_dense;
-mod cyclopean_fill;
-mod cyclopean_given_dense;
-mod cyclopean_one_eye;
-mod cyclopean_real;
-mod cyclopean_temporal;
-mod deletion;
-mod device_choice;
-mod gl_objects;
-mod gpu_context;
-mod hostile;
-mod hostile_round3;
-mod hostile_round4;
-mod hostile_round4_outputs;
-mod limits;
-mod matcher;
-mod memory_flat;
-mod messages;
-mod pass_contract;
-mod readback;
-mod refocus_accuracy;
-mod refocus_conventions;
-mod refocus_edge_cases;
-mod refocus_oracle;
-mod refocus_rgb_everywhere;
-mod reproject;
-mod scene;
-mod shader_library;
-mod stitch;
-mod stress;
+/// Device choice: `info`, `--device`, `--require-gpu`, the software-renderer warnings.
+mod device;
+/// Help that is true and findable.
+mod help;
+/// The lab's commands: `demo`, `report` and `stress` end to end.
+mod lab;
+/// The output layer: files per output and format, deletion, outputs over inputs, the terminal.
+mod outputs;
+/// refocus: formats, units, depth outputs, plausibility warnings, colour everywhere.
+mod refocus;
+/// `viewsynth reproject` and `viewsynth stitch` end to end.
+mod reproject_stitch;
+/// Hostile input and failure: every option and commit step, files and processes, resource
+/// limits, bounds on user counts, messages.
+mod safety;
+/// `--backend vulkan`: commands, the validation layer, the same files as GL.
 #[cfg(feature = "vulkan")]
-mod vulkan_cli;
-#[cfg(feature = "vulkan")]
-mod vulkan_cyclopean;
-#[cfg(feature = "vulkan")]
-mod vulkan_passes;
-#[cfg(feature = "vulkan")]
-mod vulkan_refocus;
+mod vulkan;

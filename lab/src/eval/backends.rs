@@ -2,7 +2,7 @@
 //! differ, counted as the issue of record states the agreement (masks on at most 0.5 % of
 //! pixels, colour within one level on at least 99.5 %, depth within 1e-4 relative on at least
 //! 99.5 % of the pixels valid in both). The one agreement type ([`BackendDiff`]) and rule
-//! ([`BackendDiff::agrees`]), shared by the tests (cli/tests/integration/vulkan_passes.rs) and the
+//! ([`BackendDiff::agrees`]), shared by the tests (viewsynth_tests/tests/library/vulkan/passes.rs) and the
 //! report's table ([`device_rows`], `gl_vs_vulkan.md`): every pass of [`crate::passes`] run on
 //! two devices under every convention.
 
@@ -225,7 +225,7 @@ pub fn write_section(first: &Device, out_dir: &std::path::Path) -> Result<std::p
                 text,
                 "Every pass described once (src/pass/) and run by both devices, built-in scene 96x72 \
                  (refocus: 5 focal scales; stitch: 192x96 per eye from 24 px faces), worst over the 8 \
-                 conventions. Rule (cli/tests/integration/vulkan_passes.rs): masks differ on at most 0.5 % of \
+                 conventions. Rule (viewsynth_tests/tests/library/vulkan/passes.rs): masks differ on at most 0.5 % of \
                  pixels, colour within 1 level on 99.5 %, depth within 1e-4 relative on 99.5 % of pixels \
                  valid in both. Devices: {} against {}.\n",
                 names[0], names[1]

@@ -1,6 +1,6 @@
 //! reproject under stress: shift walk, shift scan and 3-D gather against the f64 reference.
 //!
-//! Bounds (derived as in cli/tests/integration/reproject.rs):
+//! Bounds (derived as in viewsynth_tests/tests/library/reproject.rs):
 //! - depth: q = 1/Z interpolated along a segment at t = (u - f0) / (f1 - f0); the f32 error of
 //!   u - f0 (~6e-5 px over a >= 0.5 px segment) moves q by <= tau_rel q 1.2e-4 = 6e-6 q, plus a
 //!   few eps: 1e-5 for view Z and disparity. Device depth adds the cancellation of

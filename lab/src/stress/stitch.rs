@@ -1,6 +1,6 @@
 //! stitch under stress: the three methods on the GPU against the f64 stitch.
 //!
-//! Bound (derived in cli/tests/integration/stitch.rs): sample positions agree to ~1e-5 face px, so
+//! Bound (derived in viewsynth_tests/tests/library/stitch.rs): sample positions agree to ~1e-5 face px, so
 //! bilinear colour moves by < 0.01 level except where f32 and f64 take a discrete choice apart
 //! (nearest depth texel on a half-pixel tie, the band edge, the on-ray test, the agreement
 //! test): at most 0.5 % of pixels may be off by more than one level. The output is colour only.

@@ -1,7 +1,7 @@
 //! `.npz` archives written here by the zip crate as numpy's zipfile writes them (stored or
 //! deflated, zip64 local headers, real CRCs, a central directory), then damaged byte by byte
 //! for the hostile cases (the real Middlebury 2014 Motorcycle disparity:
-//! cli/tests/integration/reproject.rs).
+//! viewsynth_tests/tests/library/reproject.rs).
 
 use super::*;
 use crate::io::formats::npy::build_npy;

@@ -39,7 +39,7 @@
 //! quotient is rebuilt from integers correctly rounded (GLSL's own division may be 2.5 ulp off);
 //! the rest are single f32 additions, subtractions, comparisons and moves, which GLSL rounds as
 //! the CPU does. So the GPU's disparities are the twin's bit for bit
-//! (cli/tests/integration/matcher.rs).
+//! (viewsynth_tests/tests/library/cyclopean/matcher.rs).
 //!
 //! [`confidence`]: per pixel, how far to trust each eye's disparity (the eyes' agreement and the
 //! local spread), a further stage ([`Matcher::estimate_with_confidence`]) with its twin.
