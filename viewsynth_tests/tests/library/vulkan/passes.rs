@@ -265,7 +265,7 @@ fn stitch_methods_agree_between_gl_and_vulkan_under_every_convention() {
 /// The splat-gather method (edge snap, splat with atomics, gather listing edge pixels, indirect
 /// edge pass rewriting the colour) on both executors, under every convention and both depth
 /// kinds, with and without colour (no colour: no edge pass). Its twin check on Vulkan is in
-/// cli/tests/integration/cyclopean_real.rs.
+/// viewsynth_tests/tests/library/cyclopean/real_pairs.rs.
 #[test]
 fn splat_gather_agrees_between_gl_and_vulkan_under_every_convention() {
     let (gl, vk) = devices();
