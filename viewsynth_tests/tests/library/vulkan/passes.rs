@@ -537,3 +537,33 @@ fn a_missing_output_is_an_error_of_the_backend_the_run_was_on() {
         assert_eq!(e, want);
     }
 }
+
+/// The stereo matcher has no command of its own (the commands run under the layer in the
+/// command line's `vulkan::passes::every_vulkan_pass_runs_clean_under_the_validation_layer`):
+/// its Vulkan test (real pairs, one matcher reused across two pairs) runs again in a child of
+/// this test binary under VK_LAYER_KHRONOS_validation. Any validation message fails, and the
+/// loader's own log proves the layer was inserted, so a missing layer cannot pass silently.
+#[test]
+fn the_matcher_runs_clean_under_the_validation_layer() {
+    let test = "cyclopean::matcher::matcher_gpu_pass_is_its_twin_on_real_pairs_on_vulkan";
+    let o = std::process::Command::new(std::env::current_exe().unwrap())
+        .args([test, "--exact", "--nocapture", "--test-threads", "1"])
+        .env("VK_INSTANCE_LAYERS", "VK_LAYER_KHRONOS_validation")
+        .env("VK_LOADER_DEBUG", "layer")
+        .output()
+        .unwrap();
+    let text = format!(
+        "{}{}",
+        String::from_utf8_lossy(&o.stdout),
+        String::from_utf8_lossy(&o.stderr)
+    );
+    assert!(o.status.success(), "{test}: {text}");
+    assert!(
+        text.contains("Insert instance layer \"VK_LAYER_KHRONOS_validation\""),
+        "{test}: the validation layer was not loaded (install vulkan-validationlayers):\n{text}"
+    );
+    for bad in ["Validation Error", "VUID-", "Validation Warning"] {
+        assert!(!text.contains(bad), "{test}: {bad}:\n{text}");
+    }
+    assert!(text.contains("1 passed"), "{test} did not run:\n{text}");
+}
