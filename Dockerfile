@@ -43,15 +43,19 @@ ENV CARGO_TARGET_DIR=/src/target PYO3_PYTHON=python3
 # the workspace's crates and the extension. The root placeholder has a stand-in build.rs too, so
 # that the build script's own dependencies (gl_generator and the Khronos registries) are built in
 # this layer; the real build.rs reads shaders/ and comes with the sources. The placeholders'
-# outputs are removed: the real crates are never taken as built.
+# outputs are removed: the real crates are never taken as built. The library's test crate
+# (viewsynth_tests/) is a workspace member the image never builds: its manifest and an empty
+# lib.rs are enough for cargo to load the workspace.
 COPY Cargo.toml Cargo.lock ./
 COPY lab/Cargo.toml lab/
 COPY cli/Cargo.toml cli/
+COPY viewsynth_tests/Cargo.toml viewsynth_tests/
 COPY python/Cargo.toml python/Cargo.lock python/
-RUN mkdir -p src lab/src cli/src python/src \
+RUN mkdir -p src lab/src cli/src python/src viewsynth_tests/src \
  && echo '' > src/lib.rs \
  && echo '' > lab/src/lib.rs \
  && echo 'fn main() {}' > cli/src/main.rs \
+ && echo '' > viewsynth_tests/src/lib.rs \
  && echo 'fn main() {}' > build.rs \
  && echo '' > python/src/lib.rs \
  && cargo build --release --locked --bin viewsynth \
