@@ -141,7 +141,7 @@ pub fn run_with_progress(
 /// The built-in stereo pair (64 mm IPD, device depth, GL conventions), its ray-traced middle
 /// view, and the middle view of each cyclopean method.
 fn cyclopean_outputs(device: &Device, dir: &Path) -> Result<()> {
-    use viewsynth::stereo::gather::render::CyclopeanRenderer;
+    use viewsynth::stereo::gather::gpu::CyclopeanRenderer;
     use viewsynth::stereo::scene_frame::{scene_frame, StereoRig};
     use viewsynth::stereo::FrameDepth;
     let rig = StereoRig::demo(640, 480);

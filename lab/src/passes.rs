@@ -17,7 +17,7 @@ use viewsynth::refocus::manifest::{TargetSpec, DEFAULT_SCALES};
 use viewsynth::refocus::{BreakRule, Method, OutputSet, RefocusSource, Refocuser};
 use viewsynth::reproject::render::Reprojector;
 use viewsynth::scene::render::{GlCamera, SceneRenderer};
-use viewsynth::stereo::gather::render::CyclopeanRenderer;
+use viewsynth::stereo::gather::gpu::CyclopeanRenderer;
 use viewsynth::stereo::gather::{CyclopeanOutput, CyclopeanOutputs, CyclopeanParams, Method as Cm};
 use viewsynth::stereo::matcher::Matcher;
 use viewsynth::stereo::scene_frame::{scene_frame, StereoRig};

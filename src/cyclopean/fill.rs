@@ -20,7 +20,7 @@
 //! Filled pixels carry [`FILLED`] alone in their source bits, so the mask file tells them apart
 //! (value 128, [`crate::io::MASK_FILLED`]); rendered pixels pass through unchanged.
 //!
-//! One full-screen pass (shaders/cyclopean/fill.frag) on either executor, and [`fill_reference`],
+//! One full-screen pass (shaders/cyclopean/fill.frag) on either executor, and [`fill_reference`](super::fill_reference::fill_reference),
 //! its twin: the choices (which candidates, which layer) compare the same f32 depths, so they
 //! agree exactly; the weighted means are the same f32 sums, up to the GPU's division (GLSL allows
 //! 2.5 ulp) and its rounding of the normalised colour: one level at most, 1e-5 relative in depth.
@@ -48,8 +48,8 @@ crate::param_block! {
 pub const SAME_SURFACE: f32 = 0.05;
 
 /// [`crate::stereo::walk::DIRECTIONS`]' entries along the row: +x and -x.
-const ROW_RIGHT: usize = 0;
-const ROW_LEFT: usize = 8;
+pub(super) const ROW_RIGHT: usize = 0;
+pub(super) const ROW_LEFT: usize = 8;
 
 /// Candidates count up to this multiple of the row's span, the farther row hit (inside the
 /// image): 2, so every direction that crosses a vertical gap still does (the steepest, (1, 2),
@@ -65,7 +65,7 @@ pub struct Filler {
 }
 
 /// Colour and depth of `out`, both needed: depth chooses the side, colour is what is filled.
-fn planes(out: &CyclopeanOutput) -> Result<(&crate::io::RgbImage, &crate::io::DepthMap)> {
+pub(super) fn planes(out: &CyclopeanOutput) -> Result<(&crate::io::RgbImage, &crate::io::DepthMap)> {
     match (&out.color, &out.depth) {
         (Some(c), Some(d)) => Ok((c, d)),
         _ => Err(Error::param(
@@ -115,91 +115,10 @@ impl Filler {
     }
 }
 
-/// The twin of [`Filler::fill`]: the same rule on the CPU, in the shader's f32 arithmetic.
-pub fn fill_reference(out: &CyclopeanOutput, width: u32, height: u32) -> Result<CyclopeanOutput> {
-    let (color, depth) = planes(out)?;
-    let (w, h) = (width as i64, height as i64);
-    let valid = |x: i64, y: i64| out.sources[(y * w + x) as usize] != 0;
-    let mut filled = out.clone();
-    let (fc, fd) = (
-        filled.color.as_mut().expect("checked above"),
-        filled.depth.as_mut().expect("checked above"),
-    );
-    for y in 0..h {
-        for x in 0..w {
-            let i = (y * w + x) as usize;
-            if out.sources[i] != 0 {
-                continue;
-            }
-            // (depth, distance, index) of the first rendered pixel along each direction; and
-            // whether the row runs off the image either way with none (a border strip).
-            let hits: Vec<_> = crate::stereo::walk::DIRECTIONS
-                .iter()
-                .map(|&d| crate::stereo::walk::first_along((x, y), d, (w, h), w.max(h), valid))
-                .collect();
-            let (right, left) = (hits[ROW_RIGHT], hits[ROW_LEFT]);
-            let border_strip = right.is_none() || left.is_none();
-            // Inside, the reach: twice the row's far end. A hole's two sides are across it along
-            // the row (the baseline's direction), so a walk along a thin hole that meets a far
-            // surface beyond its end is no candidate.
-            let reach = match (right, left) {
-                (Some((_, a)), Some((_, b))) => REACH * a.max(b),
-                _ => i64::MAX,
-            };
-            let mut candidates: Vec<(f32, i64, usize)> = hits
-                .into_iter()
-                .flatten()
-                .filter(|&(_, r)| r <= reach)
-                .map(|((qx, qy), r)| {
-                    let j = (qy * w + qx) as usize;
-                    (depth.data[j], r, j)
-                })
-                .collect();
-            if candidates.is_empty() {
-                fc.data[3 * i..3 * i + 3].fill(0);
-                fd.data[i] = 0.0;
-                continue;
-            }
-            // Far to near, stable (the shader's insertion keeps direction order at equal depths).
-            candidates.sort_by(|a, b| b.0.total_cmp(&a.0));
-            // The layer's seed: the farthest candidate, or in a border strip the nearest one
-            // (first of the nearest in far-to-near order); then its chain either way.
-            let seed = match border_strip {
-                false => 0,
-                true => (0..candidates.len())
-                    .min_by_key(|&k| candidates[k].1)
-                    .expect("not empty"),
-            };
-            let linked = |k: usize| candidates[k - 1].0 - candidates[k].0 <= SAME_SURFACE * candidates[k - 1].0;
-            let (mut lo, mut hi) = (seed, seed + 1);
-            while lo > 0 && linked(lo) {
-                lo -= 1;
-            }
-            while hi < candidates.len() && linked(hi) {
-                hi += 1;
-            }
-            let (mut rgb, mut z, mut total) = ([0f32; 3], 0f32, 0f32);
-            for &(zq, r, j) in &candidates[lo..hi] {
-                let wq = 1.0 / (r * r) as f32;
-                for (c, acc) in rgb.iter_mut().enumerate() {
-                    *acc += wq * (color.data[3 * j + c] as f32 / 255.0);
-                }
-                z += wq * zq;
-                total += wq;
-            }
-            for (c, acc) in rgb.iter().enumerate() {
-                fc.data[3 * i + c] = ((acc / total) * 255.0).round().clamp(0.0, 255.0) as u8;
-            }
-            fd.data[i] = z / total;
-            filled.sources[i] = FILLED;
-        }
-    }
-    Ok(filled)
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::cyclopean::fill_reference::fill_reference;
     use crate::io::{DepthMap, RgbImage};
 
     fn view(w: u32, h: u32, z: Vec<f32>, sources: Vec<u8>) -> CyclopeanOutput {

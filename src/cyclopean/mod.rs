@@ -18,6 +18,7 @@
 pub mod baseline;
 pub mod edge_snap;
 pub mod fill;
+pub mod fill_reference;
 pub mod forward;
 mod method;
 pub mod pass;
@@ -25,6 +26,7 @@ pub mod pipeline;
 pub mod splat;
 pub mod splat_reference;
 pub mod temporal;
+pub mod temporal_reference;
 
 pub use method::CyclopeanMethod;
 pub use pass::{CyclopeanInput, CyclopeanPass};

@@ -7,8 +7,8 @@
 use super::splat::{SplatParams, SplatRenderer};
 use super::splat_reference::splat_reference;
 use crate::error::Result;
+use crate::stereo::gather::gpu::CyclopeanRenderer;
 use crate::stereo::gather::reference::cyclopean_reference;
-use crate::stereo::gather::render::CyclopeanRenderer;
 use crate::stereo::gather::{CyclopeanOutputs, CyclopeanParams};
 use crate::stereo::{MiddleCamera, StereoFrame};
 use crate::view::ViewOutput;

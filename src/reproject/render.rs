@@ -14,7 +14,7 @@ use crate::io::{DepthMap, RgbImage};
 use crate::pass::shaders::ShiftDepth;
 use crate::pass::{Device, Draw, Format, Image, ImageData, Target, ToDevice};
 use crate::pass::{ProgramKind, ShaderProgram, Timing};
-use crate::stereo::gather::render::CyclopeanRenderer;
+use crate::stereo::gather::gpu::CyclopeanRenderer;
 use crate::stereo::gather::CyclopeanOutputs;
 use crate::stereo::MiddleCamera;
 

@@ -18,7 +18,7 @@
 //! caller can tell rendered-from-matched from rendered-from-filled pixels.
 //!
 //! One full-screen pass per eye (shaders/cyclopean/densify.frag) on either executor, and
-//! [`densify_reference`], its twin. Every decision compares integers and copies a disparity, so
+//! [`densify_reference`](super::densify_reference::densify_reference), its twin. Every decision compares integers and copies a disparity, so
 //! the GPU's maps are the twin's bit for bit.
 
 use crate::error::{Error, Result};
@@ -54,7 +54,7 @@ pub struct Dense {
     pub filled: Vec<u8>,
 }
 
-fn check(disparity: &DepthMap, color: &RgbImage) -> Result<()> {
+pub(super) fn check(disparity: &DepthMap, color: &RgbImage) -> Result<()> {
     if (disparity.width, disparity.height) != (color.width, color.height) {
         return Err(Error::SizeMismatch {
             message: format!(
@@ -67,60 +67,9 @@ fn check(disparity: &DepthMap, color: &RgbImage) -> Result<()> {
 }
 
 /// The weight of a candidate at colour distance `diff` (summed levels) and walk distance `r`.
-fn weight(diff: u32, r: u32) -> u32 {
+pub(super) fn weight(diff: u32, r: u32) -> u32 {
     let s = COLOUR_SOFTNESS + diff;
     ((1u32 << 30) / (s * s)) / r
-}
-
-/// The twin of [`Densifier::densify`]: the same rule on the CPU.
-pub fn densify_reference(disparity: &DepthMap, color: &RgbImage) -> Result<Dense> {
-    check(disparity, color)?;
-    let (w, h) = (disparity.width as i64, disparity.height as i64);
-    let at = |x: i64, y: i64| disparity.data[(y * w + x) as usize];
-    let rgb = |x: i64, y: i64| {
-        let i = 3 * (y * w + x) as usize;
-        [color.data[i], color.data[i + 1], color.data[i + 2]]
-    };
-    let mut out = disparity.data.clone();
-    let mut filled = vec![0u8; out.len()];
-    for y in 0..h {
-        for x in 0..w {
-            if at(x, y) > 0.0 {
-                continue;
-            }
-            let c = rgb(x, y);
-            let mut candidates: Vec<(f32, u32)> = super::walk::DIRECTIONS
-                .iter()
-                .filter_map(|&d| super::walk::first_along((x, y), d, (w, h), RADIUS as i64, |qx, qy| at(qx, qy) > 0.0))
-                .map(|((qx, qy), r)| {
-                    let cq = rgb(qx, qy);
-                    let diff: u32 = (0..3).map(|k| c[k].abs_diff(cq[k]) as u32).sum();
-                    (at(qx, qy), weight(diff, r as u32))
-                })
-                .collect();
-            if candidates.is_empty() {
-                continue;
-            }
-            // Stable: equal disparities keep direction order, as the shader's insertion.
-            candidates.sort_by(|a, b| a.0.total_cmp(&b.0));
-            let total: u64 = candidates.iter().map(|c| c.1 as u64).sum();
-            let mut running = 0u64;
-            let pick = candidates
-                .iter()
-                .position(|c| {
-                    running += c.1 as u64;
-                    running * 100 >= total * QUANTILE_PERCENT as u64
-                })
-                .unwrap_or(candidates.len() - 1);
-            let i = (y * w + x) as usize;
-            out[i] = candidates[pick].0;
-            filled[i] = FILLED;
-        }
-    }
-    Ok(Dense {
-        disparity: DepthMap::new(disparity.width, disparity.height, out)?,
-        filled,
-    })
 }
 
 /// Makes disparity maps dense on one device.
@@ -196,6 +145,7 @@ impl Densifier {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::stereo::densify_reference::densify_reference;
 
     fn grey(w: u32, h: u32, v: impl Fn(u32, u32) -> u8) -> RgbImage {
         let mut data = Vec::with_capacity((3 * w * h) as usize);

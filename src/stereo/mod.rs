@@ -14,6 +14,7 @@
 pub mod camera_file;
 pub mod camera_spec;
 pub mod densify;
+pub mod densify_reference;
 pub mod disparity_frame;
 pub mod frame_depth;
 pub mod gather;

@@ -168,7 +168,7 @@ pub fn cyclopean_bench(
     repeats: usize,
     cases: &mut Vec<BenchCase>,
 ) -> Result<String> {
-    use viewsynth::stereo::gather::render::CyclopeanRenderer;
+    use viewsynth::stereo::gather::gpu::CyclopeanRenderer;
     use viewsynth::stereo::scene_frame::{scene_frame, StereoRig};
     use viewsynth::stereo::FrameDepth;
     let rig = StereoRig::demo(width, height);
@@ -284,7 +284,8 @@ pub fn cyclopean_bench(
         viewsynth::stereo::gather::CyclopeanOutputs::default(),
     )?
     .render(&last_mid)?;
-    use viewsynth::cyclopean::temporal::{Accumulator, TemporalAccumulator, DEPTH_TOLERANCE, FILL_ONLY};
+    use viewsynth::cyclopean::temporal::{Accumulator, DEPTH_TOLERANCE, FILL_ONLY};
+    use viewsynth::cyclopean::temporal_reference::TemporalAccumulator;
     let conv = Conventions::default();
     // Each timed push reprojects the other frame's view: the two alternate.
     let temporal = setup_and_median(

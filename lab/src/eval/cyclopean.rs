@@ -14,7 +14,7 @@ use viewsynth::io::{self, DepthDecode, DepthMap, RgbImage};
 use viewsynth::pass::{Device, Timing};
 use viewsynth::refocus::BreakRule;
 use viewsynth::stereo::disparity_frame::{disparity_frame, DisparityRig};
-use viewsynth::stereo::gather::render::CyclopeanRenderer;
+use viewsynth::stereo::gather::gpu::CyclopeanRenderer;
 use viewsynth::stereo::gather::{Blend, CyclopeanOutput, CyclopeanOutputs, CyclopeanParams, Method as CyclopeanMethod};
 use viewsynth::stereo::scene_frame::{scene_frame, StereoRig};
 use viewsynth::stereo::{FrameDepth, MiddleCamera, StereoFrame};

@@ -11,7 +11,7 @@ use crate::cyclopean::CyclopeanMethod;
 use crate::io;
 use crate::mesh::BreakRule;
 use crate::pass::Device;
-use crate::stereo::gather::render::CyclopeanRenderer;
+use crate::stereo::gather::gpu::CyclopeanRenderer;
 use crate::stereo::gather::CyclopeanOutputs;
 use crate::stereo::{MiddleCamera, StereoFrame};
 use crate::view::ViewOutput;

@@ -2,13 +2,13 @@
 //! the ray is walked to the surface each eye saw, and the eyes are combined. Cyclopean's
 //! seed/refine methods and reproject's 3-D gather both render with it.
 //!
-//! - [`reference`](mod@reference): the f64 CPU twin; [`render`]: the GPU pass
+//! - [`reference`](mod@reference): the f64 CPU twin; [`gpu`]: the GPU pass
 //!   (shaders/cyclopean/gather.frag); [`ambiguity`]: the f32 error bounds the GPU-vs-twin
 //!   tests excuse.
 
 pub mod ambiguity;
+pub mod gpu;
 pub mod reference;
-pub mod render;
 
 use super::Eye;
 use crate::error::{Error, Result};

@@ -342,7 +342,7 @@ pub struct CyclopeanReference {
     pub sources: Vec<u8>,
 }
 
-/// The f64 twin of [`CyclopeanRenderer`](crate::stereo::gather::render::CyclopeanRenderer): the middle view of `frame` through `mid` under `params`, rows top-down.
+/// The f64 twin of [`CyclopeanRenderer`](crate::stereo::gather::gpu::CyclopeanRenderer): the middle view of `frame` through `mid` under `params`, rows top-down.
 pub fn cyclopean_reference(
     frame: &StereoFrame,
     mid: &MiddleCamera,

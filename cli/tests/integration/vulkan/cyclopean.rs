@@ -6,7 +6,7 @@ use crate::cli::scratch;
 use crate::common::vulkan;
 use crate::common::{cyclopean_cli, write_cyclopean_files};
 use viewsynth::convention::Conventions;
-use viewsynth::stereo::gather::render::CyclopeanRenderer;
+use viewsynth::stereo::gather::gpu::CyclopeanRenderer;
 use viewsynth::stereo::gather::CyclopeanParams;
 use viewsynth::stereo::gather::Method;
 use viewsynth::stereo::scene_frame::{scene_frame, StereoRig};

@@ -7,7 +7,8 @@
 
 use viewsynth::io::{load_rgb, DepthMap, RgbImage};
 use viewsynth::pass::Device;
-use viewsynth::stereo::densify::{densify_reference, Densifier, FILLED};
+use viewsynth::stereo::densify::{Densifier, FILLED};
+use viewsynth::stereo::densify_reference::densify_reference;
 use viewsynth::stereo::matcher::estimate_disparities;
 use viewsynth_tests::{data_dir, gpu};
 

@@ -10,7 +10,8 @@
 //! relative). A 40-level error in any filled pixel fails.
 
 use viewsynth::convention::Conventions;
-use viewsynth::cyclopean::fill::{fill_reference, Filler, FILLED};
+use viewsynth::cyclopean::fill::{Filler, FILLED};
+use viewsynth::cyclopean::fill_reference::fill_reference;
 use viewsynth::cyclopean::splat::{SplatParams, SplatRenderer};
 use viewsynth::pass::Device;
 use viewsynth::stereo::gather::CyclopeanOutput;

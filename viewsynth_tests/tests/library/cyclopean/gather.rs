@@ -15,8 +15,8 @@
 use viewsynth::convention::Conventions;
 use viewsynth::cyclopean::{pass, CyclopeanInput, CyclopeanPass};
 use viewsynth::metrics;
+use viewsynth::stereo::gather::gpu::CyclopeanRenderer;
 use viewsynth::stereo::gather::reference::{ambiguity, cyclopean_reference};
-use viewsynth::stereo::gather::render::CyclopeanRenderer;
 use viewsynth::stereo::gather::CyclopeanOutput;
 use viewsynth::stereo::gather::CyclopeanOutputs;
 use viewsynth::stereo::gather::CyclopeanParams;
@@ -291,7 +291,8 @@ fn temporal_accumulation_fills_disocclusions_from_the_previous_frame() {
     // beside foreground edges. The head moves 10 cm between frames: the first frame saw some of
     // what the second misses. History must fill holes with the right surface (PSNR vs the
     // ray-traced view on filled pixels), never add holes, and leave a static sequence unchanged.
-    use viewsynth::cyclopean::temporal::{TemporalAccumulator, FROM_HISTORY};
+    use viewsynth::cyclopean::temporal::FROM_HISTORY;
+    use viewsynth::cyclopean::temporal_reference::TemporalAccumulator;
     let g = gpu();
     let conv = Conventions::all()[3];
     let params = CyclopeanParams {
@@ -410,7 +411,8 @@ fn unrequested_colour_and_depth_get_no_attachment_and_no_readback() {
     .unwrap()
     .render(&mid)
     .unwrap();
-    let mut taa = viewsynth::cyclopean::temporal::TemporalAccumulator::new(0.2, 0.05, Conventions::all()[7]).unwrap();
+    let mut taa =
+        viewsynth::cyclopean::temporal_reference::TemporalAccumulator::new(0.2, 0.05, Conventions::all()[7]).unwrap();
     let err = taa.push(&partial, &mid).unwrap_err();
     assert!(err.to_string().contains("colour and depth"), "{err}");
     // Last (each new context becomes current on this thread, so `g` is not used after):

@@ -7,7 +7,8 @@ use viewsynth::cyclopean::pipeline::{InputName, StereoInput, StereoKind};
 use viewsynth::io::{load_depth_with_key, load_rgb, DepthMap, RgbImage, MASK_FILLED};
 use viewsynth::job::cyclopean::CyclopeanRequest;
 use viewsynth::pass::Device;
-use viewsynth::stereo::densify::{densify_reference, Densifier, FILLED};
+use viewsynth::stereo::densify::{Densifier, FILLED};
+use viewsynth::stereo::densify_reference::densify_reference;
 use viewsynth_tests::{data_dir, gpu};
 
 /// A textured plane at disparity 4 (texture `t(x, y)` in the middle view's columns): the middle

@@ -17,9 +17,10 @@
 
 use viewsynth::camera::mat4;
 use viewsynth::convention::{Conventions, RowOrder};
-use viewsynth::cyclopean::temporal::{carried, Accumulator, TemporalAccumulator, FROM_HISTORY};
+use viewsynth::cyclopean::temporal::{Accumulator, FROM_HISTORY};
+use viewsynth::cyclopean::temporal_reference::{carried, TemporalAccumulator};
 use viewsynth::pass::Device;
-use viewsynth::stereo::gather::render::CyclopeanRenderer;
+use viewsynth::stereo::gather::gpu::CyclopeanRenderer;
 use viewsynth::stereo::gather::{CyclopeanOutput, CyclopeanParams, Method};
 use viewsynth::stereo::scene_frame::{scene_frame, StereoRig};
 use viewsynth::stereo::{FrameDepth, MiddleCamera};

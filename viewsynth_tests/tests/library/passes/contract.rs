@@ -12,8 +12,8 @@ use viewsynth::refocus::{self, BreakRule, Method, OutputSet, RefocusInput, Refoc
 use viewsynth::reproject::reference::reproject_reference;
 use viewsynth::reproject::render::Reprojector;
 use viewsynth::reproject::{self, ReprojectInput, ReprojectOutputs, ReprojectParams};
+use viewsynth::stereo::gather::gpu::CyclopeanRenderer;
 use viewsynth::stereo::gather::reference::cyclopean_reference;
-use viewsynth::stereo::gather::render::CyclopeanRenderer;
 use viewsynth::stereo::gather::{CyclopeanOutputs, CyclopeanParams};
 use viewsynth::stereo::scene_frame::{scene_frame, StereoRig};
 use viewsynth::stereo::FrameDepth;

@@ -13,7 +13,7 @@ use viewsynth::refocus::{BreakRule, Method as RefocusMethod, OutputSet, RefocusS
 use viewsynth::reproject::render::Reprojector;
 use viewsynth::reproject::{Geometry, Method, ReprojectParams, ReprojectSource, ShiftModel};
 use viewsynth::scene::render::{GlCamera, SceneRenderer};
-use viewsynth::stereo::gather::render::CyclopeanRenderer;
+use viewsynth::stereo::gather::gpu::CyclopeanRenderer;
 use viewsynth::stereo::gather::CyclopeanParams;
 use viewsynth::stereo::scene_frame::{scene_frame, StereoRig};
 use viewsynth::stereo::FrameDepth;

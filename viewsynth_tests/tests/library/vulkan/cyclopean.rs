@@ -26,7 +26,7 @@
 //!   the GL-vs-Vulkan comparison asks.
 
 use viewsynth::convention::Conventions;
-use viewsynth::stereo::gather::render::CyclopeanRenderer;
+use viewsynth::stereo::gather::gpu::CyclopeanRenderer;
 use viewsynth::stereo::gather::CyclopeanOutput;
 use viewsynth::stereo::gather::CyclopeanParams;
 use viewsynth::stereo::scene_frame::{scene_frame, StereoRig};

@@ -25,7 +25,7 @@ use viewsynth::refocus::{BreakRule, RefocusParams};
 use viewsynth::reproject::render::ShiftParams;
 use viewsynth::reproject::{self, ReprojectInput};
 use viewsynth::scene::render::{GlCamera, RaytraceParams, SceneRenderer};
-use viewsynth::stereo::gather::render::{CyclopeanRenderer, GatherParams};
+use viewsynth::stereo::gather::gpu::{CyclopeanRenderer, GatherParams};
 use viewsynth::stereo::gather::{CyclopeanOutputs, CyclopeanParams, Method};
 use viewsynth::stereo::scene_frame::{scene_frame, StereoRig};
 use viewsynth::stereo::FrameDepth;
