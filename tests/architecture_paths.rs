@@ -32,21 +32,16 @@ fn repo() -> PathBuf {
 /// The path-like tokens of `text`.
 fn tokens(text: &str) -> Vec<String> {
     let path_char = |c: char| c.is_ascii_alphanumeric() || "_-./{},<>*".contains(c);
-    // Inside a code span a `/` is enough; elsewhere an extension or a closing `/` is needed.
-    let mut in_code = Vec::new();
-    let mut code = false;
-    for c in text.chars() {
-        if c == '`' {
-            code = !code;
-        }
-        in_code.push(code);
-    }
+    // Inside a code span a `/` is enough; elsewhere an extension or a closing `/` is needed. A
+    // token is a slice of `text`: its byte offset tells how many backticks precede it (counted
+    // once, as the tokens come in order), and an odd count puts it in a code span.
     let mut out = Vec::new();
-    let mut at = 0;
+    let (mut counted, mut backticks) = (0, 0);
     for raw in text.split(|c: char| !path_char(c)) {
-        let start = text[at..].find(raw).map_or(at, |i| at + i);
-        at = start + raw.len();
-        let coded = in_code.get(text[..start].chars().count()).copied().unwrap_or(false);
+        let start = raw.as_ptr() as usize - text.as_ptr() as usize;
+        backticks += text[counted..start].matches('`').count();
+        counted = start;
+        let coded = backticks % 2 == 1;
         // Trailing sentence punctuation and list commas are not part of a path.
         let t = raw.trim_end_matches(['.', ',']).trim_start_matches(',');
         let t = t.strip_prefix("./").unwrap_or(t);

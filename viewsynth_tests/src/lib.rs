@@ -3,6 +3,8 @@
 //! folder, the real RGB-D frames and a synthetic one, GPU-against-twin agreement, the cyclopean
 //! methods every backend test runs, and the files `viewsynth cyclopean` reads.
 
+pub mod real_pairs;
+
 use std::path::PathBuf;
 use viewsynth::camera::{Intrinsics, PinholeCamera};
 use viewsynth::gpu::{DeviceChoice, Gpu};
@@ -221,3 +223,38 @@ pub fn vulkan() -> viewsynth::vulkan::Vk {
 /// (1 + variance)^2 that moves the confidence by at most 1.4e-4 x max sqrt(v) / (1 + v)^2
 /// (0.33 at v = 1/3) < 5e-5, and the agreement's f32 difference by 2^-24. So 1e-4.
 pub const CONFIDENCE_BOUND: f32 = 1e-4;
+
+/// Runs `command` under VK_LAYER_KHRONOS_validation (Debian package `vulkan-validationlayers`)
+/// and returns its stdout and stderr. It must succeed with no validation message, and the
+/// loader's own log must show the layer inserted, so a missing layer cannot pass silently.
+pub fn run_clean_under_validation_layer(what: &str, command: &mut std::process::Command) -> String {
+    let o = command
+        .env("VK_INSTANCE_LAYERS", "VK_LAYER_KHRONOS_validation")
+        .env("VK_LOADER_DEBUG", "layer")
+        .output()
+        .unwrap();
+    let text = format!(
+        "{}{}",
+        String::from_utf8_lossy(&o.stdout),
+        String::from_utf8_lossy(&o.stderr)
+    );
+    assert!(o.status.success(), "{what}: {text}");
+    assert!(
+        text.contains("Insert instance layer \"VK_LAYER_KHRONOS_validation\""),
+        "{what}: the validation layer was not loaded (install vulkan-validationlayers):\n{text}"
+    );
+    for bad in ["Validation Error", "VUID-", "Validation Warning"] {
+        assert!(!text.contains(bad), "{what}: {bad}:\n{text}");
+    }
+    text
+}
+
+/// Fails naming every failed case of a table of `cases`.
+pub fn assert_no_failures(failures: Vec<String>, cases: usize) {
+    assert!(
+        failures.is_empty(),
+        "{} of {cases} cases failed:\n{}",
+        failures.len(),
+        failures.join("\n")
+    );
+}

@@ -6,18 +6,10 @@ use viewsynth::io::DepthMap;
 use viewsynth::stereo::gather::CyclopeanOutputs;
 use viewsynth::stereo::gather::CyclopeanParams;
 use viewsynth::stereo::FrameDepth;
+use viewsynth_tests::assert_no_failures;
 
 const W: u32 = 32;
 const H: u32 = 24;
-
-fn report(failures: Vec<String>, cases: usize) {
-    assert!(
-        failures.is_empty(),
-        "{} of {cases} cases failed:\n{}",
-        failures.len(),
-        failures.join("\n")
-    );
-}
 
 /// Depth values a library caller can put in a `DepthMap` by hand that every pass must refuse
 /// (the loaders make them holes): subnormals, below 1e-6, above 1e6, up to f32::MAX.
@@ -352,7 +344,7 @@ fn library_passes_refuse_unusable_depth_and_are_finite_where_valid() {
             );
         }
     }
-    report(failures, cases);
+    assert_no_failures(failures, cases);
 }
 
 #[test]

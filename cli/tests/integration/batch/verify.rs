@@ -1,10 +1,11 @@
 //! Resume that verifies: a folder edited after the run and float settings read back bit-equal
 //! decide whether a frame is redone.
 
+use crate::common::assert_no_failures;
 use std::collections::BTreeMap;
 
 use crate::cli::{bin, files_in, scratch};
-use crate::safety::support::{copy_dir, inputs, p, report};
+use crate::safety::support::{copy_dir, inputs, p};
 
 #[test]
 fn resume_verifies_folders_and_float_settings() {
@@ -77,5 +78,5 @@ fn resume_verifies_folders_and_float_settings() {
     if before != after {
         failures.push("the folder the symlink points to changed".into());
     }
-    report(failures, cases);
+    assert_no_failures(failures, cases);
 }

@@ -3,76 +3,12 @@
 //! matchers' disparities (the splat-gather pass against its twin is `viewsynth_tests`'
 //! `cyclopean::real_pairs`).
 
-use crate::common::{data_dir, gpu};
-use std::path::{Path, PathBuf};
+use crate::common::data_dir;
+use std::path::Path;
 use viewsynth::convention::Conventions;
-use viewsynth::cyclopean::splat::{SplatParams, SplatRenderer};
-use viewsynth::io::{self, DepthDecode, DepthMap, RgbImage};
-use viewsynth::metrics;
+use viewsynth::io::{self, DepthDecode};
 use viewsynth::stereo::disparity_frame::{disparity_frame, DisparityRig};
-use viewsynth::stereo::gather::CyclopeanOutput;
-use viewsynth::stereo::gather::CyclopeanOutputs;
-use viewsynth::stereo::StereoFrame;
-
-fn splat_gpu(frame: &StereoFrame, mid: &viewsynth::stereo::MiddleCamera) -> CyclopeanOutput {
-    splat_on(&viewsynth::pass::Device::gl(&gpu()).unwrap(), frame, mid)
-}
-
-fn splat_on(
-    device: &viewsynth::pass::Device,
-    frame: &StereoFrame,
-    mid: &viewsynth::stereo::MiddleCamera,
-) -> CyclopeanOutput {
-    SplatRenderer::new(device, frame, SplatParams::default(), CyclopeanOutputs::default())
-        .unwrap()
-        .render(mid)
-        .unwrap()
-        .0
-}
-
-fn out_dir(name: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("viewsynth-{name}-{}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&dir);
-    std::fs::create_dir_all(&dir).unwrap();
-    dir
-}
-
-type Eye = (RgbImage, DepthMap);
-
-fn cones() -> (Eye, Eye, RgbImage) {
-    let dir = data_dir().join("middlebury2003_cones");
-    let dec = DepthDecode {
-        scale: Some(4.0),
-        ..Default::default()
-    };
-    let eye = |im: &str, disp: &str| {
-        (
-            io::load_rgb(&dir.join(im)).unwrap(),
-            io::load_depth(&dir.join(disp), &dec).unwrap(),
-        )
-    };
-    (
-        eye("im2.png", "disp2.pgm"),
-        eye("im6.png", "disp6.pgm"),
-        io::load_rgb(&dir.join("im4.png")).unwrap(),
-    )
-}
-
-fn psnr(a: &RgbImage, b: &RgbImage, mask: &[bool]) -> f64 {
-    let (mut sq, mut n) = (0.0, 0usize);
-    for (i, _) in mask.iter().enumerate().filter(|(_, m)| **m) {
-        n += 1;
-        for c in 0..3 {
-            let d = a.data[i * 3 + c] as f64 - b.data[i * 3 + c] as f64;
-            sq += d * d;
-        }
-    }
-    metrics::psnr_from_mse(sq / (3 * n) as f64)
-}
-
-fn count(mask: &[bool]) -> usize {
-    mask.iter().filter(|m| **m).count()
-}
+use viewsynth_tests::real_pairs::{cones, count, out_dir, psnr, splat_gpu};
 
 fn viewsynth(args: &[&str], paths: &[(&str, &Path)]) -> std::process::Output {
     let mut c = std::process::Command::new(env!("CARGO_BIN_EXE_viewsynth"));

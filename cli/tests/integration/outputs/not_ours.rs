@@ -1,12 +1,13 @@
 //! Outputs never replace what is not the run's own (a user's file at an output name, the
 //! previous set's leftovers are refused by name), and `compare` writes all or nothing.
 
+use crate::common::assert_no_failures;
 use std::path::Path;
 
 use viewsynth::io::{self, DepthMap};
 
 use crate::cli::{files_in, scratch, temporaries};
-use crate::safety::support::{inputs, mkfifo, p, report, run, s, H, W};
+use crate::safety::support::{inputs, mkfifo, p, run, s, H, W};
 
 #[test]
 fn outputs_never_replace_what_is_not_ours_and_compare_is_all_or_none() {
@@ -100,7 +101,7 @@ fn outputs_never_replace_what_is_not_ours_and_compare_is_all_or_none() {
             failures.push(format!("{label}: {} -- {}", problems.join("; "), err.trim()));
         }
     }
-    report(failures, n);
+    assert_no_failures(failures, n);
 }
 
 /// The chunk offset table of an EXR `save_depth_exr` wrote: (position, entries). Found as the
@@ -430,5 +431,5 @@ fn class6_leftovers_are_refused_by_name() {
             &mut failures,
         );
     }
-    report(failures, cases);
+    assert_no_failures(failures, cases);
 }

@@ -1,6 +1,7 @@
 //! The commit protocol killed or failed after every step, for every command that writes files:
 //! the folder holds the old set or the new one, complete, never a mixture.
 
+use crate::common::assert_no_failures;
 use std::collections::BTreeMap;
 use std::path::Path;
 use std::process::{Command, Stdio};
@@ -8,7 +9,7 @@ use std::process::{Command, Stdio};
 use viewsynth::io::{self};
 
 use crate::cli::{bin, scratch, temporaries};
-use crate::safety::support::{copy_dir, inputs, p, report, run, s};
+use crate::safety::support::{copy_dir, inputs, p, run, s};
 
 /// Per file the manifest lists, whether it is there with the CRC-32 recorded; and the method.
 fn manifest_state(dir: &Path) -> (bool, String) {
@@ -118,7 +119,7 @@ fn commit_survives_a_kill_or_a_failure_after_every_step() {
     if manifest_state(&out) != (true, old_method.clone()) || out.join(".viewsynth-1-killed").exists() {
         failures.push("killed before the journal: not the old set, or staging left".into());
     }
-    report(failures, cases);
+    assert_no_failures(failures, cases);
 }
 
 /// The files of a folder by name, for comparing whole sets: a refocus manifest (it holds
@@ -292,5 +293,5 @@ fn every_writing_command_is_all_or_none_after_any_commit_step() {
         let files = old.len() + usize::from(*name == "refocus");
         assert_eq!(steps, Some(1 + files + 3), "{name}: steps of one commit");
     }
-    report(failures, cases);
+    assert_no_failures(failures, cases);
 }

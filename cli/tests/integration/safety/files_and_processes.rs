@@ -6,6 +6,7 @@
 //! address-space limit far below what decoding the declared image would take, so a refusal
 //! that came too late would show as a crash, not pass.
 
+use crate::common::assert_no_failures;
 use std::collections::BTreeMap;
 use std::ffi::{OsStr, OsString};
 use std::os::unix::ffi::{OsStrExt, OsStringExt};
@@ -144,15 +145,6 @@ fn with(mut base: Vec<OsString>, flag: &str, value: &Path) -> Vec<OsString> {
     base.push(flag.into());
     base.push(value.into());
     base
-}
-
-fn assert_no_failures(failures: Vec<String>, cases: usize) {
-    assert!(
-        failures.is_empty(),
-        "{} of {cases} cases failed:\n{}",
-        failures.len(),
-        failures.join("\n")
-    );
 }
 
 fn write_inputs(dir: &Path, w: u32, h: u32, tag: &str) -> (PathBuf, PathBuf) {

@@ -1,10 +1,11 @@
 //! Depth and focal values over the whole f32/f64 range through the commands: never valid and
 //! non-finite; a refusal names the value.
 
+use crate::common::assert_no_failures;
 use viewsynth::io::{self, DepthMap};
 
 use crate::cli::{bin, scratch};
-use crate::safety::support::{inputs, report, H, W};
+use crate::safety::support::{inputs, H, W};
 
 #[test]
 fn depth_and_focal_values_over_the_whole_range_are_never_valid_and_non_finite() {
@@ -87,5 +88,5 @@ fn depth_and_focal_values_over_the_whole_range_are_never_valid_and_non_finite() 
             }
         }
     }
-    report(failures, cases);
+    assert_no_failures(failures, cases);
 }

@@ -2,7 +2,8 @@
 //! read from each command's `--help`, so a new option is covered), and the named usage errors.
 
 use crate::cli::{bin, files_in, scratch};
-use crate::safety::support::{inputs, p, report, run, s};
+use crate::common::assert_no_failures;
+use crate::safety::support::{inputs, p, run, s};
 
 /// The value-taking options of a command, read from its --help (so a new option is covered
 /// without editing this test).
@@ -144,7 +145,7 @@ fn every_option_refuses_an_invalid_value_with_exit_2_naming_it() {
         }
     }
     assert!(cases >= 120, "only {cases} options enumerated");
-    report(failures, cases);
+    assert_no_failures(failures, cases);
 }
 
 #[test]
@@ -210,5 +211,5 @@ fn named_usage_errors() {
             failures.push(format!("{label}: exit {:?} -- {}", o.status.code(), err.trim()));
         }
     }
-    report(failures, n);
+    assert_no_failures(failures, n);
 }

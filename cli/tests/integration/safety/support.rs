@@ -39,15 +39,6 @@ pub(crate) fn p(path: &Path) -> String {
     path.to_str().unwrap().to_string()
 }
 
-pub(crate) fn report(failures: Vec<String>, cases: usize) {
-    assert!(
-        failures.is_empty(),
-        "{} of {cases} cases failed:\n{}",
-        failures.len(),
-        failures.join("\n")
-    );
-}
-
 pub(crate) fn copy_dir(from: &Path, to: &Path) {
     std::fs::create_dir_all(to).unwrap();
     for e in std::fs::read_dir(from).unwrap().flatten() {

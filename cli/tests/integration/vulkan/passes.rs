@@ -3,6 +3,7 @@
 //! derived in `viewsynth_tests`' `vulkan::passes`), and every pass runs clean under the Khronos
 //! validation layer. A missing Vulkan loader, driver or validation layer fails, never skips.
 use crate::cli::{bin, scratch};
+use crate::common::run_clean_under_validation_layer;
 use crate::common::{cyclopean_cli, data_dir, write_cyclopean_files};
 use std::path::Path;
 use viewsynth::convention::Conventions;
@@ -361,33 +362,12 @@ fn every_vulkan_pass_runs_clean_under_the_validation_layer() {
         .unwrap();
     assert!(made.status.success(), "{}", String::from_utf8_lossy(&made.stderr));
     runs.push(s(&["cyclopean", "--sequence", &file("seq/sequence.json"), "--fill"]));
-    let under_layer = |command: &mut std::process::Command| {
-        command
-            .env("VK_INSTANCE_LAYERS", "VK_LAYER_KHRONOS_validation")
-            .env("VK_LOADER_DEBUG", "layer")
-            .output()
-            .unwrap()
-    };
-    let assert_clean = |what: &dyn std::fmt::Debug, o: std::process::Output| {
-        let text = format!(
-            "{}{}",
-            String::from_utf8_lossy(&o.stdout),
-            String::from_utf8_lossy(&o.stderr)
-        );
-        assert!(o.status.success(), "{what:?}: {text}");
-        assert!(
-            text.contains("Insert instance layer \"VK_LAYER_KHRONOS_validation\""),
-            "{what:?}: the validation layer was not loaded (install vulkan-validationlayers):\n{text}"
-        );
-        for bad in ["Validation Error", "VUID-", "Validation Warning"] {
-            assert!(!text.contains(bad), "{what:?}: {bad}:\n{text}");
-        }
-        text
-    };
     for (k, args) in runs.iter().enumerate() {
         let out = dir.join(format!("run{k}"));
-        let o = under_layer(bin().args(args).args(["--backend", "vulkan", "--out-dir"]).arg(&out));
-        assert_clean(args, o);
+        run_clean_under_validation_layer(
+            &format!("{args:?}"),
+            bin().args(args).args(["--backend", "vulkan", "--out-dir"]).arg(&out),
+        );
     }
     // The stereo matcher has no command of its own: `viewsynth_tests`'
     // `vulkan::passes::the_matcher_runs_clean_under_the_validation_layer` runs its Vulkan test

@@ -12,14 +12,13 @@
 //! relative (the f32 error of the chain, ~1e-6; as for the gather method). So one pixel 40 levels
 //! off fails. The marked share is bounded per case (see `splat_gather_twin`).
 
-use std::path::PathBuf;
 use viewsynth::camera::{gl_projection, Intrinsics, PinholeCamera};
 use viewsynth::convention::Conventions;
 use viewsynth::convention::DepthPlanes;
 use viewsynth::cyclopean::baseline::{forward_splat, forward_splat_offset, forward_splat_rounded, Rounding};
 use viewsynth::cyclopean::splat::{SplatParams, SplatRenderer};
 use viewsynth::cyclopean::splat_reference::{self, splat_reference};
-use viewsynth::io::{self, DepthDecode, DepthMap, RgbImage};
+use viewsynth::io::{self, DepthMap, RgbImage};
 use viewsynth::metrics;
 use viewsynth::stereo::disparity_frame::{disparity_frame, median_fixation, DisparityRig};
 use viewsynth::stereo::gather::gpu::CyclopeanRenderer;
@@ -32,23 +31,8 @@ use viewsynth::stereo::scene_frame::{scene_frame, StereoRig};
 use viewsynth::stereo::FrameDepth;
 use viewsynth::stereo::StereoFrame;
 use viewsynth_lab::eval::cyclopean::{estimated_cases, estimated_eyes};
+use viewsynth_tests::real_pairs::{cones, count, out_dir, psnr, splat_gpu, splat_on, Eye};
 use viewsynth_tests::{data_dir, gpu};
-
-fn splat_gpu(frame: &StereoFrame, mid: &viewsynth::stereo::MiddleCamera) -> CyclopeanOutput {
-    splat_on(&viewsynth::pass::Device::gl(&gpu()).unwrap(), frame, mid)
-}
-
-fn splat_on(
-    device: &viewsynth::pass::Device,
-    frame: &StereoFrame,
-    mid: &viewsynth::stereo::MiddleCamera,
-) -> CyclopeanOutput {
-    SplatRenderer::new(device, frame, SplatParams::default(), CyclopeanOutputs::default())
-        .unwrap()
-        .render(mid)
-        .unwrap()
-        .0
-}
 
 fn gather_gpu(frame: &StereoFrame, mid: &viewsynth::stereo::MiddleCamera, params: CyclopeanParams) -> CyclopeanOutput {
     CyclopeanRenderer::new(&gpu(), frame, params)
@@ -56,13 +40,6 @@ fn gather_gpu(frame: &StereoFrame, mid: &viewsynth::stereo::MiddleCamera, params
         .render(mid)
         .unwrap()
         .0
-}
-
-fn out_dir(name: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("viewsynth-{name}-{}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&dir);
-    std::fs::create_dir_all(&dir).unwrap();
-    dir
 }
 
 /// Among the pixels the twin does not mark `ambiguous`: those whose source bits differ; those
@@ -179,43 +156,6 @@ fn splat_gather_twin(device: &viewsynth::pass::Device) {
     let (l, r, _) = cones();
     let (frame, mid) = disparity_frame(l, r, &DisparityRig::middle(400.0, 0.1), Conventions::default()).unwrap();
     check_twin(device, "cones", &frame, &mid, CONES_MAX_AMBIGUOUS);
-}
-
-type Eye = (RgbImage, DepthMap);
-
-fn cones() -> (Eye, Eye, RgbImage) {
-    let dir = data_dir().join("middlebury2003_cones");
-    let dec = DepthDecode {
-        scale: Some(4.0),
-        ..Default::default()
-    };
-    let eye = |im: &str, disp: &str| {
-        (
-            io::load_rgb(&dir.join(im)).unwrap(),
-            io::load_depth(&dir.join(disp), &dec).unwrap(),
-        )
-    };
-    (
-        eye("im2.png", "disp2.pgm"),
-        eye("im6.png", "disp6.pgm"),
-        io::load_rgb(&dir.join("im4.png")).unwrap(),
-    )
-}
-
-fn psnr(a: &RgbImage, b: &RgbImage, mask: &[bool]) -> f64 {
-    let (mut sq, mut n) = (0.0, 0usize);
-    for (i, _) in mask.iter().enumerate().filter(|(_, m)| **m) {
-        n += 1;
-        for c in 0..3 {
-            let d = a.data[i * 3 + c] as f64 - b.data[i * 3 + c] as f64;
-            sq += d * d;
-        }
-    }
-    metrics::psnr_from_mse(sq / (3 * n) as f64)
-}
-
-fn count(mask: &[bool]) -> usize {
-    mask.iter().filter(|m| **m).count()
 }
 
 #[test]
