@@ -9,6 +9,12 @@
 layout(location = 0) out float o_disparity;
 layout(location = 1) out float o_filled;  // R8 normalised: bits / 255 stores the bits
 
+// Whether stored disparity v at column x has its match outside the other eye's frame.
+bool outside(float x, float v) {
+    float partner = x + u_sign * (v - u_offset);
+    return partner < 0.0 || partner > float(u_size.x - 1);
+}
+
 bool walk_stops_at(ivec2 q) {
     return texelFetch(u_disparity, q, 0).r > 0.0;
 }
@@ -28,6 +34,7 @@ void main() {
     uvec3 c = colour(p);
     float v[16];
     uint w[16];
+    bool leaves[16];
     int n = 0;
     for (int i = 0; i < DIRECTION_COUNT; ++i) {
         ivec2 q;
@@ -45,16 +52,34 @@ void main() {
         while (j > 0 && v[j - 1] > value) {
             v[j] = v[j - 1];
             w[j] = w[j - 1];
+            leaves[j] = leaves[j - 1];
             --j;
         }
         v[j] = value;
         w[j] = weight;
+        leaves[j] = outside(float(p.x), value);
         ++n;
     }
     if (n == 0) {
         o_disparity = 0.0;
         o_filled = 0.0;
         return;
+    }
+    // Candidates that put p's match outside the other eye's frame explain its being unknown
+    // without an occluder: those alone (the others' weights zeroed), and no lean to the
+    // background.
+    bool any_leaves = false;
+    for (int i = 0; i < n; ++i) {
+        any_leaves = any_leaves || leaves[i];
+    }
+    uint percent = QUANTILE_PERCENT;
+    if (any_leaves) {
+        percent = OUT_OF_FRAME_PERCENT;
+        for (int i = 0; i < n; ++i) {
+            if (!leaves[i]) {
+                w[i] = 0u;
+            }
+        }
     }
     uint total = 0u;
     for (int i = 0; i < n; ++i) {
@@ -64,7 +89,7 @@ void main() {
     int pick = n - 1;
     for (int i = 0; i < n; ++i) {
         running += w[i];
-        if (running * 100u >= total * QUANTILE_PERCENT) {
+        if (w[i] > 0u && running * 100u >= total * percent) {
             pick = i;
             break;
         }

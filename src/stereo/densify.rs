@@ -34,6 +34,44 @@ pub const RADIUS: u32 = 256;
 pub const COLOUR_SOFTNESS: u32 = 24;
 /// The weighted quantile taken, percent.
 pub const QUANTILE_PERCENT: u32 = 15;
+/// The weighted quantile taken among the candidates that put a pixel outside the other eye's
+/// frame, percent: no lean to the background there, since no occluder hid the pixel.
+pub const OUT_OF_FRAME_PERCENT: u32 = 50;
+
+/// Whose disparities a densify pass fills: the eye, and the offset they are stored with
+/// (d + offset, so that signed ranges stay positive), which together say where a pixel's match
+/// lies in the other eye (left: x - d, right: x + d).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct OtherEye {
+    /// The eye whose disparities are filled.
+    pub eye: crate::stereo::Eye,
+    /// The offset the disparities are stored with.
+    pub offset: u32,
+}
+
+impl OtherEye {
+    /// The left eye's disparities, stored as they are.
+    pub const LEFT: OtherEye = OtherEye {
+        eye: crate::stereo::Eye::Left,
+        offset: 0,
+    };
+
+    /// The sign of the shift to the match: x - d on the left eye, x + d on the right.
+    fn sign(self) -> f32 {
+        match self.eye {
+            crate::stereo::Eye::Left => -1.0,
+            crate::stereo::Eye::Right => 1.0,
+        }
+    }
+
+    /// Whether stored disparity `v` at column `x` puts the match outside the other eye's frame
+    /// of `width` columns: a candidate that does explains why `x` is unknown without an
+    /// occluder. f32 as the shader, so both decide alike.
+    pub(super) fn outside(self, x: f32, v: f32, width: f32) -> bool {
+        let partner = x + self.sign() * (v - self.offset as f32);
+        partner < 0.0 || partner > width - 1.0
+    }
+}
 
 crate::param_block! {
     /// shaders/cyclopean/densify_params.glsl, member for member.
@@ -41,6 +79,8 @@ crate::param_block! {
         u_size: [i32; 2],
         u_radius: i32,
         u_filled: u32,
+        u_sign: f32,
+        u_offset: f32,
     }
 }
 
@@ -89,7 +129,7 @@ impl Densifier {
     }
 
     /// `disparity` (0 = unknown) made dense, guided by the eye's `color`; the twin's maps bit for bit.
-    pub fn densify(&mut self, disparity: &DepthMap, color: &RgbImage) -> Result<Dense> {
+    pub fn densify(&mut self, disparity: &DepthMap, color: &RgbImage, other: OtherEye) -> Result<Dense> {
         check(disparity, color)?;
         let (w, h) = (disparity.width, disparity.height);
         let rgba = crate::pass::pixels::rgb_to_rgba(&color.data);
@@ -113,6 +153,8 @@ impl Densifier {
             u_size: [w as i32, h as i32],
             u_radius: RADIUS as i32,
             u_filled: FILLED.into(),
+            u_sign: other.sign(),
+            u_offset: other.offset as f32,
         };
         // Memory rows are the top-down rows and the walk reads them as the twin does: no flip.
         let target = Target {
@@ -164,6 +206,7 @@ mod tests {
         for line in [
             format!("const uint COLOUR_SOFTNESS = {}u;", COLOUR_SOFTNESS),
             format!("const uint QUANTILE_PERCENT = {}u;", QUANTILE_PERCENT),
+            format!("const uint OUT_OF_FRAME_PERCENT = {}u;", OUT_OF_FRAME_PERCENT),
         ] {
             assert!(glsl.contains(&line), "densify_params.glsl lacks `{line}`");
         }
@@ -173,16 +216,17 @@ mod tests {
 
     #[test]
     fn an_occluded_band_takes_the_background_beside_it() {
-        // Row: background 10 px (disparity 5) | unknown band 3 px | foreground (disparity 20).
+        // Row: background 30 px (disparity 5) | unknown band 3 px | foreground (disparity 20).
         // The band is background surface (its colour), and nearer the foreground's pixels in
-        // most directions: it still takes the background.
-        let (w, h) = (16u32, 5u32);
+        // most directions: it still takes the background. (Every disparity keeps its match
+        // inside the other eye's frame, as a matched pixel's does.)
+        let (w, h) = (36u32, 5u32);
         let d: Vec<f32> = (0..h)
             .flat_map(|_| {
                 (0..w).map(|x| {
-                    if x < 10 {
+                    if x < 30 {
                         5.0
-                    } else if x < 13 {
+                    } else if x < 33 {
                         0.0
                     } else {
                         20.0
@@ -190,13 +234,62 @@ mod tests {
                 })
             })
             .collect();
-        let color = grey(w, h, |x, _| if x < 13 { 90 } else { 200 });
-        let dense = densify_reference(&DepthMap::new(w, h, d).unwrap(), &color).unwrap();
-        for x in 10..13 {
+        let color = grey(w, h, |x, _| if x < 33 { 90 } else { 200 });
+        let dense = densify_reference(&DepthMap::new(w, h, d).unwrap(), &color, OtherEye::LEFT).unwrap();
+        for x in 30..33 {
             assert_eq!(dense.disparity.data[2 * w as usize + x], 5.0, "x = {x}");
             assert_eq!(dense.filled[2 * w as usize + x], FILLED);
         }
         assert_eq!(dense.filled[0], 0, "known disparities are not flagged");
+    }
+
+    #[test]
+    fn a_strip_the_other_eye_cannot_see_takes_the_surface_beside_it() {
+        // Left eye, one colour: rows 0..8 foreground (disparity 12) from x = 12 on, its first 12
+        // columns unknown: their matches would lie left of the right eye's frame. Rows 8..12:
+        // background (disparity 3) known from x = 3. The strip is no occlusion, so it
+        // takes the foreground beside it, not the background below; on the right eye (match at
+        // x + d, inside the frame) the same map leans to the background as before.
+        let (w, h) = (24u32, 12u32);
+        let color = grey(w, h, |_, _| 220);
+        let d: Vec<f32> = (0..h)
+            .flat_map(|y| {
+                (0..w).map(move |x| match (x, y) {
+                    (0..=11, 0..=7) | (0..=2, _) => 0.0,
+                    (_, 0..=7) => 12.0,
+                    _ => 3.0,
+                })
+            })
+            .collect();
+        let map = DepthMap::new(w, h, d).unwrap();
+        let left = densify_reference(&map, &color, OtherEye::LEFT).unwrap();
+        let right = OtherEye {
+            eye: crate::stereo::Eye::Right,
+            offset: 0,
+        };
+        let right = densify_reference(&map, &color, right).unwrap();
+        for y in 0..8 {
+            // Left of x = 3 the background's matches leave the frame too: either may be right.
+            for x in 3..12 {
+                let i = (y * w + x) as usize;
+                assert_eq!(left.disparity.data[i], 12.0, "left ({x}, {y})");
+            }
+        }
+        // The right eye's pixel next to the background takes it (the occlusion rule).
+        assert_eq!(right.disparity.data[(7 * w + 5) as usize], 3.0);
+        // An offset shifts the frame test with the stored values: stored 12 + 10 is d = 12.
+        let shifted = DepthMap::new(
+            w,
+            h,
+            map.data.iter().map(|v| if *v > 0.0 { v + 10.0 } else { 0.0 }).collect(),
+        )
+        .unwrap();
+        let offset = OtherEye {
+            eye: crate::stereo::Eye::Left,
+            offset: 10,
+        };
+        let shifted = densify_reference(&shifted, &color, offset).unwrap();
+        assert_eq!(shifted.disparity.data[(2 * w + 5) as usize], 22.0);
     }
 
     #[test]
@@ -214,7 +307,7 @@ mod tests {
                 })
             })
             .collect();
-        let dense = densify_reference(&DepthMap::new(w, h, d).unwrap(), &color).unwrap();
+        let dense = densify_reference(&DepthMap::new(w, h, d).unwrap(), &color, OtherEye::LEFT).unwrap();
         for y in 4..12 {
             for x in 10..16 {
                 assert_eq!(dense.disparity.data[(y * w + x) as usize], 30.0, "({x}, {y})");
@@ -227,6 +320,7 @@ mod tests {
         let dense = densify_reference(
             &DepthMap::new(4, 3, vec![0.0; 12]).unwrap(),
             &grey(4, 3, |x, _| x as u8),
+            OtherEye::LEFT,
         )
         .unwrap();
         assert!(dense.disparity.data.iter().all(|v| *v == 0.0));

@@ -249,8 +249,16 @@ pub fn cyclopean_bench(
             repeats,
             || viewsynth::stereo::densify::Densifier::new(device),
             |d| {
-                d.densify(maps[0], &left)?;
-                d.densify(maps[1], &right)
+                use viewsynth::stereo::{densify::OtherEye, Eye};
+                d.densify(maps[0], &left, OtherEye::LEFT)?;
+                d.densify(
+                    maps[1],
+                    &right,
+                    OtherEye {
+                        eye: Eye::Right,
+                        offset: 0,
+                    },
+                )
             },
         )?;
         record(

@@ -10,7 +10,7 @@ use crate::io::{DepthMap, RgbImage};
 use crate::output::OutputSet;
 use crate::pass::Device;
 use crate::stereo::camera_file::{CameraFile, EyeCameras};
-use crate::stereo::densify::Densifier;
+use crate::stereo::densify::{Densifier, OtherEye};
 use crate::stereo::disparity_frame::{disparity_frame, median_fixation, DisparityRig};
 use crate::stereo::gather::{Blend, CyclopeanParams};
 use crate::stereo::matcher::range::DisparityRange;
@@ -261,11 +261,12 @@ impl CyclopeanPlan {
                 &mut own
             }
         };
-        let [left, right] = eyes.map(|(color, disparity)| {
+        let [left, right] = [Eye::Left, Eye::Right].map(|eye| {
+            let (color, disparity) = eyes[eye as usize];
             let mut known = disparity.clone();
             known.data.iter_mut().filter(|d| !d.is_finite()).for_each(|d| *d = 0.0);
             densifier
-                .densify(&known, color)
+                .densify(&known, color, OtherEye { eye, offset })
                 .map(|dense| (color.clone(), dense.disparity))
         });
         Ok(self.disparity_frame(left?, right?, left_map, offset)?.frame)

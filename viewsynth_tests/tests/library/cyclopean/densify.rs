@@ -7,7 +7,7 @@
 
 use viewsynth::io::{load_rgb, DepthMap, RgbImage};
 use viewsynth::pass::Device;
-use viewsynth::stereo::densify::{Densifier, FILLED};
+use viewsynth::stereo::densify::{Densifier, OtherEye, FILLED};
 use viewsynth::stereo::densify_reference::densify_reference;
 use viewsynth::stereo::matcher::estimate_disparities;
 use viewsynth_tests::{data_dir, gpu};
@@ -32,8 +32,20 @@ fn check(eye: (RgbImage, DepthMap), device: &Device, what: &str) {
         unknown * 20 > disparity.data.len(),
         "{what}: the matcher leaves holes ({unknown})"
     );
-    let gpu_out = Densifier::new(device).unwrap().densify(&disparity, &color).unwrap();
-    let twin = densify_reference(&disparity, &color).unwrap();
+    let mut densifier = Densifier::new(device).unwrap();
+    // The same map as the right eye's, stored with an offset: the frame rule's other branch.
+    let right = OtherEye {
+        eye: viewsynth::stereo::Eye::Right,
+        offset: 7,
+    };
+    let gpu_right = densifier.densify(&disparity, &color, right).unwrap();
+    let twin_right = densify_reference(&disparity, &color, right).unwrap();
+    assert!(
+        gpu_right == twin_right,
+        "{what}: as a right eye with an offset, the pass differs from its twin"
+    );
+    let gpu_out = densifier.densify(&disparity, &color, OtherEye::LEFT).unwrap();
+    let twin = densify_reference(&disparity, &color, OtherEye::LEFT).unwrap();
     assert_eq!(gpu_out.filled, twin.filled, "{what}: filled flags differ");
     let differ: Vec<usize> = (0..twin.filled.len())
         .filter(|&i| gpu_out.disparity.data[i].to_bits() != twin.disparity.data[i].to_bits())

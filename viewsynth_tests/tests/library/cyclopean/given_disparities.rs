@@ -7,7 +7,7 @@ use viewsynth::cyclopean::pipeline::{InputName, StereoInput, StereoKind};
 use viewsynth::io::{load_depth_with_key, load_rgb, DepthMap, RgbImage, MASK_FILLED};
 use viewsynth::job::cyclopean::CyclopeanRequest;
 use viewsynth::pass::Device;
-use viewsynth::stereo::densify::{Densifier, FILLED};
+use viewsynth::stereo::densify::{Densifier, OtherEye, FILLED};
 use viewsynth::stereo::densify_reference::densify_reference;
 use viewsynth_tests::{data_dir, gpu};
 
@@ -127,8 +127,11 @@ fn check(eye: (RgbImage, DepthMap), device: &Device, what: &str) {
         unknown * 50 > disparity.data.len(),
         "{what}: the ground truth has holes ({unknown})"
     );
-    let gpu_out = Densifier::new(device).unwrap().densify(&disparity, &color).unwrap();
-    let twin = densify_reference(&disparity, &color).unwrap();
+    let gpu_out = Densifier::new(device)
+        .unwrap()
+        .densify(&disparity, &color, OtherEye::LEFT)
+        .unwrap();
+    let twin = densify_reference(&disparity, &color, OtherEye::LEFT).unwrap();
     assert_eq!(gpu_out.filled, twin.filled, "{what}: filled flags differ");
     let differ = (0..twin.filled.len())
         .filter(|&i| gpu_out.disparity.data[i].to_bits() != twin.disparity.data[i].to_bits())

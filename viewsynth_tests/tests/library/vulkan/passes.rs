@@ -363,7 +363,11 @@ fn a_steady_state_frame_creates_nothing_on_either_api() {
         let (matched, _) = matcher.estimate(&frame.left.color, &frame.right.color).unwrap();
         // The densify pass (issue 38) on those disparities: its first eye uploads the inputs.
         let mut densifier = viewsynth::stereo::densify::Densifier::new(d).unwrap();
-        drop(densifier.densify(&matched, &frame.left.color).unwrap());
+        drop(
+            densifier
+                .densify(&matched, &frame.left.color, viewsynth::stereo::densify::OtherEye::LEFT)
+                .unwrap(),
+        );
         let source = viewsynth_tests::synthetic(64, 48);
         let targets = viewsynth::refocus::manifest::TargetSpec {
             scales: vec![0.5, 1.0, 2.0],
@@ -436,7 +440,13 @@ fn a_steady_state_frame_creates_nothing_on_either_api() {
             ),
             (
                 "densify",
-                Box::new(|| drop(densifier.densify(&matched, &frame.left.color).unwrap())),
+                Box::new(|| {
+                    drop(
+                        densifier
+                            .densify(&matched, &frame.left.color, viewsynth::stereo::densify::OtherEye::LEFT)
+                            .unwrap(),
+                    )
+                }),
             ),
             (
                 // The batch's frame: a new source of the same size, every target in flight at once.
