@@ -140,6 +140,15 @@ pub const PROGRAMS: &[ProgramEntry] = &[
         vulkan: Some(&[]),
     },
     ProgramEntry {
+        name: "cyclopean/trust",
+        stages: &[
+            ("vert", FULLSCREEN_VERT),
+            ("frag", &["cyclopean/trust_params.glsl", "cyclopean/trust.frag"]),
+        ],
+        switches: &[],
+        vulkan: Some(&[]),
+    },
+    ProgramEntry {
         name: "cyclopean/fill",
         stages: &[
             ("vert", FULLSCREEN_VERT),

@@ -321,6 +321,10 @@ pub const PROGRAMS_WITHOUT_A_CASE: &[(&str, &str)] = &[
         "only under --rgb-everywhere, which the refocus cases leave off",
     ),
     ("cyclopean/densify", "the two-image --fill path; no lab case yet"),
+    (
+        "cyclopean/trust",
+        "the two-image path's matched/inferred split of the semi-global disparities; no lab case yet",
+    ),
     ("cyclopean/fill", "--fill; no lab case yet"),
     ("cyclopean/temporal_reproject", "--sequence history; no lab case yet"),
     ("cyclopean/temporal_compose", "--sequence history; no lab case yet"),

@@ -224,10 +224,12 @@ class Renderer:
           cameras["depth_kind"]) with cameras: a cameras.json path or a dict with its keys
           (eyes and view as K, R, t, width, height, near, far, or GL view/proj; fixation_distance
           or gaze). The view is the middle camera's; or
-        - the two images alone: the disparities are estimated by the census matcher over
-          0..=max_disparity px; min_confidence drops the estimates it trusts less, and
-          confidence=True returns each eye's confidence ("left_confidence", "right_confidence");
-          matcher="sgm" matches semi-globally (smooth where there is no texture).
+        - the two images alone: the disparities are estimated by the semi-global matcher
+          (matcher="sgm", the default: smooth where there is no texture; those the census
+          matcher does not confirm are inferred, rendered only with fill=True) or the census
+          matcher alone (matcher="census") over the estimated range or 0..=max_disparity px;
+          min_confidence drops the estimates it trusts less, and confidence=True returns each
+          eye's confidence ("left_confidence", "right_confidence"; an inferred one at most 0.25).
         See help(viewsynth.Renderer.cyclopean)."""
         ...
     def gl_objects(self) -> GlObjectCounts:

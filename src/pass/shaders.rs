@@ -205,6 +205,9 @@ pub enum ProgramKind {
     /// cyclopean/densify.frag: unknown disparities of one eye filled before rendering (`--fill`
     /// on two images alone).
     CyclopeanDensify,
+    /// cyclopean/trust.frag: which semi-global disparities the census matcher's agreement (or a
+    /// flat window) supports; the others are inferred (`--matcher sgm`).
+    CyclopeanTrust,
     /// cyclopean/fill.frag: holes filled from the background side (`--fill`).
     CyclopeanFill,
     /// cyclopean/temporal_reproject.comp: the previous middle view moved into the current
@@ -313,6 +316,7 @@ impl ProgramKind {
             ProgramKind::CyclopeanSplatEdges => "cyclopean/splat_edges",
             ProgramKind::CyclopeanEdgeSnap => "cyclopean/edge_snap",
             ProgramKind::CyclopeanDensify => "cyclopean/densify",
+            ProgramKind::CyclopeanTrust => "cyclopean/trust",
             ProgramKind::CyclopeanFill => "cyclopean/fill",
             ProgramKind::CyclopeanTemporalReproject { .. } => "cyclopean/temporal_reproject",
             ProgramKind::CyclopeanTemporalCompose => "cyclopean/temporal_compose",
@@ -354,6 +358,7 @@ impl ProgramKind {
             | ProgramKind::CyclopeanSplatEdges
             | ProgramKind::CyclopeanEdgeSnap
             | ProgramKind::CyclopeanDensify
+            | ProgramKind::CyclopeanTrust
             | ProgramKind::CyclopeanFill
             | ProgramKind::CyclopeanTemporalCompose
             | ProgramKind::CyclopeanMatcher(_)
@@ -453,6 +458,7 @@ impl ShaderProgram {
             ProgramKind::CyclopeanSplatEdges,
             ProgramKind::CyclopeanEdgeSnap,
             ProgramKind::CyclopeanDensify,
+            ProgramKind::CyclopeanTrust,
             ProgramKind::CyclopeanFill,
             ProgramKind::CyclopeanTemporalReproject { winner: false },
             ProgramKind::CyclopeanTemporalReproject { winner: true },

@@ -4,7 +4,8 @@
 //! both cyclopean's seed/refine and reproject's 3-D gather run.
 //!
 //! - [`matcher`]: the census and semi-global stereo matchers (GPU pass and CPU twin), for pairs
-//!   without ground-truth disparities; [`densify`]: unknown disparities filled along 16 walks.
+//!   without ground-truth disparities; [`trust`]: which semi-global disparities are matched and
+//!   which inferred; [`densify`]: unknown disparities filled along 16 walks.
 //! - [`camera_file`], [`camera_spec`]: the eyes' and the view's cameras from a JSON file.
 //! - [`disparity_frame`]: a rectified pair with disparities as a frame; [`one_eye`]: the other
 //!   eye's disparities from one.
@@ -21,6 +22,8 @@ pub mod gather;
 pub mod matcher;
 pub mod one_eye;
 pub mod scene_frame;
+pub mod trust;
+pub mod trust_reference;
 pub mod walk;
 
 use crate::camera::mat4::{self, Mat4};

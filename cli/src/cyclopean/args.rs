@@ -178,10 +178,12 @@ pub(crate) struct CyclopeanArgs {
     /// --min-confidence is held against.
     #[arg(help_heading = OUTPUTS, long)]
     confidence: bool,
-    /// Two images alone: the stereo matcher [default: census].
+    /// Two images alone: the stereo matcher [default: sgm].
     ///
-    /// sgm is smoother (low-texture regions take the surrounding surface's disparity, so more
-    /// pixels are rendered) but less precise on textured ones; see docs/cyclopean.md.
+    /// sgm is smooth: low-texture regions take the surrounding surface's disparity. Its
+    /// disparities the census matcher (run on the same pair) does not support, outside flat
+    /// regions, are inferred: rendered with --fill (128 in the mask), not without. census alone
+    /// is faster and leaves those pixels unknown; see docs/cyclopean.md.
     #[arg(help_heading = INPUTS, long, value_enum)]
     matcher: Option<MatcherArg>,
     /// Writes middle_rgb.png, middle_depth.exr, middle_mask.png (those in --outputs), and

@@ -7,7 +7,65 @@ use super::reuse::Reused;
 use crate::io::{DepthMap, RgbImage};
 use crate::pass::Device;
 use crate::stereo::matcher::range::{estimate_range, DisparityRange, SignedSearch};
-use crate::stereo::matcher::{EyeEstimate, Matcher};
+use crate::stereo::matcher::{Matcher, MatcherMethod};
+use crate::stereo::trust::Trust;
+
+/// Highest confidence an inferred disparity carries (`--confidence`, `--min-confidence`): the
+/// semi-global matcher took it from the surface around, not from its own costs.
+pub const INFERRED_CONFIDENCE: f32 = 0.25;
+
+/// One matcher's disparities of a pair, and their confidences where asked for.
+struct Matched {
+    disparity: [DepthMap; 2],
+    confidence: Option<[DepthMap; 2]>,
+}
+
+/// Both eyes' disparities of the (widened) pair by `method` over 0..=`max_disparity`, on a
+/// sequence's `reuse` or a matcher made for the call; the confidence stage runs only
+/// `with_confidence`.
+fn run_matcher(
+    device: &Device,
+    reuse: Option<&mut Reused>,
+    method: MatcherMethod,
+    (l, r): (&RgbImage, &RgbImage),
+    max_disparity: u32,
+    with_confidence: bool,
+) -> crate::Result<Matched> {
+    let mut own;
+    let matcher = match reuse {
+        Some(re) => re.matcher(device, l.width, l.height, max_disparity, method)?,
+        None => {
+            own = Matcher::with_method(device, l.width, l.height, max_disparity, method)?;
+            &mut own
+        }
+    };
+    Ok(match with_confidence {
+        true => {
+            let [el, er] = matcher.estimate_with_confidence(l, r)?;
+            Matched {
+                disparity: [el.disparity, er.disparity],
+                confidence: Some([el.confidence, er.confidence]),
+            }
+        }
+        false => {
+            let (dl, dr) = matcher.estimate(l, r)?;
+            Matched {
+                disparity: [dl, dr],
+                confidence: None,
+            }
+        }
+    })
+}
+
+/// The confidence of each disparity of `all` that `matched` leaves out (an inferred one) held
+/// to [`INFERRED_CONFIDENCE`].
+fn cap_inferred(confidence: &mut DepthMap, all: &DepthMap, matched: &DepthMap) {
+    for ((c, a), m) in confidence.data.iter_mut().zip(&all.data).zip(&matched.data) {
+        if *a > 0.0 && *m <= 0.0 {
+            *c = c.min(INFERRED_CONFIDENCE);
+        }
+    }
+}
 
 /// The matcher's search range for two images alone when none is given and the images give none
 /// (too little texture for the coarse pass): a sixth of the width
@@ -16,10 +74,9 @@ pub fn default_max_disparity(width: u32) -> u32 {
     (width.div_ceil(6).div_ceil(16) * 16).clamp(16, 256)
 }
 
-/// An eye's estimated disparities with those below `min` confidence (if any) made unknown (0).
-fn confident(eye: &mut EyeEstimate, min: Option<f64>) {
-    let Some(min) = min else { return };
-    for (v, c) in eye.disparity.data.iter_mut().zip(&eye.confidence.data) {
+/// Disparities whose `confidence` is below `min` made unknown (0).
+fn confident(disparity: &mut DepthMap, confidence: &DepthMap, min: f64) {
+    for (v, c) in disparity.data.iter_mut().zip(&confidence.data) {
         if f64::from(*c) < min {
             *v = 0.0;
         }
@@ -28,9 +85,13 @@ fn confident(eye: &mut EyeEstimate, min: Option<f64>) {
 
 /// A pair alone's disparities ([`CyclopeanPlan::frame`]).
 pub(super) struct Estimate {
-    /// Left and right disparities, stored as d + offset (0 unknown), the input's columns.
+    /// Left and right matched disparities, stored as d + offset (0 unknown), the input's
+    /// columns: what renders as 255 in the mask.
     pub(super) left: DepthMap,
     pub(super) right: DepthMap,
+    /// With the semi-global matcher, both eyes' disparities inferred ones included: what the
+    /// dense frame (`--fill`) starts from. None: `left` and `right` are all there is.
+    pub(super) with_inferred: Option<(DepthMap, DepthMap)>,
     pub(super) confidence: Option<[DepthMap; 2]>,
     pub(super) offset: u32,
     pub(super) range: DisparityRange,
@@ -104,36 +165,71 @@ impl CyclopeanPlan {
                 (&widened.0, &widened.1)
             }
         };
-        let mut own;
-        let matcher = match reuse {
-            Some(re) => re.matcher(device, l.width, l.height, search.max_disparity, self.matcher)?,
-            None => {
-                own = Matcher::with_method(device, l.width, l.height, search.max_disparity, self.matcher)?;
-                &mut own
-            }
-        };
+        let mut reuse = reuse;
         // The confidence stage runs only when something reads it.
-        let (dl, dr, confidence) = if self.min_confidence.is_none() && !self.confidence {
-            let (dl, dr) = matcher.estimate(l, r)?;
-            (dl, dr, None)
-        } else {
-            let [mut el, mut er] = matcher.estimate_with_confidence(l, r)?;
-            confident(&mut el, self.min_confidence);
-            confident(&mut er, self.min_confidence);
-            let confidence = match self.confidence {
-                true => {
-                    let (cl, cr) = search.crop(el.confidence, er.confidence, left.width)?;
-                    Some([cl, cr])
-                }
-                false => None,
-            };
-            (el.disparity, er.disparity, confidence)
+        let with_confidence = self.min_confidence.is_some() || self.confidence;
+        let m = run_matcher(
+            device,
+            reuse.as_deref_mut(),
+            self.matcher,
+            (l, r),
+            search.max_disparity,
+            with_confidence,
+        )?;
+        let [dl, dr] = m.disparity;
+        let (mut dl, mut dr) = search.crop(dl, dr, left.width)?;
+        let mut confidence = match m.confidence {
+            Some([cl, cr]) => Some(search.crop(cl, cr, left.width)?),
+            None => None,
         };
-        let (dl, dr) = search.crop(dl, dr, left.width)?;
+        // The semi-global matcher's disparities split into matched and inferred ones by the
+        // census matcher's on the same pair (stereo::trust).
+        let mut matched = None;
+        if self.matcher == MatcherMethod::Sgm {
+            let census = run_matcher(
+                device,
+                reuse.as_deref_mut(),
+                MatcherMethod::Census,
+                (l, r),
+                search.max_disparity,
+                false,
+            )?;
+            let [cl, cr] = census.disparity;
+            let (cl, cr) = search.crop(cl, cr, left.width)?;
+            let mut own;
+            let trust = match reuse {
+                Some(re) => re.trust(device)?,
+                None => {
+                    own = Trust::new(device)?;
+                    &mut own
+                }
+            };
+            let (ml, mr) = (trust.matched(&dl, &cl, left)?, trust.matched(&dr, &cr, right)?);
+            if let Some((kl, kr)) = confidence.as_mut() {
+                cap_inferred(kl, &dl, &ml);
+                cap_inferred(kr, &dr, &mr);
+            }
+            matched = Some((ml, mr));
+        }
+        if let (Some(min), Some((kl, kr))) = (self.min_confidence, &confidence) {
+            confident(&mut dl, kl, min);
+            confident(&mut dr, kr, min);
+            if let Some((ml, mr)) = matched.as_mut() {
+                confident(ml, kl, min);
+                confident(mr, kr, min);
+            }
+        }
+        // Matched disparities render as 255 in the mask; the dense frame (--fill) starts from
+        // every disparity, inferred ones included.
+        let (left_map, right_map, with_inferred) = match matched {
+            Some((ml, mr)) => (ml, mr, Some((dl, dr))),
+            None => (dl, dr, None),
+        };
         Ok(Estimate {
-            left: dl,
-            right: dr,
-            confidence,
+            left: left_map,
+            right: right_map,
+            with_inferred,
+            confidence: confidence.filter(|_| self.confidence).map(|(l, r)| [l, r]),
             offset: search.offset,
             range,
             estimated,

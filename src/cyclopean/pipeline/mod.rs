@@ -10,7 +10,7 @@ mod plan;
 mod reuse;
 mod synthesise;
 
-pub use estimate::default_max_disparity;
+pub use estimate::{default_max_disparity, INFERRED_CONFIDENCE};
 pub(crate) use plan::GatherSettings;
 pub use plan::{CyclopeanPlan, Framed, InputName, StereoInput, StereoKind};
 pub use reuse::Reused;

@@ -200,7 +200,11 @@ impl CyclopeanPlan {
                 let est = self.estimate(device, &left, &right, left_rgb, reuse.as_deref_mut())?;
                 let dense = match self.fill {
                     true => {
-                        let eyes = [(&left, &est.left), (&right, &est.right)];
+                        let (l, r) = est
+                            .with_inferred
+                            .as_ref()
+                            .map_or((&est.left, &est.right), |(l, r)| (l, r));
+                        let eyes = [(&left, l), (&right, r)];
                         Some(self.dense_frame(device, eyes, left_map, est.offset, reuse)?)
                     }
                     false => None,

@@ -59,7 +59,7 @@ pub struct CyclopeanRequest {
     /// Two images alone: also give each eye's matcher confidence (a float map in [0, 1], 0 where
     /// the disparity is unknown), the same values `min_confidence` is held against.
     pub confidence: bool,
-    /// Two images alone: the stereo matcher (none: [`MatcherMethod::default`], the census one).
+    /// Two images alone: the stereo matcher (none: [`MatcherMethod::default`], the semi-global one).
     pub matcher: Option<MatcherMethod>,
 }
 

@@ -68,9 +68,12 @@ use crate::io::{DepthMap, RgbImage};
 #[serde(rename_all = "kebab-case")]
 pub enum MatcherMethod {
     /// Census costs averaged over a 9 x 9 box, winner takes all (this module's design).
-    #[default]
     Census,
     /// Semi-global matching of the census costs ([`sgm`]): smooth where there is no texture.
+    /// The default: the two-image frame then leads a learned interpolator (issue 48); its
+    /// disparities the census matcher does not support are marked inferred
+    /// ([`crate::stereo::trust`]), so the mask's rendered pixels keep the census precision.
+    #[default]
     Sgm,
 }
 

@@ -8,6 +8,8 @@ mod files;
 mod fill;
 /// Flowerpots with its ground truth scores at least what its two images give.
 mod given_disparities;
+/// Two images alone against RIFE and the flow peer over issue 48's 13 pairs.
+mod learned_peer;
 /// One eye's disparity (Middlebury 2014).
 mod one_eye;
 /// Rectified pairs and two images alone: the matchers' disparities rendered.

@@ -8,6 +8,7 @@ use std::path::Path;
 use viewsynth::convention::Conventions;
 use viewsynth::io::{self, DepthDecode};
 use viewsynth::stereo::disparity_frame::{disparity_frame, DisparityRig};
+use viewsynth::stereo::trust_reference::trust_reference;
 use viewsynth_tests::real_pairs::{cones, count, out_dir, psnr, splat_gpu};
 
 fn viewsynth(args: &[&str], paths: &[(&str, &Path)]) -> std::process::Output {
@@ -114,8 +115,8 @@ fn cli_rectified_pair_matches_the_library_and_refuses_bad_input_cleanly() {
     }
 }
 
-/// Two images alone: the CLI estimates the disparities with the census matcher (its GPU pass)
-/// and renders as if they had been given. Oracle: the matcher's twin's disparities (the GPU
+/// Two images alone, `--matcher census`: the CLI estimates the disparities with the census
+/// matcher (its GPU pass) and renders as if they had been given. Oracle: the matcher's twin's disparities (the GPU
 /// pass is bit-exact with it, viewsynth_tests/tests/library/cyclopean/matcher.rs) written to files and given
 /// with --left-disparity/--right-disparity must give the same files, byte for byte. Options
 /// that decode disparity files, and a search range with disparities given, are usage errors.
@@ -133,7 +134,7 @@ fn cli_two_images_alone_render_the_matchers_disparities() {
     let (alone, given) = (out.join("alone"), out.join("given"));
     // With --confidence: the view must not change (compared with the given disparities below).
     let o = viewsynth(
-        &["--max-disparity", "64", "--confidence"],
+        &["--max-disparity", "64", "--confidence", "--matcher", "census"],
         &[("--left-rgb", &l), ("--right-rgb", &r), ("--out-dir", &alone)],
     );
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
@@ -235,7 +236,7 @@ fn cli_two_images_alone_render_the_matchers_disparities() {
     for c in ["0", "0.5", "0.9"] {
         let o_dir = out.join(format!("conf{c}"));
         let o = viewsynth(
-            &["--max-disparity", "64", "--min-confidence", c],
+            &["--max-disparity", "64", "--min-confidence", c, "--matcher", "census"],
             &[("--left-rgb", &l), ("--right-rgb", &r), ("--out-dir", &o_dir)],
         );
         assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
@@ -287,8 +288,14 @@ fn cli_two_images_alone_render_the_semi_global_matchers_disparities() {
     let (l, r) = (dir.join("tsukuba2.png"), dir.join("tsukuba4.png"));
     let (li, ri) = (io::load_rgb(&l).unwrap(), io::load_rgb(&r).unwrap());
     let mut files = Vec::new();
-    for method in [MatcherMethod::Sgm, MatcherMethod::Census] {
-        let (dl, dr) = method.estimate_reference(&li, &ri, 32).unwrap();
+    let census = MatcherMethod::Census.estimate_reference(&li, &ri, 32).unwrap();
+    let semi_global = MatcherMethod::Sgm.estimate_reference(&li, &ri, 32).unwrap();
+    // What renders without --fill: the semi-global disparities the trust twin calls matched.
+    let matched = (
+        trust_reference(&semi_global.0, &census.0, &li).unwrap(),
+        trust_reference(&semi_global.1, &census.1, &ri).unwrap(),
+    );
+    for (method, (dl, dr)) in [(MatcherMethod::Sgm, matched.clone()), (MatcherMethod::Census, census)] {
         let (dl_file, dr_file) = (
             out.join(format!("{method:?}_l.npy")),
             out.join(format!("{method:?}_r.npy")),
@@ -299,10 +306,30 @@ fn cli_two_images_alone_render_the_semi_global_matchers_disparities() {
     }
     let alone = out.join("alone");
     let o = viewsynth(
-        &["--max-disparity", "32", "--matcher", "sgm"],
+        &["--max-disparity", "32", "--matcher", "sgm", "--confidence"],
         &[("--left-rgb", &l), ("--right-rgb", &r), ("--out-dir", &alone)],
     );
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    // An inferred disparity's confidence says so: never above INFERRED_CONFIDENCE, where the
+    // confidence stage alone gives many of them more.
+    let stage = viewsynth::stereo::matcher::confidence_reference(&semi_global.0, &semi_global.1).unwrap();
+    let got = io::load_depth(&alone.join("left_confidence.exr"), &io::DepthDecode::default()).unwrap();
+    let cap = viewsynth::cyclopean::pipeline::INFERRED_CONFIDENCE;
+    let inferred: Vec<usize> = (0..got.data.len())
+        .filter(|&i| semi_global.0.data[i] > 0.0 && matched.0.data[i] <= 0.0)
+        .collect();
+    let above = inferred.iter().filter(|&&i| stage.0.data[i] > cap + 0.01).count();
+    assert!(
+        above > 50,
+        "{above} inferred pixels the stage alone trusts more than {cap}"
+    );
+    let over: Vec<&usize> = inferred.iter().filter(|&&i| got.data[i] > cap).collect();
+    assert!(
+        over.is_empty(),
+        "{} inferred disparities above {cap}, first {:?}",
+        over.len(),
+        over.first()
+    );
     for (k, (dl_file, dr_file)) in files.iter().enumerate() {
         let given = out.join(format!("given{k}"));
         let o = viewsynth(
@@ -322,7 +349,7 @@ fn cli_two_images_alone_render_the_semi_global_matchers_disparities() {
             same,
             k == 0,
             "the view from --matcher sgm vs the {} twin's disparities given",
-            ["sgm", "census"][k]
+            ["matched semi-global", "census"][k]
         );
     }
     let bad = out.join("bad");

@@ -141,6 +141,10 @@ fn layout_checks() -> Vec<LayoutCheck> {
             ProgramKind::CyclopeanDensify,
             check_block::<viewsynth::stereo::densify::DensifyParams>,
         ),
+        (
+            ProgramKind::CyclopeanTrust,
+            check_block::<viewsynth::stereo::trust::TrustParams>,
+        ),
     ]);
     checks
 }
