@@ -7,7 +7,8 @@
 //! matcher's c on the same pair:
 //! - c known: p is matched when |s - c| <= [`AGREE_PX`] (the census costs, with their own
 //!   uniqueness and left-right checks, found the same surface);
-//! - c unknown: p is matched when its census window (7 x 5, borders replicated) is flat, its
+//! - c unknown (or not looked for: a search wider than [`CENSUS_CHECK_SEARCH`]): p is matched
+//!   when its census window (7 x 5, borders replicated) is flat, its
 //!   grey levels (r + g + b) within [`FLAT_GREY`]: no texture there to render wrongly, the
 //!   low-texture regions the semi-global matcher exists for;
 //! - otherwise s is inferred: kept for the dense frame (rendered, mask 128), left out of the
@@ -32,6 +33,16 @@ use crate::pass::{Device, Draw, Format, Image, ImageData, ProgramKind, ShaderPro
 pub const AGREE_PX: f32 = 1.0;
 /// Largest grey range (r + g + b levels) of a flat census window.
 pub const FLAT_GREY: i32 = 20;
+/// Widest search (disparities) the census check runs over: its work grows with the search,
+/// the semi-global matcher's does not. Past it no census disparity is known, so only the flat
+/// windows' disparities count as matched: fewer pixels rendered as 255, none less precise, and
+/// the work stays bounded at any width.
+pub const CENSUS_CHECK_SEARCH: u32 = 256;
+
+/// Whether the census check runs on a search of 0..=`max_disparity` (stored, offset included).
+pub fn census_checked(max_disparity: u32) -> bool {
+    max_disparity < CENSUS_CHECK_SEARCH
+}
 
 crate::param_block! {
     /// shaders/cyclopean/trust_params.glsl, member for member.
@@ -128,6 +139,20 @@ mod tests {
         ] {
             assert!(glsl.contains(&line), "trust_params.glsl lacks `{line}`");
         }
+    }
+
+    #[test]
+    fn the_census_check_is_bounded_work() {
+        // The check's census costs are at most CENSUS_CHECK_SEARCH a pixel, whatever the search.
+        for max_disparity in [0u32, 63, 255, 256, 1023, 16383] {
+            let searched = if census_checked(max_disparity) {
+                max_disparity + 1
+            } else {
+                0
+            };
+            assert!(searched <= CENSUS_CHECK_SEARCH, "{max_disparity}");
+        }
+        assert!(census_checked(CENSUS_CHECK_SEARCH - 1) && !census_checked(CENSUS_CHECK_SEARCH));
     }
 
     fn map(w: u32, h: u32, v: impl Fn(u32, u32) -> f32) -> DepthMap {

@@ -174,8 +174,8 @@ pub(crate) struct CyclopeanArgs {
     #[arg(help_heading = INPUTS, long, value_name = "C", value_parser = finite_value)]
     min_confidence: Option<f64>,
     /// Two images alone: also write each eye's matcher confidence, left_confidence.exr and
-    /// right_confidence.exr (float32 in [0, 1]; 0 where the disparity is unknown), the values
-    /// --min-confidence is held against.
+    /// right_confidence.exr (float32 in [0, 1]; 0 where the disparity is unknown, at most 0.25
+    /// where the semi-global matcher inferred it), the values --min-confidence is held against.
     #[arg(help_heading = OUTPUTS, long)]
     confidence: bool,
     /// Two images alone: the stereo matcher [default: sgm].

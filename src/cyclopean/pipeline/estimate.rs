@@ -8,7 +8,7 @@ use crate::io::{DepthMap, RgbImage};
 use crate::pass::Device;
 use crate::stereo::matcher::range::{estimate_range, DisparityRange, SignedSearch};
 use crate::stereo::matcher::{Matcher, MatcherMethod};
-use crate::stereo::trust::Trust;
+use crate::stereo::trust::{census_checked, Trust};
 
 /// Highest confidence an inferred disparity carries (`--confidence`, `--min-confidence`): the
 /// semi-global matcher took it from the surface around, not from its own costs.
@@ -186,16 +186,26 @@ impl CyclopeanPlan {
         // census matcher's on the same pair (stereo::trust).
         let mut matched = None;
         if self.matcher == MatcherMethod::Sgm {
-            let census = run_matcher(
-                device,
-                reuse.as_deref_mut(),
-                MatcherMethod::Census,
-                (l, r),
-                search.max_disparity,
-                false,
-            )?;
-            let [cl, cr] = census.disparity;
-            let (cl, cr) = search.crop(cl, cr, left.width)?;
+            // Past CENSUS_CHECK_SEARCH the census matcher does not run (its work grows with the
+            // search): no census disparity is known, only flat windows count as matched.
+            let (cl, cr) = match census_checked(search.max_disparity) {
+                true => {
+                    let census = run_matcher(
+                        device,
+                        reuse.as_deref_mut(),
+                        MatcherMethod::Census,
+                        (l, r),
+                        search.max_disparity,
+                        false,
+                    )?;
+                    let [cl, cr] = census.disparity;
+                    search.crop(cl, cr, left.width)?
+                }
+                false => {
+                    let none = || DepthMap::new(left.width, left.height, vec![0.0; dl.data.len()]);
+                    (none()?, none()?)
+                }
+            };
             let mut own;
             let trust = match reuse {
                 Some(re) => re.trust(device)?,
