@@ -56,7 +56,7 @@ pub fn read_depth<'py>(
     let depth = py.detach(|| reading.read(&path)).map_err(|e| match e {
         // A missing scale is a bad argument, worded with the keyword (the library names the
         // field, `depth-scale`; as an option it becomes `depth_scale`).
-        viewsynth::Error::InvalidParameter { name, message } if !name.starts_with("--") => {
+        viewsynth::Error::InvalidParameter { name, message } if !name.to_string().starts_with("--") => {
             let option = viewsynth::Error::param(format!("--{name}"), message);
             errors::from_request(ArgError::Invalid(option))
         }

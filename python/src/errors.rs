@@ -75,7 +75,7 @@ pub fn invalid(parameter: &str, message: impl std::fmt::Display) -> PyErr {
 pub fn from_library(e: Error) -> PyErr {
     let message = e.to_string();
     match &e {
-        Error::InvalidParameter { name, .. } => raise(Kind::InvalidInput, message, Some(name)),
+        Error::InvalidParameter { name, .. } => raise(Kind::InvalidInput, message, Some(&name.to_string())),
         Error::ImageTooLarge { name, .. } => raise(Kind::InvalidInput, message, Some(name)),
         Error::SizeMismatch { .. } => raise(Kind::InvalidInput, message, None),
         Error::Egl(_) | Error::SoftwareRenderer { .. } => raise(Kind::GpuUnavailable, message, None),
@@ -148,12 +148,12 @@ pub fn from_request(e: viewsynth::job::ArgError) -> PyErr {
     while let Some(s) = source {
         chain.push_str(&format!(": {s}"));
         if let Some(Error::InvalidParameter { name, .. }) = s.downcast_ref::<Error>() {
-            named = Some(name.clone());
+            named = Some(name.to_string());
         }
         source = s.source();
     }
     if let viewsynth::job::ArgError::Invalid(Error::InvalidParameter { name, .. }) = &e {
-        named = Some(name.clone());
+        named = Some(name.to_string());
     }
     let (message, first) = keywords_in(&chain);
     let parameter = named

@@ -132,7 +132,7 @@ impl InputName<'_> {
     pub(super) fn error(self, message: impl Into<String>) -> crate::Error {
         match self {
             InputName::File(p) => crate::Error::decode(p, message),
-            InputName::Argument(a) => crate::Error::param(a, message),
+            InputName::Argument(a) => crate::Error::param(a, message.into()),
         }
     }
 
