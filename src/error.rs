@@ -67,10 +67,7 @@ pub enum Error {
     Egl(String),
     /// Hardware rendering was required (`--require-gpu`, `VIEWSYNTH_REQUIRE_GPU=1`) but the
     /// context renders in software.
-    #[error(
-        "a hardware GPU is required (--require-gpu or VIEWSYNTH_REQUIRE_GPU=1) but the renderer is \
-         software: '{renderer}' on {location}; {seen}"
-    )]
+    #[error("{}", self.software_renderer().unwrap_or_default())]
     SoftwareRenderer {
         /// GL_RENDERER of the context.
         renderer: String,
@@ -166,9 +163,38 @@ impl Error {
         }
     }
 
+    /// The fields the error names, in order: its parameter's, then its message's.
+    pub fn fields(&self) -> Vec<crate::Field> {
+        match self {
+            Error::InvalidParameter { name, message } => name.fields().chain(message.fields()).collect(),
+            Error::SoftwareRenderer { .. } => vec![crate::Field::RequireGpu],
+            _ => Vec::new(),
+        }
+    }
+
+    /// [`Error::SoftwareRenderer`]'s message, naming the option that asks for hardware.
+    fn software_renderer(&self) -> Option<Message> {
+        let Error::SoftwareRenderer {
+            renderer,
+            location,
+            seen,
+        } = self
+        else {
+            return None;
+        };
+        Some(crate::msg![
+            "a hardware GPU is required (",
+            crate::Field::RequireGpu,
+            format!(" or VIEWSYNTH_REQUIRE_GPU=1) but the renderer is software: '{renderer}' on {location}; {seen}")
+        ])
+    }
+
     /// The message with the fields it names in `spelling`'s words (`Display` is
     /// [`Spelling::Cli`]'s).
     pub fn spelled(&self, spelling: Spelling) -> String {
+        if let Some(m) = self.software_renderer() {
+            return m.spelled(spelling);
+        }
         match self {
             Error::InvalidParameter { name, message } => {
                 format!("invalid {}: {}", name.spelled(spelling), message.spelled(spelling))

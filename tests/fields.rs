@@ -66,14 +66,14 @@ fn each_field_is_spelled_as_front_ends_json_spells_it() {
 #[test]
 fn each_option_of_front_ends_json_has_its_fields_key() {
     // The other way round: the option that fills a field in front_ends.json (the first of
-    // its command line; the others are partners, as `--baseline` with `--focal`) fills that
-    // same field in the table (`--zoom-range` is `scales`'s), whenever the table holds it.
+    // its command line; the others are partners, as `--baseline` with `--focal`) is in the
+    // table, filling that same field (`--zoom-range` is `scales`'s).
     for (command, fields) in front_ends() {
         for (key, entry) in &fields {
             let option = options(entry)[0];
-            if let Some(field) = Field::ALL.iter().find(|f| f.cli() == option) {
-                assert_eq!(field.key(), key, "{command}: {option} fills {key} in front_ends.json");
-            }
+            let field = Field::ALL.iter().find(|f| f.cli() == option);
+            let field = field.unwrap_or_else(|| panic!("{command}.{key}: the field table lacks {option}"));
+            assert_eq!(field.key(), key, "{command}: {option} fills {key} in front_ends.json");
         }
     }
 }
