@@ -617,3 +617,35 @@ impl<T> OptionsContext<T> for crate::Result<T> {
         })
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_refusal_names_its_options_in_each_front_ends_spelling() {
+        let e = ArgError::BothFromEye;
+        assert_eq!(
+            e.to_string(),
+            "--to both needs --from centre (from an eye, the only other view is the other eye)"
+        );
+        assert_eq!(
+            e.spelled(Spelling::Python),
+            "target both needs source centre (from an eye, the only other view is the other eye)"
+        );
+        assert_eq!(e.fields(), [Field::To, Field::From]);
+        let e = ArgError::RigPartner(Field::Focal, Field::Baseline);
+        assert!(
+            e.spelled(Spelling::Python).starts_with("focal needs baseline too"),
+            "{e}"
+        );
+        // A library error inside is spelled the same way; a text name stays as written.
+        let e = ArgError::Invalid(crate::Error::param(msg![Field::Near, "/", Field::Far], "0 / 0"));
+        assert_eq!(e.to_string(), "invalid --near/--far: 0 / 0");
+        assert_eq!(e.spelled(Spelling::Python), "invalid near/far: 0 / 0");
+        assert_eq!(e.fields(), [Field::Near, Field::Far]);
+        let e = ArgError::Invalid(crate::Error::param("tau-rel", "-1 must be >= 0"));
+        assert_eq!(e.spelled(Spelling::Python), "invalid tau-rel: -1 must be >= 0");
+        assert!(e.fields().is_empty());
+    }
+}
