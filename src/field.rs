@@ -287,6 +287,13 @@ impl fmt::Display for Message {
     }
 }
 
+impl serde::Serialize for Message {
+    /// As the command line's text (reports and `viewsynth info --json` hold it as a string).
+    fn serialize<S: serde::Serializer>(&self, s: S) -> Result<S::Ok, S::Error> {
+        s.collect_str(self)
+    }
+}
+
 impl From<Field> for Message {
     fn from(field: Field) -> Self {
         Message {

@@ -243,12 +243,8 @@ const NOT_FIELDS: &[(&str, &str, &str)] = &[
         "(check --depth-kind, --depth-scale",
         "how the depth file was read, for its Error::Decode",
     ),
-    // Not converted yet: the GPU backends' errors and warnings are text (Error::Egl/Vulkan(String)).
-    (
-        "gpu/devices.rs",
-        "--device N",
-        "not converted yet: the EGL fallback warning is text",
-    ),
+    // Not converted yet: the Vulkan backend's errors are text (Error::Vulkan(String)).
+    ("gpu/devices.rs", "--gpus all", "Docker's option"),
     (
         "vulkan/pipeline.rs",
         "--ndc vulkan",
