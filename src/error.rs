@@ -1,5 +1,6 @@
 //! Typed errors of the library. Every variant names the file or parameter at fault.
 
+use crate::field::{Message, Spelling};
 use std::path::PathBuf;
 
 /// Result alias used across the library.
@@ -37,10 +38,11 @@ pub enum Error {
     /// A parameter is out of its domain (non-finite, non-positive, too large, mismatched).
     #[error("invalid {name}: {message}")]
     InvalidParameter {
-        /// The parameter, as the caller names it (often the command-line option).
-        name: String,
-        /// Why its value is refused.
-        message: String,
+        /// The parameter: a request field ([`crate::Field`], spelled by each front end), or the
+        /// library's own name for it.
+        name: Message,
+        /// Why its value is refused (it may name fields too).
+        message: Message,
     },
     /// An image side exceeds what the GPU context renders (`pass::check_image_size`).
     #[error("invalid {name}: {width}x{height} exceeds this GPU's limit of {limit} px per side")]
@@ -65,10 +67,7 @@ pub enum Error {
     Egl(String),
     /// Hardware rendering was required (`--require-gpu`, `VIEWSYNTH_REQUIRE_GPU=1`) but the
     /// context renders in software.
-    #[error(
-        "a hardware GPU is required (--require-gpu or VIEWSYNTH_REQUIRE_GPU=1) but the renderer is \
-         software: '{renderer}' on {location}; {seen}"
-    )]
+    #[error("{}", self.software_renderer().unwrap_or_default())]
     SoftwareRenderer {
         /// GL_RENDERER of the context.
         renderer: String,
@@ -128,7 +127,7 @@ impl Error {
     /// An [`Error::InvalidParameter`] renamed `name` (how a front end spells the parameter, e.g.
     /// the option `--png-compression` for the library's `png-compression`); any other error as
     /// it is.
-    pub fn renamed(self, name: &str) -> Self {
+    pub fn renamed(self, name: impl Into<Message>) -> Self {
         match self {
             Error::InvalidParameter { message, .. } => Error::param(name, message),
             other => other,
@@ -157,10 +156,50 @@ impl Error {
         }
     }
     /// An [`Error::InvalidParameter`] naming `name`.
-    pub fn param(name: impl Into<String>, message: impl Into<String>) -> Self {
+    pub fn param(name: impl Into<Message>, message: impl Into<Message>) -> Self {
         Error::InvalidParameter {
-            name: cut(&name.into(), MAX_EXCERPT),
-            message: cut(&message.into(), MAX_MESSAGE),
+            name: name.into().map_text(|t| cut(t, MAX_EXCERPT)),
+            message: message.into().map_text(|t| cut(t, MAX_MESSAGE)),
+        }
+    }
+
+    /// The fields the error names, in order: its parameter's, then its message's.
+    pub fn fields(&self) -> Vec<crate::Field> {
+        match self {
+            Error::InvalidParameter { name, message } => name.fields().chain(message.fields()).collect(),
+            Error::SoftwareRenderer { .. } => vec![crate::Field::RequireGpu],
+            _ => Vec::new(),
+        }
+    }
+
+    /// [`Error::SoftwareRenderer`]'s message, naming the option that asks for hardware.
+    fn software_renderer(&self) -> Option<Message> {
+        let Error::SoftwareRenderer {
+            renderer,
+            location,
+            seen,
+        } = self
+        else {
+            return None;
+        };
+        Some(crate::msg![
+            "a hardware GPU is required (",
+            crate::Field::RequireGpu,
+            format!(" or VIEWSYNTH_REQUIRE_GPU=1) but the renderer is software: '{renderer}' on {location}; {seen}")
+        ])
+    }
+
+    /// The message with the fields it names in `spelling`'s words (`Display` is
+    /// [`Spelling::Cli`]'s).
+    pub fn spelled(&self, spelling: Spelling) -> String {
+        if let Some(m) = self.software_renderer() {
+            return m.spelled(spelling);
+        }
+        match self {
+            Error::InvalidParameter { name, message } => {
+                format!("invalid {}: {}", name.spelled(spelling), message.spelled(spelling))
+            }
+            other => other.to_string(),
         }
     }
 }

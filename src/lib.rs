@@ -12,6 +12,8 @@
 //! Modules, bottom layer first:
 //!
 //! - [`error`]: the library's typed error; every variant names the file or parameter at fault.
+//! - [`field`]: the request fields a message names, spelled by each front end (`--tau-rel`,
+//!   `tau_rel`).
 //! - [`convention`]: NDC depth range, reversed-Z and row order as runtime switches; device
 //!   depth <-> view Z in f32 and f64.
 //! - [`camera`]: intrinsics (and their files), poses, projections, the stereo camera model and
@@ -61,6 +63,7 @@ pub mod cpu_time;
 pub mod cyclopean;
 pub mod depth;
 pub mod error;
+pub mod field;
 pub mod gpu;
 pub mod io;
 pub mod job;
@@ -89,3 +92,4 @@ mod test_data;
 mod test_rng;
 
 pub use error::{Error, Result};
+pub use field::{Field, Message, Spelling};

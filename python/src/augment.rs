@@ -47,18 +47,22 @@ pub fn read_depth<'py>(
 ) -> PyResult<Bound<'py, PyAny>> {
     let reading = DepthFileRequest {
         depth_scale,
-        depth_kind: crate::shared::choice("--depth-kind", depth_kind)?,
+        depth_kind: crate::shared::choice(viewsynth::Field::DepthKind, depth_kind)?,
         near,
         far,
     }
     .check()
     .map_err(errors::from_request)?;
     let depth = py.detach(|| reading.read(&path)).map_err(|e| match e {
-        // A missing scale is a bad argument, worded with the keyword (the library names the
-        // field, `depth-scale`; as an option it becomes `depth_scale`).
-        viewsynth::Error::InvalidParameter { name, message } if !name.starts_with("--") => {
-            let option = viewsynth::Error::param(format!("--{name}"), message);
-            errors::from_request(ArgError::Invalid(option))
+        // A missing scale is a bad argument, worded with the keyword: the library names the
+        // parameter in its own words (`depth-scale`), which are the request field's key
+        // (`depth_scale`) with dashes.
+        viewsynth::Error::InvalidParameter { name, message } => {
+            let key = name.to_string().replace('-', "_");
+            match viewsynth::Field::ALL.iter().find(|f| f.key() == key) {
+                Some(&field) => errors::from_request(ArgError::Invalid(viewsynth::Error::param(field, message))),
+                None => errors::from_library(viewsynth::Error::InvalidParameter { name, message }),
+            }
         }
         e => errors::from_library(e),
     })?;

@@ -73,9 +73,9 @@ impl Renderer {
         let (gpu, _busy) = self.enter()?;
         // The settings as the library's request: it alone decides and checks them.
         let request = CyclopeanRequest {
-            method: method.map(|m| choice("--method", m)).transpose()?,
+            method: method.map(|m| choice(viewsynth::Field::Method, m)).transpose()?,
             refine_steps,
-            blend: blend.map(|b| choice("--blend", b)).transpose()?,
+            blend: blend.map(|b| choice(viewsynth::Field::Blend, b)).transpose()?,
             z_threshold,
             dominant,
             position,
@@ -88,7 +88,7 @@ impl Renderer {
             min_disparity: None,
             min_confidence,
             confidence,
-            matcher: matcher.map(|m| choice("--matcher", m)).transpose()?,
+            matcher: matcher.map(|m| choice(viewsynth::Field::Matcher, m)).transpose()?,
         };
         cyclopean(
             py,

@@ -1,9 +1,9 @@
 //! The library's typed errors as the Python exception classes of `viewsynth.errors`, carrying
-//! the library's message unchanged.
+//! the library's message with the fields it names spelled as Python's keyword arguments.
 
 use pyo3::prelude::*;
 use pyo3::types::PyType;
-use viewsynth::Error;
+use viewsynth::{Error, Message, Spelling};
 
 /// Which class of `viewsynth/errors.py` a failure belongs to.
 #[derive(Clone, Copy)]
@@ -12,7 +12,7 @@ pub enum Kind {
     InvalidInput,
     /// No EGL / GL 4.5 context, or only a software one when a GPU was required.
     GpuUnavailable,
-    /// A GL call or object failed.
+    /// A call of the graphics API (OpenGL or Vulkan) or one of its objects failed.
     Gpu,
     /// A file could not be read, decoded or written (an OSError).
     File,
@@ -71,11 +71,12 @@ pub fn invalid(parameter: &str, message: impl std::fmt::Display) -> PyErr {
     )
 }
 
-/// The library's error as its Python class, with the library's own message.
+/// The library's error as its Python class, with the library's own message, the fields it
+/// names spelled as keyword arguments.
 pub fn from_library(e: Error) -> PyErr {
-    let message = e.to_string();
+    let message = e.spelled(Spelling::Python);
     match &e {
-        Error::InvalidParameter { name, .. } => raise(Kind::InvalidInput, message, Some(name)),
+        Error::InvalidParameter { name, .. } => raise(Kind::InvalidInput, message, Some(&parameter(name))),
         Error::ImageTooLarge { name, .. } => raise(Kind::InvalidInput, message, Some(name)),
         Error::SizeMismatch { .. } => raise(Kind::InvalidInput, message, None),
         Error::Egl(_) | Error::SoftwareRenderer { .. } => raise(Kind::GpuUnavailable, message, None),
@@ -89,50 +90,18 @@ pub fn from_library(e: Error) -> PyErr {
     }
 }
 
-/// A command-line option as the keyword argument that gives the same request field
-/// (tests/data/front_ends.json maps them all): `--tau-rel` -> `tau_rel`; `--from`/`--to` ->
-/// `source`/`target` (`from` is a Python keyword); refocus's target options -> `scales`,
-/// `size`, `principal`; `--force` -> `resume`.
-pub fn keyword(option: &str) -> String {
-    match option.trim_start_matches('-') {
-        "from" => "source".to_string(),
-        "to" => "target".to_string(),
-        "zoom-range" => "scales".to_string(),
-        "width-out" | "height-out" => "size".to_string(),
-        "cx-out" | "cy-out" => "principal".to_string(),
-        "force" => "resume".to_string(),
-        name => name.replace('-', "_"),
+/// The keyword a library error's parameter names: its first field's (`--near/--far` -> `near`),
+/// else the library's own name for it, up to a `/`.
+fn parameter(name: &Message) -> String {
+    match name.fields().next() {
+        Some(field) => field.python().to_string(),
+        None => name.to_string().split('/').next().unwrap_or_default().to_string(),
     }
 }
 
-/// `text` with each `--option` written as its keyword argument.
-fn keywords_in(text: &str) -> (String, Option<String>) {
-    let mut out = String::with_capacity(text.len());
-    let mut first = None;
-    let mut rest = text;
-    while let Some(at) = rest.find("--") {
-        out.push_str(&rest[..at]);
-        let tail = &rest[at + 2..];
-        let len = tail
-            .find(|c: char| !(c.is_ascii_lowercase() || c.is_ascii_digit() || c == '-'))
-            .unwrap_or(tail.len());
-        match len {
-            0 => out.push_str("--"),
-            _ => {
-                let kw = keyword(&tail[..len]);
-                first.get_or_insert_with(|| kw.clone());
-                out.push_str(&kw);
-            }
-        }
-        rest = &tail[len..];
-    }
-    out.push_str(rest);
-    (out, first)
-}
-
-/// A request the library refused (the CLI's usage errors), worded for Python: options become
-/// keyword arguments, and `parameter` is the field the library named, else the first option
-/// in the message.
+/// A request the library refused (the CLI's usage errors), worded for Python: the fields it
+/// names are keyword arguments, and `parameter` is the one a library error inside names, else
+/// the first field named.
 pub fn from_request(e: viewsynth::job::ArgError) -> PyErr {
     use std::error::Error as _;
     // A file or GPU failure found while checking is no bad argument: its own class.
@@ -142,23 +111,27 @@ pub fn from_request(e: viewsynth::job::ArgError) -> PyErr {
         }
         e => e,
     };
-    let mut chain = e.to_string();
-    let mut named = None;
+    let mut message = e.spelled(Spelling::Python);
+    let mut fields = e.fields();
+    let mut named = match &e {
+        viewsynth::job::ArgError::Invalid(Error::InvalidParameter { name, .. }) => Some(parameter(name)),
+        _ => None,
+    };
     let mut source = e.source();
     while let Some(s) = source {
-        chain.push_str(&format!(": {s}"));
-        if let Some(Error::InvalidParameter { name, .. }) = s.downcast_ref::<Error>() {
-            named = Some(name.clone());
+        match s.downcast_ref::<Error>() {
+            Some(lib) => {
+                message.push_str(&format!(": {}", lib.spelled(Spelling::Python)));
+                fields.extend(lib.fields());
+                if let Error::InvalidParameter { name, .. } = lib {
+                    named.get_or_insert_with(|| parameter(name));
+                }
+            }
+            None => message.push_str(&format!(": {s}")),
         }
         source = s.source();
     }
-    if let viewsynth::job::ArgError::Invalid(Error::InvalidParameter { name, .. }) = &e {
-        named = Some(name.clone());
-    }
-    let (message, first) = keywords_in(&chain);
-    let parameter = named
-        .map(|n| keywords_in(&n).0.split('/').next().unwrap_or_default().to_string())
-        .or(first);
+    let parameter = named.or_else(|| fields.first().map(|f| f.python().to_string()));
     let message = match message.starts_with("invalid ") {
         true => message,
         false => format!("invalid {}: {message}", parameter.as_deref().unwrap_or("argument")),

@@ -54,10 +54,14 @@ fn _request_defaults(command: &str) -> Option<String> {
     viewsynth::job::request_defaults(command).map(|v| v.to_string())
 }
 
-/// The keyword argument error messages name for a CLI option (`--tau-rel` -> "tau_rel").
+/// The keyword argument error messages name for a CLI option (`--tau-rel` -> "tau_rel"): the
+/// library's field table, which spells each field both ways (None for an option it lacks).
 #[pyfunction]
-fn _keyword(option: &str) -> String {
-    errors::keyword(option)
+fn _keyword(option: &str) -> Option<&'static str> {
+    viewsynth::Field::ALL
+        .iter()
+        .find(|f| f.cli() == option)
+        .map(|f| f.python())
 }
 
 #[pymodule]

@@ -152,7 +152,7 @@ fn refocus<'py>(py: Python<'py>, gpu: Backend, a: RefocusArgs<'_, 'py>) -> PyRes
         outputs: outputs_given(outputs)?,
         tau_rel,
         tau_abs,
-        method: choice("--method", method)?,
+        method: choice(viewsynth::Field::Method, method)?,
         rgb_everywhere,
         ..Default::default()
     };

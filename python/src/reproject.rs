@@ -54,7 +54,7 @@ impl Renderer {
         let (gpu, _busy) = self.enter()?;
         // The settings as the library's request: it alone decides and checks them.
         let request = ReprojectRequest {
-            depth_kind: choice("--depth-kind", depth_kind)?,
+            depth_kind: choice(viewsynth::Field::DepthKind, depth_kind)?,
             near,
             far,
             baseline,
@@ -62,10 +62,10 @@ impl Renderer {
             doffs,
             separation,
             convergence,
-            from: choice("--from", source)?,
-            to: choice("--to", target)?,
+            from: choice(viewsynth::Field::From, source)?,
+            to: choice(viewsynth::Field::To, target)?,
             // None: the library's default for a rig (shift-scan), as the CLI's.
-            method: method.map(|m| choice("--method", m)).transpose()?,
+            method: method.map(|m| choice(viewsynth::Field::Method, m)).transpose()?,
             steps,
             tau_rel,
             outputs: outputs_given(outputs)?,

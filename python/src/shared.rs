@@ -15,8 +15,8 @@ pub(crate) struct SameThread<T>(pub(crate) T);
 unsafe impl<T> Send for SameThread<T> {}
 
 /// A named choice keyword argument (`method="seed"`), parsed by the library's names for it;
-/// `option` is the CLI option it matches (errors name the keyword argument).
-pub(crate) fn choice<T: serde::de::DeserializeOwned>(option: &str, text: &str) -> PyResult<T> {
+/// `option` is the request field it fills (errors name its keyword argument).
+pub(crate) fn choice<T: serde::de::DeserializeOwned>(option: viewsynth::Field, text: &str) -> PyResult<T> {
     viewsynth::job::choice(option, text).map_err(errors::from_request)
 }
 

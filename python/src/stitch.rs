@@ -102,15 +102,15 @@ impl StitchArgs<'_, '_> {
         Ok(StitchRequest {
             fov: self.fov,
             overlap: self.overlap,
-            method: choice("--method", self.method)?,
+            method: choice(viewsynth::Field::Method, self.method)?,
             width: self.width,
             height: self.height,
             ipd: self.ipd,
             pole_fade: self.pole_fade,
-            depth_kind: choice("--depth-kind", self.depth_kind)?,
+            depth_kind: choice(viewsynth::Field::DepthKind, self.depth_kind)?,
             near: self.near,
             far: self.far,
-            ndc: choice("--ndc", self.ndc)?,
+            ndc: choice(viewsynth::Field::Ndc, self.ndc)?,
             reversed_z: self.reversed_z,
             outputs: outputs_given(self.outputs)?,
         })

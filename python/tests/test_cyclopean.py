@@ -167,6 +167,9 @@ def test_bad_inputs(renderer, pair):
     check(renderer, pair, "right_rgb", ["differs from left_rgb"], right_rgb=np.ascontiguousarray(right_rgb[1:]))
     check(renderer, pair, "left_disparity", ["no known disparity"], left_disparity=np.zeros_like(left_d))
     check(renderer, pair, "position", ["outside [0, 1]"], position=1.5)
+    # A library error naming request fields spells them as keywords, and names the first.
+    e = check(renderer, pair, "focal/baseline", ["outside the usable depths"], focal=1e-3, baseline=1e-6)
+    assert e.parameter == "focal" and "--" not in str(e), (e.parameter, str(e))
     check(renderer, pair, "position", ["outside [0, 1]"], position=float("nan"))
     check(renderer, pair, "method", ["'mesh'", "splat-gather"], method="mesh")
     check(renderer, pair, "baseline", ["focal needs baseline"], focal=700.0)

@@ -22,7 +22,8 @@ class GpuUnavailableError(ViewsynthError, RuntimeError):
 
 
 class GpuError(ViewsynthError, RuntimeError):
-    """A GL call or object failed (shader, framebuffer, GL error)."""
+    """A call of the GPU backend (OpenGL or Vulkan) or one of its objects failed (shader, framebuffer,
+    pipeline, an API error, an output not read back)."""
 
 
 class FileError(ViewsynthError, OSError):

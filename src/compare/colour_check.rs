@@ -12,6 +12,8 @@
 use super::colour::{srgb_decode, srgb_encode, Alpha, ChannelOrder, Transfer};
 use super::Side;
 use crate::convention::RowOrder;
+use crate::field::{Field, Message};
+use crate::msg;
 
 /// A pixel agrees when no channel differs by more than this many 8-bit levels (rounding on
 /// both sides and an sRGB step at 8 bits stay under it).
@@ -117,7 +119,7 @@ fn agreement(model: &Model, ca: &[f32], cb: &[f32], width: usize, selected: &[bo
 
 /// The readings of B's colour besides the declared one: (what, the option that declares it,
 /// is it the rows, the model of B under it).
-fn readings<'a>(a: &Side, b: &'a Side) -> Vec<(String, String, bool, Model<'a>)> {
+fn readings<'a>(a: &Side, b: &'a Side) -> Vec<(String, Message, bool, Model<'a>)> {
     let mut out = Vec::new();
     let other_rows = match b.conv.row_order {
         RowOrder::BottomUp => RowOrder::TopDown,
@@ -129,7 +131,7 @@ fn readings<'a>(a: &Side, b: &'a Side) -> Vec<(String, String, bool, Model<'a>)>
             other_rows.name(),
             b.conv.row_order.name()
         ),
-        format!("--b-rows {}", other_rows.name()),
+        msg![Field::BRows, format!(" {}", other_rows.name())],
         true,
         Model::Rows,
     ));
@@ -143,7 +145,7 @@ fn readings<'a>(a: &Side, b: &'a Side) -> Vec<(String, String, bool, Model<'a>)>
             other_channels.name(),
             b.colour.channels.name()
         ),
-        format!("--b-channels {}", other_channels.name()),
+        msg![Field::BChannels, format!(" {}", other_channels.name())],
         false,
         Model::Swapped,
     ));
@@ -151,14 +153,14 @@ fn readings<'a>(a: &Side, b: &'a Side) -> Vec<(String, String, bool, Model<'a>)>
     // (declared sRGB), or A holds sRGB values declared linear. B declared linear and still
     // short was decoded twice: no option reads that, so it is not offered.
     let short_fix = match (b.colour.transfer, a.colour.transfer) {
-        (Transfer::Srgb, _) => Some("--b-transfer linear"),
-        (Transfer::Linear, Transfer::Linear) => Some("--a-transfer srgb"),
+        (Transfer::Srgb, _) => Some(msg![Field::BTransfer, " linear"]),
+        (Transfer::Linear, Transfer::Linear) => Some(msg![Field::ATransfer, " srgb"]),
         (Transfer::Linear, Transfer::Srgb) => None,
     };
     if let Some(fix) = short_fix {
         out.push((
             "linear values stored where sRGB is expected (a UNORM target where an SRGB one belongs)".to_string(),
-            fix.to_string(),
+            fix,
             false,
             Model::Decoded,
         ));
@@ -166,14 +168,14 @@ fn readings<'a>(a: &Side, b: &'a Side) -> Vec<(String, String, bool, Model<'a>)>
     // One encoding over A: B holds sRGB values declared linear, or A holds linear values
     // declared sRGB (A declared linear too would mean B was encoded twice: not offered).
     let over_fix = match (b.colour.transfer, a.colour.transfer) {
-        (Transfer::Linear, _) => Some("--b-transfer srgb"),
-        (Transfer::Srgb, Transfer::Srgb) => Some("--a-transfer linear"),
+        (Transfer::Linear, _) => Some(msg![Field::BTransfer, " srgb"]),
+        (Transfer::Srgb, Transfer::Srgb) => Some(msg![Field::ATransfer, " linear"]),
         (Transfer::Srgb, Transfer::Linear) => None,
     };
     if let Some(fix) = over_fix {
         out.push((
             "sRGB values where linear is expected (one sRGB encoding more than A)".to_string(),
-            fix.to_string(),
+            fix,
             false,
             Model::Encoded,
         ));
@@ -185,7 +187,7 @@ fn readings<'a>(a: &Side, b: &'a Side) -> Vec<(String, String, bool, Model<'a>)>
         };
         out.push((
             format!("{} alpha (declared {})", other.name(), b.colour.alpha.name()),
-            format!("--b-alpha {}", other.name()),
+            msg![Field::BAlpha, format!(" {}", other.name())],
             false,
             Model::Alpha {
                 alpha,

@@ -16,6 +16,8 @@
 use super::{stored_top_down, view_z, Side};
 use crate::convention::{DepthPlanes, NdcDepthRange};
 use crate::depth::DepthEncoding;
+use crate::field::{Field, Message};
+use crate::msg;
 
 /// Two readings agree at a pixel within this relative difference, at most.
 pub(super) const AGREE_REL: f64 = 1e-2;
@@ -57,7 +59,7 @@ pub(super) fn diagnose(a: &Side, b: &Side, za: Option<&[f64]>, selected: &[bool]
         return None;
     }
     let score = |zb: Vec<f64>| agreement(za, &zb, selected, tolerance);
-    let named = |what: String, share: f64| {
+    let named = |what: Message, share: f64| {
         (share >= NAMED_AGREEMENT && share >= declared_agreement + NAMED_GAIN).then(|| {
             format!(
                 "B's depth fits {what}: {:.1} % of the pixels agree with A within {}, {:.1} % as declared",
@@ -107,7 +109,7 @@ impl Side {
 }
 
 /// The wrong readings with a known conversion: (what, with the options that declare it).
-fn exact_readings(a: &Side, b: &Side) -> Vec<(String, Reading)> {
+fn exact_readings(a: &Side, b: &Side) -> Vec<(Message, Reading)> {
     let mut out = Vec::new();
     let same = |storage| Reading {
         storage,
@@ -119,15 +121,15 @@ fn exact_readings(a: &Side, b: &Side) -> Vec<(String, Reading)> {
         DepthEncoding::Device { planes } => {
             let reversed_z = !b.conv.reversed_z;
             out.push((
-                format!(
-                    "reversed-Z {reversed_z} (declared {}; {})",
-                    b.conv.reversed_z,
-                    if reversed_z {
-                        "add --b-reversed-z"
-                    } else {
-                        "drop --b-reversed-z"
-                    }
-                ),
+                msg![
+                    format!(
+                        "reversed-Z {reversed_z} (declared {}; {} ",
+                        b.conv.reversed_z,
+                        if reversed_z { "add" } else { "drop" }
+                    ),
+                    Field::BReversedZ,
+                    ")"
+                ],
                 Reading {
                     reversed_z,
                     ..same(b.storage)
@@ -135,7 +137,13 @@ fn exact_readings(a: &Side, b: &Side) -> Vec<(String, Reading)> {
             ));
             if b.ndc_z {
                 out.push((
-                    "window depth, not NDC z (--b-depth-kind device, without --b-ndc)".to_string(),
+                    msg![
+                        "window depth, not NDC z (",
+                        Field::BDepthKind,
+                        " device, without ",
+                        Field::BNdc,
+                        ")"
+                    ],
                     Reading {
                         ndc_z: false,
                         ..same(b.storage)
@@ -146,7 +154,13 @@ fn exact_readings(a: &Side, b: &Side) -> Vec<(String, Reading)> {
                 // the same function of Z under either NDC range: only stored NDC z tells them
                 // apart.)
                 out.push((
-                    "GL NDC z in [-1, 1] stored instead of window depth (--b-depth-kind ndc --b-ndc gl)".to_string(),
+                    msg![
+                        "GL NDC z in [-1, 1] stored instead of window depth (",
+                        Field::BDepthKind,
+                        " ndc ",
+                        Field::BNdc,
+                        " gl)"
+                    ],
                     Reading {
                         ndc_z: true,
                         ndc: NdcDepthRange::MinusOneToOne,
@@ -156,7 +170,11 @@ fn exact_readings(a: &Side, b: &Side) -> Vec<(String, Reading)> {
             }
             if planes.far.is_finite() {
                 out.push((
-                    format!("an infinite far plane (--b-far inf; declared {})", planes.far),
+                    msg![
+                        "an infinite far plane (",
+                        Field::BFar,
+                        format!(" inf; declared {})", planes.far)
+                    ],
                     same(DepthEncoding::Device {
                         planes: DepthPlanes {
                             far: f64::INFINITY,
@@ -168,19 +186,28 @@ fn exact_readings(a: &Side, b: &Side) -> Vec<(String, Reading)> {
             if let DepthEncoding::Device { planes: pa } = a.storage {
                 if pa != planes {
                     out.push((
-                        format!(
-                            "A's planes (--b-near {} --b-far {}; declared {} / {})",
-                            plane(pa.near),
-                            plane(pa.far),
-                            plane(planes.near),
-                            plane(planes.far)
-                        ),
+                        msg![
+                            "A's planes (",
+                            Field::BNear,
+                            format!(" {} ", plane(pa.near)),
+                            Field::BFar,
+                            format!(
+                                " {}; declared {} / {})",
+                                plane(pa.far),
+                                plane(planes.near),
+                                plane(planes.far)
+                            )
+                        ],
                         same(a.storage),
                     ));
                 }
             }
             out.push((
-                "view distance in metres, not device depth (--b-depth-kind view-z)".to_string(),
+                msg![
+                    "view distance in metres, not device depth (",
+                    Field::BDepthKind,
+                    " view-z)"
+                ],
                 Reading {
                     ndc_z: false,
                     ..same(DepthEncoding::ViewZ)
@@ -191,13 +218,11 @@ fn exact_readings(a: &Side, b: &Side) -> Vec<(String, Reading)> {
             if let DepthEncoding::Device { planes } = a.storage {
                 for reversed_z in [false, true] {
                     out.push((
-                        format!(
-                            "device depth under A's planes, reversed-Z {reversed_z} (--b-depth-kind device \
-                             --b-near {} --b-far {}{})",
-                            plane(planes.near),
-                            plane(planes.far),
-                            if reversed_z { " --b-reversed-z" } else { "" }
-                        ),
+                        msg![
+                            format!("device depth under A's planes, reversed-Z {reversed_z} ("),
+                            device_planes(plane(planes.near), plane(planes.far), reversed_z),
+                            ")"
+                        ],
                         Reading {
                             reversed_z,
                             ..same(a.storage)
@@ -211,9 +236,26 @@ fn exact_readings(a: &Side, b: &Side) -> Vec<(String, Reading)> {
     out
 }
 
+/// B's options for device depth under `near`/`far`: `--b-depth-kind device --b-near N --b-far F`
+/// and `--b-reversed-z` when `reversed_z`.
+fn device_planes(near: String, far: String, reversed_z: bool) -> Message {
+    let m = msg![
+        Field::BDepthKind,
+        " device ",
+        Field::BNear,
+        format!(" {near} "),
+        Field::BFar,
+        format!(" {far}")
+    ];
+    match reversed_z {
+        true => msg![m, " ", Field::BReversedZ],
+        false => m,
+    }
+}
+
 /// Readings fitted over all pixels: B's stored value as a line in A's Z (linear depth in other
 /// units) and as a line in 1 / Z (window depth under other planes, or disparity).
-fn fitted_readings(za: &[f64], stored: &[f64], selected: &[bool]) -> Vec<(String, Vec<f64>)> {
+fn fitted_readings(za: &[f64], stored: &[f64], selected: &[bool]) -> Vec<(Message, Vec<f64>)> {
     let pairs: Vec<(f64, f64)> = za
         .iter()
         .zip(stored)
@@ -226,7 +268,9 @@ fn fitted_readings(za: &[f64], stored: &[f64], selected: &[bool]) -> Vec<(String
     if let Some((c, k)) = robust_line(&zs, &vs).filter(|(_, k)| *k != 0.0) {
         let zb = stored.iter().map(|v| positive((v - c) / k)).collect();
         out.push((
-            format!("linear depth in other units: stored = {k:.4} x metres + {c:.3}"),
+            msg![format!(
+                "linear depth in other units: stored = {k:.4} x metres + {c:.3}"
+            )],
             zb,
         ));
     }
@@ -247,13 +291,17 @@ fn fitted_readings(za: &[f64], stored: &[f64], selected: &[bool]) -> Vec<(String
             } else {
                 "inf".into()
             };
-            format!(
-                "window depth written with other planes: reversed-Z {reversed}, near ~{near:.4} m, far ~{far} \
-                 (--b-depth-kind device --b-near {near:.4} --b-far {far}{})",
-                if reversed { " --b-reversed-z" } else { "" }
-            )
+            msg![
+                format!(
+                    "window depth written with other planes: reversed-Z {reversed}, near ~{near:.4} m, far ~{far} ("
+                ),
+                device_planes(format!("{near:.4}"), far, reversed),
+                ")"
+            ]
         } else {
-            format!("disparity, not depth: stored = {k:.4} / Z + {c:.3} (a line in 1 / Z)")
+            msg![format!(
+                "disparity, not depth: stored = {k:.4} / Z + {c:.3} (a line in 1 / Z)"
+            )]
         };
         out.push((what, zb));
     }

@@ -238,7 +238,7 @@ pub fn software_warning(
     devices: &[EglDevice],
     host_evidence: &[String],
     failed_attempts: &[String],
-) -> Option<String> {
+) -> Option<crate::Message> {
     let software = renderer_is_software(renderer) || chosen.is_some_and(|d| d.software);
     if !software {
         return None;
@@ -254,10 +254,15 @@ pub fn software_warning(
     if !failed_attempts.is_empty() {
         text += &format!(". Tried first: {}", failed_attempts.join("; "));
     }
-    text += ". Pick a device with --device N (see `viewsynth info`); in Docker run with --gpus all \
-             -e NVIDIA_DRIVER_CAPABILITIES=graphics,utility so NVIDIA's EGL is mounted; \
-             --require-gpu (or VIEWSYNTH_REQUIRE_GPU=1) turns this into an error";
-    Some(text)
+    text += ". Pick a device with ";
+    Some(crate::msg![
+        text,
+        crate::Field::Device,
+        " N (see `viewsynth info`); in Docker run with --gpus all \
+         -e NVIDIA_DRIVER_CAPABILITIES=graphics,utility so NVIDIA's EGL is mounted; ",
+        crate::Field::RequireGpu,
+        " (or VIEWSYNTH_REQUIRE_GPU=1) turns this into an error"
+    ])
 }
 
 #[cfg(test)]
@@ -330,7 +335,8 @@ mod tests {
         let devices = [mesa_software(0), nvidia(1, 0)];
         let attempts = ["device 1: eglInitialize: BadAlloc".to_string()];
         let w = software_warning("llvmpipe (LLVM 15)", Some(&devices[0]), &devices, &[], &attempts)
-            .expect("hardware device visible");
+            .expect("hardware device visible")
+            .to_string();
         assert!(w.contains("llvmpipe (LLVM 15)"), "{w}");
         assert!(
             w.contains("EGL device 1 (hardware, nvidia, /dev/dri/card0, CUDA 0)"),
@@ -340,7 +346,9 @@ mod tests {
 
         let evidence = ["/dev/nvidia0".to_string()];
         let only_sw = [mesa_software(0)];
-        let w = software_warning("llvmpipe", Some(&only_sw[0]), &only_sw, &evidence, &[]).expect("driver seen");
+        let w = software_warning("llvmpipe", Some(&only_sw[0]), &only_sw, &evidence, &[])
+            .expect("driver seen")
+            .to_string();
         assert!(w.contains("llvmpipe") && w.contains("/dev/nvidia0"), "{w}");
     }
 

@@ -97,7 +97,7 @@ pub struct GpuInfo {
     pub software: bool,
     /// Set when rendering runs on software although a hardware device or an NVIDIA driver is
     /// visible: callers print it (the CLI does, on stderr).
-    pub software_warning: Option<String>,
+    pub software_warning: Option<crate::Message>,
 }
 
 /// An EGL display and a current GL context on this thread. Dropping it releases the context.

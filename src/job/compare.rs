@@ -7,7 +7,9 @@ use super::{ArgError, Event, Host, JobError};
 use crate::compare::{compare_with, ColourReading, Comparison, Measures, Side, Thresholds};
 use crate::convention::{Conventions, DepthPlanes, NdcDepthRange, RowOrder};
 use crate::depth::DepthEncoding;
+use crate::field::{Field, Message};
 use crate::io::{self, DepthDecode};
+use crate::msg;
 use std::path::{Path, PathBuf};
 
 /// What a side's depth file holds.
@@ -181,24 +183,28 @@ impl CompareJob {
         let storage = [side_storage('A', &o.a, o.planes)?, side_storage('B', &o.b, o.planes)?];
         if o.planes.is_some() && storage.iter().all(|s| !matches!(s, DepthEncoding::Device { .. })) {
             return Err(ArgError::CompareNotApplicable {
-                option: "--near/--far".into(),
+                option: msg![Field::Near, "/", Field::Far],
                 why: "neither side's depth is device or ndc depth (view-z is metres: no planes)".into(),
             });
         }
         let inputs: Vec<crate::output::NamedPath<'_>> = [
-            ("--a-rgb", Some(&o.a.rgb)),
-            ("--a-depth", o.a.depth.as_ref()),
-            ("--b-rgb", Some(&o.b.rgb)),
-            ("--b-depth", o.b.depth.as_ref()),
-            ("--mask", o.mask.as_ref()),
+            (crate::Field::ARgb.into(), Some(&o.a.rgb)),
+            (crate::Field::ADepth.into(), o.a.depth.as_ref()),
+            (crate::Field::BRgb.into(), Some(&o.b.rgb)),
+            (crate::Field::BDepth.into(), o.b.depth.as_ref()),
+            (crate::Field::Mask.into(), o.mask.as_ref()),
         ]
         .into_iter()
         .filter_map(|(option, p)| p.map(|p| (option, p.as_path())))
         .collect();
-        let mut outputs: Vec<crate::output::NamedPath<'_>> = o.diff.iter().map(|p| ("--diff", p.as_path())).collect();
-        outputs.extend(o.flip_map.iter().map(|p| ("--flip-map", p.as_path())));
+        let mut outputs: Vec<crate::output::NamedPath<'_>> = o
+            .diff
+            .iter()
+            .map(|p| (crate::Field::Diff.into(), p.as_path()))
+            .collect();
+        outputs.extend(o.flip_map.iter().map(|p| (crate::Field::FlipMap.into(), p.as_path())));
         if let Some(JsonOutput::File(p)) = &o.json {
-            outputs.push(("--json", p));
+            outputs.push((crate::Field::Json.into(), p));
         }
         crate::output::check_outputs(&inputs, &outputs).map_err(ArgError::Invalid)?;
         Ok(CompareJob {
@@ -264,15 +270,21 @@ impl CompareJob {
     pub fn run(&self, host: &dyn Host) -> Result<CompareReport, JobError> {
         let sa = self.side(&self.a, self.storage[0])?;
         let sb = self.side(&self.b, self.storage[1])?;
-        for (opts, side, name) in [(&self.a, &sa, "A"), (&self.b, &sb, "B")] {
+        for (opts, side, name) in [(&self.a, &sa, 'A'), (&self.b, &sb, 'B')] {
             if let (Some(path), Some(depth)) = (&opts.depth, &side.depth) {
-                let s = name.to_lowercase();
-                let hint = format!(
-                    "check what {name}'s file holds: metres (`--{s}-depth-kind view-z`), window depth \
-                     (`--{s}-depth-kind device --{s}-near N --{s}-far F`, far may be inf; reversed: \
-                     `--{s}-depth-kind device --{s}-near N --{s}-far F --{s}-reversed-z`), and that it is \
-                     depth, not disparity"
-                );
+                let f = SideFields::of(name);
+                let window = msg![f.depth_kind, " device ", f.near, " N ", f.far, " F"];
+                let hint = msg![
+                    format!("check what {name}'s file holds: metres (`"),
+                    f.depth_kind,
+                    " view-z`), window depth (`",
+                    &window,
+                    "`, far may be inf; reversed: `",
+                    &window,
+                    " ",
+                    f.reversed_z,
+                    "`), and that it is depth, not disparity"
+                ];
                 host.event(Event::InputDepth {
                     path,
                     summary: &side.storage.summary(&side.conv, &side_window_depth(side, depth)),
@@ -352,58 +364,70 @@ fn side_window_depth(side: &Side, depth: &io::DepthMap) -> io::DepthMap {
 /// window depth (the same function of Z under either range), premultiplied alpha nowhere to
 /// apply is checked on reading (the file decides).
 fn side_storage(name: char, o: &SideOptions, both: Option<DepthPlanes>) -> Result<DepthEncoding, ArgError> {
-    let s = name.to_ascii_lowercase();
-    let not_applicable = |option: String, why: String| Err(ArgError::CompareNotApplicable { option, why });
+    let f = SideFields::of(name);
+    let not_applicable = |option: Message, why: Message| Err(ArgError::CompareNotApplicable { option, why });
     let kind = o.depth_kind;
     if o.depth.is_none() {
         if o.planes.is_some() || o.reversed_z || o.ndc.is_some() || kind != SideDepth::ViewZ {
             return not_applicable(
-                format!("--{s}-depth-kind/--{s}-near/--{s}-far/--{s}-reversed-z/--{s}-ndc"),
-                format!("{name} has no depth file (--{s}-depth)"),
+                msg![f.depth_kind, "/", f.near, "/", f.far, "/", f.reversed_z, "/", f.ndc],
+                msg![format!("{name} has no depth file ("), f.depth, ")"],
             );
         }
         return Ok(DepthEncoding::ViewZ);
     }
     match kind {
         SideDepth::ViewZ => {
-            let metric = format!("{name}'s depth is view-z, metres (--{s}-depth-kind device or ndc for device depth)");
+            let metric = msg![
+                format!("{name}'s depth is view-z, metres ("),
+                f.depth_kind,
+                " device or ndc for device depth)"
+            ];
             if o.planes.is_some() {
-                return not_applicable(format!("--{s}-near/--{s}-far"), metric);
+                return not_applicable(msg![f.near, "/", f.far], metric);
             }
             if o.reversed_z {
-                return not_applicable(format!("--{s}-reversed-z"), metric);
+                return not_applicable(f.reversed_z.into(), metric);
             }
             if o.ndc.is_some() {
-                return not_applicable(format!("--{s}-ndc"), metric);
+                return not_applicable(f.ndc.into(), metric);
             }
             Ok(DepthEncoding::ViewZ)
         }
         SideDepth::Device | SideDepth::Ndc => {
             if kind == SideDepth::Device && o.ndc.is_some() {
                 return not_applicable(
-                    format!("--{s}-ndc"),
-                    format!(
-                        "window depth in [0, 1] is the same function of Z under gl and vulkan NDC for the \
-                         same planes, so it cannot change {name}'s reading; it applies to NDC z stored \
-                         (--{s}-depth-kind ndc)"
-                    ),
+                    f.ndc.into(),
+                    msg![
+                        format!(
+                            "window depth in [0, 1] is the same function of Z under gl and vulkan NDC for the \
+                             same planes, so it cannot change {name}'s reading; it applies to NDC z stored ("
+                        ),
+                        f.depth_kind,
+                        " ndc)"
+                    ],
                 );
             }
             if kind == SideDepth::Ndc && o.ndc.is_none() {
-                return Err(ArgError::CompareNotApplicable {
-                    option: format!("--{s}-depth-kind ndc"),
-                    why: format!("needs the NDC range the z was written in: --{s}-ndc gl or --{s}-ndc vulkan"),
-                });
+                return not_applicable(
+                    msg![f.depth_kind, " ndc"],
+                    msg![
+                        "needs the NDC range the z was written in: ",
+                        f.ndc,
+                        " gl or ",
+                        f.ndc,
+                        " vulkan"
+                    ],
+                );
             }
             let planes = o.planes.or(both).ok_or(ArgError::ComparePlanesMissing {
                 side: name,
                 kind: kind.name(),
             })?;
             if !(planes.near.is_finite() && planes.near > 0.0 && planes.far > planes.near) {
-                let options = if o.planes.is_some() {
-                    format!("--{s}-near/--{s}-far")
-                } else {
-                    "--near/--far".into()
+                let options = match o.planes.is_some() {
+                    true => msg![f.near, "/", f.far],
+                    false => msg![Field::Near, "/", Field::Far],
                 };
                 return Err(ArgError::ComparePlanes {
                     options,
@@ -412,6 +436,39 @@ fn side_storage(name: char, o: &SideOptions, both: Option<DepthPlanes>) -> Resul
                 });
             }
             Ok(DepthEncoding::Device { planes })
+        }
+    }
+}
+
+/// The convention options of one compare side (`A` or `B`).
+struct SideFields {
+    depth: Field,
+    depth_kind: Field,
+    near: Field,
+    far: Field,
+    reversed_z: Field,
+    ndc: Field,
+}
+
+impl SideFields {
+    fn of(side: char) -> Self {
+        match side {
+            'A' => SideFields {
+                depth: Field::ADepth,
+                depth_kind: Field::ADepthKind,
+                near: Field::ANear,
+                far: Field::AFar,
+                reversed_z: Field::AReversedZ,
+                ndc: Field::ANdc,
+            },
+            _ => SideFields {
+                depth: Field::BDepth,
+                depth_kind: Field::BDepthKind,
+                near: Field::BNear,
+                far: Field::BFar,
+                reversed_z: Field::BReversedZ,
+                ndc: Field::BNdc,
+            },
         }
     }
 }
@@ -495,7 +552,8 @@ mod tests {
         ] {
             let e = job(metric.clone(), b, None).unwrap_err();
             assert!(
-                matches!(&e, ArgError::CompareNotApplicable { option: o, .. } if o == option) && e.is_usage(),
+                matches!(&e, ArgError::CompareNotApplicable { option: o, .. } if o.to_string() == option)
+                    && e.is_usage(),
                 "{option}: {e}"
             );
         }

@@ -35,7 +35,7 @@ impl DepthFileRequest {
     /// Checks the options against each other: planes with device depth only (and always with
     /// it), a scale finite and > 0, no disparity (it needs a camera to become metres).
     pub fn check(&self) -> Result<DepthFileReading, ArgError> {
-        super::cyclopean::check_scale("--depth-scale", self.depth_scale)?;
+        super::cyclopean::check_scale(crate::Field::DepthScale, self.depth_scale)?;
         let encoding = match self.depth_kind {
             SourceDepth::ViewZ => {
                 if self.near.is_some() || self.far.is_some() {
@@ -46,7 +46,7 @@ impl DepthFileRequest {
             SourceDepth::Device => device_depth(self.near, self.far, "the file")?,
             SourceDepth::Disparity => {
                 return Err(ArgError::Invalid(crate::Error::param(
-                    "--depth-kind",
+                    crate::Field::DepthKind,
                     "disparity becomes metres only with a focal length and baseline: read it as \
                      stored (view-z with no depth-scale) or reproject it with them",
                 )))
@@ -108,7 +108,7 @@ mod tests {
             assert!(matches!(
                 r.check(),
                 Err(ArgError::Scale {
-                    option: "--depth-scale",
+                    option: crate::Field::DepthScale,
                     ..
                 })
             ));

@@ -2,10 +2,13 @@
 //! work), or running it failed ([`JobError`]). Each message names the option or file at fault,
 //! worded as the command line gives them.
 
+use crate::field::{Field, Message, Spelling};
+use crate::msg;
 use std::path::PathBuf;
 
 /// Options that do not make a valid job: refused in the conversion from the command line,
-/// before any input is read, GPU opened or file written.
+/// before any input is read, GPU opened or file written. The options named are [`Field`]s:
+/// `Display` spells them as the command line does, [`ArgError::spelled`] as a front end does.
 #[derive(Debug, thiserror::Error)]
 #[non_exhaustive]
 pub enum ArgError {
@@ -16,13 +19,13 @@ pub enum ArgError {
     #[error("{options}")]
     InvalidOptions {
         /// The options, e.g. `--near/--far`.
-        options: String,
+        options: Message,
         /// Why the library refused them.
         #[source]
         source: crate::Error,
     },
     /// `--device` is neither `auto`, `surfaceless` nor an index.
-    #[error("--device '{value}': expected auto, surfaceless or an index")]
+    #[error("{}", self.message())]
     Device {
         /// The value given.
         value: String,
@@ -31,33 +34,32 @@ pub enum ArgError {
         source: std::num::ParseIntError,
     },
     /// An entry of `--depth-format` names no depth file format.
-    #[error("--depth-format '{0}': expected exr, npy, png16 or a list such as exr,png16")]
+    #[error("{}", self.message())]
     DepthFormat(String),
     /// `--depth-preview` without a depth output to colour.
-    #[error("--depth-preview colours the depth output: add depth to --outputs")]
+    #[error("{}", self.message())]
     PreviewWithoutDepth,
-    /// A source intrinsic is given neither by flag nor by `--intrinsics`.
-    #[error("give the source intrinsics: --intrinsics FILE or --fx --fy --cx --cy (--{0} is missing)")]
-    MissingIntrinsic(&'static str),
+    /// A source intrinsic (`--fx`, `--fy`, `--cx` or `--cy`) is given neither by flag nor by
+    /// `--intrinsics`.
+    #[error("{}", self.message())]
+    MissingIntrinsic(Field),
     /// A command that also takes full eye matrices got neither intrinsics nor `--cameras`.
-    #[error(
-        "give the source intrinsics: --intrinsics FILE or --fx --fy --cx --cy (or full eye matrices: --cameras FILE)"
-    )]
+    #[error("{}", self.message())]
     MissingIntrinsicsOrCameras,
     /// Device depth without the planes it was written with.
-    #[error("--depth-kind device needs --near and --far (the planes {0} was written with)")]
+    #[error("{}", self.message())]
     DevicePlanesMissing(&'static str),
     /// `--near/--far` with a depth kind that has no planes.
-    #[error("--near/--far apply to --depth-kind device only")]
+    #[error("{}", self.message())]
     PlanesWithoutDevice,
     /// One frame's colour or depth is missing (clap requires both without `--batch`).
-    #[error("--rgb and --depth are required without --batch")]
+    #[error("{}", self.message())]
     PerFrameInput,
     /// An option that holds for one frame given to a batch.
     #[error("{0}")]
     PerFrameInBatch(PerFrameOption),
     /// More CPU threads than a pool takes.
-    #[error("--jobs {jobs}: at most {max}")]
+    #[error("{}", self.message())]
     TooManyJobs {
         /// Threads asked for.
         jobs: usize,
@@ -65,30 +67,28 @@ pub enum ArgError {
         max: usize,
     },
     /// Cyclopean disparities and depth input both given.
-    #[error(
-        "give disparities (--left-disparity, --right-disparity) or depth (--left-depth, --right-depth, --cameras), not both"
-    )]
+    #[error("{}", self.message())]
     DisparityAndDepth,
     /// Cyclopean depth input without one of its three parts.
-    #[error("{0} is missing: depth input needs --left-depth, --right-depth and --cameras")]
-    DepthInputMissing(&'static str),
+    #[error("{}", self.message())]
+    DepthInputMissing(Field),
     /// A disparity-rig value without its partner.
-    #[error("{0} needs {1} too (both or neither: together they make depth metric)")]
-    RigPartner(&'static str, &'static str),
+    #[error("{}", self.message())]
+    RigPartner(Field, Field),
     /// `--depth-scale` with disparity inputs.
-    #[error("--depth-scale is for --left-depth/--right-depth; use --disparity-scale with disparities")]
+    #[error("{}", self.message())]
     DepthScaleWithDisparity,
     /// A disparity-rig option given with a camera file.
-    #[error("{0} is for --left-disparity/--right-disparity; the camera file places the view")]
-    RigOptionWithCameraFile(&'static str),
+    #[error("{}", self.message())]
+    RigOptionWithCameraFile(Field),
     /// `--dominant` without the `eye:weight` form.
-    #[error("--dominant '{0}': expected left:W or right:W")]
+    #[error("{}", self.message())]
     DominantForm(String),
     /// `--dominant` names no eye.
-    #[error("--dominant '{0}': eye must be left or right")]
+    #[error("{}", self.message())]
     DominantEye(String),
     /// `--dominant`'s weight is no number.
-    #[error("--dominant '{value}': weight")]
+    #[error("{}", self.message())]
     DominantWeight {
         /// The value given.
         value: String,
@@ -97,79 +97,69 @@ pub enum ArgError {
         source: std::num::ParseFloatError,
     },
     /// A seed/refine option with another cyclopean method.
-    #[error("{0} applies to --method seed or refine only")]
-    GatherOptionOnly(&'static str),
+    #[error("{}", self.message())]
+    GatherOptionOnly(Field),
     /// A decoding option for disparity or depth files with two images alone.
-    #[error("{0} decodes disparity or depth files; with two images alone the disparities are estimated")]
-    DecodeWithoutMaps(&'static str),
+    #[error("{}", self.message())]
+    DecodeWithoutMaps(Field),
     /// A matcher option with disparities or depth given.
-    #[error("{0} applies to two images alone (the disparities are then estimated)")]
-    MatcherOptionWithMaps(&'static str),
+    #[error("{}", self.message())]
+    MatcherOptionWithMaps(Field),
     /// A metric depth output asked of disparities without a calibration.
-    #[error("--outputs depth needs --focal and --baseline (the depth is metric)")]
+    #[error("{}", self.message())]
     DepthOutputNotMetric,
     /// `--to both` from an eye.
-    #[error("--to both needs --from centre (from an eye, the only other view is the other eye)")]
+    #[error("{}", self.message())]
     BothFromEye,
     /// The target view is the source view.
-    #[error("--to is the source view itself (--from): nothing to reproject")]
+    #[error("{}", self.message())]
     TargetIsSource,
     /// Disparity depth without the baseline that makes it metric.
-    #[error("--depth-kind disparity needs --baseline (metres; Z = baseline * focal / (d + doffs))")]
+    #[error("{}", self.message())]
     DisparityWithoutBaseline,
     /// A reprojection rig neither rectified nor game-engine.
-    #[error("give the rig: --baseline B (rectified, metres) or --separation S --convergence C (game-engine stereo)")]
+    #[error("{}", self.message())]
     NoRig,
     /// Both rigs given.
-    #[error(
-        "--baseline (rectified rig) and --separation/--convergence (game-engine rig) conflict: give one \
-         (--baseline goes with --separation only to make --depth-kind disparity metric)"
-    )]
+    #[error("{}", self.message())]
     RigConflict,
     /// A scale option outside (0, inf).
-    #[error("invalid {option} {value}: must be finite and > 0")]
+    #[error("{}", self.message())]
     Scale {
         /// The option, e.g. `--disparity-scale`.
-        option: &'static str,
+        option: Field,
         /// The value given.
         value: f64,
     },
     /// A camera file's source must be an eye.
-    #[error("--cameras holds the two eyes: --from left or right")]
+    #[error("{}", self.message())]
     CameraFileFromCentre,
     /// Full eye matrices with a shift method.
-    #[error(
-        "--cameras (full eye matrices) renders by --method gather3d (its default): the shift methods need a parallel rig"
-    )]
+    #[error("{}", self.message())]
     CameraFileNeedsGather,
     /// The middle camera is a camera file's.
-    #[error("--to centre (middle) needs --cameras: a rig's centre is a source (--from centre), not a target")]
+    #[error("{}", self.message())]
     CentreTargetNeedsCameras,
     /// Depth kind or conventions given with a camera file that carries its own.
-    #[error(
-        "--cameras: the depth kind and the conventions come from the file; drop --depth-kind/--ndc/--reversed-z/--rows"
-    )]
+    #[error("{}", self.message())]
     CameraFileOverridden,
     /// `--overlap` alone outside the faces it implies.
-    #[error("--overlap {0}: must be in (0, 44) degrees (faces of 90 + 2 x overlap; or give --fov)")]
+    #[error("{}", self.message())]
     Overlap(f64),
     /// The face field of view outside (90, 178) degrees.
-    #[error("--fov {0}: the face field of view must be in (90, 178) degrees")]
+    #[error("{}", self.message())]
     FaceFov(f64),
     /// `scene --face-fov` outside (90, 178) degrees.
-    #[error("--face-fov {0}: the cube faces' field of view must be in (90, 178) degrees (stitch --faces needs over-wide faces)")]
+    #[error("{}", self.message())]
     CubeFaceFov(f64),
     /// A scene other than `demo` for stitching.
-    #[error("--scene '{0}': only the built-in `demo` scene has cube faces (use --faces DIR for your own)")]
+    #[error("{}", self.message())]
     StitchScene(String),
     /// Stitch ground truth without the built-in scene.
-    #[error("--truth needs --scene demo (the ground truth is ray-traced from the built-in scene)")]
+    #[error("{}", self.message())]
     TruthWithoutScene,
     /// A top-bottom ODS image taller than image files hold.
-    #[error(
-        "--width/--height {width}x{height}: the top-bottom image ({width}x{}) exceeds the image files' limit of {max} px per side",
-        2 * *height as u64
-    )]
+    #[error("{}", self.message())]
     TopBottomTooTall {
         /// Width per eye.
         width: u32,
@@ -179,20 +169,20 @@ pub enum ArgError {
         max: u32,
     },
     /// `--faces` is no folder.
-    #[error("--faces {}: not a directory", .0.display())]
+    #[error("{}", self.message())]
     FacesNotADirectory(PathBuf),
     /// `--depth-kind` with the built-in scene's faces.
-    #[error("--depth-kind applies to --faces (the built-in scene's faces hold view Z)")]
+    #[error("{}", self.message())]
     FaceDepthKindWithoutFaces,
     /// A negative or non-finite interocular distance.
     #[error("invalid ipd {0}: must be finite and >= 0")]
     Ipd(f64),
     /// Compare's planes out of order.
     #[cfg(feature = "compare")]
-    #[error("invalid {options} {near} / {far}: need 0 < near < far (far may be inf)")]
+    #[error("{}", self.message())]
     ComparePlanes {
         /// The options, e.g. `--b-near/--b-far`.
-        options: String,
+        options: Message,
         /// The near plane given.
         near: f64,
         /// The far plane given.
@@ -200,11 +190,7 @@ pub enum ArgError {
     },
     /// A compare side's device or NDC depth without the planes it was written with.
     #[cfg(feature = "compare")]
-    #[error(
-        "{side}'s depth is {kind} depth: give the planes it was written with, --{s}-near N --{s}-far F \
-         (far may be inf; --near/--far set both sides)",
-        s = side.to_ascii_lowercase()
-    )]
+    #[error("{}", self.message())]
     ComparePlanesMissing {
         /// `A` or `B`.
         side: char,
@@ -213,16 +199,281 @@ pub enum ArgError {
     },
     /// A compare convention option that cannot change the reading of the side it names.
     #[cfg(feature = "compare")]
-    #[error("{option} does not apply: {why}")]
+    #[error("{}", self.message())]
     CompareNotApplicable {
         /// The option, e.g. `--b-ndc`.
-        option: String,
+        option: Message,
         /// Why it changes nothing there.
-        why: String,
+        why: Message,
     },
 }
 
+/// "give the source intrinsics: --intrinsics FILE or --fx --fy --cx --cy", the start of two
+/// refusals.
+fn give_intrinsics() -> Message {
+    msg![
+        "give the source intrinsics: ",
+        Field::Intrinsics,
+        " FILE or ",
+        Field::Fx,
+        " ",
+        Field::Fy,
+        " ",
+        Field::Cx,
+        " ",
+        Field::Cy
+    ]
+}
+
 impl ArgError {
+    /// The refusal with the options it names as fields; the wrappers of a library error
+    /// (`Invalid`, `InvalidOptions`) give their own text (see [`ArgError::spelled`]).
+    fn message(&self) -> Message {
+        use Field as F;
+        match self {
+            ArgError::Invalid(e) => msg![e.to_string()],
+            ArgError::InvalidOptions { options, .. } => options.clone(),
+            ArgError::Device { value, .. } => {
+                msg![F::Device, format!(" '{value}': expected auto, surfaceless or an index")]
+            }
+            ArgError::DepthFormat(v) => {
+                msg![F::DepthFormat, format!(" '{v}': expected exr, npy, png16 or a list such as exr,png16")]
+            }
+            ArgError::PreviewWithoutDepth => {
+                msg![F::DepthPreview, " colours the depth output: add depth to ", F::Outputs]
+            }
+            ArgError::MissingIntrinsic(f) => msg![give_intrinsics(), " (", *f, " is missing)"],
+            ArgError::MissingIntrinsicsOrCameras => {
+                msg![give_intrinsics(), " (or full eye matrices: ", F::Cameras, " FILE)"]
+            }
+            ArgError::DevicePlanesMissing(what) => msg![
+                F::DepthKind,
+                " device needs ",
+                F::Near,
+                " and ",
+                F::Far,
+                format!(" (the planes {what} was written with)")
+            ],
+            ArgError::PlanesWithoutDevice => {
+                msg![F::Near, "/", F::Far, " apply to ", F::DepthKind, " device only"]
+            }
+            ArgError::PerFrameInput => msg![F::Rgb, " and ", F::Depth, " are required without ", F::Batch],
+            ArgError::PerFrameInBatch(o) => o.message(),
+            ArgError::TooManyJobs { jobs, max } => msg![F::Jobs, format!(" {jobs}: at most {max}")],
+            ArgError::DisparityAndDepth => msg![
+                "give disparities (",
+                F::LeftDisparity,
+                ", ",
+                F::RightDisparity,
+                ") or depth (",
+                F::LeftDepth,
+                ", ",
+                F::RightDepth,
+                ", ",
+                F::Cameras,
+                "), not both"
+            ],
+            ArgError::DepthInputMissing(f) => msg![
+                *f,
+                " is missing: depth input needs ",
+                F::LeftDepth,
+                ", ",
+                F::RightDepth,
+                " and ",
+                F::Cameras
+            ],
+            ArgError::RigPartner(a, b) => {
+                msg![*a, " needs ", *b, " too (both or neither: together they make depth metric)"]
+            }
+            ArgError::DepthScaleWithDisparity => msg![
+                F::DepthScale,
+                " is for ",
+                F::LeftDepth,
+                "/",
+                F::RightDepth,
+                "; use ",
+                F::DisparityScale,
+                " with disparities"
+            ],
+            ArgError::RigOptionWithCameraFile(f) => msg![
+                *f,
+                " is for ",
+                F::LeftDisparity,
+                "/",
+                F::RightDisparity,
+                "; the camera file places the view"
+            ],
+            ArgError::DominantForm(v) => msg![F::Dominant, format!(" '{v}': expected left:W or right:W")],
+            ArgError::DominantEye(v) => msg![F::Dominant, format!(" '{v}': eye must be left or right")],
+            ArgError::DominantWeight { value, .. } => msg![F::Dominant, format!(" '{value}': weight")],
+            ArgError::GatherOptionOnly(f) => msg![*f, " applies to ", F::Method, " seed or refine only"],
+            ArgError::DecodeWithoutMaps(f) => msg![
+                *f,
+                " decodes disparity or depth files; with two images alone the disparities are estimated"
+            ],
+            ArgError::MatcherOptionWithMaps(f) => {
+                msg![*f, " applies to two images alone (the disparities are then estimated)"]
+            }
+            ArgError::DepthOutputNotMetric => msg![
+                F::Outputs,
+                " depth needs ",
+                F::Focal,
+                " and ",
+                F::Baseline,
+                " (the depth is metric)"
+            ],
+            ArgError::BothFromEye => msg![
+                F::To,
+                " both needs ",
+                F::From,
+                " centre (from an eye, the only other view is the other eye)"
+            ],
+            ArgError::TargetIsSource => msg![F::To, " is the source view itself (", F::From, "): nothing to reproject"],
+            ArgError::DisparityWithoutBaseline => msg![
+                F::DepthKind,
+                " disparity needs ",
+                F::Baseline,
+                " (metres; Z = baseline * focal / (d + doffs))"
+            ],
+            ArgError::NoRig => msg![
+                "give the rig: ",
+                F::Baseline,
+                " B (rectified, metres) or ",
+                F::Separation,
+                " S ",
+                F::Convergence,
+                " C (game-engine stereo)"
+            ],
+            ArgError::RigConflict => msg![
+                F::Baseline,
+                " (rectified rig) and ",
+                F::Separation,
+                "/",
+                F::Convergence,
+                " (game-engine rig) conflict: give one (",
+                F::Baseline,
+                " goes with ",
+                F::Separation,
+                " only to make ",
+                F::DepthKind,
+                " disparity metric)"
+            ],
+            ArgError::Scale { option, value } => msg!["invalid ", *option, format!(" {value}: must be finite and > 0")],
+            ArgError::CameraFileFromCentre => msg![F::Cameras, " holds the two eyes: ", F::From, " left or right"],
+            ArgError::CameraFileNeedsGather => msg![
+                F::Cameras,
+                " (full eye matrices) renders by ",
+                F::Method,
+                " gather3d (its default): the shift methods need a parallel rig"
+            ],
+            ArgError::CentreTargetNeedsCameras => msg![
+                F::To,
+                " centre (middle) needs ",
+                F::Cameras,
+                ": a rig's centre is a source (",
+                F::From,
+                " centre), not a target"
+            ],
+            ArgError::CameraFileOverridden => msg![
+                F::Cameras,
+                ": the depth kind and the conventions come from the file; drop ",
+                F::DepthKind,
+                "/",
+                F::Ndc,
+                "/",
+                F::ReversedZ,
+                "/",
+                F::Rows
+            ],
+            ArgError::Overlap(v) => msg![
+                F::Overlap,
+                format!(" {v}: must be in (0, 44) degrees (faces of 90 + 2 x overlap; or give "),
+                F::Fov,
+                ")"
+            ],
+            ArgError::FaceFov(v) => msg![F::Fov, format!(" {v}: the face field of view must be in (90, 178) degrees")],
+            ArgError::CubeFaceFov(v) => msg![
+                F::FaceFov,
+                format!(" {v}: the cube faces' field of view must be in (90, 178) degrees (stitch "),
+                F::Faces,
+                " needs over-wide faces)"
+            ],
+            ArgError::StitchScene(v) => msg![
+                F::Scene,
+                format!(" '{v}': only the built-in `demo` scene has cube faces (use "),
+                F::Faces,
+                " DIR for your own)"
+            ],
+            ArgError::TruthWithoutScene => msg![
+                F::Truth,
+                " needs ",
+                F::Scene,
+                " demo (the ground truth is ray-traced from the built-in scene)"
+            ],
+            ArgError::TopBottomTooTall { width, height, max } => msg![
+                F::Width,
+                "/",
+                F::Height,
+                format!(
+                    " {width}x{height}: the top-bottom image ({width}x{}) exceeds the image files' limit of {max} px per side",
+                    2 * *height as u64
+                )
+            ],
+            ArgError::FacesNotADirectory(p) => msg![F::Faces, format!(" {}: not a directory", p.display())],
+            ArgError::FaceDepthKindWithoutFaces => msg![
+                F::DepthKind,
+                " applies to ",
+                F::Faces,
+                " (the built-in scene's faces hold view Z)"
+            ],
+            ArgError::Ipd(v) => msg![format!("invalid ipd {v}: must be finite and >= 0")],
+            #[cfg(feature = "compare")]
+            ArgError::ComparePlanes { options, near, far } => msg![
+                "invalid ",
+                options,
+                format!(" {near} / {far}: need 0 < near < far (far may be inf)")
+            ],
+            #[cfg(feature = "compare")]
+            ArgError::ComparePlanesMissing { side, kind } => {
+                let (near, far) = match side {
+                    'A' => (F::ANear, F::AFar),
+                    _ => (F::BNear, F::BFar),
+                };
+                msg![
+                    format!("{side}'s depth is {kind} depth: give the planes it was written with, "),
+                    near,
+                    " N ",
+                    far,
+                    " F (far may be inf; ",
+                    F::Near,
+                    "/",
+                    F::Far,
+                    " set both sides)"
+                ]
+            }
+            #[cfg(feature = "compare")]
+            ArgError::CompareNotApplicable { option, why } => msg![option, " does not apply: ", why],
+        }
+    }
+
+    /// The refusal with the options it names spelled as `spelling` writes them (`Display` is
+    /// [`Spelling::Cli`]'s). A library error inside is spelled the same way; its own source
+    /// (an I/O error, ...) is not part of it.
+    pub fn spelled(&self, spelling: Spelling) -> String {
+        match self {
+            ArgError::Invalid(e) => e.spelled(spelling),
+            other => other.message().spelled(spelling),
+        }
+    }
+
+    /// The fields the refusal names, in order (for a library error inside, its own).
+    pub fn fields(&self) -> Vec<Field> {
+        match self {
+            ArgError::Invalid(e) => e.fields(),
+            other => other.message().fields().collect(),
+        }
+    }
+
     /// Whether the command line itself is at fault (exit 2): true for every refusal except
     /// one found reading a file an option names (`--intrinsics FILE` that does not parse,
     /// does not exist, ...), which is an input found while running (exit 1).
@@ -249,18 +500,52 @@ pub enum PerFrameOption {
     NpzKey,
 }
 
+impl PerFrameOption {
+    /// The refusal, naming the options.
+    fn message(self) -> Message {
+        use Field as F;
+        match self {
+            PerFrameOption::Intrinsics => msg![
+                F::Intrinsics,
+                "/",
+                F::Fx,
+                "/",
+                F::Fy,
+                "/",
+                F::Cx,
+                "/",
+                F::Cy,
+                " are per frame: with ",
+                F::Batch,
+                " they come from the manifest"
+            ],
+            PerFrameOption::FocalList => msg![
+                F::FocalList,
+                " is per frame; with ",
+                F::Batch,
+                " give ",
+                F::ZoomRange,
+                " scales"
+            ],
+            PerFrameOption::SunBitRotate => msg![
+                F::SunBitRotate,
+                " is per frame: with ",
+                F::Batch,
+                " give the manifest a sun_bit_rotate column"
+            ],
+            PerFrameOption::NpzKey => msg![
+                F::NpzKey,
+                " is per frame: with ",
+                F::Batch,
+                " give depth files the key is not needed for"
+            ],
+        }
+    }
+}
+
 impl std::fmt::Display for PerFrameOption {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        f.write_str(match self {
-            PerFrameOption::Intrinsics => {
-                "--intrinsics/--fx/--fy/--cx/--cy are per frame: with --batch they come from the manifest"
-            }
-            PerFrameOption::FocalList => "--focal-list is per frame; with --batch give --zoom-range scales",
-            PerFrameOption::SunBitRotate => {
-                "--sun-bit-rotate is per frame: with --batch give the manifest a sun_bit_rotate column"
-            }
-            PerFrameOption::NpzKey => "--npz-key is per frame: with --batch give depth files the key is not needed for",
-        })
+        self.message().fmt(f)
     }
 }
 
@@ -278,7 +563,7 @@ pub enum JobError {
     #[error("{context}")]
     In {
         /// What was being done, e.g. the two files of a source.
-        context: String,
+        context: Message,
         /// The failure.
         #[source]
         source: crate::Error,
@@ -292,7 +577,7 @@ pub enum JobError {
         total: usize,
     },
     /// The two eyes' faces differ in size.
-    #[error("--faces {}: size mismatch: left faces {left}x{left}, right faces {right}x{right}", .dir.display())]
+    #[error("{}", msg![Field::Faces, format!(" {}: size mismatch: left faces {left}x{left}, right faces {right}x{right}", .dir.display())])]
     FaceSizes {
         /// The face folder.
         dir: PathBuf,
@@ -306,13 +591,13 @@ pub enum JobError {
 /// Attaches what was being done to a library error (the binary prints "context: error").
 pub trait InContext<T> {
     /// The error, if any, as [`JobError::In`].
-    fn within(self, context: impl FnOnce() -> String) -> Result<T, JobError>;
+    fn within<C: Into<Message>>(self, context: impl FnOnce() -> C) -> Result<T, JobError>;
 }
 
 impl<T> InContext<T> for crate::Result<T> {
-    fn within(self, context: impl FnOnce() -> String) -> Result<T, JobError> {
+    fn within<C: Into<Message>>(self, context: impl FnOnce() -> C) -> Result<T, JobError> {
         self.map_err(|source| JobError::In {
-            context: context(),
+            context: context().into(),
             source,
         })
     }
@@ -321,14 +606,46 @@ impl<T> InContext<T> for crate::Result<T> {
 /// As [`InContext`], for refusals found in the conversion.
 pub(crate) trait OptionsContext<T> {
     /// The error, if any, as [`ArgError::InvalidOptions`] naming `options`.
-    fn for_options(self, options: &str) -> Result<T, ArgError>;
+    fn for_options(self, options: impl Into<Message>) -> Result<T, ArgError>;
 }
 
 impl<T> OptionsContext<T> for crate::Result<T> {
-    fn for_options(self, options: &str) -> Result<T, ArgError> {
+    fn for_options(self, options: impl Into<Message>) -> Result<T, ArgError> {
         self.map_err(|source| ArgError::InvalidOptions {
-            options: options.to_string(),
+            options: options.into(),
             source,
         })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_refusal_names_its_options_in_each_front_ends_spelling() {
+        let e = ArgError::BothFromEye;
+        assert_eq!(
+            e.to_string(),
+            "--to both needs --from centre (from an eye, the only other view is the other eye)"
+        );
+        assert_eq!(
+            e.spelled(Spelling::Python),
+            "target both needs source centre (from an eye, the only other view is the other eye)"
+        );
+        assert_eq!(e.fields(), [Field::To, Field::From]);
+        let e = ArgError::RigPartner(Field::Focal, Field::Baseline);
+        assert!(
+            e.spelled(Spelling::Python).starts_with("focal needs baseline too"),
+            "{e}"
+        );
+        // A library error inside is spelled the same way; a text name stays as written.
+        let e = ArgError::Invalid(crate::Error::param(msg![Field::Near, "/", Field::Far], "0 / 0"));
+        assert_eq!(e.to_string(), "invalid --near/--far: 0 / 0");
+        assert_eq!(e.spelled(Spelling::Python), "invalid near/far: 0 / 0");
+        assert_eq!(e.fields(), [Field::Near, Field::Far]);
+        let e = ArgError::Invalid(crate::Error::param("tau-rel", "-1 must be >= 0"));
+        assert_eq!(e.spelled(Spelling::Python), "invalid tau-rel: -1 must be >= 0");
+        assert!(e.fields().is_empty());
     }
 }

@@ -33,11 +33,14 @@ pub fn file_formats(o: &FileOptions<'_>) -> Result<FileFormats, ArgError> {
         // A unit that changes nothing would be silently ignored: name it instead.
         if !depth.png16 {
             return Err(ArgError::Invalid(crate::Error::param(
-                "--depth-png-scale",
-                "sets the units of png16 depth: add png16 to --depth-format",
+                crate::Field::DepthPngScale,
+                crate::msg![
+                    "sets the units of png16 depth: add png16 to ",
+                    crate::Field::DepthFormat
+                ],
             )));
         }
-        depth.png16_units = io::Png16Units::new(units).map_err(|e| e.renamed("--depth-png-scale"))?;
+        depth.png16_units = io::Png16Units::new(units).map_err(|e| e.renamed(crate::Field::DepthPngScale))?;
     }
     let formats = FileFormats {
         outputs: o.outputs,
@@ -48,7 +51,7 @@ pub fn file_formats(o: &FileOptions<'_>) -> Result<FileFormats, ArgError> {
             exr: o
                 .exr_compression
                 .parse()
-                .map_err(|e: crate::Error| e.renamed("--exr-compression"))?,
+                .map_err(|e: crate::Error| e.renamed(crate::Field::ExrCompression))?,
         },
         depth_preview: o.depth_preview,
     };
@@ -61,7 +64,9 @@ pub fn file_formats(o: &FileOptions<'_>) -> Result<FileFormats, ArgError> {
 
 /// `--png-compression`: fast, default or best (refocus, reproject and bench read it alike).
 pub fn png_compression(text: &str) -> Result<io::PngCompression, ArgError> {
-    Ok(text.parse().map_err(|e: crate::Error| e.renamed("--png-compression"))?)
+    Ok(text
+        .parse()
+        .map_err(|e: crate::Error| e.renamed(crate::Field::PngCompression))?)
 }
 
 /// `--depth-format`: a comma-separated list of exr, npy, png16.

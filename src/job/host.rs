@@ -6,6 +6,7 @@ use crate::gpu::{DeviceChoice, Gpu};
 use crate::io::{DepthSummary, DisparitySummary};
 use crate::pass::GpuPolicy;
 use crate::vulkan::{Vk, VulkanContext, VulkanDeviceChoice};
+use crate::Message;
 use std::path::Path;
 
 /// Which GPU a job renders on (`--device`, `--require-gpu`).
@@ -37,9 +38,13 @@ impl GpuRequest {
     pub fn check_backend(&self, backend: Backend) -> Result<(), ArgError> {
         if backend == Backend::Vulkan && self.device == DeviceChoice::Surfaceless {
             return Err(ArgError::Invalid(crate::Error::param(
-                "--device",
-                "surfaceless is an EGL choice: with --backend vulkan give auto or an index of \
-                 `viewsynth info --backend vulkan`",
+                crate::Field::Device,
+                crate::msg![
+                    "surfaceless is an EGL choice: with ",
+                    crate::Field::Backend,
+                    " vulkan give auto or an index of \
+                 `viewsynth info --backend vulkan`"
+                ],
             )));
         }
         Ok(())
@@ -58,8 +63,12 @@ impl GpuRequest {
             DeviceChoice::Index(i) => VulkanDeviceChoice::Index(i),
             DeviceChoice::Surfaceless => {
                 return Err(crate::Error::param(
-                    "--device",
-                    "surfaceless is an EGL choice: with --backend vulkan give auto or an index of `viewsynth info --backend vulkan`",
+                    crate::Field::Device,
+                    crate::msg![
+                        "surfaceless is an EGL choice: with ",
+                        crate::Field::Backend,
+                        " vulkan give auto or an index of `viewsynth info --backend vulkan`"
+                    ],
                 ))
             }
         };
@@ -88,7 +97,7 @@ pub enum Event<'a> {
         /// Size, valid fraction, min / median / max.
         summary: &'a DepthSummary,
         /// What to check when the summary looks wrong.
-        hint: &'a str,
+        hint: &'a Message,
     },
     /// An input disparity map as decoded, in pixels, with the pair's scale check (before
     /// rendering; the warnings name `--disparity-scale`).

@@ -19,19 +19,22 @@ impl SourceIntrinsics {
     /// The file's values (when `file` is given) with the flags laid over them.
     pub fn resolve(file: Option<&Path>, flags: [Option<f64>; 4]) -> Result<Self, ArgError> {
         let file = match file {
-            Some(p) => Some((p.to_path_buf(), IntrinsicsFile::load(p).for_options("--intrinsics")?)),
+            Some(p) => Some((
+                p.to_path_buf(),
+                IntrinsicsFile::load(p).for_options(crate::Field::Intrinsics)?,
+            )),
             None => None,
         };
         let stored = file.as_ref().map(|(_, f)| f.k);
         let [fx, fy, cx, cy] = flags;
-        let pick = |flag: Option<f64>, stored: Option<f64>, name: &'static str| {
+        let pick = |flag: Option<f64>, stored: Option<f64>, name: crate::Field| {
             flag.or(stored).ok_or(ArgError::MissingIntrinsic(name))
         };
         let k = Intrinsics {
-            fx: pick(fx, stored.map(|k| k.fx), "fx")?,
-            fy: pick(fy, stored.map(|k| k.fy), "fy")?,
-            cx: pick(cx, stored.map(|k| k.cx), "cx")?,
-            cy: pick(cy, stored.map(|k| k.cy), "cy")?,
+            fx: pick(fx, stored.map(|k| k.fx), crate::Field::Fx)?,
+            fy: pick(fy, stored.map(|k| k.fy), crate::Field::Fy)?,
+            cx: pick(cx, stored.map(|k| k.cx), crate::Field::Cx)?,
+            cy: pick(cy, stored.map(|k| k.cy), crate::Field::Cy)?,
         };
         k.validate("source intrinsics")?;
         Ok(SourceIntrinsics { k, file })
@@ -40,7 +43,8 @@ impl SourceIntrinsics {
     /// Refuses a file written for another image size.
     pub fn check_size(&self, width: u32, height: u32) -> Result<(), ArgError> {
         if let Some((path, file)) = &self.file {
-            file.check_size(path, width, height).for_options("--intrinsics")?;
+            file.check_size(path, width, height)
+                .for_options(crate::Field::Intrinsics)?;
         }
         Ok(())
     }

@@ -46,7 +46,7 @@ impl TumManifestJob {
         max_difference: f64,
         out: PathBuf,
     ) -> Result<Self, ArgError> {
-        let positive = |name: &str, v: f64| {
+        let positive = |name: crate::Field, v: f64| {
             if v.is_finite() && v > 0.0 {
                 Ok(())
             } else {
@@ -56,18 +56,18 @@ impl TumManifestJob {
                 )))
             }
         };
-        positive("--depth-scale", depth_scale)?;
-        positive("--max-difference", max_difference)?;
+        positive(crate::Field::DepthScale, depth_scale)?;
+        positive(crate::Field::MaxDifference, max_difference)?;
         let (rgb_list, depth_list) = lists;
         let rgb_list = rgb_list.unwrap_or_else(|| sequence.join("rgb.txt"));
         let depth_list = depth_list.unwrap_or_else(|| sequence.join("depth.txt"));
         // The one output rule of every command: --out never replaces a listing it reads.
         crate::output::check_outputs(
             &[
-                ("--rgb-list", rgb_list.as_path()),
-                ("--depth-list", depth_list.as_path()),
+                (crate::Field::RgbList.into(), rgb_list.as_path()),
+                (crate::Field::DepthList.into(), depth_list.as_path()),
             ],
-            &[("--out", out.as_path())],
+            &[(crate::Field::Out.into(), out.as_path())],
         )
         .map_err(ArgError::Invalid)?;
         Ok(TumManifestJob {
@@ -92,12 +92,17 @@ impl TumManifestJob {
             self.max_difference,
         )?;
         // Nor a frame the listings name (known only once they are read: a run error).
-        let frames: Vec<(&str, &std::path::Path)> = a
+        let frames: Vec<crate::output::NamedPath<'_>> = a
             .frames
             .iter()
-            .flat_map(|f| [("rgb.txt", f.rgb.as_path()), ("depth.txt", f.depth.as_path())])
+            .flat_map(|f| {
+                [
+                    ("rgb.txt".into(), f.rgb.as_path()),
+                    ("depth.txt".into(), f.depth.as_path()),
+                ]
+            })
             .collect();
-        crate::output::check_outputs(&frames, &[("--out", self.out.as_path())])?;
+        crate::output::check_outputs(&frames, &[(crate::Field::Out.into(), self.out.as_path())])?;
         write_manifest_csv(&self.out, &a.frames)?;
         Ok(TumManifestReport {
             frames: a.frames.len(),

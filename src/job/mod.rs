@@ -60,14 +60,14 @@ pub(crate) fn check_npz_key(key: Option<&str>, depths: &[&std::path::Path]) -> R
     let Some(key) = key else { return Ok(()) };
     if key.is_empty() {
         return Err(ArgError::Invalid(crate::Error::param(
-            "--npz-key",
+            crate::Field::NpzKey,
             "an empty name names no array",
         )));
     }
     let is_npz = |p: &std::path::Path| p.extension().is_some_and(|e| e.eq_ignore_ascii_case("npz"));
     match depths.iter().find(|p| !is_npz(p)) {
         Some(p) => Err(ArgError::Invalid(crate::Error::param(
-            "--npz-key",
+            crate::Field::NpzKey,
             format!(
                 "{}: applies to .npz files only (it names an array of one)",
                 crate::error::excerpt(&p.display().to_string())
@@ -108,7 +108,7 @@ pub fn request_defaults(command: &str) -> Option<serde_json::Value> {
 /// A named choice (`--method`'s "shift-scan", `--depth-kind`'s "view-z", ...) by the names
 /// the request's serialisation gives it, so that each front end parses choices the same way;
 /// a refusal names `option` and the choices.
-pub fn choice<T: serde::de::DeserializeOwned>(option: &str, text: &str) -> Result<T, ArgError> {
+pub fn choice<T: serde::de::DeserializeOwned>(option: crate::Field, text: &str) -> Result<T, ArgError> {
     serde_json::from_value(serde_json::Value::String(text.to_string())).map_err(|e| {
         // serde's words: "unknown variant `x`, expected one of `a`, `b`"; the position is noise.
         let why = e.to_string();

@@ -103,33 +103,37 @@ impl SceneJob {
         if !(o.ipd.is_finite() && o.ipd >= 0.0) {
             return Err(ArgError::Ipd(o.ipd));
         }
-        io::check_output_pixels("--width/--height", o.width, o.height)?;
+        io::check_output_pixels(
+            crate::msg![crate::Field::Width, "/", crate::Field::Height],
+            o.width,
+            o.height,
+        )?;
         if !(1..=MAX_SCENE_FRAMES).contains(&o.frames) {
             return Err(ArgError::Invalid(crate::Error::param(
-                "--frames",
+                crate::Field::Frames,
                 format!("{} outside 1..={MAX_SCENE_FRAMES}", o.frames),
             )));
         }
         if !(o.dolly.is_finite() && o.dolly.abs() <= 1.0) {
             return Err(ArgError::Invalid(crate::Error::param(
-                "--dolly",
+                crate::Field::Dolly,
                 format!("{} m per frame: give a finite step within 1 m", o.dolly),
             )));
         }
         if !(o.spectator_offset.is_finite() && o.spectator_offset.abs() <= 10.0) {
             return Err(ArgError::Invalid(crate::Error::param(
-                "--spectator-offset",
+                crate::Field::SpectatorOffset,
                 format!("{} m: give a finite offset within 10 m", o.spectator_offset),
             )));
         }
         if o.frames > 1 && o.cube_faces.is_some() {
             return Err(ArgError::Invalid(crate::Error::param(
-                "--cube-faces",
-                "is for one frame: not with --frames",
+                crate::Field::CubeFaces,
+                crate::msg!["is for one frame: not with ", crate::Field::Frames],
             )));
         }
         if let SceneSource::File(path) = &scene {
-            crate::output::check_out_dir(&o.out_dir, writes, &replaced(), &[("--scene", path)])
+            crate::output::check_out_dir(&o.out_dir, writes, &replaced(), &[(crate::Field::Scene.into(), path)])
                 .map_err(ArgError::Invalid)?;
         }
         let mut rig = StereoRig::demo(o.width, o.height);
@@ -141,7 +145,7 @@ impl SceneJob {
                 if !(o.face_fov > 90.0 && o.face_fov < 178.0) {
                     return Err(ArgError::CubeFaceFov(o.face_fov));
                 }
-                io::check_output_pixels("--cube-faces", n, n)?;
+                io::check_output_pixels(crate::Field::CubeFaces, n, n)?;
                 // stitch's rig for a face folder, at this IPD: the faces are taken from the
                 // evaluation rig's centre (inside the built-in scenes), which stitch does not
                 // need to know (only the eyes' offsets from it matter).

@@ -7,13 +7,15 @@
 //! outputs may share one. Refusals name both options and the path.
 
 use crate::error::{Error, Result};
+use crate::field::{Field, Message};
 use crate::io::Replaces;
+use crate::msg;
 use std::fs;
 use std::os::unix::fs::{FileTypeExt, MetadataExt};
 use std::path::{Path, PathBuf};
 
 /// A path a run reads or writes and the option that names it (`"--diff"`, `"--a-rgb"`).
-pub type NamedPath<'a> = (&'a str, &'a Path);
+pub type NamedPath<'a> = (Message, &'a Path);
 
 /// Where an output will be: its folder resolved, and its own name.
 fn output_key(path: &Path) -> Option<PathBuf> {
@@ -47,19 +49,20 @@ fn input_key(path: &Path) -> Option<(PathBuf, (u64, u64))> {
 pub fn check_outputs(inputs: &[NamedPath<'_>], outputs: &[NamedPath<'_>]) -> Result<()> {
     let ins: Vec<_> = inputs
         .iter()
-        .filter_map(|&(o, p)| input_key(p).map(|k| (o, p, k)))
+        .filter_map(|(o, p)| input_key(p).map(|k| (o, *p, k)))
         .collect();
-    let mut seen: Vec<(&str, &Path, PathBuf)> = Vec::new();
-    for &(option, path) in outputs {
+    let mut seen: Vec<(&Message, &Path, PathBuf)> = Vec::new();
+    for (option, path) in outputs {
+        let path = *path;
         let Some(key) = output_key(path) else { continue };
         if let Some((other, other_path, _)) = seen.iter().find(|(_, _, k)| *k == key) {
             return Err(Error::param(
                 option,
-                format!(
-                    "{} is also {other} {}: each output needs a file of its own",
-                    path.display(),
-                    other_path.display()
-                ),
+                msg![
+                    format!("{} is also ", path.display()),
+                    *other,
+                    format!(" {}: each output needs a file of its own", other_path.display())
+                ],
             ));
         }
         let identity = fs::metadata(path)
@@ -70,7 +73,7 @@ pub fn check_outputs(inputs: &[NamedPath<'_>], outputs: &[NamedPath<'_>]) -> Res
             .iter()
             .find(|(_, _, (real, id))| *real == key || Some(*id) == identity)
         {
-            return Err(replaces_input(option, path, input, input_path));
+            return Err(replaces_input(option.clone(), path, input, input_path));
         }
         seen.push((option, path, key));
     }
@@ -95,12 +98,12 @@ pub fn check_out_dir(
     let writes = |name: &str| writes(name) || removes.iter().any(|n| n == name);
     let ins: Vec<_> = inputs
         .iter()
-        .filter_map(|&(o, p)| input_key(p).map(|k| (o, p, k)))
+        .filter_map(|(o, p)| input_key(p).map(|k| (o, *p, k)))
         .collect();
     for &(option, path, (ref real, _)) in &ins {
         let name = real.file_name().and_then(|n| n.to_str()).unwrap_or_default();
         if real.parent() == Some(dir.as_path()) && writes(name) {
-            return Err(replaces_input("--out-dir", &out_dir.join(name), option, path));
+            return Err(replaces_input(Field::OutDir.into(), &out_dir.join(name), option, path));
         }
     }
     if ins.is_empty() {
@@ -124,20 +127,23 @@ pub fn check_out_dir(
             continue;
         };
         if let Some(&(option, path, _)) = ins.iter().find(|(_, _, (_, input))| *input == id) {
-            return Err(replaces_input("--out-dir", &out_dir.join(&name), option, path));
+            return Err(replaces_input(Field::OutDir.into(), &out_dir.join(&name), option, path));
         }
     }
     Ok(())
 }
 
-fn replaces_input(option: &str, path: &Path, input: &str, input_path: &Path) -> Error {
+fn replaces_input(option: Message, path: &Path, input: &Message, input_path: &Path) -> Error {
     Error::param(
         option,
-        format!(
-            "{} is the input {input} {}: an output never replaces an input (write elsewhere or move the input)",
-            path.display(),
-            input_path.display()
-        ),
+        msg![
+            format!("{} is the input ", path.display()),
+            input,
+            format!(
+                " {}: an output never replaces an input (write elsewhere or move the input)",
+                input_path.display()
+            )
+        ],
     )
 }
 
@@ -154,25 +160,31 @@ mod tests {
         std::os::unix::fs::symlink(&a, dir.join("link.png")).unwrap();
         fs::hard_link(&a, dir.join("hard.png")).unwrap();
         let x = dir.join("x.png");
-        let inputs = [("--a-rgb", a.as_path())];
+        let inputs = [(Field::ARgb.into(), a.as_path())];
         let none = Replaces::recorded("none");
         // The same name twice, even spelled differently.
-        let e = check_outputs(&inputs, &[("--diff", &x), ("--json", &dir.join("./x.png"))]).unwrap_err();
+        let e = check_outputs(
+            &inputs,
+            &[(Field::Diff.into(), &x), (Field::Json.into(), &dir.join("./x.png"))],
+        )
+        .unwrap_err();
         assert!(
             e.to_string().contains("--json") && e.to_string().contains("--diff"),
             "{e}"
         );
         // An input itself, through a hard link, and spelled otherwise.
         for out in [a.clone(), dir.join("hard.png"), dir.join(".").join("a.png")] {
-            let e = check_outputs(&inputs, &[("--json", &out)]).unwrap_err().to_string();
+            let e = check_outputs(&inputs, &[(Field::Json.into(), &out)])
+                .unwrap_err()
+                .to_string();
             assert!(e.contains("--a-rgb") && e.contains("--json"), "{}: {e}", out.display());
         }
         // A symlink to an input names the input: refused too (the rename would replace only the
         // link, but the user named the input's file).
-        assert!(check_outputs(&inputs, &[("--json", &dir.join("link.png"))]).is_err());
+        assert!(check_outputs(&inputs, &[(Field::Json.into(), &dir.join("link.png"))]).is_err());
         // Devices are written in place, never replaced.
         let null = Path::new("/dev/null");
-        assert!(check_outputs(&inputs, &[("--diff", null), ("--json", null)]).is_ok());
+        assert!(check_outputs(&inputs, &[(Field::Diff.into(), null), (Field::Json.into(), null)]).is_ok());
         // An out-dir that would write one of its inputs' names.
         let e = check_out_dir(&dir, |n| n.starts_with("a."), &none, &inputs)
             .unwrap_err()

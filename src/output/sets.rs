@@ -183,7 +183,7 @@ impl FileFormats {
         if self.depth_preview && !o.depth {
             return Err(Error::param(
                 "depth-preview",
-                "colours the depth output: add depth to --outputs",
+                crate::msg!["colours the depth output: add depth to ", crate::Field::Outputs],
             ));
         }
         Ok(())

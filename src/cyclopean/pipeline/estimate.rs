@@ -151,11 +151,16 @@ impl CyclopeanPlan {
         device
             .check_image_size("widened pair", search.width(left.width), left.height)
             .map_err(|e| {
-                left_rgb.error(format!(
-                    "{} px wide, widened by {} columns for the search {}..{} px \
-                     (--min-disparity/--max-disparity): {e}",
-                    left.width, search.offset, range.min, range.max
-                ))
+                left_rgb.error(crate::msg![
+                    format!(
+                        "{} px wide, widened by {} columns for the search {}..{} px (",
+                        left.width, search.offset, range.min, range.max
+                    ),
+                    crate::Field::MinDisparity,
+                    "/",
+                    crate::Field::MaxDisparity,
+                    format!("): {e}")
+                ])
             })?;
         let widened;
         let (l, r) = match search.offset {

@@ -129,9 +129,10 @@ pub enum InputName<'a> {
 }
 
 impl InputName<'_> {
-    pub(super) fn error(self, message: impl Into<String>) -> crate::Error {
+    /// A file's error (its text as the command line spells it), or an argument's.
+    pub(super) fn error(self, message: impl Into<crate::Message>) -> crate::Error {
         match self {
-            InputName::File(p) => crate::Error::decode(p, message),
+            InputName::File(p) => crate::Error::decode(p, message.into().to_string()),
             InputName::Argument(a) => crate::Error::param(a, message),
         }
     }
@@ -305,7 +306,7 @@ impl CyclopeanPlan {
         // the rig's fault, said by name rather than a silent 0 % valid view.
         if known && !frame.left.depth.data.iter().any(|z| z.is_finite() && *z > 0.0) {
             return Err(crate::Error::param(
-                "--focal/--baseline",
+                crate::msg![crate::Field::Focal, "/", crate::Field::Baseline],
                 format!(
                     "f B / disparity = {:e} m / px puts every known disparity outside the usable depths [{:e}, {:e}] m",
                     rig.focal_px * rig.baseline,

@@ -5,8 +5,10 @@
 
 use std::fmt;
 
+use crate::field::{Field, Message};
 use crate::io::depth::disparity_fit::ScaleFit;
 use crate::io::{DepthMap, DepthSummary};
+use crate::msg;
 
 /// A 95th-percentile disparity beyond this share of the image width is implausible: the
 /// widest common rigs (KITTI) stay under a fifth of it; Cones read at 1 instead of 4 is 45 %.
@@ -113,43 +115,52 @@ impl fmt::Display for DisparitySummary {
         if let Some((lo, median, hi)) = s.range {
             write!(f, ", min {lo:.2} / median {median:.2} / max {hi:.2} px")?;
         }
-        write!(f, " at --disparity-scale {}", self.scale)
+        write!(f, " at {} {}", Field::DisparityScale, self.scale)
     }
 }
 
-impl fmt::Display for DisparityWarning {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+impl DisparityWarning {
+    /// The warning, naming the option that sets the scale.
+    pub fn message(&self) -> Message {
         match *self {
-            DisparityWarning::NoValid => write!(f, "no pixel holds a valid disparity (> 0)"),
-            DisparityWarning::MostlyInvalid { valid_fraction } => write!(
-                f,
+            DisparityWarning::NoValid => msg!["no pixel holds a valid disparity (> 0)"],
+            DisparityWarning::MostlyInvalid { valid_fraction } => msg![format!(
                 "only {:.1} % of the pixels hold a valid disparity",
                 valid_fraction * 100.0
-            ),
-            DisparityWarning::TooWide { p95, width, scale } => write!(
-                f,
-                "95 % of the disparities reach {p95:.1} px, {:.0} % of the {width} px width: implausible \
-                 for a rectified pair; check --disparity-scale (given {scale}; raw units per pixel, \
-                 4 for Middlebury 2003)",
-                100.0 * p95 / f64::from(width)
-            ),
+            )],
+            DisparityWarning::TooWide { p95, width, scale } => msg![
+                format!(
+                    "95 % of the disparities reach {p95:.1} px, {:.0} % of the {width} px width: implausible \
+                     for a rectified pair; check ",
+                    100.0 * p95 / f64::from(width)
+                ),
+                Field::DisparityScale,
+                format!(" (given {scale}; raw units per pixel, 4 for Middlebury 2003)")
+            ],
             DisparityWarning::OtherScaleFits {
                 scale,
                 error,
                 given,
                 given_error,
-            } => {
-                write!(
-                    f,
-                    "the views agree far better at --disparity-scale {scale} (mean grey difference {error:.1} "
-                )?;
+            } => msg![
+                "the views agree far better at ",
+                Field::DisparityScale,
+                format!(" {scale} (mean grey difference {error:.1} "),
                 match given_error {
-                    Some(e) => write!(f, "against {e:.1} at the scale given, {given})"),
-                    None => write!(f, "; at the scale given, {given}, most shifts leave the view)"),
-                }?;
-                write!(f, ": pass --disparity-scale {scale} if that is how the maps are stored")
-            }
+                    Some(e) => format!("against {e:.1} at the scale given, {given})"),
+                    None => format!("; at the scale given, {given}, most shifts leave the view)"),
+                },
+                ": pass ",
+                Field::DisparityScale,
+                format!(" {scale} if that is how the maps are stored")
+            ],
         }
+    }
+}
+
+impl fmt::Display for DisparityWarning {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        self.message().fmt(f)
     }
 }
 

@@ -400,7 +400,7 @@ mod tests {
         let path = dir.join("u2.npy");
         std::fs::write(&path, build_npy(dict, &payload)).unwrap();
         let err = load_depth(&path, &DepthDecode::default()).unwrap_err();
-        assert!(matches!(err, Error::InvalidParameter { ref name, .. } if name == "depth-scale"));
+        assert!(matches!(err, Error::InvalidParameter { ref name, .. } if name.to_string() == "depth-scale"));
         assert_eq!(
             load_depth(&path, &scaled(5000.0)).unwrap().data,
             vec![1.0, 0.0, 2.0, 0.5]

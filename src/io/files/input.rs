@@ -48,13 +48,17 @@ pub(crate) fn check_budget(path: &Path, width: u64, height: u64) -> Result<()> {
 }
 
 /// Same check for an image about to be rendered (`what` names the parameter).
-pub fn check_output_pixels(what: &str, width: u32, height: u32) -> Result<()> {
+pub fn check_output_pixels(what: impl Into<crate::Message>, width: u32, height: u32) -> Result<()> {
     let pixels = u64::from(width) * u64::from(height);
     let budget = max_pixels();
     if pixels > budget {
         return Err(Error::param(
             what,
-            format!("{width}x{height} = {pixels} pixels exceeds the pixel budget of {budget} (--max-pixels)"),
+            crate::msg![
+                format!("{width}x{height} = {pixels} pixels exceeds the pixel budget of {budget} ("),
+                crate::Field::MaxPixels,
+                ")"
+            ],
         ));
     }
     Ok(())

@@ -119,9 +119,9 @@ impl CyclopeanJob {
         let (maps, scale) = match kind {
             StereoKind::Images => {
                 for (flag, given) in [
-                    ("--disparity-scale", o.disparity_scale.is_some()),
-                    ("--depth-scale", o.depth_scale.is_some()),
-                    ("--npz-key", o.npz_key.is_some()),
+                    (crate::Field::DisparityScale, o.disparity_scale.is_some()),
+                    (crate::Field::DepthScale, o.depth_scale.is_some()),
+                    (crate::Field::NpzKey, o.npz_key.is_some()),
                 ] {
                     if given {
                         return Err(ArgError::DecodeWithoutMaps(flag));
@@ -133,21 +133,26 @@ impl CyclopeanJob {
                 if o.depth_scale.is_some() {
                     return Err(ArgError::DepthScaleWithDisparity);
                 }
-                check_scale("--disparity-scale", o.disparity_scale)?;
+                check_scale(crate::Field::DisparityScale, o.disparity_scale)?;
                 let maps = (o.left_disparity.clone(), o.right_disparity.clone());
                 (Some(maps), Some(o.disparity_scale.unwrap_or(1.0)))
             }
             StereoKind::Cameras => {
                 if o.disparity_scale.is_some() {
-                    return Err(ArgError::RigOptionWithCameraFile("--disparity-scale"));
+                    return Err(ArgError::RigOptionWithCameraFile(crate::Field::DisparityScale));
                 }
-                check_scale("--depth-scale", o.depth_scale)?;
+                check_scale(crate::Field::DepthScale, o.depth_scale)?;
                 (Some((o.left_depth.clone(), o.right_depth.clone())), o.depth_scale)
             }
         };
-        let map_files: Vec<(&'static str, &Path)> = maps
+        let map_files: Vec<crate::output::NamedPath<'_>> = maps
             .iter()
-            .flat_map(|(l, r)| [("--left-depth/disparity", l), ("--right-depth/disparity", r)])
+            .flat_map(|(l, r)| {
+                [
+                    (crate::msg![crate::Field::LeftDepth, "/disparity"], l),
+                    (crate::msg![crate::Field::RightDepth, "/disparity"], r),
+                ]
+            })
             .filter_map(|(flag, p)| Some((flag, p.as_deref()?)))
             .collect();
         if !map_files.is_empty() {
@@ -156,11 +161,11 @@ impl CyclopeanJob {
         }
         let plan = o.request.plan(kind)?;
         let mut inputs = vec![
-            ("--left-rgb", o.left_rgb.as_path()),
-            ("--right-rgb", o.right_rgb.as_path()),
+            (crate::Field::LeftRgb.into(), o.left_rgb.as_path()),
+            (crate::Field::RightRgb.into(), o.right_rgb.as_path()),
         ];
         inputs.extend(map_files);
-        inputs.extend(o.cameras.as_deref().map(|c| ("--cameras", c)));
+        inputs.extend(o.cameras.as_deref().map(|c| (crate::Field::Cameras.into(), c)));
         crate::output::check_out_dir(&o.out_dir, owned_name, &replaced(), &inputs).map_err(ArgError::Invalid)?;
         Ok(CyclopeanJob {
             left_rgb: o.left_rgb,
@@ -251,7 +256,7 @@ impl CyclopeanJob {
             Some((left_map, right_map)) => {
                 // An eye without a map is checked against the other eye's map (one pair size).
                 let given = left_map.as_ref().or(right_map.as_ref()).ok_or_else(|| {
-                    crate::Error::param("--left-disparity", "neither eye's disparity or depth is given")
+                    crate::Error::param(crate::Field::LeftDisparity, "neither eye's disparity or depth is given")
                 })?;
                 let eye = |rgb: &Path, map: Option<&PathBuf>| -> crate::Result<(RgbImage, Option<DepthMap>)> {
                     io::check_rgbd_sizes(rgb, map.unwrap_or(given))?;
@@ -336,13 +341,16 @@ impl CyclopeanJob {
             for (path, eye) in [(left_map, &frame.left), (right_map, &frame.right)] {
                 // cyclopean takes the conventions and planes from the file alone (--ndc and
                 // the like are refused with --cameras): the hint names the file's keys.
-                let hint = format!(
-                    "read as {} depth under {}: check its depth_kind, conventions (ndc_depth, reversed_z) \
-                     and each eye's proj or near/far (docs/formats.md); for integer depth files, \
-                     `--depth-scale S` (raw units per metre)",
-                    frame.depth_kind.name(),
-                    cameras.display()
-                );
+                let hint = crate::msg![
+                    format!(
+                        "read as {} depth under {}: check its depth_kind, conventions (ndc_depth, reversed_z) \
+                         and each eye's proj or near/far (docs/formats.md); for integer depth files, `",
+                        frame.depth_kind.name(),
+                        cameras.display()
+                    ),
+                    crate::Field::DepthScale,
+                    " S` (raw units per metre)"
+                ];
                 host.event(Event::InputDepth {
                     path,
                     summary: &depth_summary(eye, frame.depth_kind, &frame.conv)?,
@@ -419,7 +427,7 @@ fn depth_summary(eye: &EyeInput, kind: FrameDepth, conv: &Conventions) -> crate:
 
 /// A scale option, when given, must be finite and > 0 (refused by its own name, before any
 /// input is read).
-pub(crate) fn check_scale(option: &'static str, value: Option<f64>) -> Result<(), ArgError> {
+pub(crate) fn check_scale(option: crate::Field, value: Option<f64>) -> Result<(), ArgError> {
     match value {
         Some(v) if !(v.is_finite() && v > 0.0) => Err(ArgError::Scale { option, value: v }),
         _ => Ok(()),
@@ -453,7 +461,7 @@ mod tests {
         });
         assert!(matches!(
             CyclopeanJob::new(o),
-            Err(ArgError::GatherOptionOnly("--blend"))
+            Err(ArgError::GatherOptionOnly(crate::Field::Blend))
         ));
         // A lone --refine-steps picks the method, so its options are accepted.
         let o = disparity_options(CyclopeanRequest {
@@ -513,7 +521,7 @@ mod tests {
         });
         assert!(matches!(
             CyclopeanJob::new(o),
-            Err(ArgError::RigPartner("--focal", "--baseline"))
+            Err(ArgError::RigPartner(crate::Field::Focal, crate::Field::Baseline))
         ));
     }
 

@@ -90,9 +90,9 @@ impl StereoGiven {
             (true, false) => Ok(StereoKind::Disparity),
             (false, true) => {
                 for (flag, given) in [
-                    ("--left-depth", self.left_depth),
-                    ("--right-depth", self.right_depth),
-                    ("--cameras", self.cameras),
+                    (crate::Field::LeftDepth, self.left_depth),
+                    (crate::Field::RightDepth, self.right_depth),
+                    (crate::Field::Cameras, self.cameras),
                 ] {
                     if !given {
                         return Err(ArgError::DepthInputMissing(flag));
@@ -132,10 +132,10 @@ impl CyclopeanRequest {
         let gathers = matches!(method, CyclopeanMethod::Seed | CyclopeanMethod::Refine);
         if !gathers {
             for (flag, given) in [
-                ("--refine-steps", self.refine_steps.is_some()),
-                ("--blend", self.blend.is_some()),
-                ("--z-threshold", self.z_threshold.is_some()),
-                ("--dominant", self.dominant.is_some()),
+                (crate::Field::RefineSteps, self.refine_steps.is_some()),
+                (crate::Field::Blend, self.blend.is_some()),
+                (crate::Field::ZThreshold, self.z_threshold.is_some()),
+                (crate::Field::Dominant, self.dominant.is_some()),
             ] {
                 if given {
                     return Err(ArgError::GatherOptionOnly(flag));
@@ -144,16 +144,16 @@ impl CyclopeanRequest {
         }
         if let Some(steps) = self.refine_steps.filter(|s| *s > 16) {
             return Err(ArgError::Invalid(crate::Error::param(
-                "--refine-steps",
+                crate::Field::RefineSteps,
                 format!("{steps} outside 0..=16"),
             )));
         }
         for (flag, given) in [
-            ("--max-disparity", self.max_disparity.is_some()),
-            ("--min-disparity", self.min_disparity.is_some()),
-            ("--min-confidence", self.min_confidence.is_some()),
-            ("--confidence", self.confidence),
-            ("--matcher", self.matcher.is_some()),
+            (crate::Field::MaxDisparity, self.max_disparity.is_some()),
+            (crate::Field::MinDisparity, self.min_disparity.is_some()),
+            (crate::Field::MinConfidence, self.min_confidence.is_some()),
+            (crate::Field::Confidence, self.confidence),
+            (crate::Field::Matcher, self.matcher.is_some()),
         ] {
             if given && kind != StereoKind::Images {
                 return Err(ArgError::MatcherOptionWithMaps(flag));
@@ -161,14 +161,14 @@ impl CyclopeanRequest {
         }
         if let Some(c) = self.min_confidence.filter(|c| !(0.0..=1.0).contains(c)) {
             return Err(ArgError::Invalid(crate::Error::param(
-                "--min-confidence",
+                crate::Field::MinConfidence,
                 format!("{c} outside [0, 1] (the matcher's confidence)"),
             )));
         }
         if let (Some(lo), Some(hi)) = (self.min_disparity, self.max_disparity) {
             if lo >= hi {
                 return Err(ArgError::Invalid(crate::Error::param(
-                    "--min-disparity/--max-disparity",
+                    crate::msg![crate::Field::MinDisparity, "/", crate::Field::MaxDisparity],
                     format!("{lo}..{hi} px searches nothing: the minimum must be below the maximum"),
                 )));
             }
@@ -186,10 +186,10 @@ impl CyclopeanRequest {
             }
             StereoKind::Cameras => {
                 for (flag, given) in [
-                    ("--position", self.position.is_some()),
-                    ("--focal", self.focal.is_some()),
-                    ("--baseline", self.baseline.is_some()),
-                    ("--doffs", self.doffs != 0.0),
+                    (crate::Field::Position, self.position.is_some()),
+                    (crate::Field::Focal, self.focal.is_some()),
+                    (crate::Field::Baseline, self.baseline.is_some()),
+                    (crate::Field::Doffs, self.doffs != 0.0),
                 ] {
                     if given {
                         return Err(ArgError::RigOptionWithCameraFile(flag));
@@ -233,13 +233,13 @@ impl CyclopeanRequest {
     /// The disparity rig's values: finite, focal and baseline together and in range.
     fn check_rig(&self) -> Result<(), ArgError> {
         match (self.focal, self.baseline) {
-            (Some(_), None) => return Err(ArgError::RigPartner("--focal", "--baseline")),
-            (None, Some(_)) => return Err(ArgError::RigPartner("--baseline", "--focal")),
+            (Some(_), None) => return Err(ArgError::RigPartner(crate::Field::Focal, crate::Field::Baseline)),
+            (None, Some(_)) => return Err(ArgError::RigPartner(crate::Field::Baseline, crate::Field::Focal)),
             _ => {}
         }
         if !self.doffs.is_finite() {
             return Err(ArgError::Invalid(crate::Error::param(
-                "--doffs",
+                crate::Field::Doffs,
                 format!("{} must be finite", self.doffs),
             )));
         }
@@ -248,8 +248,8 @@ impl CyclopeanRequest {
         use crate::camera::{MAX_INTRINSIC, MIN_FOCAL_PX};
         let min_baseline = f64::from(crate::depth::MIN_DEPTH_VALUE);
         for (flag, v, lo) in [
-            ("--focal", self.focal, MIN_FOCAL_PX),
-            ("--baseline", self.baseline, min_baseline),
+            (crate::Field::Focal, self.focal, MIN_FOCAL_PX),
+            (crate::Field::Baseline, self.baseline, min_baseline),
         ] {
             if let Some(v) = v.filter(|v| !(v.is_finite() && (lo..=MAX_INTRINSIC).contains(v))) {
                 return Err(ArgError::Invalid(crate::Error::param(
@@ -260,7 +260,7 @@ impl CyclopeanRequest {
         }
         if let Some(p) = self.position.filter(|p| !(0.0..=1.0).contains(p)) {
             return Err(ArgError::Invalid(crate::Error::param(
-                "--position",
+                crate::Field::Position,
                 format!("{p} outside [0, 1] (0 = left eye, 1 = right eye)"),
             )));
         }

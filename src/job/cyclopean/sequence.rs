@@ -113,25 +113,29 @@ impl CyclopeanSequenceJob {
         let t = &template;
         t.gpu.check_backend(t.backend)?;
         for (flag, given) in [
-            ("--left-rgb", !t.left_rgb.as_os_str().is_empty()),
-            ("--right-rgb", !t.right_rgb.as_os_str().is_empty()),
-            ("--left-disparity", t.left_disparity.is_some()),
-            ("--right-disparity", t.right_disparity.is_some()),
-            ("--left-depth", t.left_depth.is_some()),
-            ("--right-depth", t.right_depth.is_some()),
-            ("--cameras", t.cameras.is_some()),
+            (crate::Field::LeftRgb, !t.left_rgb.as_os_str().is_empty()),
+            (crate::Field::RightRgb, !t.right_rgb.as_os_str().is_empty()),
+            (crate::Field::LeftDisparity, t.left_disparity.is_some()),
+            (crate::Field::RightDisparity, t.right_disparity.is_some()),
+            (crate::Field::LeftDepth, t.left_depth.is_some()),
+            (crate::Field::RightDepth, t.right_depth.is_some()),
+            (crate::Field::Cameras, t.cameras.is_some()),
         ] {
             if given {
                 return Err(ArgError::Invalid(Error::param(
                     flag,
-                    "names one frame's file: with --sequence each frame names its own",
+                    crate::msg![
+                        "names one frame's file: with ",
+                        crate::Field::Sequence,
+                        " each frame names its own"
+                    ],
                 )));
             }
         }
         if t.request.confidence {
             return Err(ArgError::Invalid(Error::param(
-                "--confidence",
-                "writes one pair's confidence files: not with --sequence",
+                crate::Field::Confidence,
+                crate::msg!["writes one pair's confidence files: not with ", crate::Field::Sequence],
             )));
         }
         Ok(CyclopeanSequenceJob { file, template })

@@ -17,8 +17,15 @@ use crate::refocus::{RefocusSource, Refocuser};
 use std::path::PathBuf;
 
 /// What to check when a refocus input's depth summary looks wrong.
-const DEPTH_HINT: &str = "check --depth-scale (raw units per metre: 5000 TUM, 1000 SUN RGB-D with --sun-bit-rotate) \
-     and that the file holds metric depth, not disparity";
+fn depth_hint() -> crate::Message {
+    crate::msg![
+        "check ",
+        crate::Field::DepthScale,
+        " (raw units per metre: 5000 TUM, 1000 SUN RGB-D with ",
+        crate::Field::SunBitRotate,
+        ") and that the file holds metric depth, not disparity"
+    ]
+}
 
 /// The refocus options as given (one frame, or a batch with `manifest`): the files, how to
 /// decode them, the source intrinsics and the request.
@@ -92,7 +99,7 @@ impl RefocusCommand {
     /// Checks the options against each other and the library's rules.
     pub fn new(o: RefocusOptions) -> Result<Self, ArgError> {
         o.gpu.check_backend(o.backend)?;
-        super::cyclopean::check_scale("--depth-scale", o.decode.scale)?;
+        super::cyclopean::check_scale(crate::Field::DepthScale, o.decode.scale)?;
         if let Some(manifest) = o.manifest.clone() {
             return RefocusBatchJob::new(manifest, o).map(RefocusCommand::Batch);
         }
@@ -106,8 +113,15 @@ impl RefocusCommand {
         // Every target's files start with its tag; the manifest goes last.
         let writes =
             |name: &str| name == io::MANIFEST_NAME || plan.tags.iter().any(|t| name.starts_with(&format!("{t}_")));
-        let mut inputs = vec![("--rgb", rgb.as_path()), ("--depth", depth.as_path())];
-        inputs.extend(o.intrinsics_file.as_deref().map(|p| ("--intrinsics", p)));
+        let mut inputs = vec![
+            (crate::Field::Rgb.into(), rgb.as_path()),
+            (crate::Field::Depth.into(), depth.as_path()),
+        ];
+        inputs.extend(
+            o.intrinsics_file
+                .as_deref()
+                .map(|p| (crate::Field::Intrinsics.into(), p)),
+        );
         crate::output::check_out_dir(&o.out_dir, writes, &job::replaced(), &inputs).map_err(ArgError::Invalid)?;
         Ok(RefocusCommand::Frame(RefocusJob {
             rgb,
@@ -145,7 +159,7 @@ impl RefocusJob {
         host.event(Event::InputDepth {
             path: &self.depth,
             summary: &DepthSummary::of(&depth),
-            hint: DEPTH_HINT,
+            hint: &depth_hint(),
         });
         if let Some(limit_m) = self.plan.depth_trunc {
             let pixels = io::truncate_depth(&mut depth, limit_m)?;
@@ -231,7 +245,11 @@ impl RefocusBatchJob {
         // --intrinsics FILE and --fx/--fy/--cx/--cy (laid over the file) are the defaults of
         // rows that lack them, as --depth-scale is.
         let stored = match o.intrinsics_file.as_deref() {
-            Some(p) => Some(crate::camera::IntrinsicsFile::load(p).for_options("--intrinsics")?.k),
+            Some(p) => Some(
+                crate::camera::IntrinsicsFile::load(p)
+                    .for_options(crate::Field::Intrinsics)?
+                    .k,
+            ),
             None => None,
         };
         let [fx, fy, cx, cy] = o.intrinsics;
@@ -269,7 +287,7 @@ impl RefocusBatchJob {
             &self.out_dir,
             index,
             &io::Replaces::Owned(index),
-            &[("--batch", self.manifest.as_path())],
+            &[(crate::Field::Batch.into(), self.manifest.as_path())],
         )
         .map_err(ArgError::Invalid)?;
         for frame in frames {
@@ -277,8 +295,8 @@ impl RefocusBatchJob {
             let (_, tags) = self.options.frame_targets(name);
             let writes = |n: &str| n == io::MANIFEST_NAME || tags.iter().any(|t| n.starts_with(&format!("{t}_")));
             let inputs = [
-                ("--batch rgb", frame.rgb.as_path()),
-                ("--batch depth", frame.depth.as_path()),
+                (crate::msg![crate::Field::Batch, " rgb"], frame.rgb.as_path()),
+                (crate::msg![crate::Field::Batch, " depth"], frame.depth.as_path()),
             ];
             crate::output::check_out_dir(&self.out_dir.join(name), writes, &job::replaced(), &inputs)
                 .map_err(ArgError::Invalid)?;

@@ -138,16 +138,20 @@ impl RefocusRequest {
         let focals = match (&self.focal_list, &self.scales) {
             (Some(_), Some(_)) => {
                 return Err(ArgError::Invalid(crate::Error::param(
-                    "--focal-list",
-                    "give target focal lengths or scales (--zoom-range), not both",
+                    crate::Field::FocalList,
+                    crate::msg![
+                        "give target focal lengths or scales (",
+                        crate::Field::ZoomRange,
+                        "), not both"
+                    ],
                 )))
             }
             (Some(list), None) => Focals::List(list.clone()),
             (None, scales) => Focals::Scales(scales.clone().unwrap_or_else(|| DEFAULT_SCALES.to_vec())),
         };
         let (option, values) = match &focals {
-            Focals::List(list) => ("--focal-list", list),
-            Focals::Scales(scales) => ("--zoom-range", scales),
+            Focals::List(list) => (crate::Field::FocalList, list),
+            Focals::Scales(scales) => (crate::Field::ZoomRange, scales),
         };
         if values.is_empty() {
             return Err(ArgError::Invalid(crate::Error::param(option, "no target given")));
@@ -186,22 +190,34 @@ impl RefocusRequest {
         let focals = self.focals()?;
         if self.shard.is_some() {
             return Err(ArgError::Invalid(crate::Error::param(
-                "--shard",
-                "applies with --batch only (it picks the manifest rows a run takes)",
+                crate::Field::Shard,
+                crate::msg![
+                    "applies with ",
+                    crate::Field::Batch,
+                    " only (it picks the manifest rows a run takes)"
+                ],
             )));
         }
         if self.verify {
             return Err(ArgError::Invalid(crate::Error::param(
-                "--verify",
-                "applies with --batch only (it checks finished frames before a resume skips them)",
+                crate::Field::Verify,
+                crate::msg![
+                    "applies with ",
+                    crate::Field::Batch,
+                    " only (it checks finished frames before a resume skips them)"
+                ],
             )));
         }
         // One frame draws its random scales from the seed alone (a batch adds each frame's name).
         if let Some(z) = self.zoom_random()? {
             if self.focal_list.is_some() {
                 return Err(ArgError::Invalid(crate::Error::param(
-                    "--zoom-random",
-                    "give target focal lengths (--focal-list) or a random range, not both",
+                    crate::Field::ZoomRandom,
+                    crate::msg![
+                        "give target focal lengths (",
+                        crate::Field::FocalList,
+                        ") or a random range, not both"
+                    ],
                 )));
             }
             let scales = z.scales("");
@@ -220,7 +236,7 @@ impl RefocusRequest {
         }
         let rule = self.rule()?;
         if let Some((w, h)) = self.size {
-            io::check_output_pixels("--width-out/--height-out", w, h)?;
+            io::check_output_pixels(crate::msg![crate::Field::WidthOut, "/", crate::Field::HeightOut], w, h)?;
         }
         if let Some(m) = self.depth_trunc {
             io::check_depth_trunc(m)?;
@@ -248,16 +264,20 @@ impl RefocusRequest {
         let Some((lo, hi)) = self.zoom_random else {
             if self.samples.is_some() || self.seed.is_some() {
                 return Err(ArgError::Invalid(crate::Error::param(
-                    "--samples/--seed",
-                    "apply with --zoom-random LO,HI only",
+                    crate::msg![crate::Field::Samples, "/", crate::Field::Seed],
+                    crate::msg!["apply with ", crate::Field::ZoomRandom, " LO,HI only"],
                 )));
             }
             return Ok(None);
         };
         if self.scales.is_some() {
             return Err(ArgError::Invalid(crate::Error::param(
-                "--zoom-random",
-                "give fixed scales (--zoom-range) or a random range, not both",
+                crate::Field::ZoomRandom,
+                crate::msg![
+                    "give fixed scales (",
+                    crate::Field::ZoomRange,
+                    ") or a random range, not both"
+                ],
             )));
         }
         Ok(Some(ZoomRandom::new(

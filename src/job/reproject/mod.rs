@@ -188,7 +188,8 @@ pub(crate) fn device_depth(near: Option<f64>, far: Option<f64>, what: &'static s
     let kind = DepthEncoding::Device {
         planes: DepthPlanes { near, far },
     };
-    kind.validate().for_options("--near/--far")?;
+    kind.validate()
+        .for_options(crate::msg![crate::Field::Near, "/", crate::Field::Far])?;
     Ok(kind)
 }
 
@@ -208,7 +209,7 @@ impl ReprojectJob {
             Some(path) => camera_file_views(&o, path)?,
             None => rig_views(&o)?,
         };
-        super::cyclopean::check_scale("--depth-scale", o.depth_scale)?;
+        super::cyclopean::check_scale(crate::Field::DepthScale, o.depth_scale)?;
         let eyes = match &views {
             Views::Rig(rig) => rig.plan.targets().iter().map(|&e| Some(e)).collect(),
             Views::Cameras { to, .. } => vec![*to],
@@ -217,9 +218,16 @@ impl ReprojectJob {
             eyes.iter()
                 .any(|&e| crate::output::ViewNames::tagged(view_name(e)).may_write(name))
         };
-        let mut inputs = vec![("--color", o.color.as_path()), ("--depth", o.depth.as_path())];
-        inputs.extend(o.intrinsics_file.as_deref().map(|p| ("--intrinsics", p)));
-        inputs.extend(o.cameras.as_deref().map(|p| ("--cameras", p)));
+        let mut inputs = vec![
+            (crate::Field::Color.into(), o.color.as_path()),
+            (crate::Field::Depth.into(), o.depth.as_path()),
+        ];
+        inputs.extend(
+            o.intrinsics_file
+                .as_deref()
+                .map(|p| (crate::Field::Intrinsics.into(), p)),
+        );
+        inputs.extend(o.cameras.as_deref().map(|p| (crate::Field::Cameras.into(), p)));
         crate::output::check_out_dir(&o.out_dir, writes, &replaced(), &inputs).map_err(ArgError::Invalid)?;
         Ok(ReprojectJob {
             decode: DepthDecode {
@@ -334,9 +342,19 @@ impl ReprojectJob {
             // reproject decodes device depth under its own options (cyclopean and compare name
             // theirs): the hint names them, runnable as written.
             hint: &if matches!(src.depth_kind, DepthEncoding::Device { .. }) {
-                format!("read as {what}: set `--ndc`, `--reversed-z` and `--near/--far` as the renderer wrote it")
+                crate::msg![
+                    format!("read as {what}: set `"),
+                    crate::Field::Ndc,
+                    "`, `",
+                    crate::Field::ReversedZ,
+                    "` and `",
+                    crate::Field::Near,
+                    "/",
+                    crate::Field::Far,
+                    "` as the renderer wrote it"
+                ]
             } else {
-                format!("read as {what}")
+                crate::msg![format!("read as {what}")]
             },
         });
         src.require_valid_depth(what)

@@ -148,7 +148,9 @@ impl ReprojectRequest {
             },
             tau_rel: self.tau_rel,
         };
-        params.validate().for_options("--steps/--tau-rel")?;
+        params
+            .validate()
+            .for_options(crate::msg![crate::Field::Steps, "/", crate::Field::TauRel])?;
         Ok(params)
     }
 
@@ -184,8 +186,15 @@ impl ReprojectRequest {
                     baseline,
                     doffs: self.doffs,
                 };
-                kind.validate()
-                    .for_options("--depth-kind disparity: --focal/--baseline/--doffs")?;
+                kind.validate().for_options(crate::msg![
+                    crate::Field::DepthKind,
+                    " disparity: ",
+                    crate::Field::Focal,
+                    "/",
+                    crate::Field::Baseline,
+                    "/",
+                    crate::Field::Doffs
+                ])?;
                 kind
             }
         };
@@ -193,10 +202,24 @@ impl ReprojectRequest {
             return Err(ArgError::PlanesWithoutDevice);
         }
         let seed = match (self.separation, self.convergence) {
-            (Some(s), Some(c)) => Some(StereoParams::new(s, c).for_options("--separation/--convergence")?),
+            (Some(s), Some(c)) => Some(StereoParams::new(s, c).for_options(crate::msg![
+                crate::Field::Separation,
+                "/",
+                crate::Field::Convergence
+            ])?),
             (None, None) => None,
-            (Some(_), None) => return Err(ArgError::RigPartner("--separation", "--convergence")),
-            (None, Some(_)) => return Err(ArgError::RigPartner("--convergence", "--separation")),
+            (Some(_), None) => {
+                return Err(ArgError::RigPartner(
+                    crate::Field::Separation,
+                    crate::Field::Convergence,
+                ))
+            }
+            (None, Some(_)) => {
+                return Err(ArgError::RigPartner(
+                    crate::Field::Convergence,
+                    crate::Field::Separation,
+                ))
+            }
         };
         // --baseline places a rectified rig; with a game-engine rig it would be ignored, unless
         // it makes disparity depth metric.
@@ -209,8 +232,13 @@ impl ReprojectRequest {
             (None, Some(b)) => targets
                 .iter()
                 .map(|&to| {
-                    ShiftModel::rectified(focal, b, self.doffs, from, Some(to))
-                        .for_options("--focal/--baseline/--doffs")
+                    ShiftModel::rectified(focal, b, self.doffs, from, Some(to)).for_options(crate::msg![
+                        crate::Field::Focal,
+                        "/",
+                        crate::Field::Baseline,
+                        "/",
+                        crate::Field::Doffs
+                    ])
                 })
                 .collect::<Result<_, _>>()?,
             (None, None) => return Err(ArgError::NoRig),

@@ -23,8 +23,19 @@ use std::path::PathBuf;
 use std::time::Instant;
 
 /// What to check when the face depth looks wrongly decoded.
-const FACE_DEPTH_HINT: &str = "check --depth-scale (raw units per metre of integer files) and --depth-kind \
-     (view-z, or device with the --near/--far and conventions the faces were written with)";
+fn face_depth_hint() -> crate::Message {
+    crate::msg![
+        "check ",
+        crate::Field::DepthScale,
+        " (raw units per metre of integer files) and ",
+        crate::Field::DepthKind,
+        " (view-z, or device with the ",
+        crate::Field::Near,
+        "/",
+        crate::Field::Far,
+        " and conventions the faces were written with)"
+    ]
+}
 
 /// An eye's six face depths (view Z, metres) stacked top to bottom: one summary per eye, since
 /// every face is decoded with the same options, and a face that sees only sky (no valid depth)
@@ -69,7 +80,10 @@ fn check_faces_against_outputs(faces: &std::path::Path, out_dir: &std::path::Pat
         .filter(|e| e.file_name().to_str().is_some_and(is_face))
         .map(|e| e.path())
         .collect();
-    let inputs: Vec<crate::output::NamedPath<'_>> = files.iter().map(|p| ("--faces", p.as_path())).collect();
+    let inputs: Vec<crate::output::NamedPath<'_>> = files
+        .iter()
+        .map(|p| (crate::Field::Faces.into(), p.as_path()))
+        .collect();
     let writes = |name: &str| OUTPUT_NAMES.iter().any(|n| view_names(n).may_write(name));
     crate::output::check_out_dir(out_dir, writes, &replaced(), &inputs).map_err(ArgError::Invalid)
 }
@@ -177,8 +191,12 @@ impl StitchJob {
         super::check_npz_key(o.npz_key.as_deref(), &[])?;
         if o.npz_key.is_some() && o.faces.is_none() {
             return Err(ArgError::Invalid(crate::Error::param(
-                "--npz-key",
-                "applies to --faces depth files only (the built-in scene has none)",
+                crate::Field::NpzKey,
+                crate::msg![
+                    "applies to ",
+                    crate::Field::Faces,
+                    " depth files only (the built-in scene has none)"
+                ],
             )));
         }
         let base = match &o.scene {
@@ -203,14 +221,14 @@ impl StitchJob {
         }
         if o.truth && !outputs.rgb {
             return Err(ArgError::Invalid(crate::Error::param(
-                "--truth",
-                "scores the colour image: add rgb to --outputs",
+                crate::Field::Truth,
+                crate::msg!["scores the colour image: add rgb to ", crate::Field::Outputs],
             )));
         }
         if o.faces.is_none() && o.request.depth_kind != FaceDepth::ViewZ {
             return Err(ArgError::FaceDepthKindWithoutFaces);
         }
-        super::cyclopean::check_scale("--depth-scale", o.depth_scale)?;
+        super::cyclopean::check_scale(crate::Field::DepthScale, o.depth_scale)?;
         if let Some(dir) = &o.faces {
             check_faces_against_outputs(dir, &o.out_dir)?;
         }
@@ -258,7 +276,7 @@ impl StitchJob {
                     &self.depth_kind,
                     &conv,
                 )
-                .within(|| format!("--faces {}", dir.display()))
+                .within(|| crate::msg![crate::Field::Faces, format!(" {}", dir.display())])
             };
             let (l, r) = (load(Side::Left)?, load(Side::Right)?);
             if l.size() != r.size() {
@@ -272,15 +290,15 @@ impl StitchJob {
                 host.event(Event::InputDepth {
                     path: &dir.join(format!("{eye}_{{{}}}_depth", FACE_TAGS.join(","))),
                     summary: &DepthSummary::of(&stacked_depth(set)).with_background_expected(),
-                    hint: FACE_DEPTH_HINT,
+                    hint: &face_depth_hint(),
                 });
             }
             let what = format!("loaded 12 faces of {n}x{n} from {}", dir.display(), n = l.size());
             (l, r, what)
         } else {
             let n = self.face_size;
-            let l = scene_faces(&rig, Side::Left, n, fov).within(|| "--face-size".into())?;
-            let r = scene_faces(&rig, Side::Right, n, fov).within(|| "--face-size".into())?;
+            let l = scene_faces(&rig, Side::Left, n, fov).within(|| crate::Field::FaceSize)?;
+            let r = scene_faces(&rig, Side::Right, n, fov).within(|| crate::Field::FaceSize)?;
             (l, r, format!("ray-traced 12 faces of {n}x{n} (CPU)"))
         };
         let faces_ms = t0.elapsed().as_secs_f64() * 1e3;

@@ -140,7 +140,8 @@ impl StitchRequest {
             pole_fade_start_deg: self.pole_fade,
             ..base
         };
-        rig.validate().for_options("--ipd/--pole-fade")?;
+        rig.validate()
+            .for_options(crate::msg![crate::Field::Ipd, "/", crate::Field::PoleFade])?;
         let params = StitchParams {
             method: self.method,
             overlap_deg: overlap,
@@ -153,9 +154,15 @@ impl StitchRequest {
             fov_deg: fov,
             faces: Vec::new(),
         };
-        params
-            .validate(&template)
-            .for_options("--overlap/--fov/--width/--height")?;
+        params.validate(&template).for_options(crate::msg![
+            crate::Field::Overlap,
+            "/",
+            crate::Field::Fov,
+            "/",
+            crate::Field::Width,
+            "/",
+            crate::Field::Height
+        ])?;
         // The GPU's limit is checked when rendering; the image files' bound is known now.
         let max = io::MAX_DIMENSION;
         if self.width > max || 2 * self.height as u64 > max as u64 {
@@ -166,11 +173,11 @@ impl StitchRequest {
             });
         }
         io::check_output_pixels(
-            "--width/--height (top-bottom)",
+            crate::msg![crate::Field::Width, "/", crate::Field::Height, " (top-bottom)"],
             self.width,
             self.height.saturating_mul(2),
         )?;
-        crate::stitch::render::check_outputs(self.outputs()).for_options("--outputs")?;
+        crate::stitch::render::check_outputs(self.outputs()).for_options(crate::Field::Outputs)?;
         let depth_kind = match (self.depth_kind, self.near, self.far) {
             (FaceDepth::ViewZ, None, None) => DepthEncoding::ViewZ,
             (FaceDepth::ViewZ, _, _) => return Err(ArgError::PlanesWithoutDevice),

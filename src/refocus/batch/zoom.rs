@@ -33,13 +33,17 @@ impl ZoomRandom {
     pub fn new(lo: f64, hi: f64, samples: usize, seed: u64) -> Result<Self> {
         if !(lo.is_finite() && hi.is_finite() && lo > 0.0 && hi > lo) {
             return Err(Error::param(
-                "--zoom-random",
-                format!("{lo},{hi}: expected LO,HI with 0 < LO < HI (a fixed scale is --zoom-range)"),
+                crate::Field::ZoomRandom,
+                crate::msg![
+                    format!("{lo},{hi}: expected LO,HI with 0 < LO < HI (a fixed scale is "),
+                    crate::Field::ZoomRange,
+                    ")"
+                ],
             ));
         }
         if samples == 0 || samples > MAX_SAMPLES {
             return Err(Error::param(
-                "--samples",
+                crate::Field::Samples,
                 format!("{samples}: expected 1 to {MAX_SAMPLES} scales per frame"),
             ));
         }
@@ -47,13 +51,16 @@ impl ZoomRandom {
         let tags = tag_number(hi) - tag_number(lo) + 1;
         if tags < samples as u64 {
             return Err(Error::param(
-                "--zoom-random/--samples",
-                format!(
-                    "{lo},{hi} holds {tags} distinct scale{} at the 6 decimals of the file tags, \
-                     fewer than the {samples} samples asked for per frame; widen the range or \
-                     lower --samples",
-                    if tags == 1 { "" } else { "s" }
-                ),
+                crate::msg![crate::Field::ZoomRandom, "/", crate::Field::Samples],
+                crate::msg![
+                    format!(
+                        "{lo},{hi} holds {tags} distinct scale{} at the 6 decimals of the file tags, \
+                         fewer than the {samples} samples asked for per frame; widen the range or \
+                         lower ",
+                        if tags == 1 { "" } else { "s" }
+                    ),
+                    crate::Field::Samples
+                ],
             ));
         }
         Ok(ZoomRandom { lo, hi, samples, seed })

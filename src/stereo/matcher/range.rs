@@ -80,9 +80,9 @@ impl DisparityRange {
         if self.searched() > MAX_SEARCH {
             return Err(Error::param(
                 if self.min < 0 {
-                    "--min-disparity/--max-disparity"
+                    crate::msg![crate::Field::MinDisparity, "/", crate::Field::MaxDisparity]
                 } else {
-                    "--max-disparity"
+                    crate::Field::MaxDisparity.into()
                 },
                 format!(
                     "{}..{} px: the matcher would search {} disparities, more than its {MAX_SEARCH} \
@@ -102,7 +102,7 @@ impl DisparityRange {
         let span = self.max as i64 - self.min as i64;
         if span < 1 || self.max as i64 >= width as i64 || -(self.min as i64) >= width as i64 {
             return Err(Error::param(
-                "--min-disparity/--max-disparity",
+                crate::msg![crate::Field::MinDisparity, "/", crate::Field::MaxDisparity],
                 format!(
                     "{}..{} px: needs min < max and both within +-{} px (less than the width)",
                     self.min,

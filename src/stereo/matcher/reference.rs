@@ -440,7 +440,7 @@ pub(super) mod tests {
         ));
         for bad in [0, 32, 100] {
             match estimate_disparities(&a, &a, bad) {
-                Err(Error::InvalidParameter { name, .. }) => assert_eq!(name, "max_disparity"),
+                Err(Error::InvalidParameter { name, .. }) => assert_eq!(name.to_string(), "max_disparity"),
                 other => panic!("max_disparity {bad}: {other:?}"),
             }
         }
