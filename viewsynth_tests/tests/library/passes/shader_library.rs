@@ -23,9 +23,9 @@ fn every_program_compiles_and_links_under_every_convention() {
     }
     // 8 conventions x (refocus: full-screen 2 x 2 (colour, colour everywhere), mesh 2 x 2,
     // colour everywhere 1 + gather 8 + forward, splat, splat gather, splat edges, edge snap,
-    // densify, fill, temporal reprojection's 2 stages and compose, scene 11 + shift 3 x 2 +
-    // stitch 3 + the matchers' 13 stages: census 9, semi-global 4).
-    assert_eq!(built, 8 * (9 + 8 + 11 + 6 + 3 + 13));
+    // densify, trust, fill, temporal reprojection's 2 stages and compose, scene 12 + shift 3 x 2
+    // + stitch 3 + the matchers' 13 stages: census 9, semi-global 4).
+    assert_eq!(built, 8 * (9 + 8 + 12 + 6 + 3 + 13));
 }
 
 #[test]
