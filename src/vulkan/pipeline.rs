@@ -211,6 +211,9 @@ mod tests {
         // densify 1, trust 1, fill 1 and temporal compose 1 programs of 2 stages; splat, edge
         // snap, edge pass, temporal reprojection's 2 stages and the matchers' 13 stages (census
         // 9, semi-global 4) 1 stage.
-        assert_eq!(found, ((9 + 8 + 6 + 3 + 1 + 1 + 1 + 1 + 1 + 1 + 1) * 2 + 3 + 2 + 13) * 8);
+        assert_eq!(
+            found,
+            ((9 + 8 + 6 + 3 + 1 + 1 + 1 + 1 + 1 + 1 + 1) * 2 + 3 + 2 + 13) * 8
+        );
     }
 }

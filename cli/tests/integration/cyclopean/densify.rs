@@ -20,7 +20,7 @@ struct Pair {
 }
 
 /// `img`'s columns `from..from + width`.
-fn columns(img: &RgbImage, from: u32, width: u32) -> RgbImage {
+pub(super) fn columns(img: &RgbImage, from: u32, width: u32) -> RgbImage {
     let data = img
         .data
         .chunks_exact(3 * img.width as usize)
@@ -77,7 +77,7 @@ fn pairs() -> Vec<Pair> {
 }
 
 /// PSNR of `img` against `truth` over the pixels `keep` holds.
-fn psnr(img: &RgbImage, truth: &RgbImage, keep: impl Fn(usize) -> bool) -> f64 {
+pub(super) fn psnr(img: &RgbImage, truth: &RgbImage, keep: impl Fn(usize) -> bool) -> f64 {
     let (mut se, mut n) = (0.0, 0usize);
     for i in (0..img.data.len() / 3).filter(|&i| keep(i)) {
         for c in 0..3 {

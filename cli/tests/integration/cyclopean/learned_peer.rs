@@ -7,8 +7,9 @@
 //! so are the census matcher's rendered-pixel figures (`--matcher census --fill`, this tree),
 //! the precision the default must keep.
 
+use super::densify::{columns, psnr};
 use crate::common::data_dir;
-use viewsynth::io::{load_rgb, RgbImage};
+use viewsynth::io::load_rgb;
 
 /// One pair: where its files are, the columns a cropped pair drops, and the figures held.
 struct Case {
@@ -146,28 +147,6 @@ const CASES: [Case; 13] = [
         (32.22, 79.7),
     ),
 ];
-
-/// `img`'s columns `from..from + width`.
-fn columns(img: &RgbImage, from: u32, width: u32) -> RgbImage {
-    let data = img
-        .data
-        .chunks_exact(3 * img.width as usize)
-        .flat_map(|row| row[3 * from as usize..3 * (from + width) as usize].to_vec())
-        .collect();
-    RgbImage::new(width, img.height, data).unwrap()
-}
-
-/// PSNR over the pixels `keep` holds.
-fn psnr(img: &RgbImage, truth: &RgbImage, keep: impl Fn(usize) -> bool) -> f64 {
-    let (mut se, mut n) = (0.0, 0usize);
-    for i in (0..img.data.len() / 3).filter(|&i| keep(i)) {
-        for c in 0..3 {
-            se += (img.data[3 * i + c] as f64 - truth.data[3 * i + c] as f64).powi(2);
-        }
-        n += 3;
-    }
-    viewsynth::metrics::psnr_from_mse(se / n.max(1) as f64)
-}
 
 /// The bars, same defaults for every pair (`cyclopean --fill`, nothing else): a mean
 /// lead of at least 1 dB over RIFE, no pair more than 1 dB below it; the rendered pixels at

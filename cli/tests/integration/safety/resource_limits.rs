@@ -449,13 +449,21 @@ fn json_to_a_device_or_fifo_is_written_in_place() {
     assert!(o.status.success(), "{}", text(&o));
     let fifo = d.join("fifo");
     assert!(Command::new("mkfifo").arg(&fifo).status().unwrap().success());
-    let reader = std::thread::spawn({
-        let fifo = fifo.clone();
-        move || std::fs::read_to_string(fifo).unwrap()
-    });
+    // The reader is open before the run starts (a reader thread racing the run's check for
+    // one failed under load); the JSON fits the FIFO's buffer, so it is read after the run.
+    let mut reader = {
+        use std::os::unix::fs::OpenOptionsExt;
+        std::fs::OpenOptions::new()
+            .read(true)
+            .custom_flags(libc::O_NONBLOCK)
+            .open(&fifo)
+            .unwrap()
+    };
     let o = bin().args(base).args(["--json", s(&fifo)]).output().unwrap();
     assert!(o.status.success(), "{}", text(&o));
-    assert!(reader.join().unwrap().contains("\"passed\": true"));
+    let mut json = String::new();
+    std::io::Read::read_to_string(&mut reader, &mut json).unwrap();
+    assert!(json.contains("\"passed\": true"), "{json}");
     assert_eq!(temporaries(&d), Vec::<String>::new());
 }
 
