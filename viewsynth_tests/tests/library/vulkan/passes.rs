@@ -372,6 +372,10 @@ fn a_steady_state_frame_creates_nothing_on_either_api() {
                 .densify(&matched, &frame.left.color, viewsynth::stereo::densify::OtherEye::LEFT)
                 .unwrap(),
         );
+        // The trust pass (issue 48) on the census disparities against themselves: its first eye
+        // uploads the inputs.
+        let mut trust = viewsynth::stereo::trust::Trust::new(d).unwrap();
+        drop(trust.matched(&matched, &matched, &frame.left.color).unwrap());
         let source = viewsynth_tests::synthetic(64, 48);
         let targets = viewsynth::refocus::manifest::TargetSpec {
             scales: vec![0.5, 1.0, 2.0],
@@ -451,6 +455,10 @@ fn a_steady_state_frame_creates_nothing_on_either_api() {
                             .unwrap(),
                     )
                 }),
+            ),
+            (
+                "trust",
+                Box::new(|| drop(trust.matched(&matched, &matched, &frame.left.color).unwrap())),
             ),
             (
                 // The batch's frame: a new source of the same size, every target in flight at once.
