@@ -133,21 +133,14 @@ impl Densifier {
         check(disparity, color)?;
         let (w, h) = (disparity.width, disparity.height);
         let rgba = crate::pass::pixels::rgb_to_rgba(&color.data);
-        let image = |format, bytes, label| ImageData {
-            width: w,
-            height: h,
-            format,
-            bytes,
-            label,
-        };
         let [disparity_slot, color_slot] = &mut self.inputs;
         let d = &self.device;
         let images = [
             d.put_image(
                 disparity_slot,
-                &image(Format::R32F, bytemuck::cast_slice(&disparity.data), "densify disparity"),
+                &ImageData::r32f(w, h, &disparity.data, "densify disparity"),
             )?,
-            d.put_image(color_slot, &image(Format::Rgba8, &rgba, "densify colour"))?,
+            d.put_image(color_slot, &ImageData::rgba8(w, h, &rgba, "densify colour"))?,
         ];
         let params = DensifyParams {
             u_size: [w as i32, h as i32],
@@ -164,15 +157,8 @@ impl Densifier {
             rows: crate::convention::RowOrder::TopDown,
             depth_test: None,
         };
-        let draw = Draw {
-            program: ShaderProgram::new(Default::default(), ProgramKind::CyclopeanDensify),
-            params: bytemuck::bytes_of(&params),
-            images: &images,
-            buffers: &[],
-            viewport: [0, 0, w, h],
-            triangles: 1,
-            indices: None,
-        };
+        let program = ShaderProgram::new(Default::default(), ProgramKind::CyclopeanDensify);
+        let draw = Draw::fullscreen(program, bytemuck::bytes_of(&params), &images, w, h);
         let mut r = self.device.render(&target, &[draw])?;
         let disparity = r
             .depth(0)?
