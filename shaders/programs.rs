@@ -140,15 +140,6 @@ pub const PROGRAMS: &[ProgramEntry] = &[
         vulkan: Some(&[]),
     },
     ProgramEntry {
-        name: "cyclopean/trust",
-        stages: &[
-            ("vert", FULLSCREEN_VERT),
-            ("frag", &["cyclopean/trust_params.glsl", "cyclopean/trust.frag"]),
-        ],
-        switches: &[],
-        vulkan: Some(&[]),
-    },
-    ProgramEntry {
         name: "cyclopean/fill",
         stages: &[
             ("vert", FULLSCREEN_VERT),
@@ -299,6 +290,12 @@ pub const PROGRAMS: &[ProgramEntry] = &[
     ProgramEntry {
         name: "cyclopean/matcher_confidence",
         stages: &[("comp", &[MATCHER_COMMON[0], MATCHER_COMMON[1], "cyclopean/matcher_confidence.comp"])],
+        switches: &[],
+        vulkan: Some(&[]),
+    },
+    ProgramEntry {
+        name: "cyclopean/matcher_trust",
+        stages: &[("comp", &[MATCHER_COMMON[0], MATCHER_COMMON[1], "cyclopean/matcher_trust.comp"])],
         switches: &[],
         vulkan: Some(&[]),
     },

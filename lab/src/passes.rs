@@ -321,10 +321,6 @@ pub const PROGRAMS_WITHOUT_A_CASE: &[(&str, &str)] = &[
         "only under --rgb-everywhere, which the refocus cases leave off",
     ),
     ("cyclopean/densify", "the two-image --fill path; no lab case yet"),
-    (
-        "cyclopean/trust",
-        "the two-image path's matched/inferred split of the semi-global disparities; no lab case yet",
-    ),
     ("cyclopean/fill", "--fill; no lab case yet"),
     ("cyclopean/temporal_reproject", "--sequence history; no lab case yet"),
     ("cyclopean/temporal_compose", "--sequence history; no lab case yet"),
@@ -347,6 +343,10 @@ pub const PROGRAMS_WITHOUT_A_CASE: &[(&str, &str)] = &[
     (
         "cyclopean/matcher_sgm_winner",
         "the semi-global matcher; the matcher case is census",
+    ),
+    (
+        "cyclopean/matcher_trust",
+        "the checked semi-global matcher's matched/inferred split; the matcher case is census",
     ),
 ];
 

@@ -119,11 +119,14 @@ pub enum MatcherStage {
     SgmPath,
     /// Semi-global: winner takes all on the sums, both eyes.
     SgmWinner,
+    /// The semi-global disparities the census matcher's (or a flat window) supports, both eyes
+    /// ([`crate::stereo::trust`]).
+    Trust,
 }
 
 impl MatcherStage {
     /// Every stage, in dispatch order.
-    pub const ALL: [MatcherStage; 13] = [
+    pub const ALL: [MatcherStage; 14] = [
         MatcherStage::Grey,
         MatcherStage::Census,
         MatcherStage::Rows,
@@ -137,6 +140,7 @@ impl MatcherStage {
         MatcherStage::SgmCost,
         MatcherStage::SgmPath,
         MatcherStage::SgmWinner,
+        MatcherStage::Trust,
     ];
 
     fn program_name(self) -> &'static str {
@@ -154,6 +158,7 @@ impl MatcherStage {
             MatcherStage::SgmCost => "cyclopean/matcher_sgm_cost",
             MatcherStage::SgmPath => "cyclopean/matcher_sgm_path",
             MatcherStage::SgmWinner => "cyclopean/matcher_sgm_winner",
+            MatcherStage::Trust => "cyclopean/matcher_trust",
         }
     }
 }
@@ -205,9 +210,6 @@ pub enum ProgramKind {
     /// cyclopean/densify.frag: unknown disparities of one eye filled before rendering (`--fill`
     /// on two images alone).
     CyclopeanDensify,
-    /// cyclopean/trust.frag: which semi-global disparities the census matcher's agreement (or a
-    /// flat window) supports; the others are inferred (`--matcher sgm`).
-    CyclopeanTrust,
     /// cyclopean/fill.frag: holes filled from the background side (`--fill`).
     CyclopeanFill,
     /// cyclopean/temporal_reproject.comp: the previous middle view moved into the current
@@ -316,7 +318,6 @@ impl ProgramKind {
             ProgramKind::CyclopeanSplatEdges => "cyclopean/splat_edges",
             ProgramKind::CyclopeanEdgeSnap => "cyclopean/edge_snap",
             ProgramKind::CyclopeanDensify => "cyclopean/densify",
-            ProgramKind::CyclopeanTrust => "cyclopean/trust",
             ProgramKind::CyclopeanFill => "cyclopean/fill",
             ProgramKind::CyclopeanTemporalReproject { .. } => "cyclopean/temporal_reproject",
             ProgramKind::CyclopeanTemporalCompose => "cyclopean/temporal_compose",
@@ -358,7 +359,6 @@ impl ProgramKind {
             | ProgramKind::CyclopeanSplatEdges
             | ProgramKind::CyclopeanEdgeSnap
             | ProgramKind::CyclopeanDensify
-            | ProgramKind::CyclopeanTrust
             | ProgramKind::CyclopeanFill
             | ProgramKind::CyclopeanTemporalCompose
             | ProgramKind::CyclopeanMatcher(_)
@@ -458,7 +458,6 @@ impl ShaderProgram {
             ProgramKind::CyclopeanSplatEdges,
             ProgramKind::CyclopeanEdgeSnap,
             ProgramKind::CyclopeanDensify,
-            ProgramKind::CyclopeanTrust,
             ProgramKind::CyclopeanFill,
             ProgramKind::CyclopeanTemporalReproject { winner: false },
             ProgramKind::CyclopeanTemporalReproject { winner: true },

@@ -20,13 +20,16 @@
 //! 70.5 %). The grey bound was taken low (20 of 765 levels); 40 already let Reindeer's rendered
 //! pixels fall below the census matcher's.
 //!
-//! One full-screen pass per eye (shaders/cyclopean/trust.frag) on either executor, and
-//! [`trust_reference`](super::trust_reference::trust_reference), its twin: integer grey levels
-//! and one f32 subtraction, so the GPU's maps are the twin's bit for bit.
+//! The GPU side is a stage of the semi-global matcher's own run
+//! ([`Matcher::checked`](super::matcher::Matcher::checked)): the census matcher's stages run
+//! first on the same grey levels and census codes, then the semi-global ones, then
+//! shaders/cyclopean/matcher_trust.comp on both eyes' final disparities and grey levels. So the
+//! check costs one pair upload and one readback, not a second matcher's and a pass of its own.
+//! Its twin is [`trust_reference`](super::trust_reference::trust_reference): integer grey
+//! levels and one f32 subtraction, so the GPU's maps are the twin's bit for bit.
 
 use crate::error::{Error, Result};
 use crate::io::{DepthMap, RgbImage};
-use crate::pass::{Device, Draw, Format, Image, ImageData, ProgramKind, ShaderProgram, Target, ToDevice};
 
 /// Largest difference (px) at which the census and semi-global disparities agree: the
 /// left-right check's tolerance.
@@ -44,14 +47,6 @@ pub fn census_checked(max_disparity: u32) -> bool {
     max_disparity < CENSUS_CHECK_SEARCH
 }
 
-crate::param_block! {
-    /// shaders/cyclopean/trust_params.glsl, member for member.
-    pub struct TrustParams("TrustParams") {
-        u_size: [i32; 2],
-        u_pad: [i32; 2],
-    }
-}
-
 pub(super) fn check(semi_global: &DepthMap, census: &DepthMap, color: &RgbImage) -> Result<()> {
     let size = (color.width, color.height);
     if (semi_global.width, semi_global.height) != size || (census.width, census.height) != size {
@@ -65,79 +60,20 @@ pub(super) fn check(semi_global: &DepthMap, census: &DepthMap, color: &RgbImage)
     Ok(())
 }
 
-/// Splits semi-global disparities into matched and inferred on one device.
-pub struct Trust {
-    device: Device,
-    /// Both disparities and the colour of the last eye, rewritten in place for the next.
-    inputs: [Option<Image>; 3],
-}
-
-impl Trust {
-    /// A trust pass on `device` (a [`Device`], or a GL context).
-    pub fn new(device: impl ToDevice) -> Result<Self> {
-        Ok(Trust {
-            device: device.to_device()?,
-            inputs: [None, None, None],
-        })
-    }
-
-    /// The matched disparities of `semi_global` (the inferred ones 0), given the census
-    /// matcher's `census` on the same pair and the eye's `color`; the twin's map bit for bit.
-    pub fn matched(&mut self, semi_global: &DepthMap, census: &DepthMap, color: &RgbImage) -> Result<DepthMap> {
-        check(semi_global, census, color)?;
-        let (w, h) = (color.width, color.height);
-        let rgba = crate::pass::pixels::rgb_to_rgba(&color.data);
-        let [semi_global_slot, census_slot, color_slot] = &mut self.inputs;
-        let d = &self.device;
-        let images = [
-            d.put_image(
-                semi_global_slot,
-                &ImageData::r32f(w, h, &semi_global.data, "trust semi-global disparity"),
-            )?,
-            d.put_image(
-                census_slot,
-                &ImageData::r32f(w, h, &census.data, "trust census disparity"),
-            )?,
-            d.put_image(color_slot, &ImageData::rgba8(w, h, &rgba, "trust colour"))?,
-        ];
-        let params = TrustParams {
-            u_size: [w as i32, h as i32],
-            u_pad: [0, 0],
-        };
-        // Memory rows are the top-down rows and the pass reads them as the twin does: no flip.
-        let target = Target {
-            width: w,
-            height: h,
-            outputs: vec![Some(Format::R32F)],
-            rows: crate::convention::RowOrder::TopDown,
-            depth_test: None,
-        };
-        let program = ShaderProgram::new(Default::default(), ProgramKind::CyclopeanTrust);
-        let draw = Draw::fullscreen(program, bytemuck::bytes_of(&params), &images, w, h);
-        let mut r = self.device.render(&target, &[draw])?;
-        r.depth(0)?.ok_or_else(|| {
-            r.api
-                .readback_error("trust: the matched disparities were not read back")
-        })
-    }
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
     use crate::stereo::trust_reference::trust_reference;
 
-    /// The GLSL constants are the Rust ones, and the census window is the matcher's.
+    /// The GLSL constants are the Rust ones (the census window is the matcher's own).
     #[test]
     fn the_shader_constants_are_the_twins() {
-        let glsl = include_str!("../../shaders/cyclopean/trust_params.glsl");
+        let glsl = include_str!("../../shaders/cyclopean/matcher_trust.comp");
         for line in [
             format!("const float AGREE_PX = {AGREE_PX:.1};"),
             format!("const int FLAT_GREY = {FLAT_GREY};"),
-            format!("const int HALF_W = {};", crate::stereo::matcher::CENSUS_HALF_W),
-            format!("const int HALF_H = {};", crate::stereo::matcher::CENSUS_HALF_H),
         ] {
-            assert!(glsl.contains(&line), "trust_params.glsl lacks `{line}`");
+            assert!(glsl.contains(&line), "matcher_trust.comp lacks `{line}`");
         }
     }
 

@@ -6,7 +6,7 @@ use super::trust::{check, AGREE_PX, FLAT_GREY};
 use crate::error::Result;
 use crate::io::{DepthMap, RgbImage};
 
-/// The twin of [`Trust::matched`](super::trust::Trust::matched): `semi_global`'s disparities the
+/// The twin of the trust stage ([`super::trust`]; [`Matcher::estimate_checked`](super::matcher::Matcher::estimate_checked)'s `matched`): `semi_global`'s disparities the
 /// census matcher's `census` agrees with, or whose census window in `color` is flat; 0 elsewhere.
 pub fn trust_reference(semi_global: &DepthMap, census: &DepthMap, color: &RgbImage) -> Result<DepthMap> {
     check(semi_global, census, color)?;

@@ -7,22 +7,24 @@ use super::reuse::Reused;
 use crate::io::{DepthMap, RgbImage};
 use crate::pass::Device;
 use crate::stereo::matcher::range::{estimate_range, DisparityRange, SignedSearch};
-use crate::stereo::matcher::{Matcher, MatcherMethod};
-use crate::stereo::trust::{census_checked, Trust};
+use crate::stereo::matcher::MatcherMethod;
 
 /// Highest confidence an inferred disparity carries (`--confidence`, `--min-confidence`): the
 /// semi-global matcher took it from the surface around, not from its own costs.
 pub const INFERRED_CONFIDENCE: f32 = 0.25;
 
-/// One matcher's disparities of a pair, and their confidences where asked for.
+/// The matcher's disparities of a pair, the matched ones where the matcher is the semi-global
+/// one, and their confidences where asked for.
 struct Matched {
     disparity: [DepthMap; 2],
+    /// The semi-global disparities the census matcher's supports ([`crate::stereo::trust`]).
+    matched: Option<[DepthMap; 2]>,
     confidence: Option<[DepthMap; 2]>,
 }
 
 /// Both eyes' disparities of the (widened) pair by `method` over 0..=`max_disparity`, on a
-/// sequence's `reuse` or a matcher made for the call; the confidence stage runs only
-/// `with_confidence`.
+/// sequence's `reuse` or a matcher made for the call (the semi-global one checked, in the same
+/// run); the confidence stage runs only `with_confidence`.
 fn run_matcher(
     device: &Device,
     reuse: Option<&mut Reused>,
@@ -35,22 +37,32 @@ fn run_matcher(
     let matcher = match reuse {
         Some(re) => re.matcher(device, l.width, l.height, max_disparity, method)?,
         None => {
-            own = Matcher::with_method(device, l.width, l.height, max_disparity, method)?;
+            own = Reused::make_matcher(device, l.width, l.height, max_disparity, method)?;
             &mut own
         }
     };
-    Ok(match with_confidence {
-        true => {
+    Ok(match (method, with_confidence) {
+        (MatcherMethod::Sgm, _) => {
+            let c = matcher.estimate_checked(l, r, with_confidence)?;
+            Matched {
+                disparity: c.disparity,
+                matched: Some(c.matched),
+                confidence: c.confidence,
+            }
+        }
+        (MatcherMethod::Census, true) => {
             let [el, er] = matcher.estimate_with_confidence(l, r)?;
             Matched {
                 disparity: [el.disparity, er.disparity],
+                matched: None,
                 confidence: Some([el.confidence, er.confidence]),
             }
         }
-        false => {
+        (MatcherMethod::Census, false) => {
             let (dl, dr) = matcher.estimate(l, r)?;
             Matched {
                 disparity: [dl, dr],
+                matched: None,
                 confidence: None,
             }
         }
@@ -134,9 +146,9 @@ impl CyclopeanPlan {
         Ok((range, lo.is_none() || hi.is_none()))
     }
 
-    /// Both eyes' disparities of a pair alone over its signed range, by the census matcher on
-    /// `device` (those below the minimum confidence made unknown), and their confidence when
-    /// asked for. Stored as d + offset ([`SignedSearch`]).
+    /// Both eyes' disparities of a pair alone over its signed range, by the plan's matcher on
+    /// `device` (those below the minimum confidence made unknown; the semi-global one's split
+    /// into matched and inferred), and their confidence when asked for. Stored as d + offset ([`SignedSearch`]).
     pub(super) fn estimate(
         &self,
         device: &Device,
@@ -187,45 +199,19 @@ impl CyclopeanPlan {
             Some([cl, cr]) => Some(search.crop(cl, cr, left.width)?),
             None => None,
         };
-        // The semi-global matcher's disparities split into matched and inferred ones by the
-        // census matcher's on the same pair (stereo::trust).
-        let mut matched = None;
-        if self.matcher == MatcherMethod::Sgm {
-            // Past CENSUS_CHECK_SEARCH the census matcher does not run (its work grows with the
-            // search): no census disparity is known, only flat windows count as matched.
-            let (cl, cr) = match census_checked(search.max_disparity) {
-                true => {
-                    let census = run_matcher(
-                        device,
-                        reuse.as_deref_mut(),
-                        MatcherMethod::Census,
-                        (l, r),
-                        search.max_disparity,
-                        false,
-                    )?;
-                    let [cl, cr] = census.disparity;
-                    search.crop(cl, cr, left.width)?
+        // The semi-global matcher's disparities split into matched and inferred by the census
+        // matcher's on the same pair (stereo::trust), in the matcher's own run.
+        let mut matched = match m.matched {
+            Some([ml, mr]) => {
+                let (ml, mr) = search.crop(ml, mr, left.width)?;
+                if let Some((kl, kr)) = confidence.as_mut() {
+                    cap_inferred(kl, &dl, &ml);
+                    cap_inferred(kr, &dr, &mr);
                 }
-                false => {
-                    let none = || DepthMap::new(left.width, left.height, vec![0.0; dl.data.len()]);
-                    (none()?, none()?)
-                }
-            };
-            let mut own;
-            let trust = match reuse {
-                Some(re) => re.trust(device)?,
-                None => {
-                    own = Trust::new(device)?;
-                    &mut own
-                }
-            };
-            let (ml, mr) = (trust.matched(&dl, &cl, left)?, trust.matched(&dr, &cr, right)?);
-            if let Some((kl, kr)) = confidence.as_mut() {
-                cap_inferred(kl, &dl, &ml);
-                cap_inferred(kr, &dr, &mr);
+                Some((ml, mr))
             }
-            matched = Some((ml, mr));
-        }
+            None => None,
+        };
         if let (Some(min), Some((kl, kr))) = (self.min_confidence, &confidence) {
             confident(&mut dl, kl, min);
             confident(&mut dr, kr, min);

@@ -1,5 +1,5 @@
-//! What a sequence keeps on its device from one frame to the next: the matchers and the trust
-//! pass (two images alone), the default method's renderer (its eye images rewritten in place), the fill,
+//! What a sequence keeps on its device from one frame to the next: the matchers (two images
+//! alone), the default method's renderer (its eye images rewritten in place), the fill,
 //! and the temporal history. So a
 //! sequence's next frame of the same size creates no GPU object, where one pair alone makes
 //! its renderers and drops them.
@@ -13,7 +13,6 @@ use crate::pass::Device;
 use crate::stereo::densify::Densifier;
 use crate::stereo::gather::CyclopeanOutputs;
 use crate::stereo::matcher::{Matcher, MatcherMethod};
-use crate::stereo::trust::Trust;
 use crate::stereo::StereoFrame;
 
 /// The width, height and search range a matcher was made for.
@@ -22,10 +21,9 @@ type MatcherKey = (u32, u32, u32);
 /// A sequence's renderers, made at its first frame and reused (see the module notes).
 #[derive(Default)]
 pub struct Reused {
-    /// A matcher per method (the semi-global one's matched disparities need the census one's
-    /// too), each with the width, height and search range it was made for.
+    /// A matcher per method (the semi-global one checked: [`Matcher::checked`]), each with the
+    /// width, height and search range it was made for.
     matchers: [Option<(MatcherKey, Matcher)>; 2],
-    trust: Option<Trust>,
     splat: Option<SplatRenderer>,
     filler: Option<Filler>,
     densifier: Option<Densifier>,
@@ -75,19 +73,25 @@ impl Reused {
             Some((k, m)) if k == key => m,
             old => {
                 drop(old);
-                Matcher::with_method(device, width, height, max_disparity, method)?
+                Self::make_matcher(device, width, height, max_disparity, method)?
             }
         };
         Ok(&mut slot.insert((key, matcher)).1)
     }
 
-    /// The trust pass (the semi-global matcher's matched disparities).
-    pub(crate) fn trust(&mut self, device: &Device) -> Result<&mut Trust> {
-        let trust = match self.trust.take() {
-            Some(t) => t,
-            None => Trust::new(device)?,
-        };
-        Ok(self.trust.insert(trust))
+    /// The matcher the two-image path runs for `method`: the census one, or the semi-global
+    /// one with its census check ([`Matcher::checked`]).
+    pub(crate) fn make_matcher(
+        device: &Device,
+        width: u32,
+        height: u32,
+        max_disparity: u32,
+        method: MatcherMethod,
+    ) -> Result<Matcher> {
+        match method {
+            MatcherMethod::Census => Matcher::with_method(device, width, height, max_disparity, method),
+            MatcherMethod::Sgm => Matcher::checked(device, width, height, max_disparity),
+        }
     }
 
     /// The densifier (two images alone with the fill).

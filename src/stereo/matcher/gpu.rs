@@ -14,6 +14,7 @@ use crate::pass::{
     Buffer, Device, Dispatch, Format, Groups, Image, ImageData, ImageId, Rendered, Step, StorageImage, Target, ToDevice,
 };
 use crate::pass::{ProgramKind, ShaderProgram};
+use crate::stereo::trust::census_checked;
 
 /// Words a chunk buffer holds at most (64 MiB): under GL's guaranteed-in-practice storage-block
 /// size (llvmpipe: 128 MiB) and Vulkan's storage-buffer range on the devices we run.
@@ -34,6 +35,25 @@ fn disparity(out: &mut Rendered, k: usize) -> Result<DepthMap> {
         out.api
             .readback_error(format!("stereo matcher: output {k} was not read back"))
     })
+}
+
+/// Which outputs a run writes besides both eyes' disparities.
+#[derive(Debug, Clone, Copy)]
+struct Outputs {
+    confidence: bool,
+    /// The census check and the trust stage (a checked matcher).
+    matched: bool,
+}
+
+impl Outputs {
+    const DISPARITY: Outputs = Outputs {
+        confidence: false,
+        matched: false,
+    };
+    const CONFIDENCE: Outputs = Outputs {
+        confidence: true,
+        matched: false,
+    };
 }
 
 /// Largest pair the pass takes (8 Mpx, 4K UHD fits): its census codes (4 words a pixel) then
@@ -64,6 +84,22 @@ pub struct Matcher {
     checked: Buffer,
     /// The semi-global stages' buffers, where the matcher is the semi-global one.
     sgm: Option<SgmStages>,
+    /// A checked semi-global matcher ([`Matcher::checked`]): the census matcher's final
+    /// disparities of the run, both eyes, for the trust stage; and whether the census stages run
+    /// at all (the search within [`CENSUS_CHECK_SEARCH`](crate::stereo::trust::CENSUS_CHECK_SEARCH)).
+    census_check: Option<(Buffer, bool)>,
+}
+
+/// The maps of one [`Matcher::estimate_checked`] run, each eye's.
+#[derive(Debug, Clone)]
+pub struct Checked {
+    /// The semi-global disparities (0 = unknown), inferred ones included.
+    pub disparity: [DepthMap; 2],
+    /// Those the census matcher's (or a flat window) supports, the others 0
+    /// ([`crate::stereo::trust`]).
+    pub matched: [DepthMap; 2],
+    /// The confidence in `disparity`, where asked for.
+    pub confidence: Option<[DepthMap; 2]>,
 }
 
 impl Matcher {
@@ -85,6 +121,27 @@ impl Matcher {
     ) -> Result<Self> {
         check_range(width, max_disparity)?;
         let device = device.to_device()?;
+        Self::make(device, width, height, max_disparity, method, false)
+    }
+
+    /// A semi-global matcher whose run also splits its disparities into matched and inferred
+    /// ([`Matcher::estimate_checked`], the rule in [`crate::stereo::trust`]): the census
+    /// matcher's stages and the trust stage in the same run, on the same grey levels and census
+    /// codes. Fails as [`Matcher::with_method`] does.
+    pub fn checked(device: impl ToDevice, width: u32, height: u32, max_disparity: u32) -> Result<Self> {
+        check_range(width, max_disparity)?;
+        let device = device.to_device()?;
+        Self::make(device, width, height, max_disparity, MatcherMethod::Sgm, true)
+    }
+
+    fn make(
+        device: Device,
+        width: u32,
+        height: u32,
+        max_disparity: u32,
+        method: MatcherMethod,
+        census_check: bool,
+    ) -> Result<Self> {
         device.check_image_size("stereo pair", width, height)?;
         let n = width as usize * height as usize;
         if n > MAX_PIXELS {
@@ -96,12 +153,23 @@ impl Matcher {
         let pairs = (max_disparity as usize + 1).div_ceil(2);
         let chunk_pairs = pairs.min((CHUNK_WORDS / n).max(1));
         let buffer = |words: usize, label: &str| device.create_buffer(words, label);
-        let (sgm, chunk_words) = match method {
-            MatcherMethod::Census => (None, chunk_pairs * n),
-            MatcherMethod::Sgm => (Some(SgmStages::new(&device, width, height, max_disparity)?), 1),
+        // The census stages run in a census matcher, and in a checked one within the bound.
+        let census_stages = match method {
+            MatcherMethod::Census => true,
+            MatcherMethod::Sgm => census_check && census_checked(max_disparity),
+        };
+        let chunk_words = if census_stages { chunk_pairs * n } else { 1 };
+        let sgm = match method {
+            MatcherMethod::Census => None,
+            MatcherMethod::Sgm => Some(SgmStages::new(&device, width, height, max_disparity)?),
+        };
+        let census_check = match census_check {
+            true => Some((buffer(2 * n, "matcher census disparities")?, census_stages)),
+            false => None,
         };
         Ok(Matcher {
             sgm,
+            census_check,
             greys: buffer(n, "matcher grey levels")?,
             codes: buffer(4 * n, "matcher census codes")?,
             means: buffer(chunk_words, "matcher means")?,
@@ -124,14 +192,14 @@ impl Matcher {
     /// Disparities of the left and right eye of `left` and `right` (the matcher's size), as
     /// [`super::estimate_disparities`] gives them, bit for bit.
     pub fn estimate(&mut self, left: &RgbImage, right: &RgbImage) -> Result<(DepthMap, DepthMap)> {
-        let mut out = self.run(left, right, false)?;
+        let mut out = self.run(left, right, Outputs::DISPARITY)?;
         Ok((disparity(&mut out, 0)?, disparity(&mut out, 1)?))
     }
 
     /// [`Matcher::estimate`] with each eye's confidence in its disparities (in [0, 1], 0 where
     /// unknown; [`super::confidence`] holds the rule and the twin).
     pub fn estimate_with_confidence(&mut self, left: &RgbImage, right: &RgbImage) -> Result<[EyeEstimate; 2]> {
-        let mut out = self.run(left, right, true)?;
+        let mut out = self.run(left, right, Outputs::CONFIDENCE)?;
         let mut eye = |k: usize| -> Result<EyeEstimate> {
             Ok(EyeEstimate {
                 disparity: disparity(&mut out, k)?,
@@ -141,9 +209,43 @@ impl Matcher {
         Ok([eye(0)?, eye(1)?])
     }
 
-    /// One run of every stage (and the confidence where asked for): outputs 0 and 1 the
-    /// disparities, 2 and 3 the confidences.
-    fn run(&mut self, left: &RgbImage, right: &RgbImage, confidence: bool) -> Result<Rendered> {
+    /// A [`Matcher::checked`] matcher's semi-global disparities split into matched and inferred
+    /// ([`Checked`]), with their confidence `with_confidence`: the census matcher's disparities
+    /// ([`super::estimate_disparities`]'s, where the search is within
+    /// [`CENSUS_CHECK_SEARCH`](crate::stereo::trust::CENSUS_CHECK_SEARCH)) and the trust rule's
+    /// ([`crate::stereo::trust_reference::trust_reference`]'s) bit for bit, in one run.
+    pub fn estimate_checked(&mut self, left: &RgbImage, right: &RgbImage, with_confidence: bool) -> Result<Checked> {
+        if self.census_check.is_none() {
+            return Err(Error::param(
+                "stereo matcher",
+                "estimate_checked needs a matcher made by Matcher::checked",
+            ));
+        }
+        let mut out = self.run(
+            left,
+            right,
+            Outputs {
+                confidence: with_confidence,
+                matched: true,
+            },
+        )?;
+        let mut pair =
+            |k: usize| -> Result<[DepthMap; 2]> { Ok([disparity(&mut out, k)?, disparity(&mut out, k + 1)?]) };
+        let (disparity, matched) = (pair(0)?, pair(2)?);
+        let confidence = match with_confidence {
+            true => Some(pair(4)?),
+            false => None,
+        };
+        Ok(Checked {
+            disparity,
+            matched,
+            confidence,
+        })
+    }
+
+    /// One run of every stage, and the census check and the trust stage or the confidence where
+    /// asked for: outputs 0 and 1 the disparities, then the matched ones, then the confidences.
+    fn run(&mut self, left: &RgbImage, right: &RgbImage, wanted: Outputs) -> Result<Rendered> {
         check_pair(left, right)?;
         let (w, h) = (self.width, self.height);
         if (left.width, left.height) != (w, h) {
@@ -174,6 +276,9 @@ impl Matcher {
             })
             .collect();
         let whole = params(0, 0);
+        // The trust stage's u_pairs: 1 when the census disparities were matched in the run.
+        let census_ran = wanted.matched && self.census_check.as_ref().is_some_and(|c| c.1);
+        let trust_params = params(0, census_ran as u32);
         let ids = |b: &[&Buffer]| b.iter().map(|b| b.id()).collect::<Vec<_>>();
         let grey_buffers = ids(&[&self.greys]);
         let census_buffers = ids(&[&self.greys, &self.codes]);
@@ -185,8 +290,15 @@ impl Matcher {
         // The median stores the final disparities into `raw` too (free after the check).
         let median_buffers = ids(&[&self.checked, &self.raw]);
         let confidence_buffers = ids(&[&self.raw]);
+        // A checked matcher's census disparities go to their own buffer for the trust stage.
+        let (census_median_buffers, trust_buffers) = match &self.census_check {
+            Some((census, _)) => (ids(&[&self.checked, census]), ids(&[&self.raw, census, &self.greys])),
+            None => (vec![], vec![]),
+        };
         let outputs = [StorageImage::Output(0), StorageImage::Output(1)];
-        let confidence_outputs = [StorageImage::Output(2), StorageImage::Output(3)];
+        let matched_outputs = [StorageImage::Output(2), StorageImage::Output(3)];
+        let k = if wanted.matched { 4 } else { 2 };
+        let confidence_outputs = [StorageImage::Output(k), StorageImage::Output(k + 1)];
         let pixels = Groups::Fixed([w.div_ceil(8), h.div_ceil(8)]);
         let dispatch = |stage, block, buffers, groups| Dispatch {
             program: ShaderProgram::new(Default::default(), ProgramKind::CyclopeanMatcher(stage)),
@@ -202,58 +314,79 @@ impl Matcher {
                 ..dispatch(MatcherStage::Grey, &whole, &grey_buffers, pixels)
             }),
             Step::Dispatch(dispatch(MatcherStage::Census, &whole, &census_buffers, pixels)),
+            // The census matcher's chunks: rows and columns one invocation per row (column) and
+            // disparity pair, then the winners.
         ];
-        let planned: Vec<Planned> = match &self.sgm {
-            Some(sgm) => sgm.dispatches(&self.greys, &self.codes, [&self.winners[0], &self.winners[1]]),
-            None => chunks
-                .iter()
-                .flat_map(|chunk| {
-                    // Rows and columns: one invocation per row (column) and disparity pair.
-                    let lines = |n: u32| Groups::Fixed([n.div_ceil(8), (chunk.u_pairs as u32).div_ceil(8)]);
-                    [
-                        (MatcherStage::Rows, &rows_buffers, lines(h)),
-                        (MatcherStage::Columns, &columns_buffers, lines(w)),
-                        (MatcherStage::Winner, &winner_buffers, pixels),
-                    ]
-                    .map(|(stage, buffers, groups)| Planned {
-                        stage,
-                        params: *chunk,
-                        buffers: buffers.clone(),
-                        groups,
-                    })
+        let mut census_chunks: Vec<Planned> = chunks
+            .iter()
+            .flat_map(|chunk| {
+                let lines = |n: u32| Groups::Fixed([n.div_ceil(8), (chunk.u_pairs as u32).div_ceil(8)]);
+                [
+                    (MatcherStage::Rows, &rows_buffers, lines(h)),
+                    (MatcherStage::Columns, &columns_buffers, lines(w)),
+                    (MatcherStage::Winner, &winner_buffers, pixels),
+                ]
+                .map(|(stage, buffers, groups)| Planned {
+                    stage,
+                    params: *chunk,
+                    buffers: buffers.clone(),
+                    groups,
                 })
-                .collect(),
+            })
+            .collect();
+        let winners: Vec<Planned> = match &self.sgm {
+            Some(sgm) => sgm.dispatches(&self.greys, &self.codes, [&self.winners[0], &self.winners[1]]),
+            None => std::mem::take(&mut census_chunks),
         };
-        for p in &planned {
-            steps.push(Step::Dispatch(dispatch(p.stage, &p.params, &p.buffers, p.groups)));
+        // A checked matcher runs the census matcher to its final disparities first (into their
+        // own buffer), then the semi-global one: each from its winners through the sub-pixel
+        // step, the left-right check and the median.
+        let mut runs = Vec::new();
+        if census_ran {
+            runs.push((&census_chunks, &census_median_buffers));
         }
-        steps.push(Step::Dispatch(dispatch(
-            MatcherStage::Subpixel,
-            &whole,
-            &subpixel_buffers,
-            pixels,
-        )));
-        steps.push(Step::Dispatch(dispatch(
-            MatcherStage::LrCheck,
-            &whole,
-            &check_buffers,
-            pixels,
-        )));
-        steps.push(Step::Dispatch(Dispatch {
-            storage_images: &outputs,
-            ..dispatch(MatcherStage::Median, &whole, &median_buffers, pixels)
-        }));
-        if confidence {
+        runs.push((&winners, &median_buffers));
+        for (planned, median_buffers) in runs {
+            for p in planned {
+                steps.push(Step::Dispatch(dispatch(p.stage, &p.params, &p.buffers, p.groups)));
+            }
+            steps.push(Step::Dispatch(dispatch(
+                MatcherStage::Subpixel,
+                &whole,
+                &subpixel_buffers,
+                pixels,
+            )));
+            steps.push(Step::Dispatch(dispatch(
+                MatcherStage::LrCheck,
+                &whole,
+                &check_buffers,
+                pixels,
+            )));
+            // The median also stores into outputs 0 and 1: a checked matcher's census disparities
+            // there are overwritten by the semi-global ones (full barriers order the writes).
+            steps.push(Step::Dispatch(Dispatch {
+                storage_images: &outputs,
+                ..dispatch(MatcherStage::Median, &whole, median_buffers, pixels)
+            }));
+        }
+        if wanted.confidence {
             steps.push(Step::Dispatch(Dispatch {
                 storage_images: &confidence_outputs,
                 ..dispatch(MatcherStage::Confidence, &whole, &confidence_buffers, pixels)
             }));
         }
+        if wanted.matched {
+            steps.push(Step::Dispatch(Dispatch {
+                storage_images: &matched_outputs,
+                ..dispatch(MatcherStage::Trust, &trust_params, &trust_buffers, pixels)
+            }));
+        }
         // Memory rows are the images' top-down rows (the rule is symmetric in y): no flip.
+        let count = 2 + 2 * (wanted.matched as usize) + 2 * (wanted.confidence as usize);
         let target = Target {
             width: w,
             height: h,
-            outputs: vec![Some(Format::R32F); if confidence { 4 } else { 2 }],
+            outputs: vec![Some(Format::R32F); count],
             rows: RowOrder::TopDown,
             depth_test: None,
         };

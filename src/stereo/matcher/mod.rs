@@ -56,7 +56,7 @@ pub mod reference;
 pub mod sgm;
 
 pub use confidence::confidence_reference;
-pub use gpu::{EyeEstimate, Matcher};
+pub use gpu::{Checked, EyeEstimate, Matcher};
 pub use reference::estimate_disparities;
 pub use sgm::estimate_disparities_sgm;
 

@@ -12,5 +12,5 @@ pub(crate) mod matcher;
 mod real_pairs;
 /// Temporal accumulation against its twin over a sequence.
 mod temporal;
-/// The trust pass (matched or inferred semi-global disparities) against its twin on both executors.
+/// The checked semi-global matcher (matched or inferred disparities) against the twins on both executors.
 mod trust;

@@ -1,62 +1,108 @@
-//! The trust pass (issue 48: the semi-global matcher's disparities split into matched and
-//! inferred) against its twin on both executors.
+//! The checked semi-global matcher (issue 48: the semi-global disparities split into matched
+//! and inferred, the census matcher's stages and the trust stage in the same run) against the
+//! twins on both executors.
 //!
-//! Bounds, from the numerics: the rule compares integer grey levels and one f32 difference and
-//! copies a disparity, so the GPU's map must be the twin's bit for bit (no pixel excused).
+//! Bounds, from the numerics: the matchers' stages are exact (integers, single correctly rounded
+//! f32 operations; stereo::matcher), and the trust rule compares integer grey levels and one f32
+//! difference and copies a disparity, so every map must be the twins' bit for bit (no pixel
+//! excused).
 
 use viewsynth::io::{load_rgb, DepthMap, RgbImage};
 use viewsynth::pass::Device;
-use viewsynth::stereo::matcher::{estimate_disparities, estimate_disparities_sgm};
-use viewsynth::stereo::trust::Trust;
+use viewsynth::stereo::matcher::{estimate_disparities, estimate_disparities_sgm, Matcher, MatcherMethod};
+use viewsynth::stereo::trust::census_checked;
 use viewsynth::stereo::trust_reference::trust_reference;
 use viewsynth_tests::{data_dir, gpu};
 
-/// Cones' left eye: its colour, the semi-global twin's disparities and the census twin's.
-fn cones_left() -> (RgbImage, DepthMap, DepthMap) {
+fn cones() -> (RgbImage, RgbImage) {
     let dir = data_dir().join("middlebury2003_cones");
-    let (l, r) = (
+    (
         load_rgb(&dir.join("im2.png")).unwrap(),
         load_rgb(&dir.join("im6.png")).unwrap(),
-    );
-    let (semi_global, _) = estimate_disparities_sgm(&l, &r, 64).unwrap();
-    let (census, _) = estimate_disparities(&l, &r, 64).unwrap();
-    (l, semi_global, census)
+    )
 }
 
-fn check(eye: (RgbImage, DepthMap, DepthMap), device: &Device, what: &str) {
-    let (color, semi_global, census) = eye;
-    let gpu_out = Trust::new(device)
+fn differing(a: &DepthMap, b: &DepthMap) -> usize {
+    assert_eq!(a.data.len(), b.data.len());
+    (0..a.data.len())
+        .filter(|&i| a.data[i].to_bits() != b.data[i].to_bits())
+        .count()
+}
+
+/// One checked run over 0..=`max_disparity` against the twins: the semi-global twin's
+/// disparities, the trust twin's matched ones (on the census twin's disparities, or on none past
+/// the census check's bound) and the unchecked matcher's confidence.
+fn check(device: &Device, max_disparity: u32, what: &str) {
+    let (l, r) = cones();
+    let mut matcher = Matcher::checked(device, l.width, l.height, max_disparity).unwrap();
+    let out = matcher.estimate_checked(&l, &r, true).unwrap();
+    let (sl, sr) = estimate_disparities_sgm(&l, &r, max_disparity).unwrap();
+    let (cl, cr) = match census_checked(max_disparity) {
+        true => estimate_disparities(&l, &r, max_disparity).unwrap(),
+        false => {
+            let none = || DepthMap::new(l.width, l.height, vec![0.0; sl.data.len()]).unwrap();
+            (none(), none())
+        }
+    };
+    let twin = [
+        trust_reference(&sl, &cl, &l).unwrap(),
+        trust_reference(&sr, &cr, &r).unwrap(),
+    ];
+    for (eye, (s, m)) in [(&sl, &twin[0]), (&sr, &twin[1])].into_iter().enumerate() {
+        let d = differing(&out.disparity[eye], s);
+        assert_eq!(
+            d, 0,
+            "{what}, eye {eye}: {d} semi-global disparities differ from the twin's"
+        );
+        let d = differing(&out.matched[eye], m);
+        assert_eq!(
+            d, 0,
+            "{what}, eye {eye}: {d} matched disparities differ from the twin's"
+        );
+    }
+    // The census stages leave the semi-global run as it is: its confidence is the unchecked
+    // matcher's.
+    let plain = Matcher::with_method(device, l.width, l.height, max_disparity, MatcherMethod::Sgm)
         .unwrap()
-        .matched(&semi_global, &census, &color)
+        .estimate_with_confidence(&l, &r)
         .unwrap();
-    let twin = trust_reference(&semi_global, &census, &color).unwrap();
-    let differ = (0..twin.data.len())
-        .filter(|&i| gpu_out.data[i].to_bits() != twin.data[i].to_bits())
-        .count();
-    assert_eq!(differ, 0, "{what}: {differ} disparities differ from the twin's");
+    let confidence = out.confidence.as_ref().unwrap();
+    for eye in 0..2 {
+        let d = differing(&confidence[eye], &plain[eye].confidence);
+        assert_eq!(
+            d, 0,
+            "{what}, eye {eye}: {d} confidences differ from the unchecked matcher's"
+        );
+    }
     // Both kinds occur, and of the flat-window kind too (census unknown, matched).
     let known = |d: &DepthMap, i: usize| d.data[i] > 0.0;
-    let n = twin.data.len();
-    let matched = (0..n).filter(|&i| known(&twin, i)).count();
-    let inferred = (0..n).filter(|&i| known(&semi_global, i) && !known(&twin, i)).count();
-    let flat = (0..n).filter(|&i| known(&twin, i) && !known(&census, i)).count();
-    println!("{what}: {matched} matched ({flat} in flat windows), {inferred} inferred, the twin's bit for bit");
-    assert!(
-        matched > n / 2 && inferred > 100 && flat > 0,
-        "{what}: {matched} / {inferred} / {flat}"
+    let n = sl.data.len();
+    let matched = (0..n).filter(|&i| known(&twin[0], i)).count();
+    let inferred = (0..n).filter(|&i| known(&sl, i) && !known(&twin[0], i)).count();
+    let flat = (0..n).filter(|&i| known(&twin[0], i) && !known(&cl, i)).count();
+    println!(
+        "{what}: left eye {matched} matched ({flat} in flat windows), {inferred} inferred, the twins' bit for bit"
     );
+    assert!(flat > 0 && inferred > 100, "{what}: {matched} / {inferred} / {flat}");
+    if census_checked(max_disparity) {
+        assert!(matched > n / 2, "{what}: {matched} of {n} matched");
+    }
+}
+
+fn both_searches(device: &Device, api: &str) {
+    // Within the census check's bound, and past it (flat windows only).
+    check(device, 64, &format!("{api}, search 0-64"));
+    check(device, 300, &format!("{api}, search 0-300"));
 }
 
 #[test]
-fn trust_pass_matches_its_twin_on_gl() {
-    let eye = cones_left();
-    check(eye, &Device::gl(&gpu()).unwrap(), "GL");
+fn checked_matcher_matches_the_twins_on_gl() {
+    both_searches(&Device::gl(&gpu()).unwrap(), "GL");
 }
 
 #[cfg(feature = "vulkan")]
 #[test]
-fn trust_pass_matches_its_twin_on_vulkan() {
-    let eye = cones_left();
+fn checked_matcher_matches_the_twins_on_vulkan() {
     let device = viewsynth::vulkan::VkExecutor::device(&viewsynth_tests::vulkan()).unwrap();
-    check(eye, &device, "Vulkan");
+    both_searches(&device, "Vulkan");
 }

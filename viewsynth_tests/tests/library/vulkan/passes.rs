@@ -141,10 +141,6 @@ fn layout_checks() -> Vec<LayoutCheck> {
             ProgramKind::CyclopeanDensify,
             check_block::<viewsynth::stereo::densify::DensifyParams>,
         ),
-        (
-            ProgramKind::CyclopeanTrust,
-            check_block::<viewsynth::stereo::trust::TrustParams>,
-        ),
     ]);
     checks
 }
@@ -372,10 +368,16 @@ fn a_steady_state_frame_creates_nothing_on_either_api() {
                 .densify(&matched, &frame.left.color, viewsynth::stereo::densify::OtherEye::LEFT)
                 .unwrap(),
         );
-        // The trust pass (issue 48) on the census disparities against themselves: its first eye
-        // uploads the inputs.
-        let mut trust = viewsynth::stereo::trust::Trust::new(d).unwrap();
-        drop(trust.matched(&matched, &matched, &frame.left.color).unwrap());
+        // The checked semi-global matcher (issue 48: census stages and the trust stage in its
+        // run), with and without confidence: its first pair uploads the images.
+        let mut checked = viewsynth::stereo::matcher::Matcher::checked(d, 64, 48, 8).unwrap();
+        for with_confidence in [false, true] {
+            drop(
+                checked
+                    .estimate_checked(&frame.left.color, &frame.right.color, with_confidence)
+                    .unwrap(),
+            );
+        }
         let source = viewsynth_tests::synthetic(64, 48);
         let targets = viewsynth::refocus::manifest::TargetSpec {
             scales: vec![0.5, 1.0, 2.0],
@@ -457,8 +459,16 @@ fn a_steady_state_frame_creates_nothing_on_either_api() {
                 }),
             ),
             (
-                "trust",
-                Box::new(|| drop(trust.matched(&matched, &matched, &frame.left.color).unwrap())),
+                "checked matcher",
+                Box::new(|| {
+                    for with_confidence in [false, true] {
+                        drop(
+                            checked
+                                .estimate_checked(&frame.left.color, &frame.right.color, with_confidence)
+                                .unwrap(),
+                        );
+                    }
+                }),
             ),
             (
                 // The batch's frame: a new source of the same size, every target in flight at once.
