@@ -7,6 +7,7 @@ const uint P1 = 60u;
 const uint P2 = 1000u;
 const uint EDGE_GREY = 24u;
 const int FULL_SEARCH = 64;
+const int WINDOW = 5;
 // No cost: the disparity is not searched at the pixel or looks outside the other image.
 const uint NO_CELL = 0xffffffffu;
 

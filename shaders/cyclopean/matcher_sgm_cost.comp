@@ -26,6 +26,59 @@ uint window_start(uint guide) {
     return min(centre > half_window ? centre - half_window : 0u, top);
 }
 
+const int BOX = 2 * COST_RADIUS + 1;
+
+// The left and right census codes (both words) at column x of the row starting at `row`.
+uvec2 left_code(int row, int x) {
+    int a = 4 * (row + x);
+    return uvec2(codes[a], codes[a + 1]);
+}
+uvec2 right_code(int row, int x) {
+    int b = 4 * (row + clamp(x, 0, u_size.x - 1));
+    return uvec2(codes[b + 2], codes[b + 3]);
+}
+
+// The cells of a pixel whose box never leaves the image's columns: the same sums as main's
+// general loop (integers: the order of the additions does not matter), but the box's left
+// codes are loaded once and its right codes slide one column per disparity (box column m at
+// disparity d reads right column x - COST_RADIUS + m - d, which is column m - 1's at d - 1), so
+// a cell loads one right code a row instead of the whole box's codes.
+void interior_costs(ivec2 p, int i, int start) {
+    int rows[BOX];
+    uvec2 left[BOX][BOX];
+    uvec2 right[BOX][BOX];
+    for (int r = 0; r < BOX; ++r) {
+        rows[r] = clamp(p.y + r - COST_RADIUS, 0, u_size.y - 1) * u_size.x;
+        for (int m = 0; m < BOX; ++m) {
+            left[r][m] = left_code(rows[r], p.x - COST_RADIUS + m);
+            right[r][m] = right_code(rows[r], p.x - COST_RADIUS + m - start);
+        }
+    }
+    for (int k = 0; k < u_window; ++k) {
+        int d = start + k;
+        if (k > 0) {
+            for (int r = 0; r < BOX; ++r) {
+                for (int m = BOX - 1; m > 0; --m) {
+                    right[r][m] = right[r][m - 1];
+                }
+                right[r][0] = right_code(rows[r], p.x - COST_RADIUS - d);
+            }
+        }
+        uint cost = COST_OUTSIDE;
+        if (p.x >= d) {
+            cost = 0u;
+            for (int r = 0; r < BOX; ++r) {
+                for (int m = 0; m < BOX; ++m) {
+                    uvec2 x = left[r][m] ^ right[r][m];
+                    cost += uint(bitCount(x.x) + bitCount(x.y));
+                }
+            }
+        }
+        costs[i * u_window + k] = cost;
+        sums[i * u_window + k] = 0u;
+    }
+}
+
 void main() {
     ivec2 p = this_pixel();
     if (p.x < 0) {
@@ -42,6 +95,10 @@ void main() {
     }
     starts[2 * i] = start_l;
     starts[2 * i + 1] = start_r;
+    if (p.x >= COST_RADIUS && p.x < w - COST_RADIUS) {
+        interior_costs(p, i, int(start_l));
+        return;
+    }
     for (int k = 0; k < u_window; ++k) {
         int d = int(start_l) + k;
         uint cost = 0u;

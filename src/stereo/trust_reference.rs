@@ -1,4 +1,4 @@
-//! The CPU twin of the trust pass ([`super::trust`]): the same rule, bit for bit what the GPU
+//! The CPU twin of the trust stage ([`super::trust`]): the same rule, bit for bit what the GPU
 //! writes (tests in `viewsynth_tests`' `cyclopean::trust`).
 
 use super::matcher::{CENSUS_HALF_H, CENSUS_HALF_W};

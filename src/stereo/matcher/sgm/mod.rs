@@ -150,6 +150,7 @@ mod tests {
             format!("const uint P2 = {P2}u;"),
             format!("const uint EDGE_GREY = {EDGE_GREY}u;"),
             format!("const int FULL_SEARCH = {FULL_SEARCH};"),
+            format!("const int WINDOW = {WINDOW};"),
         ] {
             assert!(glsl.contains(&line), "matcher_sgm.glsl lacks `{line}`");
         }
