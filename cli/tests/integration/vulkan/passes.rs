@@ -329,8 +329,9 @@ fn every_vulkan_pass_runs_clean_under_the_validation_layer() {
     filled[2] = "splat-gather".into();
     filled.push("--fill".into());
     runs.push(filled);
-    // Two images alone with the fill: the semi-global and census matchers over the estimated
-    // range, the trust pass and the densify pass on both eyes, the two renders and the fill.
+    // Two images alone with the fill: the semi-global matcher checked by the census one's stages
+    // and the trust stage (one run) over the estimated range, the densify pass on both eyes, the
+    // two renders and the fill.
     runs.push(s(&["cyclopean", "--left-rgb", &lr, "--right-rgb", &rr, "--fill"]));
     // The semi-global matcher's stages.
     runs.push(s(&[
