@@ -2,6 +2,11 @@
 //! dispatches on a [`Device`], the two disparity maps read back as the run's outputs. A
 //! [`Matcher`] is made for one image size and search range; its buffers are created once and
 //! its input images rewritten for each pair, so a stream of pairs creates nothing.
+//!
+//! A checked semi-global matcher ([`Matcher::checked`], the two-image path's default) runs the
+//! census matcher's stages to their final disparities first, into a buffer of their own, then
+//! the semi-global ones from the same grey levels and census codes, then the trust stage
+//! ([`crate::stereo::trust`]) on both: one upload and one readback for the whole estimate.
 
 pub use super::params::MatcherParams;
 use super::sgm::gpu::{Planned, SgmStages};

@@ -62,10 +62,10 @@ fn check(device: &Device, max_disparity: u32, what: &str) {
     }
     // The census stages leave the semi-global run as it is: its confidence is the unchecked
     // matcher's.
-    let plain = Matcher::with_method(device, l.width, l.height, max_disparity, MatcherMethod::Sgm)
-        .unwrap()
-        .estimate_with_confidence(&l, &r)
-        .unwrap();
+    let mut unchecked = Matcher::with_method(device, l.width, l.height, max_disparity, MatcherMethod::Sgm).unwrap();
+    let plain = unchecked.estimate_with_confidence(&l, &r).unwrap();
+    // Only a checked matcher splits its disparities.
+    assert!(unchecked.estimate_checked(&l, &r, false).is_err());
     let confidence = out.confidence.as_ref().unwrap();
     for eye in 0..2 {
         let d = differing(&confidence[eye], &plain[eye].confidence);
