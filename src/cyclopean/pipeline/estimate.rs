@@ -182,12 +182,11 @@ impl CyclopeanPlan {
                 (&widened.0, &widened.1)
             }
         };
-        let mut reuse = reuse;
         // The confidence stage runs only when something reads it.
         let with_confidence = self.min_confidence.is_some() || self.confidence;
         let m = run_matcher(
             device,
-            reuse.as_deref_mut(),
+            reuse,
             self.matcher,
             (l, r),
             search.max_disparity,
