@@ -17,18 +17,23 @@ fn version(text: &str) -> Vec<u64> {
 fn declared_rust_version_is_the_largest_a_locked_dependency_needs() {
     let cargo = std::env::var("CARGO").unwrap_or_else(|_| "cargo".into());
     let root = env!("CARGO_MANIFEST_DIR");
-    let out = std::process::Command::new(cargo)
-        .args([
-            "metadata",
-            "--format-version",
-            "1",
-            "--locked",
-            "--offline",
-            "--manifest-path",
-        ])
-        .arg(format!("{root}/Cargo.toml"))
-        .output()
-        .expect("cargo metadata runs");
+    // Offline first; a cargo home that holds only this platform's crates (a fresh machine: the
+    // build fetched no Windows-only dependency) lacks some manifests, so then fetch them.
+    let metadata = |offline: bool| {
+        let mut c = std::process::Command::new(&cargo);
+        c.args(["metadata", "--format-version", "1", "--locked"]);
+        if offline {
+            c.arg("--offline");
+        }
+        c.arg("--manifest-path")
+            .arg(format!("{root}/Cargo.toml"))
+            .output()
+            .expect("cargo metadata runs")
+    };
+    let mut out = metadata(true);
+    if !out.status.success() {
+        out = metadata(false);
+    }
     assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
     let meta: Value = serde_json::from_slice(&out.stdout).expect("cargo metadata is JSON");
     let members: Vec<&str> = meta["workspace_members"]
