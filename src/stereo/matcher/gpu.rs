@@ -90,9 +90,9 @@ pub struct Matcher {
     /// The semi-global stages' buffers, where the matcher is the semi-global one.
     sgm: Option<SgmStages>,
     /// A checked semi-global matcher ([`Matcher::checked`]): the census matcher's final
-    /// disparities of the run, both eyes, for the trust stage; and whether the census stages run
-    /// at all (the search within [`CENSUS_CHECK_SEARCH`](crate::stereo::trust::CENSUS_CHECK_SEARCH)).
-    census_check: Option<(Buffer, bool)>,
+    /// disparities of the run, both eyes, for the trust stage (the census stages run only where
+    /// [`census_checked`] holds for the search).
+    census_check: Option<Buffer>,
 }
 
 /// The maps of one [`Matcher::estimate_checked`] run, each eye's.
@@ -169,7 +169,7 @@ impl Matcher {
             MatcherMethod::Sgm => Some(SgmStages::new(&device, width, height, max_disparity)?),
         };
         let census_check = match census_check {
-            true => Some((buffer(2 * n, "matcher census disparities")?, census_stages)),
+            true => Some(buffer(2 * n, "matcher census disparities")?),
             false => None,
         };
         Ok(Matcher {
@@ -281,8 +281,9 @@ impl Matcher {
             })
             .collect();
         let whole = params(0, 0);
-        // The trust stage's u_pairs: 1 when the census disparities were matched in the run.
-        let census_ran = wanted.matched && self.census_check.as_ref().is_some_and(|c| c.1);
+        // The trust stage's u_pairs: 1 when the census disparities were matched in the run
+        // (`wanted.matched` only on a checked matcher: estimate_checked).
+        let census_ran = wanted.matched && census_checked(self.max_disparity);
         let trust_params = params(0, census_ran as u32);
         let ids = |b: &[&Buffer]| b.iter().map(|b| b.id()).collect::<Vec<_>>();
         let grey_buffers = ids(&[&self.greys]);
@@ -297,7 +298,7 @@ impl Matcher {
         let confidence_buffers = ids(&[&self.raw]);
         // A checked matcher's census disparities go to their own buffer for the trust stage.
         let (census_median_buffers, trust_buffers) = match &self.census_check {
-            Some((census, _)) => (ids(&[&self.checked, census]), ids(&[&self.raw, census, &self.greys])),
+            Some(census) => (ids(&[&self.checked, census]), ids(&[&self.raw, census, &self.greys])),
             None => (vec![], vec![]),
         };
         let outputs = [StorageImage::Output(0), StorageImage::Output(1)];
@@ -319,9 +320,9 @@ impl Matcher {
                 ..dispatch(MatcherStage::Grey, &whole, &grey_buffers, pixels)
             }),
             Step::Dispatch(dispatch(MatcherStage::Census, &whole, &census_buffers, pixels)),
-            // The census matcher's chunks: rows and columns one invocation per row (column) and
-            // disparity pair, then the winners.
         ];
+        // The census matcher's chunks: rows and columns one invocation per row (column) and
+        // disparity pair, then the winners.
         let mut census_chunks: Vec<Planned> = chunks
             .iter()
             .flat_map(|chunk| {
