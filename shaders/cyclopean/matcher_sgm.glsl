@@ -8,6 +8,9 @@ const uint P2 = 1000u;
 const uint EDGE_GREY = 24u;
 const int FULL_SEARCH = 64;
 const int WINDOW = 5;
+const int REPEAT_GAP = 3;
+const uint REPEAT_SECOND_PERCENT = 35u;
+const uint REPEAT_RIDGE_PERCENT = 30u;
 // No cost: the disparity is not searched at the pixel or looks outside the other image.
 const uint NO_CELL = 0xffffffffu;
 

@@ -1,8 +1,9 @@
 // One level's cost volume (the twin's `cost_volume`): each pixel's window of u_window
 // disparities starts at 0 on the coarsest level, else around twice the coarser level's winner
 // at (x / 2, y / 2) (`window_start`); cell k is the Hamming distance of the census codes for
-// disparity start + k summed over the box (coordinates clamped), COST_OUTSIDE where x < d. The sums
-// the path stage adds into start at 0.
+// disparity start + k summed over the box (coordinates clamped), COST_OUTSIDE where x < d. On the
+// coarsest level a repeated texture's cells are then raised to its floor (`repeated_floor`,
+// src/stereo/matcher/sgm/mod.rs). The sums the path stage adds into start at 0.
 layout(std430, STORAGE_BUFFER(0)) readonly buffer Codes {
     uint codes[];  // per pixel: left low, left high, right low, right high
 };
@@ -12,7 +13,7 @@ layout(std430, STORAGE_BUFFER(1)) readonly buffer Guides {
 layout(std430, STORAGE_BUFFER(2)) writeonly buffer Starts {
     uint starts[];  // each pixel's first disparity: left eye, right eye
 };
-layout(std430, STORAGE_BUFFER(3)) writeonly buffer Costs {
+layout(std430, STORAGE_BUFFER(3)) buffer Costs {
     uint costs[];
 };
 layout(std430, STORAGE_BUFFER(4)) writeonly buffer Sums {
@@ -79,6 +80,80 @@ void interior_costs(ivec2 p, int i, int start) {
     }
 }
 
+// The cells of a pixel whose box reaches past the image's columns: the general loop.
+void border_costs(ivec2 p, int i, int start) {
+    int w = u_size.x;
+    for (int k = 0; k < u_window; ++k) {
+        int d = start + k;
+        uint cost = 0u;
+        if (p.x < d) {
+            cost = COST_OUTSIDE;
+        } else {
+            for (int dy = -COST_RADIUS; dy <= COST_RADIUS; ++dy) {
+                int y = clamp(p.y + dy, 0, u_size.y - 1);
+                for (int dx = -COST_RADIUS; dx <= COST_RADIUS; ++dx) {
+                    int x = clamp(p.x + dx, 0, w - 1);
+                    int xr = clamp(x - d, 0, w - 1);
+                    int a = 4 * (y * w + x);
+                    int b = 4 * (y * w + xr);
+                    cost += uint(bitCount(codes[a] ^ codes[b + 2]) + bitCount(codes[a + 1] ^ codes[b + 3]));
+                }
+            }
+        }
+        costs[i * u_window + k] = cost;
+        sums[i * u_window + k] = 0u;
+    }
+}
+
+// The twin's `repeated_floor` over the m cells from `base` (disparities 0..m-1), or NO_CELL.
+bool local_min(int base, int k, int m, uint c) {
+    return (k == 0 || c <= costs[base + k - 1]) && (k + 1 == m || c <= costs[base + k + 1]);
+}
+
+uint repeated_floor(int base, int m) {
+    if (m < 2 * REPEAT_GAP + 1) {
+        return NO_CELL;
+    }
+    int d1 = 0;
+    uint m1 = costs[base];
+    uint total = 0u;
+    for (int k = 0; k < m; ++k) {
+        uint c = costs[base + k];
+        total += c;
+        if (c < m1) {
+            d1 = k;
+            m1 = c;
+        }
+    }
+    uint spread = total - m1 * uint(m);
+    uint second = NO_CELL;
+    // Each side of the lowest cost, walking away from it with the ridge between.
+    for (int side = 0; side < 2; ++side) {
+        int step = side == 0 ? 1 : -1;
+        uint ridge = m1;
+        for (int k = d1 + step; k >= 0 && k < m; k += step) {
+            uint c = costs[base + k];
+            ridge = max(ridge, c);
+            if (abs(k - d1) >= REPEAT_GAP && local_min(base, k, m, c) &&
+                (ridge - c) * 100u * uint(m) >= REPEAT_RIDGE_PERCENT * spread) {
+                second = min(second, c);
+            }
+        }
+    }
+    return (second != NO_CELL && (second - m1) * 100u * uint(m) < REPEAT_SECOND_PERCENT * spread) ? second : NO_CELL;
+}
+
+void flatten_repeated(int i, int x) {
+    int base = i * u_window;
+    int m = min(x + 1, u_window);
+    uint floor_cost = repeated_floor(base, m);
+    if (floor_cost != NO_CELL) {
+        for (int k = 0; k < m; ++k) {
+            costs[base + k] = max(costs[base + k], floor_cost);
+        }
+    }
+}
+
 void main() {
     ivec2 p = this_pixel();
     if (p.x < 0) {
@@ -97,26 +172,11 @@ void main() {
     starts[2 * i + 1] = start_r;
     if (p.x >= COST_RADIUS && p.x < w - COST_RADIUS) {
         interior_costs(p, i, int(start_l));
-        return;
+    } else {
+        border_costs(p, i, int(start_l));
     }
-    for (int k = 0; k < u_window; ++k) {
-        int d = int(start_l) + k;
-        uint cost = 0u;
-        if (p.x < d) {
-            cost = COST_OUTSIDE;
-        } else {
-            for (int dy = -COST_RADIUS; dy <= COST_RADIUS; ++dy) {
-                int y = clamp(p.y + dy, 0, u_size.y - 1);
-                for (int dx = -COST_RADIUS; dx <= COST_RADIUS; ++dx) {
-                    int x = clamp(p.x + dx, 0, w - 1);
-                    int xr = clamp(x - d, 0, w - 1);
-                    int a = 4 * (y * w + x);
-                    int b = 4 * (y * w + xr);
-                    cost += uint(bitCount(codes[a] ^ codes[b + 2]) + bitCount(codes[a + 1] ^ codes[b + 3]));
-                }
-            }
-        }
-        costs[i * u_window + k] = cost;
-        sums[i * u_window + k] = 0u;
+    // The coarsest level (no coarser guide): every window starts at 0.
+    if (u_other_size.x == 0) {
+        flatten_repeated(i, p.x);
     }
 }

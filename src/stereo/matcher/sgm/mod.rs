@@ -6,6 +6,14 @@
 //! - Cost: the census matcher's Hamming distance (its 7 x 5 census of grey = r + g + b) summed
 //!   over a 5 x 5 box, borders replicated; a disparity that looks outside the right image
 //!   (x < d) costs [`COST_OUTSIDE`].
+//! - Repeated texture (the coarsest level, whose pixels see the whole search): where a
+//!   pixel's costs have a second basin, a local minimum at least [`REPEAT_GAP`] disparities from
+//!   the lowest cost with a ridge between them ([`REPEAT_RIDGE_PERCENT`] % of the way from the
+//!   lowest cost to the mean), whose floor is nearly as low ([`REPEAT_SECOND_PERCENT`] % of that
+//!   way), the data cannot say which period is the surface's; every cost is raised to that
+//!   floor, so both basins are flat and the paths (the surface around) decide
+//!   ([`repeated_floor`]). Stripes that repeat every few pixels otherwise match one period off
+//!   wherever that shift lines up better, in both eyes alike, which no check catches.
 //! - Path costs along 8 directions: L(p, d) = C(p, d) + min(L(q, d), L(q, d +- 1) + [`P1`],
 //!   min_k L(q, k) + P2') - min_k L(q, k), q the previous pixel on the path; P2' is [`P2`]
 //!   lowered across a strong grey edge between q and p (divided by |dI| / [`EDGE_GREY`] above
@@ -36,6 +44,14 @@ pub const COST_MAX: u32 = 34 * ((2 * COST_RADIUS as u32 + 1) * (2 * COST_RADIUS 
 /// strip without a bias against the larger disparities. Measured: [`COST_MAX`] there cost
 /// 0.5 dB over the issue-48 pairs.
 pub const COST_OUTSIDE: u32 = 306;
+/// Nearest disparity to the lowest cost where a second basin's floor may lie (a repeated texture's
+/// period is at least this).
+pub const REPEAT_GAP: usize = 3;
+/// A second basin's floor counts when it is within this share (percent) of the way from the
+/// lowest cost to the mean cost of the pixel's disparities.
+pub const REPEAT_SECOND_PERCENT: u32 = 35;
+/// ... and the costs between the two rise above it by at least this share (percent) of that way.
+pub const REPEAT_RIDGE_PERCENT: u32 = 30;
 /// Penalty of a disparity change of one along a path (a slanted surface).
 pub const P1: u32 = 60;
 /// Penalty of a larger change (a depth edge), before the edge lowering.
@@ -126,6 +142,42 @@ pub fn window_start(level: &Level, guide: u32) -> u32 {
     (2 * guide).saturating_sub(half).min(top)
 }
 
+/// The floor every cost of a pixel is raised to when its costs `cells` (disparities 0.., those
+/// that look inside the right image) show a repeated texture (see the design above), or None:
+/// the lowest local minimum at least [`REPEAT_GAP`] from the lowest cost (the first of equal
+/// ones) with a ridge between them, if it is near enough to the lowest cost. Integers only, so
+/// the GPU's cost stage finds the same floor.
+pub fn repeated_floor(cells: &[u32]) -> Option<u32> {
+    let m = cells.len();
+    if m < 2 * REPEAT_GAP + 1 {
+        return None;
+    }
+    let (mut d1, mut m1) = (0, cells[0]);
+    for (k, &c) in cells.iter().enumerate() {
+        if c < m1 {
+            (d1, m1) = (k, c);
+        }
+    }
+    // m x (mean - lowest): the way from the lowest cost to the mean, times m.
+    let spread = cells.iter().sum::<u32>() - m1 * m as u32;
+    let local_min = |k: usize| (k == 0 || cells[k] <= cells[k - 1]) && (k + 1 == m || cells[k] <= cells[k + 1]);
+    let mut second = None::<u32>;
+    for side in [&mut (d1 + 1..m) as &mut dyn Iterator<Item = usize>, &mut (0..d1).rev()] {
+        let mut ridge = m1;
+        for k in side {
+            let c = cells[k];
+            ridge = ridge.max(c);
+            if k.abs_diff(d1) >= REPEAT_GAP
+                && local_min(k)
+                && (ridge - c) * 100 * m as u32 >= REPEAT_RIDGE_PERCENT * spread
+            {
+                second = Some(second.map_or(c, |s| s.min(c)));
+            }
+        }
+    }
+    second.filter(|&s| (s - m1) * 100 * (m as u32) < REPEAT_SECOND_PERCENT * spread)
+}
+
 /// P2 between the previous pixel on a path and this one, whose grey levels differ by `dgrey`.
 pub fn p2_across(dgrey: u32) -> u32 {
     match dgrey > EDGE_GREY {
@@ -150,6 +202,9 @@ mod tests {
             format!("const uint P2 = {P2}u;"),
             format!("const uint EDGE_GREY = {EDGE_GREY}u;"),
             format!("const int FULL_SEARCH = {FULL_SEARCH};"),
+            format!("const int REPEAT_GAP = {REPEAT_GAP};"),
+            format!("const uint REPEAT_SECOND_PERCENT = {REPEAT_SECOND_PERCENT}u;"),
+            format!("const uint REPEAT_RIDGE_PERCENT = {REPEAT_RIDGE_PERCENT}u;"),
             format!("const int WINDOW = {WINDOW};"),
         ] {
             assert!(glsl.contains(&line), "matcher_sgm.glsl lacks `{line}`");

@@ -2,7 +2,7 @@
 //! one path direction at a time over whole cost volumes. The GPU stages
 //! ([`super::gpu`], run by [`crate::stereo::matcher::Matcher`]) reproduce it bit for bit.
 
-use super::{p2_across, window_start, Level, Plan, COST_OUTSIDE, COST_RADIUS, DIRECTIONS, P1};
+use super::{p2_across, repeated_floor, window_start, Level, Plan, COST_OUTSIDE, COST_RADIUS, DIRECTIONS, P1};
 use crate::error::Result;
 use crate::io::{DepthMap, RgbImage};
 use crate::stereo::matcher::reference::{census, grey, left_right_check, median_of_known, subpixel, NO_COST};
@@ -46,7 +46,10 @@ pub fn estimate_disparities_sgm(left: &RgbImage, right: &RgbImage, max_disparity
         };
         let start_l = starts(guide.as_ref().map(|g| &g.0));
         let start_r = starts(guide.as_ref().map(|g| &g.1));
-        let costs = cost_volume(&level, &cl, &cr, &start_l);
+        let mut costs = cost_volume(&level, &cl, &cr, &start_l);
+        if guide.is_none() {
+            flatten_repeated(&level, &mut costs);
+        }
         let sums = aggregate(&level, gl, &costs, &start_l);
         let wins_l = winners_left(&level, &sums, &start_l);
         let wins_r = winners_right(&level, &sums, &start_l, &start_r);
@@ -120,6 +123,20 @@ fn cost_volume(level: &Level, cl: &[u64], cr: &[u64], start: &[u32]) -> Vec<u32>
         }
     }
     out
+}
+
+/// The coarsest level's costs (every pixel's window starts at 0) of a repeated texture raised
+/// to its [`repeated_floor`]: at pixel x, the disparities 0..=x that look inside the right image.
+fn flatten_repeated(level: &Level, costs: &mut [u32]) {
+    let (w, n) = (level.width as usize, level.window as usize);
+    for (p, cells) in costs.chunks_mut(n).enumerate() {
+        let inside = &mut cells[..(p % w + 1).min(n)];
+        if let Some(floor) = repeated_floor(inside) {
+            for c in inside {
+                *c = (*c).max(floor);
+            }
+        }
+    }
 }
 
 /// The sum over the 8 directions of the path costs (see [`super`]).
