@@ -258,4 +258,51 @@ mod tests {
         assert_eq!(p2_across(2 * EDGE_GREY), P2 / 2);
         assert_eq!(p2_across(765), (P2 * EDGE_GREY / 765).max(P1 + 1));
     }
+
+    /// A pixel's costs over 24 disparities: uncorrelated (425, half the bits) but for basins at
+    /// `dips` (disparity, floor), each with walls of floor + 100 and floor + 200 on both sides.
+    fn curve(dips: &[(usize, u32)]) -> Vec<u32> {
+        let mut c = vec![425u32; 24];
+        for &(d, floor) in dips {
+            c[d] = floor;
+            for (k, wall) in [(1, 100), (2, 200)] {
+                c[d - k] = c[d - k].min(floor + wall);
+                c[d + k] = c[d + k].min(floor + wall);
+            }
+        }
+        c
+    }
+
+    #[test]
+    fn a_second_basin_nearly_as_low_is_a_repeated_texture() {
+        // Tsukuba 2+4's binder labels at left pixel (66, 74), disparities 5..=24 (recomputed in
+        // NumPy from the census rule): 45 at 19 px (one period off), 149 at the surface's 10 px.
+        let labels = [
+            687, 532, 465, 303, 245, 149, 320, 489, 499, 740, 511, 480, 335, 295, 45, 298, 404, 476, 670, 626,
+        ];
+        assert_eq!(repeated_floor(&labels), Some(149));
+        assert_eq!(repeated_floor(&curve(&[(10, 120), (19, 45)])), Some(120));
+        // Either side of the lowest cost; the lower of two other basins.
+        assert_eq!(repeated_floor(&curve(&[(4, 45), (15, 120)])), Some(120));
+        assert_eq!(repeated_floor(&curve(&[(4, 130), (12, 45), (20, 120)])), Some(120));
+        // One basin, or a second one well above it: the data decide.
+        assert_eq!(repeated_floor(&curve(&[(19, 45)])), None);
+        assert_eq!(repeated_floor(&curve(&[(10, 250), (19, 45)])), None);
+        // A local minimum within REPEAT_GAP of the lowest cost is its own basin's wall.
+        let mut c = curve(&[(19, 45)]);
+        c[17] = 60;
+        assert_eq!(repeated_floor(&c), None);
+        c[16] = 60;
+        c[17] = 300;
+        assert_eq!(repeated_floor(&c), Some(60));
+        // No ridge between: one wide valley with a dent, not two periods.
+        let mut c = curve(&[(19, 45)]);
+        for (k, v) in c.iter_mut().enumerate().take(19).skip(10) {
+            *v = 120 + (k as u32 - 10);
+        }
+        assert_eq!(repeated_floor(&c), None);
+        // Too few disparities to tell (fewer than 2 REPEAT_GAP + 1), and a flat curve.
+        assert_eq!(repeated_floor(&[300, 45, 300, 50, 300, 300]), None);
+        assert_eq!(repeated_floor(&[300; 24]), None);
+    }
 }
