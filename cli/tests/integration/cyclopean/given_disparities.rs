@@ -9,7 +9,8 @@ use viewsynth::io::load_rgb;
 /// Flowerpots with its ground truth (15 % of view1's disparities unknown, whole regions of the
 /// pots' backdrop) went to the colour fill: 25.08 dB over all pixels before, below what the same
 /// command gives from the two images alone (30.70 dB then; 31.80 with the semi-global default
-/// and the densify pass's frame rule, cli/tests/integration/cyclopean/learned_peer.rs).
+/// and the densify pass's frame rule; 31.84 with its repeated texture rule,
+/// cli/tests/integration/cyclopean/learned_peer.rs).
 /// Densified, its holes render from geometry: 32.08 dB.
 #[test]
 fn flowerpots_with_ground_truth_scores_at_least_what_two_images_give() {
@@ -42,7 +43,7 @@ fn flowerpots_with_ground_truth_scores_at_least_what_two_images_give() {
         .sum();
     let psnr = 10.0 * (255.0f64.powi(2) * view.data.len() as f64 / se).log10();
     assert!(
-        psnr >= 31.80,
-        "Flowerpots with ground truth: {psnr:.2} dB over all pixels (two images: 31.80)"
+        psnr >= 31.84,
+        "Flowerpots with ground truth: {psnr:.2} dB over all pixels (two images: 31.84)"
     );
 }
